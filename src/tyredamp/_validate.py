@@ -1,0 +1,118 @@
+"""Argument checks shared across the package.
+
+Each function raises a :class:`~tyredamp.exceptions.TyredampError` subclass
+whose message names the argument, what was expected and what came.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .exceptions import InputError, PhysicsError, ShapeError
+
+__all__ = [
+    "as_finite",
+    "as_frequency",
+    "as_square_symmetric",
+    "check_positive",
+    "check_positive_definite",
+    "check_positive_semidefinite",
+]
+
+
+def as_finite(
+    x: ArrayLike,
+    name: str,
+    *,
+    ndim: int | None = None,
+    dtype: Any = float,
+    allow_empty: bool = False,
+) -> NDArray[Any]:
+    """Return ``x`` as an array of ``dtype``; reject NaN, inf and wrong ``ndim``."""
+    try:
+        arr = np.asarray(x, dtype=dtype)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: expected numbers, got {type(x).__name__} ({exc})") from None
+    if ndim is not None and arr.ndim != ndim:
+        raise ShapeError(f"{name}: expected a {ndim}-D array, got shape {arr.shape}")
+    if not allow_empty and arr.size == 0:
+        raise ShapeError(f"{name}: expected a non-empty array, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.size(arr) - np.count_nonzero(np.isfinite(arr)))
+        raise InputError(f"{name}: expected finite values, got {bad} NaN or infinite entries")
+    return arr
+
+
+def as_frequency(f: ArrayLike, name: str = "frequency") -> NDArray[np.float64]:
+    """Return a 1-D, finite, non-negative, strictly increasing frequency axis in Hz."""
+    arr = as_finite(f, name, ndim=1)
+    if np.any(arr < 0):
+        raise InputError(f"{name}: expected non-negative values in Hz, got minimum {arr.min():g}")
+    if arr.size > 1 and np.any(np.diff(arr) <= 0):
+        i = int(np.argmax(np.diff(arr) <= 0))
+        raise InputError(
+            f"{name}: expected strictly increasing values, "
+            f"got {arr[i]:g} followed by {arr[i + 1]:g} at index {i + 1}"
+        )
+    return arr
+
+
+def as_square_symmetric(
+    a: ArrayLike, name: str, *, n: int | None = None, rtol: float = 1e-8
+) -> NDArray[np.float64]:
+    """Return a real, finite, square, symmetric matrix (symmetrised exactly)."""
+    arr = as_finite(a, name, ndim=2)
+    if arr.shape[0] != arr.shape[1]:
+        raise ShapeError(f"{name}: expected a square matrix, got shape {arr.shape}")
+    if n is not None and arr.shape[0] != n:
+        raise ShapeError(f"{name}: expected shape ({n}, {n}), got {arr.shape}")
+    scale = float(np.max(np.abs(arr))) if arr.size else 0.0
+    asym = float(np.max(np.abs(arr - arr.T))) if arr.size else 0.0
+    if asym > rtol * max(scale, np.finfo(float).tiny):
+        raise PhysicsError(
+            f"{name}: expected a symmetric matrix, got max |A - A^T| = {asym:.3g} "
+            f"(max |A| = {scale:.3g})"
+        )
+    return 0.5 * (arr + arr.T)
+
+
+def _min_eig(a: NDArray[np.float64]) -> tuple[float, float]:
+    w = np.linalg.eigvalsh(a)
+    return float(w[0]), float(np.max(np.abs(w))) if w.size else 0.0
+
+
+def check_positive_definite(a: NDArray[np.float64], name: str) -> None:
+    """Raise :class:`PhysicsError` unless symmetric ``a`` is positive definite."""
+    try:
+        np.linalg.cholesky(a)
+    except np.linalg.LinAlgError:
+        lo, _ = _min_eig(a)
+        raise PhysicsError(
+            f"{name}: expected a positive definite matrix, got smallest eigenvalue {lo:.3g}"
+        ) from None
+
+
+def check_positive_semidefinite(a: NDArray[np.float64], name: str, *, rtol: float = 1e-10) -> None:
+    """Raise :class:`PhysicsError` unless symmetric ``a`` is positive semi-definite."""
+    lo, hi = _min_eig(a)
+    if lo < -rtol * max(hi, np.finfo(float).tiny):
+        raise PhysicsError(
+            f"{name}: expected a positive semi-definite matrix, got smallest eigenvalue {lo:.3g}"
+        )
+
+
+def check_positive(value: float, name: str, *, allow_zero: bool = False) -> float:
+    """Return ``float(value)`` if finite and > 0 (or >= 0); else raise :class:`PhysicsError`."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a number, got {value!r}") from None
+    if not np.isfinite(v):
+        raise InputError(f"{name}: expected a finite number, got {v}")
+    if v < 0 or (v == 0 and not allow_zero):
+        bound = ">= 0" if allow_zero else "> 0"
+        raise PhysicsError(f"{name}: expected a value {bound}, got {v:g}")
+    return v

@@ -1,0 +1,69 @@
+"""The ``tyredamp`` command line: parses options, calls the API, writes files.
+
+Every subcommand lives in a module of this package and is registered on
+:data:`cli` below. Errors raised on purpose (:class:`TyredampError`) and
+usage errors become one line on stderr and exit code 2; ``--debug`` shows the
+traceback instead.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from .. import __version__
+from ..exceptions import ConvergenceError, TyredampError
+from ._common import EXIT_INPUT, EXIT_RUNTIME, fail
+
+__all__ = ["cli", "main"]
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="tyredamp")
+@click.option("--debug", is_flag=True, help="Show full tracebacks on errors.")
+@click.pass_context
+def cli(ctx: click.Context, debug: bool) -> None:
+    """Measure, identify and model vibration damping in pneumatic tyres.
+
+    \b
+    Example:
+      tyredamp demo --out tyredamp-demo
+    """
+    ctx.ensure_object(dict)
+    ctx.obj["debug"] = debug
+
+
+def _register() -> None:
+    """Attach the subcommands; each subcommand module adds its lines here."""
+
+
+_register()
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of the console script."""
+    args = sys.argv[1:] if argv is None else argv
+    debug = "--debug" in args
+    try:
+        cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
+    except click.exceptions.Exit as exc:
+        sys.exit(exc.exit_code)
+    except click.exceptions.Abort:
+        fail("aborted", 130)
+    except click.ClickException as exc:
+        if debug:
+            raise
+        fail(exc.format_message(), EXIT_INPUT)
+    except ConvergenceError as exc:
+        if debug:
+            raise
+        fail(str(exc), EXIT_RUNTIME)
+    except TyredampError as exc:
+        if debug:
+            raise
+        fail(str(exc), EXIT_INPUT)
+    except OSError as exc:
+        if debug:
+            raise
+        fail(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc), EXIT_INPUT)

@@ -1,0 +1,1 @@
+"""File formats: UFF 58 (pyuff), CSV, NPZ and JSON results."""
