@@ -14,7 +14,7 @@ accelerance ``A/F = -omega^2 H`` in m/(s^2 N).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
@@ -36,8 +36,21 @@ UNITS: dict[str, str] = {
 #: Power of (i omega) that turns a receptance into each kind.
 _POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 
-_DIRECTIONS = {1: "+X", 2: "+Y", 3: "+Z", -1: "-X", -2: "-Y", -3: "-Z",
-               4: "+RX", 5: "+RY", 6: "+RZ", -4: "-RX", -5: "-RY", -6: "-RZ", 0: "scalar"}
+_DIRECTIONS = {
+    1: "+X",
+    2: "+Y",
+    3: "+Z",
+    -1: "-X",
+    -2: "-Y",
+    -3: "-Z",
+    4: "+RX",
+    5: "+RY",
+    6: "+RZ",
+    -4: "-RX",
+    -5: "-RY",
+    -6: "-RZ",
+    0: "scalar",
+}
 
 
 @dataclass(frozen=True)
@@ -202,7 +215,7 @@ class FRF:
         )
 
     def _new(self, **changes: Any) -> FRF:
-        base = {
+        base: dict[str, Any] = {
             "frequency": self.frequency,
             "H": self.H,
             "kind": self.kind,
@@ -323,7 +336,7 @@ class FRF:
 
     def plot(self, **kwargs: Any) -> Any:
         """Bode plot of the FRF; see :func:`tyredamp.plot.plot_frf` (imports matplotlib)."""
-        from .plot import plot_frf
+        from .plot import plot_frf  # type: ignore[attr-defined,unused-ignore]
 
         return plot_frf(self, **kwargs)
 
@@ -332,5 +345,7 @@ def _find(chs: tuple[Channel, ...], node: int, direction: int | None, name: str)
     for i, c in enumerate(chs):
         if c.node == node and (direction is None or c.direction == direction):
             return i
-    raise InputError(f"{name}: no channel with node {node}" + (
-        f" and direction {direction}" if direction is not None else ""))
+    raise InputError(
+        f"{name}: no channel with node {node}"
+        + (f" and direction {direction}" if direction is not None else "")
+    )

@@ -25,9 +25,7 @@ def kind_factor(omega: NDArray[np.float64], kind: FRFKind) -> NDArray[np.complex
     return (1j * np.asarray(omega, dtype=float)) ** _POWER[kind]
 
 
-def pole_from_frequency_damping(
-    f_n: ArrayLike, zeta: ArrayLike
-) -> NDArray[np.complex128]:
+def pole_from_frequency_damping(f_n: ArrayLike, zeta: ArrayLike) -> NDArray[np.complex128]:
     """Poles ``p_n = -zeta_n omega_n + i omega_n sqrt(1 - zeta_n^2)`` (spec eq. [3]).
 
     Parameters

@@ -27,8 +27,8 @@ from ..exceptions import InputError, PhysicsError
 from .system import MCKSystem
 
 __all__ = [
-    "SmallDampingModes",
     "SmallDampingError",
+    "SmallDampingModes",
     "alpha_coefficients",
     "small_damping_error",
     "small_damping_modes",
@@ -153,4 +153,6 @@ def small_damping_error(system: MCKSystem, method: Method = "improved") -> Small
     alpha_exact = gamma / diag[None, :]
     pole_error = np.abs(approx.poles - exact.poles) / np.abs(exact.poles)
     alpha_error = np.linalg.norm(approx.alpha - alpha_exact, axis=0)
-    return SmallDampingError(pole_error=pole_error, alpha_error=alpha_error, alpha_exact=alpha_exact)
+    return SmallDampingError(
+        pole_error=pole_error, alpha_error=alpha_error, alpha_exact=alpha_exact
+    )

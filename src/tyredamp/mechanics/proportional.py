@@ -43,9 +43,7 @@ def rayleigh_damping_ratios(alpha: float, beta: float, omega: ArrayLike) -> NDAr
     return alpha / (2 * w) + beta * w / 2
 
 
-def rayleigh_coefficients(
-    f1: float, zeta1: float, f2: float, zeta2: float
-) -> tuple[float, float]:
+def rayleigh_coefficients(f1: float, zeta1: float, f2: float, zeta2: float) -> tuple[float, float]:
     """Rayleigh ``(alpha, beta)`` that give ``zeta1`` at ``f1`` and ``zeta2`` at ``f2`` (Hz)."""
     f1 = check_positive(f1, "f1")
     f2 = check_positive(f2, "f2")
@@ -69,8 +67,10 @@ def modal_damping_matrix(M: ArrayLike, K: ArrayLike, zeta: ArrayLike) -> NDArray
     m = as_square_symmetric(M, "M")
     sysm = MCKSystem(m, np.zeros_like(m), K)
     um = sysm.undamped_modes()
-    z = np.broadcast_to(as_finite(zeta, "zeta"), um.omega.shape) if np.ndim(zeta) == 0 else (
-        as_finite(zeta, "zeta", ndim=1)
+    z = (
+        np.broadcast_to(as_finite(zeta, "zeta"), um.omega.shape)
+        if np.ndim(zeta) == 0
+        else (as_finite(zeta, "zeta", ndim=1))
     )
     if z.shape != um.omega.shape:
         raise ShapeError(f"zeta: expected shape {um.omega.shape} (one per mode), got {z.shape}")

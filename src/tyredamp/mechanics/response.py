@@ -62,7 +62,7 @@ def step_coefficients(
     phi = np.exp(z)
     em1 = np.expm1(z)
     small = np.abs(z) < 1e-2
-    zs = np.where(small, z, 1.0)
+    zs = np.where(small, 1.0, z)  # safe divisor where the series is used
     e0 = np.where(small, h * (1 + z / 2 + z**2 / 6 + z**3 / 24 + z**4 / 120), em1 / zs * h)
     e1 = np.where(
         small,
@@ -141,7 +141,8 @@ def time_response(
         sl = slice(start, start + _MODE_CHUNK)
         g = psi_in[:, sl].T @ f  # (chunk, ns) modal forces
         q = np.empty_like(g)
-        for j, (pj, a1, b0, b1) in enumerate(zip(phi_step[sl], e0[sl], e1[sl], q0[sl], strict=True)):
+        coeffs = zip(phi_step[sl], e0[sl], e1[sl], q0[sl], strict=True)
+        for j, (pj, a1, b0, b1) in enumerate(coeffs):
             if hold == "foh":
                 b = np.array([b0, a1 - b0])
                 zi = np.array([b1 - b0 * g[j, 0]])
@@ -159,4 +160,6 @@ def time_response(
     full[ii] = f
     minv_f = sla.cho_solve(sla.cho_factor(system.M), full)
     acc += minv_f[oi]
-    return TimeResponse(time=np.arange(ns) * h, displacement=disp, velocity=vel, acceleration=acc)
+    return TimeResponse(
+        time=np.arange(ns, dtype=float) * h, displacement=disp, velocity=vel, acceleration=acc
+    )

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -62,7 +63,10 @@ class ComplexModes:
     poles : ndarray, complex, shape (m,)
         ``p_n = -sigma_n + i Omega_n`` in rad/s.
     Psi : ndarray, complex, shape (n_dof, m)
-        Unscaled displacement eigenvectors (eq. [6]), scaled to unit 2-norm.
+        Displacement eigenvectors (eq. [6]) with the complex mass
+        normalisation ``Psi_n^T M Psi_n = 1`` (plain transpose), largest real
+        entry positive. For proportional damping ``Psi_n = phi_n`` and
+        ``a_n = 2 i Omega_n``.
     a, b : ndarray, complex, shape (m,)
         Normalisation constants of eq. [8] for ``Psi``.
     psi : ndarray, complex, shape (n_dof, m)
@@ -94,8 +98,8 @@ class ComplexModes:
         self,
         frequency: ArrayLike,
         kind: FRFKind = "receptance",
-        outputs: Sequence[int] | None = None,
-        inputs: Sequence[int] | None = None,
+        outputs: Sequence[int] | NDArray[np.integer[Any]] | None = None,
+        inputs: Sequence[int] | NDArray[np.integer[Any]] | None = None,
     ) -> NDArray[np.complex128]:
         """FRF matrix by the modal sum [10], shape (n_out, n_in, n_freq)."""
         f = as_frequency(frequency)
@@ -105,7 +109,9 @@ class ComplexModes:
         return h * kind_factor(2 * np.pi * f, kind)
 
 
-def _dofs(idx: Sequence[int] | None, n: int, name: str) -> NDArray[np.intp]:
+def _dofs(
+    idx: Sequence[int] | NDArray[np.integer[Any]] | None, n: int, name: str
+) -> NDArray[np.intp]:
     if idx is None:
         return np.arange(n)
     arr = np.atleast_1d(np.asarray(idx))
@@ -214,11 +220,13 @@ class MCKSystem:
         Psi = vec[n:, upper]
         order = np.argsort(p.imag)
         p, Psi = p[order], Psi[:, order]
-        Psi = Psi / np.linalg.norm(Psi, axis=0)
-        # make the largest entry real positive (phase is arbitrary)
-        idx = np.argmax(np.abs(Psi), axis=0)
-        ph = Psi[idx, np.arange(n)]
-        Psi = Psi * (np.abs(ph) / ph)
+        # complex mass normalisation Psi^T M Psi = 1 (plain transpose): Psi reduces
+        # to the mass-normalised phi_n for proportional damping, where a_n = 2 i Omega_n
+        Psi = Psi / np.sqrt(np.einsum("in,ij,jn->n", Psi, self.M, Psi))
+        idx = np.argmax(np.abs(Psi.real), axis=0)
+        sign = np.sign(Psi.real[idx, np.arange(n)])
+        sign[sign == 0] = 1.0
+        Psi = Psi * sign
         a, b = normalisation_constants(self.M, self.C, self.K, p, Psi)
         psi = Psi / np.sqrt(a)
         self._complex = ComplexModes(poles=p, Psi=Psi, a=a, b=b, psi=psi)
@@ -273,10 +281,10 @@ class MCKSystem:
     def receptance_direct(
         self,
         frequency: ArrayLike,
-        outputs: Sequence[int] | NDArray[np.intp] | None = None,
-        inputs: Sequence[int] | NDArray[np.intp] | None = None,
+        outputs: Sequence[int] | NDArray[np.integer[Any]] | None = None,
+        inputs: Sequence[int] | NDArray[np.integer[Any]] | None = None,
     ) -> NDArray[np.complex128]:
-        """Receptance ``(K - omega^2 M + i omega C)^-1`` rows/columns, shape (n_out, n_in, n_freq)."""
+        """Receptance ``(K - w^2 M + i w C)^-1`` at the DOFs, shape (n_out, n_in, n_freq)."""
         f = as_frequency(frequency)
         oi = _dofs(outputs, self.n_dof, "outputs")
         ii = _dofs(inputs, self.n_dof, "inputs")

@@ -105,7 +105,7 @@ class ModalModel:
         )
         if len(oc) != po.shape[0] or len(ic) != pi.shape[0]:
             raise ShapeError("outputs/inputs: expected one channel per row of psi_out/psi_in")
-        res = []
+        res: list[NDArray[np.complex128] | None] = []
         for r, name in ((lower_residual, "lower_residual"), (upper_residual, "upper_residual")):
             if r is None:
                 res.append(None)
@@ -187,7 +187,7 @@ class ModalModel:
 
     @property
     def phi_out(self) -> NDArray[np.float64]:
-        """Mass-normalised real shapes ``phi = Re(psi sqrt(2 i Omega))`` at the outputs (eq. [3])."""
+        """Real shapes ``phi = Re(psi sqrt(2 i Omega))`` at the outputs (eq. [3]), 1/sqrt(kg)."""
         return np.real(self.psi_out * np.sqrt(2j * self.poles.imag))
 
     def second_order_shapes(self) -> NDArray[np.complex128]:
@@ -221,8 +221,14 @@ class ModalModel:
         """Synthesised :class:`FRF` of this model at ``frequency`` (Hz)."""
         f = as_frequency(frequency)
         h = self.receptance(f) * kind_factor(2 * np.pi * f, kind)
-        return FRF(f, h, kind=kind, outputs=self.outputs, inputs=self.inputs,
-                   meta={"source": f"{self.mode_kind}-mode model"})
+        return FRF(
+            f,
+            h,
+            kind=kind,
+            outputs=self.outputs,
+            inputs=self.inputs,
+            meta={"source": f"{self.mode_kind}-mode model"},
+        )
 
     # ------------------------------------------------------- serialisation
     def to_dict(self) -> dict[str, Any]:
