@@ -29,7 +29,7 @@ from .helpers import chain_system, random_system
 def systems(draw: st.DrawFn) -> MCKSystem:
     seed = draw(st.integers(0, 2**31 - 1))
     n = draw(st.integers(1, 8))
-    damping = draw(st.floats(0.01, 5.0))  # up to zeta ~ 0.3; near-critical is ill-posed
+    damping = draw(st.floats(0.05, 5.0))  # up to zeta ~ 0.3; near-critical is ill-posed
     return random_system(np.random.default_rng(seed), n, damping)
 
 
