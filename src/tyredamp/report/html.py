@@ -1,0 +1,112 @@
+"""A small builder for one self-contained, offline-readable HTML file.
+
+The builder holds sections of already-escaped HTML; figures are rendered to
+PNG and embedded as base64 data URIs, so the file needs nothing beside it.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from collections.abc import Sequence
+from typing import Any
+
+__all__ = ["HtmlReport"]
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;
+max-width:1100px;color:#222;line-height:1.45;padding:0 1em}
+h1{border-bottom:2px solid #345;padding-bottom:.2em}h2{margin-top:2em;color:#234}
+table{border-collapse:collapse;margin:.6em 0 1.2em 0;font-size:.92em}
+th,td{border:1px solid #bbb;padding:.25em .6em;text-align:right}
+th{background:#eef2f6}td.l,th.l{text-align:left}
+figure{margin:1em 0}figcaption{font-size:.9em;color:#555}
+img{max-width:100%}.note{background:#f6f6ee;border-left:4px solid #cc9;padding:.5em 1em}
+.ok{color:#185}.bad{color:#a22}code{background:#f3f3f3;padding:0 .2em}
+"""
+
+
+class HtmlReport:
+    """Accumulate headings, text, tables and figures; render one HTML page.
+
+    Parameters
+    ----------
+    title : str
+        Page title and top heading.
+    """
+
+    def __init__(self, title: str) -> None:
+        self.title = title
+        self._parts: list[str] = []
+
+    def heading(self, text: str, level: int = 2) -> None:
+        """Add a heading (level 2-4)."""
+        lvl = min(max(int(level), 2), 4)
+        self._parts.append(f"<h{lvl}>{html.escape(text)}</h{lvl}>")
+
+    def paragraph(self, text: str, css_class: str | None = None) -> None:
+        """Add a paragraph of plain text (escaped)."""
+        cls = f' class="{html.escape(css_class)}"' if css_class else ""
+        self._parts.append(f"<p{cls}>{html.escape(text)}</p>")
+
+    def bullets(self, items: Sequence[str]) -> None:
+        """Add a bulleted list of plain-text items."""
+        lis = "".join(f"<li>{html.escape(s)}</li>" for s in items)
+        self._parts.append(f"<ul>{lis}</ul>")
+
+    def table(
+        self,
+        header: Sequence[str],
+        rows: Sequence[Sequence[Any]],
+        caption: str | None = None,
+        fmt: str = "{:.4g}",
+    ) -> None:
+        """Add a table; floats are formatted with ``fmt``, first column left-aligned."""
+
+        def cell(v: Any, first: bool, tag: str) -> str:
+            if isinstance(v, float):
+                s = fmt.format(v)
+            else:
+                s = str(v)
+            cls = ' class="l"' if first else ""
+            return f"<{tag}{cls}>{html.escape(s)}</{tag}>"
+
+        head = "".join(cell(h, i == 0, "th") for i, h in enumerate(header))
+        body = "".join(
+            "<tr>" + "".join(cell(v, i == 0, "td") for i, v in enumerate(r)) + "</tr>"
+            for r in rows
+        )
+        cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
+        self._parts.append(f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+
+    def figure(self, fig: Any, caption: str = "", dpi: int = 110) -> bytes:
+        """Embed a matplotlib figure as PNG; returns the PNG bytes (to save beside)."""
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=dpi)
+        png = buf.getvalue()
+        self.image(png, caption)
+        return png
+
+    def image(self, png: bytes, caption: str = "") -> None:
+        """Embed PNG bytes."""
+        b64 = base64.b64encode(png).decode("ascii")
+        cap = f"<figcaption>{html.escape(caption)}</figcaption>" if caption else ""
+        self._parts.append(
+            f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,{b64}">'
+            f"{cap}</figure>"
+        )
+
+    def raw(self, fragment: str) -> None:
+        """Add a trusted HTML fragment as is."""
+        self._parts.append(fragment)
+
+    def render(self) -> str:
+        """The whole page as one string."""
+        body = "\n".join(self._parts)
+        t = html.escape(self.title)
+        return (
+            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{t}</title><style>{_CSS}</style></head><body><h1>{t}</h1>\n"
+            f"{body}\n</body></html>\n"
+        )
