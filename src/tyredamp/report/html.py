@@ -65,20 +65,18 @@ class HtmlReport:
         """Add a table; floats are formatted with ``fmt``, first column left-aligned."""
 
         def cell(v: Any, first: bool, tag: str) -> str:
-            if isinstance(v, float):
-                s = fmt.format(v)
-            else:
-                s = str(v)
+            s = fmt.format(v) if isinstance(v, float) else str(v)
             cls = ' class="l"' if first else ""
             return f"<{tag}{cls}>{html.escape(s)}</{tag}>"
 
         head = "".join(cell(h, i == 0, "th") for i, h in enumerate(header))
         body = "".join(
-            "<tr>" + "".join(cell(v, i == 0, "td") for i, v in enumerate(r)) + "</tr>"
-            for r in rows
+            "<tr>" + "".join(cell(v, i == 0, "td") for i, v in enumerate(r)) + "</tr>" for r in rows
         )
         cap = f"<caption>{html.escape(caption)}</caption>" if caption else ""
-        self._parts.append(f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>")
+        self._parts.append(
+            f"<table>{cap}<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+        )
 
     def figure(self, fig: Any, caption: str = "", dpi: int = 110) -> bytes:
         """Embed a matplotlib figure as PNG; returns the PNG bytes (to save beside)."""
@@ -106,7 +104,7 @@ class HtmlReport:
         body = "\n".join(self._parts)
         t = html.escape(self.title)
         return (
-            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
             f"<title>{t}</title><style>{_CSS}</style></head><body><h1>{t}</h1>\n"
             f"{body}\n</body></html>\n"
         )
