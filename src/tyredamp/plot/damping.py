@@ -1,0 +1,42 @@
+"""Damping matrices as heat maps (paper Fig. 5)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+__all__ = ["plot_matrix"]
+
+
+def plot_matrix(
+    matrix: ArrayLike,
+    labels: Sequence[str] | None = None,
+    title: str = "",
+    unit: str = "",
+    ax: Axes | None = None,
+    symmetric_colors: bool = True,
+) -> Axes:
+    """Heat map of a real matrix with a diverging colour map centred on 0.
+
+    Negative entries (e.g. physical-coordinate damping from modal truncation)
+    show in blue, positive in red.
+    """
+    a = np.asarray(matrix, dtype=float)
+    if a.ndim != 2:
+        raise ValueError(f"matrix: expected a 2-D array, got shape {a.shape}")
+    if ax is None:
+        ax = Figure(figsize=(4.6, 3.9), layout="constrained").subplots()
+    lim = float(np.max(np.abs(a))) or 1.0
+    vmin, vmax = (-lim, lim) if symmetric_colors else (None, None)
+    im = ax.imshow(a, cmap="RdBu_r", vmin=vmin, vmax=vmax)
+    fig = ax.figure
+    fig.colorbar(im, ax=ax, label=unit)
+    if labels is not None:
+        ax.set_xticks(range(len(labels)), labels, rotation=90, fontsize="x-small")
+        ax.set_yticks(range(len(labels)), labels, fontsize="x-small")
+    ax.set_title(title, fontsize="small")
+    return ax
