@@ -42,7 +42,7 @@ def test_comparison_and_discrepancy() -> None:
     ax = plot_discrepancy(meas, {"fit": fit}, {"fit": 1e-3})
     d = np.sqrt(np.sum(np.abs(fit.H - meas.H) ** 2, axis=(0, 1)))
     assert_allclose(ax.lines[0].get_ydata(), d)
-    assert "1e-03" in ax.get_legend().get_texts()[0].get_text()
+    assert "RMSD 0.001" in ax.get_legend().get_texts()[0].get_text()
 
 
 def test_matrix_and_ring() -> None:
