@@ -1,0 +1,494 @@
+"""Checks with numbers: linearity, reciprocity and data quality (spec step 2).
+
+Each check returns a :class:`CheckResult` holding the verdict, the figures it
+is based on, the threshold and a one-line summary, so that a report can state
+"linear to 0.8 % (threshold 5 %)" instead of showing a plot only.
+
+Definitions (``||.||`` the Frobenius norm over the channel matrix at a line,
+sums over the lines of the band):
+
+* linearity, per line: ``d_l(f) = ||H_l(f) - H_0(f)|| / ||H_0(f)||`` for the
+  FRFs ``H_l`` measured at the other force levels against the first (the
+  reference level); overall: ``sqrt(sum ||H_l - H_0||^2 / sum ||H_0||^2)``,
+  the largest over the levels. Passed when the overall figure is at most the
+  threshold.
+* reciprocity, for each pair of inputs ``a, b`` whose points are also
+  measured as outputs: ``H_ba`` (response at ``b`` to a force at ``a``)
+  against ``H_ab``; per line ``|H_ba - H_ab| / sqrt((|H_ba|^2 + |H_ab|^2)/2)``;
+  overall ``sqrt(sum |H_ba - H_ab|^2 / sum (|H_ba|^2 + |H_ab|^2)/2)``, the
+  largest over the pairs. Direction signs are taken into account.
+* quality: flat-topped samples at a channel's extreme value (clipping or
+  overload), channels of zeros, the fraction of lines whose multiple
+  coherence is below a limit, and passivity of every drive point: a passive
+  structure has ``Re Y_kk >= 0`` for the drive-point mobility ``Y_kk``; a line
+  violates it when ``Re Y / |Y| < -(floor + k eps)``, with
+  ``eps = sqrt((1 - gamma^2) / (2 n_avg gamma^2))`` the normalised random
+  error of the estimate (Bendat & Piersol, Random Data, 4th ed., eq. 9.90).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import InputError, ShapeError
+from ..frf import FRF, Channel
+from ..timedata import TimeData
+from .estimators import estimate_frf
+
+__all__ = [
+    "CheckResult",
+    "clipping",
+    "linearity_check",
+    "merge_inputs",
+    "quality_check",
+    "reciprocity_check",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class CheckResult:
+    """Outcome of a check.
+
+    Attributes
+    ----------
+    name : str
+        ``"linearity"``, ``"reciprocity"`` or ``"quality"``.
+    passed : bool
+        The verdict.
+    figure : float
+        The main figure the verdict compares with ``threshold``.
+    threshold : float
+        The limit of ``figure`` (passed when ``figure <= threshold``, plus any
+        further conditions listed in ``notes``).
+    figures : dict of str to float
+        All figures (fractions, not percent).
+    summary : str
+        One line with the verdict and the main figures.
+    frequency : ndarray, shape (n_freq,) or None
+        Lines of ``per_line`` in Hz.
+    per_line : ndarray, shape (n_freq,) or None
+        Per-line figure (deviation ratio, or for quality the lowest coherence).
+    notes : tuple of str
+        Further findings, one sentence each.
+    """
+
+    name: str
+    passed: bool
+    figure: float
+    threshold: float
+    figures: dict[str, float]
+    summary: str
+    frequency: NDArray[np.float64] | None = None
+    per_line: NDArray[np.float64] | None = None
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    def __str__(self) -> str:
+        return self.summary
+
+    def report(self) -> str:
+        """Multi-line text: the summary, every figure, the notes."""
+        rows = [self.summary]
+        rows += [f"  {k}: {_fmt(v)}" for k, v in self.figures.items()]
+        rows += [f"  note: {n}" for n in self.notes]
+        return "\n".join(rows)
+
+
+def _fmt(v: float) -> str:
+    return f"{v:d}" if isinstance(v, int) else f"{v:.6g}"
+
+
+def _verdict(ok: bool) -> str:
+    return "PASS" if ok else "FAIL"
+
+
+def _threshold(value: float, name: str) -> float:
+    try:
+        t = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a number, got {value!r}") from None
+    if not np.isfinite(t) or t < 0:
+        raise InputError(f"{name}: expected a finite value >= 0, got {value!r}")
+    return t
+
+
+def _same_axis(a: FRF, b: FRF, what: str) -> None:
+    if a.n_freq != b.n_freq or not np.allclose(a.frequency, b.frequency, rtol=1e-9, atol=0):
+        raise ShapeError(
+            f"{what}: expected the same frequency lines as the first FRF "
+            f"({a.n_freq} lines {a.frequency[0]:g}-{a.frequency[-1]:g} Hz), got {b.n_freq} "
+            f"lines {b.frequency[0]:g}-{b.frequency[-1]:g} Hz"
+        )
+
+
+def _same_point(a: Channel, b: Channel) -> bool:
+    return a.node == b.node and abs(a.direction) == abs(b.direction)
+
+
+def _sign(c: Channel) -> int:
+    return -1 if c.direction < 0 else 1
+
+
+def _ratio(num: NDArray[np.float64], den: NDArray[np.float64]) -> NDArray[np.float64]:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(den > 0, num / np.where(den > 0, den, 1.0), np.where(num > 0, np.inf, 0.0))
+
+
+# -------------------------------------------------------------- linearity
+def linearity_check(
+    frfs: Sequence[FRF], threshold: float = 0.05, band: tuple[float, float] | None = None
+) -> CheckResult:
+    """Compare FRFs measured at two or more force levels.
+
+    Parameters
+    ----------
+    frfs : sequence of FRF
+        The same channels and lines, one FRF per force level; the first is the
+        reference. Other kinds are converted to the first one's kind.
+    threshold : float
+        Largest accepted overall relative deviation (0.05 = 5 %).
+    band : (float, float), optional
+        Compare only lines in this band (Hz).
+
+    Returns
+    -------
+    CheckResult
+        ``figures``: ``overall_deviation`` (the verdict figure),
+        ``max_line_deviation``, ``max_line_frequency_hz``, ``n_levels``;
+        ``per_line`` the largest deviation over the levels at each line.
+    """
+    thr = _threshold(threshold, "threshold")
+    if len(frfs) < 2:
+        raise InputError(f"frfs: expected FRFs at two or more force levels, got {len(frfs)}")
+    for i, f in enumerate(frfs):
+        if not isinstance(f, FRF):
+            raise InputError(f"frfs[{i}]: expected an FRF, got {type(f).__name__}")
+    ref = frfs[0] if band is None else frfs[0].band(*band)
+    others = []
+    for i, f in enumerate(frfs[1:], start=1):
+        g = f.to(ref.kind) if f.kind != ref.kind else f
+        g = g if band is None else g.band(*band)
+        _same_axis(ref, g, f"frfs[{i}]")
+        chans, ref_chans = g.outputs + g.inputs, ref.outputs + ref.inputs
+        if g.H.shape != ref.H.shape or not all(
+            _same_point(a, b) for a, b in zip(chans, ref_chans, strict=True)
+        ):
+            raise ShapeError(
+                f"frfs[{i}]: expected the same output and input channels as frfs[0] "
+                f"({[c.label for c in ref.outputs]} x {[c.label for c in ref.inputs]}), got "
+                f"{[c.label for c in g.outputs]} x {[c.label for c in g.inputs]}"
+            )
+        others.append(g)
+    h0 = ref.H
+    ref_pow = np.sum(np.abs(h0) ** 2, axis=(0, 1))  # (f,)
+    per_level = []
+    lines = []
+    for g in others:
+        d = np.sum(np.abs(g.H - h0) ** 2, axis=(0, 1))
+        per_level.append(float(np.sqrt(d.sum() / ref_pow.sum())) if ref_pow.sum() > 0 else np.inf)
+        lines.append(np.sqrt(_ratio(d, ref_pow)))
+    per_line = np.max(np.array(lines), axis=0)
+    overall = max(per_level)
+    iw = int(np.argmax(per_line))
+    passed = overall <= thr
+    figures: dict[str, float] = {
+        "overall_deviation": overall,
+        "max_line_deviation": float(per_line[iw]),
+        "max_line_frequency_hz": float(ref.frequency[iw]),
+        "n_levels": len(frfs),
+    }
+    summary = (
+        f"linearity: {_verdict(passed)} - FRFs at {len(frfs)} levels differ by "
+        f"{100 * overall:.3g} % RMS from the first (threshold {100 * thr:.3g} %); largest "
+        f"line deviation {100 * per_line[iw]:.3g} % at {ref.frequency[iw]:.4g} Hz"
+    )
+    notes = tuple(
+        f"level {i}: overall deviation {100 * v:.3g} %" for i, v in enumerate(per_level, start=1)
+    )
+    return CheckResult(
+        "linearity", passed, overall, thr, figures, summary, ref.frequency.copy(), per_line, notes
+    )
+
+
+# ------------------------------------------------------------ reciprocity
+def merge_inputs(frfs: Sequence[FRF]) -> FRF:
+    """Join FRFs of separate tests (one or more inputs each) into one matrix.
+
+    All must have the same kind (others are converted), lines and outputs;
+    the inputs are concatenated. The coherence is kept only for one FRF.
+    """
+    if len(frfs) == 0:
+        raise InputError("frfs: expected at least one FRF")
+    base = frfs[0]
+    if len(frfs) == 1:
+        return base
+    hs = [base.H]
+    ins = list(base.inputs)
+    for i, f in enumerate(frfs[1:], start=1):
+        g = f.to(base.kind) if f.kind != base.kind else f
+        _same_axis(base, g, f"frfs[{i}]")
+        if g.n_out != base.n_out or not all(
+            _same_point(a, b) for a, b in zip(g.outputs, base.outputs, strict=True)
+        ):
+            raise ShapeError(f"frfs[{i}]: expected the same outputs as frfs[0]")
+        hs.append(g.H)
+        ins += list(g.inputs)
+    return FRF(
+        base.frequency,
+        np.concatenate(hs, axis=1),
+        kind=base.kind,
+        outputs=base.outputs,
+        inputs=ins,
+        meta={"merged_from": len(frfs)},
+    )
+
+
+def reciprocity_check(
+    frf: FRF, threshold: float = 0.05, band: tuple[float, float] | None = None
+) -> CheckResult:
+    """Compare ``H_jk`` with ``H_kj`` for every reciprocal pair in an FRF matrix.
+
+    Parameters
+    ----------
+    frf : FRF
+        At least two inputs whose points (node and direction) also appear as
+        outputs (see :func:`merge_inputs` for separate tests).
+    threshold : float
+        Largest accepted overall relative difference (0.05 = 5 %).
+    band : (float, float), optional
+        Compare only lines in this band (Hz).
+
+    Returns
+    -------
+    CheckResult
+        ``figures``: ``overall_difference`` (verdict figure, the largest over
+        the pairs), ``max_line_difference``, ``max_line_frequency_hz``,
+        ``n_pairs``.
+    """
+    thr = _threshold(threshold, "threshold")
+    if not isinstance(frf, FRF):
+        raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
+    g = frf if band is None else frf.band(*band)
+    pairs: list[tuple[int, int, int, int]] = []  # (i_out, a_in, j_out, b_in)
+    for a in range(g.n_in):
+        for b in range(a + 1, g.n_in):
+            at_b = [k for k, c in enumerate(g.outputs) if _same_point(c, g.inputs[b])]
+            at_a = [k for k, c in enumerate(g.outputs) if _same_point(c, g.inputs[a])]
+            if at_b and at_a:
+                pairs.append((at_b[0], a, at_a[0], b))
+    if not pairs:
+        raise InputError(
+            "frf: reciprocity needs two inputs whose points are also measured as outputs; got "
+            f"inputs {[c.label for c in g.inputs]} and outputs {[c.label for c in g.outputs]}"
+        )
+    per_pair, lines, labels = [], [], []
+    for i, a, j, b in pairs:
+        h1 = _sign(g.outputs[i]) * _sign(g.inputs[a]) * g.H[i, a]
+        h2 = _sign(g.outputs[j]) * _sign(g.inputs[b]) * g.H[j, b]
+        d = np.abs(h1 - h2) ** 2
+        m = 0.5 * (np.abs(h1) ** 2 + np.abs(h2) ** 2)
+        per_pair.append(float(np.sqrt(d.sum() / m.sum())) if m.sum() > 0 else np.inf)
+        lines.append(np.sqrt(_ratio(d, m)))
+        labels.append(
+            f"{g.outputs[i].label}/{g.inputs[a].label} vs {g.outputs[j].label}/{g.inputs[b].label}"
+        )
+    per_line = np.max(np.array(lines), axis=0)
+    overall = max(per_pair)
+    iw = int(np.argmax(per_line))
+    passed = overall <= thr
+    figures: dict[str, float] = {
+        "overall_difference": overall,
+        "max_line_difference": float(per_line[iw]),
+        "max_line_frequency_hz": float(g.frequency[iw]),
+        "n_pairs": len(pairs),
+    }
+    summary = (
+        f"reciprocity: {_verdict(passed)} - {len(pairs)} pair(s) differ by up to "
+        f"{100 * overall:.3g} % RMS (threshold {100 * thr:.3g} %); largest line difference "
+        f"{100 * per_line[iw]:.3g} % at {g.frequency[iw]:.4g} Hz"
+    )
+    notes = tuple(f"{lab}: {100 * v:.3g} %" for lab, v in zip(labels, per_pair, strict=True))
+    return CheckResult(
+        "reciprocity", passed, overall, thr, figures, summary, g.frequency.copy(), per_line, notes
+    )
+
+
+# ---------------------------------------------------------------- quality
+def clipping(x: NDArray[np.float64], min_run: int = 3) -> int:
+    """Number of samples in flat-topped runs at the signal's maximum or minimum.
+
+    A run is ``min_run`` or more consecutive samples exactly equal to
+    ``max(x)`` (or ``min(x)``), the signature of an overloaded amplifier or
+    ADC. A signal of zeros returns 0 (see dead channels).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_samples,)
+    min_run : int
+        Shortest run counted (>= 2).
+    """
+    if int(min_run) != min_run or min_run < 2:
+        raise InputError(f"min_run: expected an integer >= 2, got {min_run!r}")
+    if not np.any(x):
+        return 0
+    total = 0
+    for extreme in (x.max(), x.min()):
+        at = np.concatenate(([0], (x == extreme).astype(np.int8), [0]))
+        edges = np.diff(at)
+        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        runs = stops - starts
+        total += int(runs[runs >= min_run].sum())
+    return total
+
+
+def _low_bands(f: NDArray[np.float64], low: NDArray[np.bool_], limit: int = 5) -> list[str]:
+    at = np.concatenate(([0], low.astype(np.int8), [0]))
+    e = np.diff(at)
+    starts, stops = np.flatnonzero(e == 1), np.flatnonzero(e == -1) - 1
+    out = [f"{f[a]:.4g}-{f[b]:.4g} Hz" for a, b in zip(starts, stops, strict=True)]
+    if len(out) > limit:
+        out = [*out[:limit], f"... ({len(out) - limit} more)"]
+    return out
+
+
+def quality_check(
+    data: TimeData | FRF,
+    *,
+    coherence_min: float = 0.9,
+    max_low_coherence_fraction: float = 0.1,
+    clip_run: int = 3,
+    passivity_floor: float = 0.02,
+    passivity_sigma: float = 3.0,
+    max_passivity_fraction: float = 0.01,
+    **estimate_kwargs: Any,
+) -> CheckResult:
+    """Data quality of a test: clipping, dead channels, coherence, passivity.
+
+    Parameters
+    ----------
+    data : TimeData or FRF
+        Time data (all checks; the FRF is estimated with
+        :func:`~tyredamp.signal.estimators.estimate_frf` and
+        ``estimate_kwargs``) or an FRF (coherence and passivity only).
+    coherence_min : float
+        Lines with multiple coherence below this count as low.
+    max_low_coherence_fraction : float
+        Largest accepted fraction of (output, line) pairs with low coherence
+        (the verdict figure and threshold).
+    clip_run : int
+        Shortest run of equal samples at a channel extreme counted as clipping.
+    passivity_floor : float
+        Allowed negative ``Re Y / |Y|`` at a drive point besides the random
+        error (0.02 is about 1 degree of phase error).
+    passivity_sigma : float
+        Multiple of the normalised random error added to the floor.
+    max_passivity_fraction : float
+        Largest accepted fraction of drive-point lines violating passivity.
+
+    Returns
+    -------
+    CheckResult
+        Passed when no channel is clipped or dead, the low-coherence fraction
+        is within its threshold and the passivity violations are within theirs.
+    """
+    cmin = _threshold(coherence_min, "coherence_min")
+    thr = _threshold(max_low_coherence_fraction, "max_low_coherence_fraction")
+    floor = _threshold(passivity_floor, "passivity_floor")
+    ksig = _threshold(passivity_sigma, "passivity_sigma")
+    pthr = _threshold(max_passivity_fraction, "max_passivity_fraction")
+    notes: list[str] = []
+    figures: dict[str, float] = {}
+    problems: list[str] = []
+    frf: FRF | None
+    if isinstance(data, TimeData):
+        clipped = {c.label: clipping(data.data[i], clip_run) for i, c in enumerate(data.channels)}
+        bad = {k: v for k, v in clipped.items() if v > 0}
+        dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
+        figures["clipped_channels"] = len(bad)
+        figures["clipped_samples"] = int(sum(bad.values()))
+        figures["dead_channels"] = len(dead)
+        if bad:
+            problems.append(f"{len(bad)} clipped channel(s)")
+            notes += [
+                f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()
+            ]
+        if dead:
+            problems.append(f"{len(dead)} channel(s) of zeros")
+            notes.append(f"channels of zeros: {', '.join(dead)}")
+        dead_force = [i for i in data.force_indices if not np.any(data.data[i])]
+        if dead_force or not data.force_indices or not data.response_indices:
+            frf = None
+            notes.append("no FRF estimated (no usable force or response channel)")
+        else:
+            frf = estimate_frf(data, **estimate_kwargs)
+    elif isinstance(data, FRF):
+        frf = data
+    else:
+        raise InputError(f"data: expected TimeData or FRF, got {type(data).__name__}")
+
+    low_frac = 0.0
+    per_line = freq = None
+    if frf is not None and frf.coherence is not None:
+        coh = frf.coherence
+        low = coh < cmin
+        low_frac = float(np.mean(low))
+        figures["low_coherence_fraction"] = low_frac
+        figures["min_coherence"] = float(coh.min())
+        figures["mean_coherence"] = float(coh.mean())
+        freq, per_line = frf.frequency.copy(), coh.min(axis=0)
+        bands = _low_bands(frf.frequency, np.mean(low, axis=0) >= 0.5)
+        if bands:
+            notes.append(f"coherence below {cmin:g} on most outputs in: {', '.join(bands)}")
+        if low_frac > thr:
+            problems.append(f"{100 * low_frac:.3g} % of lines with coherence < {cmin:g}")
+        if frf.meta.get("n_averages") == 1:
+            notes.append("one average only: the coherence is 1 by construction")
+    elif frf is not None:
+        notes.append("no coherence available: coherence check skipped")
+
+    if frf is not None:
+        dps = frf.drive_points()
+        figures["drive_points"] = len(dps)
+        if not dps:
+            notes.append("no drive point (no output at an input's point): passivity not checked")
+        else:
+            mob = frf.to("mobility")
+            n_avg = int(frf.meta.get("n_averages", 0) or 0)
+            viol, total, worst = 0, 0, np.inf
+            for i, j in dps:
+                y = _sign(mob.outputs[i]) * _sign(mob.inputs[j]) * mob.H[i, j]
+                mag = np.abs(y)
+                r = _ratio(y.real, mag)
+                r = np.where(mag > 0, r, 0.0)
+                eps = np.zeros_like(r)
+                if mob.coherence is not None and n_avg > 0:
+                    g2 = np.clip(mob.coherence[i], 1e-12, 1.0)
+                    eps = np.sqrt((1 - g2) / (2 * n_avg * g2))
+                v = r < -(floor + ksig * eps)
+                viol += int(v.sum())
+                total += r.size
+                worst = min(worst, float(r.min()))
+                if v.any():
+                    notes.append(
+                        f"drive point {mob.outputs[i].label}: Re(mobility) < 0 beyond noise at "
+                        f"{int(v.sum())} lines ({', '.join(_low_bands(mob.frequency, v, 3))})"
+                    )
+            pfrac = viol / total if total else 0.0
+            figures["passivity_violations"] = viol
+            figures["passivity_fraction"] = pfrac
+            figures["min_drive_point_real_ratio"] = worst
+            if pfrac > pthr:
+                problems.append(f"drive point not passive at {100 * pfrac:.3g} % of lines")
+    passed = not problems
+    what = "; ".join(problems) if problems else "no clipping, coherence and passivity within limits"
+    summary = (
+        f"quality: {_verdict(passed)} - {what} (low-coherence lines {100 * low_frac:.3g} %, "
+        f"threshold {100 * thr:.3g} %)"
+    )
+    return CheckResult(
+        "quality", passed, low_frac, thr, figures, summary, freq, per_line, tuple(notes)
+    )
