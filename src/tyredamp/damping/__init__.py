@@ -1,0 +1,62 @@
+"""Damping identification from complex modes (spec step 7, eq. [14]-[18]).
+
+Main entry point: :func:`identify_damping` (a :class:`~tyredamp.modal.ModalModel`
+in, a :class:`DampingModel` out). Lower-level pieces: the estimators of ``C'``
+(:func:`modal_damping_from_modes`, after Adhikari & Woodhouse 2001), the
+physical matrices at the points (:func:`physical_matrices`), Lancaster's exact
+formulas for a complete modal set (:func:`lancaster_matrices`), proportional
+damping fits (:func:`compare_proportional`) and Monte Carlo standard errors
+(:func:`monte_carlo_std`).
+"""
+
+from __future__ import annotations
+
+from .diagnostics import DampingDiagnostics, definiteness, findings
+from .estimate import identify_damping
+from .identify import (
+    METHODS,
+    Method,
+    ModalDampingEstimate,
+    align_signs,
+    first_order_damping,
+    modal_damping_from_modes,
+    modal_system_shapes,
+    normalise_shapes,
+    physical_matrices,
+)
+from .lancaster import LancasterMatrices, lancaster_matrices
+from .model import DampingModel
+from .proportional import (
+    ProportionalComparison,
+    compare_proportional,
+    comparison_grid,
+    fit_rayleigh,
+    reduced_receptance,
+)
+from .uncertainty import MonteCarloResult, monte_carlo_std
+
+__all__ = [
+    "METHODS",
+    "DampingDiagnostics",
+    "DampingModel",
+    "LancasterMatrices",
+    "Method",
+    "ModalDampingEstimate",
+    "MonteCarloResult",
+    "ProportionalComparison",
+    "align_signs",
+    "compare_proportional",
+    "comparison_grid",
+    "definiteness",
+    "findings",
+    "first_order_damping",
+    "fit_rayleigh",
+    "identify_damping",
+    "lancaster_matrices",
+    "modal_damping_from_modes",
+    "modal_system_shapes",
+    "monte_carlo_std",
+    "normalise_shapes",
+    "physical_matrices",
+    "reduced_receptance",
+]

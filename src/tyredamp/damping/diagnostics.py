@@ -1,0 +1,346 @@
+"""Diagnostics of an identified damping matrix and plain-English findings.
+
+What is checked (spec step 7 and the paper's discussion):
+
+* symmetry of ``C'`` and ``C`` (reciprocity and a consistent mode set give a
+  symmetric matrix without forcing it);
+* definiteness (eigenvalues of the symmetric part): every mode combination
+  must dissipate energy;
+* whether the data contain damping coupling at all (zero imaginary parts of
+  real modes give a diagonal ``C'`` by construction);
+* truncation: ``m`` modes at ``N`` points give a rank-``m`` physical matrix,
+  ``C = pinv(Phi)^T C' pinv(Phi)``; its negative entries come from projecting
+  the damping distribution on the few identified shapes ("power leakage"),
+  and the share of the receptance that the residual terms (out-of-band modes)
+  carry;
+* size of the second-order terms neglected by eq. [16]/[18].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["DampingDiagnostics", "definiteness", "findings"]
+
+#: Relative asymmetry below which C' counts as symmetric (measured data).
+SYMMETRY_OK = 0.05
+#: Relative asymmetry above which the input is flagged as inconsistent.
+SYMMETRY_BAD = 0.2
+#: ||Im Psi^|| / ||Re Psi^|| below which the modes count as real.
+REAL_MODES = 1e-10
+
+
+@dataclass(frozen=True)
+class DampingDiagnostics:
+    """Numbers that say how far an identified damping matrix can be trusted.
+
+    Attributes
+    ----------
+    n_modes, n_points : int
+        ``m`` and ``N``.
+    symmetry_modal, symmetry_physical : float
+        ``||A - A^T||_F / ||A||_F`` of ``C'`` and ``C``.
+    eigenvalues_modal : ndarray, shape (m,)
+        Eigenvalues of ``(C' + C'^T)/2``, 1/s, ascending.
+    eigenvalues_physical : ndarray, shape (N,)
+        Eigenvalues of ``(C + C^T)/2``, N s/m, ascending (``N - m`` are ~0).
+    definiteness_modal : str
+        "positive definite", "positive semi-definite", "indefinite" or
+        "negative semi-definite".
+    negative_diagonal_physical : int
+        Diagonal entries of ``C`` below zero (unphysical as local dampers);
+        entries within ``1e-9 max|C|`` of zero count as zero.
+    negative_offdiagonal_fraction : float
+        Share of the off-diagonal entries of ``C`` that are negative (same
+        tolerance).
+    imaginary_ratio : float
+        ``||Im Psi^||_F / ||Re Psi^||_F``; 0 for real modes.
+    non_proportionality : float
+        ``||C' - diag C'||_F / ||diag C'||_F``.
+    shape_condition : float
+        Condition number of the real shape matrix ``Phi`` (N x m).
+    residual_fraction : float or None
+        RMS of the residual terms of the modal model over the RMS of its
+        receptance in the band (out-of-band modes); None without residuals.
+    normalisation_phase : float
+        Largest phase (rad) removed by the ``alpha_n^(n) = 1`` normalisation.
+    basis_residual : float
+        ``"refined"``: imaginary share of ``Psi^ G^-1`` (0 otherwise).
+    theory_change : float or None
+        ``||C'_method - C'_refined||_F / ||C'_refined||_F``: how much the
+        second-order terms neglected by eq. [16]/[18] matter; None for
+        ``"refined"`` or when the refinement did not converge.
+    lancaster_difference : float or None
+        ``||C - C_Lancaster||_F / ||C_Lancaster||_F`` when ``m == N``.
+    max_damping_ratio : float
+        Largest identified ``zeta_n``.
+    """
+
+    n_modes: int
+    n_points: int
+    symmetry_modal: float
+    symmetry_physical: float
+    eigenvalues_modal: NDArray[np.float64]
+    eigenvalues_physical: NDArray[np.float64]
+    definiteness_modal: str
+    negative_diagonal_physical: int
+    negative_offdiagonal_fraction: float
+    imaginary_ratio: float
+    non_proportionality: float
+    shape_condition: float
+    residual_fraction: float | None
+    normalisation_phase: float
+    basis_residual: float
+    theory_change: float | None
+    lancaster_difference: float | None
+    max_damping_ratio: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary of the fields (arrays as lists)."""
+        out: dict[str, Any] = {}
+        for fl in fields(self):
+            v = getattr(self, fl.name)
+            out[fl.name] = v.tolist() if isinstance(v, np.ndarray) else v
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> DampingDiagnostics:
+        """Inverse of :meth:`to_dict`."""
+        kw: dict[str, Any] = {}
+        for fl in fields(cls):
+            v = d[fl.name]
+            kw[fl.name] = np.asarray(v, dtype=float) if fl.name.startswith("eigenvalues") else v
+        return cls(**kw)
+
+
+def _asym(a: NDArray[np.float64]) -> float:
+    n = float(np.linalg.norm(a))
+    return float(np.linalg.norm(a - a.T) / n) if n > 0 else 0.0
+
+
+def definiteness(eigenvalues: NDArray[np.float64], rtol: float = 1e-10) -> str:
+    """Classify a symmetric matrix by its eigenvalues (relative tolerance ``rtol``)."""
+    tol = rtol * max(float(np.max(np.abs(eigenvalues))), np.finfo(float).tiny)
+    if np.all(eigenvalues > tol):
+        return "positive definite"
+    if np.all(eigenvalues > -tol):
+        return "positive semi-definite"
+    if np.all(eigenvalues < tol):
+        return "negative semi-definite"
+    return "indefinite"
+
+
+def compute_diagnostics(
+    *,
+    c_modal: NDArray[np.float64],
+    c_phys: NDArray[np.float64],
+    shapes: NDArray[np.complex128],
+    basis: NDArray[np.float64],
+    damping_ratio: NDArray[np.float64],
+    residual_fraction: float | None,
+    normalisation_phase: NDArray[np.float64],
+    basis_residual: float,
+    theory_change: float | None,
+    lancaster_difference: float | None,
+) -> DampingDiagnostics:
+    """Collect :class:`DampingDiagnostics` (see its attributes for the definitions)."""
+    m, n = c_modal.shape[0], c_phys.shape[0]
+    ev_m = np.asarray(np.linalg.eigvalsh(0.5 * (c_modal + c_modal.T)), dtype=float)
+    ev_p = np.asarray(np.linalg.eigvalsh(0.5 * (c_phys + c_phys.T)), dtype=float)
+    off = ~np.eye(n, dtype=bool)
+    tiny = 1e-9 * max(float(np.max(np.abs(c_phys))), np.finfo(float).tiny)  # rounding level
+    dg = np.diag(c_modal)
+    sv = np.linalg.svd(basis, compute_uv=False)
+    nre = float(np.linalg.norm(shapes.real))
+    return DampingDiagnostics(
+        n_modes=m,
+        n_points=n,
+        symmetry_modal=_asym(c_modal),
+        symmetry_physical=_asym(c_phys),
+        eigenvalues_modal=ev_m,
+        eigenvalues_physical=ev_p,
+        definiteness_modal=definiteness(ev_m),
+        negative_diagonal_physical=int(np.count_nonzero(np.diag(c_phys) < -tiny)),
+        negative_offdiagonal_fraction=float(np.mean(c_phys[off] < -tiny)) if n > 1 else 0.0,
+        imaginary_ratio=float(np.linalg.norm(shapes.imag) / nre) if nre > 0 else 0.0,
+        non_proportionality=float(
+            np.linalg.norm(c_modal - np.diag(dg)) / max(float(np.linalg.norm(dg)), 1e-300)
+        ),
+        shape_condition=float(sv[0] / sv[-1]),
+        residual_fraction=residual_fraction,
+        normalisation_phase=float(np.max(np.abs(normalisation_phase))),
+        basis_residual=basis_residual,
+        theory_change=theory_change,
+        lancaster_difference=lancaster_difference,
+        max_damping_ratio=float(np.max(damping_ratio)),
+    )
+
+
+def findings(
+    d: DampingDiagnostics,
+    method: str,
+    proportional: Any = None,
+    std_modal: NDArray[np.float64] | None = None,
+    c_modal: NDArray[np.float64] | None = None,
+) -> list[str]:
+    """Plain-English conclusions from the diagnostics, most important first.
+
+    Parameters
+    ----------
+    d : DampingDiagnostics
+    method : str
+        The estimator used.
+    proportional : ProportionalComparison, optional
+    std_modal : ndarray, shape (m, m), optional
+        Standard errors of ``C'``.
+    c_modal : ndarray, shape (m, m), optional
+        ``C'`` (needed with ``std_modal``).
+    """
+    out: list[str] = []
+    real = d.imaginary_ratio < REAL_MODES
+    if real:
+        out.append(
+            "The mode shapes have no imaginary part (real modes), so C' is diagonal by "
+            "construction: non-proportional damping cannot be identified from real modes. "
+            "Use the complex-mode fit to identify damping coupling between modes."
+        )
+    # --- symmetry
+    if d.n_modes > 1 and not real:
+        pct = 100 * d.symmetry_modal
+        if d.symmetry_modal <= SYMMETRY_OK:
+            out.append(
+                f"C' is symmetric to {pct:.2g} % without any symmetrisation, as reciprocal "
+                "linear viscous damping requires; the mode set looks consistent."
+            )
+        elif d.symmetry_modal <= SYMMETRY_BAD:
+            out.append(
+                f"C' is {pct:.2g} % asymmetric: noticeable, from noise on the imaginary "
+                "parts of the shapes or from damping coupling to modes outside the "
+                "identified set; treat the off-diagonal terms with care."
+            )
+        else:
+            out.append(
+                f"C' is strongly asymmetric ({pct:.2g} %): the shapes and poles are probably "
+                "mismatched (modes out of order, a spurious or missing mode, wrong scaling) "
+                "or the damping is too large for the small-damping theory. Check the modal "
+                "fit before using this matrix."
+            )
+    # --- definiteness
+    lo, hi = float(d.eigenvalues_modal[0]), float(d.eigenvalues_modal[-1])
+    if d.definiteness_modal == "positive definite":
+        out.append(
+            "C' is positive definite: every identified mode and combination of modes "
+            "dissipates energy."
+        )
+    elif d.definiteness_modal == "positive semi-definite":
+        tol = 1e-10 * max(abs(lo), abs(hi))
+        n_zero = int(np.count_nonzero(np.abs(d.eigenvalues_modal) <= tol))
+        out.append(
+            f"C' is positive semi-definite with {n_zero} zero eigenvalue(s): some "
+            "combinations of modes are undamped (for example when a few local dampers "
+            "carry all the damping); none gains energy."
+        )
+    else:
+        out.append(
+            f"C' is {d.definiteness_modal} (eigenvalues {lo:.3g} to {hi:.3g} 1/s): some "
+            "combination of modes would gain energy, which no passive tyre does. This "
+            "points to errors in the modal data (noise, mismatched or spurious modes)."
+        )
+    # --- proportionality
+    if not real and d.n_modes > 1:
+        pct = 100 * d.non_proportionality
+        kind = (
+            "close to proportional" if d.non_proportionality < 0.1 else "clearly non-proportional"
+        )
+        out.append(
+            f"The off-diagonal part of C' is {pct:.2g} % of its diagonal: the damping is {kind}."
+        )
+    if proportional is not None:
+        pr = proportional
+        out.append(
+            f"Best Rayleigh model alpha = {pr.rayleigh_alpha:.4g} 1/s, beta = "
+            f"{pr.rayleigh_beta:.4g} s fits the modal damping ratios to "
+            f"{100 * pr.zeta_fit_error:.2g} % RMS. Relative FRF error at the points against "
+            f"the complex-mode data: full C' {100 * pr.frf_error_full:.2g} %, modal (diagonal) "
+            f"damping {100 * pr.frf_error_modal:.2g} %, Rayleigh "
+            f"{100 * pr.frf_error_rayleigh:.2g} %."
+        )
+        if not real and pr.frf_error_modal > 2 * max(pr.frf_error_full, 1e-12):
+            out.append(
+                "The full damping matrix describes the data clearly better than any "
+                "proportional model: keep the off-diagonal terms in simulations."
+            )
+    # --- truncation and leakage
+    if d.n_modes < d.n_points:
+        out.append(
+            f"Only {d.n_modes} modes are known at {d.n_points} points: the physical matrix C "
+            f"has rank {d.n_modes} and describes damping only for motions made of the "
+            "identified mode shapes. Projecting the damping on so few shapes smears it over "
+            f"the circumference ('power leakage'): {d.negative_diagonal_physical} negative "
+            f"diagonal and {100 * d.negative_offdiagonal_fraction:.0f} % negative off-diagonal "
+            "entries, which are artefacts of truncation, not local negative dampers. C is "
+            "as definite as C' (same signs of eigenvalues)."
+        )
+    else:
+        out.append(
+            f"The modal set is complete ({d.n_modes} modes at {d.n_points} points): C is a "
+            "full-rank physical damping matrix."
+        )
+    if d.residual_fraction is not None:
+        out.append(
+            f"The residual terms (modes outside the band) carry {100 * d.residual_fraction:.2g} "
+            "% of the receptance RMS in the band; the identified modes explain the rest."
+            + (
+                " That share is large: out-of-band modes couple through damping too, and "
+                "their effect leaks into C'."
+                if d.residual_fraction > 0.2
+                else ""
+            )
+        )
+    if d.shape_condition > 1e3:
+        out.append(
+            f"The mode shapes are nearly dependent at the points (condition number "
+            f"{d.shape_condition:.3g}); the pseudo-inverse amplifies noise: more points or "
+            "fewer modes would help."
+        )
+    # --- theory
+    if d.theory_change is not None and not real:
+        pct = 100 * d.theory_change
+        msg = (
+            f"The second-order terms neglected by the {method} small-damping formula change "
+            f"C' by {pct:.2g} % (largest damping ratio {100 * d.max_damping_ratio:.2g} %)."
+        )
+        if d.theory_change > 0.05:
+            msg += " That is significant: use method 'refined'."
+        out.append(msg)
+    if d.normalisation_phase > 0.05:
+        out.append(
+            f"The mode normalisation needed a phase correction up to {d.normalisation_phase:.2g} "
+            "rad: the scaling of some complex shapes is poorly determined by the fit."
+        )
+    if d.basis_residual > 0.05:
+        out.append(
+            f"The refined model leaves {100 * d.basis_residual:.2g} % imaginary residue in the "
+            "real mode basis: the data are not fully consistent with the truncated modal system."
+        )
+    if d.lancaster_difference is not None:
+        out.append(
+            f"Complete modal set: Lancaster's exact formula gives a C within "
+            f"{100 * d.lancaster_difference:.2g} % (Frobenius) of this estimate."
+        )
+    # --- uncertainty
+    if std_modal is not None and c_modal is not None and d.n_modes > 1:
+        off = ~np.eye(d.n_modes, dtype=bool)
+        sig = np.abs(c_modal[off]) > 2 * std_modal[off]
+        dm = np.abs(np.diag(c_modal))
+        rel_d = np.median(np.diag(std_modal) / np.where(dm > 0, dm, np.inf))
+        out.append(
+            f"Monte Carlo standard errors: diagonal of C' to {100 * rel_d:.2g} % (median); "
+            f"{int(np.count_nonzero(sig))} of {int(np.count_nonzero(off))} off-diagonal terms "
+            "exceed twice their standard error."
+        )
+    return out
