@@ -36,6 +36,11 @@ def cli(ctx: click.Context, debug: bool) -> None:
 
 def _register() -> None:
     """Attach the subcommands; each subcommand module adds its lines here."""
+    from .check import check_group
+    from .frf import frf_command
+
+    cli.add_command(frf_command)
+    cli.add_command(check_group)
 
 
 _register()

@@ -1,1 +1,166 @@
-"""File formats: UFF 58 (pyuff), CSV, NPZ and JSON results."""
+"""File formats: UFF 58/58b (pyuff), CSV and NPZ for FRFs and time data.
+
+Reading dispatches on the file extension:
+
+========================  ============================================
+extension                 format
+========================  ============================================
+``.uff``, ``.unv``, ``.uf``  UFF data set 58, ASCII or binary 58b (read both)
+``.csv``                  tyredamp CSV layout (:mod:`.csv_format`)
+``.npz``                  tyredamp NPZ layout (:mod:`.npz`)
+========================  ============================================
+
+Writing takes ``format`` (``"uff58b"`` binary UFF, ``"uff58"`` ASCII UFF,
+``"csv"``, ``"npz"``) or, by default, the extension (``.uff``/``.unv``: binary
+58b, which is lossless). Every write is atomic (the file appears whole or not
+at all) and input files are only ever opened for reading. Corrupt, truncated
+or empty files raise :class:`~tyredamp.exceptions.FileFormatError` naming the
+file and the problem. See ``docs/file-formats.md``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Literal
+
+from ..exceptions import FileFormatError, InputError
+from ..frf import FRF, FRFKind
+from ..timedata import TimeData
+from .csv_format import read_csv, write_csv
+from .npz import read_npz, write_npz
+from .uff import read_uff, uff_contents, write_uff
+
+__all__ = [
+    "FORMATS",
+    "format_of",
+    "read",
+    "read_frf",
+    "read_timedata",
+    "write",
+    "write_frf",
+    "write_timedata",
+]
+
+Format = Literal["uff58b", "uff58", "csv", "npz"]
+#: Formats accepted by the writers.
+FORMATS: tuple[str, ...] = ("uff58b", "uff58", "csv", "npz")
+_EXT: dict[str, Format] = {
+    ".uff": "uff58b",
+    ".unv": "uff58b",
+    ".uf": "uff58b",
+    ".csv": "csv",
+    ".npz": "npz",
+}
+
+
+def format_of(path: str | os.PathLike[str], format: str | None = None) -> Format:
+    """The file format for ``path``: ``format`` when given, else from the extension."""
+    if format is not None:
+        if format not in FORMATS:
+            raise InputError(f"format: expected one of {FORMATS}, got {format!r}")
+        return format  # type: ignore[return-value]
+    ext = Path(path).suffix.lower()
+    if ext not in _EXT:
+        raise InputError(
+            f"{path}: unknown file extension {ext or '(none)'!r}; expected one of "
+            f"{', '.join(sorted(_EXT))} or an explicit format"
+        )
+    return _EXT[ext]
+
+
+def _read_format(path: str | os.PathLike[str]) -> Format:
+    ext = Path(path).suffix.lower()
+    if ext not in _EXT:
+        raise FileFormatError(
+            f"{path}: unknown file extension {ext or '(none)'!r}; expected one of "
+            f"{', '.join(sorted(_EXT))}"
+        )
+    return _EXT[ext]
+
+
+def read(path: str | os.PathLike[str]) -> FRF | TimeData:
+    """Read whatever the file holds: an FRF or time data."""
+    fmt = _read_format(path)
+    if fmt == "csv":
+        return read_csv(path)
+    if fmt == "npz":
+        return read_npz(path)
+    return read_uff(path)
+
+
+def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
+    """Read an FRF matrix from a UFF, CSV or NPZ file.
+
+    Parameters
+    ----------
+    path : path-like
+    kind : {"receptance", "mobility", "accelerance"}, optional
+        UFF only: the FRF kind when the file does not state it.
+
+    Raises
+    ------
+    FileFormatError
+        The file is empty, truncated, corrupt, or holds time data.
+    """
+    fmt = _read_format(path)
+    obj = read_uff(path, "frf", kind) if fmt.startswith("uff") else read(path)
+    if not isinstance(obj, FRF):
+        raise FileFormatError(f"{path}: holds time data, not an FRF")
+    return obj
+
+
+def read_timedata(path: str | os.PathLike[str]) -> TimeData:
+    """Read time data from a UFF, CSV or NPZ file.
+
+    Raises
+    ------
+    FileFormatError
+        The file is empty, truncated, corrupt, or holds an FRF.
+    """
+    fmt = _read_format(path)
+    obj = read_uff(path, "timedata") if fmt.startswith("uff") else read(path)
+    if not isinstance(obj, TimeData):
+        raise FileFormatError(f"{path}: holds an FRF, not time data")
+    return obj
+
+
+def write(obj: FRF | TimeData, path: str | os.PathLike[str], format: str | None = None) -> Path:
+    """Write an FRF or TimeData; returns the path written.
+
+    Parameters
+    ----------
+    obj : FRF or TimeData
+    path : path-like
+    format : {"uff58b", "uff58", "csv", "npz"}, optional
+        Default from the extension (``.uff``/``.unv``: ``"uff58b"``).
+    """
+    fmt = format_of(path, format)
+    if not isinstance(obj, FRF | TimeData):
+        raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
+    if fmt == "csv":
+        write_csv(obj, path)
+    elif fmt == "npz":
+        write_npz(obj, path)
+    else:
+        write_uff(obj, path, binary=fmt == "uff58b")
+    return Path(path)
+
+
+def write_frf(frf: FRF, path: str | os.PathLike[str], format: str | None = None) -> Path:
+    """Write an FRF (see :func:`write`)."""
+    if not isinstance(frf, FRF):
+        raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
+    return write(frf, path, format)
+
+
+def write_timedata(
+    timedata: TimeData, path: str | os.PathLike[str], format: str | None = None
+) -> Path:
+    """Write time data (see :func:`write`)."""
+    if not isinstance(timedata, TimeData):
+        raise InputError(f"timedata: expected a TimeData, got {type(timedata).__name__}")
+    return write(timedata, path, format)
+
+
+_ = uff_contents  # re-exported for callers that only need to know the contents

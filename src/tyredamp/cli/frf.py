@@ -1,0 +1,120 @@
+"""``tyredamp frf``: FRFs from a time-data file."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+
+from ..exceptions import InputError
+from ..frf import FRF
+from ..io import FORMATS, format_of, read_timedata, write_frf
+from ..signal.estimators import ESTIMATORS, estimate_frf
+
+__all__ = ["frf_command", "frf_summary"]
+
+
+def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
+    """Short text summary of an estimated FRF: size, lines, estimator, coherence."""
+    f = frf.frequency
+    df = f" (df {f[1] - f[0]:.4g} Hz)" if f.size > 1 else ""
+    m = frf.meta
+    rows = [
+        f"FRF: {frf.n_out} output(s) x {frf.n_in} input(s), {frf.kind} [{frf.unit}], "
+        f"{frf.n_freq} lines {f[0]:.4g}-{f[-1]:.4g} Hz{df}",
+        f"estimator {m.get('estimator', '?')}, method {m.get('method', '?')}, "
+        f"{m.get('n_averages', '?')} averages of {m.get('segment_samples', '?')} samples",
+    ]
+    if frf.coherence is not None:
+        coh = frf.coherence
+        i_out, i_line = np.unravel_index(int(np.argmin(coh)), coh.shape)
+        rows.append(
+            f"multiple coherence: mean {coh.mean():.4f}, min {coh.min():.4f} "
+            f"(output {frf.outputs[i_out].label} at {f[i_line]:.4g} Hz), "
+            f"{100 * np.mean(coh < coherence_min):.3g} % of lines below {coherence_min:g}"
+        )
+    return rows
+
+
+@click.command("frf")
+@click.argument("time_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--out",
+    "-o",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="FRF file to write (.uff, .unv, .csv or .npz).",
+)
+@click.option(
+    "--estimator",
+    type=click.Choice(ESTIMATORS),
+    default="H1",
+    show_default=True,
+    help="H1 (noise on outputs), H2 (noise on inputs) or Hv (total least squares).",
+)
+@click.option(
+    "--reference",
+    "references",
+    multiple=True,
+    metavar="CHANNEL",
+    help="Force channel to use as input (label like 1+Z, channel name or node number); "
+    "repeat for MIMO. Default: every force channel.",
+)
+@click.option(
+    "--method",
+    type=click.Choice(["auto", "cyclic", "welch", "transient"]),
+    default="auto",
+    show_default=True,
+    help="auto: cyclic when the file states period_samples, transient when it states "
+    "record_samples, else Welch.",
+)
+@click.option("--segment", type=click.IntRange(min=2), help="Welch/transient segment in samples.")
+@click.option(
+    "--band", nargs=2, type=float, metavar="F_LO F_HI", help="Keep lines in this band (Hz)."
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(FORMATS),
+    help="Output format; default from the extension (.uff/.unv: binary UFF 58b).",
+)
+def frf_command(
+    time_file: Path,
+    out: Path,
+    estimator: str,
+    references: tuple[str, ...],
+    method: str,
+    segment: int | None,
+    band: tuple[float, float] | None,
+    fmt: str | None,
+) -> None:
+    """Estimate FRFs (with coherence) from TIME_FILE and write them to --out.
+
+    TIME_FILE holds force and response channels (UFF 58 function type 1, or
+    tyredamp CSV/NPZ). The FRF kind follows the response channels
+    (acceleration gives accelerance). A short summary with coherence
+    figures is printed. Nothing is written when an error occurs.
+
+    \b
+    Example:
+      tyredamp frf tyre_test.uff --out tyre_frf.uff --estimator H1
+      tyredamp frf rig.npz --out frf.csv --reference 1+Z --method welch --segment 4096
+    """
+    if out.resolve() == time_file.resolve():
+        raise InputError(f"--out: {out} is the input file; choose another name")
+    out_format = format_of(out, fmt)
+    td = read_timedata(time_file)
+    frf = estimate_frf(
+        td,
+        estimator,  # type: ignore[arg-type]
+        reference=list(references) or None,
+        method=None if method == "auto" else method,  # type: ignore[arg-type]
+        segment_samples=segment,
+        band=band or None,
+    )
+    write_frf(frf, out, out_format)
+    for row in frf_summary(frf):
+        click.echo(row)
+    click.echo(f"wrote {out} ({out_format})")

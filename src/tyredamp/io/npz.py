@@ -1,0 +1,134 @@
+"""NPZ files: lossless storage of FRF and TimeData objects.
+
+Layout (a NumPy ``.npz`` archive, no pickled objects):
+
+``header``
+    0-d unicode array with a JSON object: ``format`` ("tyredamp"),
+    ``version`` (1), ``type`` ("frf" or "timedata") and, for an FRF,
+    ``kind``, ``outputs``, ``inputs`` (lists of channel records ``{"node",
+    "direction", "angle_deg", "name"}``) and ``meta``; for time data
+    ``sample_rate`` (Hz), ``channels`` (channel records with ``quantity``)
+    and ``meta``.
+``frequency`` (n_freq,), ``H`` (n_out, n_in, n_freq) complex, optional
+``coherence`` (n_out, n_freq)
+    FRF arrays, Hz and SI units of the kind.
+``data`` (n_channels, n_samples)
+    Time data in SI units.
+
+Everything round-trips bit for bit (``meta`` must be JSON-compatible).
+"""
+
+from __future__ import annotations
+
+import os
+import zipfile
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import FileFormatError, InputError
+from ..frf import FRF
+from ..timedata import TimeData
+from ._atomic import atomic_path
+from ._common import (
+    channel_from_dict,
+    channel_to_dict,
+    check_input_file,
+    meta_from_json,
+    meta_to_json,
+    wrap_errors,
+)
+
+__all__ = ["read_npz", "write_npz"]
+
+_VERSION = 1
+
+
+def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
+    """Write an FRF or TimeData to ``path`` (atomically).
+
+    Parameters
+    ----------
+    obj : FRF or TimeData
+    path : path-like
+        Output file; NumPy appends nothing (the name is used as given).
+    """
+    arrays: dict[str, Any] = {}
+    if isinstance(obj, FRF):
+        head: dict[str, Any] = {
+            "type": "frf",
+            "kind": obj.kind,
+            "outputs": [channel_to_dict(c) for c in obj.outputs],
+            "inputs": [channel_to_dict(c) for c in obj.inputs],
+        }
+        arrays.update(frequency=obj.frequency, H=obj.H)
+        if obj.coherence is not None:
+            arrays["coherence"] = obj.coherence
+    elif isinstance(obj, TimeData):
+        head = {
+            "type": "timedata",
+            "sample_rate": obj.sample_rate,
+            "channels": [
+                channel_to_dict(c, quantity=q)
+                for c, q in zip(obj.channels, obj.quantities, strict=True)
+            ],
+        }
+        arrays["data"] = obj.data
+    else:
+        raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
+    text = meta_to_json({"format": "tyredamp", "version": _VERSION, **head, "meta": obj.meta})
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        np.savez(fh, header=np.array(text), **arrays)
+
+
+def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
+    """Read a file written by :func:`write_npz`.
+
+    Raises
+    ------
+    FileFormatError
+        Not an NPZ archive, truncated, or without the expected entries.
+    """
+    p = check_input_file(path)
+    try:
+        with np.load(p, allow_pickle=False) as z:
+            if "header" not in z.files:
+                raise FileFormatError(f"{p}: not a tyredamp NPZ file (no 'header' entry)")
+            head = meta_from_json(str(z["header"][()]), f"{p}: header")
+            arrays = {k: z[k] for k in z.files if k != "header"}
+    except FileFormatError:
+        raise
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError) as exc:
+        raise FileFormatError(f"{p}: not a readable NPZ file ({exc})") from None
+    if head.get("format") != "tyredamp":
+        raise FileFormatError(f"{p}: header 'format' is {head.get('format')!r}, not 'tyredamp'")
+    if head.get("version") != _VERSION:
+        raise FileFormatError(f"{p}: unsupported version {head.get('version')!r}")
+    meta = head.get("meta", {})
+    kind = head.get("type")
+    with wrap_errors(p):
+        if kind == "frf":
+            for k in ("frequency", "H"):
+                if k not in arrays:
+                    raise FileFormatError(f"{p}: missing array {k!r}")
+            return FRF(
+                arrays["frequency"],
+                arrays["H"],
+                kind=head.get("kind", ""),
+                outputs=[channel_from_dict(c, f"{p}: outputs") for c in head.get("outputs", [])],
+                inputs=[channel_from_dict(c, f"{p}: inputs") for c in head.get("inputs", [])],
+                coherence=arrays.get("coherence"),
+                meta=meta,
+            )
+        if kind == "timedata":
+            if "data" not in arrays:
+                raise FileFormatError(f"{p}: missing array 'data'")
+            chans = head.get("channels", [])
+            return TimeData(
+                arrays["data"],
+                head.get("sample_rate", 0.0),
+                [channel_from_dict(c, f"{p}: channels") for c in chans],
+                [str(c.get("quantity", "")) for c in chans],
+                meta=meta,
+            )
+    raise FileFormatError(f"{p}: header 'type' is {kind!r}, expected 'frf' or 'timedata'")

@@ -1,0 +1,662 @@
+"""Universal File Format data set 58 (ASCII) and 58b (binary) through pyuff.
+
+One data set holds one function: a time history (function type 1) of one
+channel, an FRF (function type 4) of one output/input pair, or a coherence
+(function type 6). An FRF matrix is a group of type-4 sets; a test's time
+data is a group of type-1 sets of equal length and sampling.
+
+What is written
+---------------
+* Record 6: response node and direction = the output channel (or the time
+  channel), reference node and direction = the input channel (0/0 for time
+  data and for a multiple coherence).
+* Records 8-10: abscissa data type 18 (frequency, "Hz") or 17 (time, "s");
+  ordinate (numerator) data type 8/11/12/13 for displacement, velocity,
+  acceleration, force with SI units labels ``m``, ``m/s``, ``m/s^2``, ``N``;
+  for an FRF the denominator is type 13 (excitation force, ``N``). So
+  receptance, mobility and accelerance are told apart by the ordinate data
+  type; the units exponents are set to the SI dimensions as well.
+* ID line 1: a description (``meta["description"]`` or ``"tyredamp FRF ..."``);
+  ID line 2: ``tyredamp1 ...`` with the exact frequency axis or sample rate
+  as Python floats (the fixed E13.5 fields of record 7 keep only 6 digits);
+  ID line 3: as much of ``meta`` as fits in 80 characters as JSON;
+  ID lines 4 and 5: channel name and angle of the response and reference as
+  JSON (``NONE`` when there are none).
+
+Precision
+---------
+Binary 58b (format ``"uff58b"``, the default for ``.uff`` and ``.unv``)
+stores every value as a float64 and the frequencies as uneven abscissa
+values: FRF and time data round-trip bit for bit. ASCII 58 (format
+``"uff58"``) stores values in E20.12 fields, 12 significant digits, relative
+error up to 5e-12; the frequency axis must then be evenly spaced (it is
+rebuilt exactly from ID line 2). Free metadata beyond 80 characters of JSON
+is not kept by either (use NPZ for that).
+
+Reading other programs' files
+-----------------------------
+The response quantity comes from the ordinate data type (8, 11, 12; 9 or 13
+for forces) or else from the ordinate units label; ``m``, ``mm``, ``um``,
+``in``, ``m/s``, ``mm/s``, ``in/s``, ``m/s^2``, ``mm/s^2``, ``g``,
+``in/s^2``, ``N``, ``kN``, ``lbf`` are converted to SI; a blank label or
+``NONE`` is taken as SI; another label is an error. An FRF label such as
+``g/N`` or ``(m/s^2)/N`` with a blank denominator is split at the last ``/``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyuff
+
+from ..exceptions import FileFormatError, InputError
+from ..frf import FRF, KINDS, Channel, FRFKind
+from ..timedata import TimeData
+from ._atomic import atomic_path
+from ._common import check_input_file, meta_to_json, wrap_errors
+
+__all__ = ["read_uff", "uff_contents", "write_uff"]
+
+_MARK = "tyredamp1"
+_SDT = {"displacement": 8, "velocity": 11, "acceleration": 12, "force": 13}
+_SDT_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 13: "force", 9: "force"}
+_KIND_QUANTITY = {
+    "receptance": "displacement",
+    "mobility": "velocity",
+    "accelerance": "acceleration",
+}
+_QUANTITY_KIND: dict[str, FRFKind] = {v: k for k, v in _KIND_QUANTITY.items()}  # type: ignore[misc]
+_SI_LABEL = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2", "force": "N"}
+_AXIS_LABEL = {
+    "displacement": "Displacement",
+    "velocity": "Velocity",
+    "acceleration": "Acceleration",
+    "force": "Force",
+}
+# (length exponent, force exponent) of each quantity in SI
+_EXP = {"displacement": (1, 0), "velocity": (1, 0), "acceleration": (1, 0), "force": (0, 1)}
+_LBF = 4.4482216152605
+_UNITS: dict[str, tuple[str, float]] = {
+    "m": ("displacement", 1.0),
+    "mm": ("displacement", 1e-3),
+    "um": ("displacement", 1e-6),
+    "micron": ("displacement", 1e-6),
+    "in": ("displacement", 0.0254),
+    "m/s": ("velocity", 1.0),
+    "mm/s": ("velocity", 1e-3),
+    "in/s": ("velocity", 0.0254),
+    "m/s^2": ("acceleration", 1.0),
+    "mm/s^2": ("acceleration", 1e-3),
+    "in/s^2": ("acceleration", 0.0254),
+    "g": ("acceleration", 9.80665),
+    "n": ("force", 1.0),
+    "kn": ("force", 1e3),
+    "lbf": ("force", _LBF),
+}
+
+
+def _norm_unit(label: Any) -> str:
+    s = str(label or "").strip().lower().replace(" ", "")
+    s = s.replace("²", "^2").replace("**", "^").replace("µ", "u").replace("μ", "u")
+    s = s.replace("sec", "s")
+    if s.startswith("(") and s.endswith(")"):
+        s = s[1:-1]
+    if s.endswith("/s2"):
+        s = s[:-2] + "s^2"
+    return s
+
+
+def _unit(label: Any, where: str) -> tuple[str, float] | None:
+    """(quantity, factor to SI) of a units label, None when blank."""
+    s = _norm_unit(label)
+    if s in ("", "none"):
+        return None
+    if s not in _UNITS:
+        raise FileFormatError(
+            f"{where}: unknown units label {label!r}; known: m, mm, um, in, m/s, mm/s, in/s, "
+            "m/s^2, mm/s^2, in/s^2, g, N, kN, lbf (blank or NONE = SI)"
+        )
+    return _UNITS[s]
+
+
+# ------------------------------------------------------------------ writing
+def _extras_line(c: Channel) -> str:
+    d: dict[str, Any] = {}
+    if c.name:
+        d["name"] = c.name
+    if c.angle_deg is not None:
+        d["angle_deg"] = float(c.angle_deg)
+    if not d:
+        return "NONE"
+    text = json.dumps(d, separators=(",", ":"), ensure_ascii=True)
+    if len(text) > 80:
+        raise InputError(
+            f"channel {c.label!r}: name and angle need {len(text)} characters, an UFF ID line "
+            "holds 80; shorten the name or write CSV/NPZ"
+        )
+    return text
+
+
+def _meta_line(meta: dict[str, Any]) -> str:
+    full = meta_to_json(meta)
+    if len(full) <= 80:
+        return full if meta else "NONE"
+    kept: dict[str, Any] = {}
+    for k, v in meta.items():
+        trial = {**kept, k: v}
+        if len(meta_to_json(trial)) <= 80:
+            kept = trial
+    return meta_to_json(kept) if kept else "NONE"
+
+
+def _even_axis(f: np.ndarray) -> str | None:
+    """ID-line tokens that rebuild ``f`` (bit for bit where possible), None if uneven."""
+    n = f.size
+    if n == 1:
+        return f"f0={float(f[0])!r} df=1.0"
+    d0 = (f[-1] - f[0]) / (n - 1)
+    if d0 <= 0 or np.max(np.abs(f[0] + d0 * np.arange(n) - f)) > 1e-9 * d0:
+        return None
+    k0 = round(f[0] / d0)
+    if abs(f[0] / d0 - k0) < 1e-6:
+        for d in (f[-1] / (k0 + n - 1), d0, f[1] - f[0]):
+            if np.array_equal((k0 + np.arange(n)) * d, f):
+                return f"k0={k0} df={float(d)!r}"
+    return f"f0={float(f[0])!r} df={float(d0)!r}"
+
+
+def _rebuild_axis(tokens: dict[str, str], n: int) -> np.ndarray | None:
+    try:
+        df = float(tokens["df"])
+        if "k0" in tokens:
+            return (int(tokens["k0"]) + np.arange(n)) * df
+        if "f0" in tokens:
+            return float(tokens["f0"]) + df * np.arange(n)
+    except (KeyError, ValueError):
+        return None
+    return None
+
+
+def _base_set(binary: bool, quantity: str, id1: str, id2: str, id3: str) -> dict[str, Any]:
+    le, fe = _EXP[quantity]
+    return {
+        "type": 58,
+        "binary": int(binary),
+        "id1": id1[:80] or "NONE",
+        "id2": id2,
+        "id3": id3,
+        "load_case_id": 0,
+        "ver_num": 0,
+        "rsp_ent_name": "NONE",
+        "ref_ent_name": "NONE",
+        "ordinate_spec_data_type": _SDT[quantity],
+        "ordinate_len_unit_exp": le,
+        "ordinate_force_unit_exp": fe,
+        "ordinate_temp_unit_exp": 0,
+        "ordinate_axis_lab": _AXIS_LABEL[quantity],
+        "ordinate_axis_units_lab": _SI_LABEL[quantity],
+        "orddenom_spec_data_type": 0,
+        "z_axis_spec_data_type": 0,
+    }
+
+
+def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = True) -> None:
+    """Write an FRF or TimeData as UFF 58 data sets (atomically).
+
+    Parameters
+    ----------
+    obj : FRF or TimeData
+    path : path-like
+    binary : bool
+        58b binary (lossless, default) or ASCII 58 (12 significant digits).
+
+    Raises
+    ------
+    InputError
+        ASCII with an uneven frequency axis; channel names too long for an ID
+        line; metadata that is not JSON-compatible.
+    """
+    sets: list[dict[str, Any]] = []
+    if isinstance(obj, FRF):
+        q = _KIND_QUANTITY[obj.kind]
+        axis = _even_axis(obj.frequency)
+        if not binary and axis is None:
+            raise InputError(
+                "frf: ASCII UFF keeps an uneven frequency axis to 6 digits only; write binary "
+                "UFF (uff58b), CSV or NPZ"
+            )
+        id1 = str(obj.meta.get("description", f"tyredamp FRF {obj.kind}"))
+        id2 = f"{_MARK} frf {obj.kind}" + ("" if binary else f" {axis}")
+        id3 = _meta_line(obj.meta)
+        x = obj.frequency
+        fid = 0
+        for o, co in enumerate(obj.outputs):
+            for i, ci in enumerate(obj.inputs):
+                fid += 1
+                d = _base_set(binary, q, id1, id2, id3)
+                d.update(
+                    func_type=4,
+                    func_id=fid,
+                    rsp_node=co.node,
+                    rsp_dir=co.direction,
+                    ref_node=ci.node,
+                    ref_dir=ci.direction,
+                    id4=_extras_line(co),
+                    id5=_extras_line(ci),
+                    orddenom_spec_data_type=13,
+                    orddenom_len_unit_exp=0,
+                    orddenom_force_unit_exp=1,
+                    orddenom_temp_unit_exp=0,
+                    orddenom_axis_lab="Force",
+                    orddenom_axis_units_lab="N",
+                    data=np.array(obj.H[o, i], dtype=complex),
+                )
+                sets.append(_abscissa(d, x, binary, 18, "Frequency", "Hz"))
+        if obj.coherence is not None:
+            ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
+            for o, co in enumerate(obj.outputs):
+                fid += 1
+                d = _base_set(
+                    binary,
+                    q,
+                    "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence",
+                    id2,
+                    id3,
+                )
+                d.update(
+                    func_type=6,
+                    func_id=fid,
+                    rsp_node=co.node,
+                    rsp_dir=co.direction,
+                    ref_node=ref.node,
+                    ref_dir=ref.direction,
+                    id4=_extras_line(co),
+                    id5=_extras_line(ref),
+                    ordinate_spec_data_type=0,
+                    ordinate_len_unit_exp=0,
+                    ordinate_force_unit_exp=0,
+                    ordinate_axis_lab="Coherence",
+                    ordinate_axis_units_lab="NONE",
+                    data=np.array(obj.coherence[o], dtype=float),
+                )
+                sets.append(_abscissa(d, x, binary, 18, "Frequency", "Hz"))
+    elif isinstance(obj, TimeData):
+        id1 = str(obj.meta.get("description", "tyredamp time data"))
+        id3 = _meta_line(obj.meta)
+        t = obj.time
+        for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
+            d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
+            d.update(
+                func_type=1,
+                func_id=k + 1,
+                rsp_node=c.node,
+                rsp_dir=c.direction,
+                ref_node=0,
+                ref_dir=0,
+                id4=_extras_line(c),
+                id5="NONE",
+                data=np.array(obj.data[k], dtype=float),
+            )
+            sets.append(_abscissa(d, t, False, 17, "Time", "s"))
+    else:
+        raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
+    with atomic_path(path) as tmp:
+        uff = pyuff.UFF(str(tmp))
+        try:
+            # "add" to the empty temporary file: pyuff truncates binary sets in "overwrite"
+            uff.write_sets(sets, mode="add", force_double=True)
+        except Exception as exc:  # pyuff raises bare Exception
+            raise FileFormatError(f"{path}: pyuff could not write the data sets ({exc})") from exc
+
+
+def _abscissa(
+    d: dict[str, Any], x: np.ndarray, uneven: bool, sdt: int, lab: str, unit: str
+) -> dict[str, Any]:
+    xs = np.array(x, dtype=float)
+    if xs.size == 1 and not uneven:  # pyuff reads the increment from x[1]
+        xs = np.array([xs[0], xs[0] + 1.0])
+    d.update(
+        x=xs,
+        abscissa_spacing=0 if uneven else 1,
+        abscissa_spec_data_type=sdt,
+        abscissa_len_unit_exp=0,
+        abscissa_force_unit_exp=0,
+        abscissa_temp_unit_exp=0,
+        abscissa_axis_lab=lab,
+        abscissa_axis_units_lab=unit,
+    )
+    return d
+
+
+# ------------------------------------------------------------------ reading
+def _markers(raw: bytes) -> int:
+    """Count data-set delimiters as pyuff does (``    -1`` ending a record)."""
+    count, i, n = 0, -1, len(raw)
+    while True:
+        i = raw.find(b"    -1", i + 1)
+        if i == -1:
+            return count
+        if (
+            i + 6 == n
+            or (i + 6 < n and raw[i + 6] in (10, 13))
+            or (i + 80 < n and raw[i + 6 : i + 80] == b" " * 74)
+        ):
+            count += 1
+
+
+def _load_sets(p: Path) -> list[dict[str, Any]]:
+    raw = p.read_bytes()
+    n_marks = _markers(raw)
+    if n_marks == 0:
+        raise FileFormatError(f"{p}: no UFF data set found (no '    -1' delimiters)")
+    if n_marks % 2:
+        raise FileFormatError(
+            f"{p}: truncated UFF file: the last data set has no closing '    -1' delimiter"
+        )
+    try:
+        uff = pyuff.UFF(str(p))
+        types = list(uff.get_set_types())
+        idx = [k for k, t in enumerate(types) if t == 58]
+        if not idx:
+            raise FileFormatError(
+                f"{p}: no data set 58 (function at nodal DOF); found types {sorted(set(types))}"
+            )
+        sets = uff.read_sets(idx)
+    except FileFormatError:
+        raise
+    except Exception as exc:  # pyuff raises bare Exception, and others on garbage
+        raise FileFormatError(f"{p}: corrupt UFF data set 58 ({exc})") from None
+    if isinstance(sets, dict):
+        sets = [sets]
+    for k, s in zip(idx, sets, strict=True):
+        data = s.get("data")
+        if data is None or "num_pts" not in s or len(data) != int(s["num_pts"]):
+            got = "no" if data is None else len(data)
+            raise FileFormatError(
+                f"{p}: data set #{k + 1} is corrupt or truncated: header says "
+                f"{s.get('num_pts')} values, found {got}"
+            )
+        s["_index"] = k + 1
+    return sets
+
+
+def _tokens(s: dict[str, Any]) -> dict[str, str] | None:
+    parts = str(s.get("id2", "")).split()
+    if not parts or parts[0] != _MARK:
+        return None
+    out = {"_what": parts[1] if len(parts) > 1 else "", "_q": parts[2] if len(parts) > 2 else ""}
+    for tok in parts[3:]:
+        if "=" in tok:
+            k, v = tok.split("=", 1)
+            out[k] = v
+    return out
+
+
+def _extras(line: Any) -> dict[str, Any]:
+    text = str(line or "").strip()
+    if not text.startswith("{"):
+        return {}
+    try:
+        d = json.loads(text)
+    except json.JSONDecodeError:
+        return {}
+    return d if isinstance(d, dict) else {}
+
+
+def _channel(node: Any, direction: Any, extras: dict[str, Any], where: str) -> Channel:
+    try:
+        angle = extras.get("angle_deg")
+        return Channel(
+            node=int(node),
+            direction=int(direction),
+            angle_deg=None if angle is None else float(angle),
+            name=str(extras.get("name", "")),
+        )
+    except (TypeError, ValueError) as exc:
+        raise FileFormatError(f"{where}: invalid node/direction ({exc})") from None
+
+
+def _quantity(s: dict[str, Any], where: str) -> tuple[str | None, float]:
+    sdt = int(s.get("ordinate_spec_data_type", 0) or 0)
+    label = s.get("ordinate_axis_units_lab", "")
+    num = str(label or "")
+    den_label = s.get("orddenom_axis_units_lab", "")
+    if int(s.get("func_type", 0)) == 4 and _norm_unit(den_label) in ("", "none") and "/" in num:
+        head, tail = num.rsplit("/", 1)
+        if _norm_unit(tail) in ("n", "kn", "lbf"):
+            num, den_label = head, tail
+    u = _unit(num, where)
+    q = _SDT_QUANTITY.get(sdt)
+    if q is None and u is not None:
+        q = u[0]
+    if u is not None and q is not None and u[0] != q:
+        raise FileFormatError(
+            f"{where}: ordinate data type {sdt} ({q}) disagrees with units label {label!r}"
+        )
+    scale = 1.0 if u is None else u[1]
+    if int(s.get("func_type", 0)) == 4:
+        d = _unit(den_label, where)
+        if d is not None:
+            if d[0] != "force":
+                raise FileFormatError(f"{where}: FRF denominator {den_label!r} is not a force")
+            scale /= d[1]
+    return q, scale
+
+
+def uff_contents(path: str | os.PathLike[str]) -> str:
+    """``"frf"`` or ``"timedata"``: what the UFF file at ``path`` holds."""
+    p = check_input_file(path)
+    types = {int(s.get("func_type", -1)) for s in _load_sets(p)}
+    if 4 in types:
+        return "frf"
+    if 1 in types:
+        return "timedata"
+    raise FileFormatError(
+        f"{p}: no FRF (function type 4) or time response (type 1) in data sets 58; found "
+        f"function types {sorted(types)}"
+    )
+
+
+def read_uff(
+    path: str | os.PathLike[str], what: str | None = None, kind: FRFKind | None = None
+) -> FRF | TimeData:
+    """Read FRFs (function type 4) or time data (type 1) from a UFF file.
+
+    Parameters
+    ----------
+    path : path-like
+    what : {"frf", "timedata"}, optional
+        Which to read; default FRF when the file holds FRFs, else time data.
+    kind : {"receptance", "mobility", "accelerance"}, optional
+        FRF kind when the file does not tell it (ordinate data type and units
+        label missing); when given it overrides the file.
+
+    Raises
+    ------
+    FileFormatError
+        Empty, truncated or corrupt file; missing FRFs of the matrix; channels
+        of different length or sampling; unknown units.
+    """
+    p = check_input_file(path)
+    sets = _load_sets(p)
+    if what is None:
+        types = {int(s.get("func_type", -1)) for s in sets}
+        what = "frf" if 4 in types else "timedata" if 1 in types else ""
+        if not what:
+            raise FileFormatError(
+                f"{p}: no FRF (function type 4) or time response (type 1) in data sets 58; "
+                f"found function types {sorted(types)}"
+            )
+    with wrap_errors(p):
+        if what == "frf":
+            return _read_frf(p, sets, kind)
+        if what == "timedata":
+            return _read_time(p, sets)
+    raise InputError(f"what: expected 'frf' or 'timedata', got {what!r}")
+
+
+def _meta(s: dict[str, Any], tok: dict[str, str] | None) -> dict[str, Any]:
+    meta = _extras(s.get("id3")) if tok is not None else {}
+    desc = str(s.get("id1", "")).strip()
+    if desc and desc != "NONE" and not desc.startswith("tyredamp "):
+        meta.setdefault("description", desc)
+    return meta
+
+
+def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
+    frf_sets = [s for s in sets if int(s["func_type"]) == 4]
+    if not frf_sets:
+        raise FileFormatError(f"{p}: no FRF (function type 4) data set")
+    if kind is not None and kind not in KINDS:
+        raise InputError(f"kind: expected one of {KINDS}, got {kind!r}")
+    first = frf_sets[0]
+    tok = _tokens(first)
+    n = len(first["data"])
+    x = np.asarray(first["x"], dtype=float)[:n]
+    if tok is not None and "df" in tok:
+        rebuilt = _rebuild_axis(tok, n)
+        if rebuilt is not None and np.allclose(rebuilt, x, rtol=1e-5, atol=1e-5 * abs(rebuilt[-1])):
+            x = rebuilt
+    outs: dict[tuple[int, int], Channel] = {}
+    ins: dict[tuple[int, int], Channel] = {}
+    cells: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray] = {}
+    kinds: set[str] = set()
+    for s in frf_sets:
+        where = f"{p}: data set #{s['_index']}"
+        if int(s.get("abscissa_spec_data_type", 18) or 0) not in (0, 1, 18):
+            raise FileFormatError(
+                f"{where}: abscissa data type {s['abscissa_spec_data_type']} is not frequency (18)"
+            )
+        if len(s["data"]) != n or not np.allclose(
+            np.asarray(s["x"], dtype=float)[:n],
+            np.asarray(first["x"], dtype=float)[:n],
+            rtol=1e-9,
+            atol=0,
+        ):
+            raise FileFormatError(
+                f"{where}: frequency axis differs from data set #{first['_index']}"
+            )
+        q, scale = _quantity(s, where)
+        if kind is None:
+            if q is None:
+                raise FileFormatError(
+                    f"{where}: cannot tell the response quantity (ordinate data type "
+                    f"{s.get('ordinate_spec_data_type')}, no units label); pass kind="
+                )
+            if q == "force":
+                raise FileFormatError(f"{where}: the ordinate is a force, not a response")
+            kinds.add(_QUANTITY_KIND[q])
+        ko = (int(s["rsp_node"]), int(s["rsp_dir"]))
+        ki = (int(s["ref_node"]), int(s["ref_dir"]))
+        if ko not in outs:
+            outs[ko] = _channel(*ko, _extras(s.get("id4")) if tok else {}, where)
+        if ki not in ins:
+            ins[ki] = _channel(*ki, _extras(s.get("id5")) if tok else {}, where)
+        if (ko, ki) in cells:
+            raise FileFormatError(f"{where}: a second FRF for response {ko} and reference {ki}")
+        cells[(ko, ki)] = np.asarray(s["data"], dtype=complex) * scale
+    if kind is None:
+        if len(kinds) > 1:
+            raise FileFormatError(f"{p}: FRFs of different kinds in one file: {sorted(kinds)}")
+        kind = kinds.pop()  # type: ignore[assignment]
+    h = np.empty((len(outs), len(ins), n), dtype=complex)
+    for a, ko in enumerate(outs):
+        for b, ki in enumerate(ins):
+            if (ko, ki) not in cells:
+                raise FileFormatError(
+                    f"{p}: incomplete FRF matrix: no data set for response node {ko[0]} dir "
+                    f"{ko[1]} and reference node {ki[0]} dir {ki[1]}"
+                )
+            h[a, b] = cells[(ko, ki)]
+    coh = _read_coherence(sets, list(outs), list(ins), n)
+    return FRF(
+        x,
+        h,
+        kind=kind or "receptance",
+        outputs=list(outs.values()),
+        inputs=list(ins.values()),
+        coherence=coh,
+        meta=_meta(first, tok),
+    )
+
+
+def _read_coherence(
+    sets: list[dict[str, Any]], outs: list[tuple[int, int]], ins: list[tuple[int, int]], n: int
+) -> np.ndarray | None:
+    want = ins[0] if len(ins) == 1 else (0, 0)
+    found: dict[tuple[int, int], np.ndarray] = {}
+    for s in sets:
+        if int(s["func_type"]) not in (6, 26) or len(s["data"]) != n:
+            continue
+        if (int(s["ref_node"]), int(s["ref_dir"])) != want:
+            continue
+        found[(int(s["rsp_node"]), int(s["rsp_dir"]))] = np.real(np.asarray(s["data"]))
+    if not all(o in found for o in outs):
+        return None
+    return np.array([found[o] for o in outs])
+
+
+def _read_time(p: Path, sets: list[dict[str, Any]]) -> TimeData:
+    ts = [s for s in sets if int(s["func_type"]) == 1]
+    if not ts:
+        raise FileFormatError(f"{p}: no time response (function type 1) data set")
+    first = ts[0]
+    n = len(first["data"])
+    tok = _tokens(first)
+    rows, chans, quants = [], [], []
+    for s in ts:
+        where = f"{p}: data set #{s['_index']}"
+        if int(s.get("abscissa_spec_data_type", 17) or 0) not in (0, 1, 17):
+            raise FileFormatError(
+                f"{where}: abscissa data type {s['abscissa_spec_data_type']} is not time (17)"
+            )
+        if len(s["data"]) != n:
+            raise FileFormatError(
+                f"{where}: {len(s['data'])} samples, but data set #{first['_index']} has {n}; "
+                "channels must have equal length"
+            )
+        q, scale = _quantity(s, where)
+        if q is None:
+            raise FileFormatError(
+                f"{where}: cannot tell the measured quantity (ordinate data type "
+                f"{s.get('ordinate_spec_data_type')}, no units label)"
+            )
+        rows.append(np.asarray(s["data"], dtype=float) * scale)
+        chans.append(
+            _channel(s["rsp_node"], s["rsp_dir"], _extras(s.get("id4")) if tok else {}, where)
+        )
+        quants.append(q)
+    fs = _sample_rate(p, ts, tok)
+    return TimeData(np.array(rows), fs, chans, quants, meta=_meta(first, tok))
+
+
+def _sample_rate(p: Path, ts: list[dict[str, Any]], tok: dict[str, str] | None) -> float:
+    if tok is not None and "fs" in tok:
+        try:
+            return float(tok["fs"])
+        except ValueError:
+            pass
+    steps = []
+    for s in ts:
+        x = np.asarray(s["x"], dtype=float)
+        if int(s.get("abscissa_spacing", 1)) == 1:
+            steps.append(float(s["abscissa_inc"]))
+        else:
+            dx = np.diff(x)
+            if dx.size == 0 or np.any(dx <= 0) or np.ptp(dx) > 1e-4 * np.mean(dx):
+                raise FileFormatError(f"{p}: data set #{s['_index']}: uneven time sampling")
+            steps.append(float(np.mean(dx)))
+    dt = steps[0]
+    if dt <= 0 or any(abs(d - dt) > 1e-5 * dt for d in steps):
+        raise FileFormatError(
+            f"{p}: channels have different sampling intervals {sorted(set(steps))}"
+        )
+    fs = 1.0 / dt
+    # E13.5 keeps 6 digits: snap to the integer rate it stands for
+    if abs(fs - round(fs)) <= 1e-5 * fs:
+        fs = float(round(fs))
+    return fs
