@@ -46,11 +46,13 @@ Normalisation. Adhikari & Woodhouse write each complex mode with unit
 component on its own undamped mode (``alpha_n^(n) = 1``, eq. [13]). The
 eq. [10] scaling used by the modal fit gives instead
 ``Psi^_n = Psi_n sqrt(2 i Omega_n / a_n)``, which differs from that by a
-complex factor ``1 + O(zeta^2)``. For ``"first"`` and ``"improved"`` (with
-``normalise=True``, the default) each column of ``Psi^`` is divided by the
-diagonal of ``pinv(Re Psi^) Psi^`` until that diagonal is 1, so that
-``diag(B) = 0`` as the theory assumes; the size of the removed phase is
-reported. ``"refined"`` uses the eq. [10] scaling of the data unchanged,
+complex factor ``1 + O(zeta^2)``, and a fitted shape can carry a phase
+error. For ``"first"`` and ``"improved"`` (with ``normalise=True``, the
+default) each column of ``Psi^`` is rotated (phase only, magnitude kept) until
+the diagonal of ``pinv(Re Psi^) Psi^`` is 1, so that ``diag(B) = 0`` as the
+theory assumes; the removed phase is reported. Exact eq. [10] modes need no
+rotation (to rounding); a phase error ``theta`` of a column would otherwise
+shrink ``Re Psi^`` by ``cos theta`` and mix ``theta Im Psi^`` into it. ``"refined"`` uses the eq. [10] scaling of the data unchanged,
 because its model modes are computed in the same scaling.
 
 Physical coordinates: ``C = pinv(Phi)^T C' pinv(Phi)`` at the measured points,
@@ -68,7 +70,7 @@ from typing import Literal
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import linear_sum_assignment
+from scipy.optimize import linear_sum_assignment, root
 
 from .._validate import as_finite
 from ..exceptions import ConvergenceError, InputError, PhysicsError, ShapeError
@@ -180,7 +182,14 @@ def align_signs(
 def normalise_shapes(
     shapes: NDArray[np.complex128], max_iter: int = 100
 ) -> tuple[NDArray[np.complex128], NDArray[np.float64], int]:
-    """Scale each column so that ``diag(pinv(Re Psi^) Psi^) = 1`` (``alpha_n^(n) = 1``, eq. [13]).
+    """Rotate each column so that ``diag(pinv(Re Psi^) Psi^) = 1`` (``alpha_n^(n) = 1``, eq. [13]).
+
+    ``pinv(Re Psi^) Psi^ = I + i B`` always has a unit real diagonal; the
+    condition ``B_nn = 0`` fixes the phase of each column. Only the phase is
+    changed (the magnitude of ``Psi^`` carries the mass normalisation from the
+    fitted residues); each step rotates column ``n`` by ``-arg(1 + i B_nn)``
+    and recomputes ``Re Psi^``, which converges in a few steps for small
+    damping.
 
     Parameters
     ----------
@@ -200,14 +209,15 @@ def normalise_shapes(
     s: NDArray[np.complex128] = np.array(shapes, dtype=complex)
     total = np.ones(s.shape[1], dtype=complex)
     for it in range(1, max_iter + 1):
-        g = np.diag(np.linalg.pinv(s.real) @ s)
-        s = s / g
-        total = total * g
-        if np.max(np.abs(g - 1)) < 1e-14:
+        g = np.diag(np.linalg.pinv(s.real) @ s)  # 1 + i B_nn
+        u = g / np.abs(g)  # phase only: |Psi^| carries the mass normalisation of the fit
+        s = s / u
+        total = total * u
+        if np.max(np.abs(np.angle(g))) < 1e-14:
             return s, np.asarray(np.angle(total), dtype=float), it
     raise ConvergenceError(
         f"normalise_shapes: diag(pinv(Re Psi^) Psi^) did not converge to 1 in {max_iter} "
-        f"iterations (last deviation {np.max(np.abs(g - 1)):.3g}); the modes are far from "
+        f"iterations (last phase {np.max(np.abs(np.angle(g))):.3g} rad); the modes are far from "
         "the small-damping form"
     )
 
@@ -305,32 +315,84 @@ def _b_matrix(shapes: NDArray[np.complex128]) -> NDArray[np.float64]:
 def _refine(
     p: NDArray[np.complex128], shapes: NDArray[np.complex128], max_iter: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], int]:
-    """Bias-corrected estimator: ``C' = F(data) - (F(model(S)) - S)``, ``S = sym C'``.
+    """Bias-corrected estimator ``C' = F(data) - (F(model(S, w)) - S)``.
 
-    ``F`` is eq. [15]/[16]; ``model(S)`` the exact modes of ``(I, S, diag omega^2)``.
+    ``F`` is eq. [15]/[16] (``B`` and poles to ``C'``); ``model(S, w)`` the exact
+    modes of the modal system ``(I, S, diag w^2)``. ``S`` (symmetric) and ``w``
+    solve ``sym(F(data) - F(model(S, w))) = 0`` and ``|p_model| = |p_data|``,
+    a square system of ``m(m+1)/2 + m`` equations. A fixed-point iteration
+    (whose Jacobian is close to the identity for small damping) is tried first;
+    if it stalls, as it can for close modes with overlapping resonances, the
+    same equations are solved by MINPACK's hybrid method
+    (:func:`scipy.optimize.root`). The returned ``C'`` is
+    ``S + antisym(F(data) - F(model(S, w)))``: exact data give ``S`` itself;
+    inconsistent data keep their asymmetry.
     """
+    m = p.size
+    iu = np.triu_indices(m)
+    n_s = iu[0].size
     w_data = np.abs(p)
     c0 = first_order_damping(_b_matrix(shapes), p, w_data, "first")
-    c = c0
-    w = w_data.copy()
-    for it in range(1, max_iter + 1):
-        s = 0.5 * (c + c.T)
+
+    def model_map(
+        s: NDArray[np.float64], w: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128]]:
         pm, g = modal_system_shapes(s, w)
-        bias = first_order_damping(_b_matrix(g), pm, np.abs(pm), "first") - s
-        c_new = c0 - bias
-        w_new = w_data - (np.abs(pm) - w)
-        dc = float(np.linalg.norm(c_new - c)) / max(float(np.linalg.norm(c_new)), 1e-300)
-        dw = float(np.max(np.abs(w_new - w) / w_new))
-        c, w = c_new, w_new
-        if np.any(w <= 0):
-            break
-        if dc < _REFINE_TOL and dw < _REFINE_TOL:
-            _, g = modal_system_shapes(0.5 * (c + c.T), w)
-            return c, w, g, it
-    raise ConvergenceError(
-        f"refined damping estimate did not converge in {max_iter} iterations; the damping "
-        "is too large or the modes inconsistent: use method='improved' and read the diagnostics"
-    )
+        return first_order_damping(_b_matrix(g), pm, np.abs(pm), "first"), np.abs(pm), g
+
+    def unpack(x: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        s = np.zeros((m, m))
+        s[iu] = x[:n_s]
+        return s + np.triu(s, 1).T, x[n_s:]
+
+    def residual(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        s, w = unpack(x)
+        f_mod, w_mod, _ = model_map(s, w)
+        r = c0 - f_mod
+        return np.concatenate([(0.5 * (r + r.T))[iu], w_data - w_mod])
+
+    scale = np.concatenate([np.full(n_s, max(float(np.max(np.abs(c0))), 1e-300)), w_data])
+    x = np.concatenate([(0.5 * (c0 + c0.T))[iu], w_data])
+    best, best_size = x, np.inf
+    it = 0
+    try:
+        for it in range(1, min(max_iter, 60) + 1):
+            r = residual(x)
+            size = float(np.max(np.abs(r) / scale))
+            if size < best_size:
+                best, best_size = x, size
+            elif it > 3:
+                break  # stalled: at the rounding floor, or diverging
+            if size < 1e-15:
+                break
+            x = x + r
+    except ConvergenceError:
+        pass
+    x = best
+    solved = best_size < _REFINE_TOL
+    if not solved:
+        x0 = np.concatenate([(0.5 * (c0 + c0.T))[iu], w_data])
+        try:
+            sol = root(
+                lambda y: residual(y * scale) / scale,
+                x0 / scale,
+                method="hybr",
+                options={"xtol": 1e-13, "maxfev": 200 * max_iter},
+            )
+        except ConvergenceError:
+            sol = None
+        if sol is None or float(np.max(np.abs(sol.fun))) > 1e3 * _REFINE_TOL:
+            raise ConvergenceError(
+                "refined damping estimate: the bias-correction equations have no solution "
+                "near the first-order estimate (modes too strongly coupled or inconsistent); "
+                "use method='improved' and read the diagnostics"
+            ) from None
+        x = sol.x * scale
+        it += int(sol.nfev)
+    s, w = unpack(x)
+    f_mod, _, g = model_map(s, w)
+    r = c0 - f_mod
+    return s + 0.5 * (r - r.T), w, g, it
 
 
 def modal_damping_from_modes(
