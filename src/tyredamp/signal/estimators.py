@@ -135,6 +135,7 @@ def cross_spectra(
     *,
     step_samples: int | None = None,
     start: int = 0,
+    starts: ArrayLike | None = None,
     window: str | tuple[str, float] | ArrayLike = "hann",
     input_window: ArrayLike | None = None,
     detrend: bool = False,
@@ -157,6 +158,9 @@ def cross_spectra(
         overlap).
     start : int
         First sample used (drops a settling transient).
+    starts : array_like of int, optional
+        Explicit first sample of every segment (overrides ``step_samples``
+        and ``start``), for records made of separate runs.
     window : str, tuple or array_like, shape (segment_samples,)
         Window applied to every channel (name for :func:`segment_window`).
     input_window : array_like, shape (segment_samples,), optional
@@ -189,8 +193,15 @@ def cross_spectra(
     step = seg if step_samples is None else _as_count(step_samples, "step_samples", minimum=1)
     st0 = _as_count(start, "start", minimum=0)
     n = x.shape[1]
-    starts = np.arange(st0, n - seg + 1, step)
-    if starts.size == 0:
+    if starts is None:
+        seg_starts = np.arange(st0, n - seg + 1, step)
+    else:
+        seg_starts = np.asarray(starts)
+        if seg_starts.ndim != 1 or not np.issubdtype(seg_starts.dtype, np.integer):
+            raise InputError("starts: expected a 1-D array of integer sample indices")
+        if seg_starts.size and (seg_starts.min() < 0 or seg_starts.max() > n - seg):
+            raise InputError(f"starts: every segment of {seg} samples must lie in 0..{n}")
+    if seg_starts.size == 0:
         raise InputError(
             f"segment_samples: a segment of {seg} samples from sample {st0} does not fit in "
             f"{n} samples"
@@ -215,8 +226,8 @@ def cross_spectra(
     gyy_full = np.zeros((n_f, n_out, n_out), dtype=complex) if full_output else None
     chunk = max(1, int(_CHUNK_BYTES // (16 * (n_in + n_out) * seg)))
     ar = np.arange(seg)
-    for c in range(0, starts.size, chunk):
-        idx = starts[c : c + chunk, None] + ar  # (k, seg)
+    for c in range(0, seg_starts.size, chunk):
+        idx = seg_starts[c : c + chunk, None] + ar  # (k, seg)
         xs, ys = x[:, idx], y[:, idx]  # (n_ch, k, seg)
         if detrend:
             xs = xs - xs.mean(axis=-1, keepdims=True)
@@ -230,7 +241,7 @@ def cross_spectra(
         if gyy_full is not None:
             gyy_full += yf @ yf.conj().transpose(0, 2, 1)
     # one-sided density scaling (as scipy.signal.csd): 2 / (fs sum w^2 n_avg)
-    scale = np.full(n_f, 2.0 / (fs * float(np.sum(w * w)) * starts.size))
+    scale = np.full(n_f, 2.0 / (fs * float(np.sum(w * w)) * seg_starts.size))
     scale[0] /= 2
     if seg % 2 == 0:
         scale[-1] /= 2
@@ -245,7 +256,7 @@ def cross_spectra(
         Gyx=gyx,
         Gyy=gyy,
         Gyy_full=gyy_full,
-        n_averages=int(starts.size),
+        n_averages=int(seg_starts.size),
         segment_samples=seg,
         sample_rate=fs,
     )
@@ -446,7 +457,10 @@ def estimate_frf(
         Window on all channels: ``"hann"`` for Welch, ``"boxcar"`` otherwise
         (the cyclic method accepts only ``"boxcar"``).
     settle_samples : int, optional
-        Samples dropped at the start; default ``meta["settle_samples"]`` or 0.
+        Samples dropped at the start of the record, or of each run when
+        ``meta["run_starts"]`` lists the first samples of separately driven
+        runs (segments never straddle runs); default
+        ``meta["settle_samples"]`` or 0.
     force_window_samples : int, optional
         Transient method: flat length of the force window on the inputs (with
         a taper of a tenth of it).
@@ -455,7 +469,8 @@ def estimate_frf(
         its time constant goes to ``meta["exponential_tau_s"]`` (it adds
         ``1/tau`` to every modal decay rate).
     band : (float, float), optional
-        Keep only lines with ``band[0] <= f <= band[1]`` (Hz).
+        Keep only lines with ``band[0] <= f <= band[1]`` (Hz); default
+        ``meta["band_hz"]`` when given, else all excited lines.
     min_relative_power : float
         Lines where an input's auto spectrum is below this fraction of its
         maximum are not excited and are left out (for a multisine, every line
@@ -540,10 +555,6 @@ def estimate_frf(
             )
         if overlap not in (None, 0, 0.0):
             raise InputError(f"overlap: the cyclic method uses whole periods, got {overlap!r}")
-        if n - settle < seg:
-            raise InputError(
-                f"period_samples: {n - settle} samples after settling hold no whole period of {seg}"
-            )
         win: str | tuple[str, float] = "boxcar"
         step, detrend, ov = seg, False, 0.0
     elif method == "welch":
@@ -575,8 +586,12 @@ def estimate_frf(
             ew, tau = exponential_window(seg, fs, exponential_end)
             window_arg = segment_window(win, seg) * ew
             info["exponential_tau_s"] = tau
-    if settle >= n:
-        raise InputError(f"settle_samples: expected fewer than {n} samples, got {settle}")
+    seg_starts = _segment_starts(meta, n, seg, step, settle)
+    if seg_starts.size == 0:
+        raise InputError(
+            f"timedata: no whole segment of {seg} samples ({method} method) in {n} samples "
+            f"after dropping {settle} settle samples"
+        )
     if window_arg is None:
         window_arg = win
     mimo_h2 = estimator == "H2" and len(ref_idx) > 1
@@ -585,13 +600,14 @@ def estimate_frf(
         y,
         fs,
         seg,
-        step_samples=step,
-        start=settle,
+        starts=seg_starts,
         window=window_arg,
         input_window=input_window,
         detrend=detrend,
         full_output=mimo_h2,
     )
+    if band is None and "band_hz" in meta:
+        band = (float(meta["band_hz"][0]), float(meta["band_hz"][1]))
     lines = _excited_lines(spectra, min_relative_power)
     if band is not None:
         lo, hi = float(band[0]), float(band[1])
@@ -630,6 +646,27 @@ def estimate_frf(
         coherence=coh,
         meta=meta_out,
     )
+
+
+def _segment_starts(
+    meta: dict[str, Any], n: int, seg: int, step: int, settle: int
+) -> NDArray[np.intp]:
+    """First samples of the segments: within each run (``meta["run_starts"]``), after settling."""
+    runs = meta.get("run_starts", [0])
+    try:
+        r = np.asarray(runs, dtype=np.int64).ravel()
+    except (TypeError, ValueError):
+        raise InputError(
+            f"timedata.meta['run_starts']: expected sample indices, got {runs!r}"
+        ) from None
+    if r.size == 0 or r[0] != 0 or np.any(np.diff(r) <= 0) or r[-1] >= n:
+        raise InputError(
+            "timedata.meta['run_starts']: expected increasing sample indices from 0 below "
+            f"{n}, got {runs!r}"
+        )
+    stops = np.append(r[1:], n)
+    out = [np.arange(a + settle, b - seg + 1, step) for a, b in zip(r, stops, strict=True)]
+    return np.concatenate(out).astype(np.intp)
 
 
 def _excited_lines(spectra: CrossSpectra, min_relative_power: float) -> NDArray[np.intp]:

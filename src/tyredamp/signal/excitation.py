@@ -4,7 +4,7 @@ Every generator is a function of the sample rate, the length (period or
 record), the frequency band, the RMS force and (for random signals) a random
 generator, and returns an :class:`Excitation`: the force history in N and the
 metadata the FRF estimators use (``period_samples`` for periodic signals,
-``record_samples`` for burst random), so that
+``record_samples`` for burst random, ``band_hz``), so that
 ``TimeData(..., meta=excitation.meta())`` selects the right estimation method.
 
 Signals
@@ -82,7 +82,7 @@ class Excitation:
 
     def meta(self) -> dict[str, Any]:
         """Metadata for :class:`~tyredamp.timedata.TimeData` (estimator hints)."""
-        out: dict[str, Any] = {"excitation": self.name}
+        out: dict[str, Any] = {"excitation": self.name, "band_hz": list(self.band)}
         if self.period_samples is not None:
             out["period_samples"] = self.period_samples
         if self.record_samples is not None:
