@@ -55,6 +55,12 @@ class ModalModel:
         ``"psi_out"`` (n_out, m) real magnitude of the complex standard error.
     meta : dict, optional
         Fit information (band, model order, rmsd, ...).
+    residual_modes : ModalModel, optional
+        Modes outside the analysis band that the fit used as residual terms
+        (for example the tail of a mode just above the band). They are not
+        modes of this model (``n_modes``, ``poles`` and the shapes exclude
+        them) but :meth:`receptance` adds their contribution, so the model
+        reproduces the fitted FRFs. Same outputs and inputs.
     """
 
     poles: NDArray[np.complex128]
@@ -67,6 +73,7 @@ class ModalModel:
     upper_residual: NDArray[np.complex128] | None = None
     std: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
+    residual_modes: ModalModel | None = None
 
     def __init__(
         self,
@@ -80,6 +87,7 @@ class ModalModel:
         upper_residual: ArrayLike | None = None,
         std: dict[str, ArrayLike] | None = None,
         meta: dict[str, Any] | None = None,
+        residual_modes: ModalModel | None = None,
     ) -> None:
         p = as_finite(poles, "poles", ndim=1, dtype=complex, allow_empty=True)
         po = as_finite(psi_out, "psi_out", ndim=2, dtype=complex, allow_empty=True)
@@ -132,6 +140,19 @@ class ModalModel:
         object.__setattr__(self, "upper_residual", res[1])
         object.__setattr__(self, "std", stds)
         object.__setattr__(self, "meta", dict(meta or {}))
+        if residual_modes is not None:
+            if not isinstance(residual_modes, ModalModel):
+                raise InputError(
+                    f"residual_modes: expected a ModalModel, got {type(residual_modes).__name__}"
+                )
+            if residual_modes.psi_out.shape[0] != po.shape[0] or (
+                residual_modes.psi_in.shape[0] != pi.shape[0]
+            ):
+                raise ShapeError(
+                    "residual_modes: expected the same outputs and inputs as the model, got "
+                    f"{residual_modes.psi_out.shape[0]} and {residual_modes.psi_in.shape[0]}"
+                )
+        object.__setattr__(self, "residual_modes", residual_modes)
 
     @classmethod
     def from_real_modes(
@@ -208,6 +229,8 @@ class ModalModel:
         """Receptance matrix (eq. [10] plus residuals), shape (n_out, n_in, n_freq)."""
         f = as_frequency(frequency)
         h = modal_sum_receptance(f, self.poles, self.psi_out, self.psi_in)
+        if self.residual_modes is not None:
+            h = h + self.residual_modes.receptance(f)
         if self.upper_residual is not None:
             h = h + self.upper_residual[:, :, None]
         if self.lower_residual is not None:
@@ -246,7 +269,11 @@ class ModalModel:
                                 "shape": [per output] (optional)}}, ...],
              "lower_residual": [[[re, im] per input] per output] | null,
              "upper_residual": ... | null,
-             "meta": {...}}
+             "meta": {...},
+             "residual_modes": {same layout, without residuals} | null}
+
+        ``residual_modes`` (out-of-band modes used as residual terms) is
+        optional: readers that ignore it still get every in-band mode.
         """
 
         def c2(z: Any) -> Any:
@@ -279,6 +306,9 @@ class ModalModel:
             "lower_residual": None if self.lower_residual is None else c2(self.lower_residual),
             "upper_residual": None if self.upper_residual is None else c2(self.upper_residual),
             "meta": _jsonable(self.meta),
+            "residual_modes": None
+            if self.residual_modes is None
+            else self.residual_modes.to_dict(),
         }
 
     @classmethod
@@ -311,6 +341,7 @@ class ModalModel:
                 std["psi_out"] = np.array([md["std"]["shape"] for md in modes], float).T
             lr = d.get("lower_residual")
             ur = d.get("upper_residual")
+            rm = d.get("residual_modes")
             return cls(
                 poles,
                 po,
@@ -322,6 +353,7 @@ class ModalModel:
                 upper_residual=None if ur is None else cz(ur),
                 std=std,
                 meta=d.get("meta", {}),
+                residual_modes=None if rm is None else cls.from_dict(rm),
             )
         except KeyError as exc:
             raise InputError(f"modal model: missing key {exc.args[0]!r}") from None
