@@ -37,10 +37,12 @@ def cli(ctx: click.Context, debug: bool) -> None:
 def _register() -> None:
     """Attach the subcommands; each subcommand module adds its lines here."""
     from .check import check_group
+    from .damping import damping_command
     from .frf import frf_command
 
     cli.add_command(frf_command)
     cli.add_command(check_group)
+    cli.add_command(damping_command)
 
 
 _register()

@@ -220,14 +220,21 @@ def findings(
             out.append(
                 f"C' is {pct:.2g} % asymmetric: noticeable, from noise on the imaginary "
                 "parts of the shapes or from damping coupling to modes outside the "
-                "identified set; treat the off-diagonal terms with care."
+                "identified set (leakage). The antisymmetric part is error (damping is "
+                "reciprocal), so use the symmetric part (modal_symmetric), which is never "
+                "further from the truth."
             )
         else:
+            cause = (
+                "strong leakage from damping coupling to modes outside the identified set "
+                "(truncation), shapes and poles that do not belong together (modes out of "
+                "order, a spurious or missing mode, wrong scaling), or damping too large "
+                "for the small-damping theory"
+            )
             out.append(
-                f"C' is strongly asymmetric ({pct:.2g} %): the shapes and poles are probably "
-                "mismatched (modes out of order, a spurious or missing mode, wrong scaling) "
-                "or the damping is too large for the small-damping theory. Check the modal "
-                "fit before using this matrix."
+                f"C' is strongly asymmetric ({pct:.2g} %). Possible causes: {cause}. Check "
+                "the modal fit before using this matrix; if the modes are right, use the "
+                "symmetric part (modal_symmetric), which is never further from the truth."
             )
     # --- definiteness
     lo, hi = float(d.eigenvalues_modal[0]), float(d.eigenvalues_modal[-1])

@@ -52,8 +52,9 @@ default) each column of ``Psi^`` is rotated (phase only, magnitude kept) until
 the diagonal of ``pinv(Re Psi^) Psi^`` is 1, so that ``diag(B) = 0`` as the
 theory assumes; the removed phase is reported. Exact eq. [10] modes need no
 rotation (to rounding); a phase error ``theta`` of a column would otherwise
-shrink ``Re Psi^`` by ``cos theta`` and mix ``theta Im Psi^`` into it. ``"refined"`` uses the eq. [10] scaling of the data unchanged,
-because its model modes are computed in the same scaling.
+shrink ``Re Psi^`` by ``cos theta`` and mix ``theta Im Psi^`` into it.
+``"refined"`` uses the eq. [10] scaling of the data unchanged, because its
+model modes are computed in the same scaling.
 
 Physical coordinates: ``C = pinv(Phi)^T C' pinv(Phi)`` at the measured points,
 with ``Phi = U`` (first, improved) or the real part of ``Psi^ G^-1`` where ``G``

@@ -12,7 +12,9 @@ shapes in 1/sqrt(kg))::
                "poles": [[re, im] x m]},            # rad/s
      "points": [{"node", "direction", "angle_deg", "name"} x N],
      "modal": [[m] x m],          # C' (1/s), eq. [14], not symmetrised
+     "modal_symmetric": [[m] x m],     # (C' + C'^T) / 2
      "physical": [[N] x N],       # C (N s/m) at the points
+     "physical_symmetric": [[N] x N],  # (C + C^T) / 2
      "mass": [[N] x N],           # reduced M (kg), rank m
      "stiffness": [[N] x N],      # reduced K (N/m), rank m
      "basis": [[m] x N],          # real mass-normalised shapes Phi (1/sqrt(kg))
@@ -118,6 +120,23 @@ class DampingModel:
         return int(self.physical.shape[0])
 
     @property
+    def modal_symmetric(self) -> NDArray[np.float64]:
+        """``(C' + C'^T) / 2``, 1/s, shape (m, m).
+
+        The true ``C'`` is symmetric, and the symmetric matrices form a
+        subspace on which this is the orthogonal (Frobenius) projection, so
+        the symmetric part is never further from the truth than ``C'``; the
+        antisymmetric part is pure error (noise, and leakage from modes outside
+        the identified set, which enters mostly antisymmetrically).
+        """
+        return 0.5 * (self.modal + self.modal.T)
+
+    @property
+    def physical_symmetric(self) -> NDArray[np.float64]:
+        """``(C + C^T) / 2 = pinv(Phi)^T sym(C') pinv(Phi)``, N s/m, shape (N, N)."""
+        return 0.5 * (self.physical + self.physical.T)
+
+    @property
     def omega_n(self) -> NDArray[np.float64]:
         """Undamped natural frequencies of the modal coordinates, rad/s."""
         return 2 * np.pi * self.frequency_hz
@@ -126,7 +145,8 @@ class DampingModel:
         """The reduced model at the points as an :class:`MCKSystem`.
 
         Only possible for a complete modal set (``m == N``); the damping is
-        symmetrised (the asymmetry is in ``diagnostics.symmetry_physical``).
+        :attr:`physical_symmetric` (the asymmetry is in
+        ``diagnostics.symmetry_physical``).
 
         Raises
         ------
@@ -170,7 +190,9 @@ class DampingModel:
                 for c in self.points
             ],
             "modal": self.modal.tolist(),
+            "modal_symmetric": self.modal_symmetric.tolist(),
             "physical": self.physical.tolist(),
+            "physical_symmetric": self.physical_symmetric.tolist(),
             "mass": self.mass.tolist(),
             "stiffness": self.stiffness.tolist(),
             "basis": self.basis.tolist(),

@@ -1,0 +1,172 @@
+"""``tyredamp damping``: the damping matrix from identified complex modes (spec step 7).
+
+Reads a modes JSON file (``{"kind": "modes", "models": {"complex": {...},
+"real": {...}}}``, each model in the layout of
+:meth:`tyredamp.modal.ModalModel.to_dict`), identifies the damping with
+:func:`tyredamp.damping.identify_damping` and writes a damping JSON file.
+
+Damping JSON schema (``"kind": "damping"``, ``"version": 1``; full
+description in ``docs/damping-json.md``)::
+
+    {"kind": "damping", "version": 1,
+     "method": "first" | "improved" | "refined", "normalised": bool,
+     "modes": {"frequency_hz": [m], "damping_ratio": [m], "poles": [[re, im]] x m},
+     "points": [{"node", "direction", "angle_deg", "name"}] x N,
+     "modal": m x m (C', 1/s), "modal_symmetric": m x m,
+     "physical": N x N (C, N s/m), "physical_symmetric": N x N,
+     "mass": N x N (kg), "stiffness": N x N (N/m), "basis": N x m (1/sqrt(kg)),
+     "lancaster_physical": N x N | null,
+     "std": {"modal": m x m, "physical": N x N} | {},
+     "uncertainty": {"method": "monte_carlo", "n_samples", "n_failed", "seed"} | {},
+     "diagnostics": {...}, "proportional": {...}, "findings": [str],
+     "meta": {"source": path, "model": "complex" | "real", ...}}
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from ..damping import METHODS, DampingModel, identify_damping
+from ..exceptions import FileFormatError, InputError, TyredampError
+from ..io._atomic import atomic_path
+from ..io._common import check_input_file
+from ..modal.model import ModalModel
+
+__all__ = ["damping_command", "damping_summary", "read_modes_file"]
+
+
+def read_modes_file(path: Path) -> dict[str, ModalModel]:
+    """The modal models of a modes JSON file, by name ("complex", "real", ...).
+
+    Raises
+    ------
+    FileFormatError
+        Not JSON, not ``"kind": "modes"``, or a model that does not parse.
+    """
+    p = check_input_file(path)
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise FileFormatError(f"{p}: not a JSON file ({exc})") from None
+    if not isinstance(doc, dict) or doc.get("kind") != "modes":
+        got = doc.get("kind") if isinstance(doc, dict) else type(doc).__name__
+        raise FileFormatError(f'{p}: expected a modes file ("kind": "modes"), got {got!r}')
+    models = doc.get("models")
+    if not isinstance(models, dict) or not models:
+        raise FileFormatError(f'{p}: expected a non-empty "models" object')
+    out: dict[str, ModalModel] = {}
+    for name, d in models.items():
+        if not isinstance(d, dict):
+            raise FileFormatError(f"{p}: model {name!r} is not an object")
+        try:
+            out[str(name)] = ModalModel.from_dict(d)
+        except TyredampError as exc:
+            raise FileFormatError(f"{p}: model {name!r}: {exc}") from None
+    return out
+
+
+def damping_summary(dm: DampingModel) -> list[str]:
+    """Text summary: size, C' diagonal and largest coupling, diagnostics, findings."""
+    d = dm.diagnostics
+    cp = dm.modal
+    off = cp - np.diag(np.diag(cp))
+    k, n = np.unravel_index(int(np.argmax(np.abs(off))), off.shape) if dm.n_modes > 1 else (0, 0)
+    rows = [
+        f"damping ({dm.method}): {dm.n_modes} modes at {dm.n_points} points",
+        "modes [Hz]: " + ", ".join(f"{f:.2f}" for f in dm.frequency_hz),
+        "C'_nn [1/s]: " + ", ".join(f"{c:.4g}" for c in np.diag(cp)),
+    ]
+    if dm.n_modes > 1:
+        rows.append(
+            f"largest coupling C'[{k + 1},{n + 1}] = {cp[k, n]:.4g} 1/s; "
+            f"asymmetry {100 * d.symmetry_modal:.2g} %, C' {d.definiteness_modal}"
+        )
+    rows += [f"- {s}" for s in dm.findings]
+    return rows
+
+
+@click.command("damping")
+@click.argument("modes_json", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--out",
+    "-o",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Damping JSON file to write.",
+)
+@click.option(
+    "--method",
+    type=click.Choice(METHODS),
+    default="improved",
+    show_default=True,
+    help="first: eq. [16]; improved: eq. [18]; refined: bias-corrected (exact for "
+    "consistent modes).",
+)
+@click.option(
+    "--model",
+    "model_name",
+    default="complex",
+    show_default=True,
+    help="Which model of the modes file to use (complex modes carry the coupling).",
+)
+@click.option(
+    "--samples",
+    type=click.IntRange(min=0),
+    default=200,
+    show_default=True,
+    help="Monte Carlo samples for the standard errors (0 to skip).",
+)
+@click.option("--seed", type=int, default=0, show_default=True, help="Monte Carlo seed.")
+@click.option(
+    "--no-normalise",
+    is_flag=True,
+    help="Skip the alpha_n^(n) = 1 phase normalisation of the complex shapes.",
+)
+def damping_command(
+    modes_json: Path,
+    out: Path,
+    method: str,
+    model_name: str,
+    samples: int,
+    seed: int,
+    no_normalise: bool,
+) -> None:
+    """Identify the viscous damping matrix from the complex modes in MODES_JSON.
+
+    Writes C' (modal coordinates) and C, M, K at the measured points, the
+    point labels, diagnostics (symmetry, definiteness, truncation), the best
+    proportional models, Monte Carlo standard errors and plain-English
+    findings to --out (JSON, schema in docs/damping-json.md). A summary is
+    printed. Nothing is written when an error occurs.
+
+    \b
+    Example:
+      tyredamp damping tyre_modes.json --out tyre_damping.json
+      tyredamp damping tyre_modes.json -o damping.json --method refined --samples 500
+    """
+    if out.resolve() == modes_json.resolve():
+        raise InputError(f"--out: {out} is the input file; choose another name")
+    models = read_modes_file(modes_json)
+    if model_name not in models:
+        raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")
+    meta: dict[str, Any] = {"source": str(modes_json), "model": model_name}
+    dm = identify_damping(
+        models[model_name],
+        method,  # type: ignore[arg-type]
+        normalise=not no_normalise,
+        n_samples=samples,
+        seed=seed,
+        meta=meta,
+    )
+    text = json.dumps(dm.to_dict(), indent=1, allow_nan=True)
+    with atomic_path(out) as tmp:
+        tmp.write_text(text + "\n", encoding="utf-8")
+    for row in damping_summary(dm):
+        click.echo(row)
+    click.echo(f"wrote {out}")
