@@ -1,0 +1,40 @@
+"""Virtual tyres: the in-plane ring tyre and the virtual modal test rig."""
+
+from __future__ import annotations
+
+from .excitation import chirp_lines, hadamard_drive_matrix, periodic_chirp
+from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
+from .ring import (
+    RingConvergence,
+    RingTyre,
+    analytic_ring_frequencies,
+    difference_symbol,
+    ring_convergence,
+    ring_dispersion,
+    staggered_weights,
+    wave_numbers,
+)
+from .rig import VirtualModalTest, periodic_initial_state, run_modal_test
+from .truth import TyreTruth, modal_phase_collinearity
+
+__all__ = [
+    "Imperfection",
+    "MeasurementLayout",
+    "RingConvergence",
+    "RingTyre",
+    "RingTyreParameters",
+    "TyreTruth",
+    "VirtualModalTest",
+    "analytic_ring_frequencies",
+    "chirp_lines",
+    "difference_symbol",
+    "hadamard_drive_matrix",
+    "modal_phase_collinearity",
+    "periodic_chirp",
+    "periodic_initial_state",
+    "ring_convergence",
+    "ring_dispersion",
+    "run_modal_test",
+    "staggered_weights",
+    "wave_numbers",
+]
