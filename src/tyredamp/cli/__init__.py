@@ -39,10 +39,12 @@ def _register() -> None:
     from .check import check_group
     from .damping import damping_command
     from .frf import frf_command
+    from .lateral import lateral_group
 
     cli.add_command(frf_command)
     cli.add_command(check_group)
     cli.add_command(damping_command)
+    cli.add_command(lateral_group)
 
 
 _register()

@@ -1,0 +1,113 @@
+"""Lateral tyre dynamics of paper 001 (spec ``lateral-models.md``).
+
+* :mod:`.models` -- the linear models (classic, Maxwell, visco-plastic,
+  proposed hysteretic, relaxation length, stretched string) with receptance,
+  mobility and accelerance at the ground or axle force.
+* :mod:`.fiala` -- steady-state Fiala/brush force and its non-linear damper form.
+* :mod:`.characteristics` -- corner frequency and the dB differences of
+  eq. 38-40, Figure 7 data.
+* :mod:`.fit` -- weighted complex least-squares fits, standard errors, Table 1
+  figure, AIC/BIC ranking, joint fits across speeds.
+* :mod:`.vehicle` -- the single-degree-of-freedom vehicle (eq. 41-44).
+* :mod:`.timedomain` -- exact harmonic/periodic steady states, impulse
+  response and non-causal precursor, causal generalised-Maxwell approximation
+  and exact state-space transients.
+* :mod:`.rig` -- the virtual rolling-tyre rig.
+"""
+
+from __future__ import annotations
+
+from .characteristics import (
+    CornerDifferences,
+    Figure7Curves,
+    corner_differences,
+    corner_frequency,
+    delta_ar_asymptote,
+    delta_ar_maxwell,
+    figure7_curves,
+)
+from .fiala import FialaTyre
+from .fit import (
+    DEFAULT_MODELS,
+    JointFit,
+    LateralData,
+    LateralFit,
+    Ranking,
+    fit_joint,
+    fit_model,
+    rank_models,
+)
+from .models import (
+    MODELS,
+    ClassicModel,
+    HystereticModel,
+    LateralModel,
+    MaxwellModel,
+    RelaxationLengthModel,
+    StretchedStringModel,
+    ViscoPlasticModel,
+    attach_mass,
+    axle_from_ground_accelerance,
+    get_model_class,
+    ground_from_axle_accelerance,
+)
+from .rig import AgriculturalTyre, VirtualLateralRig, ViscoelasticStringTyre
+from .timedomain import (
+    CausalError,
+    GeneralizedMaxwellTyre,
+    causal_error,
+    fit_generalized_maxwell,
+    harmonic_response,
+    impulse_response,
+    periodic_response,
+    precursor,
+    state_space,
+    transient_response,
+)
+from .vehicle import LateralVehicle, Resonance
+
+__all__ = [
+    "DEFAULT_MODELS",
+    "MODELS",
+    "AgriculturalTyre",
+    "CausalError",
+    "ClassicModel",
+    "CornerDifferences",
+    "FialaTyre",
+    "Figure7Curves",
+    "GeneralizedMaxwellTyre",
+    "HystereticModel",
+    "JointFit",
+    "LateralData",
+    "LateralFit",
+    "LateralModel",
+    "LateralVehicle",
+    "MaxwellModel",
+    "Ranking",
+    "RelaxationLengthModel",
+    "Resonance",
+    "StretchedStringModel",
+    "VirtualLateralRig",
+    "ViscoPlasticModel",
+    "ViscoelasticStringTyre",
+    "attach_mass",
+    "axle_from_ground_accelerance",
+    "causal_error",
+    "corner_differences",
+    "corner_frequency",
+    "delta_ar_asymptote",
+    "delta_ar_maxwell",
+    "figure7_curves",
+    "fit_generalized_maxwell",
+    "fit_joint",
+    "fit_model",
+    "get_model_class",
+    "ground_from_axle_accelerance",
+    "harmonic_response",
+    "impulse_response",
+    "periodic_response",
+    "precursor",
+    "rank_models",
+    "state_space",
+    "transient_response",
+]

@@ -1,0 +1,1022 @@
+"""Fitting the lateral models to a measured complex lateral FRF, and ranking them.
+
+One function fits any model of :mod:`tyredamp.lateral.models` to the
+accelerance ``y''/Fy`` measured at the ground force or at the axle force
+(paper: "best fit to the measured complex frequency response function").
+
+Method
+------
+* Data: a 1x1 :class:`~tyredamp.frf.FRF` (any kind; converted to
+  accelerance; the 0 Hz line is dropped), optionally limited to a band.
+* Residual on the complex values, stacked as real and imaginary parts:
+  ``r_k = w_k (A_model(f_k) - A_meas(f_k))``. Weights ``w_k``:
+  ``"relative"`` ``1/|A_meas|`` (each line counts by its relative error);
+  ``"coherence"`` ``1/(|A_meas| sqrt((1 - g^2)/g^2))``, the inverse of the
+  standard deviation of an FRF estimate with coherence ``g^2`` (up to the
+  number of averages); ``"uniform"`` ``1/rms|A_meas|``; ``"auto"`` is
+  ``"coherence"`` when the FRF carries coherence, else ``"relative"``; or
+  an array per frequency line of the FRF.
+* Parameters are fitted as logarithms (so they stay positive) with
+  :func:`scipy.optimize.least_squares` (trust-region reflective, bounded to
+  ``e^{+-20}`` around the start). Starting values come from each model's
+  ``initial_guesses`` (linear regressions on the asymptotes, e.g.
+  ``Re Y = 1/K``-like and ``Im Y ~ -1/(omega C_r)``), spread by a coarse grid
+  of factors 1/3, 1, 3 per parameter; the three cheapest starts are refined
+  and the best result is kept.
+* Standard errors: ``cov(log p) = s^2 (J^T J)^-1`` with ``J`` the Jacobian of
+  the weighted residuals in log-parameters (central differences) and
+  ``s^2 = RSS/(2N - P)``; ``SE(p) = p SE(log p)`` (delta method).
+* Paper Table 1 figure, defined here precisely: the **amplitude error**
+  ``mean_k | |A_model| - |A_meas| | / |A_meas|`` over the fitted lines, and the
+  signed **amplitude bias** ``mean_k (|A_model| - |A_meas|) / |A_meas|``
+  (positive: the model over-estimates, as the paper's signs). Both are
+  fractions (x 100 for %), unweighted.
+* Information criteria on the complex residuals: ``n = 2N`` real residuals,
+  Gaussian log-likelihood with the ML variance ``RSS/n``,
+  ``AIC = n ln(RSS/n) + 2 (P + 1)``, ``BIC = n ln(RSS/n) + (P + 1) ln n``
+  (the ``+1`` counts the noise variance; constants common to all models on
+  the same data and weights are dropped). Lower is better; differences
+  are meaningful only between fits to the same lines with the same weights.
+
+Several speeds (and one pressure) can be fitted together with shared
+physical parameters (:func:`fit_joint`): the tyre-road damper of each model
+(``c`` Maxwell, ``c2`` visco-plastic, ``C_r`` proposed) becomes
+``C_alpha / V`` with one cornering stiffness ``C_alpha``, and every other
+parameter (carcass ``K``, ``h`` ...) is shared.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import least_squares
+
+from .._validate import as_finite, check_positive
+from ..exceptions import ConvergenceError, InputError, ShapeError
+from ..frf import FRF
+from .models import (
+    ForceKind,
+    LateralModel,
+    _check_force,
+    get_model_class,
+    ground_from_axle_accelerance,
+)
+
+__all__ = [
+    "DEFAULT_MODELS",
+    "JointFit",
+    "LateralData",
+    "LateralFit",
+    "Ranking",
+    "fit_joint",
+    "fit_model",
+    "rank_models",
+]
+
+FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
+Criterion = Literal["bic", "aic"]
+Weights = Literal["auto", "relative", "coherence", "uniform"]
+
+#: The four spring-damper models compared in the paper.
+DEFAULT_MODELS: tuple[str, ...] = ("classic", "maxwell", "viscoplastic", "hysteretic")
+_LOG_SPAN = 20.0
+_GRID = (1.0 / 3.0, 1.0, 3.0)
+
+
+# ------------------------------------------------------------------------------------- data
+@dataclass(frozen=True)
+class LateralData:
+    """A measured lateral FRF with its operating conditions.
+
+    Parameters
+    ----------
+    frf : FRF
+        1x1 FRF of lateral acceleration (or displacement/velocity) per
+        lateral force, any kind.
+    speed : float, optional
+        Travel speed ``V`` in m/s (> 0); needed by the relaxation-length and
+        string models and by :func:`fit_joint`.
+    force : {"ground", "axle"}
+        Whether the force is the ground (contact-patch) force or the force
+        at the wheel axle.
+    wheel_mass : float
+        Wheel mass between axle force transducer and tyre, kg (>= 0); used
+        when ``force="axle"``.
+    label : str
+        Free label (for example ``"1.7 bar, 5 km/h"``).
+    """
+
+    frf: FRF
+    speed: float | None = None
+    force: ForceKind = "ground"
+    wheel_mass: float = 0.0
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.frf, FRF):
+            raise InputError(f"frf: expected an FRF, got {type(self.frf).__name__}")
+        if self.speed is not None:
+            object.__setattr__(self, "speed", check_positive(self.speed, "speed"))
+        _check_force(self.force)
+        object.__setattr__(
+            self, "wheel_mass", check_positive(self.wheel_mass, "wheel_mass", allow_zero=True)
+        )
+
+    @classmethod
+    def from_frf(
+        cls,
+        frf: FRF,
+        *,
+        speed: float | None = None,
+        force: ForceKind | None = None,
+        wheel_mass: float | None = None,
+        label: str | None = None,
+    ) -> LateralData:
+        """Build from an FRF, taking missing conditions from ``frf.meta``.
+
+        Meta keys read: ``"speed_m_s"``, ``"force"``, ``"wheel_mass_kg"``,
+        ``"label"`` (as written by :mod:`tyredamp.lateral.rig`).
+        """
+        meta = frf.meta
+        sp = speed if speed is not None else meta.get("speed_m_s")
+        fo = force if force is not None else meta.get("force", "ground")
+        wm = wheel_mass if wheel_mass is not None else meta.get("wheel_mass_kg", 0.0)
+        lb = label if label is not None else str(meta.get("label", ""))
+        return cls(
+            frf=frf,
+            speed=None if sp is None else float(sp),
+            force=fo,
+            wheel_mass=float(wm),
+            label=lb,
+        )
+
+
+@dataclass(frozen=True)
+class _Prepared:
+    data: LateralData
+    frequency: FloatArray
+    omega: FloatArray
+    measured: ComplexArray  # accelerance at the data's force
+    weights: FloatArray
+    weights_name: str
+    ground_receptance: ComplexArray  # for starting values
+
+
+def _prepare(
+    data: LateralData | FRF,
+    band: tuple[float, float] | None,
+    weights: Weights | ArrayLike,
+    channel: tuple[int, int] = (0, 0),
+) -> _Prepared:
+    d = data if isinstance(data, LateralData) else LateralData.from_frf(data)
+    frf = d.frf
+    i, j = channel
+    if not (0 <= i < frf.n_out and 0 <= j < frf.n_in):
+        raise ShapeError(
+            f"channel: expected (out, in) within {frf.n_out}x{frf.n_in}, got {channel}"
+        )
+    user_w: FloatArray | None = None
+    if not isinstance(weights, str):
+        user_w = as_finite(weights, "weights", ndim=1)
+        if user_w.size != frf.n_freq:
+            raise ShapeError(
+                f"weights: expected {frf.n_freq} values (one per line), got {user_w.size}"
+            )
+        if np.any(user_w < 0):
+            raise InputError("weights: expected values >= 0")
+    keep = np.ones(frf.n_freq, dtype=bool)
+    if band is not None:
+        lo, hi = float(band[0]), float(band[1])
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
+            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band}")
+        keep &= (frf.frequency >= lo) & (frf.frequency <= hi)
+    keep &= frf.frequency > 0
+    idx = np.flatnonzero(keep)
+    sub = frf.select(outputs=[i], inputs=[j]).select_lines(idx) if idx.size else None
+    if sub is None or sub.n_freq < 4:
+        raise InputError(f"frf: expected at least 4 lines above 0 Hz in the band, got {idx.size}")
+    acc = sub.to("accelerance").H[0, 0]
+    f = sub.frequency
+    w = 2.0 * np.pi * f
+    mag = np.abs(acc)
+    if np.any(mag == 0):
+        raise InputError("frf: some lines are exactly 0; drop them (relative weights undefined)")
+    if user_w is not None:
+        wts = user_w[idx]
+        wname = "user"
+    else:
+        mode = weights
+        if mode == "auto":
+            mode = "coherence" if sub.coherence is not None else "relative"
+        if mode == "relative":
+            wts = 1.0 / mag
+        elif mode == "uniform":
+            wts = np.full(f.size, 1.0 / float(np.sqrt(np.mean(mag**2))))
+        elif mode == "coherence":
+            if sub.coherence is None:
+                raise InputError("weights: 'coherence' needs an FRF with coherence")
+            g2 = np.clip(sub.coherence[0], 1e-6, 1.0 - 1e-9)
+            wts = 1.0 / (mag * np.sqrt((1.0 - g2) / g2))
+        else:
+            raise InputError(
+                f"weights: expected 'auto', 'relative', 'coherence', 'uniform' or an array, "
+                f"got {weights!r}"
+            )
+        wname = str(mode)
+    if np.count_nonzero(wts) < 4:
+        raise InputError("weights: expected at least 4 lines with non-zero weight")
+    a_g = ground_from_axle_accelerance(acc, d.wheel_mass) if d.force == "axle" else acc
+    rec_g = a_g / (-(w**2))
+    return _Prepared(d, f, w, acc, np.asarray(wts, dtype=float), wname, rec_g)
+
+
+# --------------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class LateralFit:
+    """Result of fitting one lateral model to one FRF.
+
+    Attributes
+    ----------
+    model : LateralModel
+        The fitted model.
+    params, stderr : dict of str to float
+        Parameters and their standard errors, SI units (``model.param_units``).
+    correlation : ndarray, shape (P, P)
+        Correlation of the log-parameters.
+    frequency : ndarray, shape (N,)
+        Lines used, Hz.
+    measured, fitted : ndarray, complex, shape (N,)
+        Accelerance at the data's force (ground or axle), m/(s^2 N).
+    weights : ndarray, shape (N,)
+        Weights used.
+    weights_name : str
+        How the weights were chosen.
+    force : {"ground", "axle"}
+    wheel_mass : float
+        kg.
+    speed : float or None
+        m/s.
+    rss : float
+        Weighted residual sum of squares (real and imaginary parts).
+    aic, bic : float
+        Information criteria (module docstring).
+    amplitude_error, amplitude_bias : float
+        Paper Table 1 figure (mean absolute and signed relative amplitude
+        error, fractions; module docstring).
+    nfev : int
+        Residual evaluations in the final refinement.
+    message : str
+        Optimizer message.
+    label : str
+        Data label.
+    """
+
+    model: LateralModel
+    params: dict[str, float]
+    stderr: dict[str, float]
+    correlation: FloatArray
+    frequency: FloatArray
+    measured: ComplexArray
+    fitted: ComplexArray
+    weights: FloatArray
+    weights_name: str
+    force: ForceKind
+    wheel_mass: float
+    speed: float | None
+    rss: float
+    aic: float
+    bic: float
+    amplitude_error: float
+    amplitude_bias: float
+    nfev: int
+    message: str
+    label: str = ""
+
+    @property
+    def name(self) -> str:
+        """Registry name of the model."""
+        return self.model.name
+
+    @property
+    def n_lines(self) -> int:
+        """Number of complex lines fitted."""
+        return int(self.frequency.size)
+
+    @property
+    def n_params(self) -> int:
+        """Number of fitted parameters."""
+        return len(self.params)
+
+    @property
+    def residual_rms(self) -> float:
+        """``sqrt(RSS / 2N)``: rms weighted residual (relative error for relative weights)."""
+        return float(np.sqrt(self.rss / (2 * self.n_lines)))
+
+    def criterion(self, name: Criterion) -> float:
+        """``aic`` or ``bic``."""
+        if name == "aic":
+            return self.aic
+        if name == "bic":
+            return self.bic
+        raise InputError(f"criterion: expected 'aic' or 'bic', got {name!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary (see :mod:`tyredamp.cli.lateral` for the layout)."""
+        return {
+            "model": self.model.name,
+            "label": self.model.label,
+            "params": self.params,
+            "stderr": self.stderr,
+            "units": dict(zip(self.model.param_names, self.model.param_units, strict=True)),
+            "conditions": self.model.conditions,
+            "derived": self.model.derived(),
+            "n_params": self.n_params,
+            "n_lines": self.n_lines,
+            "rss": self.rss,
+            "residual_rms": self.residual_rms,
+            "aic": self.aic,
+            "bic": self.bic,
+            "amplitude_error": self.amplitude_error,
+            "amplitude_bias": self.amplitude_bias,
+            "weights": self.weights_name,
+            "force": self.force,
+            "wheel_mass_kg": self.wheel_mass,
+            "speed_m_s": self.speed,
+            "message": self.message,
+        }
+
+    def plot(self, **kwargs: Any) -> Any:
+        """Measured and fitted FRF; see :func:`tyredamp.plot.lateral.plot_lateral_fit`."""
+        from ..plot.lateral import plot_lateral_fit
+
+        return plot_lateral_fit(self, **kwargs)
+
+
+def _information(rss: float, n_real: int, n_params: int) -> tuple[float, float]:
+    tiny = np.finfo(float).tiny
+    ll_term = n_real * math.log(max(rss, tiny) / n_real)
+    k = n_params + 1
+    return ll_term + 2 * k, ll_term + k * math.log(n_real)
+
+
+def _amplitude_errors(fitted: ComplexArray, measured: ComplexArray) -> tuple[float, float]:
+    rel = (np.abs(fitted) - np.abs(measured)) / np.abs(measured)
+    return float(np.mean(np.abs(rel))), float(np.mean(rel))
+
+
+def _jacobian(
+    fun: Callable[[FloatArray], FloatArray], x: FloatArray, step: float = 1e-5
+) -> FloatArray:
+    cols = []
+    for k in range(x.size):
+        e = np.zeros_like(x)
+        e[k] = step
+        cols.append((fun(x + e) - fun(x - e)) / (2.0 * step))
+    return np.column_stack(cols)
+
+
+def _covariance(jac: FloatArray, rss: float) -> tuple[FloatArray, FloatArray]:
+    """Standard deviations and correlation of the parameters from ``s^2 (J^T J)^-1``.
+
+    Directions the data do not determine (negligible singular values) give
+    infinite standard deviations for the parameters they involve.
+    """
+    n, p = jac.shape
+    s2 = rss / max(n - p, 1)
+    _, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    tol = (sv.max() if sv.size else 0.0) * max(n, p) * np.finfo(float).eps
+    keep = sv > tol
+    cov = (vt[keep].T / sv[keep] ** 2) @ vt[keep] * s2
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    if not np.all(keep):
+        bad = np.any(np.abs(vt[~keep]) > 1e-8, axis=0)
+        sd = np.where(bad, np.inf, sd)
+    finite = np.isfinite(sd) & (sd > 0)
+    scale = np.where(finite, sd, 1.0)
+    corr = cov / np.outer(scale, scale)
+    corr[~finite, :] = np.nan
+    corr[:, ~finite] = np.nan
+    return sd, corr
+
+
+def _solve(
+    fun: Callable[[FloatArray], FloatArray],
+    starts: Sequence[FloatArray],
+    max_nfev: int,
+) -> Any:
+    """Pick the cheapest starts on a factor grid, refine them, return the best result."""
+    cands: list[tuple[float, FloatArray]] = []
+    for s in starts:
+        logs = np.log(np.asarray(s, dtype=float))
+        p = logs.size
+        grid = np.array(np.meshgrid(*([np.log(_GRID)] * p), indexing="ij")).reshape(p, -1).T
+        if grid.shape[0] > 243:  # keep the grid coarse for many parameters
+            grid = np.vstack([np.zeros(p), np.eye(p) * np.log(3), -np.eye(p) * np.log(3)])
+        for g in grid:
+            x = logs + g
+            r = fun(x)
+            cost = float(r @ r) if np.all(np.isfinite(r)) else np.inf
+            cands.append((cost, x))
+    cands.sort(key=lambda c: c[0])
+    best = None
+    for _, x0 in cands[:3]:
+        lb, ub = x0 - _LOG_SPAN, x0 + _LOG_SPAN
+        res = least_squares(
+            fun,
+            x0,
+            jac="3-point",
+            bounds=(lb, ub),
+            method="trf",
+            xtol=1e-14,
+            ftol=1e-14,
+            gtol=1e-14,
+            x_scale=1.0,
+            max_nfev=max_nfev,
+        )
+        if best is None or res.cost < best.cost:
+            best = res
+    if best is None or not np.all(np.isfinite(best.x)):
+        raise ConvergenceError("fit: the least-squares refinement failed from every start")
+    return best
+
+
+def _safe(fun: Callable[[FloatArray], FloatArray], n: int) -> Callable[[FloatArray], FloatArray]:
+    def wrapped(x: FloatArray) -> FloatArray:
+        try:
+            r = fun(x)
+        except (InputError, FloatingPointError, ZeroDivisionError):
+            return np.full(n, 1e100)
+        if not np.all(np.isfinite(r)):
+            return np.full(n, 1e100)
+        return r
+
+    return wrapped
+
+
+def _model_accelerance(m: LateralModel, prep: _Prepared) -> ComplexArray:
+    d = prep.data
+    return m.response(prep.frequency, "accelerance", d.force, d.wheel_mass)
+
+
+def _conditions(cls: type[LateralModel], data: LateralData) -> dict[str, float]:
+    cond: dict[str, float] = {}
+    for n in cls.condition_names:
+        if n == "speed":
+            if data.speed is None:
+                raise InputError(
+                    f"speed: the {cls.name!r} model needs the travel speed (m/s); "
+                    f"give speed= or set frf.meta['speed_m_s']"
+                )
+            cond["speed"] = float(data.speed)
+        else:  # pragma: no cover - no other condition exists yet
+            raise InputError(f"{cls.name}: unknown condition {n!r}")
+    return cond
+
+
+def fit_model(
+    data: LateralData | FRF,
+    model: str | type[LateralModel],
+    *,
+    speed: float | None = None,
+    force: ForceKind | None = None,
+    wheel_mass: float | None = None,
+    band: tuple[float, float] | None = None,
+    weights: Weights | ArrayLike = "auto",
+    start: ArrayLike | dict[str, float] | None = None,
+    channel: tuple[int, int] = (0, 0),
+    max_nfev: int = 2000,
+) -> LateralFit:
+    """Fit one lateral model to a measured complex FRF (module docstring for the method).
+
+    Parameters
+    ----------
+    data : LateralData or FRF
+        The measurement. For an FRF, missing conditions come from the keyword
+        arguments or ``frf.meta`` (:meth:`LateralData.from_frf`).
+    model : str or LateralModel subclass
+        ``"classic"``, ``"maxwell"``, ``"viscoplastic"``, ``"hysteretic"``,
+        ``"relaxation"``, ``"string"`` or an alias (``"proposed"`` ...).
+    speed : float, optional
+        Travel speed in m/s (overrides the data's).
+    force : {"ground", "axle"}, optional
+        Force at which the FRF was measured (overrides the data's).
+    wheel_mass : float, optional
+        Wheel mass in kg for ``force="axle"`` (overrides the data's).
+    band : (float, float), optional
+        Frequency band in Hz; default all lines above 0 Hz.
+    weights : str or array_like
+        ``"auto"``, ``"relative"``, ``"coherence"``, ``"uniform"`` or one
+        weight per line of the FRF.
+    start : array_like or dict, optional
+        Starting parameters (SI); default automatic.
+    channel : (int, int)
+        Output and input positions in the FRF.
+    max_nfev : int
+        Evaluation budget of each refinement.
+
+    Returns
+    -------
+    LateralFit
+
+    Raises
+    ------
+    InputError
+        Bad data or options; a speed-dependent model without a speed.
+    ConvergenceError
+        The optimizer failed from every start.
+    """
+    cls = get_model_class(model)
+    d0 = data if isinstance(data, LateralData) else LateralData.from_frf(data)
+    d = LateralData(
+        frf=d0.frf,
+        speed=speed if speed is not None else d0.speed,
+        force=force if force is not None else d0.force,
+        wheel_mass=wheel_mass if wheel_mass is not None else d0.wheel_mass,
+        label=d0.label,
+    )
+    prep = _prepare(d, band, weights, channel)
+    cond = _conditions(cls, d)
+    n_res = 2 * prep.frequency.size
+
+    def residual(logp: FloatArray) -> FloatArray:
+        m = cls.from_vector(np.exp(logp), **cond)
+        r = prep.weights * (_model_accelerance(m, prep) - prep.measured)
+        return np.concatenate([r.real, r.imag])
+
+    fun = _safe(residual, n_res)
+    if start is None:
+        starts = cls.initial_guesses(prep.omega, prep.ground_receptance, **cond)
+    else:
+        if isinstance(start, dict):
+            try:
+                sv = np.array([float(start[n]) for n in cls.param_names])
+            except KeyError as exc:
+                raise InputError(f"start: missing parameter {exc} of {cls.param_names}") from None
+        else:
+            sv = as_finite(start, "start", ndim=1)
+        if sv.size != len(cls.param_names) or np.any(sv <= 0):
+            raise InputError(
+                f"start: expected {len(cls.param_names)} values > 0 for {cls.param_names}, got {sv}"
+            )
+        starts = [sv]
+    starts = [
+        np.asarray(s, dtype=float)
+        for s in starts
+        if np.all(np.isfinite(s)) and np.all(np.asarray(s) > 0)
+    ]
+    if not starts:
+        raise ConvergenceError(f"fit: no usable starting values for the {cls.name!r} model")
+    if d.force == "axle" and d.wheel_mass > 0:
+        # Stage 1 on the ground-force accelerance A_axle/(1 - M_w A_axle): smoother
+        # (no wheel resonance), so the starts land in the right basin.
+        a_g = -(prep.omega**2) * prep.ground_receptance
+        w_g = 1.0 / np.abs(a_g)
+
+        def residual_g(logp: FloatArray) -> FloatArray:
+            m = cls.from_vector(np.exp(logp), **cond)
+            r = w_g * (m.response(prep.frequency, "accelerance") - a_g)
+            return np.concatenate([r.real, r.imag])
+
+        res_g = _solve(_safe(residual_g, n_res), starts, max_nfev)
+        starts = [np.exp(res_g.x), *starts]
+    res = _solve(fun, starts, max_nfev)
+    return _make_fit(cls, cond, prep, fun, res)
+
+
+def _make_fit(
+    cls: type[LateralModel],
+    cond: dict[str, float],
+    prep: _Prepared,
+    fun: Callable[[FloatArray], FloatArray],
+    res: Any,
+) -> LateralFit:
+    x = np.asarray(res.x, dtype=float)
+    m = cls.from_vector(np.exp(x), **cond)
+    fitted = _model_accelerance(m, prep)
+    r = fun(x)
+    rss = float(r @ r)
+    jac = _jacobian(fun, x)
+    sd_log, corr = _covariance(jac, rss)
+    p = np.exp(x)
+    n_real = 2 * prep.frequency.size
+    aic, bic = _information(rss, n_real, x.size)
+    err, bias = _amplitude_errors(fitted, prep.measured)
+    d = prep.data
+    return LateralFit(
+        model=m,
+        params=m.params,
+        stderr={n: float(p[i] * sd_log[i]) for i, n in enumerate(cls.param_names)},
+        correlation=corr,
+        frequency=prep.frequency,
+        measured=prep.measured,
+        fitted=fitted,
+        weights=prep.weights,
+        weights_name=prep.weights_name,
+        force=d.force,
+        wheel_mass=d.wheel_mass,
+        speed=d.speed,
+        rss=rss,
+        aic=aic,
+        bic=bic,
+        amplitude_error=err,
+        amplitude_bias=bias,
+        nfev=int(res.nfev),
+        message=str(res.message),
+        label=d.label,
+    )
+
+
+# ---------------------------------------------------------------------------------- ranking
+def _evidence(delta: float) -> str:
+    # Kass & Raftery (1995) scale for BIC differences (also used for AIC here).
+    if delta < 2:
+        return "not distinguishable from the best"
+    if delta < 6:
+        return "positive evidence against it"
+    if delta < 10:
+        return "strong evidence against it"
+    return "very strong evidence against it"
+
+
+@dataclass(frozen=True)
+class Ranking:
+    """Models fitted to the same data and weights, best first.
+
+    Attributes
+    ----------
+    fits : tuple of LateralFit
+        Sorted by the criterion (lowest first).
+    criterion : {"bic", "aic"}
+    delta : tuple of float
+        Criterion minus the best one's.
+    weight : tuple of float
+        ``exp(-delta/2)`` normalised (Akaike or Schwarz weights).
+    reasons : tuple of str
+        One sentence per model explaining its place.
+    """
+
+    fits: tuple[LateralFit, ...]
+    criterion: Criterion
+    delta: tuple[float, ...]
+    weight: tuple[float, ...]
+    reasons: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def best(self) -> LateralFit:
+        """The best fit."""
+        return self.fits[0]
+
+    @property
+    def order(self) -> tuple[str, ...]:
+        """Model names, best first."""
+        return tuple(f.name for f in self.fits)
+
+    def rows(self) -> list[dict[str, Any]]:
+        """One dict per model: rank, name, P, RSS, AIC, BIC, delta, weight, errors (%)."""
+        return [
+            {
+                "rank": i + 1,
+                "model": f.name,
+                "n_params": f.n_params,
+                "rss": f.rss,
+                "aic": f.aic,
+                "bic": f.bic,
+                "delta": self.delta[i],
+                "weight": self.weight[i],
+                "amplitude_error_pct": 100.0 * f.amplitude_error,
+                "amplitude_bias_pct": 100.0 * f.amplitude_bias,
+            }
+            for i, f in enumerate(self.fits)
+        ]
+
+    def format_table(self) -> str:
+        """Plain aligned text table of :meth:`rows` followed by the reasons."""
+        crit = self.criterion.upper()
+        head = (
+            f"{'rank':>4}  {'model':<13} {'P':>2} {'AIC':>10} {'BIC':>10} "
+            f"{'d' + crit:>8} {'weight':>7} {'amp.err %':>9} {'bias %':>7}"
+        )
+        lines = [head, "-" * len(head)]
+        for r in self.rows():
+            lines.append(
+                f"{r['rank']:>4}  {r['model']:<13} {r['n_params']:>2} {r['aic']:>10.1f} "
+                f"{r['bic']:>10.1f} {r['delta']:>8.1f} {r['weight']:>7.3f} "
+                f"{r['amplitude_error_pct']:>9.2f} {r['amplitude_bias_pct']:>+7.2f}"
+            )
+        return "\n".join([*lines, "", *list(self.reasons)])
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: criterion, order, rows, reasons and every fit's summary."""
+        return {
+            "criterion": self.criterion,
+            "order": list(self.order),
+            "table": self.rows(),
+            "reasons": list(self.reasons),
+            "fits": [f.to_dict() for f in self.fits],
+        }
+
+
+def _rank(fits: Sequence[LateralFit], criterion: Criterion) -> Ranking:
+    if criterion not in ("aic", "bic"):
+        raise InputError(f"criterion: expected 'aic' or 'bic', got {criterion!r}")
+    ordered = sorted(fits, key=lambda f: f.criterion(criterion))
+    vals = np.array([f.criterion(criterion) for f in ordered])
+    delta = vals - vals[0]
+    wt = np.exp(-0.5 * delta)
+    wt = wt / wt.sum()
+    crit = criterion.upper()
+    reasons = []
+    for i, f in enumerate(ordered):
+        over = "over" if f.amplitude_bias > 0 else "under"
+        tail = (
+            f"{f.n_params} parameters; amplitude error {100 * f.amplitude_error:.1f} % "
+            f"({over}-estimates by {100 * abs(f.amplitude_bias):.1f} % on average); "
+            f"rms weighted residual {f.residual_rms:.3g}"
+        )
+        if i == 0:
+            nxt = (
+                f"; next {ordered[1].name} at d{crit} = {delta[1]:.1f}" if len(ordered) > 1 else ""
+            )
+            reasons.append(f"1. {f.name}: lowest {crit}{nxt}; {tail}.")
+        else:
+            reasons.append(
+                f"{i + 1}. {f.name}: d{crit} = {delta[i]:.1f}, {_evidence(delta[i])}; {tail}."
+            )
+    return Ranking(
+        tuple(ordered),
+        criterion,
+        tuple(float(x) for x in delta),
+        tuple(float(x) for x in wt),
+        tuple(reasons),
+    )
+
+
+def rank_models(
+    data: LateralData | FRF,
+    models: Sequence[str | type[LateralModel]] = DEFAULT_MODELS,
+    *,
+    criterion: Criterion = "bic",
+    **fit_kwargs: Any,
+) -> Ranking:
+    """Fit several models to the same data and weights and rank them.
+
+    Parameters
+    ----------
+    data : LateralData or FRF
+        The measurement.
+    models : sequence of str or LateralModel subclass
+        Models to compare; default the paper's four (:data:`DEFAULT_MODELS`).
+    criterion : {"bic", "aic"}
+        Ranking criterion (lower is better); BIC penalises extra parameters
+        more for the usual hundreds of lines.
+    **fit_kwargs
+        Passed to :func:`fit_model` (``speed``, ``force``, ``wheel_mass``,
+        ``band``, ``weights`` ...). ``start`` is not allowed.
+
+    Returns
+    -------
+    Ranking
+    """
+    if "start" in fit_kwargs:
+        raise InputError("start: not allowed in rank_models (each model finds its own)")
+    if not models:
+        raise InputError("models: expected at least one model")
+    names = [get_model_class(m).name for m in models]
+    if len(set(names)) != len(names):
+        raise InputError(f"models: duplicated entries in {names}")
+    fits = [fit_model(data, m, **fit_kwargs) for m in models]
+    return _rank(fits, criterion)
+
+
+# -------------------------------------------------------------------------------- joint fit
+@dataclass(frozen=True)
+class JointFit:
+    """One model fitted to several conditions with shared parameters.
+
+    Attributes
+    ----------
+    model_name : str
+        Registry name.
+    share : {"physical", "none"}
+        How parameters are shared (:func:`fit_joint`).
+    names, units : tuple of str
+        Global parameter names and units.
+    params, stderr : dict of str to float
+        Global parameters and standard errors (SI).
+    fits : tuple of LateralFit
+        Per-condition results with the shared parameters (their ``stderr``
+        follow from the joint covariance; their ``aic``/``bic`` are those of
+        the condition alone with the global parameter count).
+    rss : float
+        Total weighted residual sum of squares.
+    aic, bic : float
+        Of the joint fit (``n`` = all real residuals, ``P`` = global count).
+    """
+
+    model_name: str
+    share: str
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    params: dict[str, float]
+    stderr: dict[str, float]
+    fits: tuple[LateralFit, ...]
+    rss: float
+    aic: float
+    bic: float
+
+    @property
+    def n_params(self) -> int:
+        """Number of global parameters."""
+        return len(self.names)
+
+    @property
+    def amplitude_error(self) -> float:
+        """Mean of the per-condition amplitude errors (fraction)."""
+        return float(np.mean([f.amplitude_error for f in self.fits]))
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready summary."""
+        return {
+            "model": self.model_name,
+            "share": self.share,
+            "params": self.params,
+            "stderr": self.stderr,
+            "units": dict(zip(self.names, self.units, strict=True)),
+            "rss": self.rss,
+            "aic": self.aic,
+            "bic": self.bic,
+            "amplitude_error": self.amplitude_error,
+            "conditions": [f.to_dict() for f in self.fits],
+        }
+
+
+def fit_joint(
+    data: Sequence[LateralData],
+    model: str | type[LateralModel],
+    *,
+    share: Literal["physical", "none"] = "physical",
+    band: tuple[float, float] | None = None,
+    weights: Weights | ArrayLike = "auto",
+    max_nfev: int = 4000,
+) -> JointFit:
+    """Fit one model to several speeds (at one pressure) with shared physical parameters.
+
+    With ``share="physical"`` the model's tyre-road damper (``road_damper``:
+    ``c`` Maxwell, ``c2`` visco-plastic, ``C_r`` proposed) is replaced by
+    ``C_alpha / V_i`` with one global cornering stiffness ``C_alpha`` (N/rad;
+    spec: ``C_r = C_alpha / V``, eq. 19, 33) and all other parameters (carcass
+    ``K``, ``h`` ...) are shared. Models with the speed as an operating
+    condition (relaxation, string) share all their parameters. The classic
+    model has no speed term, so all its parameters are shared. With
+    ``share="none"`` every condition keeps its own parameters (the sum of
+    separate fits, for comparison by AIC/BIC).
+
+    Parameters
+    ----------
+    data : sequence of LateralData
+        Two or more measurements, each with its ``speed``.
+    model : str or LateralModel subclass
+    share : {"physical", "none"}
+    band, weights :
+        As in :func:`fit_model` (the same for every condition).
+    max_nfev : int
+        Evaluation budget of the joint refinement.
+
+    Returns
+    -------
+    JointFit
+    """
+    cls = get_model_class(model)
+    ds = list(data)
+    if len(ds) < 2:
+        raise InputError(f"data: expected at least 2 conditions, got {len(ds)}")
+    if share not in ("physical", "none"):
+        raise InputError(f"share: expected 'physical' or 'none', got {share!r}")
+    for i, d in enumerate(ds):
+        if not isinstance(d, LateralData):
+            raise InputError(f"data[{i}]: expected LateralData, got {type(d).__name__}")
+        if d.speed is None and (cls.road_damper is not None or cls.condition_names):
+            raise InputError(f"data[{i}]: the joint fit needs each condition's speed (m/s)")
+    singles = [fit_model(d, cls, band=band, weights=weights) for d in ds]
+    preps = [_prepare(d, band, weights) for d in ds]
+    conds = [_conditions(cls, d) for d in ds]
+    p = len(cls.param_names)
+    names: list[str]
+    units: list[str]
+    # Maps from global log-parameters to each condition's log-parameters:
+    # logp_i = T_i @ x + b_i.
+    maps: list[tuple[FloatArray, FloatArray]] = []
+    if share == "physical":
+        names = list(cls.param_names)
+        units = list(cls.param_units)
+        k_road = cls.param_names.index(cls.road_damper) if cls.road_damper else -1
+        if k_road >= 0:
+            names[k_road] = "C_alpha"
+            units[k_road] = "N/rad"
+        for d in ds:
+            b = np.zeros(p)
+            if k_road >= 0:
+                b[k_road] = -math.log(float(d.speed))  # type: ignore[arg-type]
+            maps.append((np.eye(p), b))
+        x0 = np.mean(
+            [np.log(f.model.vector()) - b for f, (_, b) in zip(singles, maps, strict=True)], axis=0
+        )
+    else:
+        names, units = [], []
+        for i, d in enumerate(ds):
+            tag = d.label or f"#{i}"
+            names += [f"{n}@{tag}" for n in cls.param_names]
+            units += list(cls.param_units)
+            t = np.zeros((p, p * len(ds)))
+            t[:, i * p : (i + 1) * p] = np.eye(p)
+            maps.append((t, np.zeros(p)))
+        x0 = np.concatenate([np.log(f.model.vector()) for f in singles])
+    sizes = [2 * pr.frequency.size for pr in preps]
+    n_res = int(sum(sizes))
+
+    def residual(x: FloatArray) -> FloatArray:
+        parts = []
+        for pr, cd, (t, b) in zip(preps, conds, maps, strict=True):
+            m = cls.from_vector(np.exp(t @ x + b), **cd)
+            r = pr.weights * (_model_accelerance(m, pr) - pr.measured)
+            parts += [r.real, r.imag]
+        return np.concatenate(parts)
+
+    fun = _safe(residual, n_res)
+    res = least_squares(
+        fun,
+        x0,
+        jac="3-point",
+        bounds=(x0 - _LOG_SPAN, x0 + _LOG_SPAN),
+        method="trf",
+        xtol=1e-14,
+        ftol=1e-14,
+        gtol=1e-14,
+        max_nfev=max_nfev,
+    )
+    x = np.asarray(res.x, dtype=float)
+    r = fun(x)
+    rss = float(r @ r)
+    jac = _jacobian(fun, x)
+    n_real = n_res
+    dof = max(n_real - x.size, 1)
+    sd_g, _ = _covariance(jac, rss)
+    # Full covariance for per-condition standard errors.
+    cov = np.linalg.pinv(jac.T @ jac) * (rss / dof)
+    aic, bic = _information(rss, n_real, x.size)
+    gp = np.exp(x)
+    fits = []
+    for pr, cd, (t, b) in zip(preps, conds, maps, strict=True):
+        logp = t @ x + b
+        m = cls.from_vector(np.exp(logp), **cd)
+        fitted = _model_accelerance(m, pr)
+        ri = pr.weights * (fitted - pr.measured)
+        rss_i = float(np.sum(ri.real**2 + ri.imag**2))
+        cov_i = t @ cov @ t.T
+        sd_i = np.sqrt(np.clip(np.diag(cov_i), 0.0, None))
+        corr_i = cov_i / np.outer(np.where(sd_i > 0, sd_i, 1.0), np.where(sd_i > 0, sd_i, 1.0))
+        aic_i, bic_i = _information(rss_i, 2 * pr.frequency.size, x.size)
+        err, bias = _amplitude_errors(fitted, pr.measured)
+        pv = np.exp(logp)
+        fits.append(
+            LateralFit(
+                model=m,
+                params=m.params,
+                stderr={n: float(pv[k] * sd_i[k]) for k, n in enumerate(cls.param_names)},
+                correlation=corr_i,
+                frequency=pr.frequency,
+                measured=pr.measured,
+                fitted=fitted,
+                weights=pr.weights,
+                weights_name=pr.weights_name,
+                force=pr.data.force,
+                wheel_mass=pr.data.wheel_mass,
+                speed=pr.data.speed,
+                rss=rss_i,
+                aic=aic_i,
+                bic=bic_i,
+                amplitude_error=err,
+                amplitude_bias=bias,
+                nfev=int(res.nfev),
+                message=str(res.message),
+                label=pr.data.label,
+            )
+        )
+    return JointFit(
+        model_name=cls.name,
+        share=share,
+        names=tuple(names),
+        units=tuple(units),
+        params={n: float(gp[i]) for i, n in enumerate(names)},
+        stderr={n: float(gp[i] * sd_g[i]) for i, n in enumerate(names)},
+        fits=tuple(fits),
+        rss=rss,
+        aic=aic,
+        bic=bic,
+    )
