@@ -27,8 +27,16 @@ __all__ = ["identify_damping"]
 
 
 def _residual_fraction(model: ModalModel) -> float | None:
-    """RMS of the residual terms over the RMS of the model receptance, on the comparison grid."""
-    if model.lower_residual is None and model.upper_residual is None:
+    """RMS of the residual terms (and residual modes) over the RMS of the model receptance.
+
+    Evaluated on the comparison grid of the identified modes; None when the
+    model has no residual terms.
+    """
+    if (
+        model.lower_residual is None
+        and model.upper_residual is None
+        and model.residual_modes is None
+    ):
         return None
     f = comparison_grid(model.poles)
     total = model.receptance(f)
