@@ -50,7 +50,9 @@ def test_analytic_free_ring_limit() -> None:
     )
     n = np.arange(2, 9)
     free = (
-        n * (n**2 - 1) / (2 * np.pi * p.radius**2)
+        n
+        * (n**2 - 1)
+        / (2 * np.pi * p.radius**2)
         * np.sqrt(p.bending_stiffness / (p.mass_per_length * (n**2 + 1)))
     )
     # the 1e-12 N/m^2 foundation shifts f by < 1e-12 relative
@@ -209,9 +211,7 @@ def test_imperfection_splits_doubles() -> None:
     bare = RingTyre(layout=BARE, n_ring=32).ring_frequencies(6)
     split_bare = (bare[:, 1] - bare[:, 0]) / bare[:, 0]
     assert np.all(split_bare < 1e-9)  # exact doubles (eigensolver rounding)
-    imp = RingTyre(
-        layout=BARE, n_ring=32, imperfections=[Imperfection(angle_deg=30.0, mass=0.5)]
-    )
+    imp = RingTyre(layout=BARE, n_ring=32, imperfections=[Imperfection(angle_deg=30.0, mass=0.5)])
     f = imp.ring_frequencies(6)
     split = (f[:, 1] - f[:, 0]) / f[:, 0]
     # a 0.5 kg lump on a 34.6 kg band splits each pair by O(0.1 %) or more

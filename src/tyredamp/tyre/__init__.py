@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from .excitation import chirp_lines, hadamard_drive_matrix, periodic_chirp
 from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
+from .rig import VirtualModalTest, periodic_initial_state, run_modal_test
 from .ring import (
     RingConvergence,
     RingTyre,
@@ -14,7 +15,6 @@ from .ring import (
     staggered_weights,
     wave_numbers,
 )
-from .rig import VirtualModalTest, periodic_initial_state, run_modal_test
 from .truth import TyreTruth, modal_phase_collinearity
 
 __all__ = [

@@ -120,7 +120,7 @@ class VirtualModalTest:
         """The samples of one run (including its settle samples, if kept) as a TimeData."""
         if not isinstance(run, int | np.integer) or not 0 <= run < self.n_runs:
             raise InputError(f"run: expected an integer in 0..{self.n_runs - 1}, got {run!r}")
-        starts = list(self.data.meta["run_starts"]) + [self.data.n_samples]
+        starts = [*self.data.meta["run_starts"], self.data.n_samples]
         seg = self.data.data[:, starts[run] : starts[run + 1]]
         meta = dict(self.data.meta)
         meta["run_starts"] = [0]
@@ -282,14 +282,17 @@ def run_modal_test(
         raise InputError(f"tyre: expected a RingTyre, got {type(tyre).__name__}")
     fs = check_positive(sample_rate, "sample_rate")
     t_per = check_positive(period, "period")
-    p_samples = int(round(t_per * fs))
+    p_samples = round(t_per * fs)
     if abs(p_samples - t_per * fs) > 1e-6 * max(1.0, t_per * fs) or p_samples < 4:
         raise InputError(
             f"period: expected period * sample_rate to be an integer >= 4, got "
             f"{t_per:g} s * {fs:g} Hz = {t_per * fs:g}"
         )
-    for name, val, lo in (("n_periods", n_periods, 1), ("settle_periods", settle_periods, 0),
-                          ("oversample", oversample, 1)):
+    for name, val, lo in (
+        ("n_periods", n_periods, 1),
+        ("settle_periods", settle_periods, 0),
+        ("oversample", oversample, 1),
+    ):
         if not isinstance(val, int | np.integer) or isinstance(val, bool) or val < lo:
             raise InputError(f"{name}: expected an integer >= {lo}, got {val!r}")
     f_rms = check_positive(force_rms, "force_rms")
@@ -301,9 +304,7 @@ def run_modal_test(
         if np.isnan(snr):
             raise InputError("snr_db: expected a number in dB or None, got NaN")
     if drive_mode not in ("sequential", "simultaneous"):
-        raise InputError(
-            f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}"
-        )
+        raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
     if initial_state not in ("periodic", "rest"):
         raise InputError(f"initial_state: expected 'periodic' or 'rest', got {initial_state!r}")
     if len(band) != 2:
@@ -319,12 +320,12 @@ def run_modal_test(
     base = periodic_chirp(p_samples, fs, band[0], band[1], rms=f_rms, oversample=r)
     system = tyre.system
     cm = system.complex_modes()
-    inputs = tyre.drive_dofs
-    outputs = tyre.point_dofs
+    inputs = tyre.drive_dofs.tolist()
+    outputs = tyre.point_dofs.tolist()
     n_keep = int(n_periods) + (int(settle_periods) if keep_settle else 0)
     run_len = n_keep * p_samples
     n_runs = drive.shape[0]
-    clean = np.empty((n_in + outputs.size, n_runs * run_len))
+    clean = np.empty((n_in + len(outputs), n_runs * run_len))
     for run in range(n_runs):
         force_sim = drive[run][:, None] * base[None, :]  # (n_in, P r), one period
         if initial_state == "periodic":
@@ -390,7 +391,7 @@ def run_modal_test(
         measured,
         fs,
         tyre.input_channels + tyre.output_channels,
-        ["force"] * n_in + ["acceleration"] * outputs.size,
+        ["force"] * n_in + ["acceleration"] * len(outputs),
         meta,
     )
     return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)

@@ -150,7 +150,7 @@ def staggered_weights(order: int) -> tuple[NDArray[np.float64], NDArray[np.float
     a = np.array([[2 * o ** (2 * ell + 1) for o in off] for ell in range(m)])
     rhs = np.zeros(m)
     rhs[0] = 1.0
-    return off, np.linalg.solve(a, rhs)
+    return off.astype(np.float64), np.linalg.solve(a, rhs).astype(np.float64)
 
 
 def difference_symbol(n: ArrayLike, n_ring: int | None, order: int = 4) -> NDArray[np.float64]:
@@ -399,7 +399,9 @@ class RingTyre:
                 f"params: expected RingTyreParameters, got {type(self.params).__name__}"
             )
         if not isinstance(self.layout, MeasurementLayout):
-            raise InputError(f"layout: expected MeasurementLayout, got {type(self.layout).__name__}")
+            raise InputError(
+                f"layout: expected MeasurementLayout, got {type(self.layout).__name__}"
+            )
         if not isinstance(n_ring, int | np.integer) or isinstance(n_ring, bool):
             raise InputError(f"n_ring: expected an integer, got {n_ring!r}")
         n_ring = int(n_ring)
@@ -412,8 +414,10 @@ class RingTyre:
         if fd_order not in _ORDERS:
             raise InputError(f"fd_order: expected one of {_ORDERS}, got {fd_order!r}")
         if n_ring < 2 * fd_order:
-            raise InputError(f"n_ring: expected at least {2 * fd_order} nodes for fd_order "
-                             f"{fd_order}, got {n_ring}")
+            raise InputError(
+                f"n_ring: expected at least {2 * fd_order} nodes for fd_order "
+                f"{fd_order}, got {n_ring}"
+            )
         try:
             nu = float(nonproportionality)
         except (TypeError, ValueError):
@@ -513,12 +517,12 @@ class RingTyre:
     @property
     def node_angles_deg(self) -> NDArray[np.float64]:
         """Angles of the radial DOFs (ring nodes) in deg, shape (n_ring,)."""
-        return np.arange(self.n_ring) * (360.0 / self.n_ring)
+        return np.arange(self.n_ring, dtype=np.float64) * (360.0 / self.n_ring)
 
     @property
     def tangential_angles_deg(self) -> NDArray[np.float64]:
         """Angles of the tangential DOFs (mid-points) in deg, shape (n_ring,)."""
-        return (np.arange(self.n_ring) + 0.5) * (360.0 / self.n_ring)
+        return (np.arange(self.n_ring, dtype=np.float64) + 0.5) * (360.0 / self.n_ring)
 
     @property
     def radial_dofs(self) -> NDArray[np.intp]:
@@ -552,7 +556,7 @@ class RingTyre:
 
     @property
     def output_channels(self) -> tuple[Channel, ...]:
-        """Acceleration channels: node = point number, radial (direction 3), angle, name ``A<k>``."""
+        """Acceleration channels: node = point number, radial (direction 3), name ``A<k>``."""
         return tuple(
             Channel(node=k + 1, direction=3, angle_deg=float(a), name=f"A{k + 1}")
             for k, a in enumerate(self.point_angles_deg)
@@ -611,8 +615,9 @@ class RingTyre:
             imperfect ring whose shapes mix harmonics).
         """
         if not isinstance(n_max, int | np.integer) or not 1 <= n_max < self.n_ring / 2:
-            raise InputError(f"n_max: expected an integer in 1..{self.n_ring // 2 - 1}, "
-                             f"got {n_max!r}")
+            raise InputError(
+                f"n_max: expected an integer in 1..{self.n_ring // 2 - 1}, got {n_max!r}"
+            )
         f = self.system.undamped_modes().frequency_hz
         nn, _ = self.mode_wave_numbers()
         out = np.empty((int(n_max), 2))
