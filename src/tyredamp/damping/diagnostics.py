@@ -63,6 +63,12 @@ class DampingDiagnostics:
         ``||C' - diag C'||_F / ||diag C'||_F``.
     shape_condition : float
         Condition number of the real shape matrix ``Phi`` (N x m).
+    imaginary_outside_span : float
+        ``||(I - Phi pinv(Phi)) Im Psi^||_F / ||Im Psi^||_F``: the share of the
+        imaginary parts of the shapes that no combination of the identified
+        real shapes explains. It comes from damping coupling to modes outside
+        the identified set (and noise) and is discarded by the pseudo-inverse;
+        0 for a complete set.
     residual_fraction : float or None
         RMS of the residual terms of the modal model over the RMS of its
         receptance in the band (out-of-band modes); None without residuals.
@@ -92,6 +98,7 @@ class DampingDiagnostics:
     imaginary_ratio: float
     non_proportionality: float
     shape_condition: float
+    imaginary_outside_span: float
     residual_fraction: float | None
     normalisation_phase: float
     basis_residual: float
@@ -120,6 +127,14 @@ class DampingDiagnostics:
 def _asym(a: NDArray[np.float64]) -> float:
     n = float(np.linalg.norm(a))
     return float(np.linalg.norm(a - a.T) / n) if n > 0 else 0.0
+
+
+def _outside_span(basis: NDArray[np.float64], v: NDArray[np.float64]) -> float:
+    nv = float(np.linalg.norm(v))
+    if nv == 0:
+        return 0.0
+    q, _ = np.linalg.qr(basis)
+    return float(np.linalg.norm(v - q @ (q.T @ v)) / nv)
 
 
 def definiteness(eigenvalues: NDArray[np.float64], rtol: float = 1e-10) -> str:
@@ -171,6 +186,7 @@ def compute_diagnostics(
             np.linalg.norm(c_modal - np.diag(dg)) / max(float(np.linalg.norm(dg)), 1e-300)
         ),
         shape_condition=float(sv[0] / sv[-1]),
+        imaginary_outside_span=_outside_span(basis, shapes.imag),
         residual_fraction=residual_fraction,
         normalisation_phase=float(np.max(np.abs(normalisation_phase))),
         basis_residual=basis_residual,
@@ -284,9 +300,9 @@ def findings(
     # --- truncation and leakage
     if d.n_modes < d.n_points:
         out.append(
-            f"Only {d.n_modes} modes are known at {d.n_points} points: the physical matrix C "
-            f"has rank {d.n_modes} and describes damping only for motions made of the "
-            "identified mode shapes. Projecting the damping on so few shapes smears it over "
+            f"Only {d.n_modes} modes are known at {d.n_points} points: the physical matrices "
+            f"C, M and K have rank {d.n_modes} (M is singular, so there is no full MCK model "
+            "at the points) and describe only motions made of the identified mode shapes. Projecting the damping on so few shapes smears it over "
             f"the circumference ('power leakage'): {d.negative_diagonal_physical} negative "
             f"diagonal and {100 * d.negative_offdiagonal_fraction:.0f} % negative off-diagonal "
             "entries, which are artefacts of truncation, not local negative dampers. C is "
@@ -296,6 +312,14 @@ def findings(
         out.append(
             f"The modal set is complete ({d.n_modes} modes at {d.n_points} points): C is a "
             "full-rank physical damping matrix."
+        )
+    if d.n_modes < d.n_points and not real:
+        out.append(
+            f"{100 * d.imaginary_outside_span:.2g} % of the imaginary parts of the shapes lie "
+            "outside the span of the identified real shapes: damping coupling to modes "
+            "outside the identified set (or noise), which the pseudo-inverse discards. "
+            "Coupling to outside modes whose shapes look like identified ones at the points "
+            "cannot be separated and leaks into C' instead."
         )
     if d.residual_fraction is not None:
         out.append(
