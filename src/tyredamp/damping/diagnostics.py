@@ -302,8 +302,9 @@ def findings(
         out.append(
             f"Only {d.n_modes} modes are known at {d.n_points} points: the physical matrices "
             f"C, M and K have rank {d.n_modes} (M is singular, so there is no full MCK model "
-            "at the points) and describe only motions made of the identified mode shapes. Projecting the damping on so few shapes smears it over "
-            f"the circumference ('power leakage'): {d.negative_diagonal_physical} negative "
+            "at the points) and describe only motions made of the identified mode shapes. "
+            "Projecting the damping on so few shapes smears it over the points ('power "
+            f"leakage'): {d.negative_diagonal_physical} negative "
             f"diagonal and {100 * d.negative_offdiagonal_fraction:.0f} % negative off-diagonal "
             "entries, which are artefacts of truncation, not local negative dampers. C is "
             "as definite as C' (same signs of eigenvalues)."
