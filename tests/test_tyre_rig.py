@@ -88,7 +88,8 @@ def test_periodic_chirp_spectrum() -> None:
     assert np.sqrt(np.mean(x**2)) == pytest.approx(3.0, rel=1e-12)
     spec = np.abs(np.fft.rfft(x))
     lines = chirp_lines(1024, 1024.0, 10.0, 200.0)
-    assert lines[0] == 10 and lines[-1] == 200
+    assert lines[0] == 10
+    assert lines[-1] == 200
     # flat on the band, nothing elsewhere (rounding 1e-9 of the line amplitude)
     assert_allclose(spec[lines], spec[lines][0], rtol=1e-9)
     others = np.delete(spec, lines)
@@ -123,13 +124,15 @@ def test_periodic_initial_state_is_periodic(small_tyre: RingTyre) -> None:
 def test_rest_start_settles_to_periodic(small_tyre: RingTyre) -> None:
     per = run_modal_test(small_tyre, snr_db=None, **SMALL)
     # slowest mode sigma >= 1.36 1/s: after 10 s the transient is < 1.3e-6
-    rest = run_modal_test(
-        small_tyre, snr_db=None, initial_state="rest", settle_periods=10, **SMALL
-    )
+    rest = run_modal_test(small_tyre, snr_db=None, initial_state="rest", settle_periods=10, **SMALL)
     a = per.data.data
     assert_allclose(rest.data.data, a, atol=3e-6 * np.abs(a).max())
     kept = run_modal_test(
-        small_tyre, snr_db=None, initial_state="rest", settle_periods=2, keep_settle=True,
+        small_tyre,
+        snr_db=None,
+        initial_state="rest",
+        settle_periods=2,
+        keep_settle=True,
         **SMALL,
     )
     assert kept.meta["settle_samples"] == 2 * 512
@@ -147,18 +150,23 @@ def test_default_test_shapes_and_metadata(default_test: VirtualModalTest) -> Non
     assert d.quantities == ("force",) + ("acceleration",) * 16
     assert d.force_indices == [0]
     assert [c.angle_deg for c in d.channels[1:]] == [22.5 * k for k in range(16)]
-    assert d.channels[0].node == 1 and d.channels[0].name == "F1"
+    assert d.channels[0].node == 1
+    assert d.channels[0].name == "F1"
     m = default_test.meta
     assert m["period_samples"] == 4096
     assert m["settle_samples"] == 0
-    assert m["n_runs"] == 1 and m["run_starts"] == [0]
-    assert m["snr_db"] == 40.0 and m["seed"] == 7
-    assert m["excitation"]["lines"][0] == 1 and m["excitation"]["lines"][-1] == 800
+    assert m["n_runs"] == 1
+    assert m["run_starts"] == [0]
+    assert m["snr_db"] == 40.0
+    assert m["seed"] == 7
+    assert m["excitation"]["lines"][0] == 1
+    assert m["excitation"]["lines"][-1] == 800
     assert default_test.frequency_lines[-1] == 200.0
     tr = default_test.truth
     assert tr.band == (0.0, 200.0)
     mm = tr.modal_model()
-    assert mm.n_modes == 6 and mm.mode_kind == "complex"
+    assert mm.n_modes == 6
+    assert mm.mode_kind == "complex"
     assert [c.angle_deg for c in mm.outputs] == [22.5 * k for k in range(16)]
 
 
