@@ -17,8 +17,8 @@ sums over the lines of the band):
   against ``H_ab``; per line ``|H_ba - H_ab| / sqrt((|H_ba|^2 + |H_ab|^2)/2)``;
   overall ``sqrt(sum |H_ba - H_ab|^2 / sum (|H_ba|^2 + |H_ab|^2)/2)``, the
   largest over the pairs. Direction signs are taken into account.
-* quality: flat-topped samples at a channel's extreme value (clipping or
-  overload), channels of zeros, the fraction of lines whose multiple
+* quality: samples flat-topped at a channel's extreme value (clipping or
+  overload, see :func:`clipping`), channels of zeros, the fraction of lines whose multiple
   coherence is below a limit, and passivity of every drive point: a passive
   structure has ``Re Y_kk >= 0`` for the drive-point mobility ``Y_kk``; a line
   violates it when ``Re Y / |Y| < -(floor + k eps)``, with
@@ -318,30 +318,52 @@ def reciprocity_check(
 
 
 # ---------------------------------------------------------------- quality
-def clipping(x: NDArray[np.float64], min_run: int = 3) -> int:
-    """Number of samples in flat-topped runs at the signal's maximum or minimum.
+def clipping(
+    x: NDArray[np.float64], min_run: int = 3, repeats: int = 1, min_fraction: float = 1e-4
+) -> int:
+    """Number of samples flat-topped at the signal's maximum or minimum (0 if none).
 
-    A run is ``min_run`` or more consecutive samples exactly equal to
-    ``max(x)`` (or ``min(x)``), the signature of an overloaded amplifier or
-    ADC. A signal of zeros returns 0 (see dead channels).
+    An overloaded amplifier or ADC holds the signal at its limit: the extreme
+    value appears in runs of consecutive samples, or (when the signal changes
+    fast between samples) many times over the record. Samples exactly equal to
+    ``max(x)`` (likewise ``min(x)``) count as clipped when they form a run of
+    ``min_run`` or more, or when there are more than ``repeats`` of them and at
+    least ``min_fraction`` of the record (an unclipped periodic signal repeats
+    its extreme once per period, so pass ``repeats`` = number of periods). A
+    signal of zeros returns 0 (a dead channel, reported separately).
 
     Parameters
     ----------
     x : ndarray, shape (n_samples,)
     min_run : int
         Shortest run counted (>= 2).
+    repeats : int
+        Occurrences of the extreme value accepted without a run (>= 1).
+    min_fraction : float
+        Smallest fraction of the record that scattered extreme samples must
+        reach to count.
+
+    Returns
+    -------
+    int
+        Samples at the extremes when clipping is detected, else 0.
     """
     if int(min_run) != min_run or min_run < 2:
         raise InputError(f"min_run: expected an integer >= 2, got {min_run!r}")
+    if int(repeats) != repeats or repeats < 1:
+        raise InputError(f"repeats: expected an integer >= 1, got {repeats!r}")
     if not np.any(x):
         return 0
     total = 0
     for extreme in (x.max(), x.min()):
-        at = np.concatenate(([0], (x == extreme).astype(np.int8), [0]))
+        hit = x == extreme
+        count = int(hit.sum())
+        at = np.concatenate(([0], hit.astype(np.int8), [0]))
         edges = np.diff(at)
-        starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-        runs = stops - starts
-        total += int(runs[runs >= min_run].sum())
+        runs = np.flatnonzero(edges == -1) - np.flatnonzero(edges == 1)
+        scattered = count > repeats and count >= max(3.0, min_fraction * x.size)
+        if runs.max() >= min_run or scattered:
+            total += count
     return total
 
 
@@ -380,7 +402,9 @@ def quality_check(
         Largest accepted fraction of (output, line) pairs with low coherence
         (the verdict figure and threshold).
     clip_run : int
-        Shortest run of equal samples at a channel extreme counted as clipping.
+        Shortest run of equal samples at a channel extreme counted as
+        clipping (see :func:`clipping`; with ``meta["period_samples"]`` one
+        repeat of the extreme per period is accepted).
     passivity_floor : float
         Allowed negative ``Re Y / |Y|`` at a drive point besides the random
         error (0.02 is about 1 degree of phase error).
@@ -405,7 +429,11 @@ def quality_check(
     problems: list[str] = []
     frf: FRF | None
     if isinstance(data, TimeData):
-        clipped = {c.label: clipping(data.data[i], clip_run) for i, c in enumerate(data.channels)}
+        period = data.meta.get("period_samples")
+        reps = max(1, data.n_samples // int(period)) if period else 1
+        clipped = {
+            c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)
+        }
         bad = {k: v for k, v in clipped.items() if v > 0}
         dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
         figures["clipped_channels"] = len(bad)

@@ -307,8 +307,9 @@ def burst_random(
 
     Each record holds new Gaussian noise with a flat expected spectrum on the
     band lines, multiplied by a gate that is 1 for the first
-    ``burst_fraction`` of the record (with a short cosine fade-out) and 0
-    after.
+    ``burst_fraction`` of the record and 0 after, with cosine fades of a
+    twentieth of the burst at both ends (limits the spectrum the gate adds
+    outside the band).
 
     Parameters
     ----------
@@ -340,12 +341,14 @@ def burst_random(
         raise InputError(f"burst_fraction: expected a fraction in (0, 1], got {burst_fraction!r}")
     lines = band_lines(fs, n, band)
     g = np.random.default_rng(rng)
-    on = max(2, round(bf * n))
-    fade = max(1, on // 20) if on < n else 0
+    on = max(4, round(bf * n))
+    fade = max(1, on // 20)
     gate = np.zeros(n)
     gate[:on] = 1.0
-    if fade:
-        gate[on - fade : on] = 0.5 * (1 + np.cos(np.pi * (np.arange(1, fade + 1) / (fade + 1))))
+    ramp = 0.5 * (1 - np.cos(np.pi * (np.arange(1, fade + 1) / (fade + 1))))
+    gate[:fade] = ramp
+    if on < n:
+        gate[on - fade : on] = ramp[::-1]
     out = np.empty(nr * n)
     for r in range(nr):
         spec = np.zeros(n // 2 + 1, dtype=complex)
