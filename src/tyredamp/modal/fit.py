@@ -1,0 +1,632 @@
+"""Residues (LSFD) and non-linear pole-residue refinement for real and complex modes.
+
+Both models of the paper are fitted to the FRFs in their own kind
+(receptance, mobility or accelerance, through the factor ``(i w)^q``):
+
+* complex modes (general viscous damping, spec eq. [10])::
+
+      H_jk(s) = sum_n u_jn l_kn / (s - p_n) + conj(u_jn l_kn) / (s - conj p_n)
+
+  with complex output coefficients ``u_jn`` and participation ``l_kn``
+  (rank-one residues ``R_jkn = u_jn l_kn``, one ``l_kn = 1`` per mode);
+* real modes (proportional damping, spec eq. [2]/[3])::
+
+      H_jk(s) = sum_n u_jn l_kn / (s^2 + 2 sigma_n s + omega_n^2)
+
+  with real ``u_jn`` and ``l_kn`` (the residue ``R_jkn = u_jn l_kn / (2 i Omega_n)``
+  is imaginary, eq. [3] with the factor 2);
+
+plus optional real residual terms per input: an upper residual (constant
+receptance, modes above the band) and a lower residual ``L / s^2`` (modes
+below the band).
+
+The poles (``sigma_n = w_ref exp(x1)``, ``Omega_n = w_ref x2``: always stable)
+and the participation vectors are the non-linear parameters; the coefficients
+``u`` and the residuals are linear and are eliminated by least squares for
+every output with one shared basis (variable projection, Golub & Pereyra 1973,
+with Kaufman's Jacobian). The basis has ``2 n_in n_freq`` real rows, so an
+iteration costs ``O(n_out n_in n_freq q)`` for ``q`` linear parameters per
+output and never forms the full ``(n_out n_in n_freq) x n_param`` Jacobian:
+``J^T J`` and ``J^T r`` are assembled from ``q x q`` and ``n_freq x q``
+products, and ``scipy.optimize.least_squares`` is given an equivalent square
+root of the normal equations.
+
+Scaling (spec step 3 and eq. [10]): with drive points ``(j_k, k)`` (output
+``j_k`` at the place of input ``k``) reciprocity ``psi_in[k] = psi_out[j_k]``
+fixes ``a_n^2 = sum_k conj(u_{j_k n}) l_kn / sum_k |u_{j_k n}|^2`` and
+``psi_out = a u``, ``psi_in = l / a`` (complex), or ``phi_out = a u``,
+``phi_in = l / a`` and ``psi = phi / sqrt(2 i Omega)`` (real modes; ``a^2`` must
+be real and positive, a warning says when it is not).
+
+Uncertainty: the residual variance at the optimum and the Gauss-Newton
+covariance ``s^2 (J^T J)^-1`` of the non-linear parameters, plus the
+conditional covariance of the linear coefficients, propagated to natural
+frequencies, damping ratios and mode-shape entries by the delta method.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+import scipy.linalg as sla
+from numpy.typing import NDArray
+from scipy.optimize import least_squares
+
+from ..exceptions import InputError
+
+__all__ = ["FitResult", "ModalFitter"]
+
+ModelKind = Literal["complex", "real"]
+
+
+@dataclass
+class FitResult:
+    """Outcome of one fit (internal layout; :mod:`identify` turns it into a ModalModel).
+
+    All shapes refer to ``m`` modes, ``n_out`` outputs and ``n_in`` inputs.
+    """
+
+    poles: NDArray[np.complex128]
+    psi_out: NDArray[np.complex128]
+    psi_in: NDArray[np.complex128]
+    upper: NDArray[np.float64] | None
+    lower: NDArray[np.float64] | None
+    std_frequency_hz: NDArray[np.float64]
+    std_damping_ratio: NDArray[np.float64]
+    std_psi_out: NDArray[np.float64]
+    std_pole: NDArray[np.complex128]
+    model_receptance: NDArray[np.complex128]
+    sigma_out: NDArray[np.float64]
+    cost: float
+    n_iter: int
+    status: str
+    warnings: list[str] = field(default_factory=list)
+    contribution: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    significance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    theta: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    participation: NDArray[np.complex128] = field(default_factory=lambda: np.zeros((0, 0), complex))
+    drive_phi2: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(0, complex))
+
+
+class ModalFitter:
+    """Fit poles, participation and residues to FRFs (one model kind).
+
+    Parameters
+    ----------
+    frequency : ndarray, shape (n_freq,)
+        Lines in Hz, all > 0.
+    H : ndarray, complex, shape (n_out, n_in, n_freq)
+        FRFs of kind ``power`` (0 receptance, 1 mobility, 2 accelerance).
+    power : int
+        Power of ``i w`` that turns receptance into the data kind.
+    mode_kind : {"complex", "real"}
+        Model of the residues.
+    drive : list of (int, int)
+        Drive points ``(output index, input index)`` for the scaling.
+    upper, lower : bool
+        Include the upper and lower residual terms.
+    """
+
+    def __init__(
+        self,
+        frequency: NDArray[np.float64],
+        H: NDArray[np.complex128],
+        power: int,
+        mode_kind: ModelKind,
+        drive: list[tuple[int, int]],
+        *,
+        upper: bool = True,
+        lower: bool = True,
+    ) -> None:
+        if mode_kind not in ("complex", "real"):
+            raise InputError(f"mode_kind: expected 'complex' or 'real', got {mode_kind!r}")
+        if np.any(frequency <= 0):
+            raise InputError("frequency: the fit needs lines above 0 Hz")
+        self.f = frequency
+        self.H = H
+        self.n_out, self.n_in, self.n_f = H.shape
+        self.kind = mode_kind
+        self.drive = list(drive)
+        self.use_upper = upper
+        self.use_lower = lower
+        w = 2 * np.pi * frequency
+        self.s = 1j * w
+        self.kappa = (1j * w) ** power
+        self.kappa_low = (1j * w) ** (power - 2)
+        self.w_ref = float(w[-1])
+        # data: rows (k, f) complex, stacked [Re; Im]
+        hc = H.transpose(1, 2, 0).reshape(self.n_in * self.n_f, self.n_out)
+        self.Y = np.concatenate([hc.real, hc.imag], axis=0)
+        self.n_rows = self.Y.shape[0]
+
+    # ------------------------------------------------------------ layout
+    def n_cols(self, m: int) -> int:
+        per = 2 if self.kind == "complex" else 1
+        return per * m + self.n_in * (int(self.use_upper) + int(self.use_lower))
+
+    def pack(
+        self, poles: NDArray[np.complex128], part: NDArray[np.complex128], ref: NDArray[np.intp]
+    ) -> NDArray[np.float64]:
+        """Parameter vector from poles (m,), participation (m, n_in) and reference index (m,)."""
+        sig = np.maximum(-poles.real, 1e-9 * np.abs(poles))
+        x = [np.log(sig / self.w_ref), poles.imag / self.w_ref]
+        th = np.stack(x, axis=1).ravel()
+        if self.n_in == 1:
+            return th
+        m = poles.size
+        lp = part / part[np.arange(m), ref][:, None]
+        others = []
+        for n in range(m):
+            for k in range(self.n_in):
+                if k == ref[n]:
+                    continue
+                if self.kind == "complex":
+                    others += [lp[n, k].real, lp[n, k].imag]
+                else:
+                    others.append(lp[n, k].real)
+        return np.concatenate([th, np.asarray(others, float)])
+
+    def unpack(
+        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp]
+    ) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        """Poles (m,) and participation (m, n_in) from the parameter vector."""
+        x1 = th[0 : 2 * m : 2]
+        x2 = th[1 : 2 * m : 2]
+        poles = self.w_ref * (-np.exp(x1) + 1j * x2)
+        part = np.ones((m, self.n_in), complex)
+        i = 2 * m
+        for n in range(m):
+            for k in range(self.n_in):
+                if k == ref[n]:
+                    continue
+                if self.kind == "complex":
+                    part[n, k] = th[i] + 1j * th[i + 1]
+                    i += 2
+                else:
+                    part[n, k] = th[i]
+                    i += 1
+        return poles, part
+
+    # ------------------------------------------------------------- basis
+    def basis(
+        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], derivatives: bool = True
+    ) -> tuple[
+        NDArray[np.float64], NDArray[np.float64], NDArray[np.intp], NDArray[np.intp]
+    ]:
+        """Real basis ``Phi`` (n_rows, q) and its derivative columns.
+
+        Returns ``Phi``, ``D`` (n_rows, n_d), ``dpar`` (n_d,) parameter index and
+        ``dcol`` (n_d,) basis column of each derivative column.
+        """
+        poles, part = self.unpack(th, m, ref)
+        nin, nf = self.n_in, self.n_f
+        s, kap = self.s, self.kappa
+        q = self.n_cols(m)
+        cols = np.zeros((q, nin, nf), complex)
+        dl: list[NDArray[np.complex128]] = []
+        dpar: list[int] = []
+        dcol: list[int] = []
+        pidx = 2 * m  # running index of participation parameters
+        for n in range(m):
+            p = poles[n]
+            sig, om = -p.real, p.imag
+            L = part[n]
+            if self.kind == "complex":
+                g = kap / (s - p)
+                gb = kap / (s - np.conj(p))
+                A = L[:, None] * g[None, :]
+                B = np.conj(L)[:, None] * gb[None, :]
+                ca, cb = 2 * n, 2 * n + 1
+                cols[ca] = A + B
+                cols[cb] = 1j * (A - B)
+                if not derivatives:
+                    continue
+                dA = L[:, None] * (g / (s - p))[None, :]
+                dB = np.conj(L)[:, None] * (gb / (s - np.conj(p)))[None, :]
+                for dpx, dpbx, ip in ((-sig, -sig, 2 * n), (1j * self.w_ref, -1j * self.w_ref, 2 * n + 1)):
+                    a_, b_ = dA * dpx, dB * dpbx
+                    dl += [a_ + b_, 1j * (a_ - b_)]
+                    dpar += [ip, ip]
+                    dcol += [ca, cb]
+                for k in range(nin):
+                    if k == ref[n]:
+                        continue
+                    for fa, fb in ((1.0, 1.0), (1j, -1j)):
+                        a_ = np.zeros((nin, nf), complex)
+                        b_ = np.zeros((nin, nf), complex)
+                        a_[k] = fa * g
+                        b_[k] = fb * gb
+                        dl += [a_ + b_, 1j * (a_ - b_)]
+                        dpar += [pidx, pidx]
+                        dcol += [ca, cb]
+                        pidx += 1
+            else:
+                den = s**2 + 2 * sig * s + sig**2 + om**2
+                base = kap / den
+                cols[n] = L.real[:, None] * base[None, :]
+                if not derivatives:
+                    continue
+                d_sig = -kap * (2 * s + 2 * sig) / den**2
+                d_om = -kap * (2 * om) / den**2
+                dl += [L.real[:, None] * (d_sig * sig)[None, :]]
+                dl += [L.real[:, None] * (d_om * self.w_ref)[None, :]]
+                dpar += [2 * n, 2 * n + 1]
+                dcol += [n, n]
+                for k in range(nin):
+                    if k == ref[n]:
+                        continue
+                    a_ = np.zeros((nin, nf), complex)
+                    a_[k] = base
+                    dl.append(a_)
+                    dpar.append(pidx)
+                    dcol.append(n)
+                    pidx += 1
+        c0 = (2 if self.kind == "complex" else 1) * m
+        if self.use_upper:
+            for k in range(nin):
+                cols[c0, k] = kap
+                c0 += 1
+        if self.use_lower:
+            for k in range(nin):
+                cols[c0, k] = self.kappa_low
+                c0 += 1
+        cf = cols.reshape(q, nin * nf).T
+        phi = np.concatenate([cf.real, cf.imag], axis=0)
+        if not derivatives or not dl:
+            return phi, np.zeros((self.n_rows, 0)), np.zeros(0, np.intp), np.zeros(0, np.intp)
+        dc = np.stack(dl).reshape(len(dl), nin * nf).T
+        D = np.concatenate([dc.real, dc.imag], axis=0)
+        return phi, D, np.asarray(dpar, np.intp), np.asarray(dcol, np.intp)
+
+    # ---------------------------------------------------- variable projection
+    def _solve(
+        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], Yw: NDArray[np.float64]
+    ) -> dict[str, Any]:
+        phi, D, dpar, dcol = self.basis(th, m, ref)
+        Q, Rq = np.linalg.qr(phi)
+        Ct = Q.T @ Yw
+        diag = np.abs(np.diag(Rq))
+        if diag.min() <= 1e-13 * diag.max():
+            C = np.linalg.lstsq(phi, Yw, rcond=None)[0]
+        else:
+            C = sla.solve_triangular(Rq, Ct)
+        resid = Yw - Q @ Ct
+        cost = float(np.sum(resid**2))
+        return {"phi": phi, "D": D, "dpar": dpar, "dcol": dcol, "Q": Q, "R": Rq, "C": C,
+                "resid": resid, "cost": cost}
+
+    def _normal(self, sol: dict[str, Any], n_par: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Kaufman ``J^T J`` and ``J^T r`` of the projected residual."""
+        D, Q, C = sol["D"], sol["Q"], sol["C"]
+        dpar, dcol = sol["dpar"], sol["dcol"]
+        qtd = Q.T @ D
+        G = D.T @ D - qtd.T @ qtd
+        W = C @ C.T
+        Md = G * W[np.ix_(dcol, dcol)]
+        A = np.zeros((dpar.size, n_par))
+        A[np.arange(dpar.size), dpar] = 1.0
+        jtj = A.T @ Md @ A
+        Z = sol["resid"] @ C.T  # (n_rows, q)
+        gd = np.einsum("id,id->d", D, Z[:, dcol])
+        jtr = -(A.T @ gd)
+        return 0.5 * (jtj + jtj.T), jtr
+
+    def fit(
+        self,
+        poles: NDArray[np.complex128],
+        part: NDArray[np.complex128],
+        *,
+        refine: bool = True,
+        max_nfev: int = 200,
+        passes: int = 2,
+    ) -> FitResult:
+        """Fit from initial poles (m,) and participation (m, n_in).
+
+        With ``refine=False`` only the linear residues are fitted (LSFD with
+        fixed poles); otherwise poles, participation and residues together.
+        Pass 1 weights each output by ``1 / RMS``; later passes by
+        ``1 / sigma_j`` with ``sigma_j`` the residual RMS of the previous pass.
+        """
+        m = int(poles.size)
+        part = np.asarray(part, complex).reshape(m, self.n_in)
+        if self.kind == "real":
+            ph = np.exp(-1j * np.angle(part[np.arange(m), np.argmax(np.abs(part), axis=1)]))
+            part = (part * ph[:, None]).real.astype(complex)
+        ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+        th = self.pack(np.asarray(poles, complex), part, ref)
+        rms = np.sqrt(np.mean(self.Y**2, axis=0))
+        w = 1.0 / np.where(rms > 0, rms, 1.0)
+        q = self.n_cols(m)
+        dof = self.n_rows - q
+        status = "lsfd"
+        nit = 0
+        warn: list[str] = []
+        for ip in range(max(1, passes if refine else 1)):
+            Yw = self.Y * w[None, :]
+            if refine:
+                th, nfev, status = self._refine(th, m, ref, Yw, max_nfev)
+                nit += nfev
+            sol = self._solve(th, m, ref, Yw)
+            res_ss = np.sum(sol["resid"] ** 2, axis=0) / w**2
+            sig_out = np.sqrt(res_ss / max(dof, 1))
+            if ip + 1 < passes and refine:
+                floor = 1e-9 * rms
+                w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
+        if status == "maxfev":
+            warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
+        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn)
+
+    def _refine(
+        self, th0: NDArray[np.float64], m: int, ref: NDArray[np.intp], Yw: NDArray[np.float64],
+        max_nfev: int,
+    ) -> tuple[NDArray[np.float64], int, str]:
+        n_par = th0.size
+        cache: dict[str, Any] = {}
+        # bounds keep every pole finite: sigma in [1e-7, 5] w_ref, Omega in (0, 20] w_ref
+        lb = np.full(n_par, -np.inf)
+        ub = np.full(n_par, np.inf)
+        lb[0 : 2 * m : 2], ub[0 : 2 * m : 2] = np.log(1e-7), np.log(5.0)
+        lb[1 : 2 * m : 2], ub[1 : 2 * m : 2] = 1e-6, 20.0
+        th0 = np.clip(th0, lb + 1e-9, ub - 1e-9)
+
+        def evaluate(x: NDArray[np.float64]) -> dict[str, Any]:
+            key = x.tobytes()
+            if cache.get("key") != key:
+                sol = self._solve(x, m, ref, Yw)
+                jtj, jtr = self._normal(sol, n_par)
+                scale = np.sqrt(np.maximum(np.diag(jtj), 1e-300))
+                jn = jtj / np.outer(scale, scale)
+                ev, vec = np.linalg.eigh(0.5 * (jn + jn.T))
+                ev = np.maximum(ev, 1e-12 * max(float(ev[-1]), 1e-300))
+                # rc^T rc = jtj (eigenvalues floored): a square root of the normal equations
+                rc = (np.sqrt(ev)[:, None] * vec.T) * scale[None, :]
+                u = (vec.T @ (jtr / scale)) / np.sqrt(ev)
+                rest = np.sqrt(max(sol["cost"] - float(u @ u), 0.0))
+                cache.update(key=key, r=np.append(u, rest), J=np.vstack([rc, np.zeros(n_par)]))
+            return cache
+
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            res = self._least_squares(evaluate, th0, lb, ub, max_nfev)
+        status = "maxfev" if res.status == 0 else "converged"
+        return np.asarray(res.x), int(res.nfev), status
+
+    @staticmethod
+    def _least_squares(
+        evaluate: Any, th0: NDArray[np.float64], lb: NDArray[np.float64],
+        ub: NDArray[np.float64], max_nfev: int,
+    ) -> Any:
+        # trust-region reflective on the square root of the normal equations; the
+        # errstate above silences overflow in scipy's trust-region sub-solver on
+        # wild trial steps (they are rejected by the step control)
+        return least_squares(
+            lambda x: evaluate(x)["r"],
+            th0,
+            jac=lambda x: evaluate(x)["J"],
+            bounds=(lb, ub),
+            method="trf",
+            x_scale="jac",
+            ftol=1e-10,
+            xtol=1e-10,
+            gtol=1e-10,
+            max_nfev=max_nfev,
+        )
+
+    # --------------------------------------------------------- results
+    def _scale(
+        self,
+        th: NDArray[np.float64],
+        m: int,
+        ref: NDArray[np.intp],
+        cd_w: NDArray[np.float64],
+        wd: NDArray[np.float64],
+    ) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.float64]]:
+        """Scale factors ``b`` (m,) with ``psi_out = u b``; ``psi_in`` (n_in, m); ``a^2`` check.
+
+        ``cd_w`` (n_drive, q) are the weighted coefficients of the drive outputs.
+        """
+        poles, part = self.unpack(th, m, ref)
+        if self.kind == "complex":
+            ud = (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None]
+        else:
+            ud = cd_w[:, :m] / wd[:, None] + 0j
+        if ud.shape[0] == 0:
+            a = np.ones(m, complex)
+            a2r = np.ones(m)
+        else:
+            ks = np.array([k for _, k in self.drive])
+            lk = part[:, ks].T  # (n_drive, m)
+            den = np.sum(np.abs(ud) ** 2, axis=0)
+            a2 = np.sum(np.conj(ud) * lk, axis=0) / np.where(den > 0, den, 1.0)
+            a2r = a2.real.copy()
+            if self.kind == "real":
+                a = np.sqrt(np.abs(a2.real)) + 0j
+            else:
+                a = np.sqrt(a2)
+            a = np.where(a == 0, 1.0, a)
+        psi_in = (part / a[:, None]).T
+        b = a.copy()
+        if self.kind == "real":
+            root = np.sqrt(2j * poles.imag)
+            b = a / root
+            psi_in = psi_in / root[None, :]
+        return b, psi_in, a2r
+
+    def _result(
+        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], w: NDArray[np.float64],
+        sol: dict[str, Any], sig_out: NDArray[np.float64], nit: int, status: str,
+        warn: list[str],
+    ) -> FitResult:
+        n_par = th.size
+        C = sol["C"]
+        q = C.shape[0]
+        Cu = C / w[None, :]
+        poles, _ = self.unpack(th, m, ref)
+        didx = np.array([j for j, _ in self.drive], dtype=np.intp)
+        wd = w[didx]
+        b, psi_in, a2r = self._scale(th, m, ref, C[:, didx].T, wd)
+        if self.kind == "complex":
+            u = Cu[0 : 2 * m : 2].T + 1j * Cu[1 : 2 * m : 2].T
+        else:
+            u = Cu[:m].T + 0j
+        psi_out = u * b[None, :]
+        off = (2 if self.kind == "complex" else 1) * m
+        upper = lower = None
+        if self.use_upper:
+            upper = Cu[off : off + self.n_in].T.copy()
+            off += self.n_in
+        if self.use_lower:
+            lower = Cu[off : off + self.n_in].T.copy()
+        if didx.size == 0:
+            warn.append("no drive point (output at an input): shapes are not mass-normalised")
+            phi2 = np.full(m, np.nan + 0j)
+        else:
+            kin = np.array([k for _, k in self.drive], dtype=np.intp)
+            # 2 i Omega_n R_kkn at the drive points (= phi_kn^2 for a real mode, eq. [3])
+            phi2 = np.mean(2j * poles.imag[None, :] * psi_out[didx] * psi_in[kin], axis=0)
+        for n in range(m):
+            f_n = abs(poles[n]) / (2 * np.pi)
+            if didx.size and self.kind == "real" and a2r[n] <= 0:
+                warn.append(
+                    f"mode at {f_n:.2f} Hz: drive-point residue gives phi^2 = 2 i Omega R_kk "
+                    "<= 0 (not real positive); shape scaled with |phi^2|"
+                )
+            if didx.size and self.kind == "complex" and phi2[n].real <= 0:
+                warn.append(
+                    f"mode at {f_n:.2f} Hz: drive-point residue has Re(2 i Omega R_kk) <= 0 "
+                    "(negative modal mass); check the drive point and the mode"
+                )
+        # ---- uncertainty (Gauss-Newton at the optimum + delta method)
+        n_obs = self.n_rows * self.n_out
+        dof = max(n_obs - q * self.n_out - n_par, 1)
+        s2 = sol["cost"] / dof
+        jtj, _ = self._normal(sol, n_par)
+        cth = s2 * np.linalg.pinv(jtj, hermitian=True)
+        x1 = th[0 : 2 * m : 2]
+        sig = self.w_ref * np.exp(x1)
+        om = poles.imag
+        mag = np.abs(poles)
+        jf = np.zeros((m, n_par))
+        jz = np.zeros((m, n_par))
+        ar = np.arange(m)
+        jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
+        jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
+        jz[ar, 2 * ar] = (om**2 / mag**3) * sig
+        jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
+        std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
+        std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
+        std_pole = np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig + 1j * np.sqrt(
+            np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)
+        ) * self.w_ref
+        std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
+        # ---- model, contributions
+        phi = sol["phi"]
+        model_w = phi @ C
+        hw = model_w / w[None, :]
+        nc = self.n_in * self.n_f
+        hm = (hw[:nc] + 1j * hw[nc:]).reshape(self.n_in, self.n_f, self.n_out).transpose(2, 0, 1)
+        model_rec = hm / self.kappa[None, None, :]
+        per = 2 if self.kind == "complex" else 1
+        data_ss = float(np.sum(np.abs(self.H) ** 2))
+        contrib = np.zeros(m)
+        signif = np.zeros(m)
+        for n in range(m):
+            part_n = phi[:, per * n : per * (n + 1)] @ C[per * n : per * (n + 1)]
+            contrib[n] = np.sqrt(np.sum((part_n / w[None, :]) ** 2) / max(data_ss, 1e-300))
+            signif[n] = np.sum(part_n**2) / (s2 * (per * self.n_out + 2))
+        return FitResult(
+            poles=poles,
+            psi_out=psi_out,
+            psi_in=psi_in,
+            upper=upper,
+            lower=lower,
+            std_frequency_hz=std_f,
+            std_damping_ratio=std_z,
+            std_psi_out=std_psi,
+            std_pole=std_pole,
+            model_receptance=model_rec,
+            sigma_out=sig_out,
+            cost=float(sol["cost"]),
+            n_iter=nit,
+            status=status,
+            warnings=warn,
+            contribution=contrib,
+            significance=signif,
+            theta=th,
+            participation=self.unpack(th, m, ref)[1],
+            drive_phi2=phi2,
+        )
+
+    def _shape_std(
+        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], w: NDArray[np.float64],
+        sol: dict[str, Any], cth: NDArray[np.float64], s2: float, b: NDArray[np.complex128],
+        u: NDArray[np.complex128], didx: NDArray[np.intp],
+    ) -> NDArray[np.float64]:
+        """``sqrt(E|d psi_out|^2)`` per entry (n_out, m) by the delta method."""
+        C, Rq, Q, D = sol["C"], sol["R"], sol["Q"], sol["D"]
+        dpar, dcol = sol["dpar"], sol["dcol"]
+        q = C.shape[0]
+        n_par = th.size
+        nd = didx.size
+        rinv = sla.solve_triangular(Rq, np.eye(q))
+        F = rinv @ rinv.T  # (Phi^T Phi)^-1
+        E = rinv @ (Q.T @ D)  # Phi^+ D, (q, n_d)
+        A = np.zeros((dpar.size, n_par))
+        A[np.arange(dpar.size), dpar] = 1.0
+        # M_j = -Phi^+ dPhi/dtheta C_j  -> (n_out, q, n_par)
+        M = -np.einsum("ad,dj,dk->jak", E, C[dcol], A, optimize=True)
+        MC = M @ cth  # Cov(C_j, theta), (n_out, q, n_par)
+        per = 2 if self.kind == "complex" else 1
+        # Var of the coefficient of mode n for output j
+        cov_cc_diag = s2 * np.diag(F)[None, :] + np.einsum("jak,jak->ja", MC, M)
+        if self.kind == "complex":
+            var_u = cov_cc_diag[:, 0 : 2 * m : 2] + cov_cc_diag[:, 1 : 2 * m : 2]
+        else:
+            var_u = cov_cc_diag[:, :m]
+        term1 = np.abs(b[None, :]) ** 2 * var_u / w[:, None] ** 2
+        if nd == 0:
+            # unscaled shapes: only the coefficient noise and the participation
+            return np.asarray(np.sqrt(np.maximum(term1, 0.0)))
+        # global quantities G = [theta, C_D (n_d * q)]
+        cd = C[:, didx].T.copy()
+        wd = w[didx]
+        g0 = np.concatenate([th, cd.ravel()])
+
+        def bfun(g: NDArray[np.float64]) -> NDArray[np.complex128]:
+            return self._scale(g[:n_par], m, ref, g[n_par:].reshape(nd, q), wd)[0]
+
+        ng = g0.size
+        beta = np.zeros((ng, m), complex)
+        for i in range(ng):
+            h = 1e-6 * max(abs(g0[i]), 1e-3 if i < n_par else 1e-3 * np.max(np.abs(cd)))
+            gp = g0.copy()
+            gm = g0.copy()
+            gp[i] += h
+            gm[i] -= h
+            beta[i] = (bfun(gp) - bfun(gm)) / (2 * h)
+        MD = M[didx]  # (nd, q, n_par)
+        # Sigma_GG
+        sgg = np.zeros((ng, ng))
+        sgg[:n_par, :n_par] = cth
+        cdt = MC[didx]  # Cov(C_D, theta): (nd, q, n_par)
+        sgg[n_par:, :n_par] = cdt.reshape(nd * q, n_par)
+        sgg[:n_par, n_par:] = sgg[n_par:, :n_par].T
+        dd = np.einsum("iak,kl,jbl->iajb", MD, cth, MD).reshape(nd * q, nd * q)
+        dd += s2 * np.kron(np.eye(nd), F)
+        sgg[n_par:, n_par:] = dd
+        v3 = np.real(np.einsum("gn,gh,hn->n", beta.conj(), sgg, beta))
+        term3 = np.abs(u) ** 2 * v3[None, :]
+        # Sigma_cG_j = [MC_j, MC_j MD^T + s2 F (j = drive)]  -> (n_out, q, ng)
+        scg = np.zeros((self.n_out, q, ng))
+        scg[:, :, :n_par] = MC
+        scg[:, :, n_par:] = np.einsum("jak,ibk->jaib", MC, MD).reshape(self.n_out, q, nd * q)
+        for i, j in enumerate(didx):
+            scg[j, :, n_par + i * q : n_par + (i + 1) * q] += s2 * F
+        if self.kind == "complex":
+            rows = scg[:, 0 : 2 * m : 2, :] - 1j * scg[:, 1 : 2 * m : 2, :]  # (n_out, m, ng)
+        else:
+            rows = scg[:, :m, :] + 0j
+        cross = np.einsum("jng,gn->jn", rows, beta)
+        term2 = 2 * np.real(np.conj(b)[None, :] / w[:, None] * u * cross)
+        return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))

@@ -1,0 +1,477 @@
+"""Automatic modal identification: FRFs in, real and complex modal models out.
+
+Pipeline of :func:`identify_modes` (spec ``radial-damping.md`` steps 3-6):
+
+1. poles of all model orders by pLSCF (:func:`~tyredamp.modal.lscf.plscf`);
+2. stabilisation and automatic selection (:mod:`~tyredamp.modal.selection`),
+   no frequencies needed; a mode count or approximate frequencies may be given;
+3. residues by LSFD with the complex-mode model; modes whose contribution to
+   the FRFs is negligible are rejected (rule below) and the fit repeated;
+4. for each requested model (``"complex"``: eq. [10]; ``"real"``: eq. [2]/[3])
+   non-linear refinement of poles, participation and residues over all FRFs
+   together (:class:`~tyredamp.modal.fit.ModalFitter`), mass-normalised
+   scaling from the drive points, standard errors, fit indicators.
+
+Rejection rule of step 3 (automatic selection only): a mode is dropped when
+its synthesised FRF has an RMS below ``min_contribution`` (default 0.2 %) of
+the RMS of the data, or when its energy is below ``min_significance``
+(default 25) times the energy that fitting pure noise with the same number
+of parameters would give. After the refinement a mode that left the band, or
+that merged with another (poles closer than 0.05 % of ``|p|``), is dropped
+and the fit repeated.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .._validate import as_finite
+from ..exceptions import ConvergenceError, InputError
+from ..frf import FRF
+from .fit import FitResult, ModalFitter
+from .indicators import mean_phase_deviation, modal_phase_collinearity, relative_error, rmsd
+from .lscf import PoleSet, plscf
+from .model import ModalModel
+from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
+
+__all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
+
+ModelChoice = Literal["real", "complex", "both"]
+_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
+
+
+@dataclass(frozen=True)
+class ModalIdentification:
+    """Result of :func:`identify_modes`.
+
+    Attributes
+    ----------
+    models : dict of str to ModalModel
+        ``"complex"`` and/or ``"real"``; each has ``meta["rmsd"]`` (eq. [19],
+        FRF unit), ``meta["relative_error"]``, ``meta["warnings"]``,
+        ``meta["mpc"]``, ``meta["mpd_deg"]`` and fit details, and standard
+        errors in ``std``.
+    band_hz : (float, float)
+        Analysis band.
+    frf_kind : str
+        Kind of the fitted FRFs.
+    poles : PoleSet
+        Stabilisation data (poles of all orders).
+    flags : StabilityFlags
+        Per-pole stability flags.
+    clusters : list of Cluster
+        Persistent clusters (candidate modes before the residue fit).
+    rejected : list of dict
+        Candidates dropped, each ``{"frequency_hz", "damping_ratio", "reason"}``.
+    frequency : ndarray, shape (n_freq,)
+        Lines used (Hz).
+    discrepancy : dict of str to ndarray
+        ``|H_model - H_data|`` RMS over FRFs per line, for each model.
+    warnings : list of str
+        Pipeline-level remarks.
+    """
+
+    models: dict[str, ModalModel]
+    band_hz: tuple[float, float]
+    frf_kind: str
+    poles: PoleSet
+    flags: StabilityFlags
+    clusters: list[Cluster]
+    rejected: list[dict[str, Any]]
+    frequency: NDArray[np.float64]
+    discrepancy: dict[str, NDArray[np.float64]] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+
+
+def _default_order(n_in: int, n_freq: int, n_modes: int | None) -> int:
+    base = 60 if n_modes is None else max(30, 4 * n_modes + 16)
+    p = int(np.ceil(base / n_in))
+    limit = (2 * n_freq) // (n_in + 1) - 2
+    return max(2, min(p, limit))
+
+
+def identify_modes(
+    frf: FRF,
+    band: tuple[float, float] | None = None,
+    model: ModelChoice = "both",
+    *,
+    n_modes: int | None = None,
+    frequencies: ArrayLike | None = None,
+    max_order: int | None = None,
+    residuals: bool = True,
+    refine: bool = True,
+    max_damping: float = 0.2,
+    cluster_distance: float = 0.01,
+    min_fraction: float = 0.3,
+    min_contribution: float = 0.002,
+    min_significance: float = 25.0,
+    max_helpers: int = 4,
+) -> ModalIdentification:
+    """Identify modes from measured FRFs without hand-holding.
+
+    Parameters
+    ----------
+    frf : FRF
+        Measured FRFs, shape (n_out, n_in, n_freq), any kind. Drive points
+        (an output at the node and direction of an input) fix the mass
+        normalisation; without one the shapes are unscaled (a warning says so).
+    band : (float, float), optional
+        Analysis band in Hz; default the whole axis (0 Hz lines are skipped).
+    model : {"both", "complex", "real"}
+        Which modal models to fit (default both).
+    n_modes : int, optional
+        Number of modes to keep (the most persistent clusters); default
+        automatic.
+    frequencies : array_like of float, optional
+        Approximate natural frequencies (Hz) of the wanted modes; the nearest
+        stable pole of each is used. Overrides ``n_modes``.
+    max_order : int, optional
+        Highest pLSCF order; default ``ceil(60 / n_in)`` (or more when
+        ``n_modes`` is large), capped by the number of lines.
+    residuals : bool
+        Fit upper and lower residual terms (default True).
+    refine : bool
+        Non-linear refinement of poles and residues (default True); without
+        it the poles stay at their pLSCF values (the standard errors then
+        still come from the Gauss-Newton covariance at those values).
+    max_damping, cluster_distance, min_fraction : float
+        Selection rules, see :mod:`tyredamp.modal.selection`.
+    min_contribution, min_significance : float
+        Rejection rule for modes that do not contribute (module docstring).
+    max_helpers : int
+        Largest number of out-of-band residual modes on each side of the band
+        (default 4; 0 for none). They are kept in ``ModalModel.residual_modes``.
+
+    Returns
+    -------
+    ModalIdentification
+
+    Raises
+    ------
+    InputError
+        Bad arguments, a band without lines, or no mode found.
+    """
+    if not isinstance(frf, FRF):
+        raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
+    if model not in ("both", "complex", "real"):
+        raise InputError(f"model: expected 'both', 'complex' or 'real', got {model!r}")
+    lo, hi = (float(frf.frequency[0]), float(frf.frequency[-1])) if band is None else band
+    if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo or lo < 0:
+        raise InputError(f"band: expected 0 <= f_lo < f_hi in Hz, got [{lo}, {hi}]")
+    data = frf.band(max(lo, 0.0), hi)
+    keep = data.frequency > 0
+    if not np.all(keep):
+        data = data.select_lines(np.flatnonzero(keep))
+    f = data.frequency
+    H = np.asarray(data.H)
+    n_out, n_in, n_f = H.shape
+    power = _POWER[data.kind]
+    if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
+        raise InputError(f"n_modes: expected a positive integer, got {n_modes!r}")
+    fr = None
+    if frequencies is not None:
+        fr = np.sort(as_finite(frequencies, "frequencies", ndim=1))
+        if np.any((fr < lo) | (fr > hi)):
+            raise InputError(f"frequencies: expected values inside the band [{lo:g}, {hi:g}] Hz")
+    nm_hint = int(n_modes) if n_modes is not None else (None if fr is None else fr.size)
+    p_max = _default_order(n_in, n_f, nm_hint) if max_order is None else int(max_order)
+    ps = plscf(f, H, p_max, band=(float(f[0]), float(f[-1])))
+    flags = stability_flags(
+        ps, band=(lo, hi), max_damping=max_damping
+    )
+    kept, weak = cluster_poles(ps, flags, cluster_distance=cluster_distance,
+                               min_fraction=min_fraction)
+    rejected: list[dict[str, Any]] = [
+        _rej(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}") for c in weak
+    ]
+    warnings: list[str] = []
+    auto = fr is None and n_modes is None
+    if fr is not None:
+        cand = _pick_frequencies(fr, kept + weak, ps, flags)
+    elif n_modes is not None:
+        pool = sorted(kept + weak, key=lambda c: -c.fraction)
+        if len(pool) < n_modes:
+            warnings.append(f"n_modes: asked for {n_modes}, only {len(pool)} stable clusters")
+        cand = sorted(pool[: int(n_modes)], key=lambda c: c.frequency_hz)
+        chosen = {id(c) for c in cand}
+        rejected = [r for r, c in zip(rejected, weak, strict=True) if id(c) not in chosen]
+    else:
+        cand = kept
+    if not cand:
+        raise InputError(
+            f"no stable mode found in [{lo:g}, {hi:g}] Hz up to order {p_max}; raise "
+            "--max-order, widen the band or give --frequencies"
+        )
+    poles = np.array([c.pole for c in cand])
+    part = np.array([c.participation for c in cand])
+    drive = data.drive_points()
+    cfit = ModalFitter(f, H, power, "complex", drive, upper=residuals, lower=residuals)
+    # ---- step 3: refine, add out-of-band residual modes, reject modes that do not contribute
+    hp = np.zeros(0, complex)
+    hl = np.zeros((0, n_in), complex)
+    if refine and max_helpers > 0:
+        poles, part, hp, hl = _search_helpers(
+            cfit, poles, part, (lo, hi), (float(f[0]), float(f[-1])), max_helpers, min_significance
+        )
+    if auto:
+        for _ in range(len(poles)):
+            res = cfit.fit(
+                np.concatenate([poles, hp]), np.concatenate([part, hl]), refine=refine, passes=1
+            )
+            m = len(poles)
+            con, sig = res.contribution[:m], res.significance[:m]
+            bad = (con < min_contribution) | (sig < min_significance)
+            poles, part = res.poles[:m], res.participation[:m]
+            hp, hl = res.poles[m:], res.participation[m:]
+            if not np.any(bad) or np.all(bad):
+                break
+            worst = int(np.argmin(np.where(bad, sig, np.inf)))
+            why = (
+                f"contribution {con[worst]:.2%} < {min_contribution:.2%}"
+                if con[worst] < min_contribution
+                else f"significance {sig[worst]:.3g} < {min_significance:g}"
+            )
+            rejected.append(_rej(poles[worst], why))
+            poles = np.delete(poles, worst)
+            part = np.delete(part, worst, axis=0)
+    # ---- step 4: each model
+    kinds = ["complex", "real"] if model == "both" else [model]
+    models: dict[str, ModalModel] = {}
+    disc: dict[str, NDArray[np.float64]] = {}
+    for kind in kinds:
+        fitter = cfit if kind == "complex" else ModalFitter(
+            f, H, power, "real", drive, upper=residuals, lower=residuals
+        )
+        res, n_band, dropped = _fit_checked(fitter, poles, part, hp, hl, refine, (lo, hi))
+        rejected += [_rej(p, f"{kind} fit: {why}") for p, why in dropped]
+        kap = (2j * np.pi * f) ** power
+        hm = res.model_receptance * kap[None, None, :]
+        mdl = _to_model(res, n_band, kind, data, (lo, hi), p_max, hm)
+        models[kind] = mdl
+        disc[kind] = np.sqrt(np.mean(np.abs(hm - H) ** 2, axis=(0, 1)))
+    return ModalIdentification(
+        models=models,
+        band_hz=(lo, hi),
+        frf_kind=data.kind,
+        poles=ps,
+        flags=flags,
+        clusters=kept,
+        rejected=rejected,
+        frequency=f,
+        discrepancy=disc,
+        warnings=warnings,
+    )
+
+
+def _rej(p: complex, why: str) -> dict[str, Any]:
+    return {
+        "frequency_hz": float(abs(p) / (2 * np.pi)),
+        "damping_ratio": float(-p.real / abs(p)),
+        "reason": why,
+    }
+
+
+def _pick_frequencies(
+    fr: NDArray[np.float64], clusters: list[Cluster], ps: PoleSet, flags: StabilityFlags
+) -> list[Cluster]:
+    """The cluster (or, failing that, the admissible pole) nearest to each frequency."""
+    out: list[Cluster] = []
+    used: set[int] = set()
+    adm = np.flatnonzero(flags.admissible)
+    for fi in fr:
+        best = None
+        if clusters:
+            d = np.array([abs(c.frequency_hz - fi) / fi for c in clusters])
+            for i in np.argsort(d):
+                if d[i] <= 0.05 and int(i) not in used:
+                    best = clusters[int(i)]
+                    used.add(int(i))
+                    break
+        if best is None:
+            if adm.size == 0:
+                raise InputError(f"frequencies: no admissible pole near {fi:g} Hz")
+            top = ps.order[adm].max()
+            cand = adm[ps.order[adm] >= top - 2]
+            j = cand[np.argmin(np.abs(ps.frequency_hz[cand] - fi))]
+            if abs(ps.frequency_hz[j] - fi) > 0.1 * fi:
+                raise InputError(f"frequencies: no admissible pole within 10 % of {fi:g} Hz")
+            best = Cluster(
+                pole=complex(ps.poles[j]),
+                participation=ps.participation[j],
+                members=np.array([j]),
+                fraction=0.0,
+                spread_frequency=0.0,
+            )
+        out.append(best)
+    return out
+
+
+def _search_helpers(
+    fitter: ModalFitter,
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    band: tuple[float, float],
+    data_band: tuple[float, float],
+    max_helpers: int,
+    min_significance: float,
+) -> tuple[
+    NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]
+]:
+    """Refine, then add out-of-band residual modes while they are significant.
+
+    A trial pole is started at ``1.1 f_hi`` (then ``1.3 f_hi``, ...) above the
+    band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0``, with the median
+    damping of the in-band modes. It is kept when, after the refinement, it
+    lies outside the band but within a factor 2 of its edge, no in-band mode
+    left the band, and the residual sum of squares dropped significantly:
+    ``F = sum_j dof (s2_before,j - s2_after,j) / s2_after,j / n_added``
+    (per-output residual variances) reaches ``min_significance``.
+    """
+    lo, hi = band
+    m = len(poles)
+    res = fitter.fit(poles, part, refine=True, passes=1)
+    cur_p, cur_l = res.poles, res.participation
+    per = 2 if fitter.kind == "complex" else 1
+    dof = fitter.n_rows
+    zeta0 = float(np.clip(np.median(-cur_p.real / np.abs(cur_p)), 0.005, 0.1))
+    sides = [1.0] + ([-1.0] if data_band[0] > 0 else [])
+    for side in sides:
+        for k in range(max_helpers):
+            fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
+            if fh <= 0:
+                break
+            wh = 2 * np.pi * fh
+            ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
+            lh = np.ones((1, fitter.n_in), complex)
+            try:
+                trial = fitter.fit(
+                    np.append(cur_p, ph), np.concatenate([cur_l, lh]), refine=True, passes=1
+                )
+            except (np.linalg.LinAlgError, ValueError):
+                break
+            fd = trial.poles[-1].imag / (2 * np.pi)
+            fin = trial.poles[:m].imag / (2 * np.pi)
+            outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)
+            inside = bool(np.all((fin >= lo) & (fin <= hi)))
+            s2a = np.maximum(trial.sigma_out**2, 1e-300)
+            n_added = per * fitter.n_out + 2 * fitter.n_in
+            fstat = float(np.sum(dof * (res.sigma_out**2 - s2a) / s2a)) / n_added
+            if not (outside and inside and fstat >= min_significance):
+                break
+            res = trial
+            cur_p, cur_l = trial.poles, trial.participation
+    return cur_p[:m], cur_l[:m], cur_p[m:], cur_l[m:]
+
+
+def _fit_checked(
+    fitter: ModalFitter,
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    hp: NDArray[np.complex128],
+    hl: NDArray[np.complex128],
+    refine: bool,
+    band: tuple[float, float],
+) -> tuple[FitResult, int, list[tuple[complex, str]]]:
+    """Fit modes and residual modes; drop any that left its side of the band or merged."""
+    dropped: list[tuple[complex, str]] = []
+    for _ in range(len(poles) + len(hp) + 1):
+        m = len(poles)
+        res = fitter.fit(np.concatenate([poles, hp]), np.concatenate([part, hl]), refine=refine)
+        p = res.poles
+        fd = p.imag / (2 * np.pi)
+        inb = (fd >= band[0]) & (fd <= band[1])
+        wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:]]))
+        bad: int | None = None
+        why = ""
+        if wrong.size:
+            bad = int(wrong[0])
+            why = f"crossed the band edge during refinement ({fd[bad]:.2f} Hz)"
+        else:
+            d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
+            np.fill_diagonal(d, np.inf)
+            if d.size and d.min() < 5e-4:
+                i, j = np.unravel_index(np.argmin(d), d.shape)
+                bad = int(i if res.contribution[i] < res.contribution[j] else j)
+                why = "merged with another mode during refinement"
+        if bad is None:
+            return res, m, dropped
+        if bad < m:
+            if m == 1:
+                raise ConvergenceError(f"the only mode {why}")
+            dropped.append((complex(poles[bad]), why))
+            poles = np.delete(poles, bad)
+            part = np.delete(part, bad, axis=0)
+        else:
+            hp = np.delete(hp, bad - m)
+            hl = np.delete(hl, bad - m, axis=0)
+    raise ConvergenceError("refinement kept losing modes")
+
+
+def _to_model(
+    res: FitResult,
+    n_band: int,
+    kind: str,
+    data: FRF,
+    band: tuple[float, float],
+    p_max: int,
+    h_model: NDArray[np.complex128],
+) -> ModalModel:
+    H = np.asarray(data.H)
+    mk: Literal["complex", "real"] = "complex" if kind == "complex" else "real"
+    resid_modes = None
+    if len(res.poles) > n_band:
+        resid_modes = ModalModel(
+            res.poles[n_band:],
+            res.psi_out[:, n_band:],
+            res.psi_in[:, n_band:],
+            mode_kind=mk,
+            outputs=data.outputs,
+            inputs=data.inputs,
+            meta={"role": "out-of-band modes used as residual terms"},
+        )
+    # in-band modes, sorted by Im p as ModalModel sorts them (keeps meta arrays aligned)
+    o = np.argsort(res.poles[:n_band].imag)
+    poles, psi_out, psi_in = res.poles[o], res.psi_out[:, o], res.psi_in[:, o]
+    std = {
+        "frequency_hz": res.std_frequency_hz[o],
+        "damping_ratio": res.std_damping_ratio[o],
+        "psi_out": res.std_psi_out[:, o],
+    }
+    meta = {
+        "band_hz": [band[0], band[1]],
+        "frf_kind": data.kind,
+        "rmsd": rmsd(H, h_model),
+        "relative_error": relative_error(H, h_model),
+        "rmsd_per_frf": np.asarray(rmsd(H, h_model, axis=-1)),
+        "n_lines": int(data.n_freq),
+        "method": "pLSCF poles, automatic selection, LSFD, variable-projection refinement",
+        "max_order": p_max,
+        "refinement": res.status,
+        "n_evaluations": res.n_iter,
+        "noise_rms_per_output": res.sigma_out,
+        "mpc": modal_phase_collinearity(psi_out),
+        "mpd_deg": mean_phase_deviation(psi_out),
+        "contribution": res.contribution[o],
+        "significance": res.significance[o],
+        "drive_point_phi2": res.drive_phi2[o],
+        "std_pole": res.std_pole[o],
+        "n_residual_modes": len(res.poles) - n_band,
+        "warnings": list(res.warnings),
+    }
+    return ModalModel(
+        poles,
+        psi_out,
+        psi_in,
+        mode_kind=mk,
+        outputs=data.outputs,
+        inputs=data.inputs,
+        upper_residual=res.upper,
+        lower_residual=res.lower,
+        std=std,
+        meta=meta,
+        residual_modes=resid_modes,
+    )
