@@ -23,8 +23,6 @@ from tyredamp.signal import (
 )
 from tyredamp.timedata import TimeData
 
-from .helpers import chain_system
-
 _KIND = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
 
 
@@ -235,8 +233,10 @@ def test_transient_burst_random_leakage_free() -> None:
         meta=meta,
     )
     frf = estimate_frf(td)
-    assert frf.meta["method"] == "transient" and frf.meta["n_averages"] == 6
-    assert frf.frequency[0] >= 1.0 and frf.frequency[-1] <= 40.0  # band from meta
+    assert frf.meta["method"] == "transient"
+    assert frf.meta["n_averages"] == 6
+    assert frf.frequency[0] >= 1.0
+    assert frf.frequency[-1] <= 40.0
     ref = sys2.frf(frf.frequency, inputs=[0]).H
     # the response has decayed by the end of each record (sigma >= 10 1/s, 2.4 s of
     # silence), so a rectangular window is leakage free; what remains is the
@@ -270,7 +270,9 @@ def test_kind_and_reference_selection(chain: MCKSystem, rng) -> None:
         chain, 200.0, 400, lines, [0, 3], [1, 2], 4, rng, "velocity", new_phases_each_period=True
     )
     frf = estimate_frf(td, reference="F4")  # by name: the second force only
-    assert frf.kind == "mobility" and frf.n_in == 1 and frf.inputs[0].node == 4
+    assert frf.kind == "mobility"
+    assert frf.n_in == 1
+    assert frf.inputs[0].node == 4
     assert [c.node for c in frf.outputs] == [2, 3]
     assert resolve_channels(td.channels, ["1+Z", 4, "3"], "x") == [0, 1, 3]
     with pytest.raises(InputError, match="matches 2 channels"):

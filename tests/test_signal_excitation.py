@@ -48,7 +48,7 @@ def test_pseudo_random_flat_band_spectrum(seed, period, lo, width, rms) -> None:
     assert exc.n_samples == 3 * period
     assert_allclose(exc.signal[:period], exc.signal[2 * period :], rtol=0, atol=0)  # periodic
     assert exc.rms == pytest.approx(rms, rel=1e-12)
-    f, a = exc.amplitude_spectrum()
+    _f, a = exc.amplitude_spectrum()
     # flat: every band line carries rms * sqrt(2 / n_lines); nothing outside the band
     assert_allclose(a[lines], rms * np.sqrt(2.0 / lines.size), rtol=1e-9)
     assert_allclose(np.delete(a, lines), 0.0, atol=1e-9 * rms)
@@ -79,19 +79,22 @@ def test_periodic_chirp() -> None:
 
 def test_swept_chirp_and_burst_random() -> None:
     exc = swept_chirp(1000.0, 5000, (5.0, 200.0), rms=1.0, taper=0.1)
-    assert exc.period_samples is None and exc.signal[0] == 0.0
+    assert exc.period_samples is None
+    assert exc.signal[0] == 0.0
     assert np.max(np.abs(exc.signal)) <= np.sqrt(2) + 1e-12
     b = burst_random(1000.0, 1000, (10.0, 100.0), rms=2.0, burst_fraction=0.3, n_records=3, rng=1)
     rec = b.signal.reshape(3, 1000)
     assert_allclose(rec[:, 300:], 0.0, atol=0)  # silent after the burst
     assert_allclose(np.sqrt(np.mean(rec[:, :300] ** 2, axis=1)), 2.0, rtol=1e-12)
     assert not np.allclose(rec[0], rec[1])  # new noise in every record
-    assert b.meta()["record_samples"] == 1000 and b.meta()["band_hz"] == [10.0, 100.0]
+    assert b.meta()["record_samples"] == 1000
+    assert b.meta()["band_hz"] == [10.0, 100.0]
 
 
 def test_windows() -> None:
     w, tau = exponential_window(101, 100.0, 0.05)
-    assert w[0] == 1.0 and w[-1] == pytest.approx(0.05, rel=1e-12)
+    assert w[0] == 1.0
+    assert w[-1] == pytest.approx(0.05, rel=1e-12)
     assert tau == pytest.approx(1.0 / np.log(20.0))
     assert_allclose(segment_window("rect", 8), 1.0)
     assert segment_window("hann", 8)[0] == 0.0
