@@ -40,11 +40,13 @@ def _register() -> None:
     from .damping import damping_command
     from .frf import frf_command
     from .lateral import lateral_group
+    from .modal import modal_command
 
     cli.add_command(frf_command)
     cli.add_command(check_group)
     cli.add_command(damping_command)
     cli.add_command(lateral_group)
+    cli.add_command(modal_command)
 
 
 _register()
