@@ -1,0 +1,131 @@
+"""``tyredamp lateral fit`` and ``tyredamp lateral simulate``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from tyredamp.cli import cli, main
+from tyredamp.io import read_frf
+
+
+def test_simulate_then_fit(tmp_path: Path) -> None:
+    runner = CliRunner()
+    frf_path = tmp_path / "rig.npz"
+    res = runner.invoke(
+        cli,
+        [
+            "lateral",
+            "simulate",
+            "--out",
+            str(frf_path),
+            "--speed",
+            "10",
+            "--pressure",
+            "2.4",
+            "--force",
+            "axle",
+            "--seed",
+            "3",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    frf = read_frf(frf_path)
+    assert frf.meta["force"] == "axle"
+    assert frf.meta["pressure_bar"] == 2.4
+    out = tmp_path / "fit.json"
+    res = runner.invoke(
+        cli,
+        [
+            "lateral",
+            "fit",
+            str(frf_path),
+            "--out",
+            str(out),
+            "--models",
+            "proposed,maxwell",
+            "--models",
+            "string",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert "rank  model" in res.output
+    assert "amp.err %" in res.output
+    doc = json.loads(out.read_text())
+    assert doc["tyredamp"] == "lateral-fit"
+    assert sorted(doc["order"]) == ["hysteretic", "maxwell", "string"]
+    assert doc["conditions"]["force"] == "axle"
+    assert doc["conditions"]["wheel_mass_kg"] == 100.0
+    assert abs(doc["conditions"]["speed_kmh"] - 10.0) < 1e-12
+    fit0 = doc["fits"][0]
+    for key in ("params", "stderr", "units", "aic", "bic", "amplitude_error", "amplitude_bias"):
+        assert key in fit0
+    assert len(doc["reasons"]) == 3
+
+
+def test_fit_options_override_meta(tmp_path: Path) -> None:
+    runner = CliRunner()
+    frf_path = tmp_path / "rig.csv"
+    assert runner.invoke(cli, ["lateral", "simulate", "-o", str(frf_path)]).exit_code == 0
+    out = tmp_path / "fit.json"
+    res = runner.invoke(
+        cli,
+        [
+            "lateral",
+            "fit",
+            str(frf_path),
+            "-o",
+            str(out),
+            "--speed",
+            "7",
+            "--band",
+            "0.5",
+            "8",
+            "--criterion",
+            "aic",
+            "--weights",
+            "relative",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    doc = json.loads(out.read_text())
+    assert doc["criterion"] == "aic"
+    assert abs(doc["conditions"]["speed_kmh"] - 7.0) < 1e-12
+    assert doc["input"]["band_hz"][0] >= 0.5
+
+
+@pytest.mark.parametrize("cmd", [["lateral"], ["lateral", "fit"], ["lateral", "simulate"]])
+def test_help_has_example(cmd: list[str]) -> None:
+    res = CliRunner().invoke(cli, [*cmd, "--help"])
+    assert res.exit_code == 0
+    assert "Example:" in res.output
+
+
+def test_errors_are_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "fit.json"
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(tmp_path / "missing.npz"), "--out", str(out)])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("tyredamp: error:")
+    assert len(err.strip().splitlines()) == 1
+    assert not out.exists()
+    # A model that needs the speed, on a file without one: input error, no output written.
+    frf_path = tmp_path / "plain.npz"
+    assert CliRunner().invoke(cli, ["lateral", "simulate", "-o", str(frf_path)]).exit_code == 0
+    frf = read_frf(frf_path)
+    from tyredamp.io import write_frf
+
+    bare = tmp_path / "bare.npz"
+    write_frf(frf._new(meta={}), bare)
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(bare), "--out", str(out), "--models", "relaxation"])
+    assert exc.value.code == 2
+    assert "speed" in capsys.readouterr().err
+    assert not out.exists()
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(bare), "--out", str(out), "--models", "nonsense"])
+    assert exc.value.code == 2
