@@ -10,16 +10,16 @@ from numpy.testing import assert_allclose
 
 from tyredamp import InputError, TyredampError
 from tyredamp.mechanics import time_response
+from tyredamp.signal import band_lines
 from tyredamp.timedata import TimeData
 from tyredamp.tyre import (
     MeasurementLayout,
     RingTyre,
     VirtualModalTest,
-    chirp_lines,
     hadamard_drive_matrix,
-    periodic_chirp,
     periodic_initial_state,
     run_modal_test,
+    schroeder_multisine,
 )
 
 #: A small, fast configuration: 64 DOFs, 1 s period at 512 Hz, 4x oversampling.
@@ -45,7 +45,7 @@ def cyclic_frf(data: TimeData, run_starts: list[int] | None = None) -> np.ndarra
     f, y = spec[fi], spec[ri]
     syf = np.einsum("jpk,ipk->jik", y, np.conj(f))
     sff = np.einsum("jpk,ipk->kji", f, np.conj(f))  # (line, j, i)
-    lines = np.asarray(data.meta["excitation"]["lines"])
+    lines = np.asarray(data.meta["lines"])
     h = np.empty((len(ri), len(fi), lines.size), dtype=complex)
     for n, k in enumerate(lines):
         h[:, :, n] = syf[:, :, k] @ np.linalg.inv(sff[k].T)
@@ -82,21 +82,23 @@ def exact_foh_accelerance(
 
 
 # ----------------------------------------------------------------- excitation
-def test_periodic_chirp_spectrum() -> None:
-    x = periodic_chirp(1024, 1024.0, 10.0, 200.0, rms=3.0, oversample=4)
-    assert x.shape == (4096,)
+def test_schroeder_multisine_spectrum() -> None:
+    exc = schroeder_multisine(4096.0, 4096, (10.0, 200.0), rms=3.0, n_periods=2)
+    x = exc.signal
+    assert x.shape == (8192,)
+    assert exc.period_samples == 4096
     assert np.sqrt(np.mean(x**2)) == pytest.approx(3.0, rel=1e-12)
-    spec = np.abs(np.fft.rfft(x))
-    lines = chirp_lines(1024, 1024.0, 10.0, 200.0)
+    spec = np.abs(np.fft.rfft(x[:4096]))
+    lines = band_lines(4096.0, 4096, (10.0, 200.0))
     assert lines[0] == 10
     assert lines[-1] == 200
     # flat on the band, nothing elsewhere (rounding 1e-9 of the line amplitude)
     assert_allclose(spec[lines], spec[lines][0], rtol=1e-9)
     others = np.delete(spec, lines)
     assert np.max(others) < 1e-9 * spec[lines][0]
-    # the oversampled signal is the same band-limited signal
-    base = periodic_chirp(1024, 1024.0, 10.0, 200.0, rms=3.0)
-    assert_allclose(x[::4], base * np.sqrt(np.mean(x[::4] ** 2)) / 3.0, atol=1e-12)
+    # generated 4x faster, every 4th sample is the same band-limited signal
+    slow = schroeder_multisine(1024.0, 1024, (10.0, 200.0), rms=1.0).signal
+    assert_allclose(x[:4096:4] / np.sqrt(np.mean(x[:4096:4] ** 2)), slow, atol=1e-12)
 
 
 def test_hadamard_drive_matrix_orthogonal() -> None:
@@ -109,7 +111,7 @@ def test_hadamard_drive_matrix_orthogonal() -> None:
 # -------------------------------------------------------------- steady state
 def test_periodic_initial_state_is_periodic(small_tyre: RingTyre) -> None:
     fs = 2048.0
-    base = periodic_chirp(512, fs, 0.0, 200.0, rms=10.0)[None, :]
+    base = schroeder_multisine(fs, 512, (0.0, 200.0), rms=10.0).signal[None, :]
     x0, v0 = periodic_initial_state(small_tyre.system, base, fs, small_tyre.drive_dofs)
     resp = time_response(
         small_tyre.system, np.tile(base, 3), fs, small_tyre.drive_dofs.tolist(), x0=x0, v0=v0
@@ -159,8 +161,10 @@ def test_default_test_shapes_and_metadata(default_test: VirtualModalTest) -> Non
     assert m["run_starts"] == [0]
     assert m["snr_db"] == 40.0
     assert m["seed"] == 7
-    assert m["excitation"]["lines"][0] == 1
-    assert m["excitation"]["lines"][-1] == 800
+    assert m["excitation"] == "periodic_chirp"
+    assert m["lines"][0] == 1
+    assert m["lines"][-1] == 800  # every DFT line in 0-200 Hz (DC excluded)
+    assert m["excitation_band_hz"] == [0.25, 199.75]  # sweep edges on DFT lines
     assert default_test.frequency_lines[-1] == 200.0
     tr = default_test.truth
     assert tr.band == (0.0, 200.0)
@@ -195,7 +199,7 @@ def test_noise_at_requested_snr(small_tyre: RingTyre, snr: float) -> None:
 
 
 def test_cyclic_frf_equals_exact_foh_response(small_tyre: RingTyre) -> None:
-    vt = run_modal_test(small_tyre, snr_db=None, **SMALL)
+    vt = run_modal_test(small_tyre, snr_db=None, excitation="multisine", **SMALL)
     h = cyclic_frf(vt.data)
     f = vt.frequency_lines
     ref = exact_foh_accelerance(small_tyre, f, 512.0 * 4)
@@ -216,17 +220,23 @@ def test_default_cyclic_frf_equals_true_accelerance(default_test: VirtualModalTe
     assert_allclose(h, true, rtol=1e-2)
     assert np.max(np.abs(h - true)) < 2e-3 * np.abs(true).max()
     # the noisy test (40 dB per channel, 8 averages): on lines with |A| > 0.1 max |A|
-    # the error is noise, measured 1.5-2.0 % over seeds 0-4; 3 % allowed
+    # the error is noise, max over the lines 1.6-2.7 % for seeds 0-4; 4 % allowed
     hn = cyclic_frf(default_test.data)
     big = np.abs(true) > 0.1 * np.abs(true).max()
-    assert_allclose(hn[big], true[big], rtol=3e-2)
+    assert_allclose(hn[big], true[big], rtol=4e-2)
 
 
 @pytest.mark.parametrize("mode", ["sequential", "simultaneous"])
 def test_multi_reference(mode: str) -> None:
     layout = MeasurementLayout(drive_points=(1, 4))
     tyre = RingTyre(layout=layout, n_ring=32)
-    vt = run_modal_test(tyre, snr_db=None, drive_mode=mode, **SMALL)  # type: ignore[arg-type]
+    vt = run_modal_test(
+        tyre,
+        snr_db=None,
+        drive_mode=mode,  # type: ignore[arg-type]
+        excitation="multisine",
+        **SMALL,
+    )
     assert vt.data.n_channels == 18
     assert vt.n_runs == 2
     assert vt.meta["run_starts"] == [0, 4 * 512]
@@ -253,8 +263,10 @@ def test_multi_reference(mode: str) -> None:
     ("kwargs", "word"),
     [
         ({"period": 1.0001}, "period"),
-        ({"band": (0.0, 300.0), "sample_rate": 512.0, "period": 1.0}, "f_stop"),
-        ({"band": (150.0, 100.0)}, "f_start"),
+        ({"band": (0.0, 300.0), "sample_rate": 512.0, "period": 1.0}, "band"),
+        ({"band": (150.0, 100.0)}, "band"),
+        ({"band": "wide"}, "band"),
+        ({"excitation": "noise"}, "excitation"),
         ({"n_periods": 0}, "n_periods"),
         ({"oversample": 0}, "oversample"),
         ({"settle_periods": -1}, "settle_periods"),
@@ -277,4 +289,4 @@ def test_bad_tyre_and_run_index(small_tyre: RingTyre) -> None:
     with pytest.raises(InputError, match="run"):
         vt.run_data(1)
     with pytest.raises(InputError, match="period_samples"):
-        chirp_lines(2, 100.0, 0.0, 10.0)
+        schroeder_multisine(100.0, 2, (0.0, 10.0))

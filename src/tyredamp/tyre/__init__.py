@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .excitation import chirp_lines, hadamard_drive_matrix, periodic_chirp
+from .excitation import hadamard_drive_matrix, schroeder_multisine
 from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
 from .rig import VirtualModalTest, periodic_initial_state, run_modal_test
 from .ring import (
@@ -26,15 +26,14 @@ __all__ = [
     "TyreTruth",
     "VirtualModalTest",
     "analytic_ring_frequencies",
-    "chirp_lines",
     "difference_symbol",
     "hadamard_drive_matrix",
     "modal_phase_collinearity",
-    "periodic_chirp",
     "periodic_initial_state",
     "ring_convergence",
     "ring_dispersion",
     "run_modal_test",
+    "schroeder_multisine",
     "staggered_weights",
     "wave_numbers",
 ]

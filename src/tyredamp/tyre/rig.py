@@ -1,11 +1,21 @@
 """The virtual modal test rig of paper 000: shaker, periodic chirp, 16 accelerometers.
 
 The tyre (its full ring discretisation) is driven radially at the drive
-point(s) by a periodic chirp (:func:`~tyredamp.tyre.excitation.periodic_chirp`)
-and the radial accelerations at the measured points are recorded together
-with the forces, with independent Gaussian noise on every channel. The
-response is computed with :func:`tyredamp.mechanics.time_response` (exact
-modal integration with a first-order hold of the sampled force).
+point(s) by a periodic chirp and the radial accelerations at the measured
+points are recorded together with the forces, with independent Gaussian
+noise on every channel. The response is computed with
+:func:`tyredamp.mechanics.time_response` (exact modal integration with a
+first-order hold of the sampled force).
+
+Excitation
+----------
+``excitation="chirp"`` (default): the periodic linear sweep of
+:func:`tyredamp.signal.periodic_chirp` (the chirp of paper 000; its band
+edges are moved to DFT lines so that it is continuous from period to period).
+``"multisine"``: the band-limited Schroeder multisine of
+:func:`~tyredamp.tyre.excitation.schroeder_multisine` (flat spectrum on the
+band lines, nothing elsewhere). ``meta["lines"]`` lists the DFT lines of one
+period inside ``band``.
 
 Steady state
 ------------
@@ -24,12 +34,18 @@ them and says so in ``meta["settle_samples"]``.
 
 Sampling
 --------
-The force is generated ``oversample`` times faster than ``sample_rate``,
-simulated at that rate and every ``oversample``-th sample is kept. The
-first-order hold interprets the band-limited force as piecewise linear, so
-the cyclic FRF of the noise-free data is exactly
-``sum_m A(f + m fs_sim) sinc^2(f / fs_sim + m)`` (``fs_sim = oversample fs``,
-``A`` the true accelerance; checked in the tests), which differs from
+The force is generated ``oversample`` times faster than ``sample_rate``
+(``fs_sim``) and the response simulated at that rate. The acquisition then
+applies an ideal anti-alias filter (all DFT lines of the simulated period at
+or above ``sample_rate / 2`` removed, on every channel alike, like a DAQ with
+matched filters) and keeps every ``oversample``-th sample. For the periodic
+steady state the filter is exact; in ``initial_state="rest"`` it is applied
+per period and smears the (discarded) transient slightly.
+
+The first-order hold interprets the force as piecewise linear between the
+``fs_sim`` samples, so for the band-limited multisine the cyclic FRF of the
+noise-free data is exactly ``sum_m A(f + m fs_sim) sinc^2(f / fs_sim + m)``
+(``A`` the true accelerance; checked in the tests), which differs from
 ``A(f)`` by about ``(pi f / fs_sim)^2 / 3 * |A(f) - M^-1|`` plus folded
 extensional resonances: 5e-4 at 200 Hz for the defaults, below 1 % of
 ``|A|`` at every line of the default test.
@@ -40,7 +56,7 @@ All shakers stay attached (their masses and dampers are part of the tyre)
 and the record is a sequence of *runs*, each ``n_periods`` periods of steady
 state: ``drive_mode="sequential"`` drives one input per run (classical
 roving-shaker multi-reference test); ``"simultaneous"`` drives all inputs in
-every run with the same chirp times the signs of a Hadamard matrix
+every run with the same signal times the signs of a Hadamard matrix
 (orthogonal multisines, :func:`~tyredamp.tyre.excitation.hadamard_drive_matrix`),
 so the input cross-spectral matrix summed over the runs is diagonal. Either
 way every period of the record is a steady-state period and an H1 estimator
@@ -62,8 +78,9 @@ from .._validate import check_positive
 from ..exceptions import InputError
 from ..frf import FRF, FRFKind
 from ..mechanics import ComplexModes, MCKSystem, step_coefficients, time_response
+from ..signal.excitation import band_lines, periodic_chirp
 from ..timedata import TimeData
-from .excitation import chirp_lines, hadamard_drive_matrix, periodic_chirp
+from .excitation import hadamard_drive_matrix, schroeder_multisine
 from .ring import RingTyre
 from .truth import TyreTruth
 
@@ -71,6 +88,7 @@ __all__ = ["VirtualModalTest", "periodic_initial_state", "run_modal_test"]
 
 DriveMode = Literal["sequential", "simultaneous"]
 InitialState = Literal["periodic", "rest"]
+ExcitationKind = Literal["chirp", "multisine"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,7 +102,8 @@ class VirtualModalTest:
         acceleration channels (one per measured point, ``"acceleration"``,
         m/s^2). ``data.meta`` holds ``period_samples``, ``settle_samples``,
         ``n_periods`` (per run), ``run_starts``, ``drive_matrix``,
-        ``excitation``, ``snr_db``, ``noise_std``, ``seed`` and more.
+        ``excitation`` (signal name), ``lines``, ``band_hz``, ``snr_db``,
+        ``noise_std``, ``seed`` and more.
     truth : TyreTruth
         Exact modes, damping and FRFs of the tested tyre in the test band.
     tyre : RingTyre
@@ -116,7 +135,7 @@ class VirtualModalTest:
     @property
     def frequency_lines(self) -> NDArray[np.float64]:
         """Excited frequencies in Hz (DFT lines of one period), shape (K,)."""
-        lines = np.asarray(self.data.meta["excitation"]["lines"], dtype=float)
+        lines = np.asarray(self.data.meta["lines"], dtype=float)
         return lines * self.data.sample_rate / self.period_samples
 
     def run_data(self, run: int) -> TimeData:
@@ -157,6 +176,21 @@ def _modal_propagate(
         q, _ = lfilter(b, np.array([1.0, -phi[j]]), g[j], zi=zi)
         out[j] = q[-1]
     return out
+
+
+def _acquire(x: NDArray[np.float64], r: int) -> NDArray[np.float64]:
+    """Ideal anti-alias filter and decimation by ``r`` of one period (rows of ``x``).
+
+    Keeps the DFT lines ``0 <= k < P/2`` of the ``P r``-sample period (``P``
+    samples at the acquisition rate) and returns the ``P`` samples of that
+    band-limited signal at the acquisition instants.
+    """
+    n = x.shape[1]
+    p = n // r
+    spec = np.fft.rfft(x, axis=1)[:, : p // 2 + 1]
+    if p % 2 == 0:
+        spec[:, p // 2] = 0.0
+    return np.fft.irfft(spec, n=p, axis=1) / r
 
 
 def _modal_to_physical(
@@ -223,6 +257,7 @@ def run_modal_test(
     force_rms: float = 10.0,
     snr_db: float | None = 40.0,
     seed: int | np.random.Generator | None = None,
+    excitation: ExcitationKind = "chirp",
     drive_mode: DriveMode = "sequential",
     oversample: int = 16,
     initial_state: InitialState = "periodic",
@@ -255,6 +290,9 @@ def run_modal_test(
         Default 40.
     seed : int, numpy.random.Generator or None
         Noise seed; the same seed gives the same data.
+    excitation : {"chirp", "multisine"}
+        Periodic linear sweep (:func:`tyredamp.signal.periodic_chirp`,
+        default) or band-limited Schroeder multisine (module docstring).
     drive_mode : {"sequential", "simultaneous"}
         With several drive points: one input per run, or all inputs in every
         run with Hadamard signs (module docstring).
@@ -308,19 +346,29 @@ def run_modal_test(
             raise InputError("snr_db: expected a number in dB or None, got NaN")
     if drive_mode not in ("sequential", "simultaneous"):
         raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
+    if excitation not in ("chirp", "multisine"):
+        raise InputError(f"excitation: expected 'chirp' or 'multisine', got {excitation!r}")
     if initial_state not in ("periodic", "rest"):
         raise InputError(f"initial_state: expected 'periodic' or 'rest', got {initial_state!r}")
-    if len(band) != 2:
-        raise InputError(f"band: expected (f_lo, f_hi) in Hz, got {band!r}")
-    lines = chirp_lines(p_samples, fs, band[0], band[1])
-    truth = tyre.truth(band=(float(band[0]), float(band[1])))
+    try:
+        if len(band) != 2:
+            raise TypeError
+        bnd = (float(band[0]), float(band[1]))
+    except (TypeError, ValueError):
+        raise InputError(f"band: expected (f_lo, f_hi) in Hz, got {band!r}") from None
+    lines = band_lines(fs, p_samples, bnd)
+    truth = tyre.truth(band=bnd)
     rng = np.random.default_rng(seed)
 
     n_in = len(tyre.layout.drive_points)
     drive = np.eye(n_in) if drive_mode == "sequential" else hadamard_drive_matrix(n_in)
     r = int(oversample)
     fs_sim = fs * r
-    base = periodic_chirp(p_samples, fs, band[0], band[1], rms=f_rms, oversample=r)
+    if excitation == "chirp":
+        exc = periodic_chirp(fs_sim, p_samples * r, bnd, rms=f_rms)
+    else:
+        exc = schroeder_multisine(fs_sim, p_samples * r, bnd, rms=f_rms)
+    base = exc.signal
     system = tyre.system
     cm = system.complex_modes()
     inputs = tyre.drive_dofs.tolist()
@@ -334,7 +382,7 @@ def run_modal_test(
         if initial_state == "periodic":
             x0, v0 = periodic_initial_state(system, force_sim, fs_sim, inputs)
             resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
-            acc = np.tile(resp.acceleration[:, ::r], (1, n_keep))
+            acc = np.tile(_acquire(resp.acceleration, r), (1, n_keep))
         else:
             blocks = []
             q = np.zeros(cm.poles.size, dtype=complex)
@@ -344,10 +392,10 @@ def run_modal_test(
                 x0, v0 = _modal_to_physical(cm, q)
                 resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
                 if k >= int(settle_periods) or keep_settle:
-                    blocks.append(resp.acceleration[:, ::r])
+                    blocks.append(_acquire(resp.acceleration, r))
                 q = _modal_propagate(cm, psi_in, ext, 1.0 / fs_sim, q)
             acc = np.concatenate(blocks, axis=1)
-        force = np.tile(force_sim[:, ::r], (1, n_keep))
+        force = np.tile(_acquire(force_sim, r), (1, n_keep))
         sl = slice(run * run_len, (run + 1) * run_len)
         clean[:n_in, sl] = force
         clean[n_in:, sl] = acc
@@ -371,19 +419,17 @@ def run_modal_test(
         "drive_mode": drive_mode,
         "drive_matrix": drive.tolist(),
         "drive_points": list(tyre.layout.drive_points),
-        "band_hz": [float(band[0]), float(band[1])],
-        "excitation": {
-            "kind": "periodic chirp (Schroeder multisine)",
-            "f_start": float(band[0]),
-            "f_stop": float(band[1]),
-            "lines": lines.tolist(),
-            "force_rms": f_rms,
-        },
+        "band_hz": list(bnd),
+        "excitation": exc.name,
+        "excitation_band_hz": [float(exc.band[0]), float(exc.band[1])],
+        "lines": lines.tolist(),
+        "force_rms": f_rms,
         "snr_db": None if snr_db is None else float(snr_db),
         "noise_std": noise_std.tolist(),
         "seed": int(seed) if isinstance(seed, int | np.integer) else None,
         "oversample": r,
         "hold": "foh",
+        "anti_alias": "ideal low-pass at sample_rate/2 (per simulated period)",
         "initial_state": initial_state,
         "pressure_pa": tyre.params.pressure,
         "nonproportionality": tyre.nonproportionality,
