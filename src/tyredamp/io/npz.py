@@ -91,7 +91,7 @@ def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
     """
     p = check_input_file(path)
     try:
-        with np.load(p, allow_pickle=False) as z:
+        with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
             if "header" not in z.files:
                 raise FileFormatError(f"{p}: not a tyredamp NPZ file (no 'header' entry)")
             head = meta_from_json(str(z["header"][()]), f"{p}: header")

@@ -45,8 +45,10 @@ for forces) or else from the ordinate units label; ``m``, ``mm``, ``um``,
 
 from __future__ import annotations
 
+import gc
 import json
 import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -230,7 +232,10 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
                 "UFF (uff58b), CSV or NPZ"
             )
         id1 = str(obj.meta.get("description", f"tyredamp FRF {obj.kind}"))
-        id2 = f"{_MARK} frf {obj.kind}" + ("" if binary else f" {axis}")
+        # binary: uneven abscissa, every frequency stored as a float64 (pyuff needs
+        # two abscissa values, so a single line goes the even way with ID-line 2)
+        uneven = binary and obj.n_freq > 1
+        id2 = f"{_MARK} frf {obj.kind}" + ("" if uneven else f" {axis}")
         id3 = _meta_line(obj.meta)
         x = obj.frequency
         fid = 0
@@ -255,7 +260,7 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
                     orddenom_axis_units_lab="N",
                     data=np.array(obj.H[o, i], dtype=complex),
                 )
-                sets.append(_abscissa(d, x, binary, 18, "Frequency", "Hz"))
+                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
         if obj.coherence is not None:
             ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
             for o, co in enumerate(obj.outputs):
@@ -283,7 +288,7 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
                     ordinate_axis_units_lab="NONE",
                     data=np.array(obj.coherence[o], dtype=float),
                 )
-                sets.append(_abscissa(d, x, binary, 18, "Frequency", "Hz"))
+                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
     elif isinstance(obj, TimeData):
         id1 = str(obj.meta.get("description", "tyredamp time data"))
         id3 = _meta_line(obj.meta)
@@ -304,13 +309,18 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
             sets.append(_abscissa(d, t, False, 17, "Time", "s"))
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, warnings.catch_warnings():
+        # pyuff's 58b writer reopens the file and leaves that handle to the garbage
+        # collector: silence the ResourceWarning and collect inside this block
+        warnings.simplefilter("ignore", ResourceWarning)
         uff = pyuff.UFF(str(tmp))
         try:
             # "add" to the empty temporary file: pyuff truncates binary sets in "overwrite"
             uff.write_sets(sets, mode="add", force_double=True)
         except Exception as exc:  # pyuff raises bare Exception
             raise FileFormatError(f"{path}: pyuff could not write the data sets ({exc})") from exc
+        finally:
+            gc.collect()
 
 
 def _abscissa(

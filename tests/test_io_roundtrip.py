@@ -1,0 +1,187 @@
+"""File round trips: FRF and TimeData through UFF 58b/58, CSV and NPZ lose nothing."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose, assert_array_equal
+
+from tyredamp import Channel, FileFormatError, InputError
+from tyredamp.frf import FRF
+from tyredamp.io import read, read_frf, read_timedata, write_frf, write_timedata
+from tyredamp.timedata import TimeData
+
+LOSSLESS = ["uff58b", "csv", "npz"]
+EXT = {"uff58b": ".uff", "uff58": ".unv", "csv": ".csv", "npz": ".npz"}
+
+
+def assert_same_frf(a: FRF, b: FRF, rtol: float = 0.0) -> None:
+    assert b.kind == a.kind
+    assert b.outputs == a.outputs  # node, direction, angle, name
+    assert b.inputs == a.inputs
+    if rtol == 0.0:
+        assert_array_equal(b.frequency, a.frequency)
+        assert_array_equal(b.H, a.H)
+    else:
+        assert_allclose(b.frequency, a.frequency, rtol=1e-15)
+        assert_allclose(b.H, a.H, rtol=rtol)
+    if a.coherence is None:
+        assert b.coherence is None
+    else:
+        assert b.coherence is not None
+        assert_allclose(b.coherence, a.coherence, rtol=rtol, atol=0)
+
+
+def assert_same_timedata(a: TimeData, b: TimeData, rtol: float = 0.0) -> None:
+    assert b.sample_rate == a.sample_rate
+    assert b.channels == a.channels
+    assert b.quantities == a.quantities
+    assert b.meta == a.meta
+    if rtol == 0.0:
+        assert_array_equal(b.data, a.data)
+    else:
+        assert_allclose(b.data, a.data, rtol=rtol, atol=0)
+
+
+def sample_frf(rng: np.random.Generator, n_out=3, n_in=2, n_freq=37, coherence=True) -> FRF:
+    f = np.arange(3, 3 + n_freq) * (2048 / 3000)  # rfft-style lines k * fs / N
+    h = rng.normal(size=(n_out, n_in, n_freq)) + 1j * rng.normal(size=(n_out, n_in, n_freq))
+    outs = [Channel(i + 1, 3, 22.5 * i, f"acc{i + 1:02d}") for i in range(n_out)]
+    ins = [Channel(100 + j, -3 if j else 3) for j in range(n_in)]
+    coh = rng.random((n_out, n_freq)) if coherence else None
+    meta = {"estimator": "H1", "n_averages": 8}
+    return FRF(f, h, "accelerance", outs, ins, coh, meta)
+
+
+def sample_timedata(rng: np.random.Generator) -> TimeData:
+    chans = [Channel(1, 3, 0.0, "force"), Channel(1, 3, 0.0), Channel(2, 3, 22.5), Channel(9, 2)]
+    data = rng.normal(size=(4, 1000)) * np.array([[10.0], [3.0], [1e-3], [5e4]])
+    return TimeData(
+        data,
+        2048.0,
+        chans,
+        ["force", "acceleration", "velocity", "displacement"],
+        meta={"period_samples": 500, "settle_samples": 0},
+    )
+
+
+@pytest.mark.parametrize("fmt", LOSSLESS)
+def test_frf_round_trip_exact(tmp_path: Path, fmt: str) -> None:
+    frf = sample_frf(np.random.default_rng(1))
+    p = write_frf(frf, tmp_path / f"frf{EXT[fmt]}", fmt)
+    back = read_frf(p)
+    assert_same_frf(frf, back)  # bit for bit
+    assert back.meta == frf.meta
+
+
+def test_frf_round_trip_ascii_uff(tmp_path: Path) -> None:
+    frf = sample_frf(np.random.default_rng(2))
+    back = read_frf(write_frf(frf, tmp_path / "frf.unv", "uff58"))
+    # E20.12 fields hold 12 significant digits: relative error <= 5e-12; the
+    # frequency axis is rebuilt exactly from ID line 2
+    assert_same_frf(frf, back, rtol=1e-11)
+    assert_array_equal(back.frequency, frf.frequency)
+    with pytest.raises(InputError, match="uneven frequency axis"):
+        write_frf(frf.select_lines([0, 1, 5]), tmp_path / "x.unv", "uff58")
+    assert not (tmp_path / "x.unv").exists()
+    # binary UFF keeps an uneven axis exactly
+    uneven = frf.select_lines([0, 1, 5])
+    assert_same_frf(uneven, read_frf(write_frf(uneven, tmp_path / "x.uff")))
+
+
+@pytest.mark.parametrize("fmt", [*LOSSLESS, "uff58"])
+def test_timedata_round_trip(tmp_path: Path, fmt: str) -> None:
+    td = sample_timedata(np.random.default_rng(3))
+    back = read_timedata(write_timedata(td, tmp_path / f"td{EXT[fmt]}", fmt))
+    assert_same_timedata(td, back, rtol=1e-11 if fmt == "uff58" else 0.0)
+
+
+@settings(
+    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n_out=st.integers(1, 4),
+    n_in=st.integers(1, 3),
+    n_freq=st.integers(1, 40),
+    kind=st.sampled_from(["receptance", "mobility", "accelerance"]),
+    fmt=st.sampled_from(LOSSLESS),
+    name=st.text(alphabet="abcXYZ019_-+. ", max_size=12),
+    coherence=st.booleans(),
+)
+def test_frf_round_trip_property(
+    tmp_path, seed, n_out, n_in, n_freq, kind, fmt, name, coherence
+) -> None:
+    g = np.random.default_rng(seed)
+    f = np.sort(g.choice(np.arange(1, 10_000), n_freq, replace=False)) * g.uniform(1e-3, 10)
+    h = (
+        g.normal(size=(n_out, n_in, n_freq)) + 1j * g.normal(size=(n_out, n_in, n_freq))
+    ) * 10 ** g.uniform(-8, 4)
+    outs = [
+        Channel(
+            int(g.integers(1, 10**6)) * 10 + i,
+            int(g.choice([1, 2, 3, -3])),
+            None if i % 2 else float(g.uniform(-360, 360)),
+            name if i == 0 else "",
+        )
+        for i in range(n_out)
+    ]
+    ins = [Channel(7 + 10 * j, 3, None, f"F{j}") for j in range(n_in)]
+    coh = g.random((n_out, n_freq)) if coherence else None
+    frf = FRF(f, h, kind, outs, ins, coh, {"k": [1, 2.5, "x"]})
+    back = read_frf(write_frf(frf, tmp_path / f"p{EXT[fmt]}", fmt))
+    assert_same_frf(frf, back)
+
+
+def test_read_dispatch_and_type_errors(tmp_path: Path) -> None:
+    rng = np.random.default_rng(4)
+    td, frf = sample_timedata(rng), sample_frf(rng)
+    for fmt in LOSSLESS:
+        pt = write_timedata(td, tmp_path / f"t{EXT[fmt]}", fmt)
+        pf = write_frf(frf, tmp_path / f"f{EXT[fmt]}", fmt)
+        assert isinstance(read(pt), TimeData)
+        assert isinstance(read(pf), FRF)
+        with pytest.raises(FileFormatError, match=r"not an FRF|no FRF"):
+            read_frf(pt)
+        with pytest.raises(FileFormatError, match=r"not time data|no time response"):
+            read_timedata(pf)
+    with pytest.raises(InputError, match="unknown file extension"):
+        write_frf(frf, tmp_path / "x.xls")
+    with pytest.raises(FileFormatError, match="unknown file extension"):
+        read_frf(tmp_path / "x.xls")
+    with pytest.raises(FileNotFoundError):
+        read_frf(tmp_path / "missing.uff")
+    with pytest.raises(InputError, match="format"):
+        write_frf(frf, tmp_path / "x.uff", "xlsx")
+
+
+def test_writes_are_atomic_and_inputs_untouched(tmp_path: Path, monkeypatch) -> None:
+    rng = np.random.default_rng(5)
+    frf = sample_frf(rng)
+    src = write_frf(frf, tmp_path / "in.uff")
+    digest = hashlib.sha256(src.read_bytes()).hexdigest()
+    mtime = src.stat().st_mtime_ns
+    for _ in range(2):
+        read_frf(src)
+    assert hashlib.sha256(src.read_bytes()).hexdigest() == digest  # reading never modifies
+    assert src.stat().st_mtime_ns == mtime
+
+    def boom(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savetxt", boom)
+    with pytest.raises(OSError, match="disk full"):
+        write_frf(frf, tmp_path / "out.csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.uff"]  # no partial file left
+    # an existing target survives a failed write unchanged
+    with pytest.raises(OSError, match="disk full"):
+        write_frf(frf, src.with_suffix(".csv"))
+    monkeypatch.undo()
+    with pytest.raises(InputError, match="JSON-compatible"):
+        write_frf(FRF(frf.frequency, frf.H, meta={"bad": object()}), tmp_path / "m.npz")
+    assert not (tmp_path / "m.npz").exists()
