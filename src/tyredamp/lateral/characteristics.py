@@ -147,7 +147,7 @@ def corner_differences(model: HystereticModel) -> CornerDifferences:
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Figure7Curves:
     """Data of the paper's Figure 7 (all amplitude ratios in dB re 1 m/N).
 

@@ -237,7 +237,7 @@ def _prepare(
 
 
 # --------------------------------------------------------------------------------- results
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class LateralFit:
     """Result of fitting one lateral model to one FRF.
 
@@ -644,7 +644,7 @@ def _evidence(delta: float) -> str:
     return "very strong evidence against it"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Ranking:
     """Models fitted to the same data and weights, best first.
 
@@ -795,7 +795,7 @@ def rank_models(
 
 
 # -------------------------------------------------------------------------------- joint fit
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class JointFit:
     """One model fitted to several conditions with shared parameters.
 

@@ -185,7 +185,7 @@ def periodic_response(
 
 
 # ------------------------------------------------------------------------- impulse response
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ImpulseResponse:
     """Impulse response on a time axis centred on 0 (negative times included).
 
@@ -264,7 +264,7 @@ def impulse_response(
     return ImpulseResponse(time=time, response=np.asarray(x, dtype=float), output=output)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Precursor:
     """Size of the non-causal part of an impulse response.
 
@@ -570,7 +570,7 @@ def state_space(vehicle: LateralVehicle) -> StateSpace:
     return StateSpace(a, b, c, d)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TransientResponse:
     """Simulated response of a body on a causal tyre.
 
@@ -666,7 +666,7 @@ def transient_response(
 
 
 # ---------------------------------------------------------------------------- error report
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class CausalError:
     """Error of a causal approximation of a hysteretic vehicle against the ideal model.
 
