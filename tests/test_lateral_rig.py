@@ -7,11 +7,14 @@ import pytest
 from numpy.testing import assert_allclose
 
 from tyredamp.exceptions import InputError
+from tyredamp.frf import FRF
 from tyredamp.lateral import (
     DEFAULT_MODELS,
     AgriculturalTyre,
+    LateralData,
     VirtualLateralRig,
     ViscoelasticStringTyre,
+    fit_by_pressure,
     fit_joint,
     fit_model,
     rank_models,
@@ -117,3 +120,18 @@ def test_time_test() -> None:
     # Amplitude of the acceleration channel: 3 % white noise on 1200 samples changes the
     # peak by a few %; 10 % bounds it.
     assert_allclose(np.max(np.abs(td.data[1])), amp, rtol=0.1)
+
+
+def test_joint_fits_by_pressure() -> None:
+    data = RIG.measure_all("ground", seed=0)
+    fits = fit_by_pressure(data, "maxwell")
+    assert list(fits) == [1.28, 1.7, 2.4]
+    for p, j in fits.items():
+        assert j.names == ("k", "C_alpha")
+        # Shared C_alpha gives each speed's road damper C_alpha/V (rounding).
+        assert_allclose(j.fits[0].params["c"] * j.fits[0].speed, j.params["C_alpha"], rtol=1e-12)
+        assert j.fits[0].label.startswith(f"{p:g} bar")
+    d = RIG.measure(5.0, 1.7)
+    bare = LateralData(FRF(d.frf.frequency, d.frf.H, kind="accelerance"), speed=d.speed)
+    with pytest.raises(InputError, match="pressure_bar"):
+        fit_by_pressure([bare], "maxwell")

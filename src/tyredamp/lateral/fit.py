@@ -22,7 +22,9 @@ Method
   ``initial_guesses`` (linear regressions on the asymptotes, e.g.
   ``Re Y = 1/K``-like and ``Im Y ~ -1/(omega C_r)``), spread by a coarse grid
   of factors 1/3, 1, 3 per parameter; the three cheapest starts are refined
-  and the best result is kept.
+  and the best result is kept. Axle-force data are first fitted on the
+  ground-force accelerance ``A_axle/(1 - M_w A_axle)`` (no wheel resonance,
+  so the starts land in the right basin), then refined on the axle data.
 * Standard errors: ``cov(log p) = s^2 (J^T J)^-1`` with ``J`` the Jacobian of
   the weighted residuals in log-parameters (central differences) and
   ``s^2 = RSS/(2N - P)``; ``SE(p) = p SE(log p)`` (delta method).
@@ -73,6 +75,7 @@ __all__ = [
     "LateralData",
     "LateralFit",
     "Ranking",
+    "fit_by_pressure",
     "fit_joint",
     "fit_model",
     "rank_models",
@@ -1020,3 +1023,34 @@ def fit_joint(
         aic=aic,
         bic=bic,
     )
+
+
+def fit_by_pressure(
+    data: Sequence[LateralData],
+    model: str | type[LateralModel],
+    **joint_kwargs: Any,
+) -> dict[float, JointFit]:
+    """Joint fits (:func:`fit_joint`) of the conditions grouped by inflation pressure.
+
+    Parameters
+    ----------
+    data : sequence of LateralData
+        Measurements whose ``frf.meta["pressure_bar"]`` gives the pressure (as
+        written by :mod:`tyredamp.lateral.rig`); at least two speeds per
+        pressure.
+    model : str or LateralModel subclass
+    **joint_kwargs
+        Passed to :func:`fit_joint` (``share``, ``band``, ``weights`` ...).
+
+    Returns
+    -------
+    dict of float to JointFit
+        By pressure in bar, increasing.
+    """
+    groups: dict[float, list[LateralData]] = {}
+    for i, d in enumerate(data):
+        p = d.frf.meta.get("pressure_bar") if isinstance(d, LateralData) else None
+        if p is None:
+            raise InputError(f"data[{i}]: expected frf.meta['pressure_bar'] (bar)")
+        groups.setdefault(float(p), []).append(d)
+    return {p: fit_joint(g, model, **joint_kwargs) for p, g in sorted(groups.items())}
