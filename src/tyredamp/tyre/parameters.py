@@ -86,10 +86,12 @@ class RingTyreParameters:
         ``k_t = 5e5`` N/m^2 at 7.5 bar (spec reference value).
     radial_damping, tangential_damping : float
         Viscous sidewall dampers per unit length ``c_r``, ``c_t`` in
-        N s/m^2. Defaults 300 and 30. They are *not* proportional to
+        N s/m^2. Defaults 280 and 30. They are *not* proportional to
         ``k_r``, ``k_t``: the pressure part of the sidewall stiffness is
-        lossless (gas), only the rubber dissipates. 300 N s/m^2 is a loss
-        factor ``c omega / k_r`` of 0.13 at 100 Hz (rubber 0.05-0.2).
+        lossless (gas), only the rubber dissipates. 280 N s/m^2 is a loss
+        factor ``c omega / k_r`` of 0.12 at 100 Hz (rubber 0.05-0.2). With
+        the drive-point damper they give modal damping ratios of 2-5 % at
+        5-9 bar, falling with frequency.
     band_loss_factor : float
         Loss factor of the band *bending* only (Kelvin-Voigt damping
         ``eta / omega_ref`` times the bending stiffness matrix), >= 0.
@@ -125,7 +127,7 @@ class RingTyreParameters:
     radial_stiffness_per_pressure: float = 1.2
     tangential_stiffness_base: float = 2.0e5
     tangential_stiffness_per_pressure: float = 0.4
-    radial_damping: float = 300.0
+    radial_damping: float = 280.0
     tangential_damping: float = 30.0
     band_loss_factor: float = 0.05
     band_loss_frequency: float = 200.0
@@ -195,7 +197,7 @@ class MeasurementLayout:
         so the mass acts radially only). Default 0.1.
     attachment_damping : float
         Local radial viscous damper in N s/m at each drive point (the glued
-        drive-rod tip and the locally worked tread rubber). Default 400. This
+        drive-rod tip and the locally worked tread rubber). Default 350. This
         local damper is what makes the in-band damping non-proportional: the
         distributed sidewall and band damping of an axisymmetric ring only
         couples modes of the same wave number.
@@ -204,7 +206,7 @@ class MeasurementLayout:
     n_points: int = 16
     drive_points: tuple[int, ...] = (1,)
     attachment_mass: float = 0.1
-    attachment_damping: float = 400.0
+    attachment_damping: float = 350.0
 
     def __post_init__(self) -> None:
         if not isinstance(self.n_points, int | np.integer) or self.n_points < 3:
