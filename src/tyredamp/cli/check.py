@@ -7,6 +7,7 @@ is 0 whether the check passes or fails (the verdict is in the output); with
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import click
@@ -29,7 +30,9 @@ _FILE = click.Path(dir_okay=False, path_type=Path)
 def _finish(ctx: click.Context, result: CheckResult, strict: bool) -> None:
     click.echo(result.report())
     if strict and not result.passed:
-        ctx.exit(1)
+        # SystemExit, not ctx.exit: click returns ctx.exit codes from main() when
+        # standalone_mode=False, and tyredamp.cli.main does not pass them on
+        sys.exit(1)
 
 
 _strict = click.option(

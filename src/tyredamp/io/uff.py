@@ -19,9 +19,12 @@ What is written
 * ID line 1: a description (``meta["description"]`` or ``"tyredamp FRF ..."``);
   ID line 2: ``tyredamp1 ...`` with the exact frequency axis or sample rate
   as Python floats (the fixed E13.5 fields of record 7 keep only 6 digits);
-  ID line 3: as much of ``meta`` as fits in 80 characters as JSON;
+  ID line 3: as much of ``meta`` as fits in 80 characters as JSON, the keys
+  the estimators use first (``period_samples``, ``settle_samples``,
+  ``record_samples``, ``run_starts``, ``band_hz`` ...);
   ID lines 4 and 5: channel name and angle of the response and reference as
-  JSON (``NONE`` when there are none).
+  JSON (``NONE`` when there are none); time data have no reference, and ID
+  line 5 continues the metadata.
 
 Precision
 ---------
@@ -143,16 +146,42 @@ def _extras_line(c: Channel) -> str:
     return text
 
 
-def _meta_line(meta: dict[str, Any]) -> str:
-    full = meta_to_json(meta)
-    if len(full) <= 80:
-        return full if meta else "NONE"
-    kept: dict[str, Any] = {}
-    for k, v in meta.items():
-        trial = {**kept, k: v}
-        if len(meta_to_json(trial)) <= 80:
-            kept = trial
-    return meta_to_json(kept) if kept else "NONE"
+#: Metadata the estimators use: stored first when ``meta`` does not fit an ID line.
+_PRIORITY = (
+    "period_samples",
+    "settle_samples",
+    "record_samples",
+    "run_starts",
+    "band_hz",
+    "estimator",
+    "method",
+    "n_averages",
+    "exponential_tau_s",
+    "description",
+)
+
+
+def _meta_lines(meta: dict[str, Any], n_lines: int) -> list[str]:
+    """Up to ``n_lines`` JSON objects of <= 80 characters holding as much of ``meta`` as fits.
+
+    Keys the estimators use go first; a key whose value alone needs more than
+    80 characters is left out.
+    """
+    order = [k for k in _PRIORITY if k in meta] + [k for k in meta if k not in _PRIORITY]
+    lines: list[str] = []
+    left = order
+    for _ in range(n_lines):
+        kept: dict[str, Any] = {}
+        rest = []
+        for k in left:
+            trial = {**kept, k: meta[k]}
+            if len(meta_to_json(trial)) <= 80:
+                kept = trial
+            else:
+                rest.append(k)
+        lines.append(meta_to_json(kept) if kept else "NONE")
+        left = rest
+    return lines
 
 
 def _even_axis(f: np.ndarray) -> str | None:
@@ -236,7 +265,7 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
         # two abscissa values, so a single line goes the even way with ID-line 2)
         uneven = binary and obj.n_freq > 1
         id2 = f"{_MARK} frf {obj.kind}" + ("" if uneven else f" {axis}")
-        id3 = _meta_line(obj.meta)
+        (id3,) = _meta_lines(obj.meta, 1)
         x = obj.frequency
         fid = 0
         for o, co in enumerate(obj.outputs):
@@ -291,7 +320,7 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
                 sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
     elif isinstance(obj, TimeData):
         id1 = str(obj.meta.get("description", "tyredamp time data"))
-        id3 = _meta_line(obj.meta)
+        id3, id5 = _meta_lines(obj.meta, 2)  # time data: ID line 5 continues the metadata
         t = obj.time
         for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
             d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
@@ -303,7 +332,7 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
                 ref_node=0,
                 ref_dir=0,
                 id4=_extras_line(c),
-                id5="NONE",
+                id5=id5,
                 data=np.array(obj.data[k], dtype=float),
             )
             sets.append(_abscissa(d, t, False, 17, "Time", "s"))
@@ -511,6 +540,8 @@ def read_uff(
 
 def _meta(s: dict[str, Any], tok: dict[str, str] | None) -> dict[str, Any]:
     meta = _extras(s.get("id3")) if tok is not None else {}
+    if tok is not None and tok.get("_what") == "time":
+        meta.update(_extras(s.get("id5")))
     desc = str(s.get("id1", "")).strip()
     if desc and desc != "NONE" and not desc.startswith("tyredamp "):
         meta.setdefault("description", desc)
