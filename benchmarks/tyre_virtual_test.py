@@ -75,9 +75,10 @@ def main() -> None:
     print(f"=== default tyre: {tyre!r}")
     print(" f (Hz)  zeta (%)   n  visible   MPC")
     for row in tr.table("all"):
+        vis = "yes" if row["visible"] else "no"
         print(
-            f"{row['frequency_hz']:7.2f}  {100 * row['damping_ratio']:7.2f}  {row['wave_number']:3d}"
-            f"  {'yes' if row['visible'] else 'no ':>7s}  {row['mpc']:.4f}"
+            f"{row['frequency_hz']:7.2f}  {100 * row['damping_ratio']:7.2f}  "
+            f"{row['wave_number']:3d}  {vis:>7s}  {row['mpc']:.4f}"
         )
 
     print("\n=== pressure dependence (visible modes n = 1..6: f Hz / zeta %) ===")
