@@ -290,3 +290,5 @@ def test_bad_tyre_and_run_index(small_tyre: RingTyre) -> None:
         vt.run_data(1)
     with pytest.raises(InputError, match="period_samples"):
         schroeder_multisine(100.0, 2, (0.0, 10.0))
+    with pytest.raises(InputError, match="inputs"):
+        periodic_initial_state(small_tyre.system, np.ones((1, 8)), 100.0, [small_tyre.n_dof])

@@ -238,6 +238,10 @@ def periodic_initial_state(
         raise InputError(
             f"force_period: expected {idx.size} rows (one per input), got shape {f.shape}"
         )
+    if idx.size and (idx.min() < 0 or idx.max() >= system.n_dof):
+        raise InputError(
+            f"inputs: DOF indices must lie in 0..{system.n_dof - 1}, got {idx.tolist()}"
+        )
     h = 1.0 / check_positive(sample_rate, "sample_rate")
     cm = system.complex_modes()
     ext = np.concatenate([f, f[:, :1]], axis=1)

@@ -380,6 +380,16 @@ class RingTyre:
     imperfections : sequence of Imperfection, optional
         Local masses, springs or dampers that split the double modes.
 
+    Attributes
+    ----------
+    system : MCKSystem
+        ``M`` (kg), ``C`` (N s/m, after the knob) and ``K`` (N/m) of the full
+        discretisation, shape (2 n_ring, 2 n_ring) each.
+    physical_system : MCKSystem
+        The same with the physical damping ``C_phys`` (``nu = 1``).
+    K_bend : ndarray, shape (2 n_ring, 2 n_ring)
+        The bending part of ``K`` (N/m), which carries the band loss.
+
     Raises
     ------
     InputError
