@@ -192,9 +192,7 @@ class ModalFitter:
     # ------------------------------------------------------------- basis
     def basis(
         self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], derivatives: bool = True
-    ) -> tuple[
-        NDArray[np.float64], NDArray[np.float64], NDArray[np.intp], NDArray[np.intp]
-    ]:
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp], NDArray[np.intp]]:
         """Real basis ``Phi`` (n_rows, q) and its derivative columns.
 
         Returns ``Phi``, ``D`` (n_rows, n_d), ``dpar`` (n_d,) parameter index and
@@ -225,7 +223,10 @@ class ModalFitter:
                     continue
                 dA = L[:, None] * (g / (s - p))[None, :]
                 dB = np.conj(L)[:, None] * (gb / (s - np.conj(p)))[None, :]
-                for dpx, dpbx, ip in ((-sig, -sig, 2 * n), (1j * self.w_ref, -1j * self.w_ref, 2 * n + 1)):
+                for dpx, dpbx, ip in (
+                    (-sig, -sig, 2 * n),
+                    (1j * self.w_ref, -1j * self.w_ref, 2 * n + 1),
+                ):
                     a_, b_ = dA * dpx, dB * dpbx
                     dl += [a_ + b_, 1j * (a_ - b_)]
                     dpar += [ip, ip]
@@ -294,10 +295,21 @@ class ModalFitter:
             C = sla.solve_triangular(Rq, Ct)
         resid = Yw - Q @ Ct
         cost = float(np.sum(resid**2))
-        return {"phi": phi, "D": D, "dpar": dpar, "dcol": dcol, "Q": Q, "R": Rq, "C": C,
-                "resid": resid, "cost": cost}
+        return {
+            "phi": phi,
+            "D": D,
+            "dpar": dpar,
+            "dcol": dcol,
+            "Q": Q,
+            "R": Rq,
+            "C": C,
+            "resid": resid,
+            "cost": cost,
+        }
 
-    def _normal(self, sol: dict[str, Any], n_par: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def _normal(
+        self, sol: dict[str, Any], n_par: int
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Kaufman ``J^T J`` and ``J^T r`` of the projected residual."""
         D, Q, C = sol["D"], sol["Q"], sol["C"]
         dpar, dcol = sol["dpar"], sol["dcol"]
@@ -359,7 +371,11 @@ class ModalFitter:
         return self._result(th, m, ref, w, sol, sig_out, nit, status, warn)
 
     def _refine(
-        self, th0: NDArray[np.float64], m: int, ref: NDArray[np.intp], Yw: NDArray[np.float64],
+        self,
+        th0: NDArray[np.float64],
+        m: int,
+        ref: NDArray[np.intp],
+        Yw: NDArray[np.float64],
         max_nfev: int,
     ) -> tuple[NDArray[np.float64], int, str]:
         n_par = th0.size
@@ -394,8 +410,11 @@ class ModalFitter:
 
     @staticmethod
     def _least_squares(
-        evaluate: Any, th0: NDArray[np.float64], lb: NDArray[np.float64],
-        ub: NDArray[np.float64], max_nfev: int,
+        evaluate: Any,
+        th0: NDArray[np.float64],
+        lb: NDArray[np.float64],
+        ub: NDArray[np.float64],
+        max_nfev: int,
     ) -> Any:
         # trust-region reflective on the square root of the normal equations; the
         # errstate above silences overflow in scipy's trust-region sub-solver on
@@ -428,9 +447,11 @@ class ModalFitter:
         """
         poles, part = self.unpack(th, m, ref)
         if self.kind == "complex":
-            ud = (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None]
+            ud = np.asarray(
+                (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None], complex
+            )
         else:
-            ud = cd_w[:, :m] / wd[:, None] + 0j
+            ud = np.asarray(cd_w[:, :m] / wd[:, None], complex)
         if ud.shape[0] == 0:
             a = np.ones(m, complex)
             a2r = np.ones(m)
@@ -440,10 +461,7 @@ class ModalFitter:
             den = np.sum(np.abs(ud) ** 2, axis=0)
             a2 = np.sum(np.conj(ud) * lk, axis=0) / np.where(den > 0, den, 1.0)
             a2r = a2.real.copy()
-            if self.kind == "real":
-                a = np.sqrt(np.abs(a2.real)) + 0j
-            else:
-                a = np.sqrt(a2)
+            a = np.sqrt(np.abs(a2.real)) + 0j if self.kind == "real" else np.sqrt(a2)
             a = np.where(a == 0, 1.0, a)
         psi_in = (part / a[:, None]).T
         b = a.copy()
@@ -454,8 +472,15 @@ class ModalFitter:
         return b, psi_in, a2r
 
     def _result(
-        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], w: NDArray[np.float64],
-        sol: dict[str, Any], sig_out: NDArray[np.float64], nit: int, status: str,
+        self,
+        th: NDArray[np.float64],
+        m: int,
+        ref: NDArray[np.intp],
+        w: NDArray[np.float64],
+        sol: dict[str, Any],
+        sig_out: NDArray[np.float64],
+        nit: int,
+        status: str,
         warn: list[str],
     ) -> FitResult:
         n_par = th.size
@@ -466,10 +491,11 @@ class ModalFitter:
         didx = np.array([j for j, _ in self.drive], dtype=np.intp)
         wd = w[didx]
         b, psi_in, a2r = self._scale(th, m, ref, C[:, didx].T, wd)
-        if self.kind == "complex":
-            u = Cu[0 : 2 * m : 2].T + 1j * Cu[1 : 2 * m : 2].T
-        else:
-            u = Cu[:m].T + 0j
+        u = (
+            Cu[0 : 2 * m : 2].T + 1j * Cu[1 : 2 * m : 2].T
+            if self.kind == "complex"
+            else Cu[:m].T + 0j
+        )
         psi_out = u * b[None, :]
         off = (2 if self.kind == "complex" else 1) * m
         upper = lower = None
@@ -516,9 +542,10 @@ class ModalFitter:
         jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
         std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
         std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
-        std_pole = np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig + 1j * np.sqrt(
-            np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)
-        ) * self.w_ref
+        std_pole = (
+            np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
+            + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
+        )
         std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
         # ---- model, contributions
         phi = sol["phi"]
@@ -559,9 +586,17 @@ class ModalFitter:
         )
 
     def _shape_std(
-        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], w: NDArray[np.float64],
-        sol: dict[str, Any], cth: NDArray[np.float64], s2: float, b: NDArray[np.complex128],
-        u: NDArray[np.complex128], didx: NDArray[np.intp],
+        self,
+        th: NDArray[np.float64],
+        m: int,
+        ref: NDArray[np.intp],
+        w: NDArray[np.float64],
+        sol: dict[str, Any],
+        cth: NDArray[np.float64],
+        s2: float,
+        b: NDArray[np.complex128],
+        u: NDArray[np.complex128],
+        didx: NDArray[np.intp],
     ) -> NDArray[np.float64]:
         """``sqrt(E|d psi_out|^2)`` per entry (n_out, m) by the delta method."""
         C, Rq, Q, D = sol["C"], sol["R"], sol["Q"], sol["D"]
@@ -577,7 +612,6 @@ class ModalFitter:
         # M_j = -Phi^+ dPhi/dtheta C_j  -> (n_out, q, n_par)
         M = -np.einsum("ad,dj,dk->jak", E, C[dcol], A, optimize=True)
         MC = M @ cth  # Cov(C_j, theta), (n_out, q, n_par)
-        per = 2 if self.kind == "complex" else 1
         # Var of the coefficient of mode n for output j
         cov_cc_diag = s2 * np.diag(F)[None, :] + np.einsum("jak,jak->ja", MC, M)
         if self.kind == "complex":

@@ -168,7 +168,7 @@ def identify_modes(
         data = data.select_lines(np.flatnonzero(keep))
     f = data.frequency
     H = np.asarray(data.H)
-    n_out, n_in, n_f = H.shape
+    _n_out, n_in, n_f = H.shape
     power = _POWER[data.kind]
     if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
         raise InputError(f"n_modes: expected a positive integer, got {n_modes!r}")
@@ -180,16 +180,16 @@ def identify_modes(
     nm_hint = int(n_modes) if n_modes is not None else (None if fr is None else fr.size)
     p_max = _default_order(n_in, n_f, nm_hint) if max_order is None else int(max_order)
     ps = plscf(f, H, p_max, band=(float(f[0]), float(f[-1])))
-    flags = stability_flags(
-        ps, band=(lo, hi), max_damping=max_damping
+    flags = stability_flags(ps, band=(lo, hi), max_damping=max_damping)
+    kept, weak = cluster_poles(
+        ps, flags, cluster_distance=cluster_distance, min_fraction=min_fraction
     )
-    kept, weak = cluster_poles(ps, flags, cluster_distance=cluster_distance,
-                               min_fraction=min_fraction)
     rejected: list[dict[str, Any]] = [
         _rej(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}") for c in weak
     ]
     warnings: list[str] = []
     auto = fr is None and n_modes is None
+    extra: list[Cluster] = []  # other persistent modes, fitted as residual modes
     if fr is not None:
         cand = _pick_frequencies(fr, kept + weak, ps, flags)
     elif n_modes is not None:
@@ -201,6 +201,13 @@ def identify_modes(
         rejected = [r for r, c in zip(rejected, weak, strict=True) if id(c) not in chosen]
     else:
         cand = kept
+    if not auto:
+        # modes the user did not ask for still shape the FRFs: keep the persistent
+        # clusters that are not chosen (and not within 1 % of a chosen one) as
+        # residual modes, so that the refinement does not pull the chosen poles
+        for c in kept:
+            if all(abs(c.pole - d.pole) > 0.01 * abs(d.pole) for d in cand):
+                extra.append(c)
     if not cand:
         raise InputError(
             f"no stable mode found in [{lo:g}, {hi:g}] Hz up to order {p_max}; raise "
@@ -211,12 +218,24 @@ def identify_modes(
     drive = data.drive_points()
     cfit = ModalFitter(f, H, power, "complex", drive, upper=residuals, lower=residuals)
     # ---- step 3: refine, add out-of-band residual modes, reject modes that do not contribute
-    hp = np.zeros(0, complex)
-    hl = np.zeros((0, n_in), complex)
+    hp = np.array([c.pole for c in extra], dtype=complex)
+    hl = np.array([c.participation for c in extra], dtype=complex).reshape(len(extra), n_in)
+    n_extra = len(extra)
     if refine and max_helpers > 0:
-        poles, part, hp, hl = _search_helpers(
-            cfit, poles, part, (lo, hi), (float(f[0]), float(f[-1])), max_helpers, min_significance
+        poles, part, hp2, hl2 = _search_helpers(
+            cfit,
+            np.concatenate([poles, hp]),
+            np.concatenate([part, hl]),
+            (lo, hi),
+            (float(f[0]), float(f[-1])),
+            max_helpers,
+            min_significance,
+            n_free=n_extra,
         )
+        m0 = len(poles) - n_extra
+        hp = np.concatenate([poles[m0:], hp2])
+        hl = np.concatenate([part[m0:], hl2])
+        poles, part = poles[:m0], part[:m0]
     if auto:
         for _ in range(len(poles)):
             res = cfit.fit(
@@ -243,10 +262,14 @@ def identify_modes(
     models: dict[str, ModalModel] = {}
     disc: dict[str, NDArray[np.float64]] = {}
     for kind in kinds:
-        fitter = cfit if kind == "complex" else ModalFitter(
-            f, H, power, "real", drive, upper=residuals, lower=residuals
+        fitter = (
+            cfit
+            if kind == "complex"
+            else ModalFitter(f, H, power, "real", drive, upper=residuals, lower=residuals)
         )
-        res, n_band, dropped = _fit_checked(fitter, poles, part, hp, hl, refine, (lo, hi))
+        res, n_band, dropped = _fit_checked(
+            fitter, poles, part, hp, hl, refine, (lo, hi), n_free=n_extra
+        )
         rejected += [_rej(p, f"{kind} fit: {why}") for p, why in dropped]
         kap = (2j * np.pi * f) ** power
         hm = res.model_receptance * kap[None, None, :]
@@ -318,6 +341,7 @@ def _search_helpers(
     data_band: tuple[float, float],
     max_helpers: int,
     min_significance: float,
+    n_free: int = 0,
 ) -> tuple[
     NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]
 ]:
@@ -354,7 +378,7 @@ def _search_helpers(
             except (np.linalg.LinAlgError, ValueError):
                 break
             fd = trial.poles[-1].imag / (2 * np.pi)
-            fin = trial.poles[:m].imag / (2 * np.pi)
+            fin = trial.poles[: m - n_free].imag / (2 * np.pi)
             outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)
             inside = bool(np.all((fin >= lo) & (fin <= hi)))
             s2a = np.maximum(trial.sigma_out**2, 1e-300)
@@ -375,8 +399,13 @@ def _fit_checked(
     hl: NDArray[np.complex128],
     refine: bool,
     band: tuple[float, float],
+    n_free: int = 0,
 ) -> tuple[FitResult, int, list[tuple[complex, str]]]:
-    """Fit modes and residual modes; drop any that left its side of the band or merged."""
+    """Fit modes and residual modes; drop any that left its side of the band or merged.
+
+    ``hp`` holds first ``n_free`` in-band residual modes (not checked against
+    the band), then out-of-band ones (which must stay outside).
+    """
     dropped: list[tuple[complex, str]] = []
     for _ in range(len(poles) + len(hp) + 1):
         m = len(poles)
@@ -384,7 +413,9 @@ def _fit_checked(
         p = res.poles
         fd = p.imag / (2 * np.pi)
         inb = (fd >= band[0]) & (fd <= band[1])
-        wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:]]))
+        free = np.zeros(len(hp), bool)
+        free[:n_free] = True
+        wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
         bad: int | None = None
         why = ""
         if wrong.size:
@@ -406,6 +437,8 @@ def _fit_checked(
             poles = np.delete(poles, bad)
             part = np.delete(part, bad, axis=0)
         else:
+            if bad - m < n_free:
+                n_free -= 1
             hp = np.delete(hp, bad - m)
             hl = np.delete(hl, bad - m, axis=0)
     raise ConvergenceError("refinement kept losing modes")
@@ -436,7 +469,7 @@ def _to_model(
     # in-band modes, sorted by Im p as ModalModel sorts them (keeps meta arrays aligned)
     o = np.argsort(res.poles[:n_band].imag)
     poles, psi_out, psi_in = res.poles[o], res.psi_out[:, o], res.psi_in[:, o]
-    std = {
+    std: dict[str, ArrayLike] = {
         "frequency_hz": res.std_frequency_hz[o],
         "damping_ratio": res.std_damping_ratio[o],
         "psi_out": res.std_psi_out[:, o],

@@ -24,7 +24,9 @@ __all__ = [
 ]
 
 
-def _pair(h_exp: ArrayLike, h_th: ArrayLike) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+def _pair(
+    h_exp: ArrayLike, h_th: ArrayLike
+) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
     a = as_finite(h_exp, "h_exp", dtype=complex)
     b = as_finite(h_th, "h_th", dtype=complex)
     if a.shape != b.shape:
@@ -131,7 +133,7 @@ def mac(phi_a: ArrayLike, phi_b: ArrayLike) -> NDArray[np.float64]:
 
 
 def auto_mac(phi: ArrayLike) -> NDArray[np.float64]:
-    """MAC of a set of shapes with itself, shape (m, m); off-diagonals near 0 mean distinct shapes."""
+    """MAC of a set of shapes with itself, shape (m, m); small off-diagonals: distinct shapes."""
     return mac(phi, phi)
 
 

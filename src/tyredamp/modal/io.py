@@ -131,10 +131,10 @@ def read_modes_json(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
     except json.JSONDecodeError as exc:
         raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
     if not isinstance(doc, dict) or doc.get("kind") != "modes":
-        raise FileFormatError(f"{p}: expected a modes document with \"kind\": \"modes\"")
+        raise FileFormatError(f'{p}: expected a modes document with "kind": "modes"')
     models = doc.get("models")
     if not isinstance(models, dict) or not models:
-        raise FileFormatError(f"{p}: expected a non-empty \"models\" object")
+        raise FileFormatError(f'{p}: expected a non-empty "models" object')
     out: dict[str, ModalModel] = {}
     for key, d in models.items():
         if key not in _KINDS or not isinstance(d, dict):

@@ -167,7 +167,11 @@ def plscf(
     qf = q.reshape(n_in * n_in, n_f)
     t_pos = qf @ zd
     t_neg = qf @ zd.conj()
-    T = np.where(lag[None, :, :] >= 0, t_pos.real[:, alag], t_neg.real[:, alag]).reshape(n_in, n_in, P + 1, P + 1).transpose(2, 0, 3, 1)
+    T = (
+        np.where(lag[None, :, :] >= 0, t_pos.real[:, alag], t_neg.real[:, alag])
+        .reshape(n_in, n_in, P + 1, P + 1)
+        .transpose(2, 0, 3, 1)
+    )
     T = T.reshape((P + 1) * n_in, (P + 1) * n_in)
 
     # U_o = L^-1 S_o with R = L L^T; leading rows/cols give every lower order
