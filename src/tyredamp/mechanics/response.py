@@ -156,10 +156,11 @@ def time_response(
         vel += 2 * np.real((ps * pp) @ q)
         acc += 2 * np.real((ps * pp**2) @ q)
     # direct term of the acceleration: sum_n p_n psi_n psi_n^T + c.c. = M^-1
-    full = np.zeros((n, ns))
-    full[ii] = f
-    minv_f = sla.cho_solve(sla.cho_factor(system.M), full)
-    acc += minv_f[oi]
+    # only the (outputs x inputs) block of M^-1 is needed
+    unit = np.zeros((n, ii.size))
+    unit[ii, np.arange(ii.size)] = 1.0
+    minv_block = sla.cho_solve(sla.cho_factor(system.M), unit)[oi]
+    acc += minv_block @ f
     return TimeResponse(
         time=np.arange(ns, dtype=float) * h, displacement=disp, velocity=vel, acceleration=acc
     )
