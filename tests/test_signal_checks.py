@@ -160,6 +160,10 @@ def test_quality_clean_clipped_reversed_noisy(chain: MCKSystem) -> None:
     assert clean.figures["clipped_channels"] == 0
     assert clean.figures["passivity_violations"] == 0
     assert clean.figures["low_coherence_fraction"] == 0.0
+    banded = quality_check(td, band=(2.0, 10.0))  # judge only the lines of a band
+    assert banded.frequency is not None
+    assert banded.frequency.min() >= 2.0
+    assert banded.frequency.max() <= 10.0
 
     d = td.data.copy()
     top = 0.7 * d[2].max()

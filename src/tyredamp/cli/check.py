@@ -141,6 +141,7 @@ def reciprocity_cmd(
     show_default=True,
     help="Largest accepted fraction of low-coherence lines.",
 )
+@_band
 @_strict
 @click.pass_context
 def quality_cmd(
@@ -148,6 +149,7 @@ def quality_cmd(
     data_file: Path,
     coherence_min: float,
     max_low_fraction: float,
+    band: tuple[float, float] | None,
     strict: bool,
 ) -> None:
     """Clipping, dead channels, low-coherence bands and drive-point passivity.
@@ -157,10 +159,13 @@ def quality_cmd(
 
     \b
     Example:
-      tyredamp check quality tyre_test.uff --coherence-min 0.9 --strict
+      tyredamp check quality tyre_test.uff --coherence-min 0.9 --band 30 200 --strict
     """
     obj = read(data_file)
     result = quality_check(
-        obj, coherence_min=coherence_min, max_low_coherence_fraction=max_low_fraction
+        obj,
+        coherence_min=coherence_min,
+        max_low_coherence_fraction=max_low_fraction,
+        band=band or None,
     )
     _finish(ctx, result, strict)

@@ -386,6 +386,7 @@ def quality_check(
     passivity_floor: float = 0.02,
     passivity_sigma: float = 3.0,
     max_passivity_fraction: float = 0.01,
+    band: tuple[float, float] | None = None,
     **estimate_kwargs: Any,
 ) -> CheckResult:
     """Data quality of a test: clipping, dead channels, coherence, passivity.
@@ -412,6 +413,8 @@ def quality_check(
         Multiple of the normalised random error added to the floor.
     max_passivity_fraction : float
         Largest accepted fraction of drive-point lines violating passivity.
+    band : (float, float), optional
+        Judge coherence and passivity only on the lines of this band (Hz).
 
     Returns
     -------
@@ -458,6 +461,8 @@ def quality_check(
     else:
         raise InputError(f"data: expected TimeData or FRF, got {type(data).__name__}")
 
+    if frf is not None and band is not None:
+        frf = frf.band(*band)
     low_frac = 0.0
     per_line = freq = None
     if frf is not None and frf.coherence is not None:
