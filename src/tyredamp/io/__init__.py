@@ -29,7 +29,7 @@ from ..frf import FRF, FRFKind
 from ..timedata import TimeData
 from .csv_format import read_csv, write_csv
 from .npz import read_npz, write_npz
-from .uff import read_uff, uff_contents, write_uff
+from .uff import read_uff, write_uff
 
 __all__ = [
     "FORMATS",
@@ -161,6 +161,3 @@ def write_timedata(
     if not isinstance(timedata, TimeData):
         raise InputError(f"timedata: expected a TimeData, got {type(timedata).__name__}")
     return write(timedata, path, format)
-
-
-_ = uff_contents  # re-exported for callers that only need to know the contents
