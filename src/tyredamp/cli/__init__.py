@@ -57,7 +57,10 @@ def main(argv: list[str] | None = None) -> None:
     args = sys.argv[1:] if argv is None else argv
     debug = "--debug" in args
     try:
-        cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
+        rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
+        if isinstance(rv, int) and rv != 0:
+            # ctx.exit(n) hands its code back as the return value here
+            sys.exit(rv)
     except click.exceptions.Exit as exc:
         sys.exit(exc.exit_code)
     except click.exceptions.Abort:
