@@ -1,19 +1,46 @@
 """Figures (matplotlib only; imported lazily by result objects' ``.plot()``).
 
 Every function takes ``ax=None`` (or ``axes=None``), draws, and returns what
-it drew; none calls ``show()``. The numerical core never imports this package.
+it drew; none calls ``show()`` or uses pyplot (figures are
+:class:`matplotlib.figure.Figure` objects). The numerical core never imports
+this package.
+
+=====================================  =========================================
+function                               figure
+=====================================  =========================================
+:func:`plot_frf`                       FRF: Bode, real/imaginary, or all four
+:func:`plot_frf_comparison`            measured vs fitted FRFs (paper Figs. 2, 3)
+:func:`plot_discrepancy`               discrepancy against frequency (Fig. 4)
+:func:`plot_matrix`                    damping matrices as heat maps (Fig. 5)
+:func:`plot_mode_shapes_ring`          mode shapes around the circumference
+:func:`plot_stabilisation`             stabilisation diagram of the pole search
+:func:`plot_figure7`                   lateral amplitude ratio, asymptotes, f0 (Fig. 7)
+:func:`plot_lateral_fit`               one lateral fit (Figs. 11-14)
+:func:`plot_ranking`                   every ranked lateral fit (Figs. 11, 12)
+:func:`plot_lateral_models`            measured vs predictions and truth (Figs. 11-14)
+:func:`plot_time_comparison`           lateral time response (Fig. 15)
+=====================================  =========================================
 """
 
 from __future__ import annotations
 
+from .comparison import plot_lateral_models
 from .damping import plot_matrix
 from .frf import plot_frf, plot_frf_comparison
+from .lateral import plot_figure7, plot_lateral_fit, plot_ranking, plot_time_comparison
 from .modal import plot_discrepancy, plot_mode_shapes_ring
+from .stabilisation import plot_stabilisation
 
 __all__ = [
     "plot_discrepancy",
+    "plot_figure7",
     "plot_frf",
     "plot_frf_comparison",
+    "plot_lateral_fit",
+    "plot_lateral_models",
     "plot_matrix",
     "plot_mode_shapes_ring",
+    "plot_ranking",
+    "plot_stabilisation",
+    "plot_time_comparison",
 ]

@@ -1,0 +1,295 @@
+"""The figures of the demo report, built from a :class:`~tyredamp.demo.DemoResult`.
+
+:func:`demo_figures` returns ``{name: (Figure, caption)}`` in report order;
+names are the PNG file stems (``fig02_real_fit`` ... ``fig15_time_response``;
+the numbers follow the papers' figures where there is one). Only
+:class:`matplotlib.figure.Figure` objects are used (no pyplot).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..plot import (
+    plot_discrepancy,
+    plot_figure7,
+    plot_frf_comparison,
+    plot_lateral_models,
+    plot_matrix,
+    plot_mode_shapes_ring,
+    plot_stabilisation,
+    plot_time_comparison,
+)
+from ..plot.comparison import model_color
+
+if TYPE_CHECKING:
+    from ..demo import DemoResult, LateralCondition
+
+__all__ = ["PAPER_MODELS", "demo_figures"]
+
+FigureSet = dict[str, tuple[Figure, str]]
+#: The four spring-damper models of the paper (Figures 11-15 show these).
+PAPER_MODELS = ("classic", "maxwell", "viscoplastic", "hysteretic")
+
+
+def _paper_models(names: Any) -> list[str]:
+    return [n for n in PAPER_MODELS if n in names]
+
+
+def _radial(result: DemoResult) -> FigureSet:
+    r = result.radial
+    main = r.main
+    meas = main.fitted_frf
+    real = main.synthesised("real")
+    cplx = main.synthesised("complex")
+    exact = main.exact()
+    dp = meas.drive_points()
+    out_i, in_i = dp[0] if dp else (0, 0)
+    lab = f"{meas.outputs[out_i].label}/{meas.inputs[in_i].label}"
+    p = f"{main.pressure_bar:g} bar"
+    mr, mc = main.models["real"], main.models["complex"]
+    figs: FigureSet = {}
+
+    ax = plot_frf_comparison(meas, {"real-mode fit": real}, out_i, in_i)
+    figs["fig02_real_fit"] = (
+        ax[0].figure,  # type: ignore[dict-item]
+        f"Paper Fig. 2: driving-point accelerance {lab} at {p}, measured (dots) and the "
+        f"real-mode fit (eq. [2]/[3]): real part, imaginary part, amplitude, phase. "
+        f"RMSD {mr.meta['rmsd']:.3g} {meas.unit}.",
+    )
+    ax = plot_frf_comparison(meas, {"complex-mode fit": cplx}, out_i, in_i)
+    figs["fig03_complex_fit"] = (
+        ax[0].figure,  # type: ignore[dict-item]
+        f"Paper Fig. 3: the same FRF and the complex-mode fit (eq. [10]). "
+        f"RMSD {mc.meta['rmsd']:.3g} {meas.unit}.",
+    )
+    ax1 = plot_discrepancy(
+        meas,
+        {"real-mode fit": real, "complex-mode fit": cplx, "exact FRF (noise level)": exact},
+        {"real-mode fit": mr.meta["rmsd"], "complex-mode fit": mc.meta["rmsd"]},
+    )
+    figs["fig04_discrepancy"] = (
+        ax1.figure,  # type: ignore[dict-item]
+        "Paper Fig. 4: discrepancy sqrt(sum_jk |H_fit - H_meas|^2) over the 16 FRFs against "
+        "frequency, with the RMSD of eq. [19]; the exact FRF of the virtual tyre shows the "
+        "noise level no fit can beat.",
+    )
+
+    dm = r.damping
+    dc = r.damping_truth
+    fig = Figure(figsize=(10.0, 8.4), layout="constrained")
+    axs = fig.subplots(2, 2)
+    mlab = [f"{f:.0f} Hz" for f in dm.frequency_hz]
+    tlab = [f"{dm.frequency_hz[i]:.0f} Hz" for i in dc.model_index]
+    plot_matrix(dm.modal, mlab, "identified C' (modal coordinates)", "1/s", ax=axs[0, 0])
+    plot_matrix(dc.modal_true, tlab, "true C' of the virtual tyre (eq. [14])", "1/s", axs[0, 1])
+    plab = [c.label for c in dm.points]
+    plot_matrix(
+        dm.physical_symmetric,
+        plab,
+        "identified C at the 16 points (physical coordinates)",
+        "N s/m",
+        ax=axs[1, 0],
+    )
+    if dc.physical_true is not None:
+        plot_matrix(
+            dc.physical_true,
+            plab,
+            "true C reduced to the points by the same modes",
+            "N s/m",
+            ax=axs[1, 1],
+        )
+    else:
+        axs[1, 1].set_visible(False)
+    figs["fig05_damping"] = (
+        fig,
+        f"Paper Fig. 5: damping matrices at {p} ({dm.method} method, eq. [18]) as heat maps, "
+        "identified beside the truth. Negative (blue) entries of the physical matrix come "
+        "from projecting on few modes ('power leakage'), as in the paper.",
+    )
+
+    ident = main.identification
+    ax2 = plot_stabilisation(ident.poles, ident.flags, meas, mc.frequency_hz)
+    figs["stabilisation"] = (
+        ax2.figure,  # type: ignore[dict-item]
+        f"Stabilisation diagram (pLSCF poles of every model order) at {p}; dashed lines: "
+        "the modes selected automatically; grey curve: summed FRF amplitude.",
+    )
+    axs3 = plot_mode_shapes_ring(mc)
+    figs["mode_shapes"] = (
+        axs3[0].figure,  # type: ignore[dict-item]
+        "Complex mode shapes around the circumference (16 points): real part of the "
+        "second-order shape (solid) and imaginary part (dashed), normalised.",
+    )
+
+    fig = Figure(figsize=(9.0, 3.2), layout="constrained")
+    axs = fig.subplots(1, 2)
+    for ax_, res, name in ((axs[0], r.linearity, "linearity"), (axs[1], r.reciprocity, "")):
+        if res.frequency is not None and res.per_line is not None:
+            ax_.semilogy(res.frequency, 100 * res.per_line, color="C0", lw=0.8)
+        ax_.axhline(100 * res.threshold, color="C3", ls="--", lw=0.8, label="threshold (RMS)")
+        ax_.axhline(100 * res.figure, color="k", lw=1, label=f"overall {100 * res.figure:.2g} %")
+        ax_.set_xlabel("frequency (Hz)")
+        ax_.set_ylabel("per-line deviation (%)")
+        ax_.set_title(
+            f"{name or 'reciprocity'}: {'PASS' if res.passed else 'FAIL'}", fontsize="small"
+        )
+        ax_.grid(True, which="both", alpha=0.3)
+        ax_.legend(fontsize="x-small")
+    figs["checks"] = (
+        fig,
+        f"Linearity (FRFs at {result.settings.force_levels_n[0]:g} N and "
+        f"{result.settings.force_levels_n[1]:g} N RMS) and reciprocity (H between drive points "
+        f"{result.settings.reciprocity_points[0]} and {result.settings.reciprocity_points[1]}): "
+        "relative difference per line and overall.",
+    )
+
+    fig = Figure(figsize=(9.0, 3.4), layout="constrained")
+    axs = fig.subplots(1, 2)
+    for i, run in enumerate(r.runs):
+        tr = run.truth
+        vis = tr.select("visible")
+        c = f"C{i}"
+        axs[0].plot(
+            tr.wave_number[vis], tr.frequency_hz[vis], color=c, lw=0.8, label=f"true, {run.pressure_bar:g} bar"
+        )
+        axs[1].plot(tr.frequency_hz[vis], 100 * tr.damping_ratio[vis], color=c, lw=0.8)
+        m = run.models["complex"]
+        pairs = run.matches["complex"].matched
+        n = [int(tr.wave_number[vis[t]]) for t, _ in pairs]
+        fi = [float(m.frequency_hz[j]) for _, j in pairs]
+        zi = [100 * float(m.damping_ratio[j]) for _, j in pairs]
+        axs[0].plot(n, fi, ls="none", marker="o", mfc="none", color=c, label="identified")
+        axs[1].plot(fi, zi, ls="none", marker="o", mfc="none", color=c)
+    axs[0].set_xlabel("circumferential wave number n")
+    axs[0].set_ylabel("natural frequency (Hz)")
+    axs[1].set_xlabel("natural frequency (Hz)")
+    axs[1].set_ylabel("damping ratio (%)")
+    axs[0].legend(fontsize="x-small")
+    for a in axs:
+        a.grid(True, alpha=0.3)
+    figs["pressures"] = (
+        fig,
+        "Inflation pressure: natural frequencies against wave number and damping ratios, "
+        "identified (circles, complex-mode fit) against the exact modes (lines).",
+    )
+    return figs
+
+
+def _ground_axle(
+    cond: LateralCondition, names: list[str], wheel_mass: float, force: str
+) -> tuple[Any, Any, dict[str, Any], Any]:
+    data = cond.ground if force == "ground" else cond.axle
+    f = data.frf.frequency
+    meas = data.frf.H[0, 0]
+    preds = {
+        n: cond.fit(n).model.response(f, "accelerance", force, wheel_mass) for n in names
+    }
+    truth = cond.truth.response(f, "accelerance", force, wheel_mass)
+    return f, meas, preds, truth
+
+
+def _lateral(result: DemoResult) -> FigureSet:
+    lat = result.lateral
+    figs: FigureSet = {}
+    ref = lat.reference
+    names = _paper_models(result.settings.lateral_models)
+    fig = Figure(figsize=(11.0, 4.0), layout="constrained")
+    axs = fig.subplots(1, 2)
+    plot_figure7(lat.figure7, ax=axs[0])
+    axs[0].set_title("paper's parameters: K 260 kN/m, h 20 kN/m, C_r 300 kN s/m", fontsize="small")
+    from ..lateral import figure7_curves
+
+    hy = ref.fit("hysteretic").model
+    plot_figure7(figure7_curves(hy.K, hy.h, hy.C_r, np.logspace(-3, 2, 401)), ax=axs[1])
+    axs[1].set_title(
+        f"fitted at {ref.label}: K {hy.K / 1e3:.3g} kN/m, h {hy.h / 1e3:.3g} kN/m, "
+        f"C_r {hy.C_r / 1e3:.3g} kN s/m",
+        fontsize="small",
+    )
+    figs["fig07_corner_frequency"] = (
+        fig,
+        "Paper Fig. 7: amplitude ratio of the proposed model with its low-frequency "
+        "(1/(i w C_r)) and high-frequency (1/(K + i h)) asymptotes, the Maxwell model and "
+        f"the corner frequency f0 = K/(2 pi C_r) (eq. 38; f0 = {lat.figure7.f0:.4g} Hz and "
+        f"{hy.corner_frequency():.3g} Hz).",
+    )
+    p_ref = ref.pressure_bar
+    n = 11
+    for force, style in (("ground", "reim"), ("axle", "bode")):
+        for v in result.settings.lateral_speeds_kmh:
+            cond = next(c for c in lat.conditions if c.pressure_bar == p_ref and c.speed_kmh == v)
+            f, meas, preds, truth = _ground_axle(cond, names, lat.rig.wheel_mass, force)
+            axs2 = plot_lateral_models(
+                f,
+                meas,
+                preds,
+                style=style,  # type: ignore[arg-type]
+                truth=truth,
+                title=f"{cond.label}, {force} force",
+            )
+            what = (
+                "fits to the lateral acceleration per ground force (real and imaginary parts)"
+                if force == "ground"
+                else "predictions, from the ground-force fits and the 100 kg wheel, of the "
+                "acceleration per axle force (amplitude ratio and phase)"
+            )
+            figs[f"fig{n}_{force}_{v:g}kmh"] = (
+                axs2[0].figure,  # type: ignore[dict-item]
+                f"Paper Fig. {n}: measured (dots) against the models' {what} at {cond.label}; "
+                "dotted black: the rig's exact FRF.",
+            )
+            n += 1
+
+    veh = lat.vehicle
+    f = np.linspace(0.25, 9.0, 500)
+    fig = Figure(figsize=(7.5, 3.4), layout="constrained")
+    ax = fig.subplots()
+    ax.semilogy(f, np.abs(veh.truth.accelerance(f)), color="k", lw=1.5, label="rig truth")
+    for i, (name, vh) in enumerate(veh.vehicles.items()):
+        res = veh.resonances[name]
+        lab = name + ("" if res is None else f" ({res.frequency:.2f} Hz)")
+        ax.semilogy(f, np.abs(vh.accelerance(f)), color=model_color(name, i), lw=1, label=lab)
+    ax.axvline(lat.time_test.frequency_hz, color="0.5", ls="--", lw=0.8)
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("|body acceleration / force| (m/(s^2 N))")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize="x-small")
+    figs["vehicle"] = (
+        fig,
+        f"Single-degree-of-freedom vehicle (eq. 41-42): a {veh.body_mass:g} kg body on each "
+        f"fitted tyre at {ref.label} and on the rig's exact tyre; body resonance in brackets; "
+        f"dashed: the {lat.time_test.frequency_hz:g} Hz time test.",
+    )
+
+    tt = lat.time_test
+    fig = Figure(figsize=(8.0, 5.2), layout="constrained")
+    axs = fig.subplots(2, 1, sharex=True)
+    t = tt.data.time
+    win = (t >= tt.window_s[0]) & (t <= tt.window_s[1])
+    axs[0].plot(t[win], tt.data.data[0][win], color="0.25", lw=1)
+    axs[0].set_ylabel("lateral force (N)")
+    axs[0].grid(True, alpha=0.3)
+    plot_time_comparison(
+        t,
+        tt.data.data[1],
+        {k: tt.predictions[k] for k in names},
+        ax=axs[1],
+        window=tt.window_s,
+    )
+    axs[1].grid(True, alpha=0.3)
+    figs["fig15_time_response"] = (
+        fig,
+        f"Paper Fig. 15: lateral force and body acceleration at {tt.frequency_hz:g} Hz "
+        f"({ref.label}), measured against the steady state of each fitted model "
+        f"({tt.window_s[0]:g}-{tt.window_s[1]:g} s).",
+    )
+    return figs
+
+
+def demo_figures(result: DemoResult) -> FigureSet:
+    """All demo figures in report order: ``{name: (Figure, caption)}``."""
+    return {**_radial(result), **_lateral(result)}
