@@ -157,10 +157,11 @@ def test_cli_method_and_model_options(tmp_path: Path, capsys: pytest.CaptureFixt
 @pytest.mark.parametrize(
     ("content", "message"),
     [
-        ("not json", "not a JSON file"),
-        ('{"kind": "frf"}', "expected a modes file"),
+        ("not json", "not valid JSON"),
+        ('{"kind": "frf"}', "expected a modes document"),
         ('{"kind": "modes", "models": {}}', "non-empty"),
         ('{"kind": "modes", "models": {"complex": {"modes": []}}}', "missing key"),
+        ("", "empty"),
     ],
 )
 def test_cli_bad_input_one_line_exit_2(

@@ -2,7 +2,8 @@
 
 Reads a modes JSON file (``{"kind": "modes", "models": {"complex": {...},
 "real": {...}}}``, each model in the layout of
-:meth:`tyredamp.modal.ModalModel.to_dict`), identifies the damping with
+:meth:`tyredamp.modal.ModalModel.to_dict`; read by
+:func:`tyredamp.modal.io.read_modes_json`), identifies the damping with
 :func:`tyredamp.damping.identify_damping` and writes a damping JSON file.
 
 Damping JSON schema (``"kind": "damping"``, ``"version": 1``; full
@@ -32,42 +33,12 @@ import click
 import numpy as np
 
 from ..damping import METHODS, DampingModel, identify_damping
-from ..exceptions import FileFormatError, InputError, TyredampError
+from ..exceptions import InputError
 from ..io._atomic import atomic_path
 from ..io._common import check_input_file
-from ..modal.model import ModalModel
+from ..modal.io import read_modes_json
 
-__all__ = ["damping_command", "damping_summary", "read_modes_file"]
-
-
-def read_modes_file(path: Path) -> dict[str, ModalModel]:
-    """The modal models of a modes JSON file, by name ("complex", "real", ...).
-
-    Raises
-    ------
-    FileFormatError
-        Not JSON, not ``"kind": "modes"``, or a model that does not parse.
-    """
-    p = check_input_file(path)
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise FileFormatError(f"{p}: not a JSON file ({exc})") from None
-    if not isinstance(doc, dict) or doc.get("kind") != "modes":
-        got = doc.get("kind") if isinstance(doc, dict) else type(doc).__name__
-        raise FileFormatError(f'{p}: expected a modes file ("kind": "modes"), got {got!r}')
-    models = doc.get("models")
-    if not isinstance(models, dict) or not models:
-        raise FileFormatError(f'{p}: expected a non-empty "models" object')
-    out: dict[str, ModalModel] = {}
-    for name, d in models.items():
-        if not isinstance(d, dict):
-            raise FileFormatError(f"{p}: model {name!r} is not an object")
-        try:
-            out[str(name)] = ModalModel.from_dict(d)
-        except TyredampError as exc:
-            raise FileFormatError(f"{p}: model {name!r}: {exc}") from None
-    return out
+__all__ = ["damping_command", "damping_summary"]
 
 
 def damping_summary(dm: DampingModel) -> list[str]:
@@ -152,7 +123,7 @@ def damping_command(
     """
     if out.resolve() == modes_json.resolve():
         raise InputError(f"--out: {out} is the input file; choose another name")
-    models = read_modes_file(modes_json)
+    models = read_modes_json(check_input_file(modes_json))
     if model_name not in models:
         raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")
     meta: dict[str, Any] = {"source": str(modes_json), "model": model_name}

@@ -375,4 +375,15 @@ def findings(
             f"{int(np.count_nonzero(sig))} of {int(np.count_nonzero(off))} off-diagonal terms "
             "exceed twice their standard error."
         )
+        # the antisymmetric part is pure error: compare it with the noise it could come from
+        anti = 0.5 * (c_modal - c_modal.T)[off]
+        noise = 0.5 * np.sqrt(std_modal[off] ** 2 + std_modal.T[off] ** 2)
+        ratio = float(np.linalg.norm(anti) / max(float(np.linalg.norm(noise)), 1e-300))
+        if ratio > 3:
+            out.append(
+                f"The asymmetry of C' is {ratio:.2g} times what the standard errors allow: it "
+                "is a systematic error (leakage from modes outside the set, or model error), "
+                "which the standard errors do not include. The symmetric part removes the "
+                "antisymmetric share of it."
+            )
     return out
