@@ -124,6 +124,16 @@ class DampingDiagnostics:
         return cls(**kw)
 
 
+def _pct(x: float) -> str:
+    """``x`` as a percentage with two significant digits, without exponent from 1 % up."""
+    v = 100 * float(x)
+    return f"{v:.2g}" if abs(v) < 100 else f"{v:.0f}"
+
+
+def _n(k: int, word: str) -> str:
+    return f"{k} {word}" + ("" if k == 1 else "s")
+
+
 def _asym(a: NDArray[np.float64]) -> float:
     n = float(np.linalg.norm(a))
     return float(np.linalg.norm(a - a.T) / n) if n > 0 else 0.0
@@ -217,7 +227,7 @@ def findings(
         ``C'`` (needed with ``std_modal``).
     """
     out: list[str] = []
-    real = d.imaginary_ratio < REAL_MODES
+    real = d.imaginary_ratio < REAL_MODES and d.n_modes > 1
     if real:
         out.append(
             "The mode shapes have no imaginary part (real modes), so C' is diagonal by "
@@ -226,15 +236,15 @@ def findings(
         )
     # --- symmetry
     if d.n_modes > 1 and not real:
-        pct = 100 * d.symmetry_modal
+        pct = _pct(d.symmetry_modal)
         if d.symmetry_modal <= SYMMETRY_OK:
             out.append(
-                f"C' is symmetric to {pct:.2g} % without any symmetrisation, as reciprocal "
+                f"C' is symmetric to {pct} % without any symmetrisation, as reciprocal "
                 "linear viscous damping requires; the mode set looks consistent."
             )
         elif d.symmetry_modal <= SYMMETRY_BAD:
             out.append(
-                f"C' is {pct:.2g} % asymmetric: noticeable, from noise on the imaginary "
+                f"C' is {pct} % asymmetric: noticeable, from noise on the imaginary "
                 "parts of the shapes or from damping coupling to modes outside the "
                 "identified set (leakage). The antisymmetric part is error (damping is "
                 "reciprocal), so use the symmetric part (modal_symmetric), which is never "
@@ -248,7 +258,7 @@ def findings(
                 "for the small-damping theory"
             )
             out.append(
-                f"C' is strongly asymmetric ({pct:.2g} %). Possible causes: {cause}. Check "
+                f"C' is strongly asymmetric ({pct} %). Possible causes: {cause}. Check "
                 "the modal fit before using this matrix; if the modes are right, use the "
                 "symmetric part (modal_symmetric), which is never further from the truth."
             )
@@ -275,22 +285,22 @@ def findings(
         )
     # --- proportionality
     if not real and d.n_modes > 1:
-        pct = 100 * d.non_proportionality
+        pct = _pct(d.non_proportionality)
         kind = (
             "close to proportional" if d.non_proportionality < 0.1 else "clearly non-proportional"
         )
         out.append(
-            f"The off-diagonal part of C' is {pct:.2g} % of its diagonal: the damping is {kind}."
+            f"The off-diagonal part of C' is {pct} % of its diagonal: the damping is {kind}."
         )
     if proportional is not None:
         pr = proportional
         out.append(
             f"Best Rayleigh model alpha = {pr.rayleigh_alpha:.4g} 1/s, beta = "
             f"{pr.rayleigh_beta:.4g} s fits the modal damping ratios to "
-            f"{100 * pr.zeta_fit_error:.2g} % RMS. Relative FRF error at the points against "
-            f"the complex-mode data: full C' {100 * pr.frf_error_full:.2g} %, modal (diagonal) "
-            f"damping {100 * pr.frf_error_modal:.2g} %, Rayleigh "
-            f"{100 * pr.frf_error_rayleigh:.2g} %."
+            f"{_pct(pr.zeta_fit_error)} % RMS. Relative FRF error at the points against "
+            f"the complex-mode data: full C' {_pct(pr.frf_error_full)} %, modal (diagonal) "
+            f"damping {_pct(pr.frf_error_modal)} %, Rayleigh "
+            f"{_pct(pr.frf_error_rayleigh)} %."
         )
         if not real and pr.frf_error_modal > 2 * max(pr.frf_error_full, 1e-12):
             out.append(
@@ -300,7 +310,8 @@ def findings(
     # --- truncation and leakage
     if d.n_modes < d.n_points:
         out.append(
-            f"Only {d.n_modes} modes are known at {d.n_points} points: the physical matrices "
+            f"Only {_n(d.n_modes, 'mode')} {'is' if d.n_modes == 1 else 'are'} known at "
+            f"{d.n_points} points: the physical matrices "
             f"C, M and K have rank {d.n_modes} (M is singular, so there is no full MCK model "
             "at the points) and describe only motions made of the identified mode shapes. "
             "Projecting the damping on so few shapes smears it over the points ('power "
@@ -311,12 +322,12 @@ def findings(
         )
     else:
         out.append(
-            f"The modal set is complete ({d.n_modes} modes at {d.n_points} points): C is a "
+            f"The modal set is complete ({_n(d.n_modes, 'mode')} at {d.n_points} points): C is a "
             "full-rank physical damping matrix."
         )
     if d.n_modes < d.n_points and not real:
         out.append(
-            f"{100 * d.imaginary_outside_span:.2g} % of the imaginary parts of the shapes lie "
+            f"{_pct(d.imaginary_outside_span)} % of the imaginary parts of the shapes lie "
             "outside the span of the identified real shapes: damping coupling to modes "
             "outside the identified set (or noise), which the pseudo-inverse discards. "
             "Coupling to outside modes whose shapes look like identified ones at the points "
@@ -324,7 +335,7 @@ def findings(
         )
     if d.residual_fraction is not None:
         out.append(
-            f"The residual terms (modes outside the band) carry {100 * d.residual_fraction:.2g} "
+            f"The residual terms (modes outside the band) carry {_pct(d.residual_fraction)} "
             "% of the receptance RMS in the band; the identified modes explain the rest."
             + (
                 " That share is large: out-of-band modes couple through damping too, and "
@@ -341,10 +352,10 @@ def findings(
         )
     # --- theory
     if d.theory_change is not None and not real:
-        pct = 100 * d.theory_change
+        pct = _pct(d.theory_change)
         msg = (
             f"The second-order terms neglected by the {method} small-damping formula change "
-            f"C' by {pct:.2g} % (largest damping ratio {100 * d.max_damping_ratio:.2g} %)."
+            f"C' by {pct} % (largest damping ratio {_pct(d.max_damping_ratio)} %)."
         )
         if d.theory_change > 0.05:
             msg += " That is significant: use method 'refined'."
@@ -356,13 +367,13 @@ def findings(
         )
     if d.basis_residual > 0.05:
         out.append(
-            f"The refined model leaves {100 * d.basis_residual:.2g} % imaginary residue in the "
+            f"The refined model leaves {_pct(d.basis_residual)} % imaginary residue in the "
             "real mode basis: the data are not fully consistent with the truncated modal system."
         )
     if d.lancaster_difference is not None:
         out.append(
             f"Complete modal set: Lancaster's exact formula gives a C within "
-            f"{100 * d.lancaster_difference:.2g} % (Frobenius) of this estimate."
+            f"{_pct(d.lancaster_difference)} % (Frobenius) of this estimate."
         )
     # --- uncertainty
     if std_modal is not None and c_modal is not None and d.n_modes > 1:
@@ -371,7 +382,7 @@ def findings(
         dm = np.abs(np.diag(c_modal))
         rel_d = np.median(np.diag(std_modal) / np.where(dm > 0, dm, np.inf))
         out.append(
-            f"Monte Carlo standard errors: diagonal of C' to {100 * rel_d:.2g} % (median); "
+            f"Monte Carlo standard errors: diagonal of C' to {_pct(rel_d)} % (median); "
             f"{int(np.count_nonzero(sig))} of {int(np.count_nonzero(off))} off-diagonal terms "
             "exceed twice their standard error."
         )

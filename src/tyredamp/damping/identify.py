@@ -31,16 +31,21 @@ Three estimators of ``C'`` (eq. [14], damping in undamped modal coordinates,
     ``C'_kn = Re[B_kn (lambda_n - lambda_k)(lambda_n + conj lambda_k) / lambda_n]``.
     For real ``lambda`` this is eq. [16] again; the two differ by terms of order
     ``zeta^2`` for well separated modes and by much more for close modes,
-    where ``(lambda_n - lambda_k)`` is dominated by the damping.
+    where ``(lambda_n - lambda_k)`` is dominated by the damping. (Measured on
+    random systems, ``benchmarks/damping_accuracy.py``: the inverted [18] is
+    not more accurate than [16]; both errors grow as ``zeta^2``.)
 
 ``"refined"`` (this package; not in the paper)
-    Removes the bias of the first-order theory by a fixed-point iteration:
-    the modes of the modal-coordinate system ``(I, C', diag omega^2)`` are
-    computed exactly (state space, eq. [4]-[10], same scaling and ``Psi^``
-    convention as the data) and the estimator is corrected by the difference
-    between eq. [16] applied to those exact modes and ``C'`` itself. With the
-    complete modal set and exact modes this recovers ``C`` to rounding error;
-    with a truncated set it is exact for the truncated modal system.
+    Removes the bias of the first-order theory: the modes of the
+    modal-coordinate system ``(I, S, diag w^2)`` are computed exactly (state
+    space, eq. [4]-[10], same scaling and ``Psi^`` convention as the data), and
+    the symmetric ``S`` and ``w`` are solved for so that eq. [16] applied to
+    those exact modes gives the same (symmetrised) ``C'`` and ``|p|`` as
+    applied to the data; the result is ``S`` plus the data's antisymmetric
+    residual. A fixed-point iteration solves this for small damping, MINPACK's
+    hybrid root finder when it stalls (close modes). With the complete modal
+    set and exact modes this recovers ``C`` to rounding error; with a
+    truncated set it is exact for the truncated modal system.
 
 Normalisation. Adhikari & Woodhouse write each complex mode with unit
 component on its own undamped mode (``alpha_n^(n) = 1``, eq. [13]). The
