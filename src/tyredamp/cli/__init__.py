@@ -40,13 +40,19 @@ def _register() -> None:
     from .damping import damping_command
     from .frf import frf_command
     from .lateral import lateral_group
+    from .demo import demo_command
     from .modal import modal_command
+    from .report import report_command
+    from .simulate import simulate_group
 
     cli.add_command(frf_command)
     cli.add_command(check_group)
     cli.add_command(damping_command)
     cli.add_command(lateral_group)
     cli.add_command(modal_command)
+    cli.add_command(demo_command)
+    cli.add_command(simulate_group)
+    cli.add_command(report_command)
 
 
 _register()

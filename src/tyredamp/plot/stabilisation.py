@@ -77,7 +77,8 @@ def plot_stabilisation(
     cls[f_ok & z_ok & v_ok] = 3
     for k, (label, style) in enumerate(_CLASSES):
         m = adm & (cls == k)
-        ax.scatter(fn[m], order[m], label=f"{label} ({int(m.sum())})", **style)
+        if np.any(m):
+            ax.scatter(fn[m], order[m], label=f"{label} ({int(m.sum())})", **style)
     ax.set_xlabel("frequency (Hz)")
     ax.set_ylabel("model order")
     if selected_hz is not None:

@@ -1,0 +1,54 @@
+"""``tyredamp report``: one self-contained HTML report from result files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from ..exceptions import InputError
+from ..io._atomic import atomic_path
+
+__all__ = ["report_command"]
+
+
+@click.command("report")
+@click.argument("result_files", nargs=-1, type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--out",
+    "-o",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="HTML file to write (self-contained, figures embedded).",
+)
+@click.option("--title", help="Page title (default 'tyredamp report').")
+def report_command(result_files: tuple[Path, ...], out: Path, title: str | None) -> None:
+    """Build one HTML report from RESULT_FILES of the other commands.
+
+    Accepts modes JSON (tyredamp modal), damping JSON (tyredamp damping),
+    lateral JSON (tyredamp lateral fit), the demo's results.json and FRF or
+    time-data files (.uff .unv .csv .npz). Modes are drawn against the FRF
+    file they came from (measured vs fitted, discrepancy), damping matrices
+    as heat maps with the diagnostics in words, lateral fits as a ranking
+    table with parameters; a modes file from 'simulate radial --truth' is
+    shown beside the identified modes. Nothing is written when an error
+    occurs.
+
+    \b
+    Example:
+      tyredamp report modes.json damping.json tyre_frf.uff --out report.html
+      tyredamp report lateral.json rig.npz truth.json -o all.html --title "Tyre A"
+    """
+    from ..report.files import build_files_report
+
+    if not result_files:
+        raise InputError("RESULT_FILES: expected at least one result file")
+    for p in result_files:
+        if p.exists() and out.exists() and p.resolve() == out.resolve():
+            raise InputError(f"--out: {out} is one of the input files; choose another name")
+    html = build_files_report(list(result_files), title)
+    with atomic_path(out) as tmp:
+        tmp.write_text(html, encoding="utf-8")
+    click.echo(f"report of {len(result_files)} file(s): {', '.join(p.name for p in result_files)}")
+    click.echo(f"wrote {out}")

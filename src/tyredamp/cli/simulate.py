@@ -1,0 +1,239 @@
+"""``tyredamp simulate``: test data from the virtual rigs, for the other commands.
+
+``simulate radial`` runs the virtual modal test of the truck tyre
+(:func:`tyredamp.tyre.run_modal_test`) and writes its time data (UFF 58
+function type 1) or, with ``--frf``, the H1 FRFs estimated from it (function
+type 4); ``--truth`` also writes the exact modes as a modes JSON file.
+``simulate lateral`` is the rolling-tyre rig; it is the same command as
+``tyredamp lateral simulate`` (same options, same output).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..exceptions import InputError
+from ..io import FORMATS, format_of, write_frf, write_timedata
+from ..io._atomic import atomic_path
+from ..results import finite
+from .lateral import lateral_group
+
+__all__ = ["simulate_group"]
+
+BAR = 1.0e5
+
+
+def _points(values: tuple[str, ...]) -> tuple[int, ...]:
+    out: list[int] = []
+    for v in values:
+        for s in v.replace(";", ",").split(","):
+            if not s.strip():
+                continue
+            try:
+                out.append(int(s))
+            except ValueError:
+                raise InputError(
+                    f"--drive-points: expected point numbers like 1,5, got {v!r}"
+                ) from None
+    return tuple(out) or (1,)
+
+
+@click.group("simulate")
+def simulate_group() -> None:
+    """Simulate tests on the built-in virtual tyres and write them as files.
+
+    The files are what a test rig would give (noise included) and feed the
+    other commands; the exact answer is known (--truth for the radial test).
+
+    \b
+    Example:
+      tyredamp simulate radial --out tyre_test.uff --pressure 7.5 --seed 1
+      tyredamp simulate radial --out tyre_frf.uff --frf --truth truth.json
+      tyredamp simulate lateral --out rig.npz --speed 5 --pressure 1.7
+    """
+
+
+@simulate_group.command("radial")
+@click.option(
+    "--out",
+    "-o",
+    "out",
+    required=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="File to write (.uff/.unv: UFF 58b binary, or .csv, .npz).",
+)
+@click.option(
+    "--pressure",
+    type=click.FloatRange(min=0, max=20),
+    default=7.5,
+    show_default=True,
+    metavar="BAR",
+    help="Inflation pressure, bar.",
+)
+@click.option(
+    "--snr",
+    type=float,
+    default=40.0,
+    show_default=True,
+    metavar="DB",
+    help="Signal-to-noise ratio of every channel, dB ('inf' for no noise).",
+)
+@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Noise seed.")
+@click.option(
+    "--drive-points",
+    "drive_points",
+    multiple=True,
+    metavar="P1,P2,...",
+    help="Shaker points (1-16), comma-separated or repeated; one run per point. Default 1.",
+)
+@click.option(
+    "--frf",
+    "as_frf",
+    is_flag=True,
+    help="Write the H1 FRFs (function type 4) instead of the time data (type 1).",
+)
+@click.option(
+    "--periods",
+    type=click.IntRange(min=1, max=64),
+    default=8,
+    show_default=True,
+    help="Chirp periods (averages) per drive point, 4 s each.",
+)
+@click.option(
+    "--force-rms",
+    "force_rms",
+    type=click.FloatRange(min=0, min_open=True),
+    default=10.0,
+    show_default=True,
+    metavar="N",
+    help="RMS shaker force, N.",
+)
+@click.option(
+    "--truth",
+    "truth_out",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Also write the exact modes of the tyre as a modes JSON (for tyredamp report).",
+)
+@click.option(
+    "--format", "fmt", type=click.Choice(FORMATS), help="File format (default from the extension)."
+)
+def radial_command(
+    out: Path,
+    pressure: float,
+    snr: float,
+    seed: int,
+    drive_points: tuple[str, ...],
+    as_frf: bool,
+    periods: int,
+    force_rms: float,
+    truth_out: Path | None,
+    fmt: str | None,
+) -> None:
+    """Run the virtual modal test of the truck tyre and write time data or FRFs.
+
+    The virtual 295/80R22.5 tyre (in-plane ring on an elastic foundation) is
+    driven radially by a periodic chirp of 0-200 Hz at the drive point(s) and
+    the radial accelerations at 16 points (22.5 deg apart) are recorded with
+    the forces, sampled at 1024 Hz with noise of the given SNR on every
+    channel. Nothing is written when an error occurs.
+
+    \b
+    Example:
+      tyredamp simulate radial --out tyre_test.uff
+      tyredamp simulate radial --out tyre_frf.uff --frf --pressure 9 --snr 30 --seed 2
+      tyredamp simulate radial --out mimo.uff --drive-points 1,5 --periods 4
+    """
+    from ..demo import single_threaded_blas
+    from ..modal.io import modes_document
+    from ..signal import estimate_frf
+    from ..tyre import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
+
+    if truth_out is not None and truth_out.resolve() == out.resolve():
+        raise InputError("--truth: expected another file than --out")
+    out_format = format_of(out, fmt)
+    points = _points(drive_points)
+    tyre = RingTyre(
+        RingTyreParameters(pressure=pressure * BAR), MeasurementLayout(drive_points=points)
+    )
+    with single_threaded_blas():
+        test = run_modal_test(
+            tyre, n_periods=periods, force_rms=force_rms, snr_db=snr, seed=seed
+        )
+    truth_text = None
+    if truth_out is not None:
+        doc = modes_document(
+            {"complex": test.truth.modal_model("visible")},
+            source=f"truth: virtual ring tyre at {pressure:g} bar",
+            band_hz=test.truth.band,
+            frf_kind="receptance",
+        )
+        truth_text = json.dumps(finite(doc), indent=1, allow_nan=False) + "\n"
+    existed = out.exists()
+    if as_frf:
+        frf = estimate_frf(test.data, "H1")
+        write_frf(frf, out, out_format)
+        what = f"FRFs {frf.n_out} x {frf.n_in}, {frf.n_freq} lines (function type 4)"
+    else:
+        write_timedata(test.data, out, out_format)
+        td = test.data
+        what = f"time data, {td.n_channels} channels x {td.n_samples} samples (function type 1)"
+    if truth_text is not None and truth_out is not None:
+        try:
+            with atomic_path(truth_out) as tmp:
+                tmp.write_text(truth_text, encoding="utf-8")
+        except BaseException:
+            if not existed:
+                with contextlib.suppress(OSError):
+                    out.unlink()
+            raise
+    vis = test.truth.select("visible")
+    click.echo(
+        f"virtual truck tyre at {pressure:g} bar: {tyre.layout.n_points} points, drive point(s) "
+        f"{', '.join(str(p) for p in points)}, {periods} periods of "
+        f"{test.period_samples / test.data.sample_rate:g} s at {test.data.sample_rate:g} Hz, "
+        f"SNR {snr:g} dB, seed {seed}"
+    )
+    click.echo(
+        "true modes (Hz): "
+        + ", ".join(
+            f"{test.truth.frequency_hz[i]:.2f} (zeta {100 * test.truth.damping_ratio[i]:.2f} %)"
+            for i in vis
+        )
+    )
+    click.echo(f"wrote {out} ({out_format}, {what})")
+    if truth_out is not None:
+        click.echo(f"wrote {truth_out} (exact modes, modes JSON)")
+
+
+_LATERAL = lateral_group.commands["simulate"]
+
+
+def _lateral_callback(**kwargs: Any) -> None:
+    assert _LATERAL.callback is not None
+    _LATERAL.callback(**kwargs)
+
+
+simulate_group.add_command(
+    click.Command(
+        "lateral",
+        callback=_lateral_callback,
+        params=list(_LATERAL.params),
+        help="""Write the lateral accelerance FRF of the virtual rolling-tyre rig.
+
+    The same command as 'tyredamp lateral simulate': the truth is a
+    viscoelastic stretched-string tyre with contact length and a 100 kg
+    wheel; the FRF covers 0.25-9 Hz with 3 % noise per line.
+
+    \b
+    Example:
+      tyredamp simulate lateral --out rig.npz --speed 5 --pressure 1.7
+      tyredamp simulate lateral --out rig_axle.uff --speed 10 --pressure 2.4 --force axle
+    """,
+        short_help="Write the lateral FRF of the virtual rolling-tyre rig.",
+    )
+)

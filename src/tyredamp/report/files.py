@@ -1,0 +1,498 @@
+"""A report from the result files of the other commands (``tyredamp report``).
+
+Recognised inputs (by content, not by name):
+
+===========================  ==============================================
+file                         written by
+===========================  ==============================================
+modes JSON (``"kind": "modes"``)        ``tyredamp modal`` (and ``simulate radial --truth``)
+damping JSON (``"kind": "damping"``)    ``tyredamp damping``
+lateral JSON (``"tyredamp": "lateral-fit"``)  ``tyredamp lateral fit``
+demo results (``"kind": "tyredamp-demo-results"``)  ``tyredamp demo``
+FRF or time data (.uff .unv .uf .csv .npz)  ``tyredamp frf``, ``simulate``, a DAQ
+===========================  ==============================================
+
+Modes files are drawn against an FRF file of the same channels (the one
+named in the modes file's ``source`` when given): measured against fitted
+FRFs (paper Figs. 2 and 3) and the discrepancy (Fig. 4). A modes file whose
+source starts with ``"truth"`` (the exact modes of a virtual tyre,
+``tyredamp simulate radial --truth``) is shown beside the identified modes.
+A lateral file is drawn against its FRF file in the same way.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from .. import __version__
+from ..exceptions import FileFormatError, InputError, TyredampError
+from ..frf import FRF
+from ..io._common import check_input_file
+from ..modal.model import ModalModel
+from ..timedata import TimeData
+from .build import fmt_pm
+from .html import HtmlReport
+
+__all__ = ["ResultFile", "build_files_report", "load_result_file"]
+
+_DATA_EXT = (".uff", ".unv", ".uf", ".csv", ".npz")
+
+
+@dataclass(frozen=True, eq=False)
+class ResultFile:
+    """One input of the report.
+
+    Attributes
+    ----------
+    path : Path
+    kind : str
+        ``"modes"``, ``"damping"``, ``"lateral"``, ``"demo"``, ``"frf"`` or
+        ``"timedata"``.
+    obj : Any
+        The parsed content: ``dict`` of :class:`ModalModel` (modes),
+        :class:`~tyredamp.damping.DampingModel`, the lateral or demo JSON
+        document, :class:`FRF` or :class:`TimeData`.
+    doc : dict or None
+        The JSON document (JSON inputs).
+    """
+
+    path: Path
+    kind: str
+    obj: Any
+    doc: dict[str, Any] | None = None
+
+    @property
+    def is_truth(self) -> bool:
+        """A modes file holding the exact modes of a virtual tyre."""
+        return self.kind == "modes" and str((self.doc or {}).get("source", "")).startswith("truth")
+
+
+def load_result_file(path: str | Path) -> ResultFile:
+    """Read and classify one result file.
+
+    Raises
+    ------
+    FileFormatError
+        Unreadable, not JSON where JSON is expected, or not a tyredamp result.
+    """
+    p = check_input_file(path)
+    if p.suffix.lower() in _DATA_EXT:
+        from ..io import read
+
+        obj = read(p)
+        return ResultFile(p, "frf" if isinstance(obj, FRF) else "timedata", obj)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise FileFormatError(f"{p}: not a text (JSON) file") from None
+    if not text.strip():
+        raise FileFormatError(f"{p}: the file is empty")
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    if not isinstance(doc, dict):
+        raise FileFormatError(f"{p}: expected a JSON object, got {type(doc).__name__}")
+    kind = doc.get("kind")
+    try:
+        if kind == "modes":
+            from ..modal.io import read_modes_json
+
+            return ResultFile(p, "modes", read_modes_json(p), doc)
+        if kind == "damping":
+            from ..damping import DampingModel
+
+            return ResultFile(p, "damping", DampingModel.from_dict(doc), doc)
+        if kind == "tyredamp-demo-results":
+            return ResultFile(p, "demo", doc, doc)
+        if doc.get("tyredamp") == "lateral-fit":
+            _ = doc["table"], doc["fits"], doc["conditions"]
+            return ResultFile(p, "lateral", doc, doc)
+    except KeyError as exc:
+        raise FileFormatError(f"{p}: missing key {exc.args[0]!r}") from None
+    except TyredampError as exc:
+        if isinstance(exc, FileFormatError):
+            raise
+        raise FileFormatError(f"{p}: {exc}") from None
+    raise FileFormatError(
+        f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
+        f"results JSON, or an FRF/time-data file {', '.join(_DATA_EXT)})"
+    )
+
+
+# ----------------------------------------------------------------------------- sections
+def _frf_summary(frf: FRF) -> list[list[str]]:
+    f = frf.frequency
+    rows = [
+        ["size", f"{frf.n_out} output(s) x {frf.n_in} input(s)"],
+        ["kind", f"{frf.kind} ({frf.unit})"],
+        ["lines", f"{frf.n_freq}, {f[0]:.4g}-{f[-1]:.4g} Hz"],
+        ["drive points", ", ".join(
+            f"{frf.outputs[i].label}/{frf.inputs[j].label}" for i, j in frf.drive_points()
+        ) or "none"],
+    ]
+    if frf.coherence is not None:
+        rows.append(
+            ["coherence", f"mean {float(frf.coherence.mean()):.4f}, min "
+             f"{float(frf.coherence.min()):.4f}"]
+        )
+    for key in ("estimator", "method", "n_averages"):
+        if key in frf.meta:
+            rows.append([key, str(frf.meta[key])])
+    return rows
+
+
+def _frf_section(rep: HtmlReport, item: ResultFile) -> None:
+    from ..plot import plot_frf
+
+    frf: FRF = item.obj
+    rep.heading(f"FRF: {item.path.name}", 3)
+    rep.table(["", "value"], _frf_summary(frf))
+    pairs = frf.drive_points()[:2] or [(0, 0)]
+    n = 3 if frf.coherence is not None else 2
+    fig = Figure(figsize=(7.5, 2.2 * n + 0.4), layout="constrained")
+    axs = list(fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0])
+    for i, j in pairs:
+        plot_frf(frf, i, j, "bode", axes=axs[:2])
+    axs[0].legend(fontsize="x-small")
+    if frf.coherence is not None:
+        for i, _ in pairs:
+            axs[2].plot(frf.frequency, frf.coherence[i], lw=0.8)
+        axs[2].set_ylabel("coherence")
+        axs[2].set_ylim(0, 1.05)
+        axs[2].grid(True, alpha=0.3)
+        axs[2].set_xlabel("frequency (Hz)")
+    rep.figure(fig, f"{item.path.name}: drive-point FRF(s), amplitude and phase"
+               + (", multiple coherence" if frf.coherence is not None else ""))
+
+
+def _time_section(rep: HtmlReport, item: ResultFile) -> None:
+    td: TimeData = item.obj
+    rep.heading(f"Time data: {item.path.name}", 3)
+    rows = [
+        [c.label, q, u, f"{float(np.sqrt(np.mean(td.data[k] ** 2))):.4g}"]
+        for k, (c, q, u) in enumerate(zip(td.channels, td.quantities, td.units, strict=True))
+    ]
+    rep.table(
+        ["channel", "quantity", "unit", "RMS"],
+        rows,
+        caption=f"{td.n_channels} channels, {td.n_samples} samples at {td.sample_rate:g} Hz "
+        f"({td.n_samples / td.sample_rate:.4g} s).",
+    )
+    show = [*td.force_indices[:1], *td.response_indices[:2]]
+    n_show = min(td.n_samples, int(round(2.0 * td.sample_rate)))
+    fig = Figure(figsize=(7.5, 1.8 * len(show) + 0.4), layout="constrained")
+    axs = list(fig.subplots(len(show), 1, sharex=True, squeeze=False)[:, 0])
+    t = td.time[:n_show]
+    for ax, k in zip(axs, show, strict=True):
+        ax.plot(t, td.data[k, :n_show], lw=0.7)
+        ax.set_ylabel(f"{td.channels[k].label} ({td.units[k]})")
+        ax.grid(True, alpha=0.3)
+    axs[-1].set_xlabel("time (s)")
+    rep.figure(fig, f"{item.path.name}: the first {t[-1]:.3g} s of a force and two responses")
+
+
+def _match(freq: np.ndarray, ref: np.ndarray) -> dict[int, int]:
+    from ..demo import match_modes
+
+    return {m: t for t, m in match_modes(freq, ref).matched}
+
+
+def _modes_section(
+    rep: HtmlReport, item: ResultFile, frfs: list[ResultFile], truth: ResultFile | None
+) -> None:
+    models: dict[str, ModalModel] = item.obj
+    doc = item.doc or {}
+    rep.heading(f"Modes: {item.path.name}", 3)
+    src = doc.get("source") or "?"
+    band = doc.get("band_hz")
+    rep.paragraph(
+        f"Source {src}; band {'-'.join(f'{b:g}' for b in band) if band else '?'} Hz; "
+        f"FRF kind {doc.get('frf_kind') or '?'}."
+    )
+    tmodel = None
+    if truth is not None and truth is not item:
+        tm = truth.obj
+        tmodel = tm.get("complex") or next(iter(tm.values()))
+    for name, m in models.items():
+        sf = m.std.get("frequency_hz", np.full(m.n_modes, np.nan))
+        sz = m.std.get("damping_ratio", np.full(m.n_modes, np.nan))
+        mpc = np.asarray(m.meta.get("mpc", np.full(m.n_modes, np.nan)), dtype=float)
+        match = {} if tmodel is None else _match(m.frequency_hz, tmodel.frequency_hz)
+        header = ["#", "f (Hz)", "zeta (%)", "MPC"]
+        if tmodel is not None:
+            header += ["f true (Hz)", "zeta true (%)"]
+        rows = []
+        for n in range(m.n_modes):
+            row = [
+                str(n + 1),
+                fmt_pm(float(m.frequency_hz[n]), float(sf[n]), 6),
+                fmt_pm(float(m.damping_ratio[n]), float(sz[n]), 4, 100),
+                "-" if not math.isfinite(mpc[n]) else f"{mpc[n]:.4f}",
+            ]
+            if tmodel is not None:
+                t = match.get(n)
+                row += (
+                    ["-", "-"]
+                    if t is None
+                    else [f"{tmodel.frequency_hz[t]:.3f}", f"{100 * tmodel.damping_ratio[t]:.3f}"]
+                )
+            rows.append(row)
+        rep.table(
+            header,
+            rows,
+            caption=f"{name} modes ({m.mode_kind}): value ± standard error"
+            + ("; truth of the virtual tyre beside" if tmodel is not None else ""),
+        )
+    if len(models) > 1:
+        rep.table(
+            ["model", "RMSD (eq. [19])", "relative error"],
+            [
+                [k, f"{_num(v.meta.get('rmsd')):.4g}",
+                 f"{100 * _num(v.meta.get('relative_error')):.3g} %"]
+                for k, v in models.items()
+            ],
+            caption="Real against complex modes: fit quality over the same FRFs.",
+        )
+    any_model = next(iter(models.values()))
+    frf = _frf_for(any_model, src, frfs)
+    if frf is not None:
+        _fit_figures(rep, frf, models)
+    shapes = models.get("complex") or any_model
+    if shapes.n_modes and shapes.psi_out.shape[0] >= 3:
+        from ..plot import plot_mode_shapes_ring
+
+        axs = plot_mode_shapes_ring(shapes)
+        rep.figure(axs[0].figure, f"{item.path.name}: mode shapes around the circumference "
+                   "(real part solid, imaginary part dashed)")
+
+
+def _frf_for(model: ModalModel, source: str, frfs: list[ResultFile]) -> FRF | None:
+    same = [
+        f for f in frfs
+        if f.obj.n_out == model.psi_out.shape[0] and f.obj.n_in == model.psi_in.shape[0]
+    ]
+    named = [f for f in same if f.path.name == Path(source).name]
+    pick = named or (same if len(same) == 1 else [])
+    return pick[0].obj if pick else None
+
+
+def _fit_figures(rep: HtmlReport, frf: FRF, models: dict[str, ModalModel]) -> None:
+    from ..plot import plot_discrepancy, plot_frf_comparison
+
+    band = next(iter(models.values())).meta.get("band_hz")
+    meas = frf if not band else frf.band(float(band[0]), float(band[1]))
+    meas = meas.select_lines(np.flatnonzero(meas.frequency > 0))
+    fitted = {f"{k}-mode fit": m.frf(meas.frequency, meas.kind) for k, m in models.items()}
+    dp = meas.drive_points()
+    i, j = dp[0] if dp else (0, 0)
+    for k, (lab, fr) in enumerate(fitted.items()):
+        axs = plot_frf_comparison(meas, {lab: fr}, i, j)
+        rep.figure(
+            axs[0].figure,
+            f"Measured against the {lab} at {meas.outputs[i].label}/{meas.inputs[j].label} "
+            f"(as the paper's Fig. {2 + k}).",
+        )
+    rmsd = {f"{k}-mode fit": _num(m.meta.get("rmsd")) for k, m in models.items()}
+    ax = plot_discrepancy(meas, fitted, rmsd)
+    rep.figure(ax.figure, "Discrepancy against frequency with the RMSD of eq. [19] (Fig. 4).")
+
+
+def _damping_section(rep: HtmlReport, item: ResultFile) -> None:
+    from ..plot import plot_matrix
+
+    dm = item.obj
+    d = dm.diagnostics
+    rep.heading(f"Damping: {item.path.name}", 3)
+    rep.table(
+        ["diagnostic", "value"],
+        [
+            ["method", f"{dm.method} ({dm.n_modes} modes at {dm.n_points} points)"],
+            ["asymmetry of C'", f"{100 * d.symmetry_modal:.3g} %"],
+            ["definiteness of C'", d.definiteness_modal],
+            ["non-proportionality", f"{100 * d.non_proportionality:.3g} %"],
+            ["negative off-diagonal entries of C", f"{100 * d.negative_offdiagonal_fraction:.3g} %"],
+            ["Rayleigh fit alpha, beta",
+             f"{dm.proportional.rayleigh_alpha:.4g} 1/s, {dm.proportional.rayleigh_beta:.4g} s"],
+        ],
+    )
+    rep.paragraph("What the numbers say:")
+    rep.bullets(list(dm.findings))
+    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
+    axs = fig.subplots(1, 2)
+    plot_matrix(dm.modal, [f"{f:.0f} Hz" for f in dm.frequency_hz],
+                "C' (modal coordinates)", "1/s", ax=axs[0])
+    plot_matrix(dm.physical_symmetric, [c.label for c in dm.points],
+                "C at the points (physical coordinates)", "N s/m", ax=axs[1])
+    rep.figure(fig, "Damping matrices as heat maps (as the paper's Fig. 5).")
+
+
+def _lateral_section(rep: HtmlReport, item: ResultFile, frfs: list[ResultFile]) -> None:
+    from ..lateral.models import LateralModel
+    from ..plot import plot_lateral_models
+
+    doc: dict[str, Any] = item.obj
+    cond = doc["conditions"]
+    rep.heading(f"Lateral fit: {item.path.name}", 3)
+    inp = doc.get("input", {})
+    rep.paragraph(
+        f"Input {inp.get('file', '?')}: {inp.get('n_lines', '?')} lines, {cond.get('force')} "
+        f"force, wheel mass {cond.get('wheel_mass_kg')} kg, speed "
+        f"{'?' if cond.get('speed_kmh') is None else format(cond['speed_kmh'], 'g')} km/h."
+    )
+    crit = str(doc.get("criterion", "bic")).upper()
+    rep.table(
+        ["rank", "model", "P", "AIC", "BIC", "d" + crit, "weight", "amp. error (%)", "bias (%)"],
+        [
+            [str(r["rank"]), r["model"], str(r["n_params"]), _f(r["aic"], ".1f"),
+             _f(r["bic"], ".1f"), _f(r["delta"], ".1f"), _f(r["weight"], ".3f"),
+             _f(r["amplitude_error_pct"], ".2f"), _f(r["amplitude_bias_pct"], "+.2f")]
+            for r in doc["table"]
+        ],
+        caption="Ranking (lower criterion is better; amplitude error as the paper's Table 1).",
+    )
+    rep.bullets([str(s) for s in doc.get("reasons", [])])
+    rows = []
+    for fit in doc["fits"]:
+        for n, v in fit["params"].items():
+            rows.append([fit["model"], n, fmt_pm(v, fit["stderr"].get(n)),
+                         fit["units"].get(n, "")])
+        f0 = (fit.get("derived") or {}).get("f0")
+        if f0 is not None:
+            rows.append([fit["model"], "f0 (eq. 38)", f"{f0:.4g}", "Hz"])
+    rep.table(["model", "parameter", "value ± standard error", "unit"], rows)
+    band = inp.get("band_hz") or [0.25, 9.0]
+    measured = None
+    for f in frfs:
+        if f.path.name == Path(str(inp.get("file", ""))).name and f.obj.n_out == f.obj.n_in == 1:
+            measured = f.obj.band(float(band[0]), float(band[1])).to("accelerance")
+    freq = measured.frequency if measured is not None else np.linspace(band[0], band[1], 300)
+    preds = {}
+    for fit in doc["fits"]:
+        try:
+            m = LateralModel.from_dict(
+                {"model": fit["model"], "params": fit["params"],
+                 "conditions": fit.get("conditions", {})}
+            )
+        except (InputError, TypeError):
+            continue
+        preds[fit["model"]] = m.response(
+            freq, "accelerance", cond.get("force", "ground"), cond.get("wheel_mass_kg") or 0.0
+        )
+    if preds:
+        meas = measured.H[0, 0] if measured is not None else np.full(freq.shape, np.nan + 0j)
+        axs = plot_lateral_models(freq, meas, preds, style="bode",
+                                  title=f"{item.path.name}: {cond.get('force')} force")
+        rep.figure(axs[0].figure, "Fitted models" + (" against the measured FRF"
+                   if measured is not None else "") + " (as the paper's Figs. 11-14).")
+
+
+def _num(v: Any) -> float:
+    """A float from a JSON value (``None`` or junk as NaN)."""
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _f(v: Any, spec: str) -> str:
+    return "-" if v is None else format(v, spec)
+
+
+def _demo_section(rep: HtmlReport, item: ResultFile) -> None:
+    from .build import _modes_table
+
+    doc: dict[str, Any] = item.obj
+    rep.heading(f"Demo results: {item.path.name}", 3)
+    rad, lat = doc["radial"], doc["lateral"]
+    rep.paragraph(
+        f"Radial study at {rad['pressure_bar']:g} bar: RMSD real {rad['rmsd_real']:.4g}, "
+        f"complex {rad['rmsd_complex']:.4g}; damping C' within "
+        f"{100 * rad['damping']['modal_error']:.3g} % of the truth."
+    )
+    _modes_table(rep, rad["modes"], "Modes identified beside the truth.")
+    rep.table(
+        ["rank", "model", "mean rank", "best at", "amplitude error (%)"],
+        [[str(r["rank"]), r["model"], f"{r['mean_rank']:.2f}",
+          f"{r['wins']} of {r['n_conditions']}", _f(r["mean_amplitude_error_pct"], ".2f")]
+         for r in lat["ranking"]],
+        caption="Lateral models over all conditions.",
+    )
+
+
+def build_files_report(paths: Sequence[str | Path], title: str | None = None) -> str:
+    """One self-contained HTML page from result files (module docstring).
+
+    Parameters
+    ----------
+    paths : sequence of path-like
+        At least one result file.
+    title : str, optional
+        Page title.
+
+    Returns
+    -------
+    str
+        The HTML text.
+
+    Raises
+    ------
+    InputError
+        No files.
+    FileFormatError
+        A file that is not a tyredamp result (names the file).
+    """
+    if not paths:
+        raise InputError("RESULT_FILES: expected at least one result file")
+    items = [load_result_file(p) for p in paths]
+    rep = HtmlReport(title or "tyredamp report")
+    rep.heading("Inputs")
+    names = {
+        "modes": "modal models (real/complex)",
+        "damping": "damping matrices",
+        "lateral": "lateral model fits",
+        "demo": "demo results",
+        "frf": "FRF",
+        "timedata": "time data",
+    }
+    rep.table(
+        ["file", "content"],
+        [[str(i.path), names[i.kind] + (" (truth of a virtual tyre)" if i.is_truth else "")]
+         for i in items],
+    )
+    rep.paragraph(f"tyredamp {__version__}.")
+    frfs = [i for i in items if i.kind == "frf"]
+    truth = next((i for i in items if i.is_truth), None)
+    sections = [
+        ("Measured data", [i for i in items if i.kind in ("frf", "timedata")]),
+        ("Modal analysis", [i for i in items if i.kind == "modes"]),
+        ("Damping identification", [i for i in items if i.kind == "damping"]),
+        ("Lateral tyre models", [i for i in items if i.kind == "lateral"]),
+        ("Demo results", [i for i in items if i.kind == "demo"]),
+    ]
+    for heading, group in sections:
+        if not group:
+            continue
+        rep.heading(heading)
+        for item in group:
+            if item.kind == "frf":
+                _frf_section(rep, item)
+            elif item.kind == "timedata":
+                _time_section(rep, item)
+            elif item.kind == "modes":
+                _modes_section(rep, item, frfs, truth)
+            elif item.kind == "damping":
+                _damping_section(rep, item)
+            elif item.kind == "lateral":
+                _lateral_section(rep, item, frfs)
+            else:
+                _demo_section(rep, item)
+    return rep.render()
