@@ -179,11 +179,21 @@ def identify_modes(
             raise InputError(f"frequencies: expected values inside the band [{lo:g}, {hi:g}] Hz")
     nm_hint = int(n_modes) if n_modes is not None else (None if fr is None else fr.size)
     p_max = _default_order(n_in, n_f, nm_hint) if max_order is None else int(max_order)
-    ps = plscf(f, H, p_max, band=(float(f[0]), float(f[-1])))
-    flags = stability_flags(ps, band=(lo, hi), max_damping=max_damping)
-    kept, weak = cluster_poles(
-        ps, flags, cluster_distance=cluster_distance, min_fraction=min_fraction
-    )
+    limit = (2 * n_f) // (n_in + 1) - 2
+    while True:
+        # orders below p_max / 4 do not count for persistence (most modes need a
+        # minimum order to appear at all)
+        ps = plscf(f, H, p_max, band=(float(f[0]), float(f[-1])), min_order=max(1, p_max // 4))
+        flags = stability_flags(ps, band=(lo, hi), max_damping=max_damping)
+        kept, weak = cluster_poles(
+            ps, flags, cluster_distance=cluster_distance, min_fraction=min_fraction
+        )
+        # automatic order: the highest order must give at least 2 poles per pole
+        # needed (kept modes + 2 for residual effects, conjugates counted)
+        need = 2 * 2 * (len(kept) + 2)
+        if max_order is not None or p_max * n_in >= need or p_max >= limit:
+            break
+        p_max = min(limit, max(2 * p_max, int(np.ceil(need / n_in))))
     rejected: list[dict[str, Any]] = [
         _rej(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}") for c in weak
     ]
@@ -222,7 +232,7 @@ def identify_modes(
     hl = np.array([c.participation for c in extra], dtype=complex).reshape(len(extra), n_in)
     n_extra = len(extra)
     if refine and max_helpers > 0:
-        poles, part, hp2, hl2 = _search_helpers(
+        poles, part, hp2, hl2, dropped0, n_extra = _search_helpers(
             cfit,
             np.concatenate([poles, hp]),
             np.concatenate([part, hl]),
@@ -232,6 +242,7 @@ def identify_modes(
             min_significance,
             n_free=n_extra,
         )
+        rejected += [_rej(p, f"complex fit: {why}") for p, why in dropped0]
         m0 = len(poles) - n_extra
         hp = np.concatenate([poles[m0:], hp2])
         hl = np.concatenate([part[m0:], hl2])
@@ -343,7 +354,12 @@ def _search_helpers(
     min_significance: float,
     n_free: int = 0,
 ) -> tuple[
-    NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]
+    NDArray[np.complex128],
+    NDArray[np.complex128],
+    NDArray[np.complex128],
+    NDArray[np.complex128],
+    list[tuple[complex, str]],
+    int,
 ]:
     """Refine, then add out-of-band residual modes while they are significant.
 
@@ -356,8 +372,20 @@ def _search_helpers(
     (per-output residual variances) reaches ``min_significance``.
     """
     lo, hi = band
-    m = len(poles)
-    res = fitter.fit(poles, part, refine=True, passes=1)
+    m0 = len(poles) - n_free
+    res, m0, dropped = _fit_checked(
+        fitter,
+        poles[:m0],
+        part[:m0],
+        poles[m0:],
+        part[m0:],
+        True,
+        band,
+        n_free=n_free,
+        passes=1,
+    )
+    m = len(res.poles)
+    n_free = m - m0
     cur_p, cur_l = res.poles, res.participation
     per = 2 if fitter.kind == "complex" else 1
     dof = fitter.n_rows
@@ -388,7 +416,7 @@ def _search_helpers(
                 break
             res = trial
             cur_p, cur_l = trial.poles, trial.participation
-    return cur_p[:m], cur_l[:m], cur_p[m:], cur_l[m:]
+    return cur_p[:m], cur_l[:m], cur_p[m:], cur_l[m:], dropped, n_free
 
 
 def _fit_checked(
@@ -400,6 +428,7 @@ def _fit_checked(
     refine: bool,
     band: tuple[float, float],
     n_free: int = 0,
+    passes: int = 2,
 ) -> tuple[FitResult, int, list[tuple[complex, str]]]:
     """Fit modes and residual modes; drop any that left its side of the band or merged.
 
@@ -409,7 +438,9 @@ def _fit_checked(
     dropped: list[tuple[complex, str]] = []
     for _ in range(len(poles) + len(hp) + 1):
         m = len(poles)
-        res = fitter.fit(np.concatenate([poles, hp]), np.concatenate([part, hl]), refine=refine)
+        res = fitter.fit(
+            np.concatenate([poles, hp]), np.concatenate([part, hl]), refine=refine, passes=passes
+        )
         p = res.poles
         fd = p.imag / (2 * np.pi)
         inb = (fd >= band[0]) & (fd <= band[1])
