@@ -89,6 +89,11 @@ def load_result_file(path: str | Path) -> ResultFile:
 
         obj = read(p)
         return ResultFile(p, "frf" if isinstance(obj, FRF) else "timedata", obj)
+    if p.suffix.lower() != ".json":
+        raise FileFormatError(
+            f"{p}: unknown file extension {p.suffix or '(none)'!r}; expected .json (modes, "
+            f"damping, lateral fit, demo results) or {', '.join(_DATA_EXT)} (FRF, time data)"
+        )
     try:
         text = p.read_text(encoding="utf-8")
     except UnicodeDecodeError:
@@ -263,7 +268,7 @@ def _modes_section(
             caption="Real against complex modes: fit quality over the same FRFs.",
         )
     any_model = next(iter(models.values()))
-    frf = _frf_for(any_model, src, frfs)
+    frf = _frf_for(any_model, src, frfs, fallback=not item.is_truth)
     if frf is not None:
         _fit_figures(rep, frf, models)
     shapes = models.get("complex") or any_model
@@ -275,13 +280,17 @@ def _modes_section(
                    "(real part solid, imaginary part dashed)")
 
 
-def _frf_for(model: ModalModel, source: str, frfs: list[ResultFile]) -> FRF | None:
+def _frf_for(
+    model: ModalModel, source: str, frfs: list[ResultFile], fallback: bool = True
+) -> FRF | None:
+    """The FRF a modal model was fitted to: the one named in its source, else the only
+    FRF file with the same channels (when ``fallback``)."""
     same = [
         f for f in frfs
         if f.obj.n_out == model.psi_out.shape[0] and f.obj.n_in == model.psi_in.shape[0]
     ]
     named = [f for f in same if f.path.name == Path(source).name]
-    pick = named or (same if len(same) == 1 else [])
+    pick = named or (same if fallback and len(same) == 1 else [])
     return pick[0].obj if pick else None
 
 

@@ -1,0 +1,109 @@
+"""What every command shares: --help with an example, --version, errors as one line + exit 2."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import pytest
+
+from tyredamp import __version__
+from tyredamp.cli import cli, main
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    try:
+        main(list(argv))
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def _commands(group: click.Group, prefix: tuple[str, ...] = ()) -> list[tuple[str, ...]]:
+    out: list[tuple[str, ...]] = []
+    for name, cmd in sorted(group.commands.items()):
+        out.append((*prefix, name))
+        if isinstance(cmd, click.Group):
+            out += _commands(cmd, (*prefix, name))
+    return out
+
+
+COMMANDS = _commands(cli)
+
+
+def test_all_commands_are_there() -> None:
+    names = {c[0] for c in COMMANDS}
+    assert {"demo", "simulate", "frf", "check", "modal", "damping", "lateral", "report"} <= names
+    assert ("simulate", "radial") in COMMANDS and ("simulate", "lateral") in COMMANDS
+    assert ("lateral", "fit") in COMMANDS
+
+
+@pytest.mark.parametrize("command", [(), *COMMANDS], ids=lambda c: " ".join(c) or "tyredamp")
+def test_help_has_an_example(capsys: pytest.CaptureFixture[str], command: tuple[str, ...]) -> None:
+    code, out, _ = run(capsys, *command, "--help")
+    assert code == 0
+    assert "Example:" in out
+    example = out.split("Example:")[1]
+    assert "tyredamp " in example  # the example is a command line
+    # every command that writes a file takes --out/-o
+    cmd = cli
+    for name in command:
+        cmd = cmd.commands[name]  # type: ignore[attr-defined]
+    if not isinstance(cmd, click.Group) and command not in {("check", "linearity"),
+                                                            ("check", "reciprocity"),
+                                                            ("check", "quality")}:
+        opts = {o for p in cmd.params for o in getattr(p, "opts", [])}
+        assert {"--out", "-o"} <= opts, command
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "--version")
+    assert code == 0 and __version__ in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["demo", "--seed", "-1"], "--seed"),
+        (["simulate", "radial"], "--out"),
+        (["simulate", "lateral", "--out", "{tmp}/x.npz", "--speed", "abc"], "--speed"),
+        (["frf", "{tmp}/missing.uff", "--out", "{tmp}/f.uff"], "missing.uff"),
+        (["check", "linearity", "{tmp}/one.uff"], "two or more"),
+        (["modal", "{tmp}/missing.uff", "--out", "{tmp}/m.json"], "missing.uff"),
+        (["damping", "{tmp}/notjson.json", "--out", "{tmp}/d.json"], "notjson.json"),
+        (["lateral", "fit", "{tmp}/missing.npz", "--out", "{tmp}/l.json"], "missing.npz"),
+        (["report", "--out", "{tmp}/r.html"], "RESULT_FILES"),
+        (["report", "{tmp}/notjson.json", "--out", "{tmp}/r.html"], "notjson.json"),
+        (["report", "{tmp}/other.json", "--out", "{tmp}/r.html"], "not a tyredamp result"),
+        (["report", "{tmp}/data.xyz", "--out", "{tmp}/r.html"], "extension"),
+        (["nosuchcommand"], "No such command"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, argv: list[str], needle: str
+) -> None:
+    (tmp_path / "notjson.json").write_text("{not json")
+    (tmp_path / "other.json").write_text('{"kind": "something else"}')
+    (tmp_path / "data.xyz").write_text("1 2 3")
+    (tmp_path / "one.uff").write_text("x")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    args = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    code, out, err = run(capsys, *args)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("tyredamp: error: ")
+    assert needle in lines[0]
+    assert "Traceback" not in err
+    # no output file, no temporary file
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_debug_shows_the_traceback(tmp_path: Path) -> None:
+    from tyredamp.exceptions import FileFormatError
+
+    (tmp_path / "other.json").write_text('{"kind": "something else"}')
+    with pytest.raises(FileFormatError):
+        main(["--debug", "report", str(tmp_path / "other.json"), "--out", str(tmp_path / "r.html")])
