@@ -83,8 +83,13 @@ def test_analytic_gradient_matches_finite_differences(kind: str) -> None:
     yw = fit.Y / np.sqrt(np.mean(fit.Y**2, axis=0))
     sol = fit._solve(th, 6, ref, yw)
     _, jtr = fit._normal(sol, th.size)
+    # a subset of the parameters keeps the test fast: both pole parameters of three
+    # modes and every participation parameter of two modes
+    n_pole = 12
+    per_mode = (th.size - n_pole) // 6
+    check = [0, 1, 4, 5, 10, 11, *range(n_pole, n_pole + 2 * per_mode)]
     num = np.zeros(th.size)
-    for i in range(th.size):
+    for i in check:
         e = np.zeros(th.size)
         e[i] = 1e-6 * max(1.0, abs(th[i]))
         num[i] = (
@@ -92,7 +97,7 @@ def test_analytic_gradient_matches_finite_differences(kind: str) -> None:
         ) / (2 * e[i])
     # d||r||^2/dtheta = 2 J^T r; Kaufman's J gives the exact VarPro gradient.
     # Central differences of a cost ~1e3 with steps 1e-6: agreement to ~1e-5 relative.
-    assert_allclose(2 * jtr, num, rtol=2e-4, atol=2e-4 * np.max(np.abs(num)))
+    assert_allclose(2 * jtr[check], num[check], rtol=2e-4, atol=2e-4 * np.max(np.abs(num)))
 
 
 def test_standard_errors_match_spread_over_seeds() -> None:

@@ -283,8 +283,17 @@ class ModalFitter:
 
     # ---------------------------------------------------- variable projection
     def _solve(
-        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], Yw: NDArray[np.float64]
+        self,
+        th: NDArray[np.float64],
+        m: int,
+        ref: NDArray[np.intp],
+        Yw: NDArray[np.float64],
+        residual: bool = True,
     ) -> dict[str, Any]:
+        """Projection at ``th``. With ``residual=False`` the residual matrix is not
+        formed (two products with the data instead of three): ``cost`` comes from
+        ``||Y||^2 - ||Q^T Y||^2`` unless that loses accuracy (fit error below
+        0.1 %), and ``Z = r C^T = Y C^T - Q (Q^T Y) C^T`` is returned instead."""
         phi, D, dpar, dcol = self.basis(th, m, ref)
         Q, Rq = np.linalg.qr(phi)
         Ct = Q.T @ Yw
@@ -293,8 +302,15 @@ class ModalFitter:
             C = np.linalg.lstsq(phi, Yw, rcond=None)[0]
         else:
             C = sla.solve_triangular(Rq, Ct)
-        resid = Yw - Q @ Ct
-        cost = float(np.sum(resid**2))
+        resid = None
+        ynorm = float(np.sum(Yw**2)) if residual is False else 0.0
+        cost = ynorm - float(np.sum(Ct**2))
+        if residual or cost < 1e-6 * ynorm:
+            resid = Yw - Q @ Ct
+            cost = float(np.sum(resid**2))
+            Z = resid @ C.T
+        else:
+            Z = Yw @ C.T - Q @ (Ct @ C.T)
         return {
             "phi": phi,
             "D": D,
@@ -305,6 +321,7 @@ class ModalFitter:
             "C": C,
             "resid": resid,
             "cost": cost,
+            "Z": Z,
         }
 
     def _normal(
@@ -320,7 +337,7 @@ class ModalFitter:
         A = np.zeros((dpar.size, n_par))
         A[np.arange(dpar.size), dpar] = 1.0
         jtj = A.T @ Md @ A
-        Z = sol["resid"] @ C.T  # (n_rows, q)
+        Z = sol["Z"]  # r C^T, (n_rows, q)
         gd = np.einsum("id,id->d", D, Z[:, dcol])
         jtr = -(A.T @ gd)
         return 0.5 * (jtj + jtj.T), jtr
@@ -390,7 +407,7 @@ class ModalFitter:
         def evaluate(x: NDArray[np.float64]) -> dict[str, Any]:
             key = x.tobytes()
             if cache.get("key") != key:
-                sol = self._solve(x, m, ref, Yw)
+                sol = self._solve(x, m, ref, Yw, residual=False)
                 jtj, jtr = self._normal(sol, n_par)
                 scale = np.sqrt(np.maximum(np.diag(jtj), 1e-300))
                 jn = jtj / np.outer(scale, scale)
