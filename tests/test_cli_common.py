@@ -36,7 +36,8 @@ COMMANDS = _commands(cli)
 def test_all_commands_are_there() -> None:
     names = {c[0] for c in COMMANDS}
     assert {"demo", "simulate", "frf", "check", "modal", "damping", "lateral", "report"} <= names
-    assert ("simulate", "radial") in COMMANDS and ("simulate", "lateral") in COMMANDS
+    assert ("simulate", "radial") in COMMANDS
+    assert ("simulate", "lateral") in COMMANDS
     assert ("lateral", "fit") in COMMANDS
 
 
@@ -51,16 +52,19 @@ def test_help_has_an_example(capsys: pytest.CaptureFixture[str], command: tuple[
     cmd = cli
     for name in command:
         cmd = cmd.commands[name]  # type: ignore[attr-defined]
-    if not isinstance(cmd, click.Group) and command not in {("check", "linearity"),
-                                                            ("check", "reciprocity"),
-                                                            ("check", "quality")}:
+    if not isinstance(cmd, click.Group) and command not in {
+        ("check", "linearity"),
+        ("check", "reciprocity"),
+        ("check", "quality"),
+    }:
         opts = {o for p in cmd.params for o in getattr(p, "opts", [])}
         assert {"--out", "-o"} <= opts, command
 
 
 def test_version(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "--version")
-    assert code == 0 and __version__ in out
+    assert code == 0
+    assert __version__ in out
 
 
 @pytest.mark.parametrize(
@@ -90,7 +94,7 @@ def test_bad_input_is_one_line_and_exit_2(
     (tmp_path / "one.uff").write_text("x")
     before = sorted(p.name for p in tmp_path.iterdir())
     args = [a.replace("{tmp}", str(tmp_path)) for a in argv]
-    code, out, err = run(capsys, *args)
+    code, _out, err = run(capsys, *args)
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1, err

@@ -120,16 +120,17 @@ def test_modal_on_pyuff_frf(
 ) -> None:
     path, fn = chain_frf_file
     frf = read_frf(path)
-    assert frf.kind == "accelerance" and frf.H.shape == (6, 2, 800)
+    assert frf.kind == "accelerance"
+    assert frf.H.shape == (6, 2, 800)
     modes = tmp_path / "modes.json"
-    code, out, err = run(capsys, "modal", str(path), "--out", str(modes), "--model", "complex")
+    code, _, err = run(capsys, "modal", str(path), "--out", str(modes), "--model", "complex")
     assert code == 0, err
     m = read_modes_json(modes)["complex"]
     # six modes of a 6-DOF chain from 0.1 % noise: frequencies within 0.1 %
     assert m.n_modes == fn.size
     assert_allclose(m.frequency_hz, fn, rtol=1e-3)
     report = tmp_path / "r.html"
-    code, out, err = run(capsys, "report", str(modes), str(path), "--out", str(report))
+    code, _out, err = run(capsys, "report", str(modes), str(path), "--out", str(report))
     assert code == 0, err
     assert "chain_frf.unv" in report.read_text()
 
@@ -145,7 +146,8 @@ def test_checks_on_pyuff_frf(
     fig = float(out.split("differ by up to ")[1].split(" %")[0])
     assert fig < 1.0
     code, out, err = run(capsys, "check", "quality", str(path))
-    assert code == 0 and out.startswith("quality: "), err
+    assert code == 0, err
+    assert out.startswith("quality: ")
 
 
 def test_frf_on_pyuff_time_data(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -182,17 +184,20 @@ def test_frf_on_pyuff_time_data(capsys: pytest.CaptureFixture[str], tmp_path: Pa
     peak = frf.frequency[near][np.argmax(np.abs(frf.H[0, 0][near]))]
     assert abs(peak - fn) < 2 * (frf.frequency[1] - frf.frequency[0])
     code, out, err = run(capsys, "check", "quality", str(theirs))
-    assert code == 0 and "quality:" in out
+    assert code == 0
+    assert "quality:" in out
 
 
 def test_bad_pyuff_input(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     bad = tmp_path / "broken.uff"
     bad.write_text("    -1\n    58\nthis is not a data set\n")
-    for argv in (["modal", str(bad), "--out", str(tmp_path / "m.json")],
-                 ["frf", str(bad), "--out", str(tmp_path / "f.uff")],
-                 ["check", "quality", str(bad)]):
-        code, out, err = run(capsys, *argv)
+    for argv in (
+        ["modal", str(bad), "--out", str(tmp_path / "m.json")],
+        ["frf", str(bad), "--out", str(tmp_path / "f.uff")],
+        ["check", "quality", str(bad)],
+    ):
+        code, _out, err = run(capsys, *argv)
         assert code == 2
-        assert len(err.strip().splitlines()) == 1 and "broken.uff" in err
+        assert len(err.strip().splitlines()) == 1
+        assert "broken.uff" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.uff"]
-

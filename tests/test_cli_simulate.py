@@ -51,8 +51,19 @@ def radial_files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     }
     for argv in (
         ["simulate", "radial", "--out", str(files["time"]), "--periods", "4", "--seed", "1"],
-        ["simulate", "radial", "--out", str(files["frf"]), "--frf", "--periods", "4",
-         "--seed", "1", "--truth", str(files["truth"])],
+        [
+            "simulate",
+            "radial",
+            "--out",
+            str(files["frf"]),
+            "--frf",
+            "--periods",
+            "4",
+            "--seed",
+            "1",
+            "--truth",
+            str(files["truth"]),
+        ],
     ):
         try:
             main(argv)
@@ -66,11 +77,13 @@ def test_simulate_radial_writes_uff58(radial_files: dict[str, Path]) -> None:
     assert {s["func_type"] for s in sets} == {1}  # time histories
     assert len(sets) == 17  # 1 force + 16 accelerations
     td = read_timedata(radial_files["time"])
-    assert td.quantities.count("force") == 1 and td.sample_rate == 1024.0
+    assert td.quantities.count("force") == 1
+    assert td.sample_rate == 1024.0
     sets = pyuff.UFF(str(radial_files["frf"])).read_sets()
     assert {s["func_type"] for s in sets} == {4, 6}  # FRFs and their coherence
     frf = read_frf(radial_files["frf"])
-    assert frf.H.shape[:2] == (16, 1) and frf.kind == "accelerance"
+    assert frf.H.shape[:2] == (16, 1)
+    assert frf.kind == "accelerance"
     truth = read_modes_json(radial_files["truth"])["complex"]
     assert truth.n_modes == 6
     assert_allclose(truth.frequency_hz[0], 47.9, rtol=2e-3)  # n = 1 mode of the default tyre
@@ -87,11 +100,13 @@ def test_chain_on_simulated_files(
     assert_allclose(a.H, b.H, rtol=1e-12, atol=0)
 
     code, out, err = run(capsys, "check", "quality", str(radial_files["time"]))
-    assert code == 0 and out.startswith("quality: ")
+    assert code == 0
+    assert out.startswith("quality: ")
     code, out, err = run(
         capsys, "check", "linearity", str(radial_files["frf"]), str(frf2), "--band", "30", "200"
     )
-    assert code == 0 and "linearity: PASS" in out
+    assert code == 0
+    assert "linearity: PASS" in out
 
     modes = tmp_path / "modes.json"
     code, out, err = run(capsys, "modal", str(radial_files["frf"]), "--out", str(modes))
@@ -103,9 +118,7 @@ def test_chain_on_simulated_files(
     assert_allclose(models["complex"].frequency_hz, truth.frequency_hz, rtol=5e-4)
 
     damping = tmp_path / "damping.json"
-    code, out, err = run(
-        capsys, "damping", str(modes), "--out", str(damping), "--samples", "20"
-    )
+    code, out, err = run(capsys, "damping", str(modes), "--out", str(damping), "--samples", "20")
     assert code == 0, err
     assert json.loads(damping.read_text())["kind"] == "damping"
 
@@ -133,14 +146,25 @@ def test_reciprocity_with_two_drive_points(
 ) -> None:
     out = tmp_path / "mimo.uff"
     code, stdout, err = run(
-        capsys, "simulate", "radial", "--out", str(out), "--frf", "--drive-points", "1,5",
-        "--periods", "2", "--seed", "3",
+        capsys,
+        "simulate",
+        "radial",
+        "--out",
+        str(out),
+        "--frf",
+        "--drive-points",
+        "1,5",
+        "--periods",
+        "2",
+        "--seed",
+        "3",
     )
     assert code == 0, err
     assert "drive point(s) 1, 5" in stdout
     assert read_frf(out).n_in == 2
     code, stdout, _ = run(capsys, "check", "reciprocity", str(out), "--band", "30", "200")
-    assert code == 0 and "reciprocity: PASS" in stdout
+    assert code == 0
+    assert "reciprocity: PASS" in stdout
 
 
 def test_simulate_lateral_is_lateral_simulate(
@@ -153,13 +177,14 @@ def test_simulate_lateral_is_lateral_simulate(
     fa, fb = read_frf(a), read_frf(b)
     assert_allclose(fa.H, fb.H, rtol=0, atol=0)
     lat = tmp_path / "lateral.json"
-    code, out, err = run(capsys, "lateral", "fit", str(a), "--out", str(lat))
+    code, _, err = run(capsys, "lateral", "fit", str(a), "--out", str(lat))
     assert code == 0, err
     report = tmp_path / "lateral.html"
-    code, out, err = run(capsys, "report", str(lat), str(a), "--out", str(report))
+    code, _out, err = run(capsys, "report", str(lat), str(a), "--out", str(report))
     assert code == 0, err
     html = report.read_text()
-    assert "Lateral tyre models" in html and "hysteretic" in html
+    assert "Lateral tyre models" in html
+    assert "hysteretic" in html
     assert html.count("data:image/png;base64,") == 2  # the FRF and the fitted models
 
 
@@ -180,7 +205,8 @@ def test_simulate_bad_input(
     out = tmp_path / "x.uff"
     code, _, err = run(capsys, "simulate", "radial", "--out", str(out), *argv)
     assert code == 2
-    assert len(err.strip().splitlines()) == 1 and message in err
+    assert len(err.strip().splitlines()) == 1
+    assert message in err
     assert not any(tmp_path.iterdir())  # nothing written, no temporary file left
 
 
@@ -189,7 +215,8 @@ def test_truth_and_out_must_differ(capsys: pytest.CaptureFixture[str], tmp_path:
     code, _, err = run(
         capsys, "simulate", "radial", "--out", str(out), "--truth", str(out), "--periods", "1"
     )
-    assert code == 2 and "--truth" in err
+    assert code == 2
+    assert "--truth" in err
     assert not out.exists()
 
 

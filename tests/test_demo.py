@@ -101,7 +101,9 @@ def test_generated_data_are_uff58(demo: tuple[DemoResult, Path]) -> None:
     td = read_timedata(out / "data" / "radial_7.5bar_time.uff")
     assert td.n_channels == 17
     assert_allclose(td.data, main_run.test.data.data, rtol=0, atol=0)
-    types = {s["func_type"] for s in pyuff.UFF(str(out / "data" / "radial_7.5bar_time.uff")).read_sets()}
+    types = {
+        s["func_type"] for s in pyuff.UFF(str(out / "data" / "radial_7.5bar_time.uff")).read_sets()
+    }
     assert types == {1}
     sets = pyuff.UFF(str(out / "data" / "lateral_1.7bar_5kmh_axle_frf.uff")).read_sets()
     assert {s["func_type"] for s in sets} >= {4}
@@ -126,9 +128,11 @@ def test_report_sections_and_self_contained(demo: tuple[DemoResult, Path]) -> No
     assert html.count('src="data:image/png;base64,') == n_png
     # readable offline: no external resource of any kind
     assert not re.search(r'(src|href)="(?!data:)', html)
-    assert "<script" not in html and "<link" not in html
+    assert "<script" not in html
+    assert "<link" not in html
     # truth beside the identified values
-    assert "f true (Hz)" in html and "C_alpha/V true" in html
+    assert "f true (Hz)" in html
+    assert "C_alpha/V true" in html
 
 
 def test_results_validate_and_agree_with_truth(demo: tuple[DemoResult, Path]) -> None:
@@ -147,7 +151,8 @@ def test_results_validate_and_agree_with_truth(demo: tuple[DemoResult, Path]) ->
     # the symmetric part of C' is within 4 % of the truth (leakage makes the raw C' ~9 %,
     # tests/test_damping_tyre.py); the checks pass on a linear, reciprocal tyre
     assert rad["damping"]["modal_error_symmetric"] < 0.04
-    assert rad["checks"]["linearity"]["passed"] and rad["checks"]["reciprocity"]["passed"]
+    assert rad["checks"]["linearity"]["passed"]
+    assert rad["checks"]["reciprocity"]["passed"]
     lat = doc["lateral"]
     assert {r["model"] for r in lat["ranking"]} == set(result.settings.lateral_models)
     assert len(lat["corner_frequency_hz"]) == len(lat["conditions"]) == 2
@@ -163,16 +168,17 @@ def test_summary_rows(demo: tuple[DemoResult, Path]) -> None:
 
     result, _ = demo
     rows = dict(demo_summary_rows(result, build_results(result)))
-    assert "lateral ranking" in rows and "RMSD" in " ".join(rows)
+    assert "lateral ranking" in rows
+    assert "RMSD" in " ".join(rows)
 
 
 def test_replace_and_no_partial_output(
     demo: tuple[DemoResult, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    from matplotlib.figure import Figure
+
     import tyredamp.report.build as build_mod
     import tyredamp.report.figures as fig_mod
-
-    from matplotlib.figure import Figure
 
     result, _ = demo
 
@@ -209,7 +215,8 @@ def test_refuses_foreign_directory(tmp_path: Path, capsys: pytest.CaptureFixture
         main(["demo", "--quick", "--out", str(tmp_path / "mine")])
     assert exc.value.code == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "not an earlier tyredamp demo output" in err
+    assert err.count("\n") == 1
+    assert "not an earlier tyredamp demo output" in err
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep me"
     (tmp_path / "file").write_text("x")
     with pytest.raises(SystemExit) as exc:

@@ -67,8 +67,12 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     write_frf(frf.with_H(h), paths["frf"])
     force = np.random.default_rng(0).standard_normal((1, 4000))
     resp = time_response(s, force, 200.0, [0], [0, 3])
-    td = TimeData(np.vstack([force, resp.acceleration]), 200.0, [1, 1, 4],
-                  ["force", "acceleration", "acceleration"])
+    td = TimeData(
+        np.vstack([force, resp.acceleration]),
+        200.0,
+        [1, 1, 4],
+        ["force", "acceleration", "acceleration"],
+    )
     write_timedata(td, paths["time"])
     return paths
 
@@ -112,7 +116,7 @@ def test_files_report_errors(tmp_path: Path, files: dict[str, Path]) -> None:
         load_result_file(empty)
     broken = tmp_path / "damping.json"
     broken.write_text('{"kind": "damping", "modal": []}')
-    with pytest.raises(FileFormatError, match="damping.json"):
+    with pytest.raises(FileFormatError, match=r"damping\.json"):
         load_result_file(broken)
 
 
@@ -134,8 +138,11 @@ def test_html_report_escapes_and_embeds() -> None:
     png = rep.figure(fig, "cap")
     html = rep.render()
     assert png[:4] == b"\x89PNG"
-    assert "<script>" not in html and "&lt;script&gt;" in html
-    assert "1.235" in html and _images(html) == 1 and _self_contained(html)
+    assert "<script>" not in html
+    assert "&lt;script&gt;" in html
+    assert "1.235" in html
+    assert _images(html) == 1
+    assert _self_contained(html)
 
 
 def test_stabilisation_diagram() -> None:

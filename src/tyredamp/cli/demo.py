@@ -56,7 +56,9 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
         ),
         (
             f"{lat['time_response']['frequency_hz']:g} Hz response error",
-            ", ".join(f"{k} {100 * v:.3g} %" for k, v in lat["time_response"]["relative_error"].items()),
+            ", ".join(
+                f"{k} {100 * v:.3g} %" for k, v in lat["time_response"]["relative_error"].items()
+            ),
         ),
     ]
     return rows
@@ -123,14 +125,17 @@ def demo_command(out: Path, quick: bool, seed: int) -> None:
     settings = DemoSettings.quick_preset(seed) if quick else DemoSettings.full(seed)
     err = Console(stderr=True)
     t0 = time.perf_counter()
-    with single_threaded_blas(), Progress(
-        TextColumn("{task.description:<62}"),
-        BarColumn(bar_width=24),
-        TextColumn("{task.completed}/{task.total}"),
-        TimeElapsedColumn(),
-        console=err,
-        disable=not err.is_terminal,
-    ) as prog:
+    with (
+        single_threaded_blas(),
+        Progress(
+            TextColumn("{task.description:<62}"),
+            BarColumn(bar_width=24),
+            TextColumn("{task.completed}/{task.total}"),
+            TimeElapsedColumn(),
+            console=err,
+            disable=not err.is_terminal,
+        ) as prog,
+    ):
         task = prog.add_task("starting", total=None)
 
         def report(desc: str, done: int, total: int) -> None:

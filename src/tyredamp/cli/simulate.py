@@ -83,7 +83,9 @@ def simulate_group() -> None:
     metavar="DB",
     help="Signal-to-noise ratio of every channel, dB ('inf' for no noise).",
 )
-@click.option("--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Noise seed.")
+@click.option(
+    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Noise seed."
+)
 @click.option(
     "--drive-points",
     "drive_points",
@@ -161,9 +163,7 @@ def radial_command(
         RingTyreParameters(pressure=pressure * BAR), MeasurementLayout(drive_points=points)
     )
     with single_threaded_blas():
-        test = run_modal_test(
-            tyre, n_periods=periods, force_rms=force_rms, snr_db=snr, seed=seed
-        )
+        test = run_modal_test(tyre, n_periods=periods, force_rms=force_rms, snr_db=snr, seed=seed)
     truth_text = None
     if truth_out is not None:
         doc = modes_document(

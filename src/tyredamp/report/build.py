@@ -170,30 +170,49 @@ def _settings(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
             ["model", "in-plane ring on an elastic foundation, staggered finite differences"],
             ["degrees of freedom", str(main.test.tyre.n_dof)],
             ["belt radius, width", f"{tp.radius:g} m, {tp.width:g} m"],
-            ["band mass per length, bending stiffness", f"{tp.mass_per_length:g} kg/m, "
-             f"{tp.bending_stiffness:g} N m^2"],
+            [
+                "band mass per length, bending stiffness",
+                f"{tp.mass_per_length:g} kg/m, {tp.bending_stiffness:g} N m^2",
+            ],
             ["pressures", ", ".join(f"{p:g} bar" for p in s.radial_pressures_bar)],
-            ["points, drive point", f"{lay.n_points} radial points 22.5 deg apart, shaker at "
-             f"point {lay.drive_points[0]}"],
+            [
+                "points, drive point",
+                f"{lay.n_points} radial points 22.5 deg apart, shaker at "
+                f"point {lay.drive_points[0]}",
+            ],
             ["non-proportional damping knob", f"{main.test.tyre.nonproportionality:g}"],
             ["excitation", _excitation(meta, s.force_levels_n[0])],
-            ["sampling", f"{main.test.data.sample_rate:g} Hz, period "
-             f"{main.test.period_samples / main.test.data.sample_rate:g} s"],
-            ["averages", f"{s.radial_periods} at {s.radial_pressures_bar[0]:g} bar, "
-             f"{s.radial_side_periods} at the other pressures, {s.check_periods} for the checks"],
+            [
+                "sampling",
+                f"{main.test.data.sample_rate:g} Hz, period "
+                f"{main.test.period_samples / main.test.data.sample_rate:g} s",
+            ],
+            [
+                "averages",
+                f"{s.radial_periods} at {s.radial_pressures_bar[0]:g} bar, "
+                f"{s.radial_side_periods} at the other pressures, {s.check_periods} for the checks",
+            ],
             ["noise", f"{s.snr_db:g} dB SNR on every channel"],
             ["FRF estimator", "H1, cyclic (whole periods, no window)"],
-            ["modal fits", "pLSCF poles, automatic selection, LSFD and refinement of real "
-             "(eq. [2]/[3]) and complex (eq. [10]) modes with residual terms"],
-            ["damping", f"{s.damping_method} (eq. [16]/[18]), {s.damping_samples} Monte Carlo "
-             "samples for standard errors"],
+            [
+                "modal fits",
+                "pLSCF poles, automatic selection, LSFD and refinement of real "
+                "(eq. [2]/[3]) and complex (eq. [10]) modes with residual terms",
+            ],
+            [
+                "damping",
+                f"{s.damping_method} (eq. [16]/[18]), {s.damping_samples} Monte Carlo "
+                "samples for standard errors",
+            ],
         ],
     )
     rep.table(
         ["rolling-tyre rig (paper 001)", "value"],
         [
-            ["truth", "viscoelastic stretched string with contact length (not one of the "
-             "fitted models)"],
+            [
+                "truth",
+                "viscoelastic stretched string with contact length (not one of the fitted models)",
+            ],
             ["speeds", ", ".join(f"{v:g} km/h" for v in s.lateral_speeds_kmh)],
             ["pressures", ", ".join(f"{p:g} bar" for p in s.lateral_pressures_bar)],
             ["FRF lines", f"{rig.f_min:g}-{rig.f_max:g} Hz every {rig.df:g} Hz"],
@@ -201,8 +220,11 @@ def _settings(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
             ["wheel mass, body mass", f"{rig.wheel_mass:g} kg, {rig.body_mass:g} kg"],
             ["models fitted", ", ".join(s.lateral_models)],
             ["ranking criterion", doc["lateral"]["criterion"].upper()],
-            ["time test", f"{s.time_test_frequency_hz:g} Hz sine at "
-             f"{s.reference_condition[0]:g} bar, {s.reference_condition[1]:g} km/h"],
+            [
+                "time test",
+                f"{s.time_test_frequency_hz:g} Hz sine at "
+                f"{s.reference_condition[0]:g} bar, {s.reference_condition[1]:g} km/h",
+            ],
         ],
     )
     rep.paragraph(f"tyredamp {__version__}, seed {s.seed}.")
@@ -228,9 +250,7 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     if ident.rejected:
         rep.paragraph(
             "Candidates rejected: "
-            + "; ".join(
-                f"{x['frequency_hz']:.1f} Hz ({x['reason']})" for x in ident.rejected[:8]
-            )
+            + "; ".join(f"{x['frequency_hz']:.1f} Hz ({x['reason']})" for x in ident.rejected[:8])
             + ("; ..." if len(ident.rejected) > 8 else "")
         )
 
@@ -247,10 +267,18 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     rep.table(
         ["fit", "RMSD (eq. [19])", "relative error", "modes"],
         [
-            ["real modes (eq. [2]/[3])", _num(rad["rmsd_real"]), _pct(rad["relative_error_real"]),
-             str(r.main.models["real"].n_modes)],
-            ["complex modes (eq. [10])", _num(rad["rmsd_complex"]),
-             _pct(rad["relative_error_complex"]), str(r.main.models["complex"].n_modes)],
+            [
+                "real modes (eq. [2]/[3])",
+                _num(rad["rmsd_real"]),
+                _pct(rad["relative_error_real"]),
+                str(r.main.models["real"].n_modes),
+            ],
+            [
+                "complex modes (eq. [10])",
+                _num(rad["rmsd_complex"]),
+                _pct(rad["relative_error_complex"]),
+                str(r.main.models["complex"].n_modes),
+            ],
         ],
         caption=f"Fit quality at {p} over {rad['n_lines']} lines and 16 FRFs ({rad['frf_kind']}, "
         f"{r.main.fitted_frf.unit}).",
@@ -276,12 +304,13 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
             ["C' against the true C' (matched modes)", _pct(dmp["modal_error"])],
             ["its symmetric part against the truth", _pct(dmp["modal_error_symmetric"])],
             ["diagonal of C' against the truth", _pct(dmp["diagonal_error"])],
-            ["symmetric C at the points against the true reduced C",
-             _pct(dmp["physical_error"])],
+            ["symmetric C at the points against the true reduced C", _pct(dmp["physical_error"])],
             ["asymmetry of C'", _pct(dmp["symmetry_modal"])],
             ["definiteness of C'", dmp["definiteness_modal"]],
-            ["non-proportionality ||C' - diag C'|| / ||diag C'||",
-             _pct(dmp["non_proportionality"])],
+            [
+                "non-proportionality ||C' - diag C'|| / ||diag C'||",
+                _pct(dmp["non_proportionality"]),
+            ],
             ["negative off-diagonal entries of C", _pct(dmp["negative_offdiagonal_fraction"])],
         ],
     )
@@ -295,19 +324,30 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
         ident_n = sum(1 for m in pr["modes"] if m["complex"])
         true_n = sum(1 for m in pr["modes"] if m["true"])
         fr = ", ".join(
-            f"{m['complex']['frequency_hz']:.1f}" if m["complex"] else "-"
-            for m in pr["modes"]
+            f"{m['complex']['frequency_hz']:.1f}" if m["complex"] else "-" for m in pr["modes"]
         )
         ft = ", ".join(
             f"{m['true']['frequency_hz']:.1f}" if m["true"] else "-" for m in pr["modes"]
         )
         rows.append(
-            [f"{pr['pressure_bar']:g}", str(pr["n_averages"]), f"{ident_n} / {true_n}", fr, ft,
-             _num(pr["rmsd_ratio"], ".3g")]
+            [
+                f"{pr['pressure_bar']:g}",
+                str(pr["n_averages"]),
+                f"{ident_n} / {true_n}",
+                fr,
+                ft,
+                _num(pr["rmsd_ratio"], ".3g"),
+            ]
         )
     rep.table(
-        ["pressure (bar)", "averages", "modes id. / true", "f identified (Hz)", "f true (Hz)",
-         "RMSD real / complex"],
+        [
+            "pressure (bar)",
+            "averages",
+            "modes id. / true",
+            "f identified (Hz)",
+            "f true (Hz)",
+            "RMSD real / complex",
+        ],
         rows,
     )
     _image(rep, images, "pressures")
@@ -331,13 +371,27 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
 
     rep.heading("Model ranking", 3)
     rep.table(
-        ["rank", "model", "mean rank", "best at", "mean d" + lat["criterion"].upper(),
-         "amplitude error (%)", "amplitude bias (%)", "axle prediction error (%)"],
         [
-            [str(r["rank"]), r["model"], f"{r['mean_rank']:.2f}",
-             f"{r['wins']} of {r['n_conditions']}", _num(r["mean_delta"], ".1f"),
-             _num(r["mean_amplitude_error_pct"], ".2f"), _num(r["mean_amplitude_bias_pct"], "+.2f"),
-             _num(r["mean_axle_amplitude_error_pct"], ".2f")]
+            "rank",
+            "model",
+            "mean rank",
+            "best at",
+            "mean d" + lat["criterion"].upper(),
+            "amplitude error (%)",
+            "amplitude bias (%)",
+            "axle prediction error (%)",
+        ],
+        [
+            [
+                str(r["rank"]),
+                r["model"],
+                f"{r['mean_rank']:.2f}",
+                f"{r['wins']} of {r['n_conditions']}",
+                _num(r["mean_delta"], ".1f"),
+                _num(r["mean_amplitude_error_pct"], ".2f"),
+                _num(r["mean_amplitude_bias_pct"], "+.2f"),
+                _num(r["mean_axle_amplitude_error_pct"], ".2f"),
+            ]
             for r in lat["ranking"]
         ],
         caption="Overall ranking over every condition (lower information criterion is better; "
@@ -352,23 +406,28 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         for c in conds:
             t = next(x for x in c["table"] if x["model"] == mdl)
             mark = " *" if c["best"] == mdl else ""
-            row.append(f"{t['amplitude_bias_pct']:+.1f} / {t['axle_amplitude_bias_pct']:+.1f}"
-                       + mark)
+            row.append(
+                f"{t['amplitude_bias_pct']:+.1f} / {t['axle_amplitude_bias_pct']:+.1f}" + mark
+            )
         rows.append(row)
     rep.table(
         header,
         rows,
         caption="Table 1 analogue: signed relative error (%) of the amplitude ratio, ground-force "
         "fit / axle-force prediction (positive: over-estimation); * best by "
-        + lat["criterion"].upper() + " at that condition.",
+        + lat["criterion"].upper()
+        + " at that condition.",
     )
     rep.table(
-        ["condition", "best", "f0 (Hz), eq. 38", "C_r fitted (kN s/m)",
-         "C_alpha/V true (kN s/m)"],
+        ["condition", "best", "f0 (Hz), eq. 38", "C_r fitted (kN s/m)", "C_alpha/V true (kN s/m)"],
         [
-            [c["label"], c["best"], fmt_pm(c["corner_frequency_hz"], c["corner_frequency_std_hz"]),
-             fmt_pm(c["road_damping"]["fitted"], c["road_damping"]["stderr"], 4, 1e-3),
-             _num(c["road_damping"]["true"] / 1e3, ".4g")]
+            [
+                c["label"],
+                c["best"],
+                fmt_pm(c["corner_frequency_hz"], c["corner_frequency_std_hz"]),
+                fmt_pm(c["road_damping"]["fitted"], c["road_damping"]["stderr"], 4, 1e-3),
+                _num(c["road_damping"]["true"] / 1e3, ".4g"),
+            ]
             for c in conds
         ],
         caption="Corner frequency of the fitted proposed model and its tyre-road damper C_r "
@@ -407,8 +466,11 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
     ]
     rows.append(["rig truth", _num(veh["true_resonance_hz"], ".3f"), "-"])
     rep.table(
-        ["tyre model", "body resonance (Hz)", f"time response error {tr['window_s'][0]:g}-"
-         f"{tr['window_s'][1]:g} s"],
+        [
+            "tyre model",
+            "body resonance (Hz)",
+            f"time response error {tr['window_s'][0]:g}-{tr['window_s'][1]:g} s",
+        ],
         rows,
         caption=f"{veh['body_mass_kg']:g} kg body (eq. 41-42) on each tyre fitted at "
         f"{veh['pressure_bar']:g} bar, {veh['speed_kmh']:g} km/h; time error = RMS of "

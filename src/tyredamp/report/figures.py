@@ -11,6 +11,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..plot import (
@@ -27,12 +28,21 @@ from ..plot.comparison import model_color
 
 if TYPE_CHECKING:
     from ..demo import DemoResult, LateralCondition
+    from ..lateral.models import ForceKind
 
 __all__ = ["PAPER_MODELS", "demo_figures"]
 
 FigureSet = dict[str, tuple[Figure, str]]
 #: The four spring-damper models of the paper (Figures 11-15 show these).
 PAPER_MODELS = ("classic", "maxwell", "viscoplastic", "hysteretic")
+
+
+def _figure(ax: Axes) -> Figure:
+    """The :class:`Figure` that holds ``ax``."""
+    fig = ax.figure
+    while not isinstance(fig, Figure):  # a SubFigure: go up to the root Figure
+        fig = fig.figure
+    return fig
 
 
 def _paper_models(names: Any) -> list[str]:
@@ -55,14 +65,14 @@ def _radial(result: DemoResult) -> FigureSet:
 
     ax = plot_frf_comparison(meas, {"real-mode fit": real}, out_i, in_i)
     figs["fig02_real_fit"] = (
-        ax[0].figure,  # type: ignore[dict-item]
+        _figure(ax[0]),
         f"Paper Fig. 2: driving-point accelerance {lab} at {p}, measured (dots) and the "
         f"real-mode fit (eq. [2]/[3]): real part, imaginary part, amplitude, phase. "
         f"RMSD {mr.meta['rmsd']:.3g} {meas.unit}.",
     )
     ax = plot_frf_comparison(meas, {"complex-mode fit": cplx}, out_i, in_i)
     figs["fig03_complex_fit"] = (
-        ax[0].figure,  # type: ignore[dict-item]
+        _figure(ax[0]),
         f"Paper Fig. 3: the same FRF and the complex-mode fit (eq. [10]). "
         f"RMSD {mc.meta['rmsd']:.3g} {meas.unit}.",
     )
@@ -72,7 +82,7 @@ def _radial(result: DemoResult) -> FigureSet:
         {"real-mode fit": mr.meta["rmsd"], "complex-mode fit": mc.meta["rmsd"]},
     )
     figs["fig04_discrepancy"] = (
-        ax1.figure,  # type: ignore[dict-item]
+        _figure(ax1),
         "Paper Fig. 4: discrepancy sqrt(sum_jk |H_fit - H_meas|^2) over the 16 FRFs against "
         "frequency, with the RMSD of eq. [19]; the exact FRF of the virtual tyre shows the "
         "noise level no fit can beat.",
@@ -114,13 +124,13 @@ def _radial(result: DemoResult) -> FigureSet:
     ident = main.identification
     ax2 = plot_stabilisation(ident.poles, ident.flags, meas, mc.frequency_hz)
     figs["stabilisation"] = (
-        ax2.figure,  # type: ignore[dict-item]
+        _figure(ax2),
         f"Stabilisation diagram (pLSCF poles of every model order) at {p}; dashed lines: "
         "the modes selected automatically; grey curve: summed FRF amplitude.",
     )
     axs3 = plot_mode_shapes_ring(mc)
     figs["mode_shapes"] = (
-        axs3[0].figure,  # type: ignore[dict-item]
+        _figure(axs3[0]),
         "Complex mode shapes around the circumference (16 points): real part of the "
         "second-order shape (solid) and imaginary part (dashed), normalised.",
     )
@@ -154,7 +164,11 @@ def _radial(result: DemoResult) -> FigureSet:
         vis = tr.select("visible")
         c = f"C{i}"
         axs[0].plot(
-            tr.wave_number[vis], tr.frequency_hz[vis], color=c, lw=0.8, label=f"true, {run.pressure_bar:g} bar"
+            tr.wave_number[vis],
+            tr.frequency_hz[vis],
+            color=c,
+            lw=0.8,
+            label=f"true, {run.pressure_bar:g} bar",
         )
         axs[1].plot(tr.frequency_hz[vis], 100 * tr.damping_ratio[vis], color=c, lw=0.8)
         m = run.models["complex"]
@@ -180,14 +194,12 @@ def _radial(result: DemoResult) -> FigureSet:
 
 
 def _ground_axle(
-    cond: LateralCondition, names: list[str], wheel_mass: float, force: str
+    cond: LateralCondition, names: list[str], wheel_mass: float, force: ForceKind
 ) -> tuple[Any, Any, dict[str, Any], Any]:
     data = cond.ground if force == "ground" else cond.axle
     f = data.frf.frequency
     meas = data.frf.H[0, 0]
-    preds = {
-        n: cond.fit(n).model.response(f, "accelerance", force, wheel_mass) for n in names
-    }
+    preds = {n: cond.fit(n).model.response(f, "accelerance", force, wheel_mass) for n in names}
     truth = cond.truth.response(f, "accelerance", force, wheel_mass)
     return f, meas, preds, truth
 
@@ -219,7 +231,8 @@ def _lateral(result: DemoResult) -> FigureSet:
     )
     p_ref = ref.pressure_bar
     n = 11
-    for force, style in (("ground", "reim"), ("axle", "bode")):
+    forces: tuple[tuple[ForceKind, str], ...] = (("ground", "reim"), ("axle", "bode"))
+    for force, style in forces:
         for v in result.settings.lateral_speeds_kmh:
             cond = next(c for c in lat.conditions if c.pressure_bar == p_ref and c.speed_kmh == v)
             f, meas, preds, truth = _ground_axle(cond, names, lat.rig.wheel_mass, force)
@@ -238,7 +251,7 @@ def _lateral(result: DemoResult) -> FigureSet:
                 "acceleration per axle force (amplitude ratio and phase)"
             )
             figs[f"fig{n}_{force}_{v:g}kmh"] = (
-                axs2[0].figure,  # type: ignore[dict-item]
+                _figure(axs2[0]),
                 f"Paper Fig. {n}: measured (dots) against the models' {what} at {cond.label}; "
                 "dotted black: the rig's exact FRF.",
             )

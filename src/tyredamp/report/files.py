@@ -140,14 +140,20 @@ def _frf_summary(frf: FRF) -> list[list[str]]:
         ["size", f"{frf.n_out} output(s) x {frf.n_in} input(s)"],
         ["kind", f"{frf.kind} ({frf.unit})"],
         ["lines", f"{frf.n_freq}, {f[0]:.4g}-{f[-1]:.4g} Hz"],
-        ["drive points", ", ".join(
-            f"{frf.outputs[i].label}/{frf.inputs[j].label}" for i, j in frf.drive_points()
-        ) or "none"],
+        [
+            "drive points",
+            ", ".join(
+                f"{frf.outputs[i].label}/{frf.inputs[j].label}" for i, j in frf.drive_points()
+            )
+            or "none",
+        ],
     ]
     if frf.coherence is not None:
         rows.append(
-            ["coherence", f"mean {float(frf.coherence.mean()):.4f}, min "
-             f"{float(frf.coherence.min()):.4f}"]
+            [
+                "coherence",
+                f"mean {float(frf.coherence.mean()):.4f}, min {float(frf.coherence.min()):.4f}",
+            ]
         )
     for key in ("estimator", "method", "n_averages"):
         if key in frf.meta:
@@ -175,8 +181,11 @@ def _frf_section(rep: HtmlReport, item: ResultFile) -> None:
         axs[2].set_ylim(0, 1.05)
         axs[2].grid(True, alpha=0.3)
         axs[2].set_xlabel("frequency (Hz)")
-    rep.figure(fig, f"{item.path.name}: drive-point FRF(s), amplitude and phase"
-               + (", multiple coherence" if frf.coherence is not None else ""))
+    rep.figure(
+        fig,
+        f"{item.path.name}: drive-point FRF(s), amplitude and phase"
+        + (", multiple coherence" if frf.coherence is not None else ""),
+    )
 
 
 def _time_section(rep: HtmlReport, item: ResultFile) -> None:
@@ -193,7 +202,7 @@ def _time_section(rep: HtmlReport, item: ResultFile) -> None:
         f"({td.n_samples / td.sample_rate:.4g} s).",
     )
     show = [*td.force_indices[:1], *td.response_indices[:2]]
-    n_show = min(td.n_samples, int(round(2.0 * td.sample_rate)))
+    n_show = min(td.n_samples, round(2.0 * td.sample_rate))
     fig = Figure(figsize=(7.5, 1.8 * len(show) + 0.4), layout="constrained")
     axs = list(fig.subplots(len(show), 1, sharex=True, squeeze=False)[:, 0])
     t = td.time[:n_show]
@@ -261,8 +270,11 @@ def _modes_section(
         rep.table(
             ["model", "RMSD (eq. [19])", "relative error"],
             [
-                [k, f"{_num(v.meta.get('rmsd')):.4g}",
-                 f"{100 * _num(v.meta.get('relative_error')):.3g} %"]
+                [
+                    k,
+                    f"{_num(v.meta.get('rmsd')):.4g}",
+                    f"{100 * _num(v.meta.get('relative_error')):.3g} %",
+                ]
                 for k, v in models.items()
             ],
             caption="Real against complex modes: fit quality over the same FRFs.",
@@ -276,8 +288,11 @@ def _modes_section(
         from ..plot import plot_mode_shapes_ring
 
         axs = plot_mode_shapes_ring(shapes)
-        rep.figure(axs[0].figure, f"{item.path.name}: mode shapes around the circumference "
-                   "(real part solid, imaginary part dashed)")
+        rep.figure(
+            axs[0].figure,
+            f"{item.path.name}: mode shapes around the circumference "
+            "(real part solid, imaginary part dashed)",
+        )
 
 
 def _frf_for(
@@ -286,7 +301,8 @@ def _frf_for(
     """The FRF a modal model was fitted to: the one named in its source, else the only
     FRF file with the same channels (when ``fallback``)."""
     same = [
-        f for f in frfs
+        f
+        for f in frfs
         if f.obj.n_out == model.psi_out.shape[0] and f.obj.n_in == model.psi_in.shape[0]
     ]
     named = [f for f in same if f.path.name == Path(source).name]
@@ -328,19 +344,34 @@ def _damping_section(rep: HtmlReport, item: ResultFile) -> None:
             ["asymmetry of C'", f"{100 * d.symmetry_modal:.3g} %"],
             ["definiteness of C'", d.definiteness_modal],
             ["non-proportionality", f"{100 * d.non_proportionality:.3g} %"],
-            ["negative off-diagonal entries of C", f"{100 * d.negative_offdiagonal_fraction:.3g} %"],
-            ["Rayleigh fit alpha, beta",
-             f"{dm.proportional.rayleigh_alpha:.4g} 1/s, {dm.proportional.rayleigh_beta:.4g} s"],
+            [
+                "negative off-diagonal entries of C",
+                f"{100 * d.negative_offdiagonal_fraction:.3g} %",
+            ],
+            [
+                "Rayleigh fit alpha, beta",
+                f"{dm.proportional.rayleigh_alpha:.4g} 1/s, {dm.proportional.rayleigh_beta:.4g} s",
+            ],
         ],
     )
     rep.paragraph("What the numbers say:")
     rep.bullets(list(dm.findings))
     fig = Figure(figsize=(10.0, 4.2), layout="constrained")
     axs = fig.subplots(1, 2)
-    plot_matrix(dm.modal, [f"{f:.0f} Hz" for f in dm.frequency_hz],
-                "C' (modal coordinates)", "1/s", ax=axs[0])
-    plot_matrix(dm.physical_symmetric, [c.label for c in dm.points],
-                "C at the points (physical coordinates)", "N s/m", ax=axs[1])
+    plot_matrix(
+        dm.modal,
+        [f"{f:.0f} Hz" for f in dm.frequency_hz],
+        "C' (modal coordinates)",
+        "1/s",
+        ax=axs[0],
+    )
+    plot_matrix(
+        dm.physical_symmetric,
+        [c.label for c in dm.points],
+        "C at the points (physical coordinates)",
+        "N s/m",
+        ax=axs[1],
+    )
     rep.figure(fig, "Damping matrices as heat maps (as the paper's Fig. 5).")
 
 
@@ -361,9 +392,17 @@ def _lateral_section(rep: HtmlReport, item: ResultFile, frfs: list[ResultFile]) 
     rep.table(
         ["rank", "model", "P", "AIC", "BIC", "d" + crit, "weight", "amp. error (%)", "bias (%)"],
         [
-            [str(r["rank"]), r["model"], str(r["n_params"]), _f(r["aic"], ".1f"),
-             _f(r["bic"], ".1f"), _f(r["delta"], ".1f"), _f(r["weight"], ".3f"),
-             _f(r["amplitude_error_pct"], ".2f"), _f(r["amplitude_bias_pct"], "+.2f")]
+            [
+                str(r["rank"]),
+                r["model"],
+                str(r["n_params"]),
+                _f(r["aic"], ".1f"),
+                _f(r["bic"], ".1f"),
+                _f(r["delta"], ".1f"),
+                _f(r["weight"], ".3f"),
+                _f(r["amplitude_error_pct"], ".2f"),
+                _f(r["amplitude_bias_pct"], "+.2f"),
+            ]
             for r in doc["table"]
         ],
         caption="Ranking (lower criterion is better; amplitude error as the paper's Table 1).",
@@ -372,8 +411,7 @@ def _lateral_section(rep: HtmlReport, item: ResultFile, frfs: list[ResultFile]) 
     rows = []
     for fit in doc["fits"]:
         for n, v in fit["params"].items():
-            rows.append([fit["model"], n, fmt_pm(v, fit["stderr"].get(n)),
-                         fit["units"].get(n, "")])
+            rows.append([fit["model"], n, fmt_pm(v, fit["stderr"].get(n)), fit["units"].get(n, "")])
         f0 = (fit.get("derived") or {}).get("f0")
         if f0 is not None:
             rows.append([fit["model"], "f0 (eq. 38)", f"{f0:.4g}", "Hz"])
@@ -388,8 +426,11 @@ def _lateral_section(rep: HtmlReport, item: ResultFile, frfs: list[ResultFile]) 
     for fit in doc["fits"]:
         try:
             m = LateralModel.from_dict(
-                {"model": fit["model"], "params": fit["params"],
-                 "conditions": fit.get("conditions", {})}
+                {
+                    "model": fit["model"],
+                    "params": fit["params"],
+                    "conditions": fit.get("conditions", {}),
+                }
             )
         except (InputError, TypeError):
             continue
@@ -398,10 +439,15 @@ def _lateral_section(rep: HtmlReport, item: ResultFile, frfs: list[ResultFile]) 
         )
     if preds:
         meas = measured.H[0, 0] if measured is not None else np.full(freq.shape, np.nan + 0j)
-        axs = plot_lateral_models(freq, meas, preds, style="bode",
-                                  title=f"{item.path.name}: {cond.get('force')} force")
-        rep.figure(axs[0].figure, "Fitted models" + (" against the measured FRF"
-                   if measured is not None else "") + " (as the paper's Figs. 11-14).")
+        axs = plot_lateral_models(
+            freq, meas, preds, style="bode", title=f"{item.path.name}: {cond.get('force')} force"
+        )
+        rep.figure(
+            axs[0].figure,
+            "Fitted models"
+            + (" against the measured FRF" if measured is not None else "")
+            + " (as the paper's Figs. 11-14).",
+        )
 
 
 def _num(v: Any) -> float:
@@ -430,9 +476,16 @@ def _demo_section(rep: HtmlReport, item: ResultFile) -> None:
     _modes_table(rep, rad["modes"], "Modes identified beside the truth.")
     rep.table(
         ["rank", "model", "mean rank", "best at", "amplitude error (%)"],
-        [[str(r["rank"]), r["model"], f"{r['mean_rank']:.2f}",
-          f"{r['wins']} of {r['n_conditions']}", _f(r["mean_amplitude_error_pct"], ".2f")]
-         for r in lat["ranking"]],
+        [
+            [
+                str(r["rank"]),
+                r["model"],
+                f"{r['mean_rank']:.2f}",
+                f"{r['wins']} of {r['n_conditions']}",
+                _f(r["mean_amplitude_error_pct"], ".2f"),
+            ]
+            for r in lat["ranking"]
+        ],
         caption="Lateral models over all conditions.",
     )
 
@@ -474,8 +527,10 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
     }
     rep.table(
         ["file", "content"],
-        [[str(i.path), names[i.kind] + (" (truth of a virtual tyre)" if i.is_truth else "")]
-         for i in items],
+        [
+            [str(i.path), names[i.kind] + (" (truth of a virtual tyre)" if i.is_truth else "")]
+            for i in items
+        ],
     )
     rep.paragraph(f"tyredamp {__version__}.")
     frfs = [i for i in items if i.kind == "frf"]
