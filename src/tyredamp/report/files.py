@@ -263,7 +263,7 @@ def _modes_section(
         rep.table(
             header,
             rows,
-            caption=f"{name} modes ({m.mode_kind}): value ± standard error"
+            caption=f"{name}-mode model ({m.n_modes} modes): value ± standard error"
             + ("; truth of the virtual tyre beside" if tmodel is not None else ""),
         )
     if len(models) > 1:
@@ -316,15 +316,17 @@ def _fit_figures(rep: HtmlReport, frf: FRF, models: dict[str, ModalModel]) -> No
     band = next(iter(models.values())).meta.get("band_hz")
     meas = frf if not band else frf.band(float(band[0]), float(band[1]))
     meas = meas.select_lines(np.flatnonzero(meas.frequency > 0))
-    fitted = {f"{k}-mode fit": m.frf(meas.frequency, meas.kind) for k, m in models.items()}
+    order = sorted(models, key=lambda k: {"real": 0, "complex": 1}.get(k, 2))
+    fitted = {f"{k}-mode fit": models[k].frf(meas.frequency, meas.kind) for k in order}
     dp = meas.drive_points()
     i, j = dp[0] if dp else (0, 0)
-    for k, (lab, fr) in enumerate(fitted.items()):
+    for lab, fr in fitted.items():
         axs = plot_frf_comparison(meas, {lab: fr}, i, j)
         rep.figure(
             axs[0].figure,
-            f"Measured against the {lab} at {meas.outputs[i].label}/{meas.inputs[j].label} "
-            f"(as the paper's Fig. {2 + k}).",
+            f"Measured against the {lab} at {meas.outputs[i].label}/{meas.inputs[j].label}"
+            + (" (as the paper's Fig. 2)." if lab.startswith("real") else "")
+            + (" (as the paper's Fig. 3)." if lab.startswith("complex") else ""),
         )
     rmsd = {f"{k}-mode fit": _num(m.meta.get("rmsd")) for k, m in models.items()}
     ax = plot_discrepancy(meas, fitted, rmsd)
@@ -437,10 +439,26 @@ def _lateral_section(rep: HtmlReport, item: ResultFile, frfs: list[ResultFile]) 
         preds[fit["model"]] = m.response(
             freq, "accelerance", cond.get("force", "ground"), cond.get("wheel_mass_kg") or 0.0
         )
+    truth = None if measured is None else _rig_truth(measured.meta)
+    truth_h = None
+    if truth is not None:
+        truth_h = truth.response(
+            freq, "accelerance", cond.get("force", "ground"), cond.get("wheel_mass_kg") or 0.0
+        )
+        rep.paragraph(
+            f"The FRF comes from a virtual rig whose exact tyre is a {truth.label}: "
+            + ", ".join(f"{k} = {v:.4g}" for k, v in truth.params.items())
+            + " (dotted in the figure)."
+        )
     if preds:
         meas = measured.H[0, 0] if measured is not None else np.full(freq.shape, np.nan + 0j)
         axs = plot_lateral_models(
-            freq, meas, preds, style="bode", title=f"{item.path.name}: {cond.get('force')} force"
+            freq,
+            meas,
+            preds,
+            style="bode",
+            truth=truth_h,
+            title=f"{item.path.name}: {cond.get('force')} force",
         )
         rep.figure(
             axs[0].figure,
@@ -456,6 +474,22 @@ def _num(v: Any) -> float:
         return float(v)
     except (TypeError, ValueError):
         return math.nan
+
+
+def _rig_truth(meta: dict[str, Any]) -> Any:
+    """The exact tyre model a virtual lateral rig stored in an FRF's meta, or None."""
+    from ..lateral.models import LateralModel
+    from ..lateral.rig import ViscoelasticStringTyre
+
+    d = meta.get("truth")
+    if not isinstance(d, dict) or "params" not in d:
+        return None
+    try:
+        if d.get("model") == ViscoelasticStringTyre.name:
+            return ViscoelasticStringTyre(**d["params"], **d.get("conditions", {}))
+        return LateralModel.from_dict(d)
+    except (TyredampError, TypeError, KeyError):
+        return None
 
 
 def _f(v: Any, spec: str) -> str:
