@@ -184,6 +184,7 @@ def test_simulate_lateral_is_lateral_simulate(
     assert code == 0, err
     html = report.read_text()
     assert "Lateral tyre models" in html
+    assert "virtual rig whose exact tyre" in html  # the truth from the NPZ metadata
     assert "hysteretic" in html
     assert html.count("data:image/png;base64,") == 2  # the FRF and the fitted models
 
