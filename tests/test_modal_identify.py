@@ -176,3 +176,29 @@ def test_virtual_tyre_default() -> None:
     _check(c.poles, c.psi_out, tr.poles[vis], tr.psi_points[:, vis], 1e-3, 0.05, 0.99)
     # the paper found about 2x; this tyre (nonproportionality 0.5) gives about 4x
     assert r.meta["rmsd"] > 2 * c.meta["rmsd"]
+
+
+def test_many_outputs_use_compressed_search_and_full_final_fit() -> None:
+    from tyredamp.mechanics import modal_sum_receptance, pole_from_frequency_damping
+    from tyredamp.modal.fit import ModalFitter, compress_outputs
+
+    rng = np.random.default_rng(7)
+    f = np.linspace(0.5, 100.0, 400)
+    p = pole_from_frequency_damping(
+        [12.0, 31.0, 55.0, 78.0, 120.0], [0.02, 0.01, 0.015, 0.01, 0.02]
+    )
+    psi = (rng.normal(size=(120, 5)) + 0.3j * rng.normal(size=(120, 5))) * 1e-2
+    psi[0] = np.abs(psi[0]) + 0.01
+    h = modal_sum_receptance(f, p, psi, psi[:1])
+    hc = compress_outputs(h, 20)
+    assert hc.shape == (20, 1, 400)
+    # a real orthogonal mix of outputs keeps the modal form: exact poles fit exactly
+    fit = ModalFitter(f, hc, 0, "complex", [], unit_weights=True)
+    res = fit.fit(p, np.ones((5, 1)), refine=False)
+    assert res.cost < 1e-20 * np.sum(np.abs(hc) ** 2)  # round-off of the exact model
+    noise = 1e-3 * np.sqrt(np.mean(np.abs(h) ** 2)) * rng.normal(size=h.shape)
+    frf = FRF(f, h + noise, outputs=range(1, 121), inputs=[1])
+    out = identify_modes(frf, model="complex")
+    c = out.models["complex"]
+    assert_allclose(c.poles, p[:4], rtol=1e-4)  # 120 Hz is above the band: a residual mode
+    assert c.psi_out.shape == (120, 4)  # the final fit uses every output

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._validate import as_finite
 from ..exceptions import ConvergenceError, InputError
 from ..frf import FRF
-from .fit import FitResult, ModalFitter
+from .fit import FitResult, ModalFitter, compress_outputs
 from .indicators import mean_phase_deviation, modal_phase_collinearity, relative_error, rmsd
 from .lscf import PoleSet, plscf
 from .model import ModalModel
@@ -142,6 +142,10 @@ def identify_modes(
         Selection rules, see :mod:`tyredamp.modal.selection`.
     min_contribution, min_significance : float
         Rejection rule for modes that do not contribute (module docstring).
+        With more outputs than about four times the number of modes, the
+        residual-mode search and this rule run on principal combinations of
+        the outputs (:func:`~tyredamp.modal.fit.compress_outputs`); the final
+        fits always use every output.
     max_helpers : int
         Largest number of out-of-band residual modes on each side of the band
         (default 4; 0 for none). They are kept in ``ModalModel.residual_modes``.
@@ -168,7 +172,7 @@ def identify_modes(
         data = data.select_lines(np.flatnonzero(keep))
     f = data.frequency
     H = np.asarray(data.H)
-    _n_out, n_in, n_f = H.shape
+    n_out, n_in, n_f = H.shape
     power = _POWER[data.kind]
     if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
         raise InputError(f"n_modes: expected a positive integer, got {n_modes!r}")
@@ -227,13 +231,28 @@ def identify_modes(
     part = np.array([c.participation for c in cand])
     drive = data.drive_points()
     cfit = ModalFitter(f, H, power, "complex", drive, upper=residuals, lower=residuals)
+    # the searches (residual modes, rejection) refit many times: with many outputs
+    # they run on principal output combinations; the final fits use every output
+    rank = 2 * (len(poles) + len(extra) + max_helpers + 2 * n_in) + 16
+    sfit = cfit
+    if n_out > 2 * rank:
+        sfit = ModalFitter(
+            f,
+            compress_outputs(H, rank),
+            power,
+            "complex",
+            [],
+            upper=residuals,
+            lower=residuals,
+            unit_weights=True,
+        )
     # ---- step 3: refine, add out-of-band residual modes, reject modes that do not contribute
     hp = np.array([c.pole for c in extra], dtype=complex)
     hl = np.array([c.participation for c in extra], dtype=complex).reshape(len(extra), n_in)
     n_extra = len(extra)
     if refine and max_helpers > 0:
         poles, part, hp2, hl2, dropped0, n_extra = _search_helpers(
-            cfit,
+            sfit,
             np.concatenate([poles, hp]),
             np.concatenate([part, hl]),
             (lo, hi),
@@ -249,7 +268,7 @@ def identify_modes(
         poles, part = poles[:m0], part[:m0]
     if auto:
         for _ in range(len(poles)):
-            res = cfit.fit(
+            res = sfit.fit(
                 np.concatenate([poles, hp]), np.concatenate([part, hl]), refine=refine, passes=1
             )
             m = len(poles)
