@@ -73,6 +73,7 @@ def test_version(capsys: pytest.CaptureFixture[str]) -> None:
         (["demo", "--seed", "-1"], "--seed"),
         (["simulate", "radial"], "--out"),
         (["simulate", "lateral", "--out", "{tmp}/x.npz", "--speed", "abc"], "--speed"),
+        (["simulate", "lateral", "--out", "{tmp}/x.npz", "--seed", "-1"], "--seed"),
         (["frf", "{tmp}/missing.uff", "--out", "{tmp}/f.uff"], "missing.uff"),
         (["check", "linearity", "{tmp}/one.uff"], "two or more"),
         (["modal", "{tmp}/missing.uff", "--out", "{tmp}/m.json"], "missing.uff"),

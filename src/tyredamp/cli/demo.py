@@ -72,6 +72,7 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
     default="tyredamp-demo",
     show_default=True,
     type=click.Path(path_type=Path),
+    metavar="DIR",
     help="Directory to write (replaced only if empty or an earlier demo output).",
 )
 @click.option(

@@ -215,6 +215,10 @@ _LATERAL = lateral_group.commands["simulate"]
 
 def _lateral_callback(**kwargs: Any) -> None:
     assert _LATERAL.callback is not None
+    seed = kwargs.get("seed")
+    if isinstance(seed, int) and seed < 0:
+        # numpy refuses negative seeds; say so in one line like every other input error
+        raise InputError(f"--seed: expected an integer >= 0, got {seed}")
     _LATERAL.callback(**kwargs)
 
 
