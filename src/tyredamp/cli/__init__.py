@@ -38,9 +38,9 @@ def _register() -> None:
     """Attach the subcommands; each subcommand module adds its lines here."""
     from .check import check_group
     from .damping import damping_command
+    from .demo import demo_command
     from .frf import frf_command
     from .lateral import lateral_group
-    from .demo import demo_command
     from .modal import modal_command
     from .report import report_command
     from .simulate import simulate_group
