@@ -33,7 +33,7 @@ def _images(html: str) -> int:
 
 
 def _self_contained(html: str) -> bool:
-    return not re.search(r'(src|href)="(?!data:)', html) and "<script" not in html
+    return not re.search(r'(src|href)="(?!data:|#)', html) and "<script" not in html
 
 
 @pytest.fixture(scope="module")
@@ -94,8 +94,10 @@ def test_files_report_content(files: dict[str, Path]) -> None:
     html = build_files_report(list(files.values()), title="chain <test>")
     assert _self_contained(html)
     assert "<title>chain &lt;test&gt;</title>" in html  # escaped
+    assert '<nav class="toc">' in html
+    assert 'href="#s1"' in html
     for heading in ("Inputs", "Measured data", "Modal analysis", "Damping identification"):
-        assert f"<h2>{heading}</h2>" in html
+        assert re.search(rf'<h2 id="s\d+">{re.escape(heading)}</h2>', html), heading
     # truth beside the identified modes: the 'truth' poles are 0.1 % higher
     assert "f true (Hz)" in html
     # FRF, time data, Figs. 2/3 (one model) + Fig. 4, mode shapes x 2 files, damping heat maps
@@ -140,6 +142,7 @@ def test_html_report_escapes_and_embeds() -> None:
     assert png[:4] == b"\x89PNG"
     assert "<script>" not in html
     assert "&lt;script&gt;" in html
+    assert "<nav" not in html  # no table of contents for a page without sections
     assert "1.235" in html
     assert _images(html) == 1
     assert _self_contained(html)

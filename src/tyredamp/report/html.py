@@ -24,6 +24,7 @@ th{background:#eef2f6}td.l,th.l{text-align:left}
 figure{margin:1em 0}figcaption{font-size:.9em;color:#555}
 img{max-width:100%}.note{background:#f6f6ee;border-left:4px solid #cc9;padding:.5em 1em}
 .ok{color:#185}.bad{color:#a22}code{background:#f3f3f3;padding:0 .2em}
+nav.toc{background:#f4f6f9;padding:.3em 1em;border:1px solid #dde}nav.toc ul{margin:.3em 0}
 """
 
 
@@ -34,16 +35,26 @@ class HtmlReport:
     ----------
     title : str
         Page title and top heading.
+    toc : bool
+        Put a table of contents of the level-2 headings under the title
+        (links within the page; default True).
     """
 
-    def __init__(self, title: str) -> None:
+    def __init__(self, title: str, toc: bool = True) -> None:
         self.title = title
+        self.toc = toc
         self._parts: list[str] = []
+        self._sections: list[tuple[str, str]] = []
 
     def heading(self, text: str, level: int = 2) -> None:
-        """Add a heading (level 2-4)."""
+        """Add a heading (level 2-4); level-2 headings get an anchor and a TOC entry."""
         lvl = min(max(int(level), 2), 4)
-        self._parts.append(f"<h{lvl}>{html.escape(text)}</h{lvl}>")
+        if lvl == 2:
+            anchor = f"s{len(self._sections) + 1}"
+            self._sections.append((anchor, text))
+            self._parts.append(f'<h2 id="{anchor}">{html.escape(text)}</h2>')
+        else:
+            self._parts.append(f"<h{lvl}>{html.escape(text)}</h{lvl}>")
 
     def paragraph(self, text: str, css_class: str | None = None) -> None:
         """Add a paragraph of plain text (escaped)."""
@@ -100,8 +111,15 @@ class HtmlReport:
         self._parts.append(fragment)
 
     def render(self) -> str:
-        """The whole page as one string."""
-        body = "\n".join(self._parts)
+        """The whole page as one string (with a table of contents of the level-2 headings
+        when there are three or more and ``toc`` is set)."""
+        parts = list(self._parts)
+        if self.toc and len(self._sections) >= 3:
+            items = "".join(
+                f'<li><a href="#{a}">{html.escape(t)}</a></li>' for a, t in self._sections
+            )
+            parts.insert(0, f'<nav class="toc"><ul>{items}</ul></nav>')
+        body = "\n".join(parts)
         t = html.escape(self.title)
         return (
             '<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
