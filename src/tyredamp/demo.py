@@ -568,11 +568,12 @@ class _Stages:
 def single_threaded_blas() -> contextlib.AbstractContextManager[Any]:
     """Context limiting BLAS/LAPACK to one thread (threadpoolctl; a no-op without it).
 
-    The matrices here are small (a 128-DOF tyre, least squares of a few
-    hundred columns): extra BLAS threads gain little and, on a machine whose
-    cores are busy, spin and slow everything down several times (measured:
-    the quick demo took 26 s wall and 20 s CPU with the default two threads
-    beside other jobs, 7.5 s and 5 s with one).
+    The matrices here are small (a 128-DOF tyre, batched 130 x 130 solves,
+    least squares of a few hundred columns): extra BLAS threads gain little
+    and, on a machine whose cores are busy, slow everything down many times
+    (measured on two shared cores: the full demo's computation took 111 s
+    with the default two OpenBLAS threads and 7.9 s with one;
+    ``benchmarks/demo_timing.py --compare-threads``).
     """
     try:
         from threadpoolctl import threadpool_limits
@@ -619,6 +620,9 @@ def _compare_damping(run: PressureRun, dm: DampingModel) -> DampingComparison:
     ct = ct * np.outer(sign, sign)
     cid = dm.modal[np.ix_(mi, mi)]
     norm = float(np.linalg.norm(ct))
+    if mi.size == 0 or norm == 0:  # no identified mode matches a true one
+        nan = float("nan")
+        return DampingComparison(ti, mi, ct, cid, nan, nan, nan, None, None)
     err = float(np.linalg.norm(cid - ct)) / norm
     err_sym = float(np.linalg.norm(0.5 * (cid + cid.T) - ct)) / norm
     dd = float(np.linalg.norm(np.diag(cid) - np.diag(ct)) / np.linalg.norm(np.diag(ct)))
