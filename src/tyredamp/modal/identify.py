@@ -291,18 +291,36 @@ def identify_modes(
     kinds = ["complex", "real"] if model == "both" else [model]
     models: dict[str, ModalModel] = {}
     disc: dict[str, NDArray[np.float64]] = {}
+    base: tuple[FitResult, int, int] | None = None  # complex result, n in band, n free
     for kind in kinds:
-        fitter = (
-            cfit
-            if kind == "complex"
-            else ModalFitter(f, H, power, "real", drive, upper=residuals, lower=residuals)
-        )
-        res, n_band, dropped = _fit_checked(
-            fitter, poles, part, hp, hl, refine, (lo, hi), n_free=n_extra
-        )
-        rejected += [_rej(p, f"{kind} fit: {why}") for p, why in dropped]
+        if kind == "complex":
+            res, n_band, dropped, nf = _fit_checked(
+                cfit, poles, part, hp, hl, refine, (lo, hi), n_free=n_extra
+            )
+            rejected += [_rej(p, f"complex fit: {why}") for p, why in dropped]
+            base = (res, n_band, nf)
+            extra_warn: list[str] = []
+        else:
+            res, n_band, extra_warn = _fit_real(
+                f,
+                H,
+                power,
+                drive,
+                residuals,
+                refine,
+                sfit is not cfit,
+                sfit.H,
+                poles,
+                part,
+                hp,
+                hl,
+                n_extra,
+                (lo, hi),
+                base,
+            )
         kap = (2j * np.pi * f) ** power
         hm = res.model_receptance * kap[None, None, :]
+        res.warnings.extend(extra_warn)
         mdl = _to_model(res, n_band, kind, data, (lo, hi), p_max, hm)
         models[kind] = mdl
         disc[kind] = np.sqrt(np.mean(np.abs(hm - H) ** 2, axis=(0, 1)))
@@ -392,7 +410,7 @@ def _search_helpers(
     """
     lo, hi = band
     m0 = len(poles) - n_free
-    res, m0, dropped = _fit_checked(
+    res, m0, dropped, n_free = _fit_checked(
         fitter,
         poles[:m0],
         part[:m0],
@@ -403,8 +421,7 @@ def _search_helpers(
         n_free=n_free,
         passes=1,
     )
-    m = len(res.poles)
-    n_free = m - m0
+    m = m0 + n_free
     cur_p, cur_l = res.poles, res.participation
     per = 2 if fitter.kind == "complex" else 1
     dof = fitter.n_rows
@@ -438,6 +455,81 @@ def _search_helpers(
     return cur_p[:m], cur_l[:m], cur_p[m:], cur_l[m:], dropped, n_free
 
 
+def _problem(res: FitResult, m: int, n_free: int, band: tuple[float, float]) -> str:
+    """Why a fit is not acceptable ("" when it is): a mode crossed a band edge, or two merged."""
+    p = res.poles
+    fd = p.imag / (2 * np.pi)
+    inb = (fd >= band[0]) & (fd <= band[1])
+    free = np.zeros(len(p) - m, bool)
+    free[:n_free] = True
+    wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
+    if wrong.size:
+        return f"a pole crossed the band edge ({fd[wrong[0]]:.2f} Hz)"
+    d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
+    np.fill_diagonal(d, np.inf)
+    if d.size and d.min() < 5e-4:
+        return "two poles merged"
+    return ""
+
+
+def _fit_real(
+    f: NDArray[np.float64],
+    H: NDArray[np.complex128],
+    power: int,
+    drive: list[tuple[int, int]],
+    residuals: bool,
+    refine: bool,
+    compressed: bool,
+    h_search: NDArray[np.complex128],
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    hp: NDArray[np.complex128],
+    hl: NDArray[np.complex128],
+    n_free: int,
+    band: tuple[float, float],
+    base: tuple[FitResult, int, int] | None,
+) -> tuple[FitResult, int, list[str]]:
+    """Real-mode fit (pole-pair optimisation) started from the complex-mode poles.
+
+    The real model keeps the modes of the complex model. When its refinement
+    is not acceptable (a pole crosses a band edge or two merge: real modes
+    that cannot describe strongly complex data), the poles are kept at the
+    complex-mode values, only the real residues are fitted, and a warning
+    says so.
+    """
+    if base is not None:
+        cres, m, nf = base
+        p0, l0 = cres.poles, cres.participation
+    else:
+        m, nf = len(poles), n_free
+        p0, l0 = np.concatenate([poles, hp]), np.concatenate([part, hl])
+    fitter = ModalFitter(f, H, power, "real", drive, upper=residuals, lower=residuals)
+    if not refine:
+        return fitter.fit(p0, l0, refine=False), m, []
+    start_p, start_l = p0, l0
+    if compressed:
+        # real modes start far from the complex optimum: pre-fit on the combinations
+        pre = ModalFitter(
+            f, h_search, power, "real", [], upper=residuals, lower=residuals, unit_weights=True
+        ).fit(p0, l0, passes=1)
+        if not _problem(pre, m, nf, band):
+            start_p, start_l = pre.poles, pre.participation
+    # the evaluation limit bounds the time spent on data that real modes cannot fit
+    res = fitter.fit(start_p, start_l, refine=True, max_nfev=100)
+    why = _problem(res, m, nf, band)
+    if not why:
+        return res, m, []
+    res = fitter.fit(p0, l0, refine=False)
+    return (
+        res,
+        m,
+        [
+            f"real-mode refinement not acceptable ({why}): poles kept at the complex-mode "
+            "values, real residues fitted"
+        ],
+    )
+
+
 def _fit_checked(
     fitter: ModalFitter,
     poles: NDArray[np.complex128],
@@ -448,8 +540,11 @@ def _fit_checked(
     band: tuple[float, float],
     n_free: int = 0,
     passes: int = 2,
-) -> tuple[FitResult, int, list[tuple[complex, str]]]:
+) -> tuple[FitResult, int, list[tuple[complex, str]], int]:
     """Fit modes and residual modes; drop any that left its side of the band or merged.
+
+    Returns the fit, the number of in-band modes, the dropped modes and the
+    number of in-band residual modes left.
 
     ``hp`` holds first ``n_free`` in-band residual modes (not checked against
     the band), then out-of-band ones (which must stay outside).
@@ -479,7 +574,7 @@ def _fit_checked(
                 bad = int(i if res.contribution[i] < res.contribution[j] else j)
                 why = "merged with another mode during refinement"
         if bad is None:
-            return res, m, dropped
+            return res, m, dropped, n_free
         if bad < m:
             if m == 1:
                 raise ConvergenceError(f"the only mode {why}")
