@@ -512,13 +512,16 @@ def _fit_real(
         pre = ModalFitter(
             f, h_search, power, "real", [], upper=residuals, lower=residuals, unit_weights=True
         ).fit(p0, l0, passes=1)
-        if not _problem(pre, m, nf, band):
-            start_p, start_l = pre.poles, pre.participation
-    # the evaluation limit bounds the time spent on data that real modes cannot fit
-    res = fitter.fit(start_p, start_l, refine=True, max_nfev=100)
-    why = _problem(res, m, nf, band)
+        why = _problem(pre, m, nf, band)
+        start_p, start_l = pre.poles, pre.participation
+    else:
+        why = ""
     if not why:
-        return res, m, []
+        # the evaluation limit bounds the time spent on data that real modes cannot fit
+        res = fitter.fit(start_p, start_l, refine=True, max_nfev=100)
+        why = _problem(res, m, nf, band)
+        if not why:
+            return res, m, []
     res = fitter.fit(p0, l0, refine=False)
     return (
         res,
