@@ -5,7 +5,8 @@ Run: ``python benchmarks/run_all.py [--quick] [--blas-threads 1]``
 
 Runs, one subprocess each, ``perf_compare.py`` (tyredamp against sdypy-EMA),
 ``perf_crlb.py`` (spread against the Cramér-Rao bound, Monte Carlo) and
-``perf_scaling.py`` (time and memory against size, the demo); their tables
+``perf_scaling.py`` (time and memory against size, the demo) and
+``perf_profile.py`` (where the identification spends its time); their tables
 stream to the terminal and their JSON goes to ``benchmarks/results/``
 (git-ignored). Then prints one table of the targets, measured, and writes
 ``results/summary.json`` and ``results/summary.md`` (the Markdown table of
@@ -26,7 +27,7 @@ from typing import Any
 from perf_common import RESULTS_DIR, machine_info, print_table, write_json
 
 HERE = Path(__file__).resolve().parent
-PARTS = ("perf_compare", "perf_crlb", "perf_scaling")
+PARTS = ("perf_compare", "perf_crlb", "perf_scaling", "perf_profile")
 
 
 def _f(x: float, nd: int = 2) -> str:

@@ -1,0 +1,118 @@
+"""Where the time of :func:`~tyredamp.modal.identify_modes` goes, stage by stage.
+
+Run: ``python benchmarks/perf_profile.py [--quick] [--blas-threads 1] [--json PATH]``.
+
+Profiles one call (``cProfile``, complex model, default options) on the
+virtual tyre (16 outputs, 799 lines), the synthetic structure with 128
+outputs and with 1024 outputs (4000 lines, 20 modes; 1024 not in
+``--quick``) and prints the cumulative time of the main stages as a share of
+the call: pLSCF, stabilisation and clustering, output compression, the
+search for out-of-band residual modes, the checked fits of the final models,
+and, across all fits, the projection (``ModalFitter._solve``), the normal
+equations (``_normal``), the basis (``basis``) and the result assembly
+(``_result``, standard errors and contributions included). Stages nest
+(a fit inside the search also counts in ``_solve``), so the rows do not
+add up to 100 %.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import pstats
+import time
+from typing import Any
+
+from perf_common import (
+    RESULTS_DIR,
+    limit_blas,
+    machine_info,
+    print_table,
+    synthetic_case,
+    tyre_case,
+    write_json,
+)
+
+from tyredamp.modal import identify_modes
+
+#: (label, file suffix, function name)
+STAGES = (
+    ("pLSCF (plscf)", "lscf.py", "plscf"),
+    ("stability + clustering", "selection.py", "stability_flags|cluster_poles"),
+    ("output compression", "fit.py", "compress_outputs"),
+    ("residual-mode search (_search_helpers)", "identify.py", "_search_helpers"),
+    ("checked fits (_fit_checked)", "identify.py", "_fit_checked"),
+    ("all fits (ModalFitter.fit)", "fit.py", "fit"),
+    ("  projection (_solve)", "fit.py", "_solve"),
+    ("  QR of the basis (numpy qr)", "_linalg.py", "qr"),
+    ("  normal equations (_normal)", "fit.py", "_normal"),
+    ("  basis (basis)", "fit.py", "basis"),
+    ("  result assembly (_result)", "fit.py", "_result"),
+    ("  shape standard errors (_shape_std)", "fit.py", "_shape_std"),
+)
+
+
+def profile_case(name: str, case: Any) -> dict[str, Any]:
+    identify_modes(case.frf, band=case.band, model="complex")  # warm-up (imports, caches)
+    pr = cProfile.Profile()
+    t0 = time.perf_counter()
+    pr.enable()
+    identify_modes(case.frf, band=case.band, model="complex")
+    pr.disable()
+    total = time.perf_counter() - t0
+    stats = pstats.Stats(pr).stats  # type: ignore[attr-defined]
+    out: dict[str, Any] = {"case": name, "total_s": total, "stages": {}}
+    for label, file, funcs in STAGES:
+        names = set(funcs.split("|"))
+        ct = 0.0
+        calls = 0
+        for (fname, _line, func), (_cc, nc, _tt, cum, _callers) in stats.items():
+            if func in names and fname.endswith(file):
+                ct += cum
+                calls += nc
+        out["stages"][label] = {"s": ct, "calls": calls, "share": ct / total}
+    return out
+
+
+def main(argv: list[str] | None = None) -> dict[str, Any]:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="without the 1024-output case")
+    ap.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (default 1)")
+    ap.add_argument("--json", default=str(RESULTS_DIR / "profile.json"), help="output JSON")
+    a = ap.parse_args(argv)
+    pool = limit_blas(a.blas_threads)
+    t_start = time.perf_counter()
+    cases = [
+        ("tyre 16x799x6", lambda: tyre_case(40.0, seed=1)),
+        ("synthetic 128x4000x20", lambda: synthetic_case(128, 4000, 20, seed=0)),
+    ]
+    if not a.quick:
+        cases.append(("synthetic 1024x4000x20", lambda: synthetic_case(1024, 4000, 20, seed=0)))
+    results = [profile_case(name, make()) for name, make in cases]
+    rows = []
+    for label, _f, _n in STAGES:
+        row: list[Any] = [label]
+        for r in results:
+            st = r["stages"][label]
+            row.append(f"{st['s']:.2f} s {100 * st['share']:3.0f} % ({st['calls']})")
+        rows.append(row)
+    rows.append(["total identify_modes", *(f"{r['total_s']:.2f} s" for r in results)])
+    print_table(
+        ["stage (cumulative, calls)", *(r["case"] for r in results)],
+        rows,
+        title=f"\n== identify_modes time by stage (cProfile, BLAS threads {a.blas_threads})",
+    )
+    doc = {
+        "benchmark": "perf_profile",
+        "quick": a.quick,
+        "machine": machine_info(a.blas_threads),
+        "elapsed_s": time.perf_counter() - t_start,
+        "cases": results,
+    }
+    print(f"wrote {write_json(doc, a.json)} ({doc['elapsed_s']:.0f} s)")
+    del pool
+    return doc
+
+
+if __name__ == "__main__":
+    main()
