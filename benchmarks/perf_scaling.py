@@ -20,7 +20,9 @@ Sweeps (``--quick`` in brackets): outputs 16, 128, 1024 at 4000 lines and
 4000 lines; when the automatic selection misses modes, the case is run
 again with ``n_modes`` given (marked in the table). The growth exponent between two sizes is
 ``log(t2 / t1) / log(n2 / n1)`` (1 = linear). The full mode also runs the
-1024 x 4000 x 20 case with two BLAS threads.
+1024 x 4000 x 20 case with two BLAS threads. ``--busy-check`` (not part of
+``run_all.py``: it loads the shared machine) runs that case with one and two
+BLAS threads while two CPU-bound processes compete for the cores.
 
 Demo: ``tyredamp demo --out DIR`` (and ``--quick`` in the full mode) in a
 subprocess, wall time and peak RSS (``/usr/bin/time -f %M`` when GNU time is
@@ -30,6 +32,7 @@ there, else ``ru_maxrss``, an upper bound).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import itertools
 import json
 import os
@@ -150,6 +153,18 @@ def run_case(
     }
 
 
+@contextlib.contextmanager
+def busy_load(n: int) -> Any:
+    """``n`` CPU-bound Python processes for the duration of the block (killed by pid)."""
+    procs = [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+    try:
+        yield
+    finally:
+        for p in procs:
+            p.kill()
+            p.wait()
+
+
 def exponents(rows: list[dict[str, Any]], key: str) -> list[float]:
     """Growth exponents ``log(t2/t1) / log(n2/n1)`` between consecutive sizes."""
     return [
@@ -193,6 +208,11 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--quick", action="store_true", help="smaller sweeps, one run per case")
     ap.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (default 1)")
     ap.add_argument("--json", default=str(RESULTS_DIR / "scaling.json"), help="output JSON")
+    ap.add_argument(
+        "--busy-check",
+        action="store_true",
+        help="also time 1024x4000x20 with 1 and 2 BLAS threads beside 2 CPU-bound processes",
+    )
     ap.add_argument("--child", help=argparse.SUPPRESS)
     ap.add_argument("--n-modes", type=int, default=None, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
@@ -271,6 +291,14 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             print(
                 f"\n1024 x 4000 x 20 with 2 BLAS threads: {two['t_s']:.1f} s "
                 f"(1 thread: {target_case['t_s'] if target_case else float('nan'):.1f} s)"
+            )
+        if a.busy_check:
+            with busy_load(2):
+                busy = {n: run_case(1024, 4000, 20, n, tmp, 1) for n in (1, 2)}
+            res["busy"] = {f"blas_{n}": r for n, r in busy.items()}
+            print(
+                f"\n1024 x 4000 x 20 beside two CPU-bound processes: {busy[1]['t_s']:.1f} s "
+                f"(1 BLAS thread), {busy[2]['t_s']:.1f} s (2 BLAS threads)"
             )
         demos = [run_demo([], tmp)]
         if not a.quick:
