@@ -52,6 +52,7 @@ from . import __version__
 from .damping import DampingModel, identify_damping
 from .exceptions import InputError
 from .frf import FRF
+from .io.jsonfile import json_text
 from .lateral import (
     DEFAULT_MODELS,
     CausalError,
@@ -917,12 +918,10 @@ def _save(
             band_hz=main.identification.band_hz,
             frf_kind=main.identification.frf_kind,
         )
-        (tmp / f"modes_{p0}.json").write_text(
-            json.dumps(doc, indent=1, allow_nan=True) + "\n", encoding="utf-8"
-        )
+        (tmp / f"modes_{p0}.json").write_text(json_text(doc), encoding="utf-8")
         written.append(f"modes_{p0}.json")
         (tmp / f"damping_{p0}.json").write_text(
-            json.dumps(result.radial.damping.to_dict(), indent=1, allow_nan=True) + "\n",
+            json_text(result.radial.damping.to_dict()),
             encoding="utf-8",
         )
         written.append(f"damping_{p0}.json")
@@ -930,9 +929,7 @@ def _save(
         step("results.json")
         files = sorted([*written, "report.html", "results.json"])
         results = build_results(result, files=files)
-        (tmp / "results.json").write_text(
-            json.dumps(results, indent=1, allow_nan=False) + "\n", encoding="utf-8"
-        )
+        (tmp / "results.json").write_text(json_text(results), encoding="utf-8")
 
         step("report.html")
         html = build_demo_report(result, results, {k: (pngs[k], figs[k][1]) for k in figs})

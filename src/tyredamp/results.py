@@ -25,6 +25,7 @@ import numpy as np
 
 from . import __version__
 from .exceptions import InputError
+from .io.jsonfile import finite
 
 if TYPE_CHECKING:
     from .demo import DemoResult, LateralCondition, PressureRun
@@ -43,21 +44,6 @@ __all__ = [
 
 RESULTS_KIND = "tyredamp-demo-results"
 RESULTS_VERSION = 1
-
-
-def finite(obj: Any) -> Any:
-    """Copy of ``obj`` with NumPy types as Python types and NaN/inf as ``None`` (strict JSON)."""
-    if isinstance(obj, dict):
-        return {str(k): finite(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [finite(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return finite(obj.tolist())
-    if isinstance(obj, np.generic):
-        return finite(obj.item())
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    return obj
 
 
 def _matrix(a: Any) -> list[list[float]]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 import sys
 
 import click
+from threadpoolctl import threadpool_limits
 
 from .. import __version__
 from ..exceptions import ConvergenceError, TyredampError
@@ -63,7 +64,10 @@ def main(argv: list[str] | None = None) -> None:
     args = sys.argv[1:] if argv is None else argv
     debug = "--debug" in args
     try:
-        rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
+        # Small dense solves dominate; several BLAS threads on busy cores make them
+        # 10-15x slower (benchmarks/demo_timing.py), so the CLI uses one.
+        with threadpool_limits(limits=1, user_api="blas"):
+            rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
         if isinstance(rv, int) and rv != 0:
             # ctx.exit(n) hands its code back as the return value here
             sys.exit(rv)

@@ -25,7 +25,6 @@ description in ``docs/damping-json.md``)::
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -34,8 +33,8 @@ import numpy as np
 
 from ..damping import METHODS, DampingModel, identify_damping
 from ..exceptions import InputError
-from ..io._atomic import atomic_path
 from ..io._common import check_input_file
+from ..io.jsonfile import write_json
 from ..modal.io import read_modes_json
 
 __all__ = ["damping_command", "damping_summary"]
@@ -93,7 +92,9 @@ def damping_summary(dm: DampingModel) -> list[str]:
     show_default=True,
     help="Monte Carlo samples for the standard errors (0 to skip).",
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Monte Carlo seed.")
+@click.option(
+    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Monte Carlo seed."
+)
 @click.option(
     "--no-normalise",
     is_flag=True,
@@ -135,9 +136,7 @@ def damping_command(
         seed=seed,
         meta=meta,
     )
-    text = json.dumps(dm.to_dict(), indent=1, allow_nan=True)
-    with atomic_path(out) as tmp:
-        tmp.write_text(text + "\n", encoding="utf-8")
+    write_json(dm.to_dict(), out)
     for row in damping_summary(dm):
         click.echo(row)
     click.echo(f"wrote {out}")

@@ -36,32 +36,20 @@ LATERAL_JSON layout (version 1; SI units; non-finite numbers as ``null``)::
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
-from typing import Any
 
 import click
 
 from ..exceptions import InputError
 from ..io import FORMATS, read_frf, write_frf
 from ..io._atomic import atomic_path
+from ..io.jsonfile import json_text
 from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
 from ..lateral.models import MODELS, get_model_class
 from ..lateral.rig import KMH, VirtualLateralRig
 
 __all__ = ["lateral_group"]
-
-
-def _finite(obj: Any) -> Any:
-    """Replace NaN and infinities by None, recursively (strict JSON)."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {str(k): _finite(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_finite(v) for v in obj]
-    return obj
 
 
 def _model_list(values: tuple[str, ...]) -> list[str]:
@@ -207,7 +195,7 @@ def fit_command(
         **ranking.to_dict(),
     }
     with atomic_path(out) as tmp:
-        tmp.write_text(json.dumps(_finite(doc), indent=2, allow_nan=False) + "\n")
+        tmp.write_text(json_text(doc, indent=2), encoding="utf-8")
     sp = "?" if data.speed is None else f"{data.speed / KMH:g} km/h"
     click.echo(
         f"{frf_file}: {best.n_lines} lines {best.frequency[0]:.3g}-{best.frequency[-1]:.3g} Hz, "
@@ -249,7 +237,9 @@ def fit_command(
     metavar="BAR",
     help="Inflation pressure, bar.",
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Noise seed.")
+@click.option(
+    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Noise seed."
+)
 @click.option(
     "--force",
     type=click.Choice(["ground", "axle"]),

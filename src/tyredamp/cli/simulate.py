@@ -11,7 +11,6 @@ type 4); ``--truth`` also writes the exact modes as a modes JSON file.
 from __future__ import annotations
 
 import contextlib
-import json
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +19,7 @@ import click
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
 from ..io._atomic import atomic_path
-from ..results import finite
+from ..io.jsonfile import json_text
 from .lateral import lateral_group
 
 __all__ = ["simulate_group"]
@@ -172,7 +171,7 @@ def radial_command(
             band_hz=test.truth.band,
             frf_kind="receptance",
         )
-        truth_text = json.dumps(finite(doc), indent=1, allow_nan=False) + "\n"
+        truth_text = json_text(doc)
     existed = out.exists()
     if as_frf:
         frf = estimate_frf(test.data, "H1")

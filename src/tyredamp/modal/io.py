@@ -38,7 +38,7 @@ from typing import Any
 
 from .. import __version__
 from ..exceptions import FileFormatError, InputError
-from ..io._atomic import atomic_path
+from ..io.jsonfile import write_json
 from .model import ModalModel
 
 __all__ = ["modes_document", "read_modes_json", "write_modes_json"]
@@ -101,10 +101,7 @@ def write_modes_json(
 ) -> Path:
     """Write the modes JSON atomically (no partial file on error); returns the path."""
     doc = modes_document(models, source=source, band_hz=band_hz, frf_kind=frf_kind)
-    target = Path(path)
-    with atomic_path(target) as tmp:
-        tmp.write_text(json.dumps(doc, indent=1, allow_nan=True), encoding="utf-8")
-    return target
+    return write_json(doc, path)
 
 
 def read_modes_json(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
