@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import sys
-from typing import NoReturn
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, NoReturn, TypeVar
 
 import click
 
-__all__ = ["EXIT_INPUT", "EXIT_RUNTIME", "fail"]
+__all__ = ["EXIT_INPUT", "EXIT_RUNTIME", "fail", "out_file_option", "seed_option"]
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 #: Exit code for usage and input errors (bad options, bad or corrupt files).
 EXIT_INPUT = 2
@@ -20,3 +24,22 @@ def fail(message: str, code: int = EXIT_INPUT) -> NoReturn:
     line = " ".join(str(message).split())
     click.echo(f"tyredamp: error: {line}", err=True)
     sys.exit(code)
+
+
+def out_file_option(help_text: str) -> Callable[[F], F]:
+    """The ``--out/-o FILE`` option (required) that every file-writing command shares."""
+    return click.option(
+        "--out",
+        "-o",
+        "out",
+        required=True,
+        type=click.Path(dir_okay=False, path_type=Path),
+        help=help_text,
+    )
+
+
+def seed_option(help_text: str = "Noise seed.") -> Callable[[F], F]:
+    """The ``--seed N`` option (integer >= 0, default 0)."""
+    return click.option(
+        "--seed", type=click.IntRange(min=0), default=0, show_default=True, help=help_text
+    )

@@ -36,6 +36,7 @@ from ..exceptions import InputError
 from ..io._common import check_input_file
 from ..io.jsonfile import write_json
 from ..modal.io import read_modes_json
+from ._common import out_file_option, seed_option
 
 __all__ = ["damping_command", "damping_summary"]
 
@@ -62,14 +63,7 @@ def damping_summary(dm: DampingModel) -> list[str]:
 
 @click.command("damping")
 @click.argument("modes_json", type=click.Path(dir_okay=False, path_type=Path))
-@click.option(
-    "--out",
-    "-o",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="Damping JSON file to write.",
-)
+@out_file_option("Damping JSON file to write.")
 @click.option(
     "--method",
     type=click.Choice(METHODS),
@@ -92,9 +86,7 @@ def damping_summary(dm: DampingModel) -> list[str]:
     show_default=True,
     help="Monte Carlo samples for the standard errors (0 to skip).",
 )
-@click.option(
-    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Monte Carlo seed."
-)
+@seed_option("Monte Carlo seed.")
 @click.option(
     "--no-normalise",
     is_flag=True,

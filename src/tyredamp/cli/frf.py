@@ -11,6 +11,7 @@ from ..exceptions import InputError
 from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
 from ..signal.estimators import ESTIMATORS, estimate_frf
+from ._common import out_file_option
 
 __all__ = ["frf_command", "frf_summary"]
 
@@ -39,14 +40,7 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
 
 @click.command("frf")
 @click.argument("time_file", type=click.Path(dir_okay=False, path_type=Path))
-@click.option(
-    "--out",
-    "-o",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="FRF file to write (.uff, .unv, .csv or .npz).",
-)
+@out_file_option("FRF file to write (.uff, .unv, .csv or .npz).")
 @click.option(
     "--estimator",
     type=click.Choice(ESTIMATORS),

@@ -48,6 +48,7 @@ from ..io.jsonfile import json_text
 from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
 from ..lateral.models import MODELS, get_model_class
 from ..lateral.rig import KMH, VirtualLateralRig
+from ._common import out_file_option, seed_option
 
 __all__ = ["lateral_group"]
 
@@ -74,14 +75,7 @@ def lateral_group() -> None:
 
 @lateral_group.command("fit")
 @click.argument("frf_file", type=click.Path(dir_okay=False, path_type=Path))
-@click.option(
-    "--out",
-    "-o",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="JSON file to write (layout in the module docs).",
-)
+@out_file_option("JSON file to write (layout in the module docs).")
 @click.option(
     "--models",
     "models",
@@ -218,14 +212,7 @@ def fit_command(
 
 
 @lateral_group.command("simulate")
-@click.option(
-    "--out",
-    "-o",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="FRF file to write (.npz, .csv, .uff or .unv).",
-)
+@out_file_option("FRF file to write (.npz, .csv, .uff or .unv).")
 @click.option(
     "--speed", type=float, default=5.0, show_default=True, metavar="KMH", help="Travel speed, km/h."
 )
@@ -237,9 +224,7 @@ def fit_command(
     metavar="BAR",
     help="Inflation pressure, bar.",
 )
-@click.option(
-    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Noise seed."
-)
+@seed_option("Noise seed.")
 @click.option(
     "--force",
     type=click.Choice(["ground", "axle"]),

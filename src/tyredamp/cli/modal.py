@@ -12,6 +12,7 @@ from ..io import read_frf
 from ..modal.identify import ModalIdentification, identify_modes
 from ..modal.io import write_modes_json
 from ..modal.model import ModalModel
+from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
 
@@ -54,14 +55,7 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
 
 @click.command("modal")
 @click.argument("frf_file", type=click.Path(dir_okay=False, path_type=Path))
-@click.option(
-    "--out",
-    "-o",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="Modes JSON file to write (schema: docs/modes-json.md).",
-)
+@out_file_option("Modes JSON file to write (schema: docs/modes-json.md).")
 @click.option(
     "--band", nargs=2, type=float, metavar="F_LO F_HI", help="Analysis band in Hz (default all)."
 )

@@ -8,20 +8,14 @@ import click
 
 from ..exceptions import InputError
 from ..io._atomic import atomic_path
+from ._common import out_file_option
 
 __all__ = ["report_command"]
 
 
 @click.command("report")
 @click.argument("result_files", nargs=-1, type=click.Path(dir_okay=False, path_type=Path))
-@click.option(
-    "--out",
-    "-o",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="HTML file to write (self-contained, figures embedded).",
-)
+@out_file_option("HTML file to write (self-contained, figures embedded).")
 @click.option("--title", help="Page title (default 'tyredamp report').")
 def report_command(result_files: tuple[Path, ...], out: Path, title: str | None) -> None:
     """Build one HTML report from RESULT_FILES of the other commands.

@@ -20,6 +20,7 @@ from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
 from ..io._atomic import atomic_path
 from ..io.jsonfile import json_text
+from ._common import out_file_option, seed_option
 from .lateral import lateral_group
 
 __all__ = ["simulate_group"]
@@ -58,14 +59,7 @@ def simulate_group() -> None:
 
 
 @simulate_group.command("radial")
-@click.option(
-    "--out",
-    "-o",
-    "out",
-    required=True,
-    type=click.Path(dir_okay=False, path_type=Path),
-    help="File to write (.uff/.unv: UFF 58b binary, or .csv, .npz).",
-)
+@out_file_option("File to write (.uff/.unv: UFF 58b binary, or .csv, .npz).")
 @click.option(
     "--pressure",
     type=click.FloatRange(min=0, max=20),
@@ -82,9 +76,7 @@ def simulate_group() -> None:
     metavar="DB",
     help="Signal-to-noise ratio of every channel, dB ('inf' for no noise).",
 )
-@click.option(
-    "--seed", type=click.IntRange(min=0), default=0, show_default=True, help="Noise seed."
-)
+@seed_option("Noise seed.")
 @click.option(
     "--drive-points",
     "drive_points",
