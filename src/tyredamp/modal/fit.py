@@ -46,6 +46,7 @@ frequencies, damping ratios and mode-shape entries by the delta method.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -395,6 +396,90 @@ class ModalFitter:
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
         return self._result(th, m, ref, w, sol, sig_out, nit, status, warn)
 
+    def fit_added(
+        self,
+        poles: NDArray[np.complex128],
+        part: NDArray[np.complex128],
+        pole: complex,
+        part_new: NDArray[np.complex128],
+        *,
+        omega_bounds: tuple[float, float] | None = None,
+        max_nfev: int = 200,
+    ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
+        """Refine one added mode with the modes ``poles`` (m,) held fixed.
+
+        The basis of the fixed modes and of the residual terms is projected out
+        of the data once; the added pole and participation (``part_new``,
+        (n_in,)) are then refined by variable projection on the projected data
+        (same weighting as the first pass of :meth:`fit`), which costs a
+        two-column basis per evaluation instead of the whole one.
+        ``omega_bounds`` (rad/s, lower < upper) limits the damped natural
+        frequency ``Im p`` of the added mode.
+
+        Returns
+        -------
+        pole : complex
+            Refined pole of the added mode (rad/s).
+        participation : ndarray, complex, shape (n_in,)
+        sigma_out : ndarray, shape (n_out,)
+            Residual RMS per output of the model with all ``m + 1`` modes
+            (in the units of the data), as ``FitResult.sigma_out`` of a
+            one-pass fit.
+        """
+        m = int(poles.size)
+        part = np.asarray(part, complex).reshape(m, self.n_in)
+        p1 = np.array([pole], complex)
+        l1 = np.asarray(part_new, complex).reshape(1, self.n_in)
+        if self.kind == "real":
+            allp = np.concatenate([part, l1])
+            ph = np.exp(-1j * np.angle(allp[np.arange(m + 1), np.argmax(np.abs(allp), axis=1)]))
+            allp = (allp * ph[:, None]).real.astype(complex)
+            part, l1 = allp[:m], allp[m:]
+        ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+        ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
+        rms = np.sqrt(np.mean(self.Y**2, axis=0))
+        w = 1.0 / np.where(rms > 0, rms, 1.0)
+        if self.unit_weights:
+            w = np.ones_like(rms)
+        Yw = self.Y * w[None, :]
+        phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
+        Qf = np.linalg.qr(phi_f)[0]
+        Yp = Yw - Qf @ (Qf.T @ Yw)
+        # the added mode alone: same fitter without residual columns
+        one = copy.copy(self)
+        one.use_upper = one.use_lower = False
+        th0 = one.pack(p1, l1, ref1)
+
+        def solve(th: NDArray[np.float64]) -> dict[str, Any]:
+            phi, D, dpar, dcol = one.basis(th, 1, ref1)
+            phi = phi - Qf @ (Qf.T @ phi)
+            D = D - Qf @ (Qf.T @ D)
+            Q, Rq = np.linalg.qr(phi)
+            Ct = Q.T @ Yp
+            diag = np.abs(np.diag(Rq))
+            if diag.min() <= 1e-13 * diag.max():
+                C = np.linalg.lstsq(phi, Yp, rcond=None)[0]
+            else:
+                C = sla.solve_triangular(Rq, Ct)
+            resid = Yp - Q @ Ct
+            return {
+                "D": D,
+                "dpar": dpar,
+                "dcol": dcol,
+                "Q": Q,
+                "C": C,
+                "resid": resid,
+                "cost": float(np.sum(resid**2)),
+                "Z": resid @ C.T,
+            }
+
+        th = self._refine(th0, 1, ref1, Yp, max_nfev, solve=solve, omega_bounds=omega_bounds)[0]
+        sol = solve(th)
+        p_out, l_out = one.unpack(th, 1, ref1)
+        dof = self.n_rows - self.n_cols(m + 1)
+        res_ss = np.sum(sol["resid"] ** 2, axis=0) / w**2
+        return complex(p_out[0]), l_out[0], np.sqrt(res_ss / max(dof, 1))
+
     def _refine(
         self,
         th0: NDArray[np.float64],
@@ -402,6 +487,8 @@ class ModalFitter:
         ref: NDArray[np.intp],
         Yw: NDArray[np.float64],
         max_nfev: int,
+        solve: Any = None,
+        omega_bounds: tuple[float, float] | None = None,
     ) -> tuple[NDArray[np.float64], int, str]:
         n_par = th0.size
         cache: dict[str, Any] = {}
@@ -410,12 +497,16 @@ class ModalFitter:
         ub = np.full(n_par, np.inf)
         lb[0 : 2 * m : 2], ub[0 : 2 * m : 2] = np.log(1e-7), np.log(5.0)
         lb[1 : 2 * m : 2], ub[1 : 2 * m : 2] = 1e-6, 20.0
+        if omega_bounds is not None:
+            lb[1 : 2 * m : 2] = max(1e-6, omega_bounds[0] / self.w_ref)
+            ub[1 : 2 * m : 2] = min(20.0, omega_bounds[1] / self.w_ref)
         th0 = np.clip(th0, lb + 1e-9, ub - 1e-9)
 
         def evaluate(x: NDArray[np.float64]) -> dict[str, Any]:
             key = x.tobytes()
             if cache.get("key") != key:
-                sol = self._solve(x, m, ref, Yw, residual=False)
+                # a given ``solve`` (fit_added) replaces the projection
+                sol = self._solve(x, m, ref, Yw, residual=False) if solve is None else solve(x)
                 jtj, jtr = self._normal(sol, n_par)
                 scale = np.sqrt(np.maximum(np.diag(jtj), 1e-300))
                 jn = jtj / np.outer(scale, scale)
@@ -581,12 +672,14 @@ class ModalFitter:
         model_rec = hm / self.kappa[None, None, :]
         per = 2 if self.kind == "complex" else 1
         data_ss = float(np.sum(np.abs(self.H) ** 2))
-        contrib = np.zeros(m)
-        signif = np.zeros(m)
-        for n in range(m):
-            part_n = phi[:, per * n : per * (n + 1)] @ C[per * n : per * (n + 1)]
-            contrib[n] = np.sqrt(np.sum((part_n / w[None, :]) ** 2) / max(data_ss, 1e-300))
-            signif[n] = np.sum(part_n**2) / (s2 * (per * self.n_out + 2))
+        # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's
+        # columns: no (n_rows x n_out) array per mode
+        pb = phi[:, : per * m].reshape(self.n_rows, m, per)
+        gram = np.einsum("rna,rnb->nab", pb, pb, optimize=True)
+        cb = C[: per * m].reshape(m, per, self.n_out)
+        ss = np.einsum("nao,nab,nbo->no", cb, gram, cb, optimize=True)  # (m, n_out)
+        contrib = np.sqrt(np.sum(ss / w[None, :] ** 2, axis=1) / max(data_ss, 1e-300))
+        signif = np.sum(ss, axis=1) / (s2 * (per * self.n_out + 2))
         return FitResult(
             poles=poles,
             psi_out=psi_out,

@@ -402,11 +402,17 @@ def _search_helpers(
 
     A trial pole is started at ``1.1 f_hi`` (then ``1.3 f_hi``, ...) above the
     band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0``, with the median
-    damping of the in-band modes. It is kept when, after the refinement, it
-    lies outside the band but within a factor 2 of its edge, no in-band mode
-    left the band, and the residual sum of squares dropped significantly:
-    ``F = sum_j dof (s2_before,j - s2_after,j) / s2_after,j / n_added``
-    (per-output residual variances) reaches ``min_significance``.
+    damping of the in-band modes. Only the trial mode is refined, with every
+    other mode held fixed (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`:
+    their basis is projected out of the data once) and its damped frequency
+    kept outside the band but within a factor 2 of its edge. It is kept when
+    it did not stop at one of these limits and the residual sum of squares
+    dropped significantly: ``F = sum_j dof (s2_before,j - s2_after,j) /
+    s2_after,j / n_added`` (per-output residual variances) reaches
+    ``min_significance``; all modes are then refined together, and the search
+    stops instead if that moves the trial mode out of its range or an in-band
+    mode out of the band. A rejected trial thus costs one small fit, not a
+    joint refinement.
     """
     lo, hi = band
     m0 = len(poles) - n_free
@@ -423,6 +429,7 @@ def _search_helpers(
     )
     m = m0 + n_free
     cur_p, cur_l = res.poles, res.participation
+    sig_cur = res.sigma_out
     per = 2 if fitter.kind == "complex" else 1
     dof = fitter.n_rows
     zeta0 = float(np.clip(np.median(-cur_p.real / np.abs(cur_p)), 0.005, 0.1))
@@ -434,23 +441,37 @@ def _search_helpers(
                 break
             wh = 2 * np.pi * fh
             ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
-            lh = np.ones((1, fitter.n_in), complex)
+            lh = np.ones(fitter.n_in, complex)
+            try:
+                # only the trial mode moves (the others are projected out once),
+                # kept on its side of the band, within a factor 2 of the edge
+                edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
+                w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
+                p_t, l_t, sig_t = fitter.fit_added(cur_p, cur_l, ph, lh, omega_bounds=w_lim)
+            except (np.linalg.LinAlgError, ValueError):
+                break
+            fd = p_t.imag / (2 * np.pi)
+            # a trial pole stopped at a limit did not find a mode there
+            tol = 1e-4 * (edge[1] - edge[0])
+            outside = edge[0] + tol < fd < edge[1] - tol
+            s2a = np.maximum(sig_t**2, 1e-300)
+            n_added = per * fitter.n_out + 2 * fitter.n_in
+            fstat = float(np.sum(dof * (sig_cur**2 - s2a) / s2a)) / n_added
+            if not (outside and fstat >= min_significance):
+                break
+            # accepted: refine every mode together before the next trial
             try:
                 trial = fitter.fit(
-                    np.append(cur_p, ph), np.concatenate([cur_l, lh]), refine=True, passes=1
+                    np.append(cur_p, p_t), np.concatenate([cur_l, l_t[None, :]]), passes=1
                 )
             except (np.linalg.LinAlgError, ValueError):
                 break
             fd = trial.poles[-1].imag / (2 * np.pi)
             fin = trial.poles[: m - n_free].imag / (2 * np.pi)
             outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)
-            inside = bool(np.all((fin >= lo) & (fin <= hi)))
-            s2a = np.maximum(trial.sigma_out**2, 1e-300)
-            n_added = per * fitter.n_out + 2 * fitter.n_in
-            fstat = float(np.sum(dof * (res.sigma_out**2 - s2a) / s2a)) / n_added
-            if not (outside and inside and fstat >= min_significance):
+            if not (outside and np.all((fin >= lo) & (fin <= hi))):
                 break
-            res = trial
+            sig_cur = trial.sigma_out
             cur_p, cur_l = trial.poles, trial.participation
     return cur_p[:m], cur_l[:m], cur_p[m:], cur_l[m:], dropped, n_free
 

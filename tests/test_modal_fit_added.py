@@ -1,0 +1,55 @@
+"""One added mode refined with the others held fixed (ModalFitter.fit_added), and
+the per-mode contributions of ModalFitter.fit (spec eq. [10])."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.testing import assert_allclose
+
+from tyredamp.modal.fit import ModalFitter
+
+from .helpers import chain_system
+
+F = np.linspace(0.5, 40.0, 400)
+
+
+def test_fit_added_recovers_the_missing_mode_exactly() -> None:
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    h = sys_.frf(F, kind="accelerance", inputs=[0, 5]).H
+    fit = ModalFitter(F, h, 2, "complex", [(0, 0), (5, 1)], upper=False, lower=False)
+    part = cm.psi[[0, 5]].T  # true participation (m, n_in)
+    k = int(np.argsort(cm.poles.imag)[2])  # leave one mode out, give the others exactly
+    keep = np.delete(np.arange(cm.poles.size), k)
+    start = cm.poles[k] * (1.02 + 0.01j)
+    l0 = part[k] / part[k][np.argmax(np.abs(part[k]))] * 1.1
+    lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
+    p, lk, sig = fit.fit_added(cm.poles[keep], part[keep], start, l0, omega_bounds=(lo, hi))
+    # noise-free data, the full modal set at the optimum: exact to solver tolerance
+    assert_allclose(p, cm.poles[k], rtol=1e-8)
+    ratio = lk / part[k]
+    assert_allclose(ratio, ratio[0], rtol=1e-7)  # participation up to one complex scale
+    # the residual of the full model is round-off only
+    assert np.all(sig <= 1e-8 * np.sqrt(np.mean(np.abs(h) ** 2, axis=(1, 2))))
+
+
+def test_contributions_match_the_synthesised_mode_frfs() -> None:
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(3)
+    h = sys_.frf(F, kind="mobility", inputs=[2]).H
+    h = h + 1e-3 * np.sqrt(np.mean(np.abs(h) ** 2)) * (
+        rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)
+    )
+    fit = ModalFitter(F, h, 1, "complex", [(2, 0)])
+    res = fit.fit(cm.poles, cm.psi[[2]].T, refine=False)
+    # independent reference: each mode's FRF from its scaled shape (eq. [10])
+    s = 2j * np.pi * F
+    data_ss = np.sum(np.abs(h) ** 2)
+    for n, p in enumerate(res.poles):
+        r = res.psi_out[:, n, None] * res.psi_in[None, :, n]  # (n_out, n_in)
+        g = s / (s - p)
+        gb = s / (s - np.conj(p))
+        hn = r[:, :, None] * g + np.conj(r)[:, :, None] * gb
+        # same quantity by two routes: round-off only
+        assert_allclose(res.contribution[n], np.sqrt(np.sum(np.abs(hn) ** 2) / data_ss), rtol=1e-9)
