@@ -34,6 +34,7 @@ from .excitation import (
     burst_random,
     periodic_chirp,
     pseudo_random,
+    schroeder_multisine,
     swept_chirp,
 )
 from .windows import exponential_window, force_window, segment_window
@@ -63,6 +64,7 @@ __all__ = [
     "quality_check",
     "reciprocity_check",
     "resolve_channels",
+    "schroeder_multisine",
     "segment_window",
     "swept_chirp",
 ]

@@ -22,6 +22,7 @@ Signals
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,6 +40,7 @@ __all__ = [
     "burst_random",
     "periodic_chirp",
     "pseudo_random",
+    "schroeder_multisine",
     "swept_chirp",
 ]
 
@@ -193,17 +195,85 @@ def pseudo_random(
         Periodic; ``amplitude_spectrum()`` is ``rms * sqrt(2 / n_lines)`` on
         each band line and 0 elsewhere.
     """
-    fs = check_positive(sample_rate, "sample_rate")
-    p = _length(period_samples, "period_samples")
-    a = check_positive(rms, "rms")
-    npr = _length(n_periods, "n_periods", minimum=1)
-    lines = band_lines(fs, p, band)
     g = np.random.default_rng(rng)
+    return _multisine(
+        sample_rate,
+        period_samples,
+        band,
+        rms,
+        n_periods,
+        lambda k: 2.0 * np.pi * g.random(k),
+        "pseudo_random",
+    )
+
+
+def schroeder_multisine(
+    sample_rate: float,
+    period_samples: int,
+    band: tuple[float, float],
+    rms: float = 1.0,
+    n_periods: int = 1,
+) -> Excitation:
+    """Flat-spectrum multisine with Schroeder phases (a band-limited periodic chirp).
+
+    Equal amplitudes on every DFT line of one period in the band and phases
+    ``phi_j = -pi j (j + 1) / K`` (``j = 0..K-1``, ``K`` lines; Schroeder, IEEE
+    Trans. Inf. Theory 16(1), 1970): the instantaneous frequency sweeps the
+    band once per period, and the spectrum is exactly flat on the band and
+    zero elsewhere.
+
+    Parameters
+    ----------
+    sample_rate : float
+        Hz.
+    period_samples : int
+        Samples per period ``P`` (>= 4); line spacing ``sample_rate / P``.
+    band : (float, float)
+        Excited band in Hz: every DFT line inside it (DC and Nyquist
+        excluded, :func:`band_lines`).
+    rms : float
+        RMS in N, > 0.
+    n_periods : int
+        Periods in the returned signal (the same period repeated), >= 1.
+
+    Returns
+    -------
+    Excitation
+        ``name="schroeder_multisine"``, ``period_samples=P``. Generated at a
+        multiple ``r`` of a rate (``r P`` samples per period), ``x[::r]`` is
+        the same signal at the lower rate, sample for sample.
+    """
+
+    def phases(k: int) -> NDArray[np.float64]:
+        j = np.arange(k)
+        return -np.pi * j * (j + 1) / k
+
+    return _multisine(
+        sample_rate, period_samples, band, rms, n_periods, phases, "schroeder_multisine", 4
+    )
+
+
+def _multisine(
+    sample_rate: float,
+    period_samples: int,
+    band: tuple[float, float],
+    rms: float,
+    n_periods: int,
+    phases: Callable[[int], NDArray[np.float64]],
+    name: str,
+    min_period: int = 2,
+) -> Excitation:
+    """Equal amplitudes on the band lines with ``phases(n_lines)``, scaled to ``rms``."""
+    fs = check_positive(sample_rate, "sample_rate")
+    p = _length(period_samples, "period_samples", minimum=min_period)
+    npr = _length(n_periods, "n_periods", minimum=1)
+    a = check_positive(rms, "rms")
+    lines = band_lines(fs, p, band)
     spec = np.zeros(p // 2 + 1, dtype=complex)
-    spec[lines] = np.exp(2j * np.pi * g.random(lines.size))
+    spec[lines] = np.exp(1j * phases(lines.size))
     one = np.fft.irfft(spec, p)
     one *= a / np.sqrt(np.mean(one**2))
-    return Excitation(np.tile(one, npr), fs, _band(band, fs), "pseudo_random", period_samples=p)
+    return Excitation(np.tile(one, npr), fs, _band(band, fs), name, period_samples=p)
 
 
 def periodic_chirp(

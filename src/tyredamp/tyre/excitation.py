@@ -4,7 +4,8 @@ The default shaker signal of the rig is the periodic linear sweep of
 :func:`tyredamp.signal.periodic_chirp` (the chirp of paper 000). This module
 adds what the rig needs beyond it:
 
-* :func:`schroeder_multisine`: a band-limited "periodic chirp": equal
+* :func:`schroeder_multisine` (defined in :mod:`tyredamp.signal.excitation`,
+  re-exported here): a band-limited "periodic chirp": equal
   amplitudes on every DFT line of one period in the band and the phases
   ``phi_j = -pi j (j + 1) / K`` (``j = 0..K-1``, ``K`` lines; Schroeder, IEEE
   Trans. Inf. Theory 16(1), 1970). Its instantaneous frequency sweeps the band
@@ -21,68 +22,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .._validate import check_positive
 from ..exceptions import InputError
-from ..signal.excitation import Excitation, band_lines
+from ..signal.excitation import schroeder_multisine
 
 __all__ = ["hadamard_drive_matrix", "schroeder_multisine"]
-
-
-def schroeder_multisine(
-    sample_rate: float,
-    period_samples: int,
-    band: tuple[float, float],
-    rms: float = 1.0,
-    n_periods: int = 1,
-) -> Excitation:
-    """Flat-spectrum multisine with Schroeder phases (a band-limited periodic chirp).
-
-    Parameters
-    ----------
-    sample_rate : float
-        Hz.
-    period_samples : int
-        Samples per period ``P``; line spacing ``sample_rate / P``.
-    band : (float, float)
-        Excited band in Hz: every DFT line inside it (DC and Nyquist
-        excluded, :func:`tyredamp.signal.band_lines`).
-    rms : float
-        RMS in N, > 0.
-    n_periods : int
-        Periods in the returned signal (the same period repeated), >= 1.
-
-    Returns
-    -------
-    Excitation
-        ``name="schroeder_multisine"``, ``period_samples=P``. Generated at a
-        multiple ``r`` of a rate (``r P`` samples per period), ``x[::r]`` is
-        the same signal at the lower rate, sample for sample.
-    """
-    fs = check_positive(sample_rate, "sample_rate")
-    if (
-        isinstance(period_samples, bool)
-        or not isinstance(period_samples, int | np.integer)
-        or period_samples < 4
-    ):
-        raise InputError(f"period_samples: expected an integer >= 4, got {period_samples!r}")
-    if isinstance(n_periods, bool) or not isinstance(n_periods, int | np.integer) or n_periods < 1:
-        raise InputError(f"n_periods: expected an integer >= 1, got {n_periods!r}")
-    a = check_positive(rms, "rms")
-    p = int(period_samples)
-    lines = band_lines(fs, p, band)
-    k = lines.size
-    j = np.arange(k)
-    spec = np.zeros(p // 2 + 1, dtype=complex)
-    spec[lines] = np.exp(-1j * np.pi * j * (j + 1) / k)
-    one = np.fft.irfft(spec, n=p)
-    one *= a / np.sqrt(np.mean(one**2))
-    return Excitation(
-        np.tile(one, int(n_periods)),
-        fs,
-        (float(band[0]), float(band[1])),
-        "schroeder_multisine",
-        period_samples=p,
-    )
 
 
 def hadamard_drive_matrix(n_inputs: int) -> NDArray[np.float64]:
