@@ -139,6 +139,15 @@ def _ratio(num: NDArray[np.float64], den: NDArray[np.float64]) -> NDArray[np.flo
 
 
 # -------------------------------------------------------------- linearity
+def _relative_rms(
+    diff_pow: NDArray[np.float64], ref_pow: NDArray[np.float64]
+) -> tuple[float, NDArray[np.float64]]:
+    """Overall ``sqrt(sum d / sum ref)`` (inf for zero reference) and per line ``sqrt(d / ref)``."""
+    total = ref_pow.sum()
+    overall = float(np.sqrt(diff_pow.sum() / total)) if total > 0 else np.inf
+    return overall, np.sqrt(_ratio(diff_pow, ref_pow))
+
+
 def linearity_check(
     frfs: Sequence[FRF], threshold: float = 0.05, band: tuple[float, float] | None = None
 ) -> CheckResult:
@@ -189,8 +198,9 @@ def linearity_check(
     lines = []
     for g in others:
         d = np.sum(np.abs(g.H - h0) ** 2, axis=(0, 1))
-        per_level.append(float(np.sqrt(d.sum() / ref_pow.sum())) if ref_pow.sum() > 0 else np.inf)
-        lines.append(np.sqrt(_ratio(d, ref_pow)))
+        overall_g, line_g = _relative_rms(d, ref_pow)
+        per_level.append(overall_g)
+        lines.append(line_g)
     per_line = np.max(np.array(lines), axis=0)
     overall = max(per_level)
     iw = int(np.argmax(per_line))
@@ -291,8 +301,9 @@ def reciprocity_check(
         h2 = _sign(g.outputs[j]) * _sign(g.inputs[b]) * g.H[j, b]
         d = np.abs(h1 - h2) ** 2
         m = 0.5 * (np.abs(h1) ** 2 + np.abs(h2) ** 2)
-        per_pair.append(float(np.sqrt(d.sum() / m.sum())) if m.sum() > 0 else np.inf)
-        lines.append(np.sqrt(_ratio(d, m)))
+        overall_p, line_p = _relative_rms(d, m)
+        per_pair.append(overall_p)
+        lines.append(line_p)
         labels.append(
             f"{g.outputs[i].label}/{g.inputs[a].label} vs {g.outputs[j].label}/{g.inputs[b].label}"
         )
