@@ -53,7 +53,6 @@ from typing import Any, Literal
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
-from scipy.optimize import least_squares
 
 from ..exceptions import InputError
 
@@ -297,9 +296,10 @@ class ModalFitter:
         residual: bool = True,
     ) -> dict[str, Any]:
         """Projection at ``th``. With ``residual=False`` the residual matrix is not
-        formed (two products with the data instead of three): ``cost`` comes from
-        ``||Y||^2 - ||Q^T Y||^2`` unless that loses accuracy (fit error below
-        0.1 %), and ``Z = r C^T = Y C^T - Q (Q^T Y) C^T`` is returned instead."""
+        formed (two products with the data instead of three): ``cost`` and the
+        per-output ``cost_out`` come from ``||Y||^2 - ||Q^T Y||^2`` unless that
+        loses accuracy (an output fitted better than 0.1 %), and
+        ``Z = r C^T = Y C^T - Q (Q^T Y) C^T`` is returned instead."""
         phi, D, dpar, dcol = self.basis(th, m, ref)
         Q, Rq = np.linalg.qr(phi)
         Ct = Q.T @ Yw
@@ -309,11 +309,13 @@ class ModalFitter:
         else:
             C = sla.solve_triangular(Rq, Ct)
         resid = None
-        ynorm = float(np.sum(Yw**2)) if residual is False else 0.0
-        cost = ynorm - float(np.sum(Ct**2))
-        if residual or cost < 1e-6 * ynorm:
+        ct2 = np.sum(Ct**2, axis=0)
+        cost_out = np.sum(Yw**2, axis=0) - ct2
+        cost = float(np.sum(cost_out))
+        if residual or np.any(cost_out < 1e-6 * ct2):
             resid = Yw - Q @ Ct
-            cost = float(np.sum(resid**2))
+            cost_out = np.sum(resid**2, axis=0)
+            cost = float(np.sum(cost_out))
             Z = resid @ C.T
         else:
             Z = Yw @ C.T - Q @ (Ct @ C.T)
@@ -327,6 +329,7 @@ class ModalFitter:
             "C": C,
             "resid": resid,
             "cost": cost,
+            "cost_out": cost_out,
             "Z": Z,
         }
 
@@ -356,13 +359,20 @@ class ModalFitter:
         refine: bool = True,
         max_nfev: int = 200,
         passes: int = 2,
+        sigma: NDArray[np.float64] | None = None,
+        tol: float = 1e-6,
+        uncertainty: bool = True,
     ) -> FitResult:
         """Fit from initial poles (m,) and participation (m, n_in).
 
         With ``refine=False`` only the linear residues are fitted (LSFD with
         fixed poles); otherwise poles, participation and residues together.
-        Pass 1 weights each output by ``1 / RMS``; later passes by
+        Pass 1 weights each output by ``1 / RMS`` (or by ``1 / sigma`` when
+        the noise RMS per output ``sigma`` (n_out,) is given); later passes by
         ``1 / sigma_j`` with ``sigma_j`` the residual RMS of the previous pass.
+        ``tol`` is the convergence threshold of the refinement in units of the
+        residual variance (:func:`_levenberg_marquardt`); ``uncertainty=False``
+        skips the standard errors (left at NaN), for intermediate fits.
         """
         m = int(poles.size)
         part = np.asarray(part, complex).reshape(m, self.n_in)
@@ -372,10 +382,13 @@ class ModalFitter:
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         th = self.pack(np.asarray(poles, complex), part, ref)
         rms = np.sqrt(np.mean(self.Y**2, axis=0))
+        floor = 1e-9 * rms
         w = 1.0 / np.where(rms > 0, rms, 1.0)
         if self.unit_weights:
             rms = np.ones_like(rms)
             w = np.ones_like(rms)
+        elif sigma is not None:
+            w = 1.0 / np.maximum(np.asarray(sigma, float), np.maximum(floor, 1e-300))
         q = self.n_cols(m)
         dof = self.n_rows - q
         status = "lsfd"
@@ -384,17 +397,16 @@ class ModalFitter:
         for ip in range(max(1, passes if refine else 1)):
             Yw = self.Y * w[None, :]
             if refine:
-                th, nfev, status = self._refine(th, m, ref, Yw, max_nfev)
+                th, nfev, status, sol = self._refine(th, m, ref, Yw, max_nfev, tol=tol)
                 nit += nfev
-            sol = self._solve(th, m, ref, Yw)
-            res_ss = np.sum(sol["resid"] ** 2, axis=0) / w**2
-            sig_out = np.sqrt(res_ss / max(dof, 1))
+            else:
+                sol = self._solve(th, m, ref, Yw, residual=False)
+            sig_out = np.sqrt(sol["cost_out"] / w**2 / max(dof, 1))
             if ip + 1 < passes and refine and not self.unit_weights:
-                floor = 1e-9 * rms
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
-        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn)
+        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
 
     def fit_added(
         self,
@@ -405,6 +417,7 @@ class ModalFitter:
         *,
         omega_bounds: tuple[float, float] | None = None,
         max_nfev: int = 200,
+        tol: float = 1e-6,
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
@@ -414,7 +427,7 @@ class ModalFitter:
         (same weighting as the first pass of :meth:`fit`), which costs a
         two-column basis per evaluation instead of the whole one.
         ``omega_bounds`` (rad/s, lower < upper) limits the damped natural
-        frequency ``Im p`` of the added mode.
+        frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
 
         Returns
         -------
@@ -473,8 +486,9 @@ class ModalFitter:
                 "Z": resid @ C.T,
             }
 
-        th = self._refine(th0, 1, ref1, Yp, max_nfev, solve=solve, omega_bounds=omega_bounds)[0]
-        sol = solve(th)
+        th, _, _, sol = self._refine(
+            th0, 1, ref1, Yp, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
+        )
         p_out, l_out = one.unpack(th, 1, ref1)
         dof = self.n_rows - self.n_cols(m + 1)
         res_ss = np.sum(sol["resid"] ** 2, axis=0) / w**2
@@ -489,9 +503,9 @@ class ModalFitter:
         max_nfev: int,
         solve: Any = None,
         omega_bounds: tuple[float, float] | None = None,
-    ) -> tuple[NDArray[np.float64], int, str]:
+        tol: float = 1e-6,
+    ) -> tuple[NDArray[np.float64], int, str, dict[str, Any]]:
         n_par = th0.size
-        cache: dict[str, Any] = {}
         # bounds keep every pole finite: sigma in [1e-7, 5] w_ref, Omega in (0, 20] w_ref
         lb = np.full(n_par, -np.inf)
         ub = np.full(n_par, np.inf)
@@ -502,51 +516,26 @@ class ModalFitter:
             ub[1 : 2 * m : 2] = min(20.0, omega_bounds[1] / self.w_ref)
         th0 = np.clip(th0, lb + 1e-9, ub - 1e-9)
 
-        def evaluate(x: NDArray[np.float64]) -> dict[str, Any]:
-            key = x.tobytes()
-            if cache.get("key") != key:
-                # a given ``solve`` (fit_added) replaces the projection
-                sol = self._solve(x, m, ref, Yw, residual=False) if solve is None else solve(x)
-                jtj, jtr = self._normal(sol, n_par)
-                scale = np.sqrt(np.maximum(np.diag(jtj), 1e-300))
-                jn = jtj / np.outer(scale, scale)
-                ev, vec = np.linalg.eigh(0.5 * (jn + jn.T))
-                ev = np.maximum(ev, 1e-12 * max(float(ev[-1]), 1e-300))
-                # rc^T rc = jtj (eigenvalues floored): a square root of the normal equations
-                rc = (np.sqrt(ev)[:, None] * vec.T) * scale[None, :]
-                u = (vec.T @ (jtr / scale)) / np.sqrt(ev)
-                rest = np.sqrt(max(sol["cost"] - float(u @ u), 0.0))
-                cache.update(key=key, r=np.append(u, rest), J=np.vstack([rc, np.zeros(n_par)]))
-            return cache
+        n_lin = self.n_cols(m) if solve is None else 2
+        n_obs = Yw.size
+
+        def evaluate(x: NDArray[np.float64]) -> tuple[float, Any, Any, dict[str, Any]]:
+            # a given ``solve`` (fit_added) replaces the projection
+            sol = self._solve(x, m, ref, Yw, residual=False) if solve is None else solve(x)
+            jtj, jtr = self._normal(sol, n_par)
+            return float(sol["cost"]), jtj, jtr, sol
 
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            res = self._least_squares(evaluate, th0, lb, ub, max_nfev)
-        status = "maxfev" if res.status == 0 else "converged"
-        return np.asarray(res.x), int(res.nfev), status
-
-    @staticmethod
-    def _least_squares(
-        evaluate: Any,
-        th0: NDArray[np.float64],
-        lb: NDArray[np.float64],
-        ub: NDArray[np.float64],
-        max_nfev: int,
-    ) -> Any:
-        # trust-region reflective on the square root of the normal equations; the
-        # errstate above silences overflow in scipy's trust-region sub-solver on
-        # wild trial steps (they are rejected by the step control)
-        return least_squares(
-            lambda x: evaluate(x)["r"],
-            th0,
-            jac=lambda x: evaluate(x)["J"],
-            bounds=(lb, ub),
-            method="trf",
-            x_scale="jac",
-            ftol=1e-10,
-            xtol=1e-10,
-            gtol=1e-10,
-            max_nfev=max_nfev,
-        )
+            x, nfev, ok, sol = _levenberg_marquardt(
+                evaluate,
+                th0,
+                lb,
+                ub,
+                max_nfev,
+                dof=max(n_obs - n_lin * Yw.shape[1] - n_par, 1),
+                tol=tol,
+            )
+        return x, nfev, "converged" if ok else "maxfev", sol
 
     # --------------------------------------------------------- results
     def _scale(
@@ -598,6 +587,7 @@ class ModalFitter:
         nit: int,
         status: str,
         warn: list[str],
+        uncertainty: bool = True,
     ) -> FitResult:
         n_par = th.size
         C = sol["C"]
@@ -643,26 +633,30 @@ class ModalFitter:
         n_obs = self.n_rows * self.n_out
         dof = max(n_obs - q * self.n_out - n_par, 1)
         s2 = sol["cost"] / dof
-        jtj, _ = self._normal(sol, n_par)
-        cth = s2 * np.linalg.pinv(jtj, hermitian=True)
-        x1 = th[0 : 2 * m : 2]
-        sig = self.w_ref * np.exp(x1)
-        om = poles.imag
-        mag = np.abs(poles)
-        jf = np.zeros((m, n_par))
-        jz = np.zeros((m, n_par))
-        ar = np.arange(m)
-        jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
-        jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
-        jz[ar, 2 * ar] = (om**2 / mag**3) * sig
-        jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
-        std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
-        std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
-        std_pole = (
-            np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
-            + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
-        )
-        std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
+        nan = np.full(m, np.nan)
+        std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
+        std_psi = np.full((self.n_out, m), np.nan)
+        if uncertainty:
+            jtj, _ = self._normal(sol, n_par)
+            cth = s2 * np.linalg.pinv(jtj, hermitian=True)
+            x1 = th[0 : 2 * m : 2]
+            sig = self.w_ref * np.exp(x1)
+            om = poles.imag
+            mag = np.abs(poles)
+            jf = np.zeros((m, n_par))
+            jz = np.zeros((m, n_par))
+            ar = np.arange(m)
+            jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
+            jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
+            jz[ar, 2 * ar] = (om**2 / mag**3) * sig
+            jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
+            std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
+            std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
+            std_pole = (
+                np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
+                + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
+            )
+            std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
         # ---- model, contributions
         phi = sol["phi"]
         model_w = phi @ C
@@ -782,6 +776,95 @@ class ModalFitter:
         cross = np.einsum("jng,gn->jn", rows, beta)
         term2 = 2 * np.real(np.conj(b)[None, :] / w[:, None] * u * cross)
         return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))
+
+
+def _levenberg_marquardt(
+    evaluate: Any,
+    x0: NDArray[np.float64],
+    lb: NDArray[np.float64],
+    ub: NDArray[np.float64],
+    max_nfev: int,
+    dof: int,
+    tol: float = 1e-6,
+) -> tuple[NDArray[np.float64], int, bool, Any]:
+    """Bounded Levenberg-Marquardt on the normal equations of a least-squares cost.
+
+    ``evaluate(x)`` returns the cost ``||r||^2``, ``J^T J``, ``J^T r`` (the
+    variable-projection quantities of :meth:`ModalFitter._normal`; the
+    residual itself is never formed) and any by-product, returned for the
+    final point. Steps solve ``(J^T J + lam diag(J^T J))
+    d = -J^T r`` over the free parameters; a parameter at a bound whose
+    gradient points outwards is held there (projected step). The damping
+    ``lam`` follows Nielsen's rule (gain ratio ``rho``: ``lam *= max(1/3,
+    1 - (2 rho - 1)^3)`` on success, doubled growth on failure).
+
+    Convergence is statistical: the iteration stops when the Gauss-Newton
+    decrement ``(J^T r)^T (J^T J)^-1 J^T r`` (the predicted cost reduction of
+    a full Gauss-Newton step) is below ``tol s^2`` with ``s^2 = cost / dof`` the residual
+    variance -- with the default ``tol = 1e-6`` the remaining step is about
+    1e-3 standard deviations of the parameters, far below their uncertainty --
+    or below ``1e-24`` times the starting cost (noise-free data), or when no
+    step reduces the cost any more (round-off).
+
+    Returns the parameters, the number of evaluations, whether it converged
+    and the by-product of ``evaluate`` at the returned parameters.
+    """
+    x = np.clip(np.asarray(x0, float), lb, ub)
+    cost, A, g, aux = evaluate(x)
+    cost0 = max(cost, 1e-300)
+    nfev = 1
+    lam = 1e-3
+    nu = 2.0
+    n = x.size
+    while nfev < max_nfev:
+        if not np.isfinite(cost):
+            return x, nfev, False, aux
+        diag = np.diag(A)
+        d_a = np.sqrt(np.maximum(diag, 1e-300))
+        # held: at a bound with the descent direction -g pointing outwards, or
+        # without information (e.g. the damping of a residual mode far outside
+        # the band: its column of J vanishes)
+        held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
+        held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
+        free = np.flatnonzero(~held)
+        if free.size == 0:
+            return x, nfev, True, aux
+        An = A[np.ix_(free, free)] / np.outer(d_a[free], d_a[free])
+        gn = g[free] / d_a[free]
+        # Gauss-Newton decrement at this point (convergence test)
+        try:
+            gn_step = np.linalg.solve(An + 1e-12 * np.eye(free.size), -gn)
+        except np.linalg.LinAlgError:
+            gn_step = -gn
+        decrement = float(-gn @ gn_step)
+        if decrement <= max(tol * cost / dof, 1e-24 * cost0):
+            return x, nfev, True, aux
+        try:
+            step_n = np.linalg.solve(An + lam * np.eye(free.size), -gn)
+        except np.linalg.LinAlgError:
+            lam *= nu
+            nu *= 2
+            continue
+        d = np.zeros(n)
+        d[free] = step_n / d_a[free]
+        x_new = np.clip(x + d, lb, ub)
+        d = x_new - x
+        if np.all(np.abs(d) <= 1e-15 * (1.0 + np.abs(x))):
+            return x, nfev, True, aux
+        pred = -(2.0 * float(g @ d) + float(d @ A @ d))  # predicted cost reduction
+        c_new, A_new, g_new, aux_new = evaluate(x_new)
+        nfev += 1
+        rho = (cost - c_new) / pred if pred > 0 else -1.0
+        if np.isfinite(c_new) and c_new < cost and rho > 1e-4:
+            x, cost, A, g, aux = x_new, c_new, A_new, g_new, aux_new
+            lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+            nu = 2.0
+        else:
+            lam *= nu
+            nu *= 2.0
+            if lam > 1e12:  # no descent left at round-off level
+                return x, nfev, True, aux
+    return x, nfev, False, aux
 
 
 def compress_outputs(H: NDArray[np.complex128], rank: int, seed: int = 0) -> NDArray[np.complex128]:

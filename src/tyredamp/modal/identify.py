@@ -42,6 +42,10 @@ __all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
 
 ModelChoice = Literal["real", "complex", "both"]
 _POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
+#: convergence threshold of the intermediate fits (search, rejection), in units of
+#: the residual variance: their poles are within about 0.1 standard deviation of
+#: their optimum, and the final fit converges from there to 1e-6
+_SEARCH_TOL = 1.0
 
 
 @dataclass(frozen=True)
@@ -250,8 +254,9 @@ def identify_modes(
     hp = np.array([c.pole for c in extra], dtype=complex)
     hl = np.array([c.participation for c in extra], dtype=complex).reshape(len(extra), n_in)
     n_extra = len(extra)
+    last: FitResult | None = None  # latest search fit of all current modes, on sfit
     if refine and max_helpers > 0:
-        poles, part, hp2, hl2, dropped0, n_extra = _search_helpers(
+        poles, part, hp2, hl2, dropped0, n_extra, last = _search_helpers(
             sfit,
             np.concatenate([poles, hp]),
             np.concatenate([part, hl]),
@@ -268,9 +273,16 @@ def identify_modes(
         poles, part = poles[:m0], part[:m0]
     if auto:
         for _ in range(len(poles)):
-            res = sfit.fit(
-                np.concatenate([poles, hp]), np.concatenate([part, hl]), refine=refine, passes=1
-            )
+            if last is None:
+                last = sfit.fit(
+                    np.concatenate([poles, hp]),
+                    np.concatenate([part, hl]),
+                    refine=refine,
+                    passes=1,
+                    tol=_SEARCH_TOL,
+                    uncertainty=False,
+                )
+            res = last
             m = len(poles)
             con, sig = res.contribution[:m], res.significance[:m]
             bad = (con < min_contribution) | (sig < min_significance)
@@ -287,6 +299,20 @@ def identify_modes(
             rejected.append(_rej(poles[worst], why))
             poles = np.delete(poles, worst)
             part = np.delete(part, worst, axis=0)
+            last = None
+    # noise level per output for the final fit's weights (its second pass in
+    # the 2-pass scheme of ModalFitter.fit): from the latest search fit when
+    # it ran on every output, else from a linear fit at the current poles
+    sigma0 = None
+    if refine and last is not None and sfit is cfit:
+        sigma0 = last.sigma_out
+    elif refine:
+        sigma0 = cfit.fit(
+            np.concatenate([poles, hp]),
+            np.concatenate([part, hl]),
+            refine=False,
+            uncertainty=False,
+        ).sigma_out
     # ---- step 4: each model
     kinds = ["complex", "real"] if model == "both" else [model]
     models: dict[str, ModalModel] = {}
@@ -295,7 +321,16 @@ def identify_modes(
     for kind in kinds:
         if kind == "complex":
             res, n_band, dropped, nf = _fit_checked(
-                cfit, poles, part, hp, hl, refine, (lo, hi), n_free=n_extra
+                cfit,
+                poles,
+                part,
+                hp,
+                hl,
+                refine,
+                (lo, hi),
+                n_free=n_extra,
+                passes=1 if sigma0 is not None else 2,
+                sigma=sigma0,
             )
             rejected += [_rej(p, f"complex fit: {why}") for p, why in dropped]
             base = (res, n_band, nf)
@@ -397,6 +432,7 @@ def _search_helpers(
     NDArray[np.complex128],
     list[tuple[complex, str]],
     int,
+    FitResult,
 ]:
     """Refine, then add out-of-band residual modes while they are significant.
 
@@ -412,7 +448,9 @@ def _search_helpers(
     ``min_significance``; all modes are then refined together, and the search
     stops instead if that moves the trial mode out of its range or an in-band
     mode out of the band. A rejected trial thus costs one small fit, not a
-    joint refinement.
+    joint refinement. The fits of the search converge to ``_SEARCH_TOL``
+    residual variances (they only choose modes and start the final fit) and
+    skip the standard errors; the last accepted joint fit is returned too.
     """
     lo, hi = band
     m0 = len(poles) - n_free
@@ -426,6 +464,8 @@ def _search_helpers(
         band,
         n_free=n_free,
         passes=1,
+        tol=_SEARCH_TOL,
+        uncertainty=False,
     )
     m = m0 + n_free
     cur_p, cur_l = res.poles, res.participation
@@ -447,7 +487,9 @@ def _search_helpers(
                 # kept on its side of the band, within a factor 2 of the edge
                 edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
                 w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
-                p_t, l_t, sig_t = fitter.fit_added(cur_p, cur_l, ph, lh, omega_bounds=w_lim)
+                p_t, l_t, sig_t = fitter.fit_added(
+                    cur_p, cur_l, ph, lh, omega_bounds=w_lim, tol=_SEARCH_TOL
+                )
             except (np.linalg.LinAlgError, ValueError):
                 break
             fd = p_t.imag / (2 * np.pi)
@@ -462,7 +504,11 @@ def _search_helpers(
             # accepted: refine every mode together before the next trial
             try:
                 trial = fitter.fit(
-                    np.append(cur_p, p_t), np.concatenate([cur_l, l_t[None, :]]), passes=1
+                    np.append(cur_p, p_t),
+                    np.concatenate([cur_l, l_t[None, :]]),
+                    passes=1,
+                    tol=_SEARCH_TOL,
+                    uncertainty=False,
                 )
             except (np.linalg.LinAlgError, ValueError):
                 break
@@ -473,7 +519,8 @@ def _search_helpers(
                 break
             sig_cur = trial.sigma_out
             cur_p, cur_l = trial.poles, trial.participation
-    return cur_p[:m], cur_l[:m], cur_p[m:], cur_l[m:], dropped, n_free
+            res = trial
+    return cur_p[:m], cur_l[:m], cur_p[m:], cur_l[m:], dropped, n_free, res
 
 
 def _problem(res: FitResult, m: int, n_free: int, band: tuple[float, float]) -> str:
@@ -564,11 +611,15 @@ def _fit_checked(
     band: tuple[float, float],
     n_free: int = 0,
     passes: int = 2,
+    sigma: NDArray[np.float64] | None = None,
+    tol: float = 1e-6,
+    uncertainty: bool = True,
 ) -> tuple[FitResult, int, list[tuple[complex, str]], int]:
     """Fit modes and residual modes; drop any that left its side of the band or merged.
 
     Returns the fit, the number of in-band modes, the dropped modes and the
-    number of in-band residual modes left.
+    number of in-band residual modes left. ``passes``, ``sigma``, ``tol`` and
+    ``uncertainty`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`.
 
     ``hp`` holds first ``n_free`` in-band residual modes (not checked against
     the band), then out-of-band ones (which must stay outside).
@@ -577,7 +628,13 @@ def _fit_checked(
     for _ in range(len(poles) + len(hp) + 1):
         m = len(poles)
         res = fitter.fit(
-            np.concatenate([poles, hp]), np.concatenate([part, hl]), refine=refine, passes=passes
+            np.concatenate([poles, hp]),
+            np.concatenate([part, hl]),
+            refine=refine,
+            passes=passes,
+            sigma=sigma,
+            tol=tol,
+            uncertainty=uncertainty,
         )
         p = res.poles
         fd = p.imag / (2 * np.pi)
