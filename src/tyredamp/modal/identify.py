@@ -42,10 +42,14 @@ __all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
 
 ModelChoice = Literal["real", "complex", "both"]
 _POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
-#: convergence threshold of the intermediate fits (search, rejection), in units of
-#: the residual variance: their poles are within about 0.1 standard deviation of
-#: their optimum, and the final fit converges from there to 1e-6
-_SEARCH_TOL = 1.0
+#: convergence thresholds of the intermediate fits, in units of the residual
+#: variance s^2 (ModalFitter.fit ``tol``): the joint fits of the search and of the
+#: rejection stop when a further step would lower the cost by less than 10 s^2, a
+#: trial residual mode by less than 1 s^2. They only choose the modes (the F test
+#: of a trial has 2 n_out + 2 n_in parameters, so 10 s^2 moves F by < 10 / 34 on
+#: the smallest data set) and start the final fit, which converges to 1e-6 s^2.
+_SEARCH_TOL = 10.0
+_TRIAL_TOL = 1.0
 
 
 @dataclass(frozen=True)
@@ -488,7 +492,7 @@ def _search_helpers(
                 edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
                 w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
                 p_t, l_t, sig_t = fitter.fit_added(
-                    cur_p, cur_l, ph, lh, omega_bounds=w_lim, tol=_SEARCH_TOL
+                    cur_p, cur_l, ph, lh, omega_bounds=w_lim, tol=_TRIAL_TOL
                 )
             except (np.linalg.LinAlgError, ValueError):
                 break
