@@ -145,6 +145,7 @@ class ModalFitter:
         hc = H.transpose(1, 2, 0).reshape(self.n_in * self.n_f, self.n_out)
         self.Y = np.concatenate([hc.real, hc.imag], axis=0)
         self.n_rows = self.Y.shape[0]
+        self.data_ss = float(np.sum(self.Y**2))
 
     # ------------------------------------------------------------ layout
     def n_cols(self, m: int) -> int:
@@ -361,12 +362,16 @@ class ModalFitter:
         ref: NDArray[np.intp],
         Yw: NDArray[np.float64],
         residual: bool = True,
+        gradient: bool = True,
+        yy: NDArray[np.float64] | None = None,
     ) -> dict[str, Any]:
         """Projection at ``th``. With ``residual=False`` the residual matrix is not
         formed (two products with the data instead of three): ``cost`` and the
         per-output ``cost_out`` come from ``||Y||^2 - ||Q^T Y||^2`` unless that
         loses accuracy (an output fitted better than 0.1 %), and
-        ``Z = r C^T = Y C^T - Q (Q^T Y) C^T`` is returned instead."""
+        ``Z = r C^T = Y C^T - Q (Q^T Y) C^T`` is returned instead (``None`` with
+        ``gradient=False``: a fit without refinement needs no gradient). ``yy``:
+        the column sums of ``Yw**2``, when already known."""
         phi, D, dpar, dcol = self.basis(th, m, ref)
         Q, Rq = _orth(phi)
         Ct = Q.T @ Yw
@@ -377,14 +382,16 @@ class ModalFitter:
             C = sla.solve_triangular(Rq, Ct)
         resid = None
         ct2 = np.sum(Ct**2, axis=0)
-        cost_out = np.sum(Yw**2, axis=0) - ct2
+        cost_out = (np.einsum("ij,ij->j", Yw, Yw) if yy is None else yy) - ct2
         cost = float(np.sum(cost_out))
+        Z = None
         if residual or np.any(cost_out < 1e-6 * ct2):
             resid = Yw - Q @ Ct
-            cost_out = np.sum(resid**2, axis=0)
+            cost_out = np.einsum("ij,ij->j", resid, resid)
             cost = float(np.sum(cost_out))
-            Z = resid @ C.T
-        else:
+            if gradient:
+                Z = resid @ C.T
+        elif gradient:
             Z = Yw @ C.T - Q @ (Ct @ C.T)
         return {
             "phi": phi,
@@ -414,6 +421,8 @@ class ModalFitter:
         A[np.arange(dpar.size), dpar] = 1.0
         jtj = A.T @ Md @ A
         Z = sol["Z"]  # r C^T, (n_rows, q)
+        if Z is None:
+            return 0.5 * (jtj + jtj.T), np.zeros(n_par)
         gd = np.einsum("id,id->d", D, Z[:, dcol])
         jtr = -(A.T @ gd)
         return 0.5 * (jtj + jtj.T), jtr
@@ -467,7 +476,7 @@ class ModalFitter:
                 th, nfev, status, sol = self._refine(th, m, ref, Yw, max_nfev, tol=tol)
                 nit += nfev
             else:
-                sol = self._solve(th, m, ref, Yw, residual=False)
+                sol = self._solve(th, m, ref, Yw, residual=False, gradient=False)
             sig_out = np.sqrt(sol["cost_out"] / w**2 / max(dof, 1))
             if ip + 1 < passes and refine and not self.unit_weights:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
@@ -525,6 +534,7 @@ class ModalFitter:
         phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
         Qf = _orth(phi_f)[0]
         Yp = Yw - Qf @ (Qf.T @ Yw)
+        yyp = np.einsum("ij,ij->j", Yp, Yp)
         # the added mode alone: same fitter without residual columns
         one = copy.copy(self)
         one.use_upper = one.use_lower = False
@@ -541,16 +551,22 @@ class ModalFitter:
                 C = np.linalg.lstsq(phi, Yp, rcond=None)[0]
             else:
                 C = sla.solve_triangular(Rq, Ct)
-            resid = Yp - Q @ Ct
+            cost_out = yyp - np.einsum("ij,ij->j", Ct, Ct)
+            if np.any(cost_out < 1e-6 * yyp):  # cancellation: form the residual
+                resid = Yp - Q @ Ct
+                cost_out = np.einsum("ij,ij->j", resid, resid)
+                Z = resid @ C.T
+            else:
+                Z = Yp @ C.T - Q @ (Ct @ C.T)
             return {
                 "D": D,
                 "dpar": dpar,
                 "dcol": dcol,
                 "Q": Q,
                 "C": C,
-                "resid": resid,
-                "cost": float(np.sum(resid**2)),
-                "Z": resid @ C.T,
+                "cost": float(np.sum(cost_out)),
+                "cost_out": cost_out,
+                "Z": Z,
             }
 
         th, _, _, sol = self._refine(
@@ -558,7 +574,7 @@ class ModalFitter:
         )
         p_out, l_out = one.unpack(th, 1, ref1)
         dof = self.n_rows - self.n_cols(m + 1)
-        res_ss = np.sum(sol["resid"] ** 2, axis=0) / w**2
+        res_ss = np.maximum(sol["cost_out"], 0.0) / w**2
         return complex(p_out[0]), l_out[0], np.sqrt(res_ss / max(dof, 1))
 
     def _refine(
@@ -586,9 +602,11 @@ class ModalFitter:
         n_lin = self.n_cols(m) if solve is None else 2
         n_obs = Yw.size
 
+        yy = np.einsum("ij,ij->j", Yw, Yw)
+
         def evaluate(x: NDArray[np.float64]) -> tuple[float, Any, Any, dict[str, Any]]:
             # a given ``solve`` (fit_added) replaces the projection
-            sol = self._solve(x, m, ref, Yw, residual=False) if solve is None else solve(x)
+            sol = self._solve(x, m, ref, Yw, residual=False, yy=yy) if solve is None else solve(x)
             jtj, jtr = self._normal(sol, n_par)
             return float(sol["cost"]), jtj, jtr, sol
 
@@ -724,15 +742,16 @@ class ModalFitter:
                 + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
             )
             std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
-        # ---- model, contributions
+        # ---- model (final fits only), contributions
         phi = sol["phi"]
-        model_w = phi @ C
-        hw = model_w / w[None, :]
-        nc = self.n_in * self.n_f
-        hm = (hw[:nc] + 1j * hw[nc:]).reshape(self.n_in, self.n_f, self.n_out).transpose(2, 0, 1)
-        model_rec = hm / self.kappa[None, None, :]
+        model_rec = np.zeros((0, self.n_in, self.n_f), complex)
+        if uncertainty:
+            hw = (phi @ C) / w[None, :]
+            nc = self.n_in * self.n_f
+            hm = (hw[:nc] + 1j * hw[nc:]).reshape(self.n_in, self.n_f, self.n_out)
+            model_rec = hm.transpose(2, 0, 1) / self.kappa[None, None, :]
         per = 2 if self.kind == "complex" else 1
-        data_ss = float(np.sum(np.abs(self.H) ** 2))
+        data_ss = self.data_ss
         # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's
         # columns: no (n_rows x n_out) array per mode
         pb = phi[:, : per * m].reshape(self.n_rows, m, per)
@@ -879,8 +898,12 @@ def _orth(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.flo
     ``Q`` orthonormal to round-off whenever ``cond(phi) < ~1e7`` and cost two
     ``n x q`` Gram products and triangular solves -- several times faster than
     LAPACK's Householder QR with an explicit ``Q`` for the tall bases here.
-    When a Cholesky factor is singular or too ill-conditioned, Householder QR.
+    Householder QR for small bases and when a Cholesky factor is singular or
+    too ill-conditioned.
     """
+    n, q = phi.shape
+    if n * q * q < 4e6:  # small: LAPACK's call overhead is lower than two Cholesky passes
+        return _householder(phi)
     nrm = np.sqrt(np.einsum("ij,ij->j", phi, phi))
     if np.all(nrm > 0) and np.all(np.isfinite(nrm)):
         g1 = (phi.T @ phi) / np.outer(nrm, nrm)
@@ -895,6 +918,10 @@ def _orth(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.flo
                 return q, (r2 @ r1) * nrm[None, :]
         except np.linalg.LinAlgError:
             pass
+    return _householder(phi)
+
+
+def _householder(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     q, r = np.linalg.qr(phi)
     return q, r
 

@@ -50,6 +50,10 @@ _POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 #: the smallest data set) and start the final fit, which converges to 1e-6 s^2.
 _SEARCH_TOL = 10.0
 _TRIAL_TOL = 1.0
+#: a residual mode below the band (damped frequency in [f_lo / 2, f_lo]) shapes the
+#: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
+#: starts at the first lines) it cannot be told from the lower residual term
+_MIN_LOW_LINES = 10
 
 
 @dataclass(frozen=True)
@@ -441,7 +445,8 @@ def _search_helpers(
     """Refine, then add out-of-band residual modes while they are significant.
 
     A trial pole is started at ``1.1 f_hi`` (then ``1.3 f_hi``, ...) above the
-    band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0``, with the median
+    band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0`` and at least
+    ``_MIN_LOW_LINES`` lines lie in ``[f_lo, 2 f_lo]``, with the median
     damping of the in-band modes. Only the trial mode is refined, with every
     other mode held fixed (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`:
     their basis is projected out of the data once) and its damped frequency
@@ -477,7 +482,10 @@ def _search_helpers(
     per = 2 if fitter.kind == "complex" else 1
     dof = fitter.n_rows
     zeta0 = float(np.clip(np.median(-cur_p.real / np.abs(cur_p)), 0.005, 0.1))
-    sides = [1.0] + ([-1.0] if data_band[0] > 0 else [])
+    # below the band only when the data can tell a mode there from the lower
+    # residual: at least _MIN_LOW_LINES lines in [f_lo, 2 f_lo]
+    n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
+    sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= _MIN_LOW_LINES else [])
     for side in sides:
         for k in range(max_helpers):
             fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
