@@ -10,7 +10,7 @@ from tyredamp.exceptions import InputError
 from tyredamp.frf import FRF, Channel
 from tyredamp.mechanics import MCKSystem
 from tyredamp.modal.identify import identify_modes
-from tyredamp.modal.indicators import mac
+from tyredamp.modal.indicators import mac, relative_error, rmsd
 
 F = np.arange(0.25, 200.01, 0.25)
 N_RING = 32
@@ -105,6 +105,26 @@ def test_ring_nonproportional_one_drive_point() -> None:
     assert np.all(c.std["frequency_hz"] > 0)
     assert c.std["psi_out"].shape == c.psi_out.shape
     assert np.all(np.asarray(c.meta["mpc"]) <= 1.0)
+
+
+def test_fit_indicators_equal_the_indicator_functions() -> None:
+    # identify_modes computes RMSD (eq. [19]), its per-FRF values, the relative
+    # error and the discrepancy from one |H_model - H|^2 array; the references are
+    # the indicator functions applied to the model's own synthesised FRFs
+    sys_ = ring_system()
+    data = ring_frf(sys_, [0], seed=4)
+    res = identify_modes(data, band=(0.0, 200.0), model="complex")
+    c = res.models["complex"]
+    band = data.band(*res.band_hz)
+    band = band.select_lines(np.flatnonzero(band.frequency > 0))
+    hm = np.asarray(c.frf(band.frequency, kind=band.kind).H)
+    h = np.asarray(band.H)
+    # the same sums in another order: round-off only
+    assert_allclose(c.meta["rmsd"], rmsd(h, hm), rtol=1e-9)
+    assert_allclose(c.meta["rmsd_per_frf"], rmsd(h, hm, axis=-1), rtol=1e-9)
+    assert_allclose(c.meta["relative_error"], relative_error(h, hm), rtol=1e-9)
+    disc = np.sqrt(np.mean(np.abs(hm - h) ** 2, axis=(0, 1)))
+    assert_allclose(res.discrepancy["complex"], disc, rtol=1e-9)
 
 
 def test_ring_proportional_rmsd_equal_within_noise() -> None:

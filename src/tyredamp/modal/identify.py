@@ -32,8 +32,8 @@ from numpy.typing import ArrayLike, NDArray
 from .._validate import as_finite
 from ..exceptions import ConvergenceError, InputError
 from ..frf import FRF
-from .fit import FitResult, ModalFitter, compress_outputs
-from .indicators import mean_phase_deviation, modal_phase_collinearity, relative_error, rmsd
+from .fit import FitResult, ModalFitter, _compress, combine_outputs
+from .indicators import mean_phase_deviation, modal_phase_collinearity
 from .lscf import PoleSet, plscf
 from .model import ModalModel
 from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
@@ -54,6 +54,10 @@ _TRIAL_TOL = 1.0
 #: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
 #: starts at the first lines) it cannot be told from the lower residual term
 _MIN_LOW_LINES = 10
+#: output compression (fit.compress_outputs) of the search when n_out > 1.5 rank,
+#: and of the final refinement when n_out > 4 rank (module docstring of identify)
+_COMPRESS_SEARCH = 1.5
+_COMPRESS_FINAL = 4.0
 
 
 @dataclass(frozen=True)
@@ -243,14 +247,18 @@ def identify_modes(
     part = np.array([c.participation for c in cand])
     drive = data.drive_points()
     cfit = ModalFitter(f, H, power, "complex", drive, upper=residuals, lower=residuals)
-    # the searches (residual modes, rejection) refit many times: with many outputs
-    # they run on principal output combinations; the final fits use every output
+    # the searches (residual modes, rejection) refit many times: with more outputs
+    # than 1.5 times ``rank`` they run on principal output combinations; so does
+    # the final refinement with more than 4 times ``rank`` (_COMPRESS_FINAL), whose
+    # residues, standard errors and model then use every output
     rank = 2 * (len(poles) + len(extra) + max_helpers + 2 * n_in) + 16
     sfit = cfit
-    if n_out > 2 * rank:
+    patterns = None
+    if n_out > _COMPRESS_SEARCH * rank:
+        h_comb, patterns = _compress(H, rank)
         sfit = ModalFitter(
             f,
-            compress_outputs(H, rank),
+            h_comb,
             power,
             "complex",
             [],
@@ -327,7 +335,43 @@ def identify_modes(
     disc: dict[str, NDArray[np.float64]] = {}
     base: tuple[FitResult, int, int] | None = None  # complex result, n in band, n free
     for kind in kinds:
-        if kind == "complex":
+        if (
+            kind == "complex"
+            and sigma0 is not None
+            and patterns is not None
+            and n_out > _COMPRESS_FINAL * rank
+        ):
+            # the search's output patterns re-weighted by 1 / sigma (one product)
+            rms = np.sqrt(np.mean(_abs2(H), axis=(1, 2)))
+            wts = 1.0 / np.maximum(sigma0, np.maximum(1e-9 * rms, 1e-300))
+            ffit = ModalFitter(
+                f,
+                combine_outputs(H, patterns, wts),
+                power,
+                "complex",
+                [],
+                upper=residuals,
+                lower=residuals,
+                unit_weights=True,
+            )
+            r0, n_band, dropped, nf = _fit_checked(
+                ffit,
+                poles,
+                part,
+                hp,
+                hl,
+                True,
+                (lo, hi),
+                n_free=n_extra,
+                passes=1,
+                uncertainty=False,
+            )
+            res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
+            res.status, res.n_iter = r0.status, r0.n_iter
+            rejected += [_rej(p, f"complex fit: {why}") for p, why in dropped]
+            base = (res, n_band, nf)
+            extra_warn: list[str] = []
+        elif kind == "complex":
             res, n_band, dropped, nf = _fit_checked(
                 cfit,
                 poles,
@@ -342,7 +386,7 @@ def identify_modes(
             )
             rejected += [_rej(p, f"complex fit: {why}") for p, why in dropped]
             base = (res, n_band, nf)
-            extra_warn: list[str] = []
+            extra_warn = []
         else:
             res, n_band, extra_warn = _fit_real(
                 f,
@@ -361,12 +405,12 @@ def identify_modes(
                 (lo, hi),
                 base,
             )
-        kap = (2j * np.pi * f) ** power
-        hm = res.model_receptance * kap[None, None, :]
+        hm = res.model
         res.warnings.extend(extra_warn)
-        mdl = _to_model(res, n_band, kind, data, (lo, hi), p_max, hm)
+        sq = _abs2(hm - H)
+        mdl = _to_model(res, n_band, kind, data, (lo, hi), p_max, sq)
         models[kind] = mdl
-        disc[kind] = np.sqrt(np.mean(np.abs(hm - H) ** 2, axis=(0, 1)))
+        disc[kind] = np.sqrt(np.mean(sq, axis=(0, 1)))
     return ModalIdentification(
         models=models,
         band_hz=(lo, hi),
@@ -379,6 +423,11 @@ def identify_modes(
         discrepancy=disc,
         warnings=warnings,
     )
+
+
+def _abs2(z: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """``|z|^2`` without the square root of ``np.abs``."""
+    return np.asarray(z.real**2 + z.imag**2)
 
 
 def _rej(p: complex, why: str) -> dict[str, Any]:
@@ -689,10 +738,13 @@ def _to_model(
     data: FRF,
     band: tuple[float, float],
     p_max: int,
-    h_model: NDArray[np.complex128],
+    sq: NDArray[np.float64],
 ) -> ModalModel:
-    H = np.asarray(data.H)
+    """ModalModel of one fit; ``sq = |H_model - H|^2`` (n_out, n_in, n_freq) gives the
+    fit indicators: RMSD eq. [19] (as :func:`~tyredamp.modal.indicators.rmsd`), its
+    value per FRF and the relative error (as ``relative_error``)."""
     mk: Literal["complex", "real"] = "complex" if kind == "complex" else "real"
+    data_ss = float(np.sum(_abs2(np.asarray(data.H))))
     resid_modes = None
     if len(res.poles) > n_band:
         resid_modes = ModalModel(
@@ -715,9 +767,9 @@ def _to_model(
     meta = {
         "band_hz": [band[0], band[1]],
         "frf_kind": data.kind,
-        "rmsd": rmsd(H, h_model),
-        "relative_error": relative_error(H, h_model),
-        "rmsd_per_frf": np.asarray(rmsd(H, h_model, axis=-1)),
+        "rmsd": float(np.sqrt(sq.sum()) / sq.size),
+        "relative_error": float(np.sqrt(sq.sum() / max(data_ss, 1e-300))),
+        "rmsd_per_frf": np.sqrt(sq.sum(axis=-1)) / sq.shape[-1],
         "n_lines": int(data.n_freq),
         "method": "pLSCF poles, automatic selection, LSFD, variable-projection refinement",
         "max_order": p_max,
