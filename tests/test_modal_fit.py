@@ -148,3 +148,36 @@ def test_fitter_rejects_zero_hz_and_bad_kind() -> None:
         ModalFitter(np.array([0.0, 1.0, 2.0]), h, 0, "complex", [])
     with pytest.raises(InputError, match="mode_kind"):
         ModalFitter(np.array([1.0, 2.0, 3.0]), h, 0, "both", [])  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_scale_jacobian_matches_finite_differences(kind: str) -> None:
+    # d b / d [theta, C_drive] (analytic, used by the shape standard errors) against
+    # central differences of the scaling itself, two inputs and two drive points
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    h = sys_.frf(F, inputs=[0, 4]).H
+    fit = ModalFitter(F, h, 0, kind, [(0, 0), (4, 1)])
+    rng = np.random.default_rng(5)
+    part = cm.psi[[0, 4]].T if kind == "complex" else np.abs(cm.psi[[0, 4]].T) + 0j
+    part = part * (1 + 0.1 * rng.normal(size=part.shape))
+    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+    th = fit.pack(cm.poles, part, ref)
+    q = fit.n_cols(6)
+    cd = rng.normal(size=(2, q))
+    if kind == "real":  # real modes need a positive a^2 = l_k u_k / u_k^2 at the drive
+        cd[:, :6] = np.abs(cd[:, :6]) * np.sign(part[:, [0, 1]].real.T)
+    wd = np.array([2.0, 0.5])
+    beta = fit._scale_jacobian(th, 6, ref, cd, wd)
+    g0 = np.concatenate([th, cd.ravel()])
+    num = np.zeros_like(beta)
+    for i in range(g0.size):
+        hstep = 1e-6 * max(abs(g0[i]), 1e-3)
+        gp, gm = g0.copy(), g0.copy()
+        gp[i] += hstep
+        gm[i] -= hstep
+        bp = fit._scale(gp[: th.size], 6, ref, gp[th.size :].reshape(2, q), wd)[0]
+        bm = fit._scale(gm[: th.size], 6, ref, gm[th.size :].reshape(2, q), wd)[0]
+        num[i] = (bp - bm) / (2 * hstep)
+    # central differences with relative steps 1e-6 of smooth functions: ~1e-8 relative
+    assert_allclose(beta, num, rtol=1e-5, atol=1e-6 * np.max(np.abs(num)))

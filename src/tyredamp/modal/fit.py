@@ -661,6 +661,84 @@ class ModalFitter:
             psi_in = psi_in / root[None, :]
         return b, psi_in, a2r
 
+    def _scale_jacobian(
+        self,
+        th: NDArray[np.float64],
+        m: int,
+        ref: NDArray[np.intp],
+        cd_w: NDArray[np.float64],
+        wd: NDArray[np.float64],
+    ) -> NDArray[np.complex128]:
+        """``d b / d G`` (n_par + n_drive q, m) of :meth:`_scale`, analytically.
+
+        ``G = [theta, cd_w.ravel()]``. With ``a^2 = N / den``, ``N = sum_d conj(u_d)
+        l_{k_d}``, ``den = sum_d |u_d|^2`` (``u_d = cd_w[d] / wd[d]``):
+        ``d a^2 / d Re u_d = (l - 2 a^2 Re u_d) / den``, ``d a^2 / d Im u_d =
+        (-i l - 2 a^2 Im u_d) / den``, ``d a^2 / d l_k = sum_{d: k_d = k} conj(u_d)
+        / den``; complex modes ``b = a = sqrt(a^2)``, real modes ``a = |Re
+        a^2|^(1/2)`` and ``b = a / sqrt(2 i Omega)``.
+        """
+        n_par = th.size
+        nd, q = cd_w.shape
+        beta = np.zeros((n_par + nd * q, m), complex)
+        if nd == 0:
+            return beta
+        poles, part = self.unpack(th, m, ref)
+        ks = np.array([k for _, k in self.drive], dtype=np.intp)
+        cplx = self.kind == "complex"
+        ud: NDArray[np.complex128]
+        if cplx:
+            ud = (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None]
+        else:
+            ud = cd_w[:, :m] / wd[:, None] + 0j
+        lk = part[:, ks].T  # (nd, m)
+        den = np.sum(np.abs(ud) ** 2, axis=0)
+        den = np.where(den > 0, den, 1.0)
+        a2 = np.sum(np.conj(ud) * lk, axis=0) / den
+        d_re = (lk - 2 * a2[None, :] * ud.real) / den[None, :]
+        d_im = (-1j * lk - 2 * a2[None, :] * ud.imag) / den[None, :]
+        d_l = np.zeros((m, self.n_in), complex)  # d a^2 / d l_k (a real l_k step)
+        for d, k in enumerate(ks):
+            d_l[:, k] += np.conj(ud[d]) / den
+        if cplx:
+            a = np.sqrt(a2)
+            fac = np.where(a == 0, 0.0, 0.5 / np.where(a == 0, 1.0, a))  # d a / d a^2
+
+            def conv(x: NDArray[np.complex128]) -> NDArray[np.complex128]:
+                return np.asarray(fac * x)
+
+        else:
+            a = np.sqrt(np.abs(a2.real))
+            root = np.sqrt(2j * poles.imag)
+            sgn = np.sign(a2.real)
+            fac_r = np.where(a == 0, 0.0, 0.5 * sgn / np.where(a == 0, 1.0, a))
+
+            def conv(x: NDArray[np.complex128]) -> NDArray[np.complex128]:
+                return np.asarray(fac_r * x.real / root)
+
+            b = np.where(a == 0, 1.0, a) / root
+            ar = np.arange(m)
+            beta[2 * ar + 1, ar] = -b * self.w_ref / (2 * poles.imag)
+        ar = np.arange(m)
+        for d in range(nd):
+            base = n_par + d * q
+            if cplx:
+                beta[base + 2 * ar, ar] = conv(d_re[d]) / wd[d]
+                beta[base + 2 * ar + 1, ar] = conv(d_im[d]) / wd[d]
+            else:
+                beta[base + ar, ar] = conv(d_re[d]) / wd[d]
+        i = 2 * m
+        for n in range(m):
+            for k in range(self.n_in):
+                if k == ref[n]:
+                    continue
+                beta[i, n] = conv(d_l[:, k])[n]
+                i += 1
+                if cplx:  # imaginary part of l_k
+                    beta[i, n] = conv(1j * d_l[:, k])[n]
+                    i += 1
+        return beta
+
     def _result(
         self,
         th: NDArray[np.float64],
@@ -819,23 +897,9 @@ class ModalFitter:
         if nd == 0:
             # unscaled shapes: only the coefficient noise and the participation
             return np.asarray(np.sqrt(np.maximum(term1, 0.0)))
-        # global quantities G = [theta, C_D (n_d * q)]
-        cd = C[:, didx].T.copy()
-        wd = w[didx]
-        g0 = np.concatenate([th, cd.ravel()])
-
-        def bfun(g: NDArray[np.float64]) -> NDArray[np.complex128]:
-            return self._scale(g[:n_par], m, ref, g[n_par:].reshape(nd, q), wd)[0]
-
-        ng = g0.size
-        beta = np.zeros((ng, m), complex)
-        for i in range(ng):
-            h = 1e-6 * max(abs(g0[i]), 1e-3 if i < n_par else 1e-3 * np.max(np.abs(cd)))
-            gp = g0.copy()
-            gm = g0.copy()
-            gp[i] += h
-            gm[i] -= h
-            beta[i] = (bfun(gp) - bfun(gm)) / (2 * h)
+        # global quantities G = [theta, C_D (n_d * q)] and d b / d G
+        beta = self._scale_jacobian(th, m, ref, C[:, didx].T, w[didx])
+        ng = beta.shape[0]
         MD = M[didx]  # (nd, q, n_par)
         # Sigma_GG
         sgg = np.zeros((ng, ng))
