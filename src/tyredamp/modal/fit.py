@@ -686,11 +686,11 @@ class ModalFitter:
         poles, part = self.unpack(th, m, ref)
         ks = np.array([k for _, k in self.drive], dtype=np.intp)
         cplx = self.kind == "complex"
-        ud: NDArray[np.complex128]
         if cplx:
-            ud = (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None]
+            u_raw = (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None]
         else:
-            ud = cd_w[:, :m] / wd[:, None] + 0j
+            u_raw = cd_w[:, :m] / wd[:, None]
+        ud = np.asarray(u_raw, dtype=complex)
         lk = part[:, ks].T  # (nd, m)
         den = np.sum(np.abs(ud) ** 2, axis=0)
         den = np.where(den > 0, den, 1.0)
