@@ -39,16 +39,19 @@ from tyredamp.modal import identify_modes
 STAGES = (
     ("pLSCF (plscf)", "lscf.py", "plscf"),
     ("stability + clustering", "selection.py", "stability_flags|cluster_poles"),
-    ("output compression", "fit.py", "compress_outputs"),
+    ("output compression", "fit.py", "_compress|combine_outputs"),
     ("residual-mode search (_search_helpers)", "identify.py", "_search_helpers"),
+    ("  trial residual modes (fit_added)", "fit.py", "fit_added"),
     ("checked fits (_fit_checked)", "identify.py", "_fit_checked"),
     ("all fits (ModalFitter.fit)", "fit.py", "fit"),
+    ("  Levenberg-Marquardt (all refinements)", "fit.py", "_levenberg_marquardt"),
     ("  projection (_solve)", "fit.py", "_solve"),
-    ("  QR of the basis (numpy qr)", "_linalg.py", "qr"),
+    ("  QR of the basis (_orth)", "fit.py", "_orth"),
     ("  normal equations (_normal)", "fit.py", "_normal"),
     ("  basis (basis)", "fit.py", "basis"),
     ("  result assembly (_result)", "fit.py", "_result"),
     ("  shape standard errors (_shape_std)", "fit.py", "_shape_std"),
+    ("model object and indicators (_to_model)", "identify.py", "_to_model"),
 )
 
 
