@@ -912,17 +912,24 @@ class ModalFitter:
         sgg[n_par:, n_par:] = dd
         v3 = np.real(np.einsum("gn,gh,hn->n", beta.conj(), sgg, beta))
         term3 = np.abs(u) ** 2 * v3[None, :]
-        # Sigma_cG_j = [MC_j, MC_j MD^T + s2 F (j = drive)]  -> (n_out, q, ng)
-        scg = np.zeros((self.n_out, q, ng))
-        scg[:, :, :n_par] = MC
-        scg[:, :, n_par:] = np.einsum("jak,ibk->jaib", MC, MD).reshape(self.n_out, q, nd * q)
-        for i, j in enumerate(didx):
-            scg[j, :, n_par + i * q : n_par + (i + 1) * q] += s2 * F
-        if self.kind == "complex":
-            rows = scg[:, 0 : 2 * m : 2, :] - 1j * scg[:, 1 : 2 * m : 2, :]  # (n_out, m, ng)
-        else:
-            rows = scg[:, :m, :] + 0j
-        cross = np.einsum("jng,gn->jn", rows, beta)
+        # cross_jn = sum_g Sigma_cG_j[a_n, g] beta[g, n] with Sigma_cG_j = [MC_j,
+        # MC_j MD^T + s2 F (j = drive)] (a_n the coefficient rows of mode n), summed
+        # without forming the (n_out, q, ng) matrix: T = beta_theta + MD^T beta_D
+        beta_d = beta[n_par:]  # (nd q, m)
+        T = beta[:n_par] + MD.reshape(nd * q, n_par).T @ beta_d  # (n_par, m)
+        bd = beta_d.reshape(nd, q, m)
+        fb = s2 * np.einsum("ab,ibn->ian", F, bd)  # (nd, q, m)
+        rsel = (
+            [np.arange(0, 2 * m, 2), np.arange(1, 2 * m, 2)]
+            if self.kind == "complex"
+            else [np.arange(m)]
+        )
+        cross = np.zeros((self.n_out, m), complex)
+        for sign, rr in zip((1.0, -1j), rsel, strict=False):
+            part_ = np.einsum("jnk,kn->jn", MC[:, rr, :], T)
+            for i, j in enumerate(didx):
+                part_[j] += fb[i, rr, np.arange(m)]
+            cross += sign * part_
         term2 = 2 * np.real(np.conj(b)[None, :] / w[:, None] * u * cross)
         return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))
 
