@@ -182,12 +182,15 @@ def identify_modes(
     lo, hi = (float(frf.frequency[0]), float(frf.frequency[-1])) if band is None else band
     if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo or lo < 0:
         raise InputError(f"band: expected 0 <= f_lo < f_hi in Hz, got [{lo}, {hi}]")
-    data = frf.band(max(lo, 0.0), hi)
-    keep = data.frequency > 0
-    if not np.all(keep):
-        data = data.select_lines(np.flatnonzero(keep))
-    f = data.frequency
-    H = np.asarray(data.H)
+    fa = frf.frequency
+    lines = np.flatnonzero((fa >= lo) & (fa <= hi) & (fa > 0))  # 0 Hz lines are skipped
+    if lines.size == 0:
+        frf.band(max(lo, 0.0), hi)  # raises the error naming the band and the data
+        raise InputError(f"band: no line above 0 Hz in [{lo:g}, {hi:g}] Hz")
+    # the validated FRF's lines, sliced without building (and re-checking) a new FRF
+    data = frf
+    f = fa[lines]
+    H = np.asarray(frf.H) if lines.size == fa.size else np.asarray(frf.H[:, :, lines])
     n_out, n_in, n_f = H.shape
     power = _POWER[data.kind]
     if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
@@ -408,7 +411,7 @@ def identify_modes(
         hm = res.model
         res.warnings.extend(extra_warn)
         sq = _abs2(hm - H)
-        mdl = _to_model(res, n_band, kind, data, (lo, hi), p_max, sq)
+        mdl = _to_model(res, n_band, kind, data, H, (lo, hi), p_max, sq)
         models[kind] = mdl
         disc[kind] = np.sqrt(np.mean(sq, axis=(0, 1)))
     return ModalIdentification(
@@ -736,15 +739,17 @@ def _to_model(
     n_band: int,
     kind: str,
     data: FRF,
+    H: NDArray[np.complex128],
     band: tuple[float, float],
     p_max: int,
     sq: NDArray[np.float64],
 ) -> ModalModel:
-    """ModalModel of one fit; ``sq = |H_model - H|^2`` (n_out, n_in, n_freq) gives the
+    """ModalModel of one fit; ``data`` gives the channels and kind, ``H`` (n_out, n_in,
+    n_freq) the fitted lines, and ``sq = |H_model - H|^2`` the
     fit indicators: RMSD eq. [19] (as :func:`~tyredamp.modal.indicators.rmsd`), its
     value per FRF and the relative error (as ``relative_error``)."""
     mk: Literal["complex", "real"] = "complex" if kind == "complex" else "real"
-    data_ss = float(np.sum(_abs2(np.asarray(data.H))))
+    data_ss = float(np.sum(_abs2(H)))
     resid_modes = None
     if len(res.poles) > n_band:
         resid_modes = ModalModel(
@@ -770,7 +775,7 @@ def _to_model(
         "rmsd": float(np.sqrt(sq.sum()) / sq.size),
         "relative_error": float(np.sqrt(sq.sum() / max(data_ss, 1e-300))),
         "rmsd_per_frf": np.sqrt(sq.sum(axis=-1)) / sq.shape[-1],
-        "n_lines": int(data.n_freq),
+        "n_lines": int(H.shape[-1]),
         "method": "pLSCF poles, automatic selection, LSFD, variable-projection refinement",
         "max_order": p_max,
         "refinement": res.status,
