@@ -118,6 +118,7 @@ def identify_modes(
     n_modes: int | None = None,
     frequencies: ArrayLike | None = None,
     max_order: int | None = None,
+    order_step: int = 2,
     residuals: bool = True,
     refine: bool = True,
     max_damping: float = 0.2,
@@ -148,6 +149,10 @@ def identify_modes(
     max_order : int, optional
         Highest pLSCF order; default ``ceil(60 / n_in)`` (or more when
         ``n_modes`` is large), capped by the number of lines.
+    order_step : int
+        Orders of the stabilisation diagram: every ``order_step``-th from
+        ``max_order`` down to ``max_order / 4`` (default 2; 1 for every
+        order). Stability is judged against the previous computed order.
     residuals : bool
         Fit upper and lower residual terms (default True).
     refine : bool
@@ -193,6 +198,8 @@ def identify_modes(
     H = np.asarray(frf.H) if lines.size == fa.size else np.asarray(frf.H[:, :, lines])
     n_out, n_in, n_f = H.shape
     power = _POWER[data.kind]
+    if not isinstance(order_step, (int, np.integer)) or order_step < 1:
+        raise InputError(f"order_step: expected a positive integer, got {order_step!r}")
     if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
         raise InputError(f"n_modes: expected a positive integer, got {n_modes!r}")
     fr = None
@@ -206,7 +213,14 @@ def identify_modes(
     while True:
         # orders below p_max / 4 do not count for persistence (most modes need a
         # minimum order to appear at all)
-        ps = plscf(f, H, p_max, band=(float(f[0]), float(f[-1])), min_order=max(1, p_max // 4))
+        ps = plscf(
+            f,
+            H,
+            p_max,
+            band=(float(f[0]), float(f[-1])),
+            min_order=max(1, p_max // 4),
+            order_step=order_step,
+        )
         flags = stability_flags(ps, band=(lo, hi), max_damping=max_damping)
         kept, weak = cluster_poles(
             ps, flags, cluster_distance=cluster_distance, min_fraction=min_fraction
@@ -412,6 +426,7 @@ def identify_modes(
         res.warnings.extend(extra_warn)
         sq = _abs2(hm - H)
         mdl = _to_model(res, n_band, kind, data, H, (lo, hi), p_max, sq)
+        mdl.meta["order_step"] = int(order_step)
         models[kind] = mdl
         disc[kind] = np.sqrt(np.mean(sq, axis=(0, 1)))
     return ModalIdentification(

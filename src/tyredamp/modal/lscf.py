@@ -13,9 +13,9 @@ the basis orthogonal for any band (for ``f_lo = 0`` this is the classical
 
 The numerator coefficients are eliminated per output (reduced normal
 equations). With one weight per output the normal-equation blocks are
-Toeplitz in the polynomial degree, so they are built from the sums
-``sum_f z_f^d H_ok(f)``: one real matrix product over all outputs and lines,
-``O(n_out n_freq order)``. The blocks of every lower order are leading
+Toeplitz in the polynomial degree, so they are built from the real parts of
+the sums ``sum_f z_f^d H_ok(f)``: two real matrix products over all outputs
+and lines, ``O(n_out n_freq order)``. The blocks of every lower order are leading
 sub-blocks of the highest order, so a whole stabilisation diagram costs about
 as much as one high-order solve.
 """
@@ -82,6 +82,7 @@ def plscf(
     min_order: int = 1,
     band: tuple[float, float] | None = None,
     output_weights: ArrayLike | None = None,
+    order_step: int = 1,
 ) -> PoleSet:
     """Estimate poles of all model orders ``min_order..max_order`` by pLSCF.
 
@@ -102,6 +103,9 @@ def plscf(
     output_weights : array_like, shape (n_out,), optional
         Weight of each output row; default ``1 / RMS`` of the row, so every
         output counts equally whatever its level.
+    order_step : int, optional
+        Compute every ``order_step``-th order, counting down from
+        ``max_order`` (default 1: every order from ``min_order``).
 
     Returns
     -------
@@ -114,7 +118,14 @@ def plscf(
     normal equations ``M = 2 sum_o (T_o - S_o^T R_o^{-1} S_o)``, and the poles
     ``z_n`` and participation vectors ``l_n`` from the companion matrix of
     ``A(z)^T`` (``l_n^T A(z_n) = 0``); ``p_n = i w_lo + ln(z_n) / dt`` with
-    ``dt = pi / (w_hi - w_lo)``.
+    ``dt = pi / (w_hi - w_lo)``. The poles are the eigenvalues alone; each
+    ``l_n`` is then the null vector of ``A(z_n)^T`` (for one input,
+    ``l_n = 1``).
+
+    With more outputs than entries of the lag sums of one output
+    (``n_in (2 max_order + 1)``), the sum over outputs is taken over the
+    equivalent rows of the sums' Gram matrix instead (same normal
+    equations, fewer rows).
     """
     f = as_frequency(frequency)
     h = as_finite(H, "H", dtype=complex)
@@ -122,8 +133,11 @@ def plscf(
         raise ShapeError(f"H: expected shape (n_out, n_in, {f.size}), got {h.shape}")
     p_max = int(max_order)
     p_min = int(min_order)
+    step = int(order_step)
     if p_max < 1 or p_min < 1 or p_min > p_max:
         raise InputError(f"max_order/min_order: expected 1 <= min <= max, got {p_min}, {p_max}")
+    if step < 1 or step != order_step:
+        raise InputError(f"order_step: expected a positive integer, got {order_step!r}")
     lo, hi = (float(f[0]), float(f[-1])) if band is None else (float(band[0]), float(band[1]))
     if not hi > lo:
         raise InputError(f"band: expected f_lo < f_hi, got [{lo}, {hi}] Hz")
@@ -146,50 +160,47 @@ def plscf(
     dt = np.pi / (2 * np.pi * (hi - lo))
     theta = 2 * np.pi * (f - lo) * dt  # in [0, pi]
     P = p_max
-    zd = np.exp(1j * np.outer(theta, np.arange(P + 1)))  # (n_f, P+1): z^d, d >= 0
-
+    ph = np.outer(theta, np.arange(P + 1))
+    zc, zs = np.cos(ph), np.sin(ph)  # Re and Im of z^d, d = 0..P, shape (n_f, P+1)
+    lag = np.arange(P + 1)[None, :] - np.arange(P + 1)[:, None]  # r' - r
     # R[r, r'] = Re sum_f z^(r'-r)    (common to all outputs)
-    rvec = np.real(zd.sum(axis=0))
-    dd = np.arange(P + 1)
-    lag = dd[None, :] - dd[:, None]  # r' - r
-    R = rvec[np.abs(lag)]
-    # s_ok(d) = sum_f z^d H_ok(f) for d = -P..P
-    hf = h.reshape(n_out * n_in, n_f)
-    s_pos = hf @ zd  # d >= 0
-    s_neg = hf @ zd.conj()  # d <= 0: z^-d = conj(z^d)
-    # S_o[r, (r', k)] = -Re s_ok(r' - r)
-    alag = np.abs(lag)
-    S = -np.where(lag[None, :, :] >= 0, s_pos.real[:, alag], s_neg.real[:, alag])
-    S = S.reshape(n_out, n_in, P + 1, P + 1)  # (o, k, r, r')
-    S = S.transpose(0, 2, 3, 1).reshape(n_out, P + 1, (P + 1) * n_in)  # cols r' * n_in + k
+    R = zc.sum(axis=0)[np.abs(lag)]
+    # c_ok(d) = Re sum_f z^d H_ok(f), d = -P..P (index d + P): two real products
+    c = _real_lag_sums(h.reshape(n_out * n_in, n_f), zc, zs).reshape(n_out, n_in * (2 * P + 1))
     # sum_o T_o[(r,k),(r',k')] = Re sum_f z^(r'-r) sum_o conj(H_ok) H_ok'
-    q = np.einsum("okf,olf->klf", h.conj(), h)  # (k, k', f)
-    qf = q.reshape(n_in * n_in, n_f)
-    t_pos = qf @ zd
-    t_neg = qf @ zd.conj()
-    T = (
-        np.where(lag[None, :, :] >= 0, t_pos.real[:, alag], t_neg.real[:, alag])
-        .reshape(n_in, n_in, P + 1, P + 1)
-        .transpose(2, 0, 3, 1)
-    )
-    T = T.reshape((P + 1) * n_in, (P + 1) * n_in)
-
-    # U_o = L^-1 S_o with R = L L^T; leading rows/cols give every lower order
+    q = np.einsum("okf,olf->klf", h.conj(), h).reshape(n_in * n_in, n_f)
+    t = _real_lag_sums(q, zc, zs).reshape(n_in, n_in, 2 * P + 1)
+    T = t[:, :, lag + P].transpose(2, 0, 3, 1).reshape((P + 1) * n_in, (P + 1) * n_in)
+    # sum_o S_o^T R^-1 S_o is a quadratic form in the rows c_o: with more outputs
+    # than entries of c_o, any rows with the same Gram matrix sum_o c_o c_o^T give
+    # the same sum; its scaled eigenvectors are the fewest such rows (exact)
+    if n_out > c.shape[1]:
+        lam, vec = np.linalg.eigh(c.T @ c)
+        keep = lam > lam[-1] * 1e-15
+        c = (vec[:, keep] * np.sqrt(lam[keep])).T
+    n_v = c.shape[0]
+    # S_o[r, (r', k)] = -c_ok(r' - r);  U_o = L^-1 S_o with R = L L^T
+    S = -c.reshape(n_v, n_in, 2 * P + 1)[:, :, lag + P]  # (o, k, r, r')
+    S = S.transpose(2, 0, 3, 1).reshape(P + 1, n_v * (P + 1) * n_in)
     L = np.linalg.cholesky(R)
-    U = sla.solve_triangular(L, S.transpose(1, 0, 2).reshape(P + 1, -1), lower=True)
-    U = U.reshape(P + 1, n_out, (P + 1) * n_in)
-    # cumulative sum over rows r of sum_o u_or^T u_or
-    prow = np.einsum("roa,rob->rab", U, U, optimize=True)
-    pcum = np.cumsum(prow, axis=0)
+    U = sla.solve_triangular(L, S, lower=True, check_finite=False)
+    U = U.reshape(P + 1, n_v, (P + 1) * n_in)
 
-    orders = np.arange(p_min, P + 1)
+    orders = np.arange(P, p_min - 1, -step)[::-1]
     out_order: list[NDArray[np.int64]] = []
     out_poles: list[NDArray[np.complex128]] = []
     out_part: list[NDArray[np.complex128]] = []
     w_lo = 2 * np.pi * lo
+    # the reduced matrix of order p uses the leading p + 1 rows of every U_o:
+    # sum_o U_o^T U_o accumulates row block by row block up the orders
+    acc = np.zeros(((P + 1) * n_in, (P + 1) * n_in))
+    r0 = 0
     for p in orders:
+        blk = U[r0 : p + 1].reshape(-1, U.shape[2])
+        acc += blk.T @ blk
+        r0 = p + 1
         nc = (p + 1) * n_in
-        M = T[:nc, :nc] - pcum[p, :nc, :nc]
+        M = T[:nc, :nc] - acc[:nc, :nc]
         M = 0.5 * (M + M.T)
         m11 = M[: p * n_in, : p * n_in]
         m12 = M[: p * n_in, p * n_in :]
@@ -197,25 +208,12 @@ def plscf(
             alpha = -np.linalg.solve(m11, m12)  # (p n_in, n_in): alpha_0..alpha_{p-1}
         except np.linalg.LinAlgError:
             alpha = -np.linalg.lstsq(m11, m12, rcond=None)[0]
-        # companion of A(z)^T: z l_ = ..., last block row -alpha_r^T
-        n = p * n_in
-        comp = np.zeros((n, n))
-        if p > 1:
-            comp[: n - n_in, n_in:] = np.eye(n - n_in)
-        blocks = alpha.reshape(p, n_in, n_in)
-        comp[n - n_in :, :] = -np.concatenate([b.T for b in blocks], axis=1)
-        zval, zvec = np.linalg.eig(comp)
-        keep = (zval.imag > 0) & (np.abs(zval) > 0)
-        zval, zvec = zval[keep], zvec[:, keep]
+        zval = np.linalg.eigvals(_companion(alpha, n_in))
+        zval = zval[(zval.imag > 0) & (np.abs(zval) > 0)]
         if zval.size == 0:
             continue
         pole = 1j * w_lo + np.log(zval) / dt
-        lvec = zvec[:n_in, :].T  # first block: participation
-        nrm = np.linalg.norm(lvec, axis=1, keepdims=True)
-        lvec = lvec / np.where(nrm > 0, nrm, 1.0)
-        big = np.argmax(np.abs(lvec), axis=1)
-        ph = lvec[np.arange(lvec.shape[0]), big]
-        lvec = lvec * (np.abs(ph) / np.where(ph != 0, ph, 1.0))[:, None]
+        lvec = _participation(alpha, zval, n_in)
         pos = pole.imag > 0
         out_order.append(np.full(int(pos.sum()), p, dtype=np.int64))
         out_poles.append(pole[pos])
@@ -229,3 +227,51 @@ def plscf(
         orders=orders.astype(np.int64),
         band_hz=(lo, hi),
     )
+
+
+def _real_lag_sums(
+    x: NDArray[np.complex128], zc: NDArray[np.float64], zs: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """``Re sum_f z_f^d x(f)`` for ``d = -P..P`` (column ``d + P``), rows of ``x``.
+
+    ``Re(x z^d) = Re x cos - Im x sin`` and ``Re(x z^-d) = Re x cos + Im x sin``:
+    two real matrix products instead of two complex ones.
+    """
+    a = x.real @ zc
+    b = x.imag @ zs
+    return np.concatenate([(a + b)[:, :0:-1], a - b], axis=1)
+
+
+def _companion(alpha: NDArray[np.float64], n_in: int) -> NDArray[np.float64]:
+    """Block companion matrix of ``A(z)^T`` (``alpha_p = I``), eigenvalues ``z_n``."""
+    n = alpha.shape[0]
+    comp = np.zeros((n, n))
+    if n > n_in:
+        comp[: n - n_in, n_in:] = np.eye(n - n_in)
+    comp[n - n_in :, :] = -alpha.reshape(-1, n_in, n_in).transpose(2, 0, 1).reshape(n_in, n)
+    return comp
+
+
+def _participation(
+    alpha: NDArray[np.float64], z: NDArray[np.complex128], n_in: int
+) -> NDArray[np.complex128]:
+    """Participation vectors ``l_n``: ``l_n^T A(z_n) = 0``, unit norm, largest entry real > 0.
+
+    The left null vector of ``A(z_n)`` is the right singular vector of
+    ``A(z_n)^T`` of the smallest singular value; ``A`` is evaluated as
+    ``z^-p A(z)`` for ``|z| > 1`` so that no power exceeds 1 in modulus.
+    """
+    if n_in == 1:
+        return np.ones((z.size, 1), complex)
+    p = alpha.shape[0] // n_in
+    coef = np.concatenate([alpha.reshape(p, n_in * n_in), np.eye(n_in).reshape(1, -1)])
+    big = np.abs(z) > 1
+    u = np.where(big, 1 / z, z)
+    pw = u[:, None] ** np.arange(p + 1)[None, :]  # u^r, r = 0..p
+    pw = np.where(big[:, None], pw[:, ::-1], pw)  # z^(r - p) = u^(p - r) for |z| > 1
+    A = (pw @ coef).reshape(-1, n_in, n_in)
+    vh = np.linalg.svd(A.transpose(0, 2, 1))[2]
+    lvec = vh[:, -1, :].conj()
+    big_i = np.argmax(np.abs(lvec), axis=1)
+    ph = lvec[np.arange(lvec.shape[0]), big_i]
+    return np.asarray(lvec * (np.abs(ph) / np.where(ph != 0, ph, 1.0))[:, None])

@@ -5,8 +5,9 @@ Rules (all thresholds are arguments with the defaults stated here):
 1. *Admissible poles*: ``0 < zeta <= max_damping`` (default 0.2: negative
    damping and heavily damped computational poles are rejected) and damped
    frequency inside the analysis band.
-2. *Stability*: a pole of order ``p`` is stable when the nearest pole of order
-   ``p - 1`` differs by at most ``tol_frequency`` (1 %) in natural frequency,
+2. *Stability*: a pole of order ``p`` is stable when the nearest pole of the
+   previous computed order (``p - 1``, or ``p - order_step``) differs by at
+   most ``tol_frequency`` (1 %) in natural frequency,
    ``tol_damping`` (5 %) relative in damping ratio and, with several inputs,
    has participation-vector MAC >= ``tol_mac`` (0.95).
 3. *Clustering*: the stable poles are grouped by complete-linkage hierarchical
@@ -32,11 +33,15 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.cluster.hierarchy import fcluster, linkage
+from scipy.cluster.hierarchy import linkage
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial.distance import squareform
 
 from ..exceptions import InputError
 from .lscf import PoleSet
+
+_CHUNK = 200  # poles per complete-linkage call (groups split at gaps are joined up to it)
 
 __all__ = ["Cluster", "StabilityFlags", "cluster_poles", "stability_flags"]
 
@@ -46,7 +51,7 @@ class StabilityFlags:
     """Per-pole flags of a :class:`PoleSet` (all arrays of shape (n,)).
 
     ``admissible``: passes the damping and band rules; ``frequency``,
-    ``damping``, ``vector``: stable against the previous order; ``stable``:
+    ``damping``, ``vector``: stable against the previous computed order; ``stable``:
     admissible and all three.
     """
 
@@ -136,9 +141,9 @@ def stability_flags(
     zstab = np.zeros(n, bool)
     vstab = np.zeros(n, bool)
     multi = ps.participation.shape[1] > 1
-    for p in ps.orders[1:]:
+    for p_prev, p in zip(ps.orders[:-1], ps.orders[1:], strict=True):
         cur = ps.at_order(int(p))
-        prev = ps.at_order(int(p) - 1)
+        prev = ps.at_order(int(p_prev))
         prev = prev[adm[prev]]
         if cur.size == 0 or prev.size == 0:
             continue
@@ -151,6 +156,39 @@ def stability_flags(
         else:
             vstab[cur] = True
     return StabilityFlags(admissible=adm, frequency=fstab, damping=zstab, vector=vstab)
+
+
+def _complete_linkage(
+    p: NDArray[np.complex128],
+    lv: NDArray[np.complex128],
+    od: NDArray[np.int64],
+    cut: float,
+) -> NDArray[np.int64]:
+    """Labels ``0..k-1`` of complete-linkage clusters cut at ``cut`` (rule 3)."""
+    if p.size == 1:
+        return np.zeros(1, np.int64)
+    mag = np.maximum(np.abs(p)[:, None], np.abs(p)[None, :])
+    d = np.abs(p[:, None] - p[None, :]) / mag
+    if lv.shape[1] > 1:
+        num = np.abs(lv.conj() @ lv.T) ** 2
+        nn = np.sum(np.abs(lv) ** 2, axis=1)
+        d = d + (1.0 - num / np.outer(nn, nn))
+    big = 1e6
+    d = np.where(od[:, None] == od[None, :], big, d)
+    np.fill_diagonal(d, 0.0)
+    d = np.clip(0.5 * (d + d.T), 0.0, big)
+    z = linkage(squareform(d, checks=False), method="complete")
+    # complete linkage is monotone: the merges up to the cut are the first rows
+    # of z; the clusters are the connected components of those merges
+    n = p.size
+    k = int(np.searchsorted(z[:, 2], cut, side="right"))
+    if k == 0:
+        return np.arange(n, dtype=np.int64)
+    a = z[:k, :2].astype(np.int64).ravel()
+    b = np.repeat(n + np.arange(k), 2)
+    g = coo_matrix((np.ones(2 * k), (a, b)), shape=(n + k, n + k))
+    lab = connected_components(g, directed=False)[1][:n]
+    return np.asarray(np.unique(lab, return_inverse=True)[1], np.int64)
 
 
 def cluster_poles(
@@ -190,42 +228,57 @@ def cluster_poles(
     p = ps.poles[idx]
     lv = ps.participation[idx]
     od = ps.order[idx]
-    if idx.size == 1:
-        labels = np.array([1])
-    else:
-        mag = np.maximum(np.abs(p)[:, None], np.abs(p)[None, :])
-        d = np.abs(p[:, None] - p[None, :]) / mag
-        if lv.shape[1] > 1:
-            num = np.abs(lv.conj() @ lv.T) ** 2
-            nn = np.sum(np.abs(lv) ** 2, axis=1)
-            d = d + (1.0 - num / np.outer(nn, nn))
-        big = 1e6
-        d = np.where(od[:, None] == od[None, :], big, d)
-        np.fill_diagonal(d, 0.0)
-        d = np.clip(0.5 * (d + d.T), 0.0, big)
-        z = linkage(squareform(d, checks=False), method="complete")
-        labels = fcluster(z, t=cluster_distance, criterion="distance")
+    labels = np.zeros(idx.size, np.int64)
+    # complete linkage never joins poles farther apart than the cut, and the
+    # distance is at least the relative gap of |p|: groups split at such gaps
+    # cluster independently (same clusters, no n^2 matrix over all poles)
+    order = np.argsort(np.abs(p), kind="stable")
+    mag = np.abs(p)[order]
+    gap = 1.0 - mag[:-1] / np.where(mag[1:] > 0, mag[1:], 1.0)
+    cuts = np.flatnonzero(gap > cluster_distance) + 1
+    # consecutive groups are joined up to _CHUNK poles (fewer, larger linkages)
+    chunks: list[int] = []
+    for c in cuts:
+        if c - (chunks[-1] if chunks else 0) >= _CHUNK:
+            chunks.append(int(c))
+    n_lab = 0
+    for grp in np.split(order, chunks):
+        sub = _complete_linkage(p[grp], lv[grp], od[grp], cluster_distance)
+        labels[grp] = sub + n_lab
+        n_lab += int(sub.max()) + 1
+    # per-cluster medians, spread, persistence and representative, all at once
     n_orders = ps.orders.size
+    n_cl = n_lab
+    fn_all = np.abs(p) / (2 * np.pi)
+    zz_all = -p.real / np.abs(p)
+    count = np.bincount(labels, minlength=n_cl)
+    start = np.concatenate([[0], np.cumsum(count)[:-1]])
+    lo_i, hi_i = start + (count - 1) // 2, start + count // 2
+    fs = fn_all[np.lexsort((fn_all, labels))]
+    zs = zz_all[np.lexsort((zz_all, labels))]
+    f_med = 0.5 * (fs[lo_i] + fs[hi_i])
+    z_med = 0.5 * (zs[lo_i] + zs[hi_i])
+    w = 2 * np.pi * f_med
+    poles = -z_med * w + 1j * w * np.sqrt(np.maximum(1 - z_med**2, 0.0))
+    dist = np.abs(p - poles[labels])
+    by_dist = np.lexsort((np.arange(idx.size), dist, labels))
+    best = by_dist[start]
+    pairs = np.unique(labels * (int(od.max()) + 1) + od)
+    frac = np.bincount(pairs // (int(od.max()) + 1), minlength=n_cl) / n_orders
+    mean = np.bincount(labels, fn_all, n_cl) / count
+    var = np.maximum(np.bincount(labels, (fn_all - mean[labels]) ** 2, n_cl) / count, 0.0)
+    members = np.split(np.argsort(labels, kind="stable"), np.cumsum(count)[:-1])
     kept: list[Cluster] = []
     rejected: list[Cluster] = []
-    for lab in np.unique(labels):
-        mem = np.flatnonzero(labels == lab)
-        fn = np.abs(p[mem]) / (2 * np.pi)
-        zz = -p[mem].real / np.abs(p[mem])
-        f_med = float(np.median(fn))
-        z_med = float(np.median(zz))
-        w = 2 * np.pi * f_med
-        pole = complex(-z_med * w, w * np.sqrt(max(1 - z_med**2, 0.0)))
-        best = int(np.argmin(np.abs(p[mem] - pole)))
-        frac = np.unique(od[mem]).size / n_orders
+    for c in range(n_cl):
         cl = Cluster(
-            pole=pole,
-            participation=lv[mem[best]],
-            members=idx[mem],
-            fraction=float(frac),
-            spread_frequency=float(np.std(fn) / f_med),
+            pole=complex(poles[c]),
+            participation=lv[best[c]],
+            members=idx[members[c]],
+            fraction=float(frac[c]),
+            spread_frequency=float(np.sqrt(var[c]) / f_med[c]),
         )
-        (kept if frac >= min_fraction else rejected).append(cl)
+        (kept if frac[c] >= min_fraction else rejected).append(cl)
     kept.sort(key=lambda c: c.frequency_hz)
     rejected.sort(key=lambda c: c.frequency_hz)
     return kept, rejected
