@@ -83,3 +83,105 @@ def test_plscf_input_checks() -> None:
             stability_flags(plscf(F, chain_system().frf(F).H, 4)),
             min_fraction=0.0,
         )
+
+
+def _direct_lscf_poles(f: np.ndarray, h: np.ndarray, p: int) -> np.ndarray:
+    """Poles of order ``p`` from the stacked linear least-squares problem (one input).
+
+    Unknowns: real ``beta_o0..beta_op`` per output and ``alpha_0..alpha_{p-1}``
+    (``alpha_p = 1``); equation error ``B_o(z) - H_o(f) A(z)`` on every line,
+    real and imaginary parts stacked. Independent of the normal-equation code.
+    """
+    n_out = h.shape[0]
+    lo, hi = f[0], f[-1]
+    dt = 0.5 / (hi - lo)
+    z = np.exp(1j * 2 * np.pi * (f - lo) * dt)
+    zp = z[:, None] ** np.arange(p + 1)[None, :]
+    n_f = f.size
+    rows = []
+    rhs = []
+    for o in range(n_out):
+        blk = np.zeros((n_f, n_out * (p + 1) + p), complex)
+        blk[:, o * (p + 1) : (o + 1) * (p + 1)] = zp
+        blk[:, n_out * (p + 1) :] = -h[o, 0][:, None] * zp[:, :p]
+        rows.append(blk)
+        rhs.append(h[o, 0] * zp[:, p])
+    a = np.concatenate(rows)
+    b = np.concatenate(rhs)
+    ab = np.vstack([a.real, a.imag])
+    x = np.linalg.lstsq(ab, np.concatenate([b.real, b.imag]), rcond=None)[0]
+    alpha = np.concatenate([x[n_out * (p + 1) :], [1.0]])
+    zr = np.roots(alpha[::-1])
+    zr = zr[zr.imag > 0]
+    return 1j * 2 * np.pi * lo + np.log(zr) / dt
+
+
+def test_plscf_equals_the_stacked_least_squares_problem_with_many_outputs() -> None:
+    # 40 outputs > 2 * 6 + 1 lag sums: the Gram-reduced normal equations are used
+    rng = np.random.default_rng(2)
+    f = np.linspace(2.0, 38.0, 300)
+    sys_ = chain_system()
+    h = sys_.frf(f, inputs=[0]).H
+    h = np.concatenate([h * rng.normal(size=(1, 1, 1)) for _ in range(7)])[:40]
+    h = h + 1e-3 * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    ps = plscf(f, h, 6, min_order=2, output_weights=np.ones(h.shape[0]))
+    for p in (2, 4, 6):
+        got = np.sort_complex(ps.poles[ps.at_order(p)])
+        ref = np.sort_complex(_direct_lscf_poles(f, h, p))
+        assert_allclose(got, ref, rtol=1e-8)
+
+
+def test_plscf_order_step_counts_down_from_the_highest_order() -> None:
+    h = chain_system().frf(F, inputs=[0]).H
+    ps = plscf(F, h, 24, min_order=5, order_step=3)
+    assert ps.orders.tolist() == [6, 9, 12, 15, 18, 21, 24]
+    assert set(np.unique(ps.order)) <= set(ps.orders.tolist())
+    full = plscf(F, h, 24, min_order=5)
+    for p in (6, 15, 24):  # the same orders give the same poles
+        assert_allclose(
+            np.sort_complex(ps.poles[ps.at_order(p)]),
+            np.sort_complex(full.poles[full.at_order(p)]),
+            rtol=1e-9,
+        )
+    # stability is judged against the previous computed order
+    flags = stability_flags(ps)
+    kept, _ = cluster_poles(ps, flags)
+    assert len(kept) == chain_system().complex_modes().poles.size
+    with pytest.raises(InputError, match="order_step"):
+        plscf(F, h, 24, order_step=0)
+
+
+def test_clusters_split_at_gaps_equal_one_complete_linkage(monkeypatch: pytest.MonkeyPatch) -> None:
+    from scipy.cluster.hierarchy import fcluster, linkage
+    from scipy.spatial.distance import squareform
+
+    import tyredamp.modal.selection as sel
+
+    sys_ = chain_system()
+    rng = np.random.default_rng(8)
+    h = sys_.frf(F, inputs=[0, 3]).H
+    h = h + 0.02 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    ps = plscf(F, h, 30)
+    flags = stability_flags(ps, max_damping=0.5)
+    monkeypatch.setattr(sel, "_CHUNK", 1)  # every gap splits
+    kept, rej = cluster_poles(ps, flags)
+    # reference: one complete linkage over all stable poles (rule 3 distance)
+    idx = np.flatnonzero(flags.stable)
+    p, lv, od = ps.poles[idx], ps.participation[idx], ps.order[idx]
+    d = np.abs(p[:, None] - p[None, :]) / np.maximum(np.abs(p)[:, None], np.abs(p)[None, :])
+    d = d + 1 - mac(lv.T, lv.T)
+    d = np.where(od[:, None] == od[None, :], 1e6, d)
+    np.fill_diagonal(d, 0.0)
+    lab = fcluster(
+        linkage(squareform(np.clip(0.5 * (d + d.T), 0, 1e6), checks=False), "complete"),
+        t=0.01,
+        criterion="distance",
+    )
+    ref = sorted(tuple(idx[lab == k].tolist()) for k in np.unique(lab))
+    got = sorted(tuple(c.members.tolist()) for c in kept + rej)
+    assert len(ref) > 5
+    assert got == ref
+    for c in kept + rej:  # representative: median frequency and damping of the members
+        fn = np.abs(ps.poles[c.members]) / (2 * np.pi)
+        assert c.frequency_hz == pytest.approx(np.median(fn), rel=1e-12)
+        assert c.fraction == np.unique(ps.order[c.members]).size / ps.orders.size

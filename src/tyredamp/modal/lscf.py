@@ -205,14 +205,15 @@ def plscf(
         m11 = M[: p * n_in, : p * n_in]
         m12 = M[: p * n_in, p * n_in :]
         try:
-            alpha = -np.linalg.solve(m11, m12)  # (p n_in, n_in): alpha_0..alpha_{p-1}
+            sol = np.linalg.solve(m11, m12)
         except np.linalg.LinAlgError:
-            alpha = -np.linalg.lstsq(m11, m12, rcond=None)[0]
-        zval = np.linalg.eigvals(_companion(alpha, n_in))
+            sol = np.linalg.lstsq(m11, m12, rcond=None)[0]
+        alpha = np.asarray(-sol, dtype=float)  # (p n_in, n_in): alpha_0..alpha_{p-1}
+        zval = np.asarray(np.linalg.eigvals(_companion(alpha, n_in)), dtype=complex)
         zval = zval[(zval.imag > 0) & (np.abs(zval) > 0)]
         if zval.size == 0:
             continue
-        pole = 1j * w_lo + np.log(zval) / dt
+        pole: NDArray[np.complex128] = 1j * w_lo + np.log(zval) / dt
         lvec = _participation(alpha, zval, n_in)
         pos = pole.imag > 0
         out_order.append(np.full(int(pos.sum()), p, dtype=np.int64))

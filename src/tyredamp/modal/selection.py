@@ -238,9 +238,9 @@ def cluster_poles(
     cuts = np.flatnonzero(gap > cluster_distance) + 1
     # consecutive groups are joined up to _CHUNK poles (fewer, larger linkages)
     chunks: list[int] = []
-    for c in cuts:
-        if c - (chunks[-1] if chunks else 0) >= _CHUNK:
-            chunks.append(int(c))
+    for cut in cuts.tolist():
+        if cut - (chunks[-1] if chunks else 0) >= _CHUNK:
+            chunks.append(cut)
     n_lab = 0
     for grp in np.split(order, chunks):
         sub = _complete_linkage(p[grp], lv[grp], od[grp], cluster_distance)
