@@ -50,6 +50,11 @@ _POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 #: the smallest data set) and start the final fit, which converges to 1e-6 s^2.
 _SEARCH_TOL = 10.0
 _TRIAL_TOL = 1.0
+#: evaluation limit of the search's first joint fit: before the residual modes are
+#: found, the modes near a band edge absorb the out-of-band ones and converge slowly
+#: (linearly) to that biased optimum; two Gauss-Newton steps take most of the gain
+#: from the pLSCF poles, the later joint fits and the final fit do the rest
+_FIRST_NFEV = 3
 #: a residual mode below the band (damped frequency in [f_lo / 2, f_lo]) shapes the
 #: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
 #: starts at the first lines) it cannot be told from the lower residual term
@@ -542,6 +547,7 @@ def _search_helpers(
         passes=1,
         tol=_SEARCH_TOL,
         uncertainty=False,
+        max_nfev=_FIRST_NFEV,
     )
     m = m0 + n_free
     cur_p, cur_l = res.poles, res.participation
@@ -693,12 +699,13 @@ def _fit_checked(
     sigma: NDArray[np.float64] | None = None,
     tol: float = 1e-6,
     uncertainty: bool = True,
+    max_nfev: int = 200,
 ) -> tuple[FitResult, int, list[tuple[complex, str]], int]:
     """Fit modes and residual modes; drop any that left its side of the band or merged.
 
     Returns the fit, the number of in-band modes, the dropped modes and the
-    number of in-band residual modes left. ``passes``, ``sigma``, ``tol`` and
-    ``uncertainty`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`.
+    number of in-band residual modes left. ``passes``, ``sigma``, ``tol``,
+    ``uncertainty`` and ``max_nfev`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`.
 
     ``hp`` holds first ``n_free`` in-band residual modes (not checked against
     the band), then out-of-band ones (which must stay outside).
@@ -714,6 +721,7 @@ def _fit_checked(
             sigma=sigma,
             tol=tol,
             uncertainty=uncertainty,
+            max_nfev=max_nfev,
         )
         p = res.poles
         fd = p.imag / (2 * np.pi)
