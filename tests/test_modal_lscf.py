@@ -185,3 +185,45 @@ def test_clusters_split_at_gaps_equal_one_complete_linkage(monkeypatch: pytest.M
         fn = np.abs(ps.poles[c.members]) / (2 * np.pi)
         assert c.frequency_hz == pytest.approx(np.median(fn), rel=1e-12)
         assert c.fraction == np.unique(ps.order[c.members]).size / ps.orders.size
+
+
+def test_aberth_roots_equal_companion_eigenvalues() -> None:
+    from tyredamp.modal.lscf import _aberth
+
+    rng = np.random.default_rng(4)
+    # roots near the unit circle (poles), a few far inside and outside, real pairs
+    r = np.concatenate(
+        [
+            rng.uniform(0.9, 0.99, 12) * np.exp(1j * np.linspace(0.2, 2.9, 12)),
+            [0.2 + 0.1j, 3.0 + 1.0j, 40.0 + 5.0j],
+        ]
+    )
+    roots = np.concatenate([r, r.conj(), [0.5, -2.0]])
+    c = np.real(np.poly(roots))[::-1]  # ascending, leading coefficient 1
+    # starting values: the roots of a nearby polynomial of lower degree
+    guess = np.sort_complex(roots)[2:] * (1 + 1e-3 * rng.normal(size=roots.size - 2))
+    got = _aberth(c, guess)
+    assert got is not None
+    ref = np.roots(c[::-1])
+    d = np.abs(np.sort_complex(got)[:, None] - ref[None, :]).min(axis=1)
+    assert np.all(d <= 1e-9 * np.maximum(np.abs(np.sort_complex(got)), 1.0))
+    # no convergence -> None (the caller falls back to the eigenvalues)
+    assert _aberth(c, guess, max_iter=1) is None
+    assert _aberth(c, np.zeros(roots.size + 1, complex)) is None  # more guesses than roots
+
+
+def test_plscf_aberth_orders_equal_eigenvalue_orders(monkeypatch: pytest.MonkeyPatch) -> None:
+    import tyredamp.modal.lscf as lscf_mod
+
+    rng = np.random.default_rng(6)
+    h = chain_system().frf(F, inputs=[0]).H
+    h = h + 0.01 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    monkeypatch.setattr(lscf_mod, "_ABERTH_MIN_ORDER", 10**9)
+    ref = plscf(F, h, 60, min_order=15, order_step=2)
+    monkeypatch.setattr(lscf_mod, "_ABERTH_MIN_ORDER", 16)
+    got = plscf(F, h, 60, min_order=15, order_step=2)
+    assert got.poles.size == ref.poles.size
+    for p in ref.orders:
+        a = np.sort_complex(ref.poles[ref.at_order(p)])
+        b = np.sort_complex(got.poles[got.at_order(p)])
+        assert_allclose(b, a, rtol=1e-9)

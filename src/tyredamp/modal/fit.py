@@ -311,9 +311,12 @@ class ModalFitter:
         eb = 1.0 / (s - np.conj(poles)[:, None])
         g = kap * e
         gb = kap * eb
-        lc = part[:, :, None]  # (m, nin, 1)
-        A = lc * g[:, None, :]  # (m, nin, nf)
-        B = np.conj(lc) * gb[:, None, :]
+        if nin == 1:  # participation 1: A = g, B = gb
+            A, B = g[:, None, :], gb[:, None, :]
+        else:
+            lc = part[:, :, None]  # (m, nin, 1)
+            A = lc * g[:, None, :]  # (m, nin, nf)
+            B = np.conj(lc) * gb[:, None, :]
         pt = np.zeros((q, 2, nin, nf))  # rows: columns of phi; [Re; Im] stacked
         _put_pair(pt, 0, A, B)
         c0 = 2 * m
@@ -327,12 +330,24 @@ class ModalFitter:
         if not derivatives:
             return phi, np.zeros((self.n_rows, 0)), np.zeros(0, np.intp), np.zeros(0, np.intp)
         npp = 4 * nin  # derivative columns per mode
-        dt = np.zeros((m, npp, 2, nin, nf))
+        dt = np.empty((m, npp, 2, nin, nf)) if nin == 1 else np.zeros((m, npp, 2, nin, nf))
         dA = A * e[:, None, :]
         dB = B * eb[:, None, :]
+        # pole columns: dp/dx1 = -sigma, dp/dx2 = i w_ref (and conjugates for B):
+        # with S = dA + dB, T = dA - dB the four columns are [-sigma S], [-sigma i T],
+        # [i w_ref T], [-w_ref S], each as [Re; Im]
+        S = dA + dB
+        T = dA - dB
         sig = (-poles.real)[:, None, None]
-        _put_pair(dt, 0, dA * -sig, dB * -sig, step=1)
-        _put_pair(dt, 2, dA * (1j * self.w_ref), dB * (-1j * self.w_ref), step=1)
+        wr = self.w_ref
+        np.multiply(S.real, -sig, out=dt[:, 0, 0])
+        np.multiply(S.imag, -sig, out=dt[:, 0, 1])
+        np.multiply(T.imag, sig, out=dt[:, 1, 0])
+        np.multiply(T.real, -sig, out=dt[:, 1, 1])
+        np.multiply(T.imag, -wr, out=dt[:, 2, 0])
+        np.multiply(T.real, wr, out=dt[:, 2, 1])
+        np.multiply(S.real, -wr, out=dt[:, 3, 0])
+        np.multiply(S.imag, -wr, out=dt[:, 3, 1])
         dpar_l = [2 * np.arange(m)[:, None] + np.array([0, 0, 1, 1])[None, :]]
         if nin > 1:
             # free participation entries: inputs k != ref[n] in increasing k, Re then Im:
@@ -939,22 +954,16 @@ def _put_pair(
     c: int,
     a: NDArray[np.complex128],
     b: NDArray[np.complex128],
-    step: int = 2,
 ) -> None:
     """Write the real-stacked columns ``a + b`` and ``i (a - b)`` of every mode.
 
-    ``a``, ``b``: (m, nin, nf) complex. With ``step=2`` (basis, ``out`` of shape
-    (q, 2, nin, nf)) mode ``n`` goes to rows ``c + 2n, c + 2n + 1``; with
-    ``step=1`` (derivatives, ``out`` of shape (m, npp, 2, nin, nf)) to
-    ``out[n, c]`` and ``out[n, c + 1]``.
+    ``a``, ``b``: (m, nin, nf) complex; ``out`` of shape (q, 2, nin, nf); mode
+    ``n`` goes to rows ``c + 2n, c + 2n + 1``.
     """
     sm = a + b
     df = a - b
-    if step == 2:
-        m = a.shape[0]
-        o1, o2 = out[c : c + 2 * m : 2], out[c + 1 : c + 2 * m : 2]
-    else:
-        o1, o2 = out[:, c], out[:, c + 1]
+    m = a.shape[0]
+    o1, o2 = out[c : c + 2 * m : 2], out[c + 1 : c + 2 * m : 2]
     o1[:, 0] = sm.real
     o1[:, 1] = sm.imag
     o2[:, 0] = -df.imag  # Re(i d) = -Im d

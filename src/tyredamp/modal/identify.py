@@ -47,7 +47,7 @@ _POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 #: rejection stop when a further step would lower the cost by less than 10 s^2, a
 #: trial residual mode by less than 1 s^2. They only choose the modes (the F test
 #: of a trial has 2 n_out + 2 n_in parameters, so 10 s^2 moves F by < 10 / 34 on
-#: the smallest data set) and start the final fit, which converges to 1e-6 s^2.
+#: the smallest data set) and start the final fit, which converges to _FINAL_TOL.
 _SEARCH_TOL = 10.0
 _TRIAL_TOL = 1.0
 #: evaluation limit of the search's first joint fit: before the residual modes are
@@ -55,6 +55,10 @@ _TRIAL_TOL = 1.0
 #: (linearly) to that biased optimum; two Gauss-Newton steps take most of the gain
 #: from the pLSCF poles, the later joint fits and the final fit do the rest
 _FIRST_NFEV = 3
+#: the final fits stop when a full Gauss-Newton step would lower the cost by less
+#: than 1e-4 s^2: the remaining step is about 0.01 standard deviations of the
+#: parameters, far below their uncertainty (ModalFitter.fit's default is 1e-6)
+_FINAL_TOL = 1e-4
 #: a residual mode below the band (damped frequency in [f_lo / 2, f_lo]) shapes the
 #: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
 #: starts at the first lines) it cannot be told from the lower residual term
@@ -386,6 +390,7 @@ def identify_modes(
                 (lo, hi),
                 n_free=n_extra,
                 passes=1,
+                tol=_FINAL_TOL,
                 uncertainty=False,
             )
             res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
@@ -405,6 +410,7 @@ def identify_modes(
                 n_free=n_extra,
                 passes=1 if sigma0 is not None else 2,
                 sigma=sigma0,
+                tol=_FINAL_TOL,
             )
             rejected += [_rej(p, f"complex fit: {why}") for p, why in dropped]
             base = (res, n_band, nf)
@@ -671,7 +677,7 @@ def _fit_real(
         why = ""
     if not why:
         # the evaluation limit bounds the time spent on data that real modes cannot fit
-        res = fitter.fit(start_p, start_l, refine=True, max_nfev=100)
+        res = fitter.fit(start_p, start_l, refine=True, max_nfev=100, tol=_FINAL_TOL)
         why = _problem(res, m, nf, band)
         if not why:
             return res, m, []
