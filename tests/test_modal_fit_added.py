@@ -4,6 +4,7 @@ the per-mode contributions of ModalFitter.fit (spec eq. [10])."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from numpy.testing import assert_allclose
 
 from tyredamp.modal.fit import ModalFitter
@@ -53,3 +54,36 @@ def test_contributions_match_the_synthesised_mode_frfs() -> None:
         hn = r[:, :, None] * g + np.conj(r)[:, :, None] * gb
         # same quantity by two routes: round-off only
         assert_allclose(res.contribution[n], np.sqrt(np.sum(np.abs(hn) ** 2) / data_ss), rtol=1e-9)
+
+
+def test_fit_added_reuses_the_latest_fit_basis_with_the_same_result(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import tyredamp.modal.fit as fit_mod
+
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(9)
+    h = sys_.frf(F, kind="accelerance", inputs=[0]).H
+    h = h + 1e-3 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    fit = ModalFitter(F, h, 2, "complex", [(0, 0)])
+    k = int(np.argsort(cm.poles.imag)[-1])  # the highest mode is "added"
+    keep = np.delete(np.arange(cm.poles.size), k)
+    res = fit.fit(cm.poles[keep] * 1.001, np.ones((keep.size, 1)), uncertainty=False)
+    lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
+    args = (res.poles, res.participation, cm.poles[k] * 1.01, np.ones(1))
+    calls: list[int] = []
+    orth = fit_mod._orth
+
+    def counted(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(phi.shape[1])
+        return orth(phi)
+
+    monkeypatch.setattr(fit_mod, "_orth", counted)
+    a = fit.fit_added(*args, omega_bounds=(lo, hi))
+    n_plain = len(calls)
+    b = fit.fit_added(*args, omega_bounds=(lo, hi), theta=res.theta)  # cached basis
+    assert len(calls) - n_plain == n_plain - 1  # the fixed modes' basis is not redone
+    assert_allclose(b[0], a[0], rtol=1e-12)
+    assert_allclose(b[2], a[2], rtol=1e-9)
+    assert abs(a[0] - cm.poles[k]) < 1e-3 * abs(cm.poles[k])

@@ -141,6 +141,10 @@ class ModalFitter:
         self.kappa = (1j * w) ** power
         self.kappa_low = (1j * w) ** (power - 2)
         self.w_ref = float(w[-1])
+        # (theta, ref, Q) of the latest fit, reused by fit_added(theta=...)
+        self._last_q: tuple[NDArray[np.float64], NDArray[np.intp], NDArray[np.float64]] | None = (
+            None
+        )
         # data: rows (k, f) complex, stacked [Re; Im]
         hc = H.transpose(1, 2, 0).reshape(self.n_in * self.n_f, self.n_out)
         self.Y = np.concatenate([hc.real, hc.imag], axis=0)
@@ -497,6 +501,8 @@ class ModalFitter:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
+        # the projection at the result, for fit_added(theta=...) on these modes
+        self._last_q = (th.copy(), ref.copy(), sol["Q"])
         return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
 
     def fit_added(
@@ -509,6 +515,7 @@ class ModalFitter:
         omega_bounds: tuple[float, float] | None = None,
         max_nfev: int = 200,
         tol: float = 1e-6,
+        theta: NDArray[np.float64] | None = None,
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
@@ -519,6 +526,9 @@ class ModalFitter:
         two-column basis per evaluation instead of the whole one.
         ``omega_bounds`` (rad/s, lower < upper) limits the damped natural
         frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
+        ``theta``: the parameter vector of the fixed modes when they come from
+        this fitter's latest :meth:`fit` (``FitResult.theta``), whose
+        orthonormal basis is then reused.
 
         Returns
         -------
@@ -546,8 +556,17 @@ class ModalFitter:
         if self.unit_weights:
             w = np.ones_like(rms)
         Yw = self.Y * w[None, :]
-        phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
-        Qf = _orth(phi_f)[0]
+        last = self._last_q
+        if (
+            theta is not None
+            and last is not None
+            and np.array_equal(theta, last[0])
+            and np.array_equal(ref, last[1])
+        ):
+            Qf = last[2]
+        else:
+            phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
+            Qf = _orth(phi_f)[0]
         Yp = Yw - Qf @ (Qf.T @ Yw)
         yyp = np.einsum("ij,ij->j", Yp, Yp)
         # the added mode alone: same fitter without residual columns
@@ -623,6 +642,7 @@ class ModalFitter:
             # a given ``solve`` (fit_added) replaces the projection
             sol = self._solve(x, m, ref, Yw, residual=False, yy=yy) if solve is None else solve(x)
             jtj, jtr = self._normal(sol, n_par)
+            sol["jtj"] = jtj  # kept for the standard errors at the optimum
             return float(sol["cost"]), jtj, jtr, sol
 
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -815,7 +835,7 @@ class ModalFitter:
         std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
         std_psi = np.full((self.n_out, m), np.nan)
         if uncertainty:
-            jtj, _ = self._normal(sol, n_par)
+            jtj = sol["jtj"] if "jtj" in sol else self._normal(sol, n_par)[0]
             cth = s2 * np.linalg.pinv(jtj, hermitian=True)
             x1 = th[0 : 2 * m : 2]
             sig = self.w_ref * np.exp(x1)

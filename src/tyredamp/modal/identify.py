@@ -579,7 +579,7 @@ def _search_helpers(
                 edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
                 w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
                 p_t, l_t, sig_t = fitter.fit_added(
-                    cur_p, cur_l, ph, lh, omega_bounds=w_lim, tol=_TRIAL_TOL
+                    cur_p, cur_l, ph, lh, omega_bounds=w_lim, tol=_TRIAL_TOL, theta=res.theta
                 )
             except (np.linalg.LinAlgError, ValueError):
                 break
