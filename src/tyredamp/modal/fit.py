@@ -53,6 +53,7 @@ from typing import Any, Literal
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
+from scipy.linalg import lapack
 
 from ..exceptions import InputError
 
@@ -141,6 +142,7 @@ class ModalFitter:
         self.kappa = (1j * w) ** power
         self.kappa_low = (1j * w) ** (power - 2)
         self.w_ref = float(w[-1])
+        self._sel_cache: dict[tuple[int, bytes], NDArray[np.float64]] = {}
         # (theta, ref, Q) of the latest fit, reused by fit_added(theta=...)
         self._last_q: tuple[NDArray[np.float64], NDArray[np.intp], NDArray[np.float64]] | None = (
             None
@@ -426,6 +428,18 @@ class ModalFitter:
             "Z": Z,
         }
 
+    def _selection(self, dpar: NDArray[np.intp], n_par: int) -> NDArray[np.float64]:
+        """0/1 matrix (n_d, n_par) mapping derivative columns to parameters (cached)."""
+        key = (n_par, dpar.tobytes())
+        A = self._sel_cache.get(key)
+        if A is None:
+            A = np.zeros((dpar.size, n_par))
+            A[np.arange(dpar.size), dpar] = 1.0
+            if len(self._sel_cache) > 16:
+                self._sel_cache.clear()
+            self._sel_cache[key] = A
+        return A
+
     def _normal(
         self, sol: dict[str, Any], n_par: int
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -435,9 +449,8 @@ class ModalFitter:
         qtd = Q.T @ D
         G = D.T @ D - qtd.T @ qtd
         W = C @ C.T
-        Md = G * W[np.ix_(dcol, dcol)]
-        A = np.zeros((dpar.size, n_par))
-        A[np.arange(dpar.size), dpar] = 1.0
+        Md = G * W[dcol[:, None], dcol[None, :]]
+        A = self._selection(dpar, n_par)
         jtj = A.T @ Md @ A
         Z = sol["Z"]  # r C^T, (n_rows, q)
         if Z is None:
@@ -867,9 +880,9 @@ class ModalFitter:
         # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's
         # columns: no (n_rows x n_out) array per mode
         pb = phi[:, : per * m].reshape(self.n_rows, m, per)
-        gram = np.einsum("rna,rnb->nab", pb, pb, optimize=True)
+        gram = np.matmul(pb.transpose(1, 2, 0), pb.transpose(1, 0, 2))  # (m, per, per)
         cb = C[: per * m].reshape(m, per, self.n_out)
-        ss = np.einsum("nao,nab,nbo->no", cb, gram, cb, optimize=True)  # (m, n_out)
+        ss = np.sum(cb * np.matmul(gram, cb), axis=1)  # (m, n_out)
         contrib = np.sqrt(np.sum(ss / w[None, :] ** 2, axis=1) / max(data_ss, 1e-300))
         signif = np.sum(ss, axis=1) / (s2 * (per * self.n_out + 2))
         return FitResult(
@@ -917,8 +930,7 @@ class ModalFitter:
         rinv = sla.solve_triangular(Rq, np.eye(q))
         F = rinv @ rinv.T  # (Phi^T Phi)^-1
         E = rinv @ (Q.T @ D)  # Phi^+ D, (q, n_d)
-        A = np.zeros((dpar.size, n_par))
-        A[np.arange(dpar.size), dpar] = 1.0
+        A = self._selection(dpar, n_par)
         # M_j = -Phi^+ dPhi/dtheta C_j  -> (n_out, q, n_par)
         M = -np.einsum("ad,dj,dk->jak", E, C[dcol], A, optimize=True)
         MC = M @ cth  # Cov(C_j, theta), (n_out, q, n_par)
@@ -1021,8 +1033,18 @@ def _orth(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.flo
 
 
 def _householder(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    q, r = np.linalg.qr(phi)
-    return q, r
+    """Thin Householder QR by LAPACK ``dgeqrf`` + ``dorgqr`` (less call overhead
+    than :func:`numpy.linalg.qr` for the small bases); NumPy's on failure."""
+    n, q = phi.shape
+    if n >= q > 0:
+        qr, tau, _, info = lapack.dgeqrf(phi)
+        if info == 0:
+            r = np.triu(qr[:q])
+            qm, _, info = lapack.dorgqr(qr, tau, overwrite_a=1)
+            if info == 0:
+                return qm, r
+    qn, rn = np.linalg.qr(phi)
+    return qn, rn
 
 
 def _levenberg_marquardt(
