@@ -52,9 +52,9 @@ _SEARCH_TOL = 10.0
 _TRIAL_TOL = 1.0
 #: evaluation limit of the search's first joint fit: before the residual modes are
 #: found, the modes near a band edge absorb the out-of-band ones and converge slowly
-#: (linearly) to that biased optimum; two Gauss-Newton steps take most of the gain
+#: (linearly) to that biased optimum; one Gauss-Newton step takes most of the gain
 #: from the pLSCF poles, the later joint fits and the final fit do the rest
-_FIRST_NFEV = 3
+_FIRST_NFEV = 2
 #: the final fits stop when a full Gauss-Newton step would lower the cost by less
 #: than 1e-4 s^2: the remaining step is about 0.01 standard deviations of the
 #: parameters, far below their uncertainty (ModalFitter.fit's default is 1e-6)
