@@ -129,6 +129,18 @@ def test_modal_on_pyuff_frf(
     # six modes of a 6-DOF chain from 0.1 % noise: frequencies within 0.1 %
     assert m.n_modes == fn.size
     assert_allclose(m.frequency_hz, fn, rtol=1e-3)
+    # every order of the diagram (--order-step 1): the same modes, recorded in meta
+    modes1 = tmp_path / "modes1.json"
+    code, _, err = run(
+        capsys, "modal", str(path), "-o", str(modes1), "--model", "complex", "--order-step", "1"
+    )
+    assert code == 0, err
+    m1 = read_modes_json(modes1)["complex"]
+    assert m1.meta["order_step"] == 1
+    assert m.meta["order_step"] == 2
+    assert_allclose(m1.frequency_hz, m.frequency_hz, rtol=1e-6)
+    code, _, err = run(capsys, "modal", str(path), "-o", str(modes1), "--order-step", "0")
+    assert code != 0
     report = tmp_path / "r.html"
     code, _out, err = run(capsys, "report", str(modes), str(path), "--out", str(report))
     assert code == 0, err

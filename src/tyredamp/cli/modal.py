@@ -77,6 +77,13 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     type=click.IntRange(min=2),
     help="Highest pLSCF model order (default 60 / number of inputs).",
 )
+@click.option(
+    "--order-step",
+    type=click.IntRange(min=1),
+    default=2,
+    show_default=True,
+    help="Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
+)
 @click.option("--no-residuals", is_flag=True, help="Fit without lower/upper residual terms.")
 def modal_command(
     frf_file: Path,
@@ -86,6 +93,7 @@ def modal_command(
     n_modes: int | None,
     frequencies: str | None,
     max_order: int | None,
+    order_step: int,
     no_residuals: bool,
 ) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
@@ -109,6 +117,7 @@ def modal_command(
         n_modes=n_modes,
         frequencies=_parse_frequencies(frequencies),
         max_order=max_order,
+        order_step=order_step,
         residuals=not no_residuals,
     )
     write_modes_json(
