@@ -2,7 +2,9 @@
 
 Pipeline of :func:`identify_modes` (spec ``radial-damping.md`` steps 3-6):
 
-1. poles of all model orders by pLSCF (:func:`~tyredamp.modal.lscf.plscf`);
+1. poles of the model orders ``max_order / 4 .. max_order`` (every
+   ``order_step``-th, default every second) by pLSCF
+   (:func:`~tyredamp.modal.lscf.plscf`);
 2. stabilisation and automatic selection (:mod:`~tyredamp.modal.selection`),
    no frequencies needed; a mode count or approximate frequencies may be given;
 3. residues by LSFD with the complex-mode model; modes whose contribution to
