@@ -147,8 +147,9 @@ def test_plscf_order_step_counts_down_from_the_highest_order() -> None:
     flags = stability_flags(ps)
     kept, _ = cluster_poles(ps, flags)
     assert len(kept) == chain_system().complex_modes().poles.size
-    with pytest.raises(InputError, match="order_step"):
-        plscf(F, h, 24, order_step=0)
+    for bad in (0, -2, 1.5, "2", True):
+        with pytest.raises(InputError, match="order_step"):
+            plscf(F, h, 24, order_step=bad)  # type: ignore[arg-type]
 
 
 def test_clusters_split_at_gaps_equal_one_complete_linkage(monkeypatch: pytest.MonkeyPatch) -> None:

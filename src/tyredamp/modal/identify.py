@@ -209,8 +209,6 @@ def identify_modes(
     H = np.asarray(frf.H) if lines.size == fa.size else np.asarray(frf.H[:, :, lines])
     n_out, n_in, n_f = H.shape
     power = _POWER[data.kind]
-    if not isinstance(order_step, (int, np.integer)) or order_step < 1:
-        raise InputError(f"order_step: expected a positive integer, got {order_step!r}")
     if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
         raise InputError(f"n_modes: expected a positive integer, got {n_modes!r}")
     fr = None

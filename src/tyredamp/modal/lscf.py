@@ -138,10 +138,12 @@ def plscf(
         raise ShapeError(f"H: expected shape (n_out, n_in, {f.size}), got {h.shape}")
     p_max = int(max_order)
     p_min = int(min_order)
-    step = int(order_step)
     if p_max < 1 or p_min < 1 or p_min > p_max:
         raise InputError(f"max_order/min_order: expected 1 <= min <= max, got {p_min}, {p_max}")
-    if step < 1 or step != order_step:
+    if isinstance(order_step, bool) or not isinstance(order_step, (int, np.integer)):
+        raise InputError(f"order_step: expected a positive integer, got {order_step!r}")
+    step = int(order_step)
+    if step < 1:
         raise InputError(f"order_step: expected a positive integer, got {order_step!r}")
     lo, hi = (float(f[0]), float(f[-1])) if band is None else (float(band[0]), float(band[1]))
     if not hi > lo:
