@@ -228,3 +228,89 @@ def test_plscf_aberth_orders_equal_eigenvalue_orders(monkeypatch: pytest.MonkeyP
         a = np.sort_complex(ref.poles[ref.at_order(p)])
         b = np.sort_complex(got.poles[got.at_order(p)])
         assert_allclose(b, a, rtol=1e-9)
+
+
+def test_companion_eigvals_equal_numpy_eigvals_of_the_companion() -> None:
+    from tyredamp.modal.lscf import _companion, _companion_eigvals
+
+    rng = np.random.default_rng(11)
+    # one input: the roots of a polynomial built from known roots (closed form)
+    r = rng.uniform(0.5, 0.99, 9) * np.exp(1j * rng.uniform(0.1, 3.0, 9))
+    roots = np.concatenate([r, r.conj(), [0.3, -0.7]])
+    alpha = np.real(np.poly(roots))[::-1][:-1, None]  # alpha_0..alpha_{p-1}, alpha_p = 1
+    got = np.sort_complex(_companion_eigvals(alpha, 1))
+    assert_allclose(got, np.sort_complex(roots), rtol=1e-10)
+    # any number of inputs: the eigenvalues of the block companion matrix
+    for n_in, p in ((1, 3), (1, 40), (2, 7), (3, 5)):
+        alpha = rng.normal(size=(p * n_in, n_in))
+        ref = np.linalg.eigvals(_companion(alpha, n_in))
+        got = _companion_eigvals(alpha, n_in)
+        assert got.shape == ref.shape
+        d = np.abs(got[:, None] - ref[None, :]).min(axis=1)
+        assert np.all(d <= 1e-10 * np.maximum(np.abs(got), 1.0))
+    with pytest.raises(np.linalg.LinAlgError):  # as np.linalg.eigvals
+        _companion_eigvals(np.array([[np.nan], [1.0]]), 1)
+
+
+def test_aberth_any_degree_equals_companion_eigenvalues() -> None:
+    from tyredamp.modal.lscf import _aberth, _companion
+
+    rng = np.random.default_rng(12)
+    # degrees at and around the block lengths of the evaluation (b = isqrt(n) + 1).
+    # Random coefficients: roots around the unit circle, about half outside it
+    # (reversed evaluation), well conditioned as in the stabilisation diagrams
+    for n in (1, 2, 3, 4, 8, 15, 16, 24, 63, 80, 121):
+        c = np.append(rng.normal(size=n), 1.0)
+        ref = np.linalg.eigvals(_companion(c[:-1, None], 1))
+        # starting values: the roots of a nearby polynomial of degree n - 2
+        keep = max(n - 2, 0)
+        guess = ref[:keep] * (1 + 1e-3 * rng.normal(size=keep))
+        got = _aberth(c, guess)
+        assert got is not None
+        assert got.size == n
+        d = np.abs(got[:, None] - ref[None, :]).min(axis=1)
+        assert np.all(d <= 1e-11 * np.maximum(np.abs(got), 1.0)), n
+        d = np.abs(ref[:, None] - got[None, :]).min(axis=1)  # every root found
+        assert np.all(d <= 1e-11 * np.maximum(np.abs(ref), 1.0)), n
+
+
+def test_unit_powers_equal_cosine_and_sine() -> None:
+    from tyredamp.modal.lscf import _unit_powers
+
+    theta = np.linspace(0.0, np.pi, 333)
+    eps = np.finfo(float).eps
+    for p in (0, 1, 2, 5, 8, 61, 120):
+        zc, zs = _unit_powers(theta, p)
+        d = np.arange(p + 1)
+        ph = np.outer(d, theta)
+        assert zc.shape == zs.shape == (p + 1, theta.size)
+        # the reference cos(d theta) carries the rounding of d * theta itself
+        tol = ((d * np.pi + 8) * eps)[:, None]
+        assert np.all(np.abs(zc - np.cos(ph)) <= tol)
+        assert np.all(np.abs(zs - np.sin(ph)) <= tol)
+    zc, zs = _unit_powers(theta, 1)
+    assert np.array_equal(zc, np.vstack([np.ones_like(theta), np.cos(theta)]))
+    assert np.array_equal(zs, np.vstack([np.zeros_like(theta), np.sin(theta)]))
+
+
+def test_plscf_cholesky_fallback_gives_the_same_poles(monkeypatch: pytest.MonkeyPatch) -> None:
+    import tyredamp.modal.lscf as lscf_mod
+
+    rng = np.random.default_rng(13)
+    h = chain_system().frf(F, inputs=[0, 3]).H
+    h = h + 0.01 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    ref = plscf(F, h, 20, min_order=4)
+
+    def failing_dposv(a: np.ndarray, b: np.ndarray, **kw: object) -> tuple:
+        return a, b, 1  # "not positive definite": the LU solve takes over
+
+    monkeypatch.setattr(lscf_mod.sla.lapack, "dposv", failing_dposv)
+    got = plscf(F, h, 20, min_order=4)
+    assert got.poles.size == ref.poles.size
+    for p in ref.orders:
+        a = np.sort_complex(ref.poles[ref.at_order(p)])
+        b = np.sort_complex(got.poles[got.at_order(p)])
+        assert_allclose(b, a, rtol=1e-9)
+    # singular normal equations (no signal): least squares, then no pole at all
+    with pytest.raises(InputError, match="no pole"):
+        plscf(F, np.zeros((2, 1, F.size), complex), 4)

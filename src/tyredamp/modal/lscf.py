@@ -18,10 +18,22 @@ the sums ``sum_f z_f^d H_ok(f)``: two real matrix products over all outputs
 and lines, ``O(n_out n_freq order)``. The blocks of every lower order are leading
 sub-blocks of the highest order, so a whole stabilisation diagram costs about
 as much as one high-order solve.
+
+Computation: the table ``z_f^d``, ``d = 0..order``, comes from repeated
+products of ``z_f`` (about ``log2 order`` block products; rounding error
+growing like ``d 1e-16``, as that of ``cos(d theta)``) instead of a cosine
+and sine per entry. The per-output
+elimination is one triangular solve (BLAS ``dtrsm``, in place) and a rank
+update per order (``dsyrk``); the reduced equations of each order are solved
+by Cholesky (``dposv``), with LU and least squares as fallbacks. The roots
+of each order are the eigenvalues of the companion matrix (``dgeev``), or,
+for one input and high orders, Aberth-Ehrlich sweeps started at the previous
+order's roots (the same roots to round-off, fewer operations).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +49,10 @@ __all__ = ["PoleSet", "plscf"]
 #: at the previous order's roots instead of the companion eigenvalues (same roots
 #: to ~1e-13; faster for the large orders of many-mode bands)
 _ABERTH_MIN_ORDER = 64
+#: convergence tolerances of :func:`_aberth` on ``|w| / |z|``, chosen by the
+#: shrink ratio ``|w| / |w_last|`` of the correction (edges ``_SHRINK``)
+_SHRINK = np.array([1e-3, 0.5, 1e300])
+_TOL = np.array([1e-8, 1e-14, 1e-9, 1e-14])
 
 
 @dataclass(frozen=True)
@@ -149,7 +165,8 @@ def plscf(
     if not hi > lo:
         raise InputError(f"band: expected f_lo < f_hi, got [{lo}, {hi}] Hz")
     sel = (f >= lo) & (f <= hi)
-    f, h = f[sel], h[:, :, sel]
+    if not sel.all():  # (no copy when the band holds every line)
+        f, h = f[sel], h[:, :, sel]
     n_out, n_in, n_f = h.shape
     if n_f * 2 <= (p_max + 1) * (n_in + 1):
         raise InputError(
@@ -157,26 +174,31 @@ def plscf(
             f"(need 2 * n_freq > (max_order + 1) * (n_in + 1))"
         )
     if output_weights is None:
-        rms = np.sqrt(np.mean(np.abs(h) ** 2, axis=(1, 2)))
+        ms = np.einsum("okf,okf->o", h.real, h.real) + np.einsum("okf,okf->o", h.imag, h.imag)
+        rms = np.sqrt(ms / (n_in * n_f))
         w = 1.0 / np.where(rms > 0, rms, 1.0)
     else:
         w = as_finite(output_weights, "output_weights", ndim=1)
         if w.size != n_out:
             raise ShapeError(f"output_weights: expected {n_out} values, got {w.size}")
-    h = h * w[:, None, None]
+    # weighted real and imaginary parts, each contiguous for the matrix products
+    h_re = h.real * w[:, None, None]
+    h_im = h.imag * w[:, None, None]
     dt = np.pi / (2 * np.pi * (hi - lo))
     theta = 2 * np.pi * (f - lo) * dt  # in [0, pi]
     P = p_max
-    ph = np.outer(theta, np.arange(P + 1))
-    zc, zs = np.cos(ph), np.sin(ph)  # Re and Im of z^d, d = 0..P, shape (n_f, P+1)
+    zc, zs = _unit_powers(theta, P)  # Re and Im of z^d, d = 0..P, shape (P+1, n_f)
     lag = np.arange(P + 1)[None, :] - np.arange(P + 1)[:, None]  # r' - r
     # R[r, r'] = Re sum_f z^(r'-r)    (common to all outputs)
-    R = zc.sum(axis=0)[np.abs(lag)]
+    R = zc.sum(axis=1)[np.abs(lag)]
     # c_ok(d) = Re sum_f z^d H_ok(f), d = -P..P (index d + P): two real products
-    c = _real_lag_sums(h.reshape(n_out * n_in, n_f), zc, zs).reshape(n_out, n_in * (2 * P + 1))
-    # sum_o T_o[(r,k),(r',k')] = Re sum_f z^(r'-r) sum_o conj(H_ok) H_ok'
-    q = np.einsum("okf,olf->klf", h.conj(), h).reshape(n_in * n_in, n_f)
-    t = _real_lag_sums(q, zc, zs).reshape(n_in, n_in, 2 * P + 1)
+    c = _real_lag_sums(h_re.reshape(n_out * n_in, n_f), h_im.reshape(n_out * n_in, n_f), zc, zs)
+    c = c.reshape(n_out, n_in * (2 * P + 1))
+    # sum_o T_o[(r,k),(r',k')] = Re sum_f z^(r'-r) q_kk'(f),  q_kk' = sum_o conj(H_ok) H_ok'
+    q_re = np.einsum("okf,olf->klf", h_re, h_re) + np.einsum("okf,olf->klf", h_im, h_im)
+    q_im = np.einsum("okf,olf->klf", h_re, h_im) - np.einsum("okf,olf->klf", h_im, h_re)
+    t = _real_lag_sums(q_re.reshape(n_in * n_in, n_f), q_im.reshape(n_in * n_in, n_f), zc, zs)
+    t = t.reshape(n_in, n_in, 2 * P + 1)
     T = t[:, :, lag + P].transpose(2, 0, 3, 1).reshape((P + 1) * n_in, (P + 1) * n_in)
     # sum_o S_o^T R^-1 S_o is a quadratic form in the rows c_o: with more outputs
     # than entries of c_o, any rows with the same Gram matrix sum_o c_o c_o^T give
@@ -186,74 +208,124 @@ def plscf(
         keep = lam > lam[-1] * 1e-15
         c = (vec[:, keep] * np.sqrt(lam[keep])).T
     n_v = c.shape[0]
-    # S_o[r, (r', k)] = -c_ok(r' - r);  U_o = L^-1 S_o with R = L L^T
-    S = -c.reshape(n_v, n_in, 2 * P + 1)[:, :, lag + P]  # (o, k, r, r')
-    S = S.transpose(2, 0, 3, 1).reshape(P + 1, n_v * (P + 1) * n_in)
+    # S_o[r, (r', k)] = -c_ok(r' - r);  U_o = L^-1 S_o with R = L L^T. Only the
+    # products U_o^T U_o are used, so the sign is dropped. All S_o side by side:
+    # S[r, (o, r', k)] = c_ok(r' - r), C-ordered (P+1, n_v (P+1) n_in); row r of
+    # S_o is the window of c_ok starting at lag -r
+    win = np.lib.stride_tricks.sliding_window_view(c.reshape(n_v, n_in, 2 * P + 1), P + 1, axis=2)
+    S = np.ascontiguousarray(win[:, :, ::-1, :].transpose(2, 0, 3, 1)).reshape(P + 1, -1)
     L = np.linalg.cholesky(R)
-    U = sla.solve_triangular(L, S, lower=True, check_finite=False)
+    # U^T = S^T L^-T by BLAS dtrsm (right side) on S^T, an F-ordered view of S:
+    # solved in place, no copy of S, and U comes out C-ordered
+    U = sla.blas.dtrsm(1.0, L, S.T, side=1, lower=1, trans_a=1, overwrite_b=1).T
     U = U.reshape(P + 1, n_v, (P + 1) * n_in)
 
     orders = np.arange(P, p_min - 1, -step)[::-1]
-    out_order: list[NDArray[np.int64]] = []
-    out_poles: list[NDArray[np.complex128]] = []
-    out_part: list[NDArray[np.complex128]] = []
+    z_up: list[NDArray[np.complex128]] = []  # upper-half-plane roots of each order
+    l_up: list[NDArray[np.complex128]] = []  # their participation vectors (n_in > 1)
     w_lo = 2 * np.pi * lo
     # the reduced matrix of order p uses the leading p + 1 rows of every U_o:
-    # sum_o U_o^T U_o accumulates row block by row block up the orders
-    acc = np.zeros(((P + 1) * n_in, (P + 1) * n_in))
+    # sum_o U_o^T U_o accumulates row block by row block up the orders (lower
+    # triangle only, F-ordered, updated in place by BLAS dsyrk)
+    nm = (P + 1) * n_in
+    acc = np.zeros((nm, nm), order="F")
+    Tf = np.asfortranarray(T)
     r0 = 0
     prev_roots: NDArray[np.complex128] | None = None  # all roots of the previous order
     for p in orders:
-        blk = U[r0 : p + 1].reshape(-1, U.shape[2])
-        acc += blk.T @ blk
+        blk = U[r0 : p + 1].reshape(-1, nm)
+        acc = sla.blas.dsyrk(1.0, blk.T, beta=1.0, c=acc, trans=0, lower=1, overwrite_c=1)
         r0 = p + 1
         nc = (p + 1) * n_in
-        M = T[:nc, :nc] - acc[:nc, :nc]
-        M = 0.5 * (M + M.T)
-        m11 = M[: p * n_in, : p * n_in]
-        m12 = M[: p * n_in, p * n_in :]
-        try:
-            sol = np.linalg.solve(m11, m12)
-        except np.linalg.LinAlgError:
-            sol = np.linalg.lstsq(m11, m12, rcond=None)[0]
+        k = p * n_in
+        # M = T - acc (symmetric): m11 = M[:k, :k] (lower triangle), m12 = M[:k, k:]
+        m11 = Tf[:k, :k] - acc[:k, :k]
+        m12 = np.asfortranarray((Tf[k:nc, :k] - acc[k:nc, :k]).T)
+        # M is a Schur complement of a Gram matrix (positive semi-definite):
+        # Cholesky (LAPACK dposv), or the general solvers (LU, least squares)
+        # when round-off left it indefinite or it is singular
+        _, sol, info = sla.lapack.dposv(m11, m12, lower=1, overwrite_a=1, overwrite_b=0)
+        if info != 0:
+            m11 = Tf[:k, :k] - acc[:k, :k]
+            m11 = np.tril(m11) + np.tril(m11, -1).T
+            try:
+                sol = np.linalg.solve(m11, m12)
+            except np.linalg.LinAlgError:
+                sol = np.linalg.lstsq(m11, m12, rcond=None)[0]
         alpha = np.asarray(-sol, dtype=float)  # (p n_in, n_in): alpha_0..alpha_{p-1}
         zall = None
         if n_in == 1 and p >= _ABERTH_MIN_ORDER and prev_roots is not None:
             zall = _aberth(np.append(alpha[:, 0], 1.0), prev_roots)
         if zall is None:
-            zall = np.asarray(np.linalg.eigvals(_companion(alpha, n_in)), dtype=complex)
+            zall = _companion_eigvals(alpha, n_in)
         prev_roots = zall
         # upper half plane (a real root from the sweeps has |Im| at round-off level)
         zval = zall[zall.imag > 1e-12 * np.abs(zall)]
-        if zval.size == 0:
-            continue
-        pole = np.asarray(1j * w_lo + np.log(zval) / dt, dtype=complex)
-        lvec = _participation(alpha, zval, n_in)
-        pos = pole.imag > 0
-        out_order.append(np.full(int(pos.sum()), p, dtype=np.int64))
-        out_poles.append(pole[pos])
-        out_part.append(lvec[pos])
-    if not out_poles:
+        z_up.append(zval)
+        if n_in > 1:
+            l_up.append(_participation(alpha, zval, n_in))
+    # the poles of all orders at once
+    zv = np.concatenate(z_up)
+    if zv.size == 0:
         raise InputError("plscf: no pole found in the band at any order")
+    pole = np.asarray(1j * w_lo + np.log(zv) / dt, dtype=complex)
+    order = np.repeat(orders.astype(np.int64), [z.size for z in z_up])
+    lvec = np.ones((zv.size, 1), complex) if n_in == 1 else np.concatenate(l_up)
+    pos = pole.imag > 0
     return PoleSet(
-        order=np.concatenate(out_order),
-        poles=np.concatenate(out_poles),
-        participation=np.concatenate(out_part),
+        order=order[pos],
+        poles=pole[pos],
+        participation=lvec[pos],
         orders=orders.astype(np.int64),
         band_hz=(lo, hi),
     )
 
 
+def _unit_powers(
+    theta: NDArray[np.float64], p: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``cos(d theta)`` and ``sin(d theta)`` for ``d = 0..p``, each of shape (p+1, n_f).
+
+    With rows ``0..k`` known, ``z^(k+j) = z^k z^j`` gives rows ``k+1..k+j``
+    (``j <= k``) by one complex product per entry (in real arithmetic), so the
+    table costs about ``log2 p`` block products instead of ``n_f (p+1)``
+    cosines and sines. The rounding error grows about linearly in ``d``
+    (``d 1e-16``), as that of ``np.cos(d * theta)`` does through the rounding
+    of ``d * theta`` (the two tables differ by up to ``4e-14`` at ``d = 120``).
+    """
+    zc = np.empty((p + 1, theta.size))
+    zs = np.empty((p + 1, theta.size))
+    tmp = np.empty((max(p // 2, 1), theta.size))
+    zc[0], zs[0] = 1.0, 0.0
+    if p >= 1:
+        zc[1], zs[1] = np.cos(theta), np.sin(theta)
+    k = 1
+    while k < p:  # rows 0..k known: rows k+1..k+j = row k times rows 1..j
+        j = min(k, p - k)
+        a, b = zc[k], zs[k]
+        ca, sa, t = zc[1 : j + 1], zs[1 : j + 1], tmp[:j]
+        np.multiply(ca, a, out=zc[k + 1 : k + j + 1])
+        zc[k + 1 : k + j + 1] -= np.multiply(sa, b, out=t)
+        np.multiply(sa, a, out=zs[k + 1 : k + j + 1])
+        zs[k + 1 : k + j + 1] += np.multiply(ca, b, out=t)
+        k += j
+    return zc, zs
+
+
 def _real_lag_sums(
-    x: NDArray[np.complex128], zc: NDArray[np.float64], zs: NDArray[np.float64]
+    xr: NDArray[np.float64],
+    xi: NDArray[np.float64],
+    zc: NDArray[np.float64],
+    zs: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """``Re sum_f z_f^d x(f)`` for ``d = -P..P`` (column ``d + P``), rows of ``x``.
+    """``Re sum_f z_f^d x(f)`` for ``d = -P..P`` (column ``d + P``), rows of ``x = xr + i xi``.
 
     ``Re(x z^d) = Re x cos - Im x sin`` and ``Re(x z^-d) = Re x cos + Im x sin``:
-    two real matrix products instead of two complex ones.
+    two real matrix products instead of two complex ones (``zc``, ``zs``: the
+    tables of :func:`_unit_powers`, shape (P+1, n_f)).
     """
-    a = x.real @ zc
-    b = x.imag @ zs
+    a = xr @ zc.T
+    b = xi @ zs.T
     return np.concatenate([(a + b)[:, :0:-1], a - b], axis=1)
 
 
@@ -266,13 +338,23 @@ def _aberth(
     diagram, which are close to most roots of this one; the missing starting
     values (one per added degree) are spread asymmetrically so that a pair of
     real roots can form. Each root is updated by ``w_k = N_k / (1 - N_k sum_j
-    1 / (z_k - z_j))`` with the Newton correction ``N_k = P(z_k) / P'(z_k)``
-    (evaluated through the reversed polynomial for ``|z_k| > 1``) until
-    ``|w_k| <= 1e-14 |z_k|``, or ``|w_k| <= 1e-9 |z_k|`` and no longer shrinking
-    (the attainable accuracy); converged roots leave the active set. Cubic
-    convergence from close starting values: a few ``O(n^2)`` sweeps replace
-    the ``O(n^3)`` eigenvalues of the companion matrix. Returns ``None`` when
-    the iteration does not converge (the caller then uses the eigenvalues).
+    1 / (z_k - z_j))`` with the Newton correction ``N_k = P(z_k) / P'(z_k)``,
+    evaluated in powers of ``u = z_k`` or, for ``|z_k| > 1``, of ``u = 1 / z_k``
+    through the reversed polynomial ``q(u) = u^n P(1/u)``
+    (``N_k = q(u) / (u (n q(u) - u q'(u)))``), so that no power exceeds 1 in
+    modulus. The four polynomials ``P, P', q`` and ``u (n q - u q')`` are
+    evaluated together by splitting the degree into blocks of ``b ~ sqrt(n)``:
+    ``sum_J u^(bJ) sum_i c_(bJ+i) u^i``, one matrix product with the powers
+    ``u^0..u^(b-1)`` and a short sum over the powers of ``u^b``.
+
+    A root leaves the active set when ``|w_k| <= 1e-14 |z_k|`` (round-off), when
+    ``|w_k| <= 1e-9 |z_k|`` and ``|w_k|`` no longer shrinks (at least half the
+    previous correction: the attainable accuracy), or when ``|w_k| <= 1e-8 |z_k|``
+    after a step that shrank the correction at least 1000-fold (the cubic
+    convergence then leaves an error far below ``1e-14 |z_k|``; not on the
+    first sweep, which has no previous correction). A few ``O(n^2)`` sweeps
+    replace the ``O(n^3)`` eigenvalues of the companion matrix. Returns ``None``
+    when the iteration does not converge (the caller then uses the eigenvalues).
     """
     n = c.size - 1
     k_new = n - guess.size
@@ -280,37 +362,70 @@ def _aberth(
         return None
     extra = (1.4 - 0.3 * np.arange(k_new)) * np.exp(1j * (0.3 + 2.4 * np.arange(k_new)))
     z = np.concatenate([np.asarray(guess, complex), extra])
-    dc = c[1:] * np.arange(1, n + 1)  # P'
-    cr = c[::-1]  # reversed: u^n P(1/u)
-    dcr = cr[1:] * np.arange(1, n + 1)
-    act = np.arange(n)
-    w_last = np.full(n, np.inf)  # |w| of the previous sweep, per root
+    b = math.isqrt(n) + 1  # block length, b * b >= n + 1
+    nb = -(-(n + 1) // b)  # number of blocks
+    k = np.arange(n + 1)
+    cr = c[::-1]
+    coef = np.zeros((nb * b, 4))  # columns: P, P', q, u (n q - u q'), ascending powers of u
+    coef[: n + 1, 0] = c
+    coef[:n, 1] = c[1:] * k[1:]
+    coef[: n + 1, 2] = cr
+    coef[1 : n + 1, 3] = (n - k[:-1]) * cr[:-1]
+    # cb[i, (col, J)] = coef[b J + i, col]
+    cb = np.ascontiguousarray(
+        coef.reshape(nb, b, 4).transpose(1, 2, 0).reshape(b, 4 * nb), dtype=complex
+    )
+    kb, kn = np.arange(b), np.arange(nb)
+    act = np.arange(n)  # active roots
+    diag = act * (n + 1)  # flat indices of the pairs (k, k) in the (active, all) differences
+    w_last = np.zeros(n)  # |w| of the previous sweep (0: none yet), per active root
     with np.errstate(all="ignore"):
         for _ in range(max_iter):
             za = z[act]
-            big = np.abs(za) > 1
-            u = np.where(big, 1 / za, za)
-            ones = np.ones((u.size, 1), complex)
-            V = np.cumprod(np.hstack([ones, np.broadcast_to(u[:, None], (u.size, n))]), axis=1)
-            fwd = (V @ c) / (V[:, :n] @ dc)
-            qv = V @ cr
-            rev = za * qv / (n * qv - u * (V[:, :n] @ dcr))
-            N = np.where(big, rev, fwd)
-            diff = za[:, None] - z[None, :]
-            diff[np.arange(act.size), act] = np.inf
-            w = N / (1 - N * np.sum(1 / diff, axis=1))
-            if not np.all(np.isfinite(w)):
-                return None
+            m = za.size
+            az = np.abs(za)
+            big = az > 1
+            u = np.where(big, 1 / za, za)[:, None]
+            low = u**kb  # u^i, i < b
+            ev = (low @ cb).reshape(m, 4, nb) @ ((low[:, -1:] * u) ** kn)[:, :, None]
+            newton = np.where(big, ev[:, 2, 0] / ev[:, 3, 0], ev[:, 0, 0] / ev[:, 1, 0])
+            d = np.subtract.outer(za, z)
+            d.flat[diag] = np.inf  # no self term
+            w = newton / (1 - newton * np.reciprocal(d, out=d).sum(axis=1))
             z[act] = za - w
-            # done: at round-off, or at the attainable accuracy (|w| small and no
-            # longer shrinking: the polynomial's own rounding error)
-            aw, az = np.abs(w), np.abs(z[act])
-            done = (aw <= 1e-14 * az) | ((aw <= 1e-9 * az) & (aw >= 0.5 * w_last[act]))
-            w_last[act] = aw
-            act = act[~done]
-            if act.size == 0:
+            aw = np.abs(w)
+            if not math.isfinite(aw.sum()):
+                return None
+            # tolerance on |w| / |z| by the shrink ratio |w| / |w_last|: <= 1e-3
+            # (cubic phase) 1e-8, up to 0.5 1e-14, > 0.5 (stalled) 1e-9, and
+            # inf or nan (first sweep) 1e-14
+            done = aw <= az * _TOL[np.searchsorted(_SHRINK, aw / w_last)]
+            if done.all():
                 return z
+            keep = ~done
+            act = act[keep]
+            w_last = aw[keep]
+            diag = act + n * np.arange(act.size)
     return None
+
+
+def _companion_eigvals(alpha: NDArray[np.float64], n_in: int) -> NDArray[np.complex128]:
+    """Eigenvalues of the block companion matrix of ``A(z)^T`` (all roots ``z_n``).
+
+    LAPACK ``dgeev`` (eigenvalues only) on the transposed matrix: the
+    F-ordered view of the C-ordered companion is passed without a copy, and
+    for one input it is upper Hessenberg already (a little faster than the
+    companion itself). The same eigenvalues as ``np.linalg.eigvals`` of the
+    companion to round-off (possibly in another order); that is the fallback
+    when the QR iteration does not converge or ``alpha`` is not finite (it
+    then raises ``LinAlgError``).
+    """
+    comp = _companion(alpha, n_in)
+    if np.isfinite(alpha).all():
+        wr, wi, _, _, info = sla.lapack.dgeev(comp.T, compute_vl=0, compute_vr=0, overwrite_a=1)
+        if info == 0:
+            return np.asarray(wr + 1j * wi)
+    return np.asarray(np.linalg.eigvals(_companion(alpha, n_in)), dtype=complex)
 
 
 def _companion(alpha: NDArray[np.float64], n_in: int) -> NDArray[np.float64]:
