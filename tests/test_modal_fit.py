@@ -206,3 +206,92 @@ def test_basis_derivative_columns_match_finite_differences(kind: str, inputs: li
             ana[:, dcol[j]] += D[:, j]
         # central differences near sharp peaks: agreement to ~3e-6 relative
         assert_allclose(ana, num, rtol=2e-5, atol=1e-6 * np.max(np.abs(num)))
+
+
+def _random_problem(kind: str, inputs: list[int], power: int = 0) -> tuple:
+    """Noisy FRFs of the chain, a fitter with both residuals, a perturbed theta."""
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(11)
+    h = sys_.frf(F, inputs=inputs).H * (1j * 2 * np.pi * F) ** power
+    h = h + 1e-3 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    fit = ModalFitter(F, h, power, kind, [])
+    part = cm.psi[inputs].T.astype(complex)
+    if kind == "real":
+        part = np.abs(part) + 0j
+    part = part * (1 + 0.05 * rng.normal(size=part.shape))
+    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+    th = fit.pack(cm.poles * (1 + 0.003), part, ref)
+    yw = fit.Y / np.sqrt(np.mean(fit.Y**2, axis=0))
+    return fit, th, cm.poles.size, ref, yw
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+@pytest.mark.parametrize("inputs", [[0], [0, 4], [0, 2, 4]])
+def test_derivative_columns_are_scaled_copies_of_the_distinct_columns(
+    kind: str, inputs: list[int]
+) -> None:
+    # D = E[:, ecol] * coef (E: half the columns of D for complex modes), exactly
+    fit, th, m, ref, _ = _random_problem(kind, inputs)
+    phi, D, dpar, dcol = fit.basis(th, m, ref)
+    B, poles = fit._basis_ek(th, m, ref)
+    q = fit.n_cols(m)
+    lay = fit._layout(m)
+    E = B[:, q:]
+    assert_allclose(B[:, :q], phi, rtol=0, atol=0)
+    assert_allclose(E[:, lay.ecol] * fit._coef(lay, poles)[None, :], D, rtol=0, atol=0)
+    assert np.array_equal(lay.dpar, dpar)
+    assert np.array_equal(lay.dcol, dcol)
+    if kind == "complex":
+        assert 2 * E.shape[1] == D.shape[1] == 4 * len(inputs) * m
+    assert_allclose(fit.basis(th, m, ref, derivatives=False)[0], phi, rtol=0, atol=0)
+    assert_allclose(lay.A.T @ np.ones(D.shape[1]), np.bincount(dpar, minlength=th.size))
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+@pytest.mark.parametrize("inputs", [[0], [0, 4]])
+@pytest.mark.parametrize("gram", [True, False])
+def test_normal_equations_match_the_explicit_kaufman_formulas(
+    kind: str, inputs: list[int], gram: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import tyredamp.modal.fit as fit_mod
+
+    if not gram:  # every basis "ill-conditioned": the QR route
+        monkeypatch.setattr(fit_mod, "_MAX_GRAM_COND", 0.0)
+    fit, th, m, ref, yw = _random_problem(kind, inputs, power=2)
+    # reference: the full derivative matrix, a Householder QR and the residual
+    phi, D, dpar, dcol = fit.basis(th, m, ref)
+    Q, _ = np.linalg.qr(phi)
+    C = np.linalg.lstsq(phi, yw, rcond=None)[0]
+    r = yw - phi @ C
+    qtd = Q.T @ D
+    G = D.T @ D - qtd.T @ qtd
+    A = np.zeros((D.shape[1], th.size))
+    A[np.arange(D.shape[1]), dpar] = 1.0
+    jtj_ref = A.T @ (G * (C @ C.T)[dcol[:, None], dcol[None, :]]) @ A
+    jtr_ref = -(A.T @ np.einsum("id,id->d", D, (r @ C.T)[:, dcol]))
+    for residual in (False, True):
+        sol = fit._solve(th, m, ref, yw, residual=residual)
+        assert (sol["Q"] is None) == gram
+        jtj, jtr = fit._normal(sol, th.size)
+        assert_allclose(sol["cost"], np.sum(r**2), rtol=1e-10)
+        assert_allclose(sol["C"], C, rtol=0, atol=1e-9 * np.max(np.abs(C)))
+        assert_allclose(jtj, jtj_ref, rtol=0, atol=1e-10 * np.max(np.abs(jtj_ref)))
+        assert_allclose(jtr, jtr_ref, rtol=0, atol=1e-10 * np.max(np.abs(jtr_ref)))
+
+
+def test_ill_conditioned_basis_is_orthogonalised() -> None:
+    # two nearly equal poles: cond(Phi)^2 beyond _MAX_GRAM_COND, so the projection
+    # takes the QR route and still fits the data as well as a least-squares solver
+    fit, th, m, ref, yw = _random_problem("complex", [0])
+    poles = fit.unpack(th, m, ref)[0]
+    poles = np.append(poles, poles[2] * (1 + 1e-6))
+    ref2 = np.append(ref, 0).astype(np.intp)
+    th2 = fit.pack(poles, np.ones((m + 1, 1), complex), ref2)
+    sol = fit._solve(th2, m + 1, ref2, yw, residual=False)
+    assert sol["Q"] is not None
+    phi = fit.basis(th2, m + 1, ref2, derivatives=False)[0]
+    c = np.linalg.lstsq(phi, yw, rcond=None)[0]
+    assert_allclose(sol["cost"], np.sum((yw - phi @ c) ** 2), rtol=1e-8)
+    jtj, _ = fit._normal(sol, th2.size)
+    assert np.all(np.isfinite(jtj))

@@ -87,3 +87,37 @@ def test_fit_added_reuses_the_latest_fit_basis_with_the_same_result(
     assert_allclose(b[0], a[0], rtol=1e-12)
     assert_allclose(b[2], a[2], rtol=1e-9)
     assert abs(a[0] - cm.poles[k]) < 1e-3 * abs(cm.poles[k])
+
+
+@pytest.mark.parametrize("noise", [1e-2, 1e-3])
+def test_fit_added_gram_blocks_match_the_explicit_projection(
+    noise: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # fit_added evaluates from Gram blocks with the fixed basis (no projected data or
+    # columns) unless a subtraction would lose accuracy; forcing the explicit
+    # projections everywhere must give the same refinement, and its residual is
+    # that of a linear fit with all modes at the refined pole
+    import tyredamp.modal.fit as fit_mod
+
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(4)
+    h = sys_.frf(F, kind="accelerance", inputs=[0, 5]).H
+    h = h + noise * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    fit = ModalFitter(F, h, 2, "complex", [(0, 0), (5, 1)])
+    part = cm.psi[[0, 5]].T
+    k = int(np.argsort(cm.poles.imag)[3])
+    keep = np.delete(np.arange(cm.poles.size), k)
+    lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
+    args = (cm.poles[keep], part[keep], cm.poles[k] * (1.01 + 0.01j), np.ones(2))
+    a = fit.fit_added(*args, omega_bounds=(lo, hi))
+    res = fit.fit(
+        np.append(cm.poles[keep], a[0]), np.concatenate([part[keep], a[1][None]]), refine=False
+    )
+    assert_allclose(a[2], res.sigma_out, rtol=1e-9)
+    monkeypatch.setattr(fit_mod, "_CANCEL_TOL", np.inf)
+    monkeypatch.setattr(fit_mod, "_PROJ_TOL", np.inf)
+    b = fit.fit_added(*args, omega_bounds=(lo, hi))
+    assert_allclose(b[0], a[0], rtol=1e-10)
+    assert_allclose(b[1], a[1], rtol=1e-8)
+    assert_allclose(b[2], a[2], rtol=1e-9)

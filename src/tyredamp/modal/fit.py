@@ -24,12 +24,26 @@ The poles (``sigma_n = w_ref exp(x1)``, ``Omega_n = w_ref x2``: always stable)
 and the participation vectors are the non-linear parameters; the coefficients
 ``u`` and the residuals are linear and are eliminated by least squares for
 every output with one shared basis (variable projection, Golub & Pereyra 1973,
-with Kaufman's Jacobian). The basis has ``2 n_in n_freq`` real rows, so an
-iteration costs ``O(n_out n_in n_freq q)`` for ``q`` linear parameters per
-output and never forms the full ``(n_out n_in n_freq) x n_param`` Jacobian:
-``J^T J`` and ``J^T r`` are assembled from ``q x q`` and ``n_freq x q``
-products, and ``scipy.optimize.least_squares`` is given an equivalent square
-root of the normal equations.
+with Kaufman's Jacobian). The basis ``Phi`` has ``2 n_in n_freq`` real rows
+and ``q`` columns; its derivative columns ``D`` (two per non-linear parameter
+and complex mode) are scaled copies of half as many distinct columns ``E``:
+per complex mode the pole derivatives are ``-sigma [S]``, ``-sigma [i T]``,
+``w_ref [i T]``, ``-w_ref [S]`` (``[.]`` a complex column as real rows, ``S``,
+``T`` the sum and difference of the derivatives of the two conjugate terms),
+per free participation entry ``[g]``, ``[i g']``, ``[i g']``, ``-[g]``. An evaluation
+therefore needs only the Gram blocks of ``B = [Phi | E]`` and ``B^T Y`` (one
+symmetric rank-k update and one matrix product with the data, ``O(n_in n_freq
+(q + n_e) (q + n_e + n_out))``): with the Cholesky factor ``R`` of ``Phi^T Phi``
+(``Phi = Q R``) follow ``Q^T E``, ``Q^T Y``, the coefficients, the cost
+``||Y||^2 - ||Q^T Y||^2``, ``E^T P E`` and ``E^T r`` (``P`` the projector on the
+complement of the basis, ``r`` the residual), and from them ``J^T J`` and
+``J^T r`` -- neither ``Q``, nor the residual, nor the ``(n_out n_in n_freq) x
+n_param`` Jacobian is formed. This is accurate to ``eps cond(Phi)^2`` (the
+columns scaled to unit norm); a basis whose condition estimate is too large
+for that is orthogonalised (Householder or CholeskyQR2) instead, and the
+residual is formed when the cost would lose accuracy by cancellation. The
+refinement is a bounded Levenberg-Marquardt iteration on these normal
+equations.
 
 Scaling (spec step 3 and eq. [10]): with drive points ``(j_k, k)`` (output
 ``j_k`` at the place of input ``k``) reciprocity ``psi_in[k] = psi_out[j_k]``
@@ -47,6 +61,7 @@ frequencies, damping ratios and mode-shape entries by the delta method.
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -60,6 +75,9 @@ from ..exceptions import InputError
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
 
 ModelKind = Literal["complex", "real"]
+
+#: derivative-column layouts (ModalFitter._layout) per (kind, m, n_in, q, w_ref)
+_LAYOUTS: dict[tuple[str, int, int, int, float], _Layout] = {}
 
 
 @dataclass
@@ -141,17 +159,18 @@ class ModalFitter:
         self.s = 1j * w
         self.kappa = (1j * w) ** power
         self.kappa_low = (1j * w) ** (power - 2)
+        self._kap2 = 2.0 * self.kappa[None, :]
         self.w_ref = float(w[-1])
-        self._sel_cache: dict[tuple[int, bytes], NDArray[np.float64]] = {}
-        # (theta, ref, Q) of the latest fit, reused by fit_added(theta=...)
-        self._last_q: tuple[NDArray[np.float64], NDArray[np.intp], NDArray[np.float64]] | None = (
-            None
-        )
-        # data: rows (k, f) complex, stacked [Re; Im]
+        # theta, ref, Phi, R and Q (None when not formed) of the latest fit's
+        # projection, reused by fit_added(theta=...)
+        self._last_q: tuple[Any, ...] | None = None
+        # data: rows (k, f) complex, real and imaginary part interleaved (row 2i:
+        # Re, row 2i + 1: Im of line i); the basis columns use the same layout
         hc = H.transpose(1, 2, 0).reshape(self.n_in * self.n_f, self.n_out)
-        self.Y = np.concatenate([hc.real, hc.imag], axis=0)
+        self.Y = np.stack([hc.real, hc.imag], axis=1).reshape(2 * hc.shape[0], self.n_out)
         self.n_rows = self.Y.shape[0]
         self.data_ss = float(np.sum(self.Y**2))
+        self._rms = np.sqrt(np.mean(self.Y**2, axis=0))  # RMS per output row
 
     # ------------------------------------------------------------ layout
     def n_cols(self, m: int) -> int:
@@ -188,17 +207,13 @@ class ModalFitter:
         x2 = th[1 : 2 * m : 2]
         poles = self.w_ref * (-np.exp(x1) + 1j * x2)
         part = np.ones((m, self.n_in), complex)
-        i = 2 * m
-        for n in range(m):
-            for k in range(self.n_in):
-                if k == ref[n]:
-                    continue
-                if self.kind == "complex":
-                    part[n, k] = th[i] + 1j * th[i + 1]
-                    i += 2
-                else:
-                    part[n, k] = th[i]
-                    i += 1
+        if self.n_in > 1:
+            free = np.ones((m, self.n_in), bool)
+            free[np.arange(m), ref] = False  # row-major: modes, then inputs k != ref
+            if self.kind == "complex":
+                part[free] = th[2 * m :: 2] + 1j * th[2 * m + 1 :: 2]
+            else:
+                part[free] = th[2 * m :]
         return poles, part
 
     # ------------------------------------------------------------- basis
@@ -208,77 +223,212 @@ class ModalFitter:
         """Real basis ``Phi`` (n_rows, q) and its derivative columns.
 
         Returns ``Phi``, ``D`` (n_rows, n_d), ``dpar`` (n_d,) parameter index and
-        ``dcol`` (n_d,) basis column of each derivative column.
+        ``dcol`` (n_d,) basis column of each derivative column. ``D`` is
+        ``E[:, ecol] * coef`` of the distinct columns ``E`` that the fits use
+        (:meth:`_basis_ek`, :meth:`_layout`, :meth:`_coef`).
         """
+        B, poles = self._basis_ek(th, m, ref, derivatives)
+        q = self.n_cols(m)
+        phi = B[:, :q]
+        if not derivatives:
+            return phi, np.zeros((self.n_rows, 0)), np.zeros(0, np.intp), np.zeros(0, np.intp)
+        lay = self._layout(m)
+        D = B[:, q:][:, lay.ecol] * self._coef(lay, poles)[None, :]
+        return phi, D, lay.dpar.copy(), lay.dcol.copy()
+
+    def _layout(self, m: int) -> _Layout:
+        """Derivative columns of ``m`` modes: ``D = E[:, ecol] * coef`` (cached, read-only).
+
+        Complex modes: per mode ``n`` the columns of ``E`` are ``[S]``, ``[i T]``
+        (see :meth:`_basis_ek`), then ``[g]``, ``[i g']`` of each free
+        participation entry (inputs ``k != ref[n]`` in increasing ``k``); the
+        derivative columns, in the order of :meth:`basis`, are ``(-sigma [S], x1,
+        col 2n)``, ``(-sigma [i T], x1, 2n+1)``, ``(w_ref [i T], x2, 2n)``, ``(-w_ref
+        [S], x2, 2n+1)`` and per free entry ``([g], Re l, 2n)``, ``([i g'], Re l,
+        2n+1)``, ``([i g'], Im l, 2n)``, ``(-[g], Im l, 2n+1)`` -- (column of ``E``
+        and factor, parameter, basis column). Real modes: ``E = D`` (no repeated
+        columns).
+        """
+        q = self.n_cols(m)
+        key = (self.kind, m, self.n_in, q, self.w_ref)
+        lay = _LAYOUTS.get(key)
+        if lay is not None:
+            return lay
+        nin = self.n_in
+        ar = np.arange(m)
         if self.kind == "complex":
-            return self._basis_complex(th, m, ref, derivatives)
+            n_par = 2 * m + 2 * (nin - 1) * m
+            npp, ne_m = 4 * nin, 2 * nin
+            e_m = [0, 1, 1, 0]
+            for j in range(nin - 1):
+                e_m += [2 + 2 * j, 3 + 2 * j, 3 + 2 * j, 2 + 2 * j]
+            sign_m = [-1.0, -1.0, self.w_ref, -self.w_ref] + [1.0, 1.0, 1.0, -1.0] * (nin - 1)
+            pp = 2 * m + 2 * (nin - 1) * ar[:, None] + 2 * np.arange(nin - 1)[None, :]
+            part = (pp[:, :, None] + np.array([0, 0, 1, 1])[None, None, :]).reshape(m, -1)
+            pole = 2 * ar[:, None] + np.array([0, 0, 1, 1])[None, :]
+            dpar = np.concatenate([pole, part], axis=1).ravel()
+            dcol = 2 * np.repeat(ar, npp) + np.tile([0, 1, 0, 1], m * nin)
+            nsig = 2
+        else:
+            n_par = 2 * m + (nin - 1) * m
+            npp = ne_m = 2 + (nin - 1)
+            e_m = list(range(npp))
+            sign_m = [1.0] * npp
+            part = 2 * m + (nin - 1) * ar[:, None] + np.arange(nin - 1)[None, :]
+            dpar = np.concatenate([2 * ar[:, None] + np.array([0, 1])[None, :], part], 1).ravel()
+            dcol = np.repeat(ar, npp)
+            nsig = 0
+        ecol = (ne_m * ar[:, None] + np.array(e_m, np.intp)[None, :]).ravel()
+        nd, ne = ecol.size, ne_m * m
+        A = np.zeros((nd, n_par))
+        A[np.arange(nd), dpar] = 1.0
+        lay = _Layout(
+            ecol=ecol.astype(np.intp),
+            sign=np.tile(np.array(sign_m), m),
+            nsig=nsig,
+            dpar=dpar.astype(np.intp),
+            dcol=dcol.astype(np.intp),
+            A=A,
+            ee=(ecol[:, None] * ne + ecol[None, :]).astype(np.intp),
+            dd=(dcol[:, None] * q + dcol[None, :]).astype(np.intp),
+            eq=(ecol * q + dcol).astype(np.intp),
+        )
+        for arr in (lay.ecol, lay.sign, lay.dpar, lay.dcol, lay.A, lay.ee, lay.dd, lay.eq):
+            arr.flags.writeable = False
+        if len(_LAYOUTS) >= 64:
+            _LAYOUTS.clear()
+        _LAYOUTS[key] = lay
+        return lay
+
+    @staticmethod
+    def _coef(lay: _Layout, poles: NDArray[np.complex128]) -> NDArray[np.float64]:
+        """Factors ``coef`` (n_d,) of ``D = E[:, ecol] * coef`` at the poles."""
+        coef = lay.sign.copy()
+        if lay.nsig:
+            cm = coef.reshape(poles.size, -1)
+            cm[:, : lay.nsig] *= (-poles.real)[:, None]  # d p / d x1 = -sigma
+        return coef
+
+    def _basis_ek(
+        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], derivatives: bool = True
+    ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
+        """``B = [Phi | E]`` (n_rows, q + n_e), Fortran-ordered, and the poles.
+
+        Complex modes, all at once: columns ``2n, 2n+1`` of mode ``n`` are ``A + B``
+        and ``i (A - B)`` with ``A_k = l_kn kappa / (s - p_n)`` and ``B_k =
+        conj(l_kn) kappa / (s - conj p_n)`` (real and imaginary part of the output
+        coefficient ``u_jn``). The distinct derivative columns ``E`` (``n_e = 2
+        n_in m``) of mode ``n`` are ``[S]`` and ``[i T]`` with ``S = A' + B'``, ``T =
+        A' - B'`` (``A' = A / (s - p_n)``, ``B' = B / (s - conj p_n)``: ``d A / d p =
+        A'``), then ``[g]`` and ``[i g']`` at input ``k`` only (``g = kappa / (s -
+        p_n) + kappa / (s - conj p_n)``, ``g'`` the difference) for each free
+        participation entry; ``[.]`` is a complex column as real rows (real and
+        imaginary part of each line interleaved, as the data ``Y``). With one
+        input (``l = 1``), ``t = s + sigma_n`` and ``d = (s - p_n)(s - conj p_n) =
+        t^2 + Omega_n^2``: ``A + B = 2 t kappa / d``,
+        ``i (A - B) = -2 Omega_n kappa / d``, ``S = 2 (t^2 - Omega_n^2) kappa / d^2``
+        and ``i T = -4 Omega_n t kappa / d^2`` (one complex division per line and
+        mode). Each column is written in place (transposed, contiguous). Real
+        modes: ``E`` holds the derivative columns of :meth:`_basis_real`.
+        ``derivatives=False``: ``B = Phi``.
+        """
         poles, part = self.unpack(th, m, ref)
+        q = self.n_cols(m)
+        if self.kind == "real":
+            phi, D = self._basis_real(poles, part, ref, derivatives)
+            B = np.empty((self.n_rows, q + D.shape[1]), order="F")
+            B[:, :q] = phi
+            B[:, q:] = D
+            return B, poles
+        nin, nf = self.n_in, self.n_f
+        ne = 2 * nin * m if derivatives else 0
+        # rows: columns of B, complex (real and imaginary part interleaved as in Y)
+        bt = np.empty((q + ne, nin, nf), complex)
+        s, kap = self.s[None, :], self.kappa[None, :]
+        if nin == 1:
+            sig = (-poles.real)[:, None] + 0j  # complex factors: no casts in the loops
+            mom = -poles.imag[:, None] + 0j
+            den = s - poles[:, None]
+            den *= s - np.conj(poles)[:, None]  # d = (s - p)(s - conj p)
+            r = np.reciprocal(den)
+            h = self._kap2 * r  # 2 kappa / d
+            t = s + sig
+            np.multiply(t, h, out=bt[0 : 2 * m : 2, 0])
+            np.multiply(h, mom, out=bt[1 : 2 * m : 2, 0])
+            if derivatives:
+                h *= r  # 2 kappa / d^2
+                den -= 2.0 * mom * mom  # t^2 - Omega^2
+                np.multiply(den, h, out=bt[q::2, 0])
+                o = bt[q + 1 :: 2, 0]
+                np.multiply(t, h, out=o)
+                o *= 2.0 * mom
+        else:
+            e = 1.0 / (s - poles[:, None])  # (m, nf)
+            eb = 1.0 / (s - np.conj(poles)[:, None])
+            g = kap * e
+            gb = kap * eb
+            lc = part[:, :, None]  # (m, nin, 1)
+            A = lc * g[:, None, :]  # (m, nin, nf)
+            B_ = np.conj(lc) * gb[:, None, :]
+            _put_pair(bt, 0, 2, A, B_)
+            if derivatives:
+                A *= e[:, None, :]
+                B_ *= eb[:, None, :]
+                _put_pair(bt, q, 2 * nin, A, B_)
+                # participation columns: zero but at input k
+                oth = np.array([[k for k in range(nin) if k != ref[n]] for n in range(m)])
+                rows = q + 2 * nin * np.arange(m)
+                pairs = bt[q:].reshape(m, nin, 2, nin, nf)[:, 1:]  # (m, nin - 1, 2, nin, nf)
+                pairs[...] = 0.0
+                gp = g + gb
+                gm = 1j * (g - gb)
+                for j in range(nin - 1):
+                    kk_ = oth[:, j]
+                    bt[rows + 2 + 2 * j, kk_] = gp
+                    bt[rows + 3 + 2 * j, kk_] = gm
+        c0 = 2 * m
+        for use, kk in ((self.use_upper, self.kappa), (self.use_lower, self.kappa_low)):
+            if use:
+                bt[c0 : c0 + nin] = 0.0
+                for k in range(nin):
+                    bt[c0 + k, k] = kk
+                c0 += nin
+        return bt.reshape(q + ne, nin * nf).view(np.float64).T, poles
+
+    def _basis_real(
+        self,
+        poles: NDArray[np.complex128],
+        part: NDArray[np.complex128],
+        ref: NDArray[np.intp],
+        derivatives: bool,
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``Phi`` and ``D`` of the real-mode model (columns of :meth:`_layout`)."""
         nin, nf = self.n_in, self.n_f
         s, kap = self.s, self.kappa
+        m = poles.size
         q = self.n_cols(m)
         cols = np.zeros((q, nin, nf), complex)
         dl: list[NDArray[np.complex128]] = []
-        dpar: list[int] = []
-        dcol: list[int] = []
-        pidx = 2 * m  # running index of participation parameters
         for n in range(m):
             p = poles[n]
             sig, om = -p.real, p.imag
             L = part[n]
-            if self.kind == "complex":
-                g = kap / (s - p)
-                gb = kap / (s - np.conj(p))
-                A = L[:, None] * g[None, :]
-                B = np.conj(L)[:, None] * gb[None, :]
-                ca, cb = 2 * n, 2 * n + 1
-                cols[ca] = A + B
-                cols[cb] = 1j * (A - B)
-                if not derivatives:
+            den = s**2 + 2 * sig * s + sig**2 + om**2
+            base = kap / den
+            cols[n] = L.real[:, None] * base[None, :]
+            if not derivatives:
+                continue
+            d_sig = -kap * (2 * s + 2 * sig) / den**2
+            d_om = -kap * (2 * om) / den**2
+            dl += [L.real[:, None] * (d_sig * sig)[None, :]]
+            dl += [L.real[:, None] * (d_om * self.w_ref)[None, :]]
+            for k in range(nin):
+                if k == ref[n]:
                     continue
-                dA = L[:, None] * (g / (s - p))[None, :]
-                dB = np.conj(L)[:, None] * (gb / (s - np.conj(p)))[None, :]
-                for dpx, dpbx, ip in (
-                    (-sig, -sig, 2 * n),
-                    (1j * self.w_ref, -1j * self.w_ref, 2 * n + 1),
-                ):
-                    a_, b_ = dA * dpx, dB * dpbx
-                    dl += [a_ + b_, 1j * (a_ - b_)]
-                    dpar += [ip, ip]
-                    dcol += [ca, cb]
-                for k in range(nin):
-                    if k == ref[n]:
-                        continue
-                    for fa, fb in ((1.0, 1.0), (1j, -1j)):
-                        a_ = np.zeros((nin, nf), complex)
-                        b_ = np.zeros((nin, nf), complex)
-                        a_[k] = fa * g
-                        b_[k] = fb * gb
-                        dl += [a_ + b_, 1j * (a_ - b_)]
-                        dpar += [pidx, pidx]
-                        dcol += [ca, cb]
-                        pidx += 1
-            else:
-                den = s**2 + 2 * sig * s + sig**2 + om**2
-                base = kap / den
-                cols[n] = L.real[:, None] * base[None, :]
-                if not derivatives:
-                    continue
-                d_sig = -kap * (2 * s + 2 * sig) / den**2
-                d_om = -kap * (2 * om) / den**2
-                dl += [L.real[:, None] * (d_sig * sig)[None, :]]
-                dl += [L.real[:, None] * (d_om * self.w_ref)[None, :]]
-                dpar += [2 * n, 2 * n + 1]
-                dcol += [n, n]
-                for k in range(nin):
-                    if k == ref[n]:
-                        continue
-                    a_ = np.zeros((nin, nf), complex)
-                    a_[k] = base
-                    dl.append(a_)
-                    dpar.append(pidx)
-                    dcol.append(n)
-                    pidx += 1
-        c0 = (2 if self.kind == "complex" else 1) * m
+                a_ = np.zeros((nin, nf), complex)
+                a_[k] = base
+                dl.append(a_)
+        c0 = m
         if self.use_upper:
             for k in range(nin):
                 cols[c0, k] = kap
@@ -287,93 +437,10 @@ class ModalFitter:
             for k in range(nin):
                 cols[c0, k] = self.kappa_low
                 c0 += 1
-        cf = cols.reshape(q, nin * nf).T
-        phi = np.concatenate([cf.real, cf.imag], axis=0)
+        phi = cols.reshape(q, nin * nf).view(np.float64).T
         if not derivatives or not dl:
-            return phi, np.zeros((self.n_rows, 0)), np.zeros(0, np.intp), np.zeros(0, np.intp)
-        dc = np.stack(dl).reshape(len(dl), nin * nf).T
-        D = np.concatenate([dc.real, dc.imag], axis=0)
-        return phi, D, np.asarray(dpar, np.intp), np.asarray(dcol, np.intp)
-
-    def _basis_complex(
-        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], derivatives: bool
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.intp], NDArray[np.intp]]:
-        """:meth:`basis` of the complex-mode model, all modes at once.
-
-        Columns ``2n, 2n+1`` of mode ``n`` are ``A + B`` and ``i (A - B)`` with
-        ``A_k = l_kn kappa / (s - p_n)`` and ``B_k = conj(l_kn) kappa / (s - conj p_n)``
-        (real and imaginary part of the output coefficient ``u_jn``); per mode the
-        derivative columns are those of the two pole parameters (``d p / d x1 =
-        -sigma``, ``d p / d x2 = i w_ref``), then of the real and imaginary part
-        of each free participation entry. The arrays are built column by column
-        (transposed, each column contiguous) and returned as Fortran-ordered views.
-        """
-        poles, part = self.unpack(th, m, ref)
-        nin, nf = self.n_in, self.n_f
-        nc = nin * nf
-        q = self.n_cols(m)
-        s, kap = self.s[None, :], self.kappa[None, :]
-        e = 1.0 / (s - poles[:, None])  # (m, nf)
-        eb = 1.0 / (s - np.conj(poles)[:, None])
-        g = kap * e
-        gb = kap * eb
-        if nin == 1:  # participation 1: A = g, B = gb
-            A, B = g[:, None, :], gb[:, None, :]
-        else:
-            lc = part[:, :, None]  # (m, nin, 1)
-            A = lc * g[:, None, :]  # (m, nin, nf)
-            B = np.conj(lc) * gb[:, None, :]
-        pt = np.zeros((q, 2, nin, nf))  # rows: columns of phi; [Re; Im] stacked
-        _put_pair(pt, 0, A, B)
-        c0 = 2 * m
-        for use, kk in ((self.use_upper, self.kappa), (self.use_lower, self.kappa_low)):
-            if use:
-                for k in range(nin):
-                    pt[c0 + k, 0, k] = kk.real
-                    pt[c0 + k, 1, k] = kk.imag
-                c0 += nin
-        phi = pt.reshape(q, 2 * nc).T
-        if not derivatives:
-            return phi, np.zeros((self.n_rows, 0)), np.zeros(0, np.intp), np.zeros(0, np.intp)
-        npp = 4 * nin  # derivative columns per mode
-        dt = np.empty((m, npp, 2, nin, nf)) if nin == 1 else np.zeros((m, npp, 2, nin, nf))
-        dA = A * e[:, None, :]
-        dB = B * eb[:, None, :]
-        # pole columns: dp/dx1 = -sigma, dp/dx2 = i w_ref (and conjugates for B):
-        # with S = dA + dB, T = dA - dB the four columns are [-sigma S], [-sigma i T],
-        # [i w_ref T], [-w_ref S], each as [Re; Im]
-        S = dA + dB
-        T = dA - dB
-        sig = (-poles.real)[:, None, None]
-        wr = self.w_ref
-        np.multiply(S.real, -sig, out=dt[:, 0, 0])
-        np.multiply(S.imag, -sig, out=dt[:, 0, 1])
-        np.multiply(T.imag, sig, out=dt[:, 1, 0])
-        np.multiply(T.real, -sig, out=dt[:, 1, 1])
-        np.multiply(T.imag, -wr, out=dt[:, 2, 0])
-        np.multiply(T.real, wr, out=dt[:, 2, 1])
-        np.multiply(S.real, -wr, out=dt[:, 3, 0])
-        np.multiply(S.imag, -wr, out=dt[:, 3, 1])
-        dpar_l = [2 * np.arange(m)[:, None] + np.array([0, 0, 1, 1])[None, :]]
-        if nin > 1:
-            # free participation entries: inputs k != ref[n] in increasing k, Re then Im:
-            # columns [g + gb, i (g - gb)] (Re) and [i (g - gb), -(g + gb)] (Im) at input k
-            oth = np.array([[k for k in range(nin) if k != ref[n]] for n in range(m)])
-            gp = g + gb
-            gm = 1j * (g - gb)
-            for j in range(nin - 1):
-                kk = oth[:, j]
-                ar = np.arange(m)
-                for c, v in enumerate((gp, gm, gm, -gp)):
-                    dt[ar, 4 + 4 * j + c, 0, kk] = v.real
-                    dt[ar, 4 + 4 * j + c, 1, kk] = v.imag
-            pbase = 2 * m + 2 * (nin - 1) * np.arange(m)[:, None] + 2 * np.arange(nin - 1)[None]
-            pp = pbase[:, :, None] + np.array([0, 0, 1, 1])[None, None, :]
-            dpar_l.append(pp.reshape(m, 4 * (nin - 1)))
-        dpar = np.concatenate(dpar_l, axis=1).ravel().astype(np.intp)
-        dcol = (2 * np.repeat(np.arange(m), npp) + np.tile([0, 1, 0, 1], m * nin)).astype(np.intp)
-        D = dt.reshape(m * npp, 2 * nc).T
-        return phi, D, dpar, dcol
+            return phi, np.zeros((self.n_rows, 0))
+        return phi, np.stack(dl).reshape(len(dl), nin * nf).view(np.float64).T
 
     # ---------------------------------------------------- variable projection
     def _solve(
@@ -385,79 +452,58 @@ class ModalFitter:
         residual: bool = True,
         gradient: bool = True,
         yy: NDArray[np.float64] | None = None,
+        derivatives: bool = True,
     ) -> dict[str, Any]:
-        """Projection at ``th``. With ``residual=False`` the residual matrix is not
-        formed (two products with the data instead of three): ``cost`` and the
-        per-output ``cost_out`` come from ``||Y||^2 - ||Q^T Y||^2`` unless that
-        loses accuracy (an output fitted better than 0.1 %), and
-        ``Z = r C^T = Y C^T - Q (Q^T Y) C^T`` is returned instead (``None`` with
-        ``gradient=False``: a fit without refinement needs no gradient). ``yy``:
-        the column sums of ``Yw**2``, when already known."""
-        phi, D, dpar, dcol = self.basis(th, m, ref)
-        Q, Rq = _orth(phi)
-        Ct = Q.T @ Yw
-        diag = np.abs(np.diag(Rq))
-        if diag.min() <= 1e-13 * diag.max():
-            C = np.linalg.lstsq(phi, Yw, rcond=None)[0]
-        else:
-            C = sla.solve_triangular(Rq, Ct)
-        resid = None
-        ct2 = np.sum(Ct**2, axis=0)
-        cost_out = (np.einsum("ij,ij->j", Yw, Yw) if yy is None else yy) - ct2
-        cost = float(np.sum(cost_out))
-        Z = None
-        if residual or np.any(cost_out < 1e-6 * ct2):
-            resid = Yw - Q @ Ct
-            cost_out = np.einsum("ij,ij->j", resid, resid)
-            cost = float(np.sum(cost_out))
-            if gradient:
-                Z = resid @ C.T
-        elif gradient:
-            Z = Yw @ C.T - Q @ (Ct @ C.T)
-        return {
-            "phi": phi,
-            "D": D,
-            "dpar": dpar,
-            "dcol": dcol,
-            "Q": Q,
-            "R": Rq,
-            "C": C,
-            "resid": resid,
-            "cost": cost,
-            "cost_out": cost_out,
-            "Z": Z,
-        }
-
-    def _selection(self, dpar: NDArray[np.intp], n_par: int) -> NDArray[np.float64]:
-        """0/1 matrix (n_d, n_par) mapping derivative columns to parameters (cached)."""
-        key = (n_par, dpar.tobytes())
-        A = self._sel_cache.get(key)
-        if A is None:
-            A = np.zeros((dpar.size, n_par))
-            A[np.arange(dpar.size), dpar] = 1.0
-            if len(self._sel_cache) > 16:
-                self._sel_cache.clear()
-            self._sel_cache[key] = A
-        return A
+        """Projection at ``th`` from the Gram blocks ``B^T B`` and ``B^T Yw`` of ``B =
+        [Phi | E]`` (:func:`_vp_solve`). With ``residual=False`` the residual
+        matrix is not formed unless the cost would lose accuracy (an output
+        fitted better than 0.1 %); ``gradient=False``: no ``E^T r`` (a fit
+        without refinement needs no gradient); ``derivatives=False``: no ``E``
+        (nor ``J^T J``). ``yy``: the column sums of ``Yw**2``, when already known."""
+        B, poles = self._basis_ek(th, m, ref, derivatives)
+        q = self.n_cols(m)
+        if yy is None:
+            yy = np.einsum("ij,ij->j", Yw, Yw)
+        sol = _vp_solve(
+            B.T @ B,
+            B.T @ Yw,
+            q,
+            yy,
+            lambda: (B, Yw),
+            residual=residual,
+            gradient=gradient and derivatives,
+        )
+        sol["phi"] = B[:, :q]
+        if derivatives:
+            lay = self._layout(m)
+            sol["lay"] = lay
+            sol["coef"] = self._coef(lay, poles)
+        return sol
 
     def _normal(
         self, sol: dict[str, Any], n_par: int
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Kaufman ``J^T J`` and ``J^T r`` of the projected residual."""
-        D, Q, C = sol["D"], sol["Q"], sol["C"]
-        dpar, dcol = sol["dpar"], sol["dcol"]
-        qtd = Q.T @ D
-        G = D.T @ D - qtd.T @ qtd
+        """Kaufman ``J^T J`` and ``J^T r`` of the projected residual.
+
+        With ``D = E[:, ecol] * coef``, ``dpar`` and ``dcol`` (:meth:`_layout`),
+        ``G_E = E^T P E`` and ``W = C C^T``: ``J^T J = Ac^T (G_E[ecol, ecol] o
+        W[dcol, dcol]) Ac`` (``Ac`` the 0/1 map of derivative columns to
+        parameters times ``coef``) and ``J^T r = -Ac^T h`` with ``h_d = (E^T r
+        C^T)[ecol_d, dcol_d]``.
+        """
+        lay, C = sol["lay"], sol["C"]
+        Ac = lay.A * sol["coef"][:, None]
+        if Ac.shape[1] != n_par:
+            raise ValueError(f"n_par: layout has {Ac.shape[1]} parameters, got {n_par}")
         W = C @ C.T
-        Md = G * W[dcol[:, None], dcol[None, :]]
-        A = self._selection(dpar, n_par)
-        jtj = A.T @ Md @ A
-        Z = sol["Z"]  # r C^T, (n_rows, q)
-        if Z is None:
-            return 0.5 * (jtj + jtj.T), np.zeros(n_par)
-        gd = np.einsum("id,id->d", D, Z[:, dcol])
-        jtr = -(A.T @ gd)
-        return 0.5 * (jtj + jtj.T), jtr
+        Md = np.take(sol["GE"], lay.ee) * np.take(W, lay.dd)
+        jtj = Ac.T @ Md @ Ac
+        jtj = 0.5 * (jtj + jtj.T)
+        Etr = sol["Etr"]  # E^T r, (n_e, n_out)
+        if Etr is None:
+            return jtj, np.zeros(n_par)
+        jtr = -(Ac.T @ np.take(Etr @ C.T, lay.eq))
+        return jtj, jtr
 
     def fit(
         self,
@@ -489,7 +535,7 @@ class ModalFitter:
             part = (part * ph[:, None]).real.astype(complex)
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         th = self.pack(np.asarray(poles, complex), part, ref)
-        rms = np.sqrt(np.mean(self.Y**2, axis=0))
+        rms = self._rms
         floor = 1e-9 * rms
         w = 1.0 / np.where(rms > 0, rms, 1.0)
         if self.unit_weights:
@@ -508,14 +554,16 @@ class ModalFitter:
                 th, nfev, status, sol = self._refine(th, m, ref, Yw, max_nfev, tol=tol)
                 nit += nfev
             else:
-                sol = self._solve(th, m, ref, Yw, residual=False, gradient=False)
+                sol = self._solve(
+                    th, m, ref, Yw, residual=False, gradient=False, derivatives=uncertainty
+                )
             sig_out = np.sqrt(sol["cost_out"] / w**2 / max(dof, 1))
             if ip + 1 < passes and refine and not self.unit_weights:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
         # the projection at the result, for fit_added(theta=...) on these modes
-        self._last_q = (th.copy(), ref.copy(), sol["Q"])
+        self._last_q = (th.copy(), ref.copy(), sol["phi"], sol["R"], sol["Q"])
         return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
 
     def fit_added(
@@ -532,11 +580,15 @@ class ModalFitter:
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
-        The basis of the fixed modes and of the residual terms is projected out
-        of the data once; the added pole and participation (``part_new``,
-        (n_in,)) are then refined by variable projection on the projected data
-        (same weighting as the first pass of :meth:`fit`), which costs a
-        two-column basis per evaluation instead of the whole one.
+        The basis of the fixed modes and of the residual terms (orthonormal
+        ``Qf``) is projected out of the data; the added pole and participation
+        (``part_new``, (n_in,)) are then refined by variable projection on the
+        projected data (same weighting as the first pass of :meth:`fit`). An
+        evaluation needs the Gram blocks of the added mode's columns ``B1 = [Phi_1
+        | E_1]`` only: ``B1^T B1 - (Qf^T B1)^T Qf^T B1`` and ``B1^T Y - (Qf^T
+        B1)^T Qf^T Y`` (``Qf^T Y`` once per call), neither the projected data nor
+        the projected columns are formed unless the subtraction would lose
+        accuracy (columns or data mostly in the span of ``Qf``).
         ``omega_bounds`` (rad/s, lower < upper) limits the damped natural
         frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
         ``theta``: the parameter vector of the fixed modes when they come from
@@ -564,11 +616,12 @@ class ModalFitter:
             part, l1 = allp[:m], allp[m:]
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
-        rms = np.sqrt(np.mean(self.Y**2, axis=0))
+        rms = self._rms
         w = 1.0 / np.where(rms > 0, rms, 1.0)
         if self.unit_weights:
             w = np.ones_like(rms)
         Yw = self.Y * w[None, :]
+        yy = np.einsum("ij,ij->j", Yw, Yw)
         last = self._last_q
         if (
             theta is not None
@@ -576,48 +629,87 @@ class ModalFitter:
             and np.array_equal(theta, last[0])
             and np.array_equal(ref, last[1])
         ):
-            Qf = last[2]
+            phi_f, r_f, q_f = last[2], last[3], last[4]
         else:
             phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
-            Qf = _orth(phi_f)[0]
-        Yp = Yw - Qf @ (Qf.T @ Yw)
-        yyp = np.einsum("ij,ij->j", Yp, Yp)
+            q_f, r_f = _orth(phi_f)
+        # products with the fixed modes' orthonormal basis Qf (Qf = Phi_f R_f^-1 when
+        # the latest fit did not form it)
+        if q_f is None:
+
+            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(lapack.dtrtrs(r_f, phi_f.T @ X, trans=1)[0])
+
+            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(phi_f @ lapack.dtrtrs(r_f, QX)[0])
+
+        else:
+            qf = q_f
+
+            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(qf.T @ X)
+
+            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(qf @ QX)
+
+        # the data projected on the complement of the fixed basis, Yp = Yw - Qf Qf^T Yw,
+        # enters through Qf^T Yw only (formed when ||Yp||^2 would lose accuracy)
+        qty = qt(Yw)
+        Yp: NDArray[np.float64] | None = None
+        yyp = yy - np.einsum("ij,ij->j", qty, qty)
+        if np.any(yyp < _CANCEL_TOL * yy):
+            Yp = Yw - back(qty)
+            yyp = np.einsum("ij,ij->j", Yp, Yp)
+        yp_cache: list[NDArray[np.float64]] = [] if Yp is None else [Yp]
+
+        def projected_data() -> NDArray[np.float64]:
+            if not yp_cache:
+                yp_cache.append(Yw - back(qty))
+            return yp_cache[0]
+
         # the added mode alone: same fitter without residual columns
         one = copy.copy(self)
         one.use_upper = one.use_lower = False
         th0 = one.pack(p1, l1, ref1)
+        q1 = one.n_cols(1)
+        lay1 = one._layout(1)
 
         def solve(th: NDArray[np.float64]) -> dict[str, Any]:
-            phi, D, dpar, dcol = one.basis(th, 1, ref1)
-            phi = phi - Qf @ (Qf.T @ phi)
-            D = D - Qf @ (Qf.T @ D)
-            Q, Rq = _orth(phi)
-            Ct = Q.T @ Yp
-            diag = np.abs(np.diag(Rq))
-            if diag.min() <= 1e-13 * diag.max():
-                C = np.linalg.lstsq(phi, Yp, rcond=None)[0]
+            # Gram blocks of the added mode's [Phi | E] projected on the complement of Qf
+            B1, p_1 = one._basis_ek(th, 1, ref1)
+            QB = qt(B1)
+            G0 = B1.T @ B1
+            G = G0 - QB.T @ QB
+            d0 = np.diag(G0)
+            Bp: NDArray[np.float64] | None = None
+            if np.any(np.diag(G) < _PROJ_TOL * d0):  # mostly in span(Qf): project explicitly
+                Bp = B1 - back(QB)
+                G = Bp.T @ Bp
+                P = Bp.T @ projected_data()
+            elif Yp is None:
+                P = B1.T @ Yw - QB.T @ qty
             else:
-                C = sla.solve_triangular(Rq, Ct)
-            cost_out = yyp - np.einsum("ij,ij->j", Ct, Ct)
-            if np.any(cost_out < 1e-6 * yyp):  # cancellation: form the residual
-                resid = Yp - Q @ Ct
-                cost_out = np.einsum("ij,ij->j", resid, resid)
-                Z = resid @ C.T
-            else:
-                Z = Yp @ C.T - Q @ (Ct @ C.T)
-            return {
-                "D": D,
-                "dpar": dpar,
-                "dcol": dcol,
-                "Q": Q,
-                "C": C,
-                "cost": float(np.sum(cost_out)),
-                "cost_out": cost_out,
-                "Z": Z,
-            }
+                P = B1.T @ Yp
+
+            def explicit() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+                return (B1 - back(QB) if Bp is None else Bp), projected_data()
+
+            sol = _vp_solve(
+                G,
+                P,
+                q1,
+                yyp,
+                explicit,
+                residual=False,
+                gradient=True,
+                cancel=yy if Yp is None else yyp,
+            )
+            sol["lay"] = lay1
+            sol["coef"] = one._coef(lay1, p_1)
+            return sol
 
         th, _, _, sol = self._refine(
-            th0, 1, ref1, Yp, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
+            th0, 1, ref1, Yw, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
         )
         p_out, l_out = one.unpack(th, 1, ref1)
         dof = self.n_rows - self.n_cols(m + 1)
@@ -649,7 +741,7 @@ class ModalFitter:
         n_lin = self.n_cols(m) if solve is None else 2
         n_obs = Yw.size
 
-        yy = np.einsum("ij,ij->j", Yw, Yw)
+        yy = np.einsum("ij,ij->j", Yw, Yw) if solve is None else None
 
         def evaluate(x: NDArray[np.float64]) -> tuple[float, Any, Any, dict[str, Any]]:
             # a given ``solve`` (fit_added) replaces the projection
@@ -872,15 +964,14 @@ class ModalFitter:
         phi = sol["phi"]
         model = np.zeros((0, self.n_in, self.n_f), complex)
         if uncertainty:
-            hw = (C / w[None, :]).T @ phi.T  # (n_out, n_rows): rows of the data kind
-            nc = self.n_in * self.n_f
-            model = (hw[:, :nc] + 1j * hw[:, nc:]).reshape(self.n_out, self.n_in, self.n_f)
+            hw = np.ascontiguousarray((C / w[None, :]).T @ phi.T)  # (n_out, n_rows)
+            model = hw.view(np.complex128).reshape(self.n_out, self.n_in, self.n_f)
         per = 2 if self.kind == "complex" else 1
         data_ss = self.data_ss
         # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's
-        # columns: no (n_rows x n_out) array per mode
-        pb = phi[:, : per * m].reshape(self.n_rows, m, per)
-        gram = np.matmul(pb.transpose(1, 2, 0), pb.transpose(1, 0, 2))  # (m, per, per)
+        # columns, a diagonal block of Phi^T Phi = R^T R: no (n_rows x n_out) array
+        rb = sol["R"][:, : per * m].reshape(-1, m, per)
+        gram = np.matmul(rb.transpose(1, 2, 0), rb.transpose(1, 0, 2))  # (m, per, per)
         cb = C[: per * m].reshape(m, per, self.n_out)
         ss = np.sum(cb * np.matmul(gram, cb), axis=1)  # (m, n_out)
         contrib = np.sqrt(np.sum(ss / w[None, :] ** 2, axis=1) / max(data_ss, 1e-300))
@@ -922,18 +1013,19 @@ class ModalFitter:
         didx: NDArray[np.intp],
     ) -> NDArray[np.float64]:
         """``sqrt(E|d psi_out|^2)`` per entry (n_out, m) by the delta method."""
-        C, Rq, Q, D = sol["C"], sol["R"], sol["Q"], sol["D"]
-        dpar, dcol = sol["dpar"], sol["dcol"]
-        q = C.shape[0]
+        C, Rq = sol["C"], sol["R"]
+        lay = sol["lay"]
+        q, n_out = C.shape
         n_par = th.size
         nd = didx.size
-        rinv = sla.solve_triangular(Rq, np.eye(q))
+        rinv = lapack.dtrtri(Rq)[0]
         F = rinv @ rinv.T  # (Phi^T Phi)^-1
-        E = rinv @ (Q.T @ D)  # Phi^+ D, (q, n_d)
-        A = self._selection(dpar, n_par)
-        # M_j = -Phi^+ dPhi/dtheta C_j  -> (n_out, q, n_par)
-        M = -np.einsum("ad,dj,dk->jak", E, C[dcol], A, optimize=True)
-        MC = M @ cth  # Cov(C_j, theta), (n_out, q, n_par)
+        E = rinv @ (sol["QtE"][:, lay.ecol] * sol["coef"][None, :])  # Phi^+ D, (q, n_d)
+        A = lay.A
+        # M_j = -Phi^+ dPhi/dtheta C_j: M[j, a, k] = -sum_d E[a, d] C[dcol_d, j] A[d, k]
+        ec = E[None, :, :] * C[lay.dcol].T[:, None, :]  # (n_out, q, n_d)
+        M = -(ec.reshape(n_out * q, -1) @ A).reshape(n_out, q, n_par)
+        MC = (M.reshape(n_out * q, n_par) @ cth).reshape(M.shape)  # Cov(C_j, theta)
         # Var of the coefficient of mode n for output j
         cov_cc_diag = s2 * np.diag(F)[None, :] + np.einsum("jak,jak->ja", MC, M)
         if self.kind == "complex":
@@ -954,10 +1046,10 @@ class ModalFitter:
         cdt = MC[didx]  # Cov(C_D, theta): (nd, q, n_par)
         sgg[n_par:, :n_par] = cdt.reshape(nd * q, n_par)
         sgg[:n_par, n_par:] = sgg[n_par:, :n_par].T
-        dd = np.einsum("iak,kl,jbl->iajb", MD, cth, MD).reshape(nd * q, nd * q)
+        dd = cdt.reshape(nd * q, n_par) @ MD.reshape(nd * q, n_par).T  # MD cth MD^T
         dd += s2 * np.kron(np.eye(nd), F)
         sgg[n_par:, n_par:] = dd
-        v3 = np.real(np.einsum("gn,gh,hn->n", beta.conj(), sgg, beta))
+        v3 = np.real(np.sum(beta.conj() * (sgg @ beta), axis=0))
         term3 = np.abs(u) ** 2 * v3[None, :]
         # cross_jn = sum_g Sigma_cG_j[a_n, g] beta[g, n] with Sigma_cG_j = [MC_j,
         # MC_j MD^T + s2 F (j = drive)] (a_n the coefficient rows of mode n), summed
@@ -965,7 +1057,7 @@ class ModalFitter:
         beta_d = beta[n_par:]  # (nd q, m)
         T = beta[:n_par] + MD.reshape(nd * q, n_par).T @ beta_d  # (n_par, m)
         bd = beta_d.reshape(nd, q, m)
-        fb = s2 * np.einsum("ab,ibn->ian", F, bd)  # (nd, q, m)
+        fb = s2 * np.matmul(F, bd)  # (nd, q, m)
         rsel = (
             [np.arange(0, 2 * m, 2), np.arange(1, 2 * m, 2)]
             if self.kind == "complex"
@@ -981,25 +1073,180 @@ class ModalFitter:
         return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))
 
 
+@dataclass(frozen=True)
+class _Layout:
+    """Derivative columns ``D = E[:, ecol] * coef`` of one basis layout.
+
+    ``coef = sign`` with the first ``nsig`` entries of every mode's block times
+    ``sigma_n`` (:meth:`ModalFitter._coef`); ``dpar``, ``dcol``: parameter and
+    basis column of each derivative column; ``A`` (n_d, n_par): 0/1 map of
+    derivative columns to parameters; ``ee``, ``dd``, ``eq``: flat indices of
+    ``(ecol_d, ecol_d')`` in ``E^T P E``, ``(dcol_d, dcol_d')`` in ``C C^T`` and
+    ``(ecol_d, dcol_d)`` in ``E^T r C^T``.
+    """
+
+    ecol: NDArray[np.intp]
+    sign: NDArray[np.float64]
+    nsig: int
+    dpar: NDArray[np.intp]
+    dcol: NDArray[np.intp]
+    A: NDArray[np.float64]
+    ee: NDArray[np.intp]
+    dd: NDArray[np.intp]
+    eq: NDArray[np.intp]
+
+
 def _put_pair(
-    out: NDArray[np.float64],
+    out: NDArray[np.complex128],
     c: int,
+    stride: int,
     a: NDArray[np.complex128],
     b: NDArray[np.complex128],
 ) -> None:
-    """Write the real-stacked columns ``a + b`` and ``i (a - b)`` of every mode.
+    """Write the columns ``a + b`` and ``i (a - b)`` of every mode.
 
-    ``a``, ``b``: (m, nin, nf) complex; ``out`` of shape (q, 2, nin, nf); mode
-    ``n`` goes to rows ``c + 2n, c + 2n + 1``.
+    ``a``, ``b``: (m, nin, nf) complex; ``out`` of shape (rows, nin, nf); mode
+    ``n`` goes to rows ``c + stride n, c + stride n + 1``.
     """
-    sm = a + b
-    df = a - b
     m = a.shape[0]
-    o1, o2 = out[c : c + 2 * m : 2], out[c + 1 : c + 2 * m : 2]
-    o1[:, 0] = sm.real
-    o1[:, 1] = sm.imag
-    o2[:, 0] = -df.imag  # Re(i d) = -Im d
-    o2[:, 1] = df.real  # Im(i d) = Re d
+    o1, o2 = out[c : c + stride * m : stride], out[c + 1 : c + stride * m : stride]
+    np.add(a, b, out=o1)
+    np.subtract(a, b, out=o2)
+    o2 *= 1j
+
+
+#: largest condition estimate of the unit-column Gram matrix of the basis for which
+#: the projection is taken from the Gram blocks (relative error ~ eps * this)
+_MAX_GRAM_COND = 1e6
+#: a squared norm ``||x||^2 - ||Q^T x||^2`` smaller than this fraction of the
+#: subtracted term (relative error ~ eps / this) is formed from the explicit residual
+_CANCEL_TOL = 1e-6
+#: fit_added: an added column whose squared norm drops below this fraction when the
+#: fixed basis is projected out is projected explicitly
+_PROJ_TOL = 1e-4
+
+
+def _gram_chol(
+    g: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """Cholesky factor of a Gram matrix with unit diagonal scaling, or None.
+
+    ``g = Phi^T Phi``: returns ``rs`` (upper) and ``d`` with ``g = diag(d) rs^T rs
+    diag(d)`` (so ``Phi = Q R`` with ``R = rs diag(d)``), or None when a column
+    vanishes, the factorisation fails or the condition estimate of ``rs^T rs``
+    exceeds ``_MAX_GRAM_COND``.
+    """
+    dg = g.diagonal()
+    if g.shape[0] == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):  # NaN: False
+        return None
+    d = np.sqrt(dg)
+    gs = g / np.multiply.outer(d, d)
+    rs, info = lapack.dpotrf(gs, lower=0, clean=1)
+    if info != 0:
+        return None
+    rcond, info = lapack.dpocon(rs, float(abs(gs).sum(axis=0).max()))
+    if info != 0 or not rcond * _MAX_GRAM_COND >= 1.0:
+        return None
+    return rs, d
+
+
+def _vp_solve(
+    G: NDArray[np.float64],
+    P: NDArray[np.float64],
+    q: int,
+    yy: NDArray[np.float64],
+    explicit: Any,
+    *,
+    residual: bool,
+    gradient: bool,
+    cancel: NDArray[np.float64] | None = None,
+) -> dict[str, Any]:
+    """Variable projection from the Gram blocks of ``B = [Phi | E]``.
+
+    Parameters
+    ----------
+    G : ndarray, shape (q + n_e, q + n_e)
+        ``B^T B``.
+    P : ndarray, shape (q + n_e, n_out)
+        ``B^T Y``.
+    q : int
+        Number of basis columns (the first ``q`` of ``B``).
+    yy : ndarray, shape (n_out,)
+        ``||Y_j||^2`` per column.
+    explicit : callable
+        Returns ``(B, Y)`` (n_rows rows), called only to orthogonalise an
+        ill-conditioned basis or to form the residual.
+    residual : bool
+        Form the residual ``r = Y - Phi C`` (else only when ``cost`` loses
+        accuracy by cancellation: ``cost_j < _CANCEL_TOL cancel_j``).
+    gradient : bool
+        Return ``E^T r``.
+    cancel : ndarray, shape (n_out,), optional
+        Reference of the cancellation test (default ``||Q^T Y_j||^2``).
+
+    Returns
+    -------
+    dict
+        ``R`` (``Phi = Q R``), ``C`` (q, n_out) coefficients, ``Ct = Q^T Y``,
+        ``QtE = Q^T E``, ``GE = E^T P E`` (``P`` the projector on the complement
+        of ``Phi``), ``Etr = E^T r`` (or None), ``cost``, ``cost_out``, ``resid``
+        (or None) and ``Q`` (None unless the basis was orthogonalised).
+
+    Notes
+    -----
+    With ``R`` from the Cholesky factor of ``Phi^T Phi`` (:func:`_gram_chol`):
+    ``Q^T X = R^-T Phi^T X`` for ``X = E, Y``, ``C = R^-1 Q^T Y``, ``cost_j =
+    ||Y_j||^2 - ||Q^T Y_j||^2``, ``E^T P E = E^T E - (Q^T E)^T Q^T E`` and ``E^T r =
+    E^T Y - (Q^T E)^T Q^T Y``. When the Gram matrix is too ill-conditioned
+    ``Q`` comes from :func:`_orth` of the explicit basis.
+    """
+    ne = G.shape[0] - q
+    fac = _gram_chol(G[:q, :q])
+    Q = None
+    Bx = Yx = None
+    if fac is not None:
+        rs, d = fac
+        rhs = np.concatenate([G[:q, q:], P[:q]], axis=1) / d[:, None]
+        x = lapack.dtrtrs(rs, rhs, trans=1)[0]
+        QtE, Ct = x[:, :ne], x[:, ne:]
+        R = rs * d[None, :]
+        C = lapack.dtrtrs(rs, Ct)[0] / d[:, None]
+    else:
+        Bx, Yx = explicit()
+        phi = Bx[:, :q]
+        Q, R = _orth(phi)
+        QtE = Q.T @ Bx[:, q:]
+        Ct = Q.T @ Yx
+        diag = np.abs(np.diag(R))
+        if diag.min() <= 1e-13 * diag.max():
+            C = np.linalg.lstsq(phi, Yx, rcond=None)[0]
+        else:
+            C = sla.solve_triangular(R, Ct)
+    ct2 = (Ct * Ct).sum(axis=0)
+    cost_out = yy - ct2
+    GE = G[q:, q:] - QtE.T @ QtE
+    resid = Etr = None
+    if residual or (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
+        if Bx is None:
+            Bx, Yx = explicit()
+        resid = Yx - (Bx[:, :q] @ C if Q is None else Q @ Ct)
+        cost_out = np.einsum("ij,ij->j", resid, resid)
+        if gradient:
+            Etr = Bx[:, q:].T @ resid
+    elif gradient:
+        Etr = P[q:] - QtE.T @ Ct
+    return {
+        "R": R,
+        "C": C,
+        "Ct": Ct,
+        "Q": Q,
+        "QtE": QtE,
+        "GE": GE,
+        "Etr": Etr,
+        "resid": resid,
+        "cost": float(cost_out.sum()),
+        "cost_out": cost_out,
+    }
 
 
 def _orth(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -1047,6 +1294,12 @@ def _householder(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray
     return qn, rn
 
 
+def _lu_solve(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.float64], int]:
+    """``a x = b`` by LAPACK ``dgesv`` (LU, partial pivoting) and its ``info`` (> 0: singular)."""
+    x, info = lapack.dgesv(a, b)[2:]
+    return x, int(info)
+
+
 def _levenberg_marquardt(
     evaluate: Any,
     x0: NDArray[np.float64],
@@ -1085,38 +1338,50 @@ def _levenberg_marquardt(
     lam = 1e-3
     nu = 2.0
     n = x.size
+    new_point = True  # the quantities of the current point are computed once
     while nfev < max_nfev:
-        if not np.isfinite(cost):
-            return x, nfev, False, aux
-        diag = np.diag(A)
-        d_a = np.sqrt(np.maximum(diag, 1e-300))
-        # held: at a bound with the descent direction -g pointing outwards, or
-        # without information (e.g. the damping of a residual mode far outside
-        # the band: its column of J vanishes)
-        held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
-        held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
-        free = np.flatnonzero(~held)
-        if free.size == 0:
-            return x, nfev, True, aux
-        An = A[np.ix_(free, free)] / np.outer(d_a[free], d_a[free])
-        gn = g[free] / d_a[free]
-        # Gauss-Newton decrement at this point (convergence test)
-        try:
-            gn_step = np.linalg.solve(An + 1e-12 * np.eye(free.size), -gn)
-        except np.linalg.LinAlgError:
-            gn_step = -gn
-        decrement = float(-gn @ gn_step)
-        if decrement <= max(tol * cost / dof, 1e-24 * cost0):
-            return x, nfev, True, aux
-        try:
-            step_n = np.linalg.solve(An + lam * np.eye(free.size), -gn)
-        except np.linalg.LinAlgError:
+        if new_point:
+            if not math.isfinite(cost):
+                return x, nfev, False, aux
+            diag = A.diagonal()
+            d_a = np.sqrt(np.maximum(diag, 1e-300))
+            # held: at a bound with the descent direction -g pointing outwards, or
+            # without information (e.g. the damping of a residual mode far outside
+            # the band: its column of J vanishes)
+            held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
+            held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
+            free: NDArray[np.intp] | None = None
+            d_f = d_a
+            if held.any():
+                idx = np.flatnonzero(~held)
+                if idx.size == 0:
+                    return x, nfev, True, aux
+                free, d_f = idx, d_a[idx]
+                An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
+                gn = g[idx] / d_f
+            else:
+                An = A / np.outer(d_a, d_a)
+                gn = g / d_a
+            eye = np.eye(gn.size)
+            # Gauss-Newton decrement at this point (convergence test)
+            gn_step, info = _lu_solve(An + 1e-12 * eye, -gn)
+            if info != 0:
+                gn_step = -gn
+            decrement = float(-gn @ gn_step)
+            if decrement <= max(tol * cost / dof, 1e-24 * cost0):
+                return x, nfev, True, aux
+            new_point = False
+        step_n, info = _lu_solve(An + lam * eye, -gn)
+        if info != 0:  # singular
             lam *= nu
             nu *= 2
             continue
-        d = np.zeros(n)
-        d[free] = step_n / d_a[free]
-        x_new = np.clip(x + d, lb, ub)
+        if free is None:
+            d = step_n / d_f
+        else:
+            d = np.zeros(n)
+            d[free] = step_n / d_f
+        x_new = np.minimum(np.maximum(x + d, lb), ub)
         d = x_new - x
         if np.all(np.abs(d) <= 1e-15 * (1.0 + np.abs(x))):
             return x, nfev, True, aux
@@ -1124,10 +1389,11 @@ def _levenberg_marquardt(
         c_new, A_new, g_new, aux_new = evaluate(x_new)
         nfev += 1
         rho = (cost - c_new) / pred if pred > 0 else -1.0
-        if np.isfinite(c_new) and c_new < cost and rho > 1e-4:
+        if math.isfinite(c_new) and c_new < cost and rho > 1e-4:
             x, cost, A, g, aux = x_new, c_new, A_new, g_new, aux_new
             lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
             nu = 2.0
+            new_point = True
         else:
             lam *= nu
             nu *= 2.0
