@@ -8,9 +8,11 @@ outputs and with 1024 outputs (4000 lines, 20 modes; 1024 not in
 ``--quick``) and prints the cumulative time of the main stages as a share of
 the call: pLSCF, stabilisation and clustering, output compression, the
 search for out-of-band residual modes, the checked fits of the final models,
-and, across all fits, the projection (``ModalFitter._solve``), the normal
-equations (``_normal``), the basis (``basis``) and the result assembly
-(``_result``, standard errors and contributions included). Stages nest
+and, across all fits, the projection (``ModalFitter._solve``; inside it the
+Cholesky route from the Gram blocks ``_vp_solve`` and the QR fallback
+``_orth`` for ill-conditioned bases), the normal equations (``_normal``), the
+basis with its distinct derivative columns (``_basis_ek``) and the result
+assembly (``_result``, standard errors and contributions included). Stages nest
 (a fit inside the search also counts in ``_solve``), so the rows do not
 add up to 100 %.
 """
@@ -46,9 +48,10 @@ STAGES = (
     ("all fits (ModalFitter.fit)", "fit.py", "fit"),
     ("  Levenberg-Marquardt (all refinements)", "fit.py", "_levenberg_marquardt"),
     ("  projection (_solve)", "fit.py", "_solve"),
-    ("  QR of the basis (_orth)", "fit.py", "_orth"),
+    ("  projection from the Gram blocks (_vp_solve)", "fit.py", "_vp_solve"),
+    ("  QR fallback (_orth)", "fit.py", "_orth"),
     ("  normal equations (_normal)", "fit.py", "_normal"),
-    ("  basis (basis)", "fit.py", "basis"),
+    ("  basis and derivative columns (_basis_ek)", "fit.py", "_basis_ek"),
     ("  result assembly (_result)", "fit.py", "_result"),
     ("  shape standard errors (_shape_std)", "fit.py", "_shape_std"),
     ("model object and indicators (_to_model)", "identify.py", "_to_model"),
