@@ -194,6 +194,7 @@ def test_virtual_tyre_default() -> None:
     res = identify_modes(frf.with_H(frf.H + 0.01 * rms * noise), band=(0.0, 200.0))
     c, r = res.models["complex"], res.models["real"]
     _check(c.poles, c.psi_out, tr.poles[vis], tr.psi_points[:, vis], 1e-3, 0.05, 0.99)
+    assert c.meta["max_order"] == 60  # sized and settled at the starting order
     # the paper found about 2x; this tyre (nonproportionality 0.5) gives about 4x
     assert r.meta["rmsd"] > 2 * c.meta["rmsd"]
 
@@ -222,3 +223,69 @@ def test_many_outputs_use_compressed_search_and_full_final_fit() -> None:
     c = out.models["complex"]
     assert_allclose(c.poles, p[:4], rtol=1e-4)  # 120 Hz is above the band: a residual mode
     assert c.psi_out.shape == (120, 4)  # the final fit uses every output
+
+
+def many_mode_frf(n_out: int, n_lines: int, n_modes: int, seed: int = 0) -> tuple[FRF, np.ndarray]:
+    """Accelerances of ``n_modes`` complex modes in 10-190 Hz plus two above 200 Hz.
+
+    As ``benchmarks/perf_common.synthetic_case``: frequencies evenly spread with
+    +-1 % jitter, damping 0.5-3 %, shapes ``a + 0.3 i b`` (non-proportional), one
+    drive point at output 1; lines ``df .. 200 Hz + df`` with ``df = 200 / n_lines``,
+    complex noise at 1 % of each FRF's RMS. Returns the FRFs and the in-band poles.
+    """
+    from tyredamp.mechanics import pole_from_frequency_damping
+    from tyredamp.modal import ModalModel
+
+    rng = np.random.default_rng(seed)
+    f_n = np.linspace(10.0, 190.0, n_modes) * (1 + 0.01 * rng.uniform(-1, 1, n_modes))
+    f_n = np.sort(np.concatenate([f_n, [215.0, 240.0]]))
+    p = pole_from_frequency_damping(f_n, rng.uniform(0.005, 0.03, f_n.size))
+    psi = (rng.normal(size=(n_out, f_n.size)) + 0.3j * rng.normal(size=(n_out, f_n.size))) * 1e-2
+    psi[0] = (np.abs(psi[0].real) + 0.5e-2) + 0.3j * psi[0].imag
+    model = ModalModel(
+        p, psi, psi[:1], mode_kind="complex", outputs=range(1, n_out + 1), inputs=[1]
+    )
+    df = 200.0 / n_lines
+    frf = model.frf(df * np.arange(1, n_lines + 2), kind="accelerance")
+    h = np.asarray(frf.H)
+    rms = np.sqrt(np.mean(np.abs(h) ** 2, axis=2, keepdims=True))
+    e = rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)
+    return frf.with_H(h + 0.01 * rms * e / np.sqrt(2)), p[:n_modes]
+
+
+def test_automatic_order_resolves_a_band_full_of_modes() -> None:
+    # 30 modes in the band: order 60 spreads its 30 root pairs over them and few
+    # columns persist; the sizing rule alone stopped there (4 modes identified).
+    # The unsettled diagram triggers a trial order (128) that resolves the band
+    frf, poles = many_mode_frf(32, 1000, 30)
+    band = (float(frf.frequency[0]), 200.0)
+    c = identify_modes(frf, band=band, model="complex").models["complex"]
+    assert c.meta["max_order"] > 60
+    assert c.n_modes == poles.size  # every mode, no spurious one
+    f_id, f_tr = np.sort(c.frequency_hz), np.sort(np.abs(poles) / (2 * np.pi))
+    assert np.all(np.abs(f_id / f_tr - 1) < 1e-3)
+    z_tr = (-poles.real / np.abs(poles))[np.argsort(np.abs(poles))]
+    z_id = c.damping_ratio[np.argsort(c.frequency_hz)]
+    assert np.all(np.abs(z_id / z_tr - 1) < 0.05)
+    # an explicit order is used as given (here too low for the band)
+    low = identify_modes(frf, band=band, model="complex", max_order=60).models["complex"]
+    assert low.meta["max_order"] == 60
+    assert low.n_modes < 10
+
+
+def test_automatic_order_trial_that_finds_nothing_keeps_the_diagram(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import tyredamp.modal.identify as ident
+
+    frf = ring_frf(ring_system(), [0], seed=1)
+    ref = identify_modes(frf, band=(0.0, 200.0), model="complex")
+    # every diagram counts as unsettled: the ring's trial order (128) only adds
+    # noise poles (fewer of the stable poles persist), so order 60 and its
+    # diagram stay, and so does the result
+    monkeypatch.setattr(ident, "_SETTLED_SHARE", 1.01)
+    res = identify_modes(frf, band=(0.0, 200.0), model="complex")
+    assert ref.models["complex"].meta["max_order"] == 60
+    assert res.models["complex"].meta["max_order"] == 60
+    assert_allclose(res.poles.poles, ref.poles.poles, rtol=0, atol=0)
+    assert_allclose(res.models["complex"].poles, ref.models["complex"].poles, rtol=0, atol=0)

@@ -14,6 +14,37 @@ Pipeline of :func:`identify_modes` (spec ``radial-damping.md`` steps 3-6):
    together (:class:`~tyredamp.modal.fit.ModalFitter`), mass-normalised
    scaling from the drive points, standard errors, fit indicators.
 
+Automatic order of step 1 (``max_order`` not given; ``n = n_in`` inputs, ``m``
+persistent clusters in the diagram of highest order ``p``, which has ``p n``
+roots; ``limit = 2 n_freq / (n_in + 1) - 2``):
+
+* start at ``ceil(60 / n)``, or ``ceil((4 n_modes + 16) / n)`` (at least
+  ``30 / n``) with a mode count or frequencies;
+* *sizing*: while ``p n < 4 (m + 2)`` (fewer than twice the roots of the ``m``
+  modes and of two residual terms), raise ``p`` to ``max(2 p, 4 (m + 2) / n)``;
+* *settling*: a sized diagram whose persistent clusters hold fewer than two
+  thirds of its stable poles is unsettled. Such a share is the signature of an
+  order too low for the band: with about as many modes as root pairs, the
+  roots are shared among the modes and move from order to order, and few
+  columns persist, so ``m`` is small and the sizing rule is met although most
+  modes are missing (30 modes in 10-190 Hz at order 60: 3-5 persistent
+  clusters holding 24-55 % of the stable poles; the settled diagrams of the
+  virtual tyre, the rings and synthetic bands of 6-20 modes hold 67-100 %).
+  An order too high also lowers the share: its surplus roots fit the noise
+  and are now and then stable. A trial at ``2 p + 8 / n`` (what the sizing
+  rule asks when every root pair of order ``p`` is a mode) tells the two
+  apart. It is kept, and sizing and settling go on from it, only when its
+  diagram has more persistent clusters *and* a larger persistent share:
+  modes that were not resolved form columns at the higher order, whereas a
+  higher order only adds noise poles to a resolved band, so the share falls.
+  Otherwise order ``p`` and its diagram are kept as they were and the
+  search stops.
+
+No order exceeds ``limit``. Settled diagrams (the virtual tyre, the rings,
+bands of up to about 20 modes) take no trial and cost what the sizing rule
+alone costs; each raise or trial recomputes pLSCF at the higher order, and a
+rejected trial costs one pLSCF at about twice the final order.
+
 Rejection rule of step 3 (automatic selection only): a mode is dropped when
 its synthesised FRF has an RMS below ``min_contribution`` (default 0.2 %) of
 the RMS of the data, or when its energy is below ``min_significance``
@@ -43,6 +74,8 @@ from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
 __all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
 
 ModelChoice = Literal["real", "complex", "both"]
+#: a stabilisation diagram: poles of all orders, their flags, kept and weak clusters
+_Diagram = tuple[PoleSet, StabilityFlags, list[Cluster], list[Cluster]]
 _POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 #: convergence thresholds of the intermediate fits, in units of the residual
 #: variance s^2 (ModalFitter.fit ``tol``): the joint fits of the search and of the
@@ -69,6 +102,11 @@ _MIN_LOW_LINES = 10
 #: and of the final refinement when n_out > 4 rank (module docstring of identify)
 _COMPRESS_SEARCH = 1.5
 _COMPRESS_FINAL = 4.0
+#: automatic order (module docstring): a stabilisation diagram is settled when at
+#: least this share of its stable poles belongs to persistent clusters. Settled
+#: diagrams of the test cases (virtual tyre, rings, synthetic 6-20 modes at 20-60 dB)
+#: have 0.67-1.0; a band with more modes than the order can hold has 0.1-0.55
+_SETTLED_SHARE = 2.0 / 3.0
 
 
 @dataclass(frozen=True)
@@ -121,6 +159,17 @@ def _default_order(n_in: int, n_freq: int, n_modes: int | None) -> int:
     return max(2, min(p, limit))
 
 
+def _persistent_share(flags: StabilityFlags, kept: list[Cluster]) -> float:
+    """Share of the stable poles that belong to the persistent clusters ``kept``.
+
+    0 when no pole is stable (nothing settled).
+    """
+    n_stable = int(np.count_nonzero(flags.stable))
+    if n_stable == 0:
+        return 0.0
+    return sum(c.members.size for c in kept) / n_stable
+
+
 def identify_modes(
     frf: FRF,
     band: tuple[float, float] | None = None,
@@ -158,8 +207,13 @@ def identify_modes(
         Approximate natural frequencies (Hz) of the wanted modes; the nearest
         stable pole of each is used. Overrides ``n_modes``.
     max_order : int, optional
-        Highest pLSCF order; default ``ceil(60 / n_in)`` (or more when
-        ``n_modes`` is large), capped by the number of lines.
+        Highest pLSCF order, used as given. Default automatic: from
+        ``ceil(60 / n_in)`` (or more when ``n_modes`` is large), raised while
+        the highest order has fewer than two roots per mode found plus two,
+        or while the diagram is unsettled (fewer than two thirds of its
+        stable poles in persistent clusters) and a trial at about twice the
+        order finds more persistent modes in a more settled diagram (module
+        docstring); capped by the number of lines.
     order_step : int
         Orders of the stabilisation diagram: every ``order_step``-th from
         ``max_order`` down to ``max_order / 4`` (default 2; 1 for every
@@ -219,27 +273,51 @@ def identify_modes(
     nm_hint = int(n_modes) if n_modes is not None else (None if fr is None else fr.size)
     p_max = _default_order(n_in, n_f, nm_hint) if max_order is None else int(max_order)
     limit = (2 * n_f) // (n_in + 1) - 2
-    while True:
-        # orders below p_max / 4 do not count for persistence (most modes need a
+
+    def diagram(p: int) -> _Diagram:
+        # orders below p / 4 do not count for persistence (most modes need a
         # minimum order to appear at all)
-        ps = plscf(
+        ps_ = plscf(
             f,
             H,
-            p_max,
+            p,
             band=(float(f[0]), float(f[-1])),
-            min_order=max(1, p_max // 4),
+            min_order=max(1, p // 4),
             order_step=order_step,
         )
-        flags = stability_flags(ps, band=(lo, hi), max_damping=max_damping)
-        kept, weak = cluster_poles(
-            ps, flags, cluster_distance=cluster_distance, min_fraction=min_fraction
+        flags_ = stability_flags(ps_, band=(lo, hi), max_damping=max_damping)
+        kept_, weak_ = cluster_poles(
+            ps_, flags_, cluster_distance=cluster_distance, min_fraction=min_fraction
         )
-        # automatic order: the highest order must give at least 2 poles per pole
-        # needed (kept modes + 2 for residual effects, conjugates counted)
+        return ps_, flags_, kept_, weak_
+
+    # automatic order (module docstring): the sizing rule, and trial raises of an
+    # unsettled diagram that are kept only when they reveal more persistent modes
+    # in a more settled diagram
+    ps, flags, kept, weak = diagram(p_max)
+    trial: tuple[int, float, _Diagram] | None = None  # order, share, diagram before a trial
+    while max_order is None:
+        share = _persistent_share(flags, kept)
+        if trial is not None:
+            p_prev, share_prev, prev = trial
+            trial = None
+            if len(kept) <= len(prev[2]) or share <= share_prev:
+                p_max, (ps, flags, kept, weak) = p_prev, prev
+                break
+        # sizing: the highest order must give at least 2 poles per pole needed
+        # (kept modes + 2 for residual effects, conjugates counted)
         need = 2 * 2 * (len(kept) + 2)
-        if max_order is not None or p_max * n_in >= need or p_max >= limit:
+        if p_max >= limit:
             break
-        p_max = min(limit, max(2 * p_max, int(np.ceil(need / n_in))))
+        if p_max * n_in < need:
+            p_max = min(limit, max(2 * p_max, int(np.ceil(need / n_in))))
+        elif share < _SETTLED_SHARE:
+            # as if every root pair of the top order were a mode: p n_in / 2 modes
+            trial = (p_max, share, (ps, flags, kept, weak))
+            p_max = min(limit, 2 * p_max + int(np.ceil(8 / n_in)))
+        else:
+            break
+        ps, flags, kept, weak = diagram(p_max)
     rejected: list[dict[str, Any]] = [
         _rej(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}") for c in weak
     ]
