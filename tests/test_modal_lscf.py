@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from numpy.testing import assert_allclose
+from numpy.testing import assert_allclose, assert_array_equal
 
 from tyredamp.exceptions import InputError, ShapeError
 from tyredamp.modal.indicators import mac
-from tyredamp.modal.lscf import plscf
-from tyredamp.modal.selection import cluster_poles, stability_flags
+from tyredamp.modal.lscf import PoleSet, plscf
+from tyredamp.modal.selection import StabilityFlags, cluster_poles, stability_flags
 
 from .helpers import chain_system
 
@@ -152,33 +152,36 @@ def test_plscf_order_step_counts_down_from_the_highest_order() -> None:
             plscf(F, h, 24, order_step=bad)  # type: ignore[arg-type]
 
 
-def test_clusters_split_at_gaps_equal_one_complete_linkage(monkeypatch: pytest.MonkeyPatch) -> None:
+def _rule3_distance(p: np.ndarray, lv: np.ndarray, od: np.ndarray) -> np.ndarray:
+    """Dense rule-3 distance matrix (1e6 for two poles of the same order)."""
+    d = np.abs(p[:, None] - p[None, :]) / np.maximum(np.abs(p)[:, None], np.abs(p)[None, :])
+    if lv.shape[1] > 1:
+        d = d + 1 - mac(lv.T, lv.T)
+    d = np.where(od[:, None] == od[None, :], 1e6, d)
+    np.fill_diagonal(d, 0.0)
+    return np.clip(0.5 * (d + d.T), 0, 1e6)
+
+
+def _one_linkage(ps: PoleSet, flags: StabilityFlags, cut: float = 0.01) -> list[tuple[int, ...]]:
+    """Reference clusters: one complete linkage over all stable poles, cut at ``cut``."""
     from scipy.cluster.hierarchy import fcluster, linkage
     from scipy.spatial.distance import squareform
 
-    import tyredamp.modal.selection as sel
+    idx = np.flatnonzero(flags.stable)
+    d = _rule3_distance(ps.poles[idx], ps.participation[idx], ps.order[idx])
+    lab = fcluster(linkage(squareform(d, checks=False), "complete"), t=cut, criterion="distance")
+    return sorted(tuple(idx[lab == k].tolist()) for k in np.unique(lab))
 
+
+def test_clusters_equal_one_complete_linkage() -> None:
     sys_ = chain_system()
     rng = np.random.default_rng(8)
     h = sys_.frf(F, inputs=[0, 3]).H
     h = h + 0.02 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
     ps = plscf(F, h, 30)
     flags = stability_flags(ps, max_damping=0.5)
-    monkeypatch.setattr(sel, "_CHUNK", 1)  # every gap splits
     kept, rej = cluster_poles(ps, flags)
-    # reference: one complete linkage over all stable poles (rule 3 distance)
-    idx = np.flatnonzero(flags.stable)
-    p, lv, od = ps.poles[idx], ps.participation[idx], ps.order[idx]
-    d = np.abs(p[:, None] - p[None, :]) / np.maximum(np.abs(p)[:, None], np.abs(p)[None, :])
-    d = d + 1 - mac(lv.T, lv.T)
-    d = np.where(od[:, None] == od[None, :], 1e6, d)
-    np.fill_diagonal(d, 0.0)
-    lab = fcluster(
-        linkage(squareform(np.clip(0.5 * (d + d.T), 0, 1e6), checks=False), "complete"),
-        t=0.01,
-        criterion="distance",
-    )
-    ref = sorted(tuple(idx[lab == k].tolist()) for k in np.unique(lab))
+    ref = _one_linkage(ps, flags)
     got = sorted(tuple(c.members.tolist()) for c in kept + rej)
     assert len(ref) > 5
     assert got == ref
@@ -186,6 +189,68 @@ def test_clusters_split_at_gaps_equal_one_complete_linkage(monkeypatch: pytest.M
         fn = np.abs(ps.poles[c.members]) / (2 * np.pi)
         assert c.frequency_hz == pytest.approx(np.median(fn), rel=1e-12)
         assert c.fraction == np.unique(ps.order[c.members]).size / ps.orders.size
+
+
+@pytest.mark.parametrize("n_in", [1, 2])
+def test_clusters_of_a_dense_pole_cloud_equal_one_complete_linkage(n_in: int) -> None:
+    # 12 orders of 25 jittered modes (each present at 80 % of the orders) and 30
+    # spurious poles, all in 40-60 Hz: ~550 poles, almost no gap of |p| above the cut
+    rng = np.random.default_rng(30 + n_in)
+    orders = np.arange(20, 44, 2)
+    f0, z0 = rng.uniform(40, 60, 25), rng.uniform(0.01, 0.05, 25)
+    l0 = rng.normal(size=(25, n_in)) + 1j * rng.normal(size=(25, n_in))
+    od, f, z, lv = [], [], [], []
+    for o in orders:
+        m = rng.random(25) < 0.8
+        f += [f0[m] * (1 + 0.002 * rng.normal(size=m.sum())), rng.uniform(40, 60, 30)]
+        z += [z0[m] + 0.001 * rng.normal(size=m.sum()), rng.uniform(0.005, 0.15, 30)]
+        noise = rng.normal(size=(m.sum() + 30, n_in)) + 1j * rng.normal(size=(m.sum() + 30, n_in))
+        lv.append(np.concatenate([l0[m], np.zeros((30, n_in))]) + 0.03 * noise)
+        lv[-1][m.sum() :] = noise[m.sum() :]
+        od.append(np.full(m.sum() + 30, o))
+    w, zz = 2 * np.pi * np.concatenate(f), np.abs(np.concatenate(z))
+    ps = PoleSet(
+        order=np.concatenate(od),
+        poles=-zz * w + 1j * w * np.sqrt(1 - zz**2),
+        participation=np.concatenate(lv) / np.linalg.norm(np.concatenate(lv), axis=1)[:, None],
+        orders=orders,
+        band_hz=(40.0, 60.0),
+    )
+    n = ps.poles.size
+    stable = rng.random(n) < 0.95
+    flags = StabilityFlags(*(4 * [stable]))
+    mag = np.sort(np.abs(ps.poles[stable]))
+    assert n > 500
+    assert np.count_nonzero(mag[1:] / mag[:-1] - 1 > 0.01) <= 2  # few gaps to split at
+    kept, rej = cluster_poles(ps, flags)
+    got = sorted(tuple(c.members.tolist()) for c in kept + rej)
+    ref = _one_linkage(ps, flags)
+    assert got == ref
+    assert sum(len(c) >= 5 for c in ref) >= 15  # the modes
+    assert len(kept) >= 15
+
+
+def test_threshold_edges_hold_every_pair_within_the_cut() -> None:
+    from tyredamp.modal.selection import _threshold_edges
+
+    # clumps of poles all around the circle (arg p wraps at -pi/pi) over a decade of |p|
+    rng = np.random.default_rng(4)
+    centre = np.exp(rng.uniform(0, np.log(10), 80) + 1j * rng.uniform(-np.pi, np.pi, 80))
+    centre[:4] = [-1 + 1e-3j, -1 - 1e-3j, -3 + 0j, -3 - 2e-3j]  # on either side of the wrap
+    p = np.repeat(centre, 5) * (1 + 0.004 * (rng.normal(size=400) + 1j * rng.normal(size=400)))
+    od = rng.integers(0, 8, 400)
+    for n_in in (1, 2):
+        lv = rng.normal(size=(400, n_in)) + 1j * rng.normal(size=(400, n_in))
+        lv[1::2] = lv[::2] + 0.05 * rng.normal(size=(200, n_in))  # MAC near 1 for half the pairs
+        d_ref = _rule3_distance(p, lv, od)
+        for cut in (0.01, 0.05, 0.5, 1.5):
+            i, j, d = _threshold_edges(p, lv, od, cut)
+            ri, rj = np.nonzero(np.triu(d_ref <= cut, 1))
+            assert ri.size > 50
+            o = np.lexsort((j, i))
+            assert_array_equal(i[o], ri)
+            assert_array_equal(j[o], rj)
+            assert_allclose(d[o], d_ref[ri, rj], rtol=1e-12, atol=1e-14)
 
 
 def test_aberth_roots_equal_companion_eigenvalues() -> None:

@@ -33,15 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.cluster.hierarchy import linkage
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial.distance import squareform
+from scipy.spatial import cKDTree
 
 from ..exceptions import InputError
 from .lscf import PoleSet
 
-_CHUNK = 200  # poles per complete-linkage call (groups split at gaps are joined up to it)
+_SLACK = 1e-6  # relative widening of the candidate search (rounding of log|p|, arg p)
 
 __all__ = ["Cluster", "StabilityFlags", "cluster_poles", "stability_flags"]
 
@@ -158,36 +155,116 @@ def stability_flags(
     return StabilityFlags(admissible=adm, frequency=fstab, damping=zstab, vector=vstab)
 
 
-def _complete_linkage(
+def _threshold_edges(
     p: NDArray[np.complex128],
     lv: NDArray[np.complex128],
     od: NDArray[np.int64],
     cut: float,
-) -> NDArray[np.int64]:
-    """Labels ``0..k-1`` of complete-linkage clusters cut at ``cut`` (rule 3)."""
-    if p.size == 1:
-        return np.zeros(1, np.int64)
-    mag = np.maximum(np.abs(p)[:, None], np.abs(p)[None, :])
-    d = np.abs(p[:, None] - p[None, :]) / mag
-    if lv.shape[1] > 1:
-        num = np.abs(lv.conj() @ lv.T) ** 2
-        nn = np.sum(np.abs(lv) ** 2, axis=1)
-        d = d + (1.0 - num / np.outer(nn, nn))
-    big = 1e6
-    d = np.where(od[:, None] == od[None, :], big, d)
-    np.fill_diagonal(d, 0.0)
-    d = np.clip(0.5 * (d + d.T), 0.0, big)
-    z = linkage(squareform(d, checks=False), method="complete")
-    # complete linkage is monotone: the merges up to the cut are the first rows
-    # of z; the clusters are the connected components of those merges
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
+    """Pairs of poles of different orders at rule-3 distance ``<= cut``.
+
+    Returns ``(i, j, d)`` with ``i < j`` (each pair once) and ``d`` the distance
+    of rule 3. Candidates come from a k-d tree: with ``m <= M`` the two moduli
+    and ``theta`` the angle between the poles, ``|p_i - p_j| >= M - m`` and
+    ``|p_i - p_j| >= M sin(theta)`` (``>= M`` for ``theta > pi/2``), so a pole
+    distance ``<= cut < 1`` implies ``log M - log m <= -log(1 - cut)`` and
+    ``theta <= arcsin(cut)``. In ``(log|p|, arg p)`` scaled by these two bounds
+    every such pair lies within a unit max-norm ball (widened by ``_SLACK`` for
+    rounding); the participation term ``1 - MAC >= 0`` only adds, so the
+    candidates hold every pair within the cut. Their exact distance, element by
+    element, then keeps the pairs ``<= cut``.
+    """
     n = p.size
-    k = int(np.searchsorted(z[:, 2], cut, side="right"))
-    if k == 0:
-        return np.arange(n, dtype=np.int64)
-    a = z[:k, :2].astype(np.int64).ravel()
-    b = np.repeat(n + np.arange(k), 2)
-    g = coo_matrix((np.ones(2 * k), (a, b)), shape=(n + k, n + k))
-    lab = connected_components(g, directed=False)[1][:n]
+    mag = np.abs(p)
+    if cut < 1:
+        ang = np.angle(p)
+        r_ang = float(np.arcsin(cut))
+        x = np.column_stack(
+            [np.log(np.maximum(mag, np.finfo(float).tiny)) / -np.log1p(-cut), ang / r_ang]
+        )
+        # arg p wraps at -pi/pi: poles within the bound above -pi get a copy past pi
+        wrap = np.flatnonzero(ang < -np.pi + r_ang)
+        x = np.vstack([x, x[wrap] + [0.0, 2 * np.pi / r_ang]])
+        ij = cKDTree(x).query_pairs(1.0 + _SLACK, p=np.inf, output_type="ndarray")
+        i, j = ij[:, 0].astype(np.int64), ij[:, 1].astype(np.int64)  # i < j
+        if wrap.size:
+            keep = i < n  # two copies: the same pair as the two originals
+            i, j = i[keep], np.concatenate([np.arange(n), wrap])[j[keep]]
+            i, j = np.minimum(i, j), np.maximum(i, j)
+    else:  # no bound: every pair is a candidate
+        i, j = (np.asarray(k, np.int64) for k in np.triu_indices(n, 1))
+    keep = od[i] != od[j]  # same order: never in one cluster
+    i, j = i[keep], j[keep]
+    d = np.abs(p[i] - p[j]) / np.maximum(mag[i], mag[j])
+    if lv.shape[1] > 1:
+        nn = np.sum(np.abs(lv) ** 2, axis=1)
+        s = np.zeros(i.size, np.complex128)
+        for k in range(lv.shape[1]):
+            s += lv[i, k].conj() * lv[j, k]
+        d = np.maximum(d + (1.0 - np.abs(s) ** 2 / (nn[i] * nn[j])), 0.0)
+    keep = d <= cut
+    return i[keep], j[keep], d[keep]
+
+
+def _complete_linkage(
+    n: int, i: NDArray[np.int64], j: NDArray[np.int64], d: NDArray[np.float64]
+) -> NDArray[np.int64]:
+    """Labels ``0..k-1`` of the complete-linkage clusters (rule 3) of ``n`` poles.
+
+    ``(i, j, d)`` are the pole pairs at distance ``<= cut``
+    (:func:`_threshold_edges`). The complete-linkage distance of two clusters is
+    the largest distance of their member pairs: it is ``<= cut`` exactly when
+    every member pair is an edge, and it then is the largest of those edges.
+    Larger distances never lead to a merge below the cut, so the edges alone
+    give every merge up to the cut (a cluster is a clique of the graph; poles in
+    different connected components are never merged). Complete linkage is
+    reducible (a merged cluster is at least as far from any other as the nearer
+    of its two parts), so pairs of reciprocal nearest neighbours stay reciprocal
+    when other pairs merge: merging all of them at once gives the same
+    dendrogram as one merge at a time. The rounds below repeat this on the
+    cluster graph (per cluster pair: count of member pairs within the cut and
+    their largest distance) until no cluster pair has all its member pairs
+    within the cut. Each round costs O(edges), and the edges shrink fast (a pair
+    with a member pair missing is dropped for good). The result is the clusters
+    of :func:`scipy.cluster.hierarchy.linkage` (``"complete"``) cut at ``cut``,
+    the order of exactly tied merges aside; no n^2 matrix is formed. A cluster
+    keeps its smallest pole index as label, so the labels are numbered in the
+    order of the smallest members.
+    """
+    lab = np.arange(n)
+    size = np.ones(n, np.int64)
+    a, b, dist, cnt = i, j, d, np.ones(i.size, np.int64)
+    while a.size:
+        near = np.full(n, np.inf)
+        np.minimum.at(near, a, dist)
+        np.minimum.at(near, b, dist)
+        nn = np.full(n, n)  # nearest neighbour, the smallest label among ties
+        m = dist == near[a]
+        np.minimum.at(nn, a[m], b[m])
+        m = dist == near[b]
+        np.minimum.at(nn, b[m], a[m])
+        c = np.flatnonzero(nn < n)
+        c = c[(nn[nn[c]] == c) & (c < nn[c])]  # reciprocal pairs (c, nn[c]) merge into c
+        if c.size == 0:  # cannot happen (the closest pair is reciprocal); never loop
+            break
+        new = np.arange(n)
+        new[nn[c]] = c
+        size[c] += size[nn[c]]
+        lab = new[lab]
+        a, b = new[a], new[b]
+        keep = a != b
+        a, b, dist, cnt = a[keep], b[keep], dist[keep], cnt[keep]
+        key = np.minimum(a, b) * n + np.maximum(a, b)
+        o = np.argsort(key, kind="stable")  # after round 1: sorted runs, cheap
+        key, dist, cnt = key[o], dist[o], cnt[o]
+        if key.size == 0:
+            break
+        first = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]]))
+        cnt = np.add.reduceat(cnt, first)
+        dist = np.maximum.reduceat(dist, first)
+        a, b = key[first] // n, key[first] % n
+        keep = cnt == size[a] * size[b]  # some member pair beyond the cut: never merges
+        a, b, dist, cnt = a[keep], b[keep], dist[keep], cnt[keep]
     return np.asarray(np.unique(lab, return_inverse=True)[1], np.int64)
 
 
@@ -228,24 +305,15 @@ def cluster_poles(
     p = ps.poles[idx]
     lv = ps.participation[idx]
     od = ps.order[idx]
-    labels = np.zeros(idx.size, np.int64)
-    # complete linkage never joins poles farther apart than the cut, and the
-    # distance is at least the relative gap of |p|: groups split at such gaps
-    # cluster independently (same clusters, no n^2 matrix over all poles)
+    # complete linkage on the graph of the pole pairs within the cut (exact, no
+    # n^2 matrix: see _complete_linkage); poles numbered by increasing |p|, so
+    # the clusters are numbered by their member of smallest |p|
     order = np.argsort(np.abs(p), kind="stable")
-    mag = np.abs(p)[order]
-    gap = 1.0 - mag[:-1] / np.where(mag[1:] > 0, mag[1:], 1.0)
-    cuts = np.flatnonzero(gap > cluster_distance) + 1
-    # consecutive groups are joined up to _CHUNK poles (fewer, larger linkages)
-    chunks: list[int] = []
-    for cut in cuts.tolist():
-        if cut - (chunks[-1] if chunks else 0) >= _CHUNK:
-            chunks.append(cut)
-    n_lab = 0
-    for grp in np.split(order, chunks):
-        sub = _complete_linkage(p[grp], lv[grp], od[grp], cluster_distance)
-        labels[grp] = sub + n_lab
-        n_lab += int(sub.max()) + 1
+    labels = np.empty(idx.size, np.int64)
+    labels[order] = _complete_linkage(
+        idx.size, *_threshold_edges(p[order], lv[order], od[order], cluster_distance)
+    )
+    n_lab = int(labels.max()) + 1
     # per-cluster medians, spread, persistence and representative, all at once
     n_orders = ps.orders.size
     n_cl = n_lab
