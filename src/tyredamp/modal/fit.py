@@ -171,6 +171,12 @@ class ModalFitter:
         self.n_rows = self.Y.shape[0]
         self.data_ss = float(np.sum(self.Y**2))
         self._rms = np.sqrt(np.mean(self.Y**2, axis=0))  # RMS per output row
+        # weights of a first pass (fit without sigma, fit_added): 1 / RMS per output
+        self._w1 = (
+            np.ones_like(self._rms)
+            if unit_weights
+            else 1.0 / np.where(self._rms > 0, self._rms, 1.0)
+        )
 
     # ------------------------------------------------------------ layout
     def n_cols(self, m: int) -> int:
@@ -535,13 +541,9 @@ class ModalFitter:
             part = (part * ph[:, None]).real.astype(complex)
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         th = self.pack(np.asarray(poles, complex), part, ref)
-        rms = self._rms
-        floor = 1e-9 * rms
-        w = 1.0 / np.where(rms > 0, rms, 1.0)
-        if self.unit_weights:
-            rms = np.ones_like(rms)
-            w = np.ones_like(rms)
-        elif sigma is not None:
+        floor = 1e-9 * self._rms
+        w = self._w1
+        if sigma is not None and not self.unit_weights:
             w = 1.0 / np.maximum(np.asarray(sigma, float), np.maximum(floor, 1e-300))
         q = self.n_cols(m)
         dof = self.n_rows - q
@@ -616,10 +618,7 @@ class ModalFitter:
             part, l1 = allp[:m], allp[m:]
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
-        rms = self._rms
-        w = 1.0 / np.where(rms > 0, rms, 1.0)
-        if self.unit_weights:
-            w = np.ones_like(rms)
+        w = self._w1
         Yw = self.Y * w[None, :]
         yy = np.einsum("ij,ij->j", Yw, Yw)
         last = self._last_q
