@@ -85,3 +85,87 @@ def test_lateral_fit_on_demo_files_reproduces_the_demo(
             assert set(f["params"]) == set(want)
             for k, v in want.items():
                 assert_allclose(f["params"][k], v, rtol=1e-9, err_msg=f"{tag} {f['model']} {k}")
+
+
+def _sections(html_text: str) -> dict[str, str]:
+    """The report's radial and lateral sections (text between their level-2 headings)."""
+    import re
+
+    def at(title: str) -> int:
+        m = re.search(rf'<h2 id="s\d+">{re.escape(title)}', html_text)
+        assert m is not None, title
+        return m.start()
+
+    r0, l0 = at("Radial study: modal test"), at("Lateral study: rolling-tyre rig")
+    f0 = at("Files")
+    return {"radial": html_text[r0:l0], "lateral": html_text[l0:f0]}
+
+
+def test_every_stage_warning_reaches_the_report_beside_its_result(
+    demo: tuple[DemoResult, Path],
+) -> None:
+    import html
+
+    from tyredamp.report.findings import demo_findings
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    page = (out / "report.html").read_text(encoding="utf-8")
+    sec = _sections(page)
+    # collected again from the stages' own results: nothing is lost on the way
+    raw = []
+    for run in result.radial.runs:
+        raw += list(run.identification.warnings)
+        for mdl in run.models.values():
+            raw += list(mdl.meta.get("warnings", []))
+    for chk in (result.radial.linearity, result.radial.reciprocity, result.radial.quality):
+        if not chk.passed:
+            raw.append(chk.summary)
+    messages = [w["message"] for w in doc["warnings"]]
+    for w in raw:
+        core = w.split("(", 1)[-1].split(")", 1)[0] if w.startswith("real-mode refinement") else w
+        assert any(core in m for m in messages), w
+    fnd = demo_findings(result)
+    assert [f.to_dict() for f in fnd.findings] == doc["warnings"]
+    assert doc["warnings"]  # the quick demo has failures to report (9 bar, real modes)
+    for w in doc["warnings"]:
+        text = html.escape(w["message"])
+        where = "radial" if w["about"].startswith("radial") else "lateral"
+        assert text in sec[where], w  # beside the result it concerns
+        assert page.count(text) >= 2, w  # and in the summary's list
+
+
+def test_every_pressure_and_condition_fits_or_says_why(demo: tuple[DemoResult, Path]) -> None:
+    import html
+
+    from tyredamp.cli.demo import demo_summary_rows
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    page = (out / "report.html").read_text(encoding="utf-8")
+    rows = dict(demo_summary_rows(result, doc))
+    verdicts = []
+    for pr in doc["radial"]["pressures"]:
+        for name in ("complex", "real"):
+            verdicts.append((f"{name}-mode fit {pr['pressure_bar']:g} bar", pr["verdict"][name]))
+    for c in doc["lateral"]["conditions"]:
+        verdicts.append((f"{c['best']} fit {c['label']}", c["verdict"]))
+    assert len(verdicts) == 2 * len(result.radial.runs) + len(result.lateral.conditions)
+    for key, v in verdicts:
+        if v["status"] == "ok":
+            assert v["residual_to_noise"] <= v["threshold"]
+            assert rows[key] == "within noise"
+            continue
+        assert v["status"] == "failed"
+        assert v["reasons"], key
+        assert rows[key].startswith("FAILED: ")
+        assert v["reasons"][0] in rows[key]
+        assert f'<div class="verdict bad">{html.escape(v["summary"])}</div>' in page
+    # the 9 bar fit misses its band-edge mode: failed, and the report says why
+    nine = next(p for p in doc["radial"]["pressures"] if p["pressure_bar"] == 9.0)
+    reasons = " ".join(nine["verdict"]["complex"]["reasons"])
+    if nine["verdict"]["complex"]["status"] == "failed":
+        assert "band edge" in reasons
+    # the main pressure's complex-mode fit is within its noise
+    main = doc["radial"]["pressures"][0]["verdict"]["complex"]
+    assert main["status"] == "ok"

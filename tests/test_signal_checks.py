@@ -225,3 +225,11 @@ def test_clipping_counter() -> None:
     assert clipping(per, repeats=5) == 0
     with pytest.raises(InputError, match="min_run"):
         clipping(x, 1)
+
+
+def test_low_coherence_bands_print_single_lines_once() -> None:
+    from tyredamp.signal.checks import _low_bands
+
+    f = np.array([25.0, 25.5, 26.0, 26.5, 27.0])
+    low = np.array([False, True, False, True, True])
+    assert _low_bands(f, low) == ["25.5 Hz", "26.5-27 Hz"]

@@ -136,8 +136,8 @@ class DemoSettings:
     snr_db : float
         Signal-to-noise ratio of every channel of the modal tests, dB.
     check_band_hz : (float, float)
-        Band of the linearity and reciprocity figures, Hz (below it the
-        accelerance of a free tread band is tiny and noise dominates).
+        Band of the linearity, reciprocity and data-quality checks, Hz (below
+        it the accelerance of a free tread band is tiny and noise dominates).
     damping_method : {"first", "improved", "refined"}
         Estimator of ``C'`` (eq. [16], [18] or bias-corrected).
     damping_samples : int
@@ -719,7 +719,7 @@ def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
     )
     frf_high = estimate_frf(high.data, "H1")
     lin = linearity_check([main.frf, frf_high], band=s.check_band_hz)
-    quality = quality_check(main.test.data)
+    quality = quality_check(main.test.data, band=s.check_band_hz)  # the band of the other checks
 
     st.start(f"radial: reciprocity check, drive points {s.reciprocity_points}")
     recip_test = run_modal_test(

@@ -253,7 +253,9 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         Valid against :func:`load_schema` (checked in the tests).
     """
     from .lateral.characteristics import corner_differences
+    from .report.findings import demo_findings, lateral_key, radial_key
 
+    fnd = demo_findings(result)
     s = result.settings
     r = result.radial
     main = r.main
@@ -278,6 +280,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
             "nonproportionality": tyre.nonproportionality,
         },
         **_fit_quality(main),
+        "verdict": {k: v.to_dict() for k, v in fnd.radial[radial_key(main)].items()},
         "checks": {
             "linearity": _check(r.linearity),
             "reciprocity": _check(r.reciprocity),
@@ -305,6 +308,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
                 "pressure_bar": run.pressure_bar,
                 "n_averages": run.n_periods,
                 **_fit_quality(run),
+                "verdict": {k: v.to_dict() for k, v in fnd.radial[radial_key(run)].items()},
                 "modes": _modes(run),
             }
             for run in r.runs
@@ -312,6 +316,10 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     }
     lat = result.lateral
     conds = [_condition(c) for c in lat.conditions]
+    for c, cd_ in zip(lat.conditions, conds, strict=True):
+        vs = fnd.lateral[lateral_key(c)]
+        cd_["verdict"] = vs[c.ranking.best.name].to_dict()
+        cd_["verdicts"] = {k: v.to_dict() for k, v in vs.items()}
     fig7 = lat.figure7.model
     cd = corner_differences(fig7)
     veh = lat.vehicle
@@ -382,6 +390,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         "files": list(files or []),
         "radial": radial,
         "lateral": lateral,
+        "warnings": [f.to_dict() for f in fnd.findings],
     }
     out = finite(doc)
     assert isinstance(out, dict)

@@ -35,8 +35,11 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
             "checks",
             f"linearity {'PASS' if r.linearity.passed else 'FAIL'} "
             f"{100 * r.linearity.figure:.2g} %, reciprocity "
-            f"{'PASS' if r.reciprocity.passed else 'FAIL'} {100 * r.reciprocity.figure:.2g} %",
+            f"{'PASS' if r.reciprocity.passed else 'FAIL'} {100 * r.reciprocity.figure:.2g} %, "
+            f"quality {'PASS' if r.quality.passed else 'FAIL'} {100 * r.quality.figure:.2g} % "
+            "low-coherence lines",
         ),
+        *_verdict_rows(doc),
         (
             "damping C' vs truth",
             f"{100 * rad['damping']['modal_error']:.3g} % (symmetric part "
@@ -61,6 +64,25 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
             ),
         ),
     ]
+    n_warn = sum(1 for w in doc.get("warnings", []) if w["severity"] == "warning")
+    if n_warn:
+        rows.append(("warnings", f"{n_warn} more, listed in the report and results.json"))
+    return rows
+
+
+def _verdict_rows(doc: dict[str, Any]) -> list[tuple[str, str]]:
+    """One row per identification: within the noise, or FAILED and why."""
+    rows = []
+    for pr in doc["radial"]["pressures"]:
+        v = pr["verdict"]
+        for name in ("complex", "real"):
+            x = v[name]
+            text = "within noise" if x["passed"] else "FAILED: " + "; ".join(x["reasons"])
+            rows.append((f"{name}-mode fit {pr['pressure_bar']:g} bar", text))
+    for c in doc["lateral"]["conditions"]:
+        x = c["verdict"]
+        text = "within noise" if x["passed"] else "FAILED: " + "; ".join(x["reasons"])
+        rows.append((f"{c['best']} fit {c['label']}", text))
     return rows
 
 

@@ -14,6 +14,7 @@ The report for result files of the other commands is
 
 from __future__ import annotations
 
+import html
 import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
@@ -62,6 +63,31 @@ def _image(rep: HtmlReport, images: Mapping[str, tuple[bytes, str]], name: str) 
     if name in images:
         png, caption = images[name]
         rep.image(png, caption)
+
+
+def _verdict(rep: HtmlReport, v: dict[str, Any] | None) -> None:
+    """A fit verdict: green when within the noise, red with its reasons when not."""
+    if v is None:
+        return
+    cls = "verdict" if v["passed"] else "verdict bad"
+    rep.raw(f'<div class="{cls}">{html.escape(v["summary"])}</div>')
+
+
+def _warnings(rep: HtmlReport, doc: dict[str, Any], about: str) -> None:
+    """The warnings of the stage that produced a result, beside that result."""
+    ws = [w for w in doc.get("warnings", []) if w["about"] == about]
+    if not ws:
+        return
+    bad = any(w["severity"] == "failed" for w in ws)
+    items = "".join(
+        f"<li>{'<b>FAILED</b> ' if w['severity'] == 'failed' else ''}{html.escape(w['message'])}"
+        "</li>"
+        for w in ws
+    )
+    rep.raw(
+        f'<div class="warn{" bad" if bad else ""}"><b>Warnings ({html.escape(ws[0]["stage"])})'
+        f"</b><ul>{items}</ul></div>"
+    )
 
 
 def _modes_table(rep: HtmlReport, modes: list[dict[str, Any]], caption: str) -> None:
@@ -144,6 +170,48 @@ def _summary(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
             ["computation time", f"{result.elapsed_s:.1f} s"],
         ],
     )
+    _summary_verdicts(rep, doc)
+
+
+def _status(v: dict[str, Any] | None) -> str:
+    return (
+        "-"
+        if v is None
+        else {"ok": "within noise", "failed": "FAILED"}.get(v["status"], v["status"])
+    )
+
+
+def _summary_verdicts(rep: HtmlReport, doc: dict[str, Any]) -> None:
+    """Every fit's verdict, the failures in red, and every warning of every stage."""
+    rad, lat = doc["radial"], doc["lateral"]
+    rep.heading("Fit verdicts and warnings", 3)
+    rows = []
+    failed: list[dict[str, Any]] = []
+    for pr in rad["pressures"]:
+        v = pr["verdict"]
+        rows.append(
+            [f"radial {pr['pressure_bar']:g} bar", _status(v["complex"]), _status(v["real"])]
+        )
+        failed += [x for x in (v["complex"], v["real"]) if not x["passed"]]
+    for c in lat["conditions"]:
+        rows.append([f"lateral {c['label']} ({c['best']})", _status(c["verdict"]), "-"])
+        if not c["verdict"]["passed"]:
+            failed.append(c["verdict"])
+    rep.table(
+        ["identification", "complex-mode / best-model fit", "real-mode fit"],
+        rows,
+        caption="Each fit judged against the noise its FRF's coherence implies (residual power "
+        "within the 99.9 % quantile of noise alone), the band-edge position and shape of its "
+        "modes and, on the virtual tyre, the modes it should find.",
+    )
+    for v in failed:
+        _verdict(rep, v)
+    ws = doc.get("warnings", [])
+    if ws:
+        rep.paragraph(f"Warnings of every stage ({len(ws)}; each is repeated beside its result):")
+        rep.bullets([f"{w['stage']}: {w['message']}" for w in ws])
+    else:
+        rep.paragraph("No stage issued a warning.")
 
 
 def _excitation(meta: dict[str, Any], force_rms: float) -> str:
@@ -237,6 +305,7 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     rep.heading(SECTIONS[2])
     rep.heading("Linearity, reciprocity and data quality", 3)
     rep.bullets([c.summary for c in (r.linearity, r.reciprocity, r.quality)])
+    _warnings(rep, doc, "radial:checks")
     rep.paragraph(
         "A linear model with a symmetric damping matrix needs both checks to pass. The quality "
         "check counts lines with coherence below 0.9; on this tyre they lie at the "
@@ -283,6 +352,9 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
         caption=f"Fit quality at {p} over {rad['n_lines']} lines and 16 FRFs ({rad['frf_kind']}, "
         f"{r.main.fitted_frf.unit}).",
     )
+    _verdict(rep, rad["verdict"]["complex"])
+    _verdict(rep, rad["verdict"]["real"])
+    _warnings(rep, doc, f"radial:{rad['pressure_bar']:g}")
     ratio = rad["rmsd_ratio"]
     rep.paragraph(
         f"The complex-mode fit is {_num(ratio, '.3g')} times better in RMSD (the paper found "
@@ -316,6 +388,7 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     )
     rep.paragraph("What the numbers say:")
     rep.bullets(dmp["findings"])
+    _warnings(rep, doc, "radial:damping")
     _image(rep, images, "fig05_damping")
 
     rep.heading("Inflation pressure", 3)
@@ -337,6 +410,8 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
                 fr,
                 ft,
                 _num(pr["rmsd_ratio"], ".3g"),
+                _status(pr["verdict"]["complex"]),
+                _status(pr["verdict"]["real"]),
             ]
         )
     rep.table(
@@ -347,9 +422,19 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
             "f identified (Hz)",
             "f true (Hz)",
             "RMSD real / complex",
+            "complex fit",
+            "real fit",
         ],
         rows,
+        caption="A ratio of RMSDs compares two fits only when both are sound: see the verdicts "
+        "and warnings of each pressure below.",
     )
+    for pr in rad["pressures"]:
+        if pr["pressure_bar"] == rad["pressure_bar"]:
+            continue  # the main pressure's verdicts stand beside its fit above
+        _verdict(rep, pr["verdict"]["complex"])
+        _verdict(rep, pr["verdict"]["real"])
+        _warnings(rep, doc, f"radial:{pr['pressure_bar']:g}")
     _image(rep, images, "pressures")
 
 
@@ -436,6 +521,9 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         "transition region, where the rig's stiffening foundation and contact length depart "
         "from the model: a model-form difference, not noise (compare the standard error).",
     )
+    for c in conds:
+        _verdict(rep, c["verdict"])
+        _warnings(rep, doc, f"lateral:{c['label']}")
     ref = result.lateral.reference
     rep.paragraph(f"Ranking at {ref.label}:")
     rep.bullets(list(ref.ranking.reasons))

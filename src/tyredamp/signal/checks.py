@@ -382,7 +382,10 @@ def _low_bands(f: NDArray[np.float64], low: NDArray[np.bool_], limit: int = 5) -
     at = np.concatenate(([0], low.astype(np.int8), [0]))
     e = np.diff(at)
     starts, stops = np.flatnonzero(e == 1), np.flatnonzero(e == -1) - 1
-    out = [f"{f[a]:.4g}-{f[b]:.4g} Hz" for a, b in zip(starts, stops, strict=True)]
+    out = [
+        f"{f[a]:.4g} Hz" if a == b else f"{f[a]:.4g}-{f[b]:.4g} Hz"
+        for a, b in zip(starts, stops, strict=True)
+    ]
     if len(out) > limit:
         out = [*out[:limit], f"... ({len(out) - limit} more)"]
     return out
