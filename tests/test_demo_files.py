@@ -169,3 +169,46 @@ def test_every_pressure_and_condition_fits_or_says_why(demo: tuple[DemoResult, P
     # the main pressure's complex-mode fit is within its noise
     main = doc["radial"]["pressures"][0]["verdict"]["complex"]
     assert main["status"] == "ok"
+
+
+def test_maxwell_and_relaxation_are_one_model_ranked_once(demo: tuple[DemoResult, Path]) -> None:
+    import numpy as np
+
+    from tyredamp.lateral.models import MaxwellModel, RelaxationLengthModel
+
+    # closed form: Y/F = sigma/C_alpha + V/(i w C_alpha) = 1/k + 1/(i w c)
+    rl = RelaxationLengthModel(C_alpha=8e4, sigma=0.6, speed=5 / 3.6)
+    mx = MaxwellModel(k=8e4 / 0.6, c=8e4 / (5 / 3.6))
+    f = np.linspace(0.1, 10, 50)
+    assert_allclose(rl.response(f, "receptance"), mx.response(f, "receptance"), rtol=1e-12)
+    _, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    lat = doc["lateral"]
+    assert ["maxwell", "relaxation"] in lat["equivalent_models"]
+    names = [r["model"] for r in lat["ranking"]]
+    assert "maxwell = relaxation" in names
+    assert "maxwell" not in names
+    assert "relaxation" not in names
+
+
+def test_time_response_truth_and_gap(demo: tuple[DemoResult, Path]) -> None:
+    import numpy as np
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    tr = doc["lateral"]["time_response"]
+    # the rig's exact response misses the measurement by its noise alone: white noise of
+    # relative_noise x the peak amplitude on a sine, RMS ratio relative_noise * sqrt(2)
+    noise = result.lateral.rig.relative_noise * np.sqrt(2)
+    assert_allclose(tr["truth_error"], noise, rtol=0.25)
+    for name, err in tr["relative_error"].items():
+        gap = tr["error_to_truth"][name]
+        # misfit to the measurement = gap to the truth and noise, roughly in quadrature
+        assert gap < err + 1e-12
+        assert gap > 0.5 * err
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "error against the rig&#x27;s exact response" in page
+    assert "The exact response misses the measurement by" in page
+    for c in doc["lateral"]["conditions"]:
+        rd = c["road_damping"]
+        assert_allclose(rd["ratio"], rd["fitted"] / rd["true"], rtol=1e-12)

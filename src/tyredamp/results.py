@@ -22,6 +22,7 @@ from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from . import __version__
 from .exceptions import InputError
@@ -36,9 +37,11 @@ __all__ = [
     "RESULTS_VERSION",
     "build_results",
     "corner_frequency_std",
+    "equivalent_models",
     "finite",
     "lateral_overall_ranking",
     "load_schema",
+    "time_test_truth",
     "validate_results",
 ]
 
@@ -132,6 +135,77 @@ def _fit_quality(run: PressureRun) -> dict[str, Any]:
     }
 
 
+def time_test_truth(result: DemoResult) -> tuple[NDArray[np.float64], dict[str, float]]:
+    """The rig's own steady-state body acceleration in the time test and the gaps it shows.
+
+    Returns
+    -------
+    (ndarray, dict)
+        The exact body acceleration of the rig's vehicle (m/s^2, on
+        ``time_test.data.time``) and ``{"truth_vs_measured": e, <model>: g}``:
+        RMS of truth minus measurement over RMS of the measurement in the
+        window (the noise alone), and for each fitted model the RMS of its
+        prediction minus the truth over RMS of the truth (its own error,
+        free of noise).
+    """
+    from .lateral import harmonic_response
+
+    tt = result.lateral.time_test
+    t = tt.data.time
+    truth = harmonic_response(
+        result.lateral.vehicle.truth, tt.frequency_hz, tt.force_amplitude, t, "acceleration"
+    )
+    win = (t >= tt.window_s[0]) & (t <= tt.window_s[1])
+    meas = tt.data.data[1]
+
+    def rel(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+        return float(np.sqrt(np.mean((a[win] - b[win]) ** 2) / np.mean(b[win] ** 2)))
+
+    gaps = {"truth_vs_measured": rel(truth, meas)}
+    for name, pred in tt.predictions.items():
+        gaps[name] = rel(pred, truth)
+    return np.asarray(truth, dtype=float), gaps
+
+
+def equivalent_models(conditions: Sequence[LateralCondition]) -> list[list[str]]:
+    """Groups of fitted models that are the same model in other parameters.
+
+    Two fits are the same model when they have the same number of parameters
+    and their fitted FRFs agree to 1e-6 (relative, every line) at every
+    condition: for example the first-order relaxation-length model with the
+    speed known is the Maxwell model with ``k = C_alpha/sigma``,
+    ``c = C_alpha/V`` (:meth:`~tyredamp.lateral.models.RelaxationLengthModel.maxwell`).
+    Their ranking order is then decided by rounding alone.
+    """
+    if not conditions:
+        return []
+    names = [f.name for f in conditions[0].ranking.fits]
+    groups: list[list[str]] = []
+    seen: set[str] = set()
+    for i, a in enumerate(names):
+        if a in seen:
+            continue
+        group = [a]
+        for b in names[i + 1 :]:
+            if b in seen:
+                continue
+            same = True
+            for c in conditions:
+                fa, fb = c.fit(a), c.fit(b)
+                scale = float(np.max(np.abs(fa.fitted)))
+                if fa.n_params != fb.n_params or not np.all(
+                    np.abs(fa.fitted - fb.fitted) <= 1e-6 * scale
+                ):
+                    same = False
+                    break
+            if same:
+                group.append(b)
+        if len(group) > 1:
+            groups.append(sorted(group))
+            seen.update(group)
+    return groups
+
+
 def corner_frequency_std(fit: LateralFit) -> float:
     """Standard error of ``f0 = K / (2 pi C_r)`` of a hysteretic fit (delta method), Hz.
 
@@ -190,6 +264,7 @@ def _condition(cond: LateralCondition) -> dict[str, Any]:
             "fitted": hy.params["C_r"],
             "stderr": hy.stderr["C_r"],
             "true": cond.true_road_damping,
+            "ratio": hy.params["C_r"] / cond.true_road_damping,
             "unit": "N s/m",
         },
         "params": params,
@@ -205,9 +280,13 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
     list of dict
         ``model``, ``mean_rank``, ``wins`` (conditions where it is best),
         ``n_conditions``, ``mean_delta``, ``mean_amplitude_error_pct``,
-        ``mean_amplitude_bias_pct``, ``mean_axle_amplitude_error_pct``.
+        ``mean_amplitude_bias_pct``, ``mean_axle_amplitude_error_pct``,
+        ``equivalent`` (the models of the entry: models that are the same
+        model in other parameters, :func:`equivalent_models`, share one
+        entry named ``"a = b"`` with their best mean rank, so that rounding
+        cannot order them).
     """
-    stats: dict[str, dict[str, list[float]]] = {}
+    stats: dict[str, dict[str, list[float]]] = {}  # per model, one value per condition
     for c in conditions:
         for row, fit in zip(c.ranking.rows(), c.ranking.fits, strict=True):
             s = stats.setdefault(
@@ -218,9 +297,19 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
             s["err"].append(row["amplitude_error_pct"])
             s["bias"].append(row["amplitude_bias_pct"])
             s["axle"].append(100 * _axle_errors(c, fit)[0])
-    out = [
+    groups = equivalent_models(conditions)
+    for group in groups:  # one model in other parameters: one entry, its best rank per condition
+        parts = [stats.pop(g) for g in group if g in stats]
+        if not parts:
+            continue
+        merged = {k: list(v) for k, v in parts[0].items()}
+        merged["rank"] = [float(min(x)) for x in zip(*(p["rank"] for p in parts), strict=True)]
+        merged["delta"] = [float(min(x)) for x in zip(*(p["delta"] for p in parts), strict=True)]
+        stats[" = ".join(group)] = merged
+    out: list[dict[str, Any]] = [
         {
             "model": name,
+            "equivalent": next((list(g) for g in groups if " = ".join(g) == name), [name]),
             "mean_rank": float(np.mean(s["rank"])),
             "wins": int(sum(1 for r in s["rank"] if r == 1)),
             "n_conditions": len(s["rank"]),
@@ -326,6 +415,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     tt = lat.time_test
     ce = tt.causal
     ref = lat.reference
+    _, tt_gaps = time_test_truth(result)
     lateral: dict[str, Any] = {
         "models": list(s.lateral_models),
         "criterion": lat.conditions[0].ranking.criterion,
@@ -362,8 +452,11 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
                 None if veh.truth_resonance is None else veh.truth_resonance.frequency
             ),
         },
+        "equivalent_models": equivalent_models(lat.conditions),
         "time_response": {
             "frequency_hz": tt.frequency_hz,
+            "truth_error": tt_gaps["truth_vs_measured"],
+            "error_to_truth": {k: v for k, v in tt_gaps.items() if k != "truth_vs_measured"},
             "force_amplitude_n": tt.force_amplitude,
             "window_s": list(tt.window_s),
             "relative_error": dict(tt.errors),

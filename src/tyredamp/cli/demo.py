@@ -53,15 +53,18 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
         (
             "corner frequency f0",
             ", ".join(
-                f"{c['value']:.3g} Hz ({c['pressure_bar']:g} bar, {c['speed_kmh']:g} km/h)"
-                for c in lat["corner_frequency_hz"]
+                f"{c['corner_frequency_hz']:.3g} Hz at {c['label']} (its C_r = "
+                f"{c['road_damping']['ratio']:.3g} x the rig's C_alpha/V)"
+                for c in lat["conditions"]
             ),
         ),
         (
             f"{lat['time_response']['frequency_hz']:g} Hz response error",
             ", ".join(
                 f"{k} {100 * v:.3g} %" for k, v in lat["time_response"]["relative_error"].items()
-            ),
+            )
+            + f" (rig's exact response {100 * lat['time_response']['truth_error']:.3g} %: "
+            "the rest is model error)",
         ),
     ]
     n_warn = sum(1 for w in doc.get("warnings", []) if w["severity"] == "warning")

@@ -62,6 +62,11 @@ def _model_list(values: tuple[str, ...]) -> list[str]:
     return [get_model_class(n).name for n in names]
 
 
+def _with_unit(name: str, value: float, unit: str) -> str:
+    """``"sigma = 0.5933 m"``; dimensionless values (unit ``-``) without a unit."""
+    return f"{name} = {value:.4g}" + ("" if unit in ("", "-") else f" {unit}")
+
+
 @click.group("lateral")
 def lateral_group() -> None:
     """Lateral tyre dynamics: fit spring-damper models, simulate the rolling-tyre rig.
@@ -265,9 +270,10 @@ def simulate_command(
     data = rig.measure(speed, pressure, force, seed)  # type: ignore[arg-type]
     path = write_frf(data.frf, out, fmt)
     truth = data.frf.meta["truth"]["params"]
+    units = data.frf.meta["truth"].get("units", {})
     click.echo(
         f"virtual rig: {data.label}, {force} force, wheel mass {rig.wheel_mass:g} kg, "
         f"{data.frf.n_freq} lines {data.frf.frequency[0]:g}-{data.frf.frequency[-1]:g} Hz; "
-        "truth " + ", ".join(f"{k} = {v:.4g}" for k, v in truth.items())
+        "truth " + ", ".join(_with_unit(k, v, units.get(k, "")) for k, v in truth.items())
     )
     click.echo(f"wrote {path}")
