@@ -124,8 +124,23 @@ def test_errors_are_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixtur
     with pytest.raises(SystemExit) as exc:
         main(["lateral", "fit", str(bare), "--out", str(out), "--models", "relaxation"])
     assert exc.value.code == 2
-    assert "speed" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "give --speed KMH" in err  # the CLI option, not a Python keyword
+    assert "meta[" not in err
+    assert "speed=" not in err
     assert not out.exists()
+    # --channel counts from 1 like every other option; 0 and out-of-range are errors
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(bare), "--out", str(out), "--channel", "2", "1"])
+    assert exc.value.code == 2
+    assert "--channel: expected an output 1..1" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(bare), "--out", str(out), "--channel", "0", "0"])
+    assert exc.value.code == 2
+    capsys.readouterr()
+    main(["lateral", "fit", str(bare), "--out", str(out), "--channel", "1", "1"])
+    assert json.loads(out.read_text())["fits"]
+    out.unlink()
     with pytest.raises(SystemExit) as exc:
         main(["lateral", "fit", str(bare), "--out", str(out), "--models", "nonsense"])
     assert exc.value.code == 2

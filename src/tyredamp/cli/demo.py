@@ -156,22 +156,30 @@ def demo_command(out: Path, quick: bool, seed: int) -> None:
         Progress(
             TextColumn("{task.description:<62}"),
             BarColumn(bar_width=24),
-            TextColumn("{task.completed}/{task.total}"),
+            TextColumn("{task.fields[count]}"),  # blank until the total is known
             TimeElapsedColumn(),
             console=err,
             disable=not err.is_terminal,
         ) as prog,
     ):
-        task = prog.add_task("starting", total=None)
+        task = prog.add_task("starting", total=None, count="")
 
         def report(desc: str, done: int, total: int) -> None:
-            prog.update(task, description=desc, completed=done, total=total)
+            prog.update(
+                task, description=desc, completed=done, total=total, count=f"{done}/{total}"
+            )
 
         result = run_demo(settings, report)
-        wtask = prog.add_task("writing", total=None)
+        wtask = prog.add_task("writing", total=None, count="")
 
         def report_w(desc: str, done: int, total: int) -> None:
-            prog.update(wtask, description=f"writing {desc}", completed=done, total=total)
+            prog.update(
+                wtask,
+                description=f"writing {desc}",
+                completed=done,
+                total=total,
+                count=f"{done}/{total}",
+            )
 
         files = save_demo(result, out, report_w)
     wall = time.perf_counter() - t0

@@ -129,11 +129,11 @@ def lateral_group() -> None:
 @click.option(
     "--channel",
     nargs=2,
-    type=int,
-    default=(0, 0),
+    type=click.IntRange(min=1),
+    default=(1, 1),
     show_default=True,
     metavar="OUT IN",
-    help="Output and input positions of the FRF to fit.",
+    help="Output and input of the FRF to fit, counted from 1 like every other option.",
 )
 def fit_command(
     frf_file: Path,
@@ -161,19 +161,33 @@ def fit_command(
     names = _model_list(models)
     if speed is not None and not (math.isfinite(speed) and speed > 0):
         raise InputError(f"--speed: expected a speed > 0 km/h, got {speed}")
+    out_ch, in_ch = channel
+    if out_ch > frf.n_out or in_ch > frf.n_in:
+        raise InputError(
+            f"--channel: expected an output 1..{frf.n_out} and an input 1..{frf.n_in} of "
+            f"{frf_file}, got {out_ch} {in_ch}"
+        )
     data = LateralData.from_frf(
         frf,
         speed=None if speed is None else speed * KMH,
         force=force,  # type: ignore[arg-type]
         wheel_mass=wheel_mass,
     )
+    if data.speed is None:
+        need = [n for n in names if "speed" in get_model_class(n).condition_names]
+        if need:
+            raise InputError(
+                f"--speed: the {', '.join(need)} model{'s' if len(need) > 1 else ''} "
+                f"need{'' if len(need) > 1 else 's'} the travel speed and {frf_file} does not "
+                "store it; give --speed KMH"
+            )
     ranking = rank_models(
         data,
         names,
         criterion=criterion,  # type: ignore[arg-type]
         band=band,
         weights=weights,
-        channel=channel,
+        channel=(out_ch - 1, in_ch - 1),
     )
     best = ranking.best
     doc = {

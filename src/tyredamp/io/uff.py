@@ -674,7 +674,8 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
             if q is None:
                 raise FileFormatError(
                     f"{where}: cannot tell the response quantity (ordinate data type "
-                    f"{s.get('ordinate_spec_data_type')}, no units label); pass kind="
+                    f"{s.get('ordinate_spec_data_type')}, no units label); give the ordinate "
+                    "data type or units label in the file, or kind= to read_frf (Python)"
                 )
             if q == "force":
                 raise FileFormatError(f"{where}: the ordinate is a force, not a response")

@@ -473,8 +473,9 @@ def _conditions(cls: type[LateralModel], data: LateralData) -> dict[str, float]:
         if n == "speed":
             if data.speed is None:
                 raise InputError(
-                    f"speed: the {cls.name!r} model needs the travel speed (m/s); "
-                    f"give speed= or set frf.meta['speed_m_s']"
+                    f"speed: the {cls.name!r} model needs the travel speed: give speed= in "
+                    "m/s (Python), --speed KMH (command line), or store it with the FRF "
+                    "(meta key speed_m_s, as tyredamp's rig files do)"
                 )
             cond["speed"] = float(data.speed)
         else:  # pragma: no cover - no other condition exists yet

@@ -572,7 +572,10 @@ def estimate_frf(
     else:
         rec = segment_samples if segment_samples is not None else meta.get("record_samples")
         if rec is None:
-            raise InputError("method: 'transient' needs segment_samples or meta['record_samples']")
+            raise InputError(
+                "method: 'transient' needs the record length: --segment N (command line), "
+                "segment_samples= (Python) or record_samples stored with the time data"
+            )
         seg = _as_count(rec, "segment_samples", minimum=2)
         if overlap not in (None, 0, 0.0):
             raise InputError(f"overlap: the transient method uses whole records, got {overlap!r}")
