@@ -233,7 +233,7 @@ def _settings(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
     rig = result.lateral.rig
     rep.heading(SECTIONS[1])
     rep.table(
-        ["virtual truck tyre (paper 000)", "value"],
+        ["virtual truck tyre (Popov & Geng 2005)", "value"],
         [
             ["model", "in-plane ring on an elastic foundation, staggered finite differences"],
             ["degrees of freedom", str(main.test.tyre.n_dof)],
@@ -275,7 +275,7 @@ def _settings(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
         ],
     )
     rep.table(
-        ["rolling-tyre rig (paper 001)", "value"],
+        ["rolling-tyre rig (Peng et al.)", "value"],
         [
             [
                 "truth",

@@ -150,6 +150,17 @@ class FitVerdict:
             )
         return f"{self.subject}: {head}" + (f": {self.cautions[0]}" if self.cautions else "")
 
+    def brief(self) -> str:
+        """A short form for a summary table: ``"FAILED (residual 11x the noise): <cause>"``."""
+        t = self.test
+        if self.status == "ok":
+            return "within noise"
+        if self.status == "not judged":
+            return "not judged (no coherence)"
+        size = "" if t is None else f" (residual {math.sqrt(t.ratio):.3g}x the noise)"
+        causes = [r for r in self.reasons if not r.startswith("the residual is")]
+        return f"FAILED{size}: " + ("; ".join(causes) or "see the report")
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (results.json ``verdict`` objects)."""
         t = self.test
@@ -158,6 +169,7 @@ class FitVerdict:
             "status": self.status,
             "passed": self.passed,
             "summary": self.summary(),
+            "brief": self.brief(),
             "reasons": list(self.reasons),
             "cautions": list(self.cautions),
             "residual_to_noise": None if t is None else t.ratio,
@@ -347,8 +359,8 @@ def modal_fit_verdict(
                 )
             if better is not None and better.passed:
                 reasons.append(
-                    f"{better.subject} fits the same data within the noise: the model form "
-                    "misses (for real modes: damping that couples the modes)"
+                    f"the {better.subject} is within the noise: the model form misses (real "
+                    "modes cannot hold damping that couples the modes)"
                 )
     fn = np.asarray(model.frequency_hz, dtype=float)
     zeta = np.asarray(model.damping_ratio, dtype=float)
