@@ -82,6 +82,8 @@ def test_files_exist(demo: tuple[DemoResult, Path]) -> None:
         "fig13_axle_5kmh.png",
         "fig14_axle_10kmh.png",
         "fig15_time_response.png",
+        "residual_zoom.png",
+        "mac.png",
     ):
         assert name in pngs
         assert (out / "figures" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -48,11 +48,20 @@ def test_json_documents_read_back(demo: tuple[DemoResult, Path]) -> None:
 
     result, out = demo
     p0 = f"{result.radial.main.pressure_bar:g}bar"
+    from tyredamp.io.jsonfile import json_text
+
+    def same(a: object, b: object) -> None:
+        # everything the documents hold, compared in their JSON form
+        assert json.loads(json_text(a)) == json.loads(json_text(b))
+
     models = read_modes_json(out / f"modes_{p0}.json")
+    assert set(models) == set(result.radial.main.models)
     for name, mdl in result.radial.main.models.items():
         assert_allclose(models[name].poles, mdl.poles, rtol=1e-15)
+        same(models[name].to_dict(), mdl.to_dict())
     dm = DampingModel.from_dict(json.loads((out / f"damping_{p0}.json").read_text()))
     assert_allclose(dm.modal, result.radial.damping.modal, rtol=1e-15)
+    same(dm.to_dict(), result.radial.damping.to_dict())
 
 
 @pytest.mark.parametrize("force", ["ground", "axle"])

@@ -362,10 +362,11 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
         "proportional damping), yet the complex description fits better because the damping "
         "couples the modes (off-diagonal C')."
     )
-    for name in ("fig02_real_fit", "fig03_complex_fit", "fig04_discrepancy"):
+    for name in ("fig02_real_fit", "fig03_complex_fit", "fig04_discrepancy", "residual_zoom"):
         _image(rep, images, name)
     rep.heading("Mode shapes", 3)
     _image(rep, images, "mode_shapes")
+    _image(rep, images, "mac")
 
     rep.heading("Damping matrices", 3)
     dmp = rad["damping"]
