@@ -222,3 +222,30 @@ def test_time_response_truth_and_gap(demo: tuple[DemoResult, Path]) -> None:
     for c in doc["lateral"]["conditions"]:
         rd = c["road_damping"]
         assert_allclose(rd["ratio"], rd["fitted"] / rd["true"], rtol=1e-12)
+
+
+def test_modal_cli_prints_and_stores_the_verdict(
+    demo: tuple[DemoResult, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The demo's 9 bar FRF: a mode at 199 Hz sits on the 200 Hz band edge."""
+    result, out = demo
+    if 9.0 not in result.settings.radial_pressures_bar:
+        pytest.skip("no 9 bar run")
+    frf = out / "data" / "radial_9bar_frf.uff"
+    js = tmp_path / "m.json"
+    verdicts = {}
+    for band in (None, ("0", "195")):
+        capsys.readouterr()
+        main(["modal", str(frf), "--out", str(js), *(["--band", *band] if band else [])])
+        text = capsys.readouterr().out
+        assert "verdict: complex-mode fit: " in text
+        doc = json.loads(js.read_text())
+        verdicts[band] = doc["models"]["complex"]["meta"]["verdict"]
+    demo_v = json.loads((out / "results.json").read_text())
+    nine = next(p for p in demo_v["radial"]["pressures"] if p["pressure_bar"] == 9.0)
+    # the command reaches the demo's own verdict on the same file and band
+    assert verdicts[None]["status"] == nine["verdict"]["complex"]["status"]
+    if verdicts[None]["status"] == "failed":
+        assert "band edge" in " ".join(verdicts[None]["reasons"])
+        # and the remedy it names works: a band that stops short of the edge mode
+        assert verdicts[("0", "195")]["status"] == "ok"

@@ -8,10 +8,12 @@ import click
 import numpy as np
 
 from ..exceptions import InputError
+from ..frf import FRF
 from ..io import read_frf
 from ..modal.identify import ModalIdentification, identify_modes
 from ..modal.io import write_modes_json
 from ..modal.model import ModalModel
+from ..report.verdicts import FitVerdict, modal_fit_verdict
 from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
@@ -120,6 +122,9 @@ def modal_command(
         order_step=order_step,
         residuals=not no_residuals,
     )
+    verdicts = _verdicts(frf, res)
+    for name, v in verdicts.items():  # stored with the model: meta.verdict of the modes JSON
+        res.models[name].meta["verdict"] = v.to_dict()
     write_modes_json(
         out, res.models, source=frf_file.name, band_hz=res.band_hz, frf_kind=res.frf_kind
     )
@@ -138,4 +143,22 @@ def modal_command(
         click.echo(f"RMSD real / complex = {ratio:.3g}")
     for w in res.warnings:
         click.echo(f"warning: {w}")
+    for v in verdicts.values():
+        click.echo(f"verdict: {v.summary()}")
+        for c in v.cautions:
+            click.echo(f"  caution: {c}")
     click.echo(f"wrote {out}")
+
+
+def _verdicts(frf: FRF, res: ModalIdentification) -> dict[str, FitVerdict]:
+    """Verdict of each fitted model against the noise of the fitted lines."""
+    keep = np.flatnonzero(np.isin(frf.frequency, res.frequency))
+    meas = frf.select_lines(keep).to(res.frf_kind)  # type: ignore[arg-type]
+    out: dict[str, FitVerdict] = {}
+    if "complex" in res.models:
+        out["complex"] = modal_fit_verdict(res.models["complex"], meas, subject="complex-mode fit")
+    if "real" in res.models:
+        out["real"] = modal_fit_verdict(
+            res.models["real"], meas, subject="real-mode fit", better=out.get("complex")
+        )
+    return out
