@@ -65,6 +65,16 @@ def _image(rep: HtmlReport, images: Mapping[str, tuple[bytes, str]], name: str) 
         rep.image(png, caption)
 
 
+def _fallback_mark(doc: dict[str, Any], pressure_bar: float) -> str:
+    """A note on an RMSD ratio whose real-mode fit kept the complex-mode poles."""
+    about = f"radial:{pressure_bar:g}"
+    fell = any(
+        w["about"] == about and "fell back to the complex-mode poles" in w["message"]
+        for w in doc.get("warnings", [])
+    )
+    return " (real-mode fit fell back to the complex poles: not a refined real fit)" if fell else ""
+
+
 def _verdict(rep: HtmlReport, v: dict[str, Any] | None) -> None:
     """A fit verdict: green when within the noise, red with its reasons when not."""
     if v is None:
@@ -410,7 +420,7 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
                 f"{ident_n} / {true_n}",
                 fr,
                 ft,
-                _num(pr["rmsd_ratio"], ".3g"),
+                _num(pr["rmsd_ratio"], ".3g") + _fallback_mark(doc, pr["pressure_bar"]),
                 _status(pr["verdict"]["complex"]),
                 _status(pr["verdict"]["real"]),
             ]
