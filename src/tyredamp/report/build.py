@@ -116,6 +116,8 @@ def _modes_table(rep: HtmlReport, modes: list[dict[str, Any]], caption: str) -> 
                 "-" if r is None else fmt_pm(r["damping_ratio"], r["damping_ratio_std"], 4, 100),
                 "-" if t is None else f"{t['mpc']:.4f}",
                 "-" if c is None or c["mpc"] is None else f"{c['mpc']:.4f}",
+                _gap(c, t, "frequency_hz"),
+                _gap(c, t, "damping_ratio"),
             ]
         )
     rep.table(
@@ -130,10 +132,23 @@ def _modes_table(rep: HtmlReport, modes: list[dict[str, Any]], caption: str) -> 
             "zeta real (%)",
             "MPC true",
             "MPC complex",
+            "f complex - true",
+            "zeta complex - true",
         ],
         rows,
-        caption=caption,
+        caption=caption + " Gaps: relative difference, and in standard errors (sigma); a "
+        "gap of more than about 3 sigma is more than the noise explains.",
     )
+
+
+def _gap(c: dict[str, Any] | None, t: dict[str, Any] | None, key: str) -> str:
+    """``"+0.02 % (0.4 sigma)"``: identified minus true, relative and in standard errors."""
+    if c is None or t is None or not t[key]:
+        return "-"
+    d = c[key] - t[key]
+    std = c.get("frequency_std_hz" if key == "frequency_hz" else "damping_ratio_std")
+    sig = f" ({d / std:+.1f} sigma)" if std and math.isfinite(std) and std > 0 else ""
+    return f"{100 * d / t[key]:+.3g} %{sig}"
 
 
 def _summary(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
@@ -446,6 +461,11 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
         _verdict(rep, pr["verdict"]["complex"])
         _verdict(rep, pr["verdict"]["real"])
         _warnings(rep, doc, f"radial:{pr['pressure_bar']:g}")
+        _modes_table(
+            rep,
+            pr["modes"],
+            f"Modes at {pr['pressure_bar']:g} bar ({pr['n_averages']} averages), as above.",
+        )
     _image(rep, images, "pressures")
 
 
@@ -553,11 +573,35 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
     rep.bullets(list(ref.ranking.reasons))
     rep.heading(f"Fitted parameters at {ref.label}", 3)
     rows = []
+    truth = ref.truth
     for f in ref.ranking.fits:
         for n, u in zip(f.model.param_names, f.model.param_units, strict=True):
-            rows.append([f.name, n, fmt_pm(f.params[n], f.stderr[n]), u])
-    rep.table(["model", "parameter", "value ± standard error", "unit"], rows)
-    truth = ref.truth
+            if n == getattr(f.model, "road_damper", None):
+                tv: float | None = ref.true_road_damping
+                tname = "C_alpha/V"
+            elif n in truth.params:
+                tv, tname = float(truth.params[n]), n
+            else:
+                tv, tname = None, ""
+            gap = "-" if tv is None or tv == 0 else f"{100 * (f.params[n] / tv - 1):+.3g} %"
+            rows.append(
+                [
+                    f.name,
+                    n,
+                    fmt_pm(f.params[n], f.stderr[n]),
+                    u,
+                    "-" if tv is None else f"{tv:.4g} ({tname})",
+                    gap,
+                ]
+            )
+    rep.table(
+        ["model", "parameter", "value ± standard error", "unit", "truth", "gap"],
+        rows,
+        caption="Each parameter beside the rig's own value where the rig's tyre has one: its "
+        "cornering stiffness and relaxation length, and C_alpha/V for the tyre-road damper of "
+        "each model (the low-frequency limit of the rig's mobility, eq. 33). The other "
+        "parameters have no counterpart in the rig's tyre (a string with contact length).",
+    )
     units = truth.to_dict().get("units", {})
     rep.paragraph(
         "Truth at this condition (viscoelastic string): "
