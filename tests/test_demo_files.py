@@ -6,6 +6,7 @@ Uses the one quick demo of the test session (:func:`tests.test_demo.quick_demo`)
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -249,3 +250,24 @@ def test_modal_cli_prints_and_stores_the_verdict(
         assert "band edge" in " ".join(verdicts[None]["reasons"])
         # and the remedy it names works: a band that stops short of the edge mode
         assert verdicts[("0", "195")]["status"] == "ok"
+
+
+def test_quality_check_judged_over_the_checks_band_and_summarised(
+    demo: tuple[DemoResult, Path],
+) -> None:
+    from tyredamp.cli.demo import demo_summary_rows
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    q = result.radial.quality
+    lo, hi = result.settings.check_band_hz
+    assert q.frequency is not None
+    assert q.frequency[0] >= lo
+    assert q.frequency[-1] <= hi
+    # the clean virtual test passes once the nearly silent band below the first mode is
+    # judged as the other checks judge it; the summary reports the verdict either way
+    assert doc["radial"]["checks"]["quality"]["passed"]
+    rows = dict(demo_summary_rows(result, doc))
+    assert "quality PASS" in rows["checks"]
+    for note in q.notes:
+        assert not re.search(r"(\d+(?:\.\d+)?)-\1 Hz", note), note  # no "25.5-25.5 Hz"

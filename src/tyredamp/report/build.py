@@ -648,6 +648,7 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         f"the exact response by {_pct(worst)} or more: a model-form gap at "
         f"{tr['frequency_hz']:g} Hz, not noise.",
     )
+    _warnings(rep, doc, "lateral:time")
     _image(rep, images, "vehicle")
     _image(rep, images, "fig15_time_response")
     ca = tr["causal"]

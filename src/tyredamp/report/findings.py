@@ -185,4 +185,23 @@ def demo_findings(result: DemoResult) -> DemoFindings:
         for f in c.ranking.fits:
             if f.nfev <= 0 or "maximum" in f.message.lower():
                 findings.append(Finding(key, stage, f"{f.name} fit: optimiser: {f.message}"))
+    veh = result.lateral.vehicle
+    for name, res in veh.resonances.items():
+        if res is None:
+            findings.append(
+                Finding(
+                    "lateral:time",
+                    "lateral vehicle",
+                    f"vehicle on the {name} tyre: no body resonance between 0.3 and 20 Hz "
+                    "(over-damped or outside the search band)",
+                )
+            )
+    if veh.truth_resonance is None:
+        findings.append(
+            Finding(
+                "lateral:time",
+                "lateral vehicle",
+                "vehicle on the rig's exact tyre: no body resonance between 0.3 and 20 Hz",
+            )
+        )
     return DemoFindings(radial, lateral, findings)
