@@ -271,3 +271,21 @@ def test_quality_check_judged_over_the_checks_band_and_summarised(
     assert "quality PASS" in rows["checks"]
     for note in q.notes:
         assert not re.search(r"(\d+(?:\.\d+)?)-\1 Hz", note), note  # no "25.5-25.5 Hz"
+
+
+def test_files_report_shows_the_demo_verdicts_and_warnings(
+    demo: tuple[DemoResult, Path], tmp_path: Path
+) -> None:
+    import html
+
+    from tyredamp.report.files import build_files_report
+
+    _, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    page = build_files_report([out / "results.json"])
+    for pr in doc["radial"]["pressures"]:
+        for v in pr["verdict"].values():
+            cls = "verdict" if v["passed"] else "verdict bad"
+            assert f'<div class="{cls}">{html.escape(v["summary"])}</div>' in page
+    for w in doc["warnings"]:
+        assert html.escape(w["message"]) in page
