@@ -53,7 +53,13 @@ def measured(model: ModalModel, n_avg: int, snr: float, seed: int) -> FRF:
     coh = np.abs(gxf) ** 2 / (gff * gxx)
     ch = [Channel(1, 3)]
     return FRF(
-        F, (gxf / gff)[None, None, :], "receptance", ch, ch, coh[None, :], {"n_averages": n_avg}
+        F,
+        (gxf / gff)[None, None, :],
+        "receptance",
+        ch,
+        ch,
+        coh[None, :],
+        {"n_averages": n_avg, "method": "cyclic"},
     )
 
 

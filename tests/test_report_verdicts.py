@@ -27,33 +27,45 @@ def two_modes(f2: float = 80.0) -> ModalModel:
     return ModalModel(poles, psi, psi.copy(), mode_kind="complex", meta={"band_hz": [5.0, 100.0]})
 
 
-def measured(model: ModalModel, n_avg: int, snr: float, seed: int) -> FRF:
-    """H1 from ``n_avg`` periods of a fixed periodic force, noise on the response.
+def measured(
+    model: ModalModel, n_avg: int, snr: float, seed: int, random_force: bool = False
+) -> FRF:
+    """H1 from ``n_avg`` averages, noise on the response.
 
-    The coherence is estimated from the averages, as an analyser does.
+    A fixed periodic force repeated in every average (cyclic), or a new random
+    force in every average (Welch-like). The coherence is estimated from the
+    averages, as an analyser does.
     """
     rng = np.random.default_rng(seed)
     h = model.frf(F, "receptance").H[0, 0]
     sd = np.abs(h).max() / snr
-    force = np.exp(1j * rng.uniform(0, 2 * np.pi, F.size))  # unit-amplitude periodic force
+    if random_force:
+        force = (
+            rng.standard_normal((n_avg, F.size)) + 1j * rng.standard_normal((n_avg, F.size))
+        ) / np.sqrt(2)
+    else:  # unit-amplitude periodic force
+        force = np.tile(np.exp(1j * rng.uniform(0, 2 * np.pi, F.size)), (n_avg, 1))
     x = h * force + sd * (
         rng.standard_normal((n_avg, F.size)) + 1j * rng.standard_normal((n_avg, F.size))
     ) / np.sqrt(2)
-    gff = n_avg * np.abs(force) ** 2
+    gff = np.sum(np.abs(force) ** 2, axis=0)
     gxf = np.sum(x * np.conj(force), axis=0)
     gxx = np.sum(np.abs(x) ** 2, axis=0)
     h1 = gxf / gff
     coh = np.abs(gxf) ** 2 / (gff * gxx)
     ch = [Channel(1, 3)]
-    return FRF(F, h1[None, None, :], "receptance", ch, ch, coh[None, :], {"n_averages": n_avg})
+    meta = {"n_averages": n_avg, "method": "welch" if random_force else "cyclic"}
+    return FRF(F, h1[None, None, :], "receptance", ch, ch, coh[None, :], meta)
 
 
-@pytest.mark.parametrize("n_avg", [2, 4, 16])
-def test_the_true_model_is_within_the_noise(n_avg: int) -> None:
+@pytest.mark.parametrize(
+    ("n_avg", "random_force"), [(2, False), (4, False), (16, False), (4, True), (16, True)]
+)
+def test_the_true_model_is_within_the_noise(n_avg: int, random_force: bool) -> None:
     model = two_modes()
     ratios = []
     for seed in range(5):
-        meas = measured(model, n_avg, 300.0, seed)
+        meas = measured(model, n_avg, 300.0, seed, random_force)
         v = modal_fit_verdict(model, meas, subject="true model")
         assert v.status == "ok", v.summary()
         assert v.test is not None
@@ -142,3 +154,42 @@ def test_lateral_verdict_on_the_rig() -> None:
     # misses by more than the 3 % noise, and the verdict says where
     assert v.status == "failed"
     assert "model form" in " ".join(v.reasons)
+
+
+def test_mimo_noise_from_the_multiple_coherence() -> None:
+    """Two uncorrelated forces of equal power: the true 2-input model is within the noise."""
+    m1 = two_modes()
+    wn = m1.poles
+    psi_in = np.vstack([m1.psi_in, 0.7 * m1.psi_in * np.array([1.0, -1.0])])  # 2 inputs
+    model = ModalModel(wn, m1.psi_out, psi_in, meta={"band_hz": [5.0, 100.0]})
+    h = model.frf(F, "receptance").H[0]  # (2, n_freq)
+    ratios = []
+    for seed, n_avg in enumerate((8, 8, 32, 32)):
+        rng = np.random.default_rng(seed)
+        f_in = (
+            rng.standard_normal((n_avg, 2, F.size)) + 1j * rng.standard_normal((n_avg, 2, F.size))
+        ) / np.sqrt(2)
+        sd = np.abs(h).max() / 300.0
+        x = np.einsum("jf,ajf->af", h, f_in) + sd * (
+            rng.standard_normal((n_avg, F.size)) + 1j * rng.standard_normal((n_avg, F.size))
+        ) / np.sqrt(2)
+        gff = np.einsum("aif,ajf->fij", f_in, np.conj(f_in))
+        gxf = np.einsum("af,ajf->fj", x, np.conj(f_in))
+        gxx = np.sum(np.abs(x) ** 2, axis=0)
+        h1 = np.linalg.solve(np.transpose(gff, (0, 2, 1)), gxf[:, :, None])[:, :, 0]  # (f, 2)
+        coh = np.real(np.einsum("fj,fj->f", h1, np.conj(gxf))) / gxx
+        ch = [Channel(1, 3)]
+        meas = FRF(
+            F,
+            h1.T[None, :, :],
+            "receptance",
+            ch,
+            [Channel(1, 3), Channel(2, 3)],
+            coh[None, :],
+            {"n_averages": n_avg, "method": "welch"},  # random forces
+        )
+        v = modal_fit_verdict(model, meas)
+        assert v.status == "ok", v.summary()
+        assert v.test is not None
+        ratios.append(v.test.ratio)
+    assert 0.75 < np.mean(ratios) < 1.05  # approximate, on the side of more noise

@@ -3,21 +3,36 @@
 The verdict judges a fit from the data alone:
 
 * **against the noise.** The variance of an FRF estimate follows from its
-  coherence: for an H1 estimate from ``n_d`` averages with noise on the
-  response, ``var(H) = |H|^2 (1 - g^2) / (n_d g^2)`` (Bendat & Piersol,
-  *Random Data*, 4th ed., eq. 9.90 with the complex variance). The estimated
-  coherence is biased upwards, ``E[1 - g_est^2] ~ (1 - g^2)(n_d - 1)/n_d``,
-  so the variance is taken as ``|H|^2 (1 - g_est^2) / ((n_d - 1) g_est^2)``
-  (``n_d`` from ``frf.meta["n_averages"]``). An FRF without a number of
-  averages (the virtual rolling-tyre rig) carries the coherence of the
-  estimate itself: ``var(H) = |H|^2 (1 - g^2) / g^2``.
+  coherence: for an H1 estimate from ``n_d`` averages of a periodic force
+  with noise on the response, ``var(H) = |H|^2 (1 - g^2) / (n_d g^2)``
+  (the random error of frequency-response estimates, Bendat & Piersol,
+  *Random Data*, ch. 9, for the complex value). The estimated coherence is
+  biased upwards, ``E[1 - g_est^2] ~ (1 - g^2)(n_d - 1)/n_d``, so the
+  variance is taken as ``|H|^2 (1 - g_est^2) / ((n_d - 1) g_est^2)``
+  (``n_d`` from ``frf.meta["n_averages"]``). With a new random force in
+  every average the variance of H1 is larger, ``|H|^2 (1 - g^2) /
+  ((n_d - 1) g^2)`` (the mean inverse force spectrum), and the same formula
+  holds again: for a periodic and a random force alike the mean of the
+  statistic ``q`` below is 1 (``tests/test_report_verdicts.py``,
+  ``benchmarks/verdict_calibration.py``).
+
+  With ``m > 1`` inputs (``g^2`` the multiple coherence of an output) the
+  inputs are taken as uncorrelated and of equal power, so ``|H|^2`` becomes
+  ``sum_j |H_oj|^2``, and the factor ``1/(n_d - 1)`` becomes
+  ``n_d / (n_d - m)^2`` (mean inverse spectrum ``1/(n_d - m)`` of random
+  forces, coherence bias ``(n_d - m)/n_d``). The line-to-line scatter of the
+  forces' spectra makes this approximate, on the side of more noise (mean
+  ``q`` 0.9-1.0 for two inputs and 8-32 averages): a MIMO verdict is
+  conservative. An FRF without a number of averages (the virtual
+  rolling-tyre rig) carries the coherence of the estimate itself:
+  ``var(H) = |H|^2 (1 - g^2) / g^2``.
 
   The statistic is ``q = sum |H_model - H|^2 / sum var(H)`` over the fitted
   lines and FRFs: about 1 when the model leaves only noise. Under that
   hypothesis ``sum |e|^2`` is a weighted sum of chi-square variables with
   ``nu = 2 (sum var)^2 / sum var^2`` effective degrees of freedom
   (Satterthwaite), and the variance estimated from ``n_d`` averages has
-  ``(n_d - 1) nu``; ``q`` is then F-distributed, and the fit is *within the
+  ``(n_d - m) nu``; ``q`` is then F-distributed, and the fit is *within the
   noise* when ``q`` is below the ``1 - alpha`` quantile (``alpha = 1e-3``).
   Without averages the chi-square quantile ``chi2(nu) / nu`` is used.
   Fitted parameters only lower ``q``, so the test is conservative.
@@ -185,26 +200,36 @@ class FitVerdict:
 def frf_noise_variance(frf: FRF) -> tuple[NDArray[np.float64], float] | None:
     """Variance of each FRF value from the coherence, and the noise estimate's dof factor.
 
+    Module docstring; uses ``frf.meta["n_averages"]`` and ``frf.meta["method"]``.
+
     Returns
     -------
     (ndarray, float) or None
         ``var`` of shape ``frf.H.shape`` (in the FRF's unit squared) and
-        ``n_d - 1`` (``inf`` when the coherence is that of the estimate
-        itself); None when the FRF has no coherence or a single average.
+        ``n_d - m`` for ``m`` inputs (``inf`` when the coherence is that of the estimate
+        itself); None when the FRF has no coherence or no more averages than
+        inputs.
     """
     if frf.coherence is None:
         return None
     nd = frf.meta.get("n_averages")
     g2 = np.clip(np.asarray(frf.coherence, dtype=float), 1e-12, 1.0)
     snr = (1.0 - g2) / g2  # (n_out, n_freq)
+    n_in = frf.n_in
     if nd is None:
         scale, factor = 1.0, math.inf
     else:
         nd = int(nd)
-        if nd < 2:  # one average: coherence 1 everywhere, no noise information
+        if nd <= n_in:  # coherence 1 by construction: no noise information
             return None
-        scale, factor = 1.0 / (nd - 1), float(nd - 1)
-    var = np.abs(frf.H) ** 2 * snr[:, None, :] * scale
+        factor = float(nd - n_in)
+        # m inputs: mean inverse spectrum of random forces and coherence bias (docstring)
+        scale = 1.0 / (nd - 1) if n_in == 1 else nd / (nd - n_in) ** 2
+    # MIMO (multiple coherence per output): with uncorrelated inputs of equal power, the
+    # noise of output o spreads evenly over its FRFs, var(H_oj) = (1 - g_o^2)/g_o^2 *
+    # sum_j |H_oj|^2 / n_d, for every j; for one input this is the SISO formula
+    power = np.sum(np.abs(frf.H) ** 2, axis=1, keepdims=True)
+    var = np.broadcast_to(power * snr[:, None, :] * scale, frf.H.shape).copy()
     return var, factor
 
 
