@@ -3,17 +3,18 @@
 Run: ``python benchmarks/verdict_calibration.py [--trials N]``.
 
 A two-mode FRF (30 and 80 Hz, 2 % damping, 400 lines 5-100 Hz) is measured
-as an analyser does it: ``n_d`` periods of a fixed periodic force with
-Gaussian noise on the response (SNR 300 on the peak), H1 and coherence from
-the averages. The verdict (:func:`tyredamp.report.verdicts.modal_fit_verdict`,
-test level ``alpha = 1e-3``) judges
+as an analyser does it: ``n_d`` averages of a fixed periodic force (or of a
+new random force each) with Gaussian noise on the response (SNR 300 on the
+peak), H1 and coherence from the averages. The verdict
+(:func:`tyredamp.report.verdicts.modal_fit_verdict`, test level
+``alpha = 1e-3``) judges
 
 * the true model: the share of FAILED verdicts is the false-alarm rate
   (should be about ``alpha``);
 * the model with the second natural frequency shifted by ``df/f``: the share
   of FAILED verdicts is the power to see that misfit.
 
-Prints one row per number of averages.
+Prints one row per force and number of averages.
 """
 
 from __future__ import annotations
@@ -39,28 +40,31 @@ def two_modes(f2: float = 80.0) -> ModalModel:
     return ModalModel(poles, psi, psi.copy(), meta={"band_hz": [5.0, 100.0]})
 
 
-def measured(model: ModalModel, n_avg: int, snr: float, seed: int) -> FRF:
-    """H1 and coherence from ``n_avg`` periods of a fixed force, noise on the response."""
+def measured(
+    model: ModalModel, n_avg: int, snr: float, seed: int, random_force: bool = False
+) -> FRF:
+    """H1 and coherence from ``n_avg`` averages, noise on the response.
+
+    A fixed periodic force repeated in every average, or a new random force
+    in every average.
+    """
     rng = np.random.default_rng(seed)
     h = model.frf(F, "receptance").H[0, 0]
     sd = np.abs(h).max() / snr
-    force = np.exp(1j * rng.uniform(0, 2 * np.pi, F.size))
-    noise = rng.standard_normal((n_avg, F.size)) + 1j * rng.standard_normal((n_avg, F.size))
+    shape = (n_avg, F.size)
+    if random_force:
+        force = (rng.standard_normal(shape) + 1j * rng.standard_normal(shape)) / np.sqrt(2)
+    else:
+        force = np.tile(np.exp(1j * rng.uniform(0, 2 * np.pi, F.size)), (n_avg, 1))
+    noise = rng.standard_normal(shape) + 1j * rng.standard_normal(shape)
     x = h * force + sd * noise / np.sqrt(2)
-    gff = n_avg * np.abs(force) ** 2
+    gff = np.sum(np.abs(force) ** 2, axis=0)
     gxf = np.sum(x * np.conj(force), axis=0)
     gxx = np.sum(np.abs(x) ** 2, axis=0)
     coh = np.abs(gxf) ** 2 / (gff * gxx)
     ch = [Channel(1, 3)]
-    return FRF(
-        F,
-        (gxf / gff)[None, None, :],
-        "receptance",
-        ch,
-        ch,
-        coh[None, :],
-        {"n_averages": n_avg, "method": "cyclic"},
-    )
+    meta = {"n_averages": n_avg, "method": "welch" if random_force else "cyclic"}
+    return FRF(F, (gxf / gff)[None, None, :], "receptance", ch, ch, coh[None, :], meta)
 
 
 def main() -> None:
@@ -70,25 +74,27 @@ def main() -> None:
     true = two_modes()
     shifts = (1e-3, 3e-3, 1e-2)
     print(
-        f"{'n_d':>4} {'mean q':>8} {'false alarms':>13} "
+        f"{'force':>8} {'n_d':>4} {'mean q':>8} {'false alarms':>13} "
         + " ".join(f"{'FAIL at df/f=' + format(s, 'g'):>17}" for s in shifts)
     )
-    for nd in (2, 4, 8, 16):
-        q, fa = [], 0
-        hits = dict.fromkeys(shifts, 0)
-        for seed in range(args.trials):
-            meas = measured(true, nd, 300.0, seed)
-            v = modal_fit_verdict(true, meas)
-            assert v.test is not None
-            q.append(v.test.ratio)
-            fa += v.status == "failed"
-            for s in shifts:
-                hits[s] += modal_fit_verdict(two_modes(80.0 * (1 + s)), meas).status == "failed"
-        n = args.trials
-        print(
-            f"{nd:>4} {np.mean(q):>8.3f} {fa / n:>13.4f} "
-            + " ".join(f"{hits[s] / n:>17.3f}" for s in shifts)
-        )
+    for random_force in (False, True):
+        for nd in (2, 4, 8, 16):
+            q, fa = [], 0
+            hits = dict.fromkeys(shifts, 0)
+            for seed in range(args.trials):
+                meas = measured(true, nd, 300.0, seed, random_force)
+                v = modal_fit_verdict(true, meas)
+                assert v.test is not None
+                q.append(v.test.ratio)
+                fa += v.status == "failed"
+                for s in shifts:
+                    wrong = two_modes(80.0 * (1 + s))
+                    hits[s] += modal_fit_verdict(wrong, meas).status == "failed"
+            n = args.trials
+            print(
+                f"{'random' if random_force else 'periodic':>8} {nd:>4} {np.mean(q):>8.3f} "
+                f"{fa / n:>13.4f} " + " ".join(f"{hits[s] / n:>17.3f}" for s in shifts)
+            )
 
 
 if __name__ == "__main__":
