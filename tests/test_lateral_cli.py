@@ -140,6 +140,8 @@ def test_errors_are_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixtur
     capsys.readouterr()
     main(["lateral", "fit", str(bare), "--out", str(out), "--channel", "1", "1"])
     assert json.loads(out.read_text())["fits"]
+    # a file without its conditions: the assumption is said, not silent
+    assert "note: the file does not say which force" in capsys.readouterr().err
     out.unlink()
     with pytest.raises(SystemExit) as exc:
         main(["lateral", "fit", str(bare), "--out", str(out), "--models", "nonsense"])

@@ -209,6 +209,16 @@ def fit_command(
     }
     with atomic_path(out) as tmp:
         tmp.write_text(json_text(doc, indent=2), encoding="utf-8")
+    assumed = []
+    if force is None and "force" not in frf.meta:
+        assumed.append(
+            "the file does not say which force the FRF refers to: ground assumed "
+            "(give --force axle for an axle-force FRF)"
+        )
+    if wheel_mass is None and "wheel_mass_kg" not in frf.meta and data.force == "axle":
+        assumed.append("the file gives no wheel mass: 0 kg assumed (give --wheel-mass KG)")
+    for a in assumed:
+        click.echo(f"note: {a}", err=True)
     sp = "?" if data.speed is None else f"{data.speed / KMH:g} km/h"
     click.echo(
         f"{frf_file}: {best.n_lines} lines {best.frequency[0]:.3g}-{best.frequency[-1]:.3g} Hz, "
