@@ -333,8 +333,10 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     _warnings(rep, doc, "radial:checks")
     rep.paragraph(
         "A linear model with a symmetric damping matrix needs both checks to pass. The quality "
-        "check counts lines with coherence below 0.9; on this tyre they lie at the "
-        "anti-resonances and below the first mode, where the response is small."
+        "check counts lines with coherence below 0.9 over the same band as the other checks "
+        f"({result.settings.check_band_hz[0]:g}-{result.settings.check_band_hz[1]:g} Hz); on "
+        "this tyre they lie at the anti-resonances, where the response is small, and below "
+        "the first mode, outside that band."
     )
     _image(rep, images, "checks")
 
