@@ -498,6 +498,7 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
             "amplitude error (%)",
             "amplitude bias (%)",
             "axle prediction error (%)",
+            "within noise at",
         ],
         [
             [
@@ -509,6 +510,7 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
                 _num(r["mean_amplitude_error_pct"], ".2f"),
                 _num(r["mean_amplitude_bias_pct"], "+.2f"),
                 _num(r["mean_axle_amplitude_error_pct"], ".2f"),
+                _within_noise(lat["conditions"], r["equivalent"][0]),
             ]
             for r in lat["ranking"]
         ],
@@ -663,6 +665,17 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         f"{_pct(ca['frf_error'])} and the {tr['frequency_hz']:g} Hz switched-on sine by "
         f"{_pct(ca['sine_error'])}."
     )
+
+
+def _within_noise(conds: list[dict[str, Any]], model: str) -> str:
+    """``"0 of 6 (residual 1.4-2.8x the noise)"``: conditions a model fits within the noise."""
+    vs = [c["verdicts"][model] for c in conds if model in c.get("verdicts", {})]
+    if not vs:
+        return "-"
+    ok = sum(1 for v in vs if v["passed"])
+    r = [math.sqrt(v["residual_to_noise"]) for v in vs if v["residual_to_noise"] is not None]
+    span = f" (residual {min(r):.2g}-{max(r):.2g}x the noise)" if r else ""
+    return f"{ok} of {len(vs)}{span}"
 
 
 def _fig_name(images: Mapping[str, Any], force: str, v: float) -> str:
