@@ -161,6 +161,11 @@ def test_every_pressure_and_condition_fits_or_says_why(demo: tuple[DemoResult, P
     for c in doc["lateral"]["conditions"]:
         verdicts.append((f"{c['best']} fit {c['label']}", c["verdict"]))
     assert len(verdicts) == 2 * len(result.radial.runs) + len(result.lateral.conditions)
+    # every warning reaches the summary too (failures through the verdict rows)
+    shown = " ".join(rows.values())
+    for w in doc["warnings"]:
+        if w["severity"] == "warning":
+            assert w["message"] in shown, w
     for key, v in verdicts:
         if v["status"] == "ok":
             assert v["residual_to_noise"] <= v["threshold"]

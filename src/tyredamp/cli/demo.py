@@ -67,9 +67,10 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
             "the rest is model error)",
         ),
     ]
-    n_warn = sum(1 for w in doc.get("warnings", []) if w["severity"] == "warning")
-    if n_warn:
-        rows.append(("warnings", f"{n_warn} more, listed in the report and results.json"))
+    # the warnings that are not failures shown above, each with its stage
+    warns = [w for w in doc.get("warnings", []) if w["severity"] == "warning"]
+    for k, w in enumerate(warns):
+        rows.append((f"warning {k + 1} ({w['stage']})", w["message"]))
     return rows
 
 
