@@ -193,3 +193,20 @@ def test_mimo_noise_from_the_multiple_coherence() -> None:
         assert v.test is not None
         ratios.append(v.test.ratio)
     assert 0.75 < np.mean(ratios) < 1.05  # approximate, on the side of more noise
+
+
+def test_a_fallback_of_the_refinement_is_named() -> None:
+    true = two_modes(f2=99.0)
+    meas = measured(true, 8, 300.0, 3)
+    one = ModalModel(
+        true.poles[:1],
+        true.psi_out[:, :1],
+        true.psi_in[:, :1],
+        meta={
+            "band_hz": [5.0, 100.0],
+            "warnings": ["real-mode refinement not acceptable (a pole crossed the band edge)"],
+        },
+    )
+    v = modal_fit_verdict(one, meas)
+    assert v.status == "failed"
+    assert any("fell back to the complex-mode poles" in r for r in v.reasons)

@@ -382,6 +382,14 @@ def modal_fit_verdict(
                 reasons.append(
                     f"the misfit lies at {test.misfit_hz[0]:.4g}-{test.misfit_hz[1]:.4g} Hz"
                 )
+            if any(
+                str(w).startswith("real-mode refinement not acceptable")
+                for w in model.meta.get("warnings", [])
+            ):
+                reasons.append(
+                    "its refinement fell back to the complex-mode poles (only the residues "
+                    "are fitted)"
+                )
             if better is not None and better.passed:
                 reasons.append(
                     f"the {better.subject} is within the noise: the model form misses (real "
