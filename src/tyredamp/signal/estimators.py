@@ -660,11 +660,12 @@ def _segment_starts(
         r = np.asarray(runs, dtype=np.int64).ravel()
     except (TypeError, ValueError):
         raise InputError(
-            f"timedata.meta['run_starts']: expected sample indices, got {runs!r}"
+            f"run_starts (time-data metadata, first sample of each run): expected sample "
+            f"indices, got {runs!r}"
         ) from None
     if r.size == 0 or r[0] != 0 or np.any(np.diff(r) <= 0) or r[-1] >= n:
         raise InputError(
-            "timedata.meta['run_starts']: expected increasing sample indices from 0 below "
+            "run_starts (time-data metadata): expected increasing sample indices from 0 below "
             f"{n}, got {runs!r}"
         )
     stops = np.append(r[1:], n)
