@@ -171,6 +171,11 @@ _PRIORITY = (
     "method",
     "n_averages",
     "exponential_tau_s",
+    # operating conditions of a lateral rig FRF, readable in the ID lines by other programs
+    "speed_m_s",
+    "force",
+    "wheel_mass_kg",
+    "pressure_bar",
     "description",
 )
 
