@@ -21,7 +21,10 @@ What is written
   as Python floats (the fixed E13.5 fields of record 7 keep only 6 digits);
   ID line 3: as much of ``meta`` as fits in 80 characters as JSON, the keys
   the estimators use first (``period_samples``, ``settle_samples``,
-  ``record_samples``, ``run_starts``, ``band_hz`` ...);
+  ``record_samples``, ``run_starts``, ``band_hz`` ...), then the operating
+  conditions of a lateral rig FRF (``speed_m_s``, ``force``,
+  ``wheel_mass_kg``, ``pressure_bar``); the whole ``meta`` is in the metadata
+  record below when it does not fit;
   ID lines 4 and 5: channel name and angle of the response and reference as
   JSON (``NONE`` when there are none); time data have no reference, and ID
   line 5 continues the metadata.
