@@ -233,3 +233,9 @@ def test_uff_meta_record_is_deterministic_and_readable_by_pyuff(tmp_path: Path) 
     (tmp_path / "c.uff").write_bytes(raw[:first] + raw[second:])
     with pytest.raises(FileFormatError, match="incomplete tyredamp metadata record"):
         read_frf(tmp_path / "c.uff")
+    # a damaged record is an error naming it, and the file is left as it was
+    bad = raw.replace(b'{"estimator"', b'{"estimator"}}', 1)
+    (tmp_path / "d.uff").write_bytes(bad)
+    with pytest.raises(FileFormatError, match="metadata record"):
+        read_frf(tmp_path / "d.uff")
+    assert (tmp_path / "d.uff").read_bytes() == bad
