@@ -106,9 +106,14 @@ def test_bad_input_is_one_line_and_exit_2(
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
-def test_debug_shows_the_traceback(tmp_path: Path) -> None:
-    from tyredamp.exceptions import FileFormatError
-
+def test_debug_shows_the_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # --debug adds the traceback; the exit code and the last line stay the same (issue 15)
     (tmp_path / "other.json").write_text('{"kind": "something else"}')
-    with pytest.raises(FileFormatError):
-        main(["--debug", "report", str(tmp_path / "other.json"), "--out", str(tmp_path / "r.html")])
+    argv = ["report", str(tmp_path / "other.json"), "--out", str(tmp_path / "r.html")]
+    code, _, err = run(capsys, "--debug", *argv)
+    assert code == 2
+    assert "Traceback" in err and "FileFormatError" in err
+    assert err.strip().splitlines()[-1].startswith("tyredamp: error: ")
+    code2, _, err2 = run(capsys, *argv)
+    assert code2 == code
+    assert err2.strip() == err.strip().splitlines()[-1]

@@ -2,20 +2,34 @@
 
 Every subcommand lives in a module of this package and is registered on
 :data:`cli` below. Errors raised on purpose (:class:`TyredampError`) and
-usage errors become one line on stderr and exit code 2; ``--debug`` shows the
-traceback instead.
+usage errors become one line on stderr and exit code 2; anything else becomes
+one ``internal error`` line and exit code 70 (:func:`main`); ``--debug`` shows
+the traceback as well, with the same exit code.
 """
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
+import traceback
+import warnings
+from typing import Any
 
 import click
 from threadpoolctl import threadpool_limits
 
 from .. import __version__
 from ..exceptions import ConvergenceError, TyredampError
-from ._common import EXIT_INPUT, EXIT_RUNTIME, fail
+from ._common import (
+    EXIT_INPUT,
+    EXIT_INTERNAL,
+    EXIT_RUNTIME,
+    EXIT_SIGINT,
+    EXIT_SIGTERM,
+    Interrupted,
+    fail,
+)
 
 __all__ = ["cli", "main"]
 
@@ -59,35 +73,112 @@ def _register() -> None:
 _register()
 
 
+def _install_signal_handlers() -> dict[int, Any]:
+    """SIGINT and SIGTERM raise :class:`Interrupted` (so that cleanup runs); returns the old ones."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+
+    def handler(signum: int, frame: Any) -> None:
+        # a second signal must not cut the cleanup short
+        for s in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(s, signal.SIG_IGN)
+        raise Interrupted(signum)
+
+    old = {}
+    for s in (signal.SIGINT, signal.SIGTERM):
+        old[s] = signal.getsignal(s)
+        signal.signal(s, handler)
+    return old
+
+
+def _restore_signal_handlers(old: dict[int, Any]) -> None:
+    for s, h in old.items():
+        signal.signal(s, h if h is not None else signal.SIG_DFL)
+
+
+def _warning_lines(caught: list[warnings.WarningMessage]) -> list[str]:
+    lines: list[str] = []
+    for w in caught:
+        line = " ".join(f"{w.category.__name__}: {w.message}".split())
+        if line not in lines:
+            lines.append(line)
+    return lines
+
+
 def main(argv: list[str] | None = None) -> None:
-    """Entry point of the console script."""
+    """Entry point of the console script.
+
+    Every failure ends in one line ``tyredamp: error: ...`` on stderr and an exit
+    code (see the README's "Safety" section): 2 bad input or output path, 3 a
+    numerical method failed on valid input, 70 an internal error (a bug),
+    130/143 interrupted by SIGINT/SIGTERM (temporaries removed). ``--debug``
+    prints the traceback as well; the exit code stays the same. Warnings are
+    collected and printed after a successful run as ``tyredamp: warning: ...``
+    lines (dropped when the run fails, so the error is the only line).
+    """
     args = sys.argv[1:] if argv is None else argv
     debug = "--debug" in args
+    old = _install_signal_handlers()
+    caught: list[warnings.WarningMessage] = []
+    code = 0
+    message = ""
+    error: BaseException | None = None
     try:
-        # Small dense solves dominate; several BLAS threads on busy cores make them
-        # 10-15x slower (benchmarks/demo_timing.py), so the CLI uses one.
-        with threadpool_limits(limits=1, user_api="blas"):
-            rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
-        if isinstance(rv, int) and rv != 0:
-            # ctx.exit(n) hands its code back as the return value here
-            sys.exit(rv)
+        with warnings.catch_warnings(record=not debug) as rec:
+            if not debug:
+                warnings.simplefilter("default")
+            try:
+                # Small dense solves dominate; several BLAS threads on busy cores make them
+                # 10-15x slower (benchmarks/demo_timing.py), so the CLI uses one.
+                with threadpool_limits(limits=1, user_api="blas"):
+                    rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
+                if isinstance(rv, int) and rv != 0:
+                    # ctx.exit(n) hands its code back as the return value here
+                    code = rv
+            finally:
+                caught = list(rec or [])
     except click.exceptions.Exit as exc:
-        sys.exit(exc.exit_code)
+        code = exc.exit_code
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+    except Interrupted as exc:
+        error = sys.exc_info()[1]
+        name = signal.Signals(exc.signum).name
+        code = EXIT_SIGTERM if exc.signum == signal.SIGTERM else EXIT_SIGINT
+        message = f"interrupted by {name}; nothing was written"
     except click.exceptions.Abort:
-        fail("aborted", 130)
+        error = sys.exc_info()[1]
+        code, message = EXIT_SIGINT, "aborted"
     except click.ClickException as exc:
-        if debug:
-            raise
-        fail(exc.format_message(), EXIT_INPUT)
+        error = sys.exc_info()[1]
+        code, message = EXIT_INPUT, exc.format_message()
     except ConvergenceError as exc:
-        if debug:
-            raise
-        fail(str(exc), EXIT_RUNTIME)
+        error = sys.exc_info()[1]
+        code, message = EXIT_RUNTIME, str(exc)
     except TyredampError as exc:
-        if debug:
-            raise
-        fail(str(exc), EXIT_INPUT)
+        error = sys.exc_info()[1]
+        code, message = EXIT_INPUT, str(exc)
     except OSError as exc:
-        if debug:
-            raise
-        fail(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc), EXIT_INPUT)
+        error = sys.exc_info()[1]
+        code = EXIT_INPUT
+        text = exc.strerror or str(exc)
+        message = f"{exc.filename}: {text}" if exc.filename else text
+    except (MemoryError, RecursionError) as exc:
+        error = sys.exc_info()[1]
+        code = EXIT_INTERNAL
+        what = "not enough memory" if isinstance(exc, MemoryError) else "input nested too deeply"
+        message = f"internal error ({type(exc).__name__}: {what}); rerun with --debug"
+    except Exception as exc:  # the last resort: no traceback reaches the user
+        error = sys.exc_info()[1]
+        code = EXIT_INTERNAL
+        message = f"internal error ({type(exc).__name__}: {exc}); rerun with --debug"
+    finally:
+        _restore_signal_handlers(old)
+    if message:
+        if debug and error is not None:
+            traceback.print_exception(error)
+        fail(message, code)
+    for line in _warning_lines(caught):
+        click.echo(f"tyredamp: warning: {line}", err=True)
+    if code:
+        sys.exit(code)
