@@ -112,7 +112,8 @@ def test_debug_shows_the_traceback(tmp_path: Path, capsys: pytest.CaptureFixture
     argv = ["report", str(tmp_path / "other.json"), "--out", str(tmp_path / "r.html")]
     code, _, err = run(capsys, "--debug", *argv)
     assert code == 2
-    assert "Traceback" in err and "FileFormatError" in err
+    assert "Traceback" in err
+    assert "FileFormatError" in err
     assert err.strip().splitlines()[-1].startswith("tyredamp: error: ")
     code2, _, err2 = run(capsys, *argv)
     assert code2 == code

@@ -36,8 +36,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import shutil
-import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -802,32 +800,38 @@ def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
 
 
 # ------------------------------------------------------------------------------- writing
-def check_output_dir(out: Path) -> None:
+def check_output_dir(out: Path) -> Path:
     """Refuse to replace anything but an empty directory or an earlier demo output.
+
+    An earlier demo output (a ``results.json`` of kind ``tyredamp-demo-results``)
+    is replaced only when the directory holds nothing but the files listed in
+    that results.json; links are followed (see
+    :func:`tyredamp.io._safety.check_output_dir`). Returns the real directory.
 
     Raises
     ------
     InputError
-        ``out`` is a file, or a non-empty directory without a demo results.json.
+        ``out`` is a file, the current directory, has no parent directory, or is a
+        non-empty directory that is not an earlier demo output or holds other files.
     """
-    if not out.exists():
-        return
-    if not out.is_dir():
-        raise InputError(f"--out: {out} exists and is not a directory")
-    entries = list(out.iterdir())
-    if not entries:
-        return
-    marker = out / "results.json"
+    from .io._safety import check_output_dir as check
+
+    return check(out, _demo_files)
+
+
+def _demo_files(root: Path) -> list[str] | None:
+    """The files an earlier demo wrote in ``root`` (its results.json's list), or None."""
     try:
-        doc = json.loads(marker.read_text(encoding="utf-8"))
-        ok = isinstance(doc, dict) and doc.get("kind") == DEMO_MARKER
-    except (OSError, ValueError):
-        ok = False
-    if not ok:
-        raise InputError(
-            f"--out: {out} exists and is not an earlier tyredamp demo output "
-            "(no demo results.json); choose another directory or remove it"
-        )
+        doc = json.loads((root / "results.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    if not isinstance(doc, dict) or doc.get("kind") != DEMO_MARKER:
+        return None
+    files = doc.get("files")
+    if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+        return None
+    ok = [f for f in files if not Path(f).is_absolute() and ".." not in Path(f).parts]
+    return [*ok, "results.json"]
 
 
 def save_demo(
@@ -869,17 +873,15 @@ def _save(
     result: DemoResult, out: Path, progress: ProgressCallback | None, dpi: int
 ) -> dict[str, Path]:
     from .io import write_frf, write_timedata
+    from .io._safety import atomic_dir
     from .modal.io import modes_document
     from .report.build import build_demo_report
     from .report.figures import demo_figures
     from .results import build_results
 
     check_output_dir(out)
-    parent = out.resolve().parent
-    parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".tmp", dir=parent))
     written: list[str] = []
-    try:
+    with atomic_dir(out) as tmp:
         figs = demo_figures(result)
         total = len(figs) + 4
         done = 0
@@ -936,11 +938,6 @@ def _save(
         (tmp / "report.html").write_text(html, encoding="utf-8")
         if progress is not None:
             progress("done", total, total)
-        _normal_permissions(tmp)
-        _move_into_place(tmp, out)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return {name: out / name for name in files}
 
 
@@ -971,32 +968,3 @@ def _data_files(result: DemoResult) -> dict[str, FRF | TimeData]:
     tt = result.lateral.time_test
     files[f"data/lateral_time_{tt.frequency_hz:g}Hz.uff"] = tt.data
     return files
-
-
-def _normal_permissions(root: Path) -> None:
-    """Give the temporary tree the usual permissions (mkdtemp/mkstemp create 0700/0600)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(root, 0o777 & ~umask)
-    for dirpath, dirnames, filenames in os.walk(root):
-        for d in dirnames:
-            os.chmod(os.path.join(dirpath, d), 0o777 & ~umask)
-        for f in filenames:
-            os.chmod(os.path.join(dirpath, f), 0o666 & ~umask)
-
-
-def _move_into_place(tmp: Path, out: Path) -> None:
-    """Rename ``tmp`` to ``out``; an existing ``out`` (checked before) is replaced."""
-    if not out.exists():
-        os.replace(tmp, out)
-        return
-    old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.resolve().parent))
-    old.rmdir()
-    os.replace(out, old)
-    try:
-        os.replace(tmp, out)
-    except BaseException:
-        os.replace(old, out)
-        raise
-    with contextlib.suppress(OSError):
-        shutil.rmtree(old)

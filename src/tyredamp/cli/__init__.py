@@ -74,7 +74,7 @@ _register()
 
 
 def _install_signal_handlers() -> dict[int, Any]:
-    """SIGINT and SIGTERM raise :class:`Interrupted` (so that cleanup runs); returns the old ones."""
+    """Make SIGINT and SIGTERM raise :class:`Interrupted` (cleanup runs); return the old ones."""
     if threading.current_thread() is not threading.main_thread():
         return {}
 
@@ -84,7 +84,7 @@ def _install_signal_handlers() -> dict[int, Any]:
             signal.signal(s, signal.SIG_IGN)
         raise Interrupted(signum)
 
-    old = {}
+    old: dict[int, Any] = {}
     for s in (signal.SIGINT, signal.SIGTERM):
         old[s] = signal.getsignal(s)
         signal.signal(s, handler)

@@ -35,7 +35,7 @@ EXIT_SIGINT = 130
 EXIT_SIGTERM = 143
 
 
-class Interrupted(BaseException):  # noqa: N818 - a signal, not an error
+class Interrupted(BaseException):
     """Raised by the CLI's SIGINT/SIGTERM handler so that every ``finally`` cleans up."""
 
     def __init__(self, signum: int) -> None:

@@ -34,6 +34,7 @@ import numpy as np
 from ..damping import METHODS, DampingModel, identify_damping
 from ..exceptions import InputError
 from ..io._common import check_input_file
+from ..io._safety import check_output_file
 from ..io.jsonfile import write_json
 from ..modal.io import read_modes_json
 from ._common import out_file_option, seed_option
@@ -114,8 +115,7 @@ def damping_command(
       tyredamp damping tyre_modes.json --out tyre_damping.json
       tyredamp damping tyre_modes.json -o damping.json --method refined --samples 500
     """
-    if out.resolve() == modes_json.resolve():
-        raise InputError(f"--out: {out} is the input file; choose another name")
+    check_output_file(out, [modes_json])
     models = read_modes_json(check_input_file(modes_json))
     if model_name not in models:
         raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")

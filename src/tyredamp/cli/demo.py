@@ -109,6 +109,13 @@ def demo_command(out: Path, quick: bool, seed: int) -> None:
       tyredamp demo
       tyredamp demo --out demo-quick --quick --seed 3
     """
+    from ..io._safety import private_matplotlib_config
+
+    with private_matplotlib_config():
+        _demo(out, quick, seed)
+
+
+def _demo(out: Path, quick: bool, seed: int) -> None:
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table

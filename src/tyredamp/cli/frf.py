@@ -7,9 +7,9 @@ from pathlib import Path
 import click
 import numpy as np
 
-from ..exceptions import InputError
 from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
+from ..io._safety import check_output_file
 from ..signal.estimators import ESTIMATORS, estimate_frf
 from ._common import out_file_option
 
@@ -96,8 +96,7 @@ def frf_command(
       tyredamp frf tyre_test.uff --out tyre_frf.uff --estimator H1
       tyredamp frf rig.npz --out frf.csv --reference 1+Z --method welch --segment 4096
     """
-    if out.resolve() == time_file.resolve():
-        raise InputError(f"--out: {out} is the input file; choose another name")
+    check_output_file(out, [time_file])
     out_format = format_of(out, fmt)
     td = read_timedata(time_file)
     frf = estimate_frf(

@@ -42,8 +42,8 @@ from pathlib import Path
 import click
 
 from ..exceptions import InputError
-from ..io import FORMATS, read_frf, write_frf
-from ..io._atomic import atomic_path
+from ..io import FORMATS, format_of, read_frf, write_frf
+from ..io._safety import atomic_path, check_output_file
 from ..io.jsonfile import json_text
 from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
 from ..lateral.models import MODELS, get_model_class
@@ -152,6 +152,7 @@ def fit_command(
       tyredamp lateral fit rig.npz --out lateral.json --models proposed,maxwell \\
           --speed 5 --force axle --wheel-mass 100
     """
+    check_output_file(out, [frf_file])
     frf = read_frf(frf_file)
     names = _model_list(models)
     if speed is not None and not (math.isfinite(speed) and speed > 0):
@@ -261,6 +262,8 @@ def simulate_command(
       tyredamp lateral simulate --out rig_axle.npz --speed 10 --pressure 2.4 \\
           --force axle --seed 3
     """
+    check_output_file(out)
+    fmt = format_of(out, fmt)
     rig = VirtualLateralRig() if noise is None else VirtualLateralRig(relative_noise=noise)
     data = rig.measure(speed, pressure, force, seed)  # type: ignore[arg-type]
     path = write_frf(data.frf, out, fmt)

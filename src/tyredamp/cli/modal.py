@@ -9,6 +9,7 @@ import numpy as np
 
 from ..exceptions import InputError
 from ..io import read_frf
+from ..io._safety import check_output_file
 from ..modal.identify import ModalIdentification, identify_modes
 from ..modal.io import write_modes_json
 from ..modal.model import ModalModel
@@ -109,6 +110,7 @@ def modal_command(
       tyredamp modal tyre_frf.uff --out modes.json --band 0 200
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
+    check_output_file(out, [frf_file])
     frf = read_frf(frf_file)
     res: ModalIdentification = identify_modes(
         frf,

@@ -10,7 +10,6 @@ type 4); ``--truth`` also writes the exact modes as a modes JSON file.
 
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +17,7 @@ import click
 
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
-from ..io._atomic import atomic_path
+from ..io._safety import atomic_paths, check_distinct, check_output_file
 from ..io.jsonfile import json_text
 from ._common import out_file_option, seed_option
 from .lateral import lateral_group
@@ -146,8 +145,10 @@ def radial_command(
     from ..signal import estimate_frf
     from ..tyre import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
 
-    if truth_out is not None and truth_out.resolve() == out.resolve():
-        raise InputError("--truth: expected another file than --out")
+    check_output_file(out)
+    if truth_out is not None:
+        check_output_file(truth_out, option="--truth")
+        check_distinct([("--out", out), ("--truth", truth_out)])
     out_format = format_of(out, fmt)
     points = _points(drive_points)
     tyre = RingTyre(
@@ -164,24 +165,18 @@ def radial_command(
             frf_kind="receptance",
         )
         truth_text = json_text(doc)
-    existed = out.exists()
-    if as_frf:
-        frf = estimate_frf(test.data, "H1")
-        write_frf(frf, out, out_format)
-        what = f"FRFs {frf.n_out} x {frf.n_in}, {frf.n_freq} lines (function type 4)"
-    else:
-        write_timedata(test.data, out, out_format)
-        td = test.data
-        what = f"time data, {td.n_channels} channels x {td.n_samples} samples (function type 1)"
-    if truth_text is not None and truth_out is not None:
-        try:
-            with atomic_path(truth_out) as tmp:
-                tmp.write_text(truth_text, encoding="utf-8")
-        except BaseException:
-            if not existed:
-                with contextlib.suppress(OSError):
-                    out.unlink()
-            raise
+    # both files or neither: a replaced --out is put back when --truth fails
+    with atomic_paths([out] if truth_out is None else [out, truth_out]) as tmps:
+        if as_frf:
+            frf = estimate_frf(test.data, "H1")
+            write_frf(frf, tmps[0], out_format)
+            what = f"FRFs {frf.n_out} x {frf.n_in}, {frf.n_freq} lines (function type 4)"
+        else:
+            write_timedata(test.data, tmps[0], out_format)
+            td = test.data
+            what = f"time data, {td.n_channels} channels x {td.n_samples} samples (function type 1)"
+        if truth_text is not None:
+            tmps[1].write_text(truth_text, encoding="utf-8")
     vis = test.truth.select("visible")
     click.echo(
         f"virtual truck tyre at {pressure:g} bar: {tyre.layout.n_points} points, drive point(s) "

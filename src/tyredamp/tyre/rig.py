@@ -346,8 +346,8 @@ def run_modal_test(
             snr = float(snr_db)
         except (TypeError, ValueError):
             raise InputError(f"snr_db: expected a number in dB or None, got {snr_db!r}") from None
-        if np.isnan(snr):
-            raise InputError("snr_db: expected a number in dB or None, got NaN")
+        if not (snr > -300.0):  # NaN, -inf (infinite noise) or noise 1e15 x the signal
+            raise InputError(f"snr_db: expected a ratio in dB > -300 (inf: no noise), got {snr:g}")
     if drive_mode not in ("sequential", "simultaneous"):
         raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
     if excitation not in ("chirp", "multisine"):
