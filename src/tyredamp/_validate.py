@@ -33,8 +33,18 @@ def as_finite(
 ) -> NDArray[Any]:
     """Return ``x`` as an array of ``dtype``; reject NaN, inf and wrong ``ndim``."""
     try:
-        arr = np.asarray(x, dtype=dtype)
-    except (TypeError, ValueError) as exc:
+        raw = np.asarray(x)
+        if np.iscomplexobj(raw) and not np.issubdtype(np.dtype(dtype), np.complexfloating):
+            if np.any(raw.imag != 0):
+                raise InputError(
+                    f"{name}: expected real values, got complex numbers "
+                    f"({int(np.count_nonzero(raw.imag))} with a non-zero imaginary part)"
+                )
+            raw = raw.real
+        arr = np.asarray(raw, dtype=dtype)
+    except InputError:
+        raise
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{name}: expected numbers, got {type(x).__name__} ({exc})") from None
     if ndim is not None and arr.ndim != ndim:
         raise ShapeError(f"{name}: expected a {ndim}-D array, got shape {arr.shape}")

@@ -816,7 +816,7 @@ def check_output_dir(out: Path) -> Path:
     """
     from .io._safety import check_output_dir as check
 
-    return check(out, _demo_files)
+    return check(out, _demo_files, what="tyredamp demo output")
 
 
 def _demo_files(root: Path) -> list[str] | None:

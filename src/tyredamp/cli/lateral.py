@@ -125,10 +125,10 @@ def lateral_group() -> None:
     "--channel",
     nargs=2,
     type=int,
-    default=(0, 0),
-    show_default=True,
+    default=None,
     metavar="OUT IN",
-    help="Output and input positions of the FRF to fit.",
+    help="Output and input positions of the FRF to fit (needed when the file holds "
+    "more than one FRF).",
 )
 def fit_command(
     frf_file: Path,
@@ -140,7 +140,7 @@ def fit_command(
     band: tuple[float, float] | None,
     weights: str,
     criterion: str,
-    channel: tuple[int, int],
+    channel: tuple[int, int] | None,
 ) -> None:
     """Fit lateral tyre models to a measured FRF and rank them.
 
@@ -171,6 +171,7 @@ def fit_command(
         weights=weights,
         channel=channel,
     )
+    ranking.check()  # no model fits: exit 3 with the reasons, nothing written
     best = ranking.best
     doc = {
         "tyredamp": "lateral-fit",
@@ -188,6 +189,7 @@ def fit_command(
             "wheel_mass_kg": data.wheel_mass,
         },
         **ranking.to_dict(),
+        "problems": {f.name: f.problems() for f in ranking.fits},
     }
     with atomic_path(out) as tmp:
         tmp.write_text(json_text(doc, indent=2), encoding="utf-8")
@@ -209,6 +211,8 @@ def fit_command(
             )
         )
     )
+    for p in best.problems():
+        click.echo(f"note: {p}")
     click.echo(f"wrote {out}")
 
 

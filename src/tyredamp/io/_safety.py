@@ -244,6 +244,7 @@ def check_output_dir(
     out: str | os.PathLike[str],
     owned_files: Callable[[Path], Sequence[str] | None],
     option: str = "--out",
+    what: str = "tyredamp output",
 ) -> Path:
     """Refuse an output directory that cannot work or holds data that is not ours; before work.
 
@@ -257,6 +258,8 @@ def check_output_dir(
         directory is not an earlier output.
     option : str
         Name of the option, for the message.
+    what : str
+        What an earlier output is called, for the message.
 
     Returns
     -------
@@ -293,7 +296,7 @@ def check_output_dir(
     owned = owned_files(real)
     if owned is None:
         raise InputError(
-            f"{option}: {text} exists and is not an earlier tyredamp output; "
+            f"{option}: {text} exists and is not an earlier {what}; "
             "choose another directory or remove it"
         )
     allowed = set()
@@ -305,7 +308,7 @@ def check_output_dir(
     if extra:
         shown = ", ".join(extra[:3]) + (f" and {len(extra) - 3} more" if len(extra) > 3 else "")
         raise InputError(
-            f"{option}: {text} holds files an earlier tyredamp output did not write ({shown}); "
+            f"{option}: {text} holds files an earlier {what} did not write ({shown}); "
             "not replaced: choose another directory or move them"
         )
     return real

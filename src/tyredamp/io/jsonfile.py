@@ -15,9 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from ..exceptions import FileFormatError
 from ._atomic import atomic_path
 
-__all__ = ["finite", "json_text", "write_json"]
+__all__ = ["finite", "json_text", "loads_json", "read_json", "write_json"]
 
 
 def finite(obj: Any) -> Any:
@@ -47,3 +48,31 @@ def write_json(obj: Any, path: str | os.PathLike[str], indent: int = 1) -> Path:
     with atomic_path(target) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return target
+
+
+def loads_json(text: str, where: str | os.PathLike[str]) -> Any:
+    """Parse JSON text read from ``where``; every failure is a :class:`FileFormatError`.
+
+    Empty text, invalid JSON and nesting too deep for the parser (a hostile
+    file of 100 000 brackets) are named with ``where``.
+    """
+    if not text.strip():
+        raise FileFormatError(f"{os.fspath(where)}: the file is empty")
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise FileFormatError(
+            f"{os.fspath(where)}: not valid JSON ({exc.msg} at line {exc.lineno})"
+        ) from None
+    except RecursionError:
+        raise FileFormatError(f"{os.fspath(where)}: JSON nested too deeply") from None
+
+
+def read_json(path: str | os.PathLike[str]) -> Any:
+    """Read a JSON file (UTF-8); every failure to parse is a :class:`FileFormatError`."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise FileFormatError(f"{p}: not a text (JSON) file") from None
+    return loads_json(text, p)

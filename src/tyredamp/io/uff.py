@@ -441,7 +441,7 @@ def _extras(line: Any) -> dict[str, Any]:
         return {}
     try:
         d = json.loads(text)
-    except json.JSONDecodeError:
+    except (json.JSONDecodeError, RecursionError):
         return {}
     return d if isinstance(d, dict) else {}
 

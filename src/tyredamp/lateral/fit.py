@@ -147,17 +147,31 @@ class LateralData:
         ``"label"`` (as written by :mod:`tyredamp.lateral.rig`).
         """
         meta = frf.meta
-        sp = speed if speed is not None else meta.get("speed_m_s")
+        sp = speed if speed is not None else _meta_number(meta, "speed_m_s", "m/s", None)
         fo = force if force is not None else meta.get("force", "ground")
-        wm = wheel_mass if wheel_mass is not None else meta.get("wheel_mass_kg", 0.0)
+        if not isinstance(fo, str):
+            raise InputError(f"FRF meta 'force': expected 'ground' or 'axle', got {fo!r}")
+        wm = (
+            wheel_mass if wheel_mass is not None else _meta_number(meta, "wheel_mass_kg", "kg", 0.0)
+        )
         lb = label if label is not None else str(meta.get("label", ""))
         return cls(
             frf=frf,
             speed=None if sp is None else float(sp),
-            force=fo,
-            wheel_mass=float(wm),
+            force=fo,  # type: ignore[arg-type]
+            wheel_mass=float(0.0 if wm is None else wm),
             label=lb,
         )
+
+
+def _meta_number(meta: dict[str, Any], key: str, unit: str, default: float | None) -> float | None:
+    """A number from FRF meta (absent: ``default``); anything else is an InputError naming it."""
+    if key not in meta:
+        return default
+    v = meta[key]
+    if isinstance(v, bool) or not isinstance(v, int | float) or not np.isfinite(v):
+        raise InputError(f"FRF meta {key!r}: expected a finite number in {unit}, got {v!r}")
+    return float(v)
 
 
 @dataclass(frozen=True)
@@ -175,10 +189,17 @@ def _prepare(
     data: LateralData | FRF,
     band: tuple[float, float] | None,
     weights: Weights | ArrayLike,
-    channel: tuple[int, int] = (0, 0),
+    channel: tuple[int, int] | None = None,
 ) -> _Prepared:
     d = data if isinstance(data, LateralData) else LateralData.from_frf(data)
     frf = d.frf
+    if channel is None:
+        if frf.n_out * frf.n_in != 1:
+            raise ShapeError(
+                f"channel: the FRF holds {frf.n_out}x{frf.n_in} FRFs, a lateral fit takes one; "
+                "choose it with channel=(out, in) (command line: --channel OUT IN)"
+            )
+        channel = (0, 0)
     i, j = channel
     if not (0 <= i < frf.n_out and 0 <= j < frf.n_in):
         raise ShapeError(
@@ -300,6 +321,38 @@ class LateralFit:
     nfev: int
     message: str
     label: str = ""
+    at_bound: tuple[str, ...] = ()
+
+    def problems(self) -> list[str]:
+        """Why this fit cannot be trusted, one sentence each (empty: none found).
+
+        * a parameter ended on the bound of the search (the data drive it to
+          0 or infinity: the model's feature is not in the data);
+        * a parameter's standard error exceeds its value (not determined);
+        * the corner frequency ``f0`` lies more than a decade outside the fitted
+          lines (an extrapolation the data cannot support).
+        """
+        out: list[str] = []
+        if self.at_bound:
+            out.append(f"{self.name}: {', '.join(self.at_bound)} at the bound of the search")
+        loose = [
+            n
+            for n, v in self.params.items()
+            if not (np.isfinite(self.stderr.get(n, np.nan)) and self.stderr[n] <= abs(v))
+        ]
+        if loose:
+            out.append(
+                f"{self.name}: {', '.join(loose)} not determined by the data "
+                "(standard error above the value)"
+            )
+        f0 = self.model.derived().get("f0")
+        lo, hi = float(self.frequency[0]), float(self.frequency[-1])
+        if f0 is not None and not (lo / 10.0 <= f0 <= 10.0 * hi):
+            out.append(
+                f"{self.name}: f0 = {f0:.3g} Hz more than a decade outside the fitted band "
+                f"{lo:g}-{hi:g} Hz"
+            )
+        return out
 
     @property
     def name(self) -> str:
@@ -492,7 +545,7 @@ def fit_model(
     band: tuple[float, float] | None = None,
     weights: Weights | ArrayLike = "auto",
     start: ArrayLike | dict[str, float] | None = None,
-    channel: tuple[int, int] = (0, 0),
+    channel: tuple[int, int] | None = None,
     max_nfev: int = 2000,
 ) -> LateralFit:
     """Fit one lateral model to a measured complex FRF (module docstring for the method).
@@ -632,6 +685,9 @@ def _make_fit(
         nfev=int(res.nfev),
         message=str(res.message),
         label=d.label,
+        at_bound=tuple(
+            n for n, a in zip(cls.param_names, np.asarray(res.active_mask), strict=True) if a != 0
+        ),
     )
 
 
@@ -674,6 +730,26 @@ class Ranking:
     def best(self) -> LateralFit:
         """The best fit."""
         return self.fits[0]
+
+    def check(self) -> None:
+        """Raise :class:`ConvergenceError` when no model fits the data (a verdict, not a rank).
+
+        A fit fails when :meth:`LateralFit.problems` finds anything (a parameter at
+        the bound of the search, a parameter the data do not determine, ``f0``
+        a decade or more outside the fitted band). Ranking models that all fail says nothing.
+
+        Raises
+        ------
+        ConvergenceError
+            Every model failed; the message gives the best model's reasons.
+        """
+        if any(not f.problems() for f in self.fits):
+            return
+        why = "; ".join(self.best.problems())
+        raise ConvergenceError(
+            f"no model fits the data ({len(self.fits)} tried; best by "
+            f"{self.criterion.upper()}: {why})"
+        )
 
     @property
     def order(self) -> tuple[str, ...]:

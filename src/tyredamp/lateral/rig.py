@@ -297,12 +297,21 @@ class VirtualLateralRig:
     #: Conditions of the paper's experiment.
     SPEEDS_KMH: ClassVar[tuple[float, ...]] = (5.0, 10.0)
     PRESSURES_BAR: ClassVar[tuple[float, ...]] = (1.28, 1.7, 2.4)
+    #: Highest speed the rig accepts, km/h (above any road tyre's speed rating).
+    MAX_SPEED_KMH: ClassVar[float] = 400.0
+    #: Highest relative noise accepted (1000 % of the response).
+    MAX_RELATIVE_NOISE: ClassVar[float] = 10.0
 
     def __post_init__(self) -> None:
         for n in ("wheel_mass", "body_mass", "f_min", "f_max", "df"):
             object.__setattr__(self, n, check_positive(getattr(self, n), n))
         for n in ("relative_noise", "noise_floor"):
             object.__setattr__(self, n, check_positive(getattr(self, n), n, allow_zero=True))
+        if self.relative_noise > self.MAX_RELATIVE_NOISE:
+            raise InputError(
+                f"relative_noise: expected a value <= {self.MAX_RELATIVE_NOISE:g}, "
+                f"got {self.relative_noise:g}"
+            )
         if self.f_max <= self.f_min + self.df:
             raise InputError(f"f_max: expected > f_min + df, got {self.f_max:g}")
 
@@ -314,7 +323,12 @@ class VirtualLateralRig:
 
     def truth(self, speed_kmh: float, pressure_bar: float) -> ViscoelasticStringTyre:
         """The truth tyre model at a speed (km/h) and pressure (bar)."""
-        return self.tyre.model(check_positive(speed_kmh, "speed_kmh") * KMH, pressure_bar)
+        v = check_positive(speed_kmh, "speed_kmh")
+        if v > self.MAX_SPEED_KMH:
+            raise InputError(
+                f"speed_kmh: expected a speed <= {self.MAX_SPEED_KMH:g} km/h, got {v:g}"
+            )
+        return self.tyre.model(v * KMH, pressure_bar)
 
     def measure(
         self,

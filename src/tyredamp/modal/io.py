@@ -38,7 +38,7 @@ from typing import Any
 
 from .. import __version__
 from ..exceptions import FileFormatError, InputError
-from ..io.jsonfile import write_json
+from ..io.jsonfile import loads_json, write_json
 from .model import ModalModel
 
 __all__ = ["modes_document", "read_modes_json", "write_modes_json"]
@@ -124,7 +124,7 @@ def read_modes_json(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
     if not text.strip():
         raise FileFormatError(f"{p}: the file is empty")
     try:
-        doc = json.loads(text)
+        doc = loads_json(text, p)
     except json.JSONDecodeError as exc:
         raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
     if not isinstance(doc, dict) or doc.get("kind") != "modes":
@@ -138,7 +138,7 @@ def read_modes_json(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
             raise FileFormatError(f"{p}: models: unexpected entry {key!r}")
         try:
             mdl = ModalModel.from_dict(d)
-        except InputError as exc:
+        except (InputError, TypeError, ValueError, KeyError) as exc:
             raise FileFormatError(f"{p}: models[{key!r}]: {exc}") from None
         for extra in ("rmsd", "relative_error"):
             if extra in d and extra not in mdl.meta:

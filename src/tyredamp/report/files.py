@@ -22,7 +22,6 @@ A lateral file is drawn against its FRF file in the same way.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -100,10 +99,9 @@ def load_result_file(path: str | Path) -> ResultFile:
         raise FileFormatError(f"{p}: not a text (JSON) file") from None
     if not text.strip():
         raise FileFormatError(f"{p}: the file is empty")
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    from ..io.jsonfile import loads_json
+
+    doc = loads_json(text, p)
     if not isinstance(doc, dict):
         raise FileFormatError(f"{p}: expected a JSON object, got {type(doc).__name__}")
     kind = doc.get("kind")
