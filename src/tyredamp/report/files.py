@@ -22,8 +22,9 @@ A lateral file is drawn against its FRF file in the same way.
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -121,6 +122,11 @@ def load_result_file(path: str | Path) -> ResultFile:
             return ResultFile(p, "lateral", doc, doc)
     except KeyError as exc:
         raise FileFormatError(f"{p}: missing key {exc.args[0]!r}") from None
+    except (TypeError, ValueError, AttributeError, IndexError) as exc:
+        if isinstance(exc, TyredampError):
+            raise FileFormatError(f"{p}: {exc}") from None
+        name = type(exc).__name__
+        raise FileFormatError(f"{p}: a field has the wrong type ({name}: {exc})") from None
     except TyredampError as exc:
         if isinstance(exc, FileFormatError):
             raise
@@ -579,16 +585,32 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
             continue
         rep.heading(heading)
         for item in group:
-            if item.kind == "frf":
-                _frf_section(rep, item)
-            elif item.kind == "timedata":
-                _time_section(rep, item)
-            elif item.kind == "modes":
-                _modes_section(rep, item, frfs, truth)
-            elif item.kind == "damping":
-                _damping_section(rep, item)
-            elif item.kind == "lateral":
-                _lateral_section(rep, item, frfs)
-            else:
-                _demo_section(rep, item)
+            with _content_errors(item.path):
+                if item.kind == "frf":
+                    _frf_section(rep, item)
+                elif item.kind == "timedata":
+                    _time_section(rep, item)
+                elif item.kind == "modes":
+                    _modes_section(rep, item, frfs, truth)
+                elif item.kind == "damping":
+                    _damping_section(rep, item)
+                elif item.kind == "lateral":
+                    _lateral_section(rep, item, frfs)
+                else:
+                    _demo_section(rep, item)
     return rep.render()
+
+
+@contextlib.contextmanager
+def _content_errors(path: Path) -> Iterator[None]:
+    """A result JSON whose fields have the wrong type (strings for numbers, a number for a
+    list ...) is the file's fault: one FileFormatError naming it, not a traceback."""
+    try:
+        yield
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError) as exc:
+        if isinstance(exc, TyredampError):
+            raise FileFormatError(f"{path}: {exc}") from exc
+        name = type(exc).__name__
+        raise FileFormatError(
+            f"{path}: a field has the wrong type or value ({name}: {exc})"
+        ) from exc
