@@ -16,6 +16,7 @@ __all__ = [
     "EXIT_SIGINT",
     "EXIT_SIGTERM",
     "Interrupted",
+    "OutPath",
     "fail",
     "out_file_option",
     "seed_option",
@@ -50,6 +51,15 @@ def fail(message: str, code: int = EXIT_INPUT) -> NoReturn:
     sys.exit(code)
 
 
+class OutPath(click.Path):
+    """A click path for outputs: an empty string is refused (``Path('')`` would mean ``.``)."""
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, str) and value == "":
+            self.fail("empty path; expected a name", param, ctx)
+        return super().convert(value, param, ctx)
+
+
 def out_file_option(help_text: str) -> Callable[[F], F]:
     """The ``--out/-o FILE`` option (required) that every file-writing command shares."""
     return click.option(
@@ -57,7 +67,7 @@ def out_file_option(help_text: str) -> Callable[[F], F]:
         "-o",
         "out",
         required=True,
-        type=click.Path(dir_okay=False, path_type=Path),
+        type=OutPath(dir_okay=False, path_type=Path),
         help=help_text,
     )
 

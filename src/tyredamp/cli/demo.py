@@ -11,6 +11,8 @@ import click
 if TYPE_CHECKING:
     from ..demo import DemoResult
 
+from ._common import OutPath
+
 __all__ = ["demo_command", "demo_summary_rows"]
 
 
@@ -71,7 +73,7 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
     "out",
     default="tyredamp-demo",
     show_default=True,
-    type=click.Path(path_type=Path),
+    type=OutPath(path_type=Path),
     metavar="DIR",
     help="Directory to write (replaced only if empty or an earlier demo output).",
 )

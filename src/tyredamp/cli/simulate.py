@@ -19,7 +19,7 @@ from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
 from ..io._safety import atomic_paths, check_distinct, check_output_file
 from ..io.jsonfile import json_text
-from ._common import out_file_option, seed_option
+from ._common import OutPath, out_file_option, seed_option
 from .lateral import lateral_group
 
 __all__ = ["simulate_group"]
@@ -108,7 +108,7 @@ def simulate_group() -> None:
 @click.option(
     "--truth",
     "truth_out",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=OutPath(dir_okay=False, path_type=Path),
     help="Also write the exact modes of the tyre as a modes JSON (for tyredamp report).",
 )
 @click.option(

@@ -395,6 +395,12 @@ def atomic_paths(paths: Sequence[str | os.PathLike[str]]) -> Iterator[list[Path]
     try:
         for t in targets:
             if t.direct:
+                # a device is never renamed over: the data go to a private temporary
+                # first (formats such as NPZ need a seekable file) and are then copied
+                fd, name = tempfile.mkstemp(prefix="tyredamp-", suffix=".tmp")
+                os.close(fd)
+                t.tmp = Path(name)
+                names[name] = t.given
                 continue
             if not t.real.parent.is_dir():
                 t.real.parent.mkdir(parents=True, exist_ok=True)
@@ -404,9 +410,9 @@ def atomic_paths(paths: Sequence[str | os.PathLike[str]]) -> Iterator[list[Path]
             os.close(fd)
             t.tmp = tmp
             names[str(tmp)] = t.given
-        yield [t.real if t.direct or t.tmp is None else t.tmp for t in targets]
+        yield [t.real if t.tmp is None else t.tmp for t in targets]
         for t in targets:
-            if t.tmp is not None:
+            if t.tmp is not None and not t.direct:
                 _fsync_file(t.tmp)
                 _usual_mode(t.tmp)
         _commit(targets, names)
@@ -423,6 +429,8 @@ def _commit(targets: list[_Target], names: dict[str, str]) -> None:
     try:
         for t in targets:
             if t.tmp is None:
+                continue
+            if t.direct:
                 continue
             if len(targets) > 1 and os.path.lexists(t.real):
                 t.backup = t.real.parent / temp_name(t.real.name, "old")
@@ -454,6 +462,12 @@ def _commit(targets: list[_Target], names: dict[str, str]) -> None:
             with contextlib.suppress(OSError):
                 t.backup.unlink()
             t.backup = None
+    for t in targets:  # devices last: what is sent there cannot be taken back
+        if t.direct and t.tmp is not None:
+            with open(t.tmp, "rb") as src, open(t.real, "wb") as dst:
+                shutil.copyfileobj(src, dst)
+            t.tmp.unlink()
+            t.tmp = None
 
 
 def _cleanup(targets: list[_Target]) -> None:
