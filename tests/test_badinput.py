@@ -939,3 +939,21 @@ def test_interrupted(
     rc, err = _interrupt(tmp_path, argv, signum)
     check_one_error_line(err, rc, code, f"interrupted by {signal.Signals(signum).name}")
     assert snapshot(tmp_path) == before
+
+
+def test_readme_states_the_exit_codes() -> None:
+    """The README's exit-code table is the one cli.main uses."""
+    from tyredamp.cli import _common as c
+
+    text = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Safety", 1)[1].split("\n## ", 1)[0]
+    codes = {
+        int(x)
+        for row in section.splitlines()
+        if row.startswith("| ") and row[2].isdigit()
+        for x in row.split("|")[1].replace("/", " ").split()
+    }
+    expected = {0, 1, c.EXIT_INPUT, c.EXIT_RUNTIME, c.EXIT_INTERNAL, c.EXIT_SIGINT, c.EXIT_SIGTERM}
+    assert codes == expected
+    for promise in ("--out", "symbolic link", "hard link", "/dev/null", "SIGTERM", "--debug"):
+        assert promise in section
