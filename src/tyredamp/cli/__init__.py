@@ -73,6 +73,15 @@ def _register() -> None:
 _register()
 
 
+class _NeverRaised(Exception):
+    """Stand-in for exception classes an older click does not have."""
+
+
+
+#: raised by click >= 8.2 for a group called without a subcommand
+_NoArgsIsHelp: type[Exception] = getattr(click.exceptions, "NoArgsIsHelpError", _NeverRaised)
+
+
 def _install_signal_handlers() -> dict[int, Any]:
     """Make SIGINT and SIGTERM raise :class:`Interrupted` (cleanup runs); return the old ones."""
     if threading.current_thread() is not threading.main_thread():
@@ -145,7 +154,12 @@ def main(argv: list[str] | None = None) -> None:
         error = sys.exc_info()[1]
         name = signal.Signals(exc.signum).name
         code = EXIT_SIGTERM if exc.signum == signal.SIGTERM else EXIT_SIGINT
-        message = f"interrupted by {name}; nothing was written"
+        message = f"interrupted by {name}; no partial output left"
+    except _NoArgsIsHelp as exc:
+        # a group called without a subcommand: its help, as --help would show it
+        ctx = getattr(exc, "ctx", None)
+        click.echo(ctx.get_help() if ctx is not None else cli.get_help(click.Context(cli)))
+        code = 0
     except click.exceptions.Abort:
         error = sys.exc_info()[1]
         code, message = EXIT_SIGINT, "aborted"
