@@ -957,3 +957,20 @@ def test_readme_states_the_exit_codes() -> None:
     assert codes == expected
     for promise in ("--out", "symbolic link", "hard link", "/dev/null", "SIGTERM", "--debug"):
         assert promise in section
+
+
+def test_replaced_file_keeps_its_permissions(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A private earlier result stays private; a new file gets the usual mode (umask)."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.npz").write_bytes(b"old")
+    os.chmod(tmp_path / "s.npz", 0o600)
+    code, _, err = run_main(["lateral", "simulate", "-o", "s.npz"], capsys)
+    assert code == 0, err
+    assert stat.S_IMODE(os.stat(tmp_path / "s.npz").st_mode) == 0o600
+    umask = os.umask(0)
+    os.umask(umask)
+    code, _, err = run_main(["lateral", "simulate", "-o", "new.npz"], capsys)
+    assert code == 0, err
+    assert stat.S_IMODE(os.stat(tmp_path / "new.npz").st_mode) == 0o666 & ~umask

@@ -77,7 +77,6 @@ class _NeverRaised(Exception):
     """Stand-in for exception classes an older click does not have."""
 
 
-
 #: raised by click >= 8.2 for a group called without a subcommand
 _NoArgsIsHelp: type[Exception] = getattr(click.exceptions, "NoArgsIsHelpError", _NeverRaised)
 

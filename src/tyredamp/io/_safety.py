@@ -34,6 +34,7 @@ import os
 import re
 import secrets
 import shutil
+import signal
 import stat
 import tempfile
 import time
@@ -342,6 +343,39 @@ def _fsync_dir(p: Path) -> None:
             os.close(fd)
 
 
+@contextlib.contextmanager
+def _signals_blocked() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back while files are moved into place.
+
+    A signal between two renames would otherwise leave one target replaced and
+    its backup gone; held back, it arrives when every target is in place.
+    """
+    sigs = {signal.SIGINT, signal.SIGTERM}
+    try:
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, sigs)
+    except (AttributeError, OSError, ValueError):  # pragma: no cover - not POSIX
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+def _keep_mode(tmp: Path, target: Path) -> None:
+    """Give ``tmp`` the mode of the file it replaces (a private file stays private),
+    else the usual mode for a new file."""
+    try:
+        st = os.stat(target)
+    except OSError:
+        _usual_mode(tmp)
+        return
+    if stat.S_ISREG(st.st_mode):
+        os.chmod(tmp, stat.S_IMODE(st.st_mode))
+    else:
+        _usual_mode(tmp)
+
+
 def _usual_mode(p: Path, directory: bool = False) -> None:
     umask = os.umask(0)
     os.umask(umask)
@@ -414,8 +448,9 @@ def atomic_paths(paths: Sequence[str | os.PathLike[str]]) -> Iterator[list[Path]
         for t in targets:
             if t.tmp is not None and not t.direct:
                 _fsync_file(t.tmp)
-                _usual_mode(t.tmp)
-        _commit(targets, names)
+                _keep_mode(t.tmp, t.real)
+        with _signals_blocked():
+            _commit(targets, names)
     except OSError as exc:
         _cleanup(targets)
         raise _rename_error(exc, names) from None
@@ -517,17 +552,18 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
             for d in dirnames:
                 _usual_mode(Path(dirpath) / d, directory=True)
         _usual_mode(tmp, directory=True)
-        if not os.path.lexists(real):
-            os.replace(tmp, real)
-        else:
-            old = real.parent / temp_name(real.name, "old")
-            os.replace(real, old)
-            try:
+        with _signals_blocked():
+            if not os.path.lexists(real):
                 os.replace(tmp, real)
-            except BaseException:
-                os.replace(old, real)
-                raise
-            shutil.rmtree(old, ignore_errors=True)
+            else:
+                old = real.parent / temp_name(real.name, "old")
+                os.replace(real, old)
+                try:
+                    os.replace(tmp, real)
+                except BaseException:
+                    os.replace(old, real)
+                    raise
+                shutil.rmtree(old, ignore_errors=True)
         _fsync_dir(real.parent)
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
