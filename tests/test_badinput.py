@@ -364,6 +364,11 @@ def _modes_variant(doc: dict[str, Any], how: str) -> dict[str, Any]:
             md["pole"] = ["a", "b"]
     elif how == "shape-huge":
         m["modes"][0]["shape"] = [[1e300, 1e300]] * len(m["modes"][0]["shape"])
+    elif how == "shape-tiny":
+        for md in m["modes"]:
+            md["shape"] = [[1e-300, 1e-300]] * len(md["shape"])
+    elif how == "pole-huge":
+        m["modes"][0]["pole"] = [-1e300, 1e300]
     elif how == "modes-not-list":
         m["modes"] = 5
     elif how == "wrong-kind":
@@ -394,7 +399,21 @@ def json_cases(lib_files: dict[str, bytes]) -> list[Case]:
             EXIT_INPUT,
             "shapes",
             {"x.json": json.dumps(_modes_variant(modes, "shape-huge")).encode()},
-        )
+        ),
+        Case(
+            "damping-json-modes-shape-tiny",
+            ["damping", "x.json", "-o", "d.json", "--samples", "0"],
+            EXIT_INPUT,
+            "modal masses",
+            {"x.json": json.dumps(_modes_variant(modes, "shape-tiny")).encode()},
+        ),
+        Case(
+            "damping-json-modes-pole-huge",
+            ["damping", "x.json", "-o", "d.json", "--samples", "0"],
+            EXIT_INPUT,
+            "poles",
+            {"x.json": json.dumps(_modes_variant(modes, "pole-huge")).encode()},
+        ),
     ]
     for name, (content, needle) in bad.items():
         cases.append(
