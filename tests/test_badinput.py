@@ -389,6 +389,7 @@ def json_cases(lib_files: dict[str, bytes]) -> list[Case]:
         "empty-object": (b"{}", "x.json"),
         "whitespace": (b"   \n\n", "empty"),
         "nan-literal": (b'{"kind": "modes", "models": NaN}', "x.json"),
+        "int-of-5000-digits": (b'{"kind": "modes", "models": ' + b"9" * 5000 + b"}", "x.json"),
     }
     for how in ("pole-strings", "modes-not-list", "wrong-kind", "no-models"):
         bad[f"modes-{how}"] = (json.dumps(_modes_variant(modes, how)).encode(), "x.json")
@@ -993,3 +994,18 @@ def test_replaced_file_keeps_its_permissions(
     code, _, err = run_main(["lateral", "simulate", "-o", "new.npz"], capsys)
     assert code == 0, err
     assert stat.S_IMODE(os.stat(tmp_path / "new.npz").st_mode) == 0o666 & ~umask
+
+
+def test_npz_larger_than_memory_is_refused_before_unpacking(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A compressed NPZ that unpacks beyond the memory available (a zip bomb) is refused."""
+    import tyredamp.io.npz as npz_mod
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "x.npz").write_bytes(frf_npz())
+    before = snapshot(tmp_path)
+    monkeypatch.setattr(npz_mod, "_available_memory", lambda: 1000)  # bytes
+    code, _, err = run_main(["modal", "x.npz", "-o", "m.json"], capsys)
+    check_one_error_line(err, code, EXIT_INPUT, "memory available")
+    assert snapshot(tmp_path) == before

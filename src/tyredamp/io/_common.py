@@ -105,6 +105,8 @@ def meta_from_json(text: str, where: str) -> dict[str, Any]:
         raise FileFormatError(f"{where}: invalid JSON ({exc})") from None
     except RecursionError:
         raise FileFormatError(f"{where}: JSON nested too deeply") from None
+    except ValueError as exc:  # for example an integer of more than 4300 digits
+        raise FileFormatError(f"{where}: invalid JSON ({exc})") from None
     if not isinstance(out, dict):
         raise FileFormatError(f"{where}: expected a JSON object, got {type(out).__name__}")
     return out

@@ -66,6 +66,8 @@ def loads_json(text: str, where: str | os.PathLike[str]) -> Any:
         ) from None
     except RecursionError:
         raise FileFormatError(f"{os.fspath(where)}: JSON nested too deeply") from None
+    except ValueError as exc:  # for example an integer of more than 4300 digits
+        raise FileFormatError(f"{os.fspath(where)}: not valid JSON ({exc})") from None
 
 
 def read_json(path: str | os.PathLike[str]) -> Any:

@@ -85,8 +85,11 @@ def _check_members(p: os.PathLike[str]) -> None:
     """Refuse members whose .npy header claims more data than the archive holds.
 
     A hostile or corrupt header (``shape`` of 1e12 elements) would otherwise
-    make NumPy allocate that much memory before noticing the data is missing.
+    make NumPy allocate that much memory before noticing the data is missing;
+    a compressed archive that unpacks to more than the memory available (a
+    "zip bomb") is refused before it is unpacked.
     """
+    total = 0
     with zipfile.ZipFile(p) as zf:
         for info in zf.infolist():
             if not info.filename.endswith(".npy"):
@@ -105,6 +108,25 @@ def _check_members(p: os.PathLike[str]) -> None:
                     f"{p}: {info.filename}: header claims shape {shape} ({need} bytes) but the "
                     f"archive holds {info.file_size} bytes; the file is corrupt"
                 )
+            total += need
+    avail = _available_memory()
+    if avail is not None and total > avail:
+        raise InputError(
+            f"{p}: its arrays take {total / 1e9:.3g} GB unpacked, more than the "
+            f"{avail / 1e9:.3g} GB of memory available"
+        )
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available to a new allocation (Linux ``MemAvailable``), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
 
 
 def _check_header(p: os.PathLike[str], head: dict[str, Any]) -> None:
@@ -148,7 +170,7 @@ def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
                 )
             head = meta_from_json(str(h[()]), f"{p}: header")
             arrays = {k: z[k] for k in z.files if k != "header"}
-    except FileFormatError:
+    except (FileFormatError, InputError):
         raise
     except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError) as exc:
         raise FileFormatError(f"{p}: not a readable NPZ file ({exc})") from None
