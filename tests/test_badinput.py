@@ -1009,3 +1009,45 @@ def test_npz_larger_than_memory_is_refused_before_unpacking(
     code, _, err = run_main(["modal", "x.npz", "-o", "m.json"], capsys)
     check_one_error_line(err, code, EXIT_INPUT, "memory available")
     assert snapshot(tmp_path) == before
+
+
+def test_matplotlib_config_is_private(monkeypatch: pytest.MonkeyPatch) -> None:
+    """demo and report point MPLCONFIGDIR at a temporary directory (not the user's home)
+    when it is unset and matplotlib is not loaded yet; a user's own setting is kept."""
+    monkeypatch.delenv("MPLCONFIGDIR", raising=False)
+    monkeypatch.delitem(sys.modules, "matplotlib", raising=False)
+    with safety.private_matplotlib_config():
+        d = os.environ["MPLCONFIGDIR"]
+        assert Path(d).is_dir()
+        assert not Path(d).is_relative_to(Path.home())
+    assert "MPLCONFIGDIR" not in os.environ
+    assert not Path(d).exists()
+    monkeypatch.setenv("MPLCONFIGDIR", "/somewhere/of/mine")
+    with safety.private_matplotlib_config():
+        assert os.environ["MPLCONFIGDIR"] == "/somewhere/of/mine"
+
+
+def test_fsync_before_rename(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The temporary is flushed to disk before it is renamed onto the target."""
+    events: list[tuple[str, str]] = []
+    real_fsync, real_replace = safety._fsync_file, os.replace
+
+    def fsync(p: Path) -> None:
+        events.append(("fsync", str(p)))
+        real_fsync(p)
+
+    def replace(src: Any, dst: Any, **kw: Any) -> None:
+        events.append(("replace", str(src)))
+        real_replace(src, dst, **kw)
+
+    monkeypatch.setattr(safety, "_fsync_file", fsync)
+    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_main(["lateral", "simulate", "-o", "s.npz"], capsys)
+    assert code == 0, err
+    renamed = [p for e, p in events if e == "replace" and ".s.npz.tyredamp-" in p]
+    assert renamed
+    for p in renamed:
+        assert events.index(("fsync", p)) < events.index(("replace", p))
