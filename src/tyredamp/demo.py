@@ -3,15 +3,15 @@
 :func:`run_demo` runs, in memory and without printing:
 
 * the **radial study** (paper 000, spec ``radial-damping.md``) on the virtual
-  truck tyre (:class:`~tyredamp.tyre.RingTyre`): the modal test with a
+  truck tyre (:class:`~tyredamp.virtual.RingTyre`): the modal test with a
   periodic chirp at the main pressure (7.5 bar) and at further pressures,
   FRFs (H1, cyclic), a linearity check at two force levels, a reciprocity
   check with two drive points, a data-quality check, the real-mode (eq.
   [2]/[3]) and complex-mode (eq. [10]) fits with their RMSD (eq. [19]) and
   the damping identification (eq. [14]-[18]); every identified value is
-  paired with the exact value of the tyre (:class:`~tyredamp.tyre.TyreTruth`);
+  paired with the exact value of the tyre (:class:`~tyredamp.virtual.TyreTruth`);
 * the **lateral study** (paper 001, spec ``lateral-models.md``) on the
-  virtual rolling-tyre rig (:class:`~tyredamp.lateral.VirtualLateralRig`):
+  virtual rolling-tyre rig (:class:`~tyredamp.virtual.VirtualLateralRig`):
   ground- and axle-force FRFs at both speeds and the three pressures, every
   model fitted to the ground-force FRF and ranked, axle-force predictions,
   the corner frequency of the proposed model (eq. 38-40), the single-DOF
@@ -61,19 +61,18 @@ from .lateral import (
     LateralVehicle,
     Ranking,
     Resonance,
-    VirtualLateralRig,
     causal_error,
     figure7_curves,
     harmonic_response,
     rank_models,
 )
-from .lateral.rig import ViscoelasticStringTyre
 from .modal.identify import ModalIdentification, identify_modes
 from .modal.model import ModalModel
 from .signal import CheckResult, estimate_frf, linearity_check, quality_check, reciprocity_check
 from .timedata import TimeData
-from .tyre import MeasurementLayout, RingTyre, RingTyreParameters, TyreTruth, run_modal_test
-from .tyre.rig import VirtualModalTest
+from .virtual import MeasurementLayout, RingTyre, RingTyreParameters, TyreTruth, run_modal_test
+from .virtual.lateral_rig import VirtualLateralRig, ViscoelasticStringTyre
+from .virtual.modal_rig import VirtualModalTest
 
 __all__ = [
     "DEMO_MARKER",

@@ -5,7 +5,7 @@
 hysteretic) to the lateral accelerance in ``FRF_FILE`` (UFF, CSV or NPZ, read
 with :func:`tyredamp.io.read_frf`), prints the ranking table and writes the
 JSON below. ``tyredamp lateral simulate --out FILE`` writes a noisy FRF of the
-virtual rolling-tyre rig (:mod:`tyredamp.lateral.rig`) with
+virtual rolling-tyre rig (:mod:`tyredamp.virtual.lateral_rig`) with
 :func:`tyredamp.io.write_frf`; its ``meta`` carries the speed, force and
 wheel mass, which ``fit`` uses when the options are not given.
 
@@ -47,7 +47,7 @@ from ..io._atomic import atomic_path
 from ..io.jsonfile import json_text
 from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
 from ..lateral.models import MODELS, get_model_class
-from ..lateral.rig import KMH, VirtualLateralRig
+from ..virtual.lateral_rig import KMH, VirtualLateralRig
 from ._common import out_file_option, seed_option
 
 __all__ = ["lateral_group"]
@@ -254,7 +254,7 @@ def simulate_command(
     """Write the lateral accelerance FRF of the virtual rolling-tyre rig.
 
     The truth is a viscoelastic stretched-string tyre with contact length and
-    a 100 kg wheel (see tyredamp.lateral.rig); the FRF covers 0.25-9 Hz.
+    a 100 kg wheel (see tyredamp.virtual.lateral_rig); the FRF covers 0.25-9 Hz.
 
     \b
     Example:

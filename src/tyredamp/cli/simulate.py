@@ -1,7 +1,7 @@
 """``tyredamp simulate``: test data from the virtual rigs, for the other commands.
 
 ``simulate radial`` runs the virtual modal test of the truck tyre
-(:func:`tyredamp.tyre.run_modal_test`) and writes its time data (UFF 58
+(:func:`tyredamp.virtual.run_modal_test`) and writes its time data (UFF 58
 function type 1) or, with ``--frf``, the H1 FRFs estimated from it (function
 type 4); ``--truth`` also writes the exact modes as a modes JSON file.
 ``simulate lateral`` is the rolling-tyre rig; it is the same command as
@@ -144,7 +144,7 @@ def radial_command(
     from ..demo import single_threaded_blas
     from ..modal.io import modes_document
     from ..signal import estimate_frf
-    from ..tyre import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
+    from ..virtual import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
 
     if truth_out is not None and truth_out.resolve() == out.resolve():
         raise InputError("--truth: expected another file than --out")

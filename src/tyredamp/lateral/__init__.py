@@ -12,7 +12,8 @@
 * :mod:`.timedomain` -- exact harmonic/periodic steady states, impulse
   response and non-causal precursor, causal generalised-Maxwell approximation
   and exact state-space transients.
-* :mod:`.rig` -- the virtual rolling-tyre rig.
+
+The virtual rolling-tyre rig is :mod:`tyredamp.virtual.lateral_rig`.
 """
 
 from __future__ import annotations
@@ -52,7 +53,6 @@ from .models import (
     get_model_class,
     ground_from_axle_accelerance,
 )
-from .rig import AgriculturalTyre, VirtualLateralRig, ViscoelasticStringTyre
 from .timedomain import (
     CausalError,
     GeneralizedMaxwellTyre,
@@ -70,7 +70,6 @@ from .vehicle import LateralVehicle, Resonance
 __all__ = [
     "DEFAULT_MODELS",
     "MODELS",
-    "AgriculturalTyre",
     "CausalError",
     "ClassicModel",
     "CornerDifferences",
@@ -88,9 +87,7 @@ __all__ = [
     "RelaxationLengthModel",
     "Resonance",
     "StretchedStringModel",
-    "VirtualLateralRig",
     "ViscoPlasticModel",
-    "ViscoelasticStringTyre",
     "attach_mass",
     "axle_from_ground_accelerance",
     "causal_error",

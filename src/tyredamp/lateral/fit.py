@@ -144,7 +144,7 @@ class LateralData:
         """Build from an FRF, taking missing conditions from ``frf.meta``.
 
         Meta keys read: ``"speed_m_s"``, ``"force"``, ``"wheel_mass_kg"``,
-        ``"label"`` (as written by :mod:`tyredamp.lateral.rig`).
+        ``"label"`` (as written by :mod:`tyredamp.virtual.lateral_rig`).
         """
         meta = frf.meta
         sp = speed if speed is not None else meta.get("speed_m_s")
@@ -1036,7 +1036,7 @@ def fit_by_pressure(
     ----------
     data : sequence of LateralData
         Measurements whose ``frf.meta["pressure_bar"]`` gives the pressure (as
-        written by :mod:`tyredamp.lateral.rig`); at least two speeds per
+        written by :mod:`tyredamp.virtual.lateral_rig`); at least two speeds per
         pressure.
     model : str or LateralModel subclass
     **joint_kwargs

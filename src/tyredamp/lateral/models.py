@@ -787,7 +787,7 @@ def string_impedance(
     ``a = 0`` gives the first-order relaxation model exactly.
 
     ``c_c`` and ``sigma`` may be complex arrays of ``omega``'s shape (the
-    viscoelastic string of :mod:`tyredamp.lateral.rig`).
+    viscoelastic string of :mod:`tyredamp.virtual.lateral_rig`).
 
     Parameters
     ----------

@@ -479,7 +479,7 @@ def _num(v: Any) -> float:
 def _rig_truth(meta: dict[str, Any]) -> Any:
     """The exact tyre model a virtual lateral rig stored in an FRF's meta, or None."""
     from ..lateral.models import LateralModel
-    from ..lateral.rig import ViscoelasticStringTyre
+    from ..virtual.lateral_rig import ViscoelasticStringTyre
 
     d = meta.get("truth")
     if not isinstance(d, dict) or "params" not in d:
