@@ -18,8 +18,8 @@ from numpy.testing import assert_allclose
 from threadpoolctl import threadpool_limits
 
 from tyredamp.cli import main
+from tyredamp.documents.modes import read_modes_json
 from tyredamp.io import read_frf, read_timedata
-from tyredamp.modal.io import read_modes_json
 
 
 @pytest.fixture(scope="module", autouse=True)

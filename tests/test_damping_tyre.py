@@ -32,9 +32,9 @@ from numpy.testing import assert_allclose
 
 from tyredamp.cli import main
 from tyredamp.damping import DampingModel, identify_damping
+from tyredamp.documents.modes import write_modes_json
 from tyredamp.modal import ModalModel
 from tyredamp.modal.identify import identify_modes
-from tyredamp.modal.io import write_modes_json
 from tyredamp.signal.estimators import estimate_frf
 from tyredamp.virtual import RingTyre, TyreTruth, VirtualModalTest, run_modal_test
 

@@ -13,16 +13,16 @@ from numpy.testing import assert_allclose
 
 from tyredamp import Channel
 from tyredamp.damping import identify_damping
+from tyredamp.documents.modes import modes_document
 from tyredamp.exceptions import FileFormatError, InputError
 from tyredamp.io import write_frf, write_timedata
 from tyredamp.mechanics import time_response
 from tyredamp.modal import ModalModel
-from tyredamp.modal.io import modes_document
 from tyredamp.plot import plot_lateral_models, plot_stabilisation
 from tyredamp.report.build import fmt_pm
 from tyredamp.report.files import build_files_report, load_result_file
 from tyredamp.report.html import HtmlReport
-from tyredamp.results import finite
+from tyredamp.studies.document import finite
 from tyredamp.timedata import TimeData
 
 from .helpers import chain_system

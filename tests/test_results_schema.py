@@ -12,9 +12,9 @@ import jsonschema
 import pytest
 
 from tyredamp.exceptions import InputError
-from tyredamp.results import build_results, finite, load_schema, validate_results
+from tyredamp.studies.document import build_results, finite, load_schema, validate_results
 
-from .test_demo import quick_demo
+from .test_studies_demo import quick_demo
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 

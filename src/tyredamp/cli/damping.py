@@ -3,7 +3,7 @@
 Reads a modes JSON file (``{"kind": "modes", "models": {"complex": {...},
 "real": {...}}}``, each model in the layout of
 :meth:`tyredamp.modal.ModalModel.to_dict`; read by
-:func:`tyredamp.modal.io.read_modes_json`), identifies the damping with
+:func:`tyredamp.documents.modes.read_modes_json`), identifies the damping with
 :func:`tyredamp.damping.identify_damping` and writes a damping JSON file.
 
 Damping JSON schema (``"kind": "damping"``, ``"version": 1``; full
@@ -32,10 +32,10 @@ import click
 import numpy as np
 
 from ..damping import METHODS, DampingModel, identify_damping
+from ..documents.jsonfile import write_json
+from ..documents.modes import read_modes_json
 from ..exceptions import InputError
 from ..io._common import check_input_file
-from ..io.jsonfile import write_json
-from ..modal.io import read_modes_json
 from ._common import out_file_option, seed_option
 
 __all__ = ["damping_command", "damping_summary"]

@@ -41,10 +41,10 @@ from pathlib import Path
 
 import click
 
+from ..documents.jsonfile import json_text
 from ..exceptions import InputError
 from ..io import FORMATS, read_frf, write_frf
 from ..io._atomic import atomic_path
-from ..io.jsonfile import json_text
 from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
 from ..lateral.models import MODELS, get_model_class
 from ..virtual.lateral_rig import KMH, VirtualLateralRig

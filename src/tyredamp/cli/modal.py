@@ -7,10 +7,10 @@ from pathlib import Path
 import click
 import numpy as np
 
+from ..documents.modes import write_modes_json
 from ..exceptions import InputError
 from ..io import read_frf
 from ..modal.identify import ModalIdentification, identify_modes
-from ..modal.io import write_modes_json
 from ..modal.model import ModalModel
 from ._common import out_file_option
 

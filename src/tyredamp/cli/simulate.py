@@ -16,10 +16,10 @@ from typing import Any
 
 import click
 
+from ..documents.jsonfile import json_text
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
 from ..io._atomic import atomic_path
-from ..io.jsonfile import json_text
 from ._common import out_file_option, seed_option
 from .lateral import lateral_group
 
@@ -141,9 +141,9 @@ def radial_command(
       tyredamp simulate radial --out tyre_frf.uff --frf --pressure 9 --snr 30 --seed 2
       tyredamp simulate radial --out mimo.uff --drive-points 1,5 --periods 4
     """
-    from ..demo import single_threaded_blas
-    from ..modal.io import modes_document
+    from ..documents.modes import modes_document
     from ..signal import estimate_frf
+    from ..studies.demo import single_threaded_blas
     from ..virtual import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
 
     if truth_out is not None and truth_out.resolve() == out.resolve():

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from ._atomic import atomic_path
+from ..io._atomic import atomic_path
 
 __all__ = ["finite", "json_text", "write_json"]
 

@@ -37,9 +37,9 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__
+from ..documents.jsonfile import write_json
 from ..exceptions import FileFormatError, InputError
-from ..io.jsonfile import write_json
-from .model import ModalModel
+from ..modal.model import ModalModel
 
 __all__ = ["modes_document", "read_modes_json", "write_modes_json"]
 

@@ -1,8 +1,8 @@
 """The demo's HTML report: results and figures into one self-contained page.
 
 :func:`build_demo_report` lays out the page from a
-:class:`~tyredamp.demo.DemoResult`, its results document
-(:func:`tyredamp.results.build_results`) and the rendered figures
+:class:`~tyredamp.studies.demo.DemoResult`, its results document
+(:func:`tyredamp.studies.document.build_results`) and the rendered figures
 (:func:`tyredamp.report.figures.demo_figures`). Sections: summary, inputs and
 settings, the radial study (checks, stabilisation, modes with standard errors
 beside the truth, real against complex fit, mode shapes, damping matrices with
@@ -22,7 +22,7 @@ from .. import __version__
 from .html import HtmlReport
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult
+    from ..studies.demo import DemoResult
 
 __all__ = ["SECTIONS", "build_demo_report", "fmt_pm"]
 
@@ -509,7 +509,7 @@ def build_demo_report(
     ----------
     result : DemoResult
     doc : dict
-        Its results document (:func:`tyredamp.results.build_results`).
+        Its results document (:func:`tyredamp.studies.document.build_results`).
     images : mapping of str to (bytes, str)
         PNG bytes and caption of each figure by name
         (:func:`tyredamp.report.figures.demo_figures`).

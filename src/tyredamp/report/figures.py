@@ -1,4 +1,4 @@
-"""The figures of the demo report, built from a :class:`~tyredamp.demo.DemoResult`.
+"""The figures of the demo report, built from a :class:`~tyredamp.studies.demo.DemoResult`.
 
 :func:`demo_figures` returns ``{name: (Figure, caption)}`` in report order;
 names are the PNG file stems (``fig02_real_fit`` ... ``fig15_time_response``;
@@ -27,8 +27,8 @@ from ..plot import (
 from ..plot.comparison import model_color
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult, LateralCondition
     from ..lateral.models import ForceKind
+    from ..studies.demo import DemoResult, LateralCondition
 
 __all__ = ["PAPER_MODELS", "demo_figures"]
 

@@ -109,7 +109,7 @@ def load_result_file(path: str | Path) -> ResultFile:
     kind = doc.get("kind")
     try:
         if kind == "modes":
-            from ..modal.io import read_modes_json
+            from ..documents.modes import read_modes_json
 
             return ResultFile(p, "modes", read_modes_json(p), doc)
         if kind == "damping":
@@ -215,7 +215,7 @@ def _time_section(rep: HtmlReport, item: ResultFile) -> None:
 
 
 def _match(freq: np.ndarray, ref: np.ndarray) -> dict[int, int]:
-    from ..demo import match_modes
+    from ..studies.demo import match_modes
 
     return {m: t for t, m in match_modes(freq, ref).matched}
 

@@ -48,12 +48,12 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
-from . import __version__
-from .damping import DampingModel, identify_damping
-from .exceptions import InputError
-from .frf import FRF
-from .io.jsonfile import json_text
-from .lateral import (
+from .. import __version__
+from ..damping import DampingModel, identify_damping
+from ..documents.jsonfile import json_text
+from ..exceptions import InputError
+from ..frf import FRF
+from ..lateral import (
     DEFAULT_MODELS,
     CausalError,
     Figure7Curves,
@@ -66,13 +66,13 @@ from .lateral import (
     harmonic_response,
     rank_models,
 )
-from .modal.identify import ModalIdentification, identify_modes
-from .modal.model import ModalModel
-from .signal import CheckResult, estimate_frf, linearity_check, quality_check, reciprocity_check
-from .timedata import TimeData
-from .virtual import MeasurementLayout, RingTyre, RingTyreParameters, TyreTruth, run_modal_test
-from .virtual.lateral_rig import VirtualLateralRig, ViscoelasticStringTyre
-from .virtual.modal_rig import VirtualModalTest
+from ..modal.identify import ModalIdentification, identify_modes
+from ..modal.model import ModalModel
+from ..signal import CheckResult, estimate_frf, linearity_check, quality_check, reciprocity_check
+from ..timedata import TimeData
+from ..virtual import MeasurementLayout, RingTyre, RingTyreParameters, TyreTruth, run_modal_test
+from ..virtual.lateral_rig import VirtualLateralRig, ViscoelasticStringTyre
+from ..virtual.modal_rig import VirtualModalTest
 
 __all__ = [
     "DEMO_MARKER",
@@ -649,7 +649,7 @@ def _compare_damping(run: PressureRun, dm: DampingModel) -> DampingComparison:
 
 
 def _resonance(vehicle: LateralVehicle) -> Resonance | None:
-    from .exceptions import PhysicsError
+    from ..exceptions import PhysicsError
 
     try:
         return vehicle.resonance((0.3, 20.0))
@@ -867,11 +867,11 @@ def save_demo(
 def _save(
     result: DemoResult, out: Path, progress: ProgressCallback | None, dpi: int
 ) -> dict[str, Path]:
-    from .io import write_frf, write_timedata
-    from .modal.io import modes_document
-    from .report.build import build_demo_report
-    from .report.figures import demo_figures
-    from .results import build_results
+    from ..documents.modes import modes_document
+    from ..io import write_frf, write_timedata
+    from ..report.build import build_demo_report
+    from ..report.figures import demo_figures
+    from .document import build_results
 
     check_output_dir(out)
     parent = out.resolve().parent

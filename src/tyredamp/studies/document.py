@@ -1,4 +1,4 @@
-"""The demo's ``results.json``: assembly from a :class:`~tyredamp.demo.DemoResult` and its schema.
+"""The demo's ``results.json``: assembly from a :class:`~.demo.DemoResult` and its schema.
 
 The document (``"kind": "tyredamp-demo-results"``, ``"version": 1``) holds
 the settings, the radial study at the main pressure (RMSD of the real and
@@ -23,13 +23,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import __version__
-from .exceptions import InputError
-from .io.jsonfile import finite
+from .. import __version__
+from ..documents.jsonfile import finite
+from ..exceptions import InputError
 
 if TYPE_CHECKING:
+    from ..lateral.fit import LateralFit
     from .demo import DemoResult, LateralCondition, PressureRun
-    from .lateral.fit import LateralFit
 
 __all__ = [
     "RESULTS_KIND",
@@ -252,7 +252,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     dict
         Valid against :func:`load_schema` (checked in the tests).
     """
-    from .lateral.characteristics import corner_differences
+    from ..lateral.characteristics import corner_differences
 
     s = result.settings
     r = result.radial

@@ -1,0 +1,1 @@
+"""Result documents: modes, damping, lateral fit, demo results."""
