@@ -13,6 +13,7 @@ from numpy.testing import assert_allclose
 
 from tyredamp import Channel
 from tyredamp.damping import identify_damping
+from tyredamp.documents.jsonfile import finite
 from tyredamp.documents.modes import modes_document
 from tyredamp.exceptions import FileFormatError, InputError
 from tyredamp.io import write_frf, write_timedata
@@ -22,7 +23,6 @@ from tyredamp.plot import plot_lateral_models, plot_stabilisation
 from tyredamp.report.build import fmt_pm
 from tyredamp.report.files import build_files_report, load_result_file
 from tyredamp.report.html import HtmlReport
-from tyredamp.studies.document import finite
 from tyredamp.timedata import TimeData
 
 from .helpers import chain_system

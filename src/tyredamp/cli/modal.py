@@ -10,8 +10,9 @@ import numpy as np
 from ..documents.modes import write_modes_json
 from ..exceptions import InputError
 from ..io import read_frf
-from ..modal.identify import ModalIdentification, identify_modes
+from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
+from ..studies.radial import modes_from_frf
 from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
@@ -110,7 +111,7 @@ def modal_command(
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
     frf = read_frf(frf_file)
-    res: ModalIdentification = identify_modes(
+    res: ModalIdentification = modes_from_frf(
         frf,
         band=None if band is None else (float(band[0]), float(band[1])),
         model=model,  # type: ignore[arg-type]

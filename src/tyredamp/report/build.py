@@ -22,7 +22,7 @@ from .. import __version__
 from .html import HtmlReport
 
 if TYPE_CHECKING:
-    from ..studies.demo import DemoResult
+    from ..studies.results import DemoResult
 
 __all__ = ["SECTIONS", "build_demo_report", "fmt_pm"]
 

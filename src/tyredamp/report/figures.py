@@ -28,7 +28,7 @@ from ..plot.comparison import model_color
 
 if TYPE_CHECKING:
     from ..lateral.models import ForceKind
-    from ..studies.demo import DemoResult, LateralCondition
+    from ..studies.results import DemoResult, LateralCondition
 
 __all__ = ["PAPER_MODELS", "demo_figures"]
 

@@ -22,7 +22,6 @@ A lateral file is drawn against its FRF file in the same way.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -94,43 +93,19 @@ def load_result_file(path: str | Path) -> ResultFile:
             f"{p}: unknown file extension {p.suffix or '(none)'!r}; expected .json (modes, "
             f"damping, lateral fit, demo results) or {', '.join(_DATA_EXT)} (FRF, time data)"
         )
-    try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise FileFormatError(f"{p}: not a text (JSON) file") from None
-    if not text.strip():
-        raise FileFormatError(f"{p}: the file is empty")
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    if not isinstance(doc, dict):
-        raise FileFormatError(f"{p}: expected a JSON object, got {type(doc).__name__}")
-    kind = doc.get("kind")
-    try:
-        if kind == "modes":
-            from ..documents.modes import read_modes_json
+    from ..documents import read_document
 
-            return ResultFile(p, "modes", read_modes_json(p), doc)
-        if kind == "damping":
-            from ..damping import DampingModel
-
-            return ResultFile(p, "damping", DampingModel.from_dict(doc), doc)
-        if kind == "tyredamp-demo-results":
-            return ResultFile(p, "demo", doc, doc)
-        if doc.get("tyredamp") == "lateral-fit":
-            _ = doc["table"], doc["fits"], doc["conditions"]
-            return ResultFile(p, "lateral", doc, doc)
-    except KeyError as exc:
-        raise FileFormatError(f"{p}: missing key {exc.args[0]!r}") from None
-    except TyredampError as exc:
-        if isinstance(exc, FileFormatError):
+    try:
+        kind, obj, doc = read_document(p)
+    except FileFormatError as exc:
+        if "not a tyredamp result document" not in str(exc):
             raise
-        raise FileFormatError(f"{p}: {exc}") from None
-    raise FileFormatError(
-        f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
-        f"results JSON, or an FRF/time-data file {', '.join(_DATA_EXT)})"
-    )
+        raise FileFormatError(
+            f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
+            f"results JSON, or an FRF/time-data file {', '.join(_DATA_EXT)})"
+        ) from None
+    short = {"lateral-fit": "lateral", "tyredamp-demo-results": "demo"}.get(kind, kind)
+    return ResultFile(p, short, obj, doc)
 
 
 # ----------------------------------------------------------------------------- sections
@@ -215,7 +190,7 @@ def _time_section(rep: HtmlReport, item: ResultFile) -> None:
 
 
 def _match(freq: np.ndarray, ref: np.ndarray) -> dict[int, int]:
-    from ..studies.demo import match_modes
+    from ..studies.radial import match_modes
 
     return {m: t for t, m in match_modes(freq, ref).matched}
 

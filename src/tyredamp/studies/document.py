@@ -9,41 +9,28 @@ model and the time test). SI units unless a key says otherwise (``_hz``,
 ``_bar``, ``_kmh``, ``_pct``); non-finite numbers are written as ``null``.
 The layout is described key by key in the README ("results.json") and
 formally in ``tyredamp/schemas/results.schema.json`` (JSON Schema draft
-2020-12), which :func:`validate_results` applies. jsonschema is needed only
-for validation (a test dependency), never to write the file.
+2020-12), which :func:`tyredamp.documents.demo.validate_results` applies;
+reading and writing the file is :mod:`tyredamp.documents.demo`.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
-from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .. import __version__
+from ..documents.demo import RESULTS_KIND, RESULTS_VERSION
 from ..documents.jsonfile import finite
 from ..exceptions import InputError
 
 if TYPE_CHECKING:
     from ..lateral.fit import LateralFit
-    from .demo import DemoResult, LateralCondition, PressureRun
+    from .results import DemoResult, LateralCondition, PressureRun
 
-__all__ = [
-    "RESULTS_KIND",
-    "RESULTS_VERSION",
-    "build_results",
-    "corner_frequency_std",
-    "finite",
-    "lateral_overall_ranking",
-    "load_schema",
-    "validate_results",
-]
-
-RESULTS_KIND = "tyredamp-demo-results"
-RESULTS_VERSION = 1
+__all__ = ["build_results", "corner_frequency_std", "lateral_overall_ranking"]
 
 
 def _matrix(a: Any) -> list[list[float]]:
@@ -386,38 +373,3 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     out = finite(doc)
     assert isinstance(out, dict)
     return out
-
-
-def load_schema() -> dict[str, Any]:
-    """The JSON Schema (draft 2020-12) of results.json, from the package data."""
-    text = resources.files("tyredamp").joinpath("schemas/results.schema.json").read_text("utf-8")
-    schema = json.loads(text)
-    assert isinstance(schema, dict)
-    return schema
-
-
-def validate_results(doc: Any) -> None:
-    """Validate a results document against :func:`load_schema`.
-
-    Needs the optional ``jsonschema`` package (a test dependency).
-
-    Raises
-    ------
-    InputError
-        The document does not follow the schema (the message names the first
-        offending key), or jsonschema is not installed.
-    """
-    try:
-        import jsonschema
-    except ImportError:  # pragma: no cover - jsonschema is a test dependency
-        raise InputError(
-            "validate_results: needs the jsonschema package (pip install jsonschema)"
-        ) from None
-    schema = load_schema()
-    cls = jsonschema.validators.validator_for(schema)
-    cls.check_schema(schema)
-    errors = sorted(cls(schema).iter_errors(doc), key=lambda e: list(e.absolute_path))
-    if errors:
-        e = errors[0]
-        where = "/".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise InputError(f"results: {where}: {e.message} ({len(errors)} problem(s) in all)")
