@@ -58,7 +58,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
-from .._validate import as_finite, check_positive
+from .._validate import as_band, as_finite, check_positive
 from ..exceptions import ConvergenceError, InputError, ShapeError
 from ..frf import FRF
 from .models import (
@@ -195,9 +195,7 @@ def _prepare(
             raise InputError("weights: expected values >= 0")
     keep = np.ones(frf.n_freq, dtype=bool)
     if band is not None:
-        lo, hi = float(band[0]), float(band[1])
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
-            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band}")
+        lo, hi = as_band(band)
         keep &= (frf.frequency >= lo) & (frf.frequency <= hi)
     keep &= frf.frequency > 0
     idx = np.flatnonzero(keep)

@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 
 from ..frf import FRF
 from ..modal.model import ModalModel
+from ._axes import single_axes
 
 __all__ = ["plot_discrepancy", "plot_mode_shapes_ring"]
 
@@ -32,8 +33,7 @@ def plot_discrepancy(
     rmsd : mapping of label to float, optional
         RMSD values (spec eq. [19]) shown in the legend.
     """
-    if ax is None:
-        ax = Figure(figsize=(7.0, 3.0), layout="constrained").subplots()
+    ax = single_axes(ax, (7.0, 3.0))
     for i, (name, fr) in enumerate(fitted.items()):
         d = np.sqrt(np.sum(np.abs(fr.to(measured.kind).H - measured.H) ** 2, axis=(0, 1)))
         lab = name if rmsd is None or name not in rmsd else f"{name} (RMSD {rmsd[name]:.3g})"

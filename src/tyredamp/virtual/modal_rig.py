@@ -74,7 +74,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import lfilter
 
-from .._validate import check_positive
+from .._validate import as_band, check_positive
 from ..exceptions import InputError
 from ..frf import FRF, FRFKind
 from ..mechanics import ComplexModes, MCKSystem, step_coefficients, time_response
@@ -354,12 +354,7 @@ def run_modal_test(
         raise InputError(f"excitation: expected 'chirp' or 'multisine', got {excitation!r}")
     if initial_state not in ("periodic", "rest"):
         raise InputError(f"initial_state: expected 'periodic' or 'rest', got {initial_state!r}")
-    try:
-        if len(band) != 2:
-            raise TypeError
-        bnd = (float(band[0]), float(band[1]))
-    except (TypeError, ValueError):
-        raise InputError(f"band: expected (f_lo, f_hi) in Hz, got {band!r}") from None
+    bnd = as_band(band)
     lines = band_lines(fs, p_samples, bnd)
     truth = tyre.truth(band=bnd)
     rng = np.random.default_rng(seed)

@@ -16,10 +16,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from .._validate import as_finite
+from .._validate import as_band, as_finite
 from ..exceptions import InputError, PhysicsError, ShapeError
 from ..frf import FRF, Channel, FRFKind
-from ..mechanics import MCKSystem
+from ..mechanics import MCKSystem, pole_quantities
 from ..modal.model import ModalModel
 
 __all__ = ["MeasuredRing", "TyreTruth", "modal_phase_collinearity", "wave_numbers"]
@@ -237,9 +237,7 @@ class TyreTruth:
             An overdamped mode in the discretisation (too much band loss for
             this ``n_ring``), where complex modes in pairs do not exist.
         """
-        b = as_finite(band, "band", ndim=1)
-        if b.size != 2 or not 0 <= b[0] < b[1]:
-            raise InputError(f"band: expected (f_lo, f_hi) in Hz with 0 <= f_lo < f_hi, got {band}")
+        b = as_band(band)
         system = tyre.system
         try:
             cm = system.complex_modes()
@@ -310,12 +308,12 @@ class TyreTruth:
     @property
     def frequency_hz(self) -> NDArray[np.float64]:
         """Natural frequencies ``|p_n| / 2 pi`` in Hz, shape (m,)."""
-        return np.abs(self.poles) / (2 * np.pi)
+        return pole_quantities(self.poles)[0]
 
     @property
     def damping_ratio(self) -> NDArray[np.float64]:
         """Damping ratios ``-Re p_n / |p_n|``, shape (m,)."""
-        return -self.poles.real / np.abs(self.poles)
+        return pole_quantities(self.poles)[1]
 
     def select(self, modes: ModeSet = "visible") -> NDArray[np.intp]:
         """Indices of the ``"visible"``, ``"measurable"`` or ``"all"`` in-band modes."""
