@@ -295,8 +295,12 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     rep.heading("Mode shapes", 3)
     _image(rep, images, "mode_shapes")
 
+    _radial_damping(rep, rad["damping"], images)
+    _radial_pressures(rep, rad["pressures"], images)
+
+
+def _radial_damping(rep: HtmlReport, dmp: dict[str, Any], images: Any) -> None:
     rep.heading("Damping matrices", 3)
-    dmp = rad["damping"]
     rep.table(
         ["diagnostic", "value"],
         [
@@ -318,9 +322,11 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     rep.bullets(dmp["findings"])
     _image(rep, images, "fig05_damping")
 
+
+def _radial_pressures(rep: HtmlReport, pressures: list[dict[str, Any]], images: Any) -> None:
     rep.heading("Inflation pressure", 3)
     rows = []
-    for pr in rad["pressures"]:
+    for pr in pressures:
         ident_n = sum(1 for m in pr["modes"] if m["complex"])
         true_n = sum(1 for m in pr["modes"] if m["true"])
         fr = ", ".join(
@@ -457,6 +463,11 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         for v in speeds:
             _image(rep, images, _fig_name(images, force, v))
 
+    _lateral_vehicle(rep, lat, images)
+
+
+def _lateral_vehicle(rep: HtmlReport, lat: dict[str, Any], images: Any) -> None:
+    models = lat["models"]
     rep.heading("Vehicle model and time response", 3)
     veh = lat["vehicle"]
     tr = lat["time_response"]

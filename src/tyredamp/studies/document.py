@@ -224,23 +224,8 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
     return out
 
 
-def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dict[str, Any]:
-    """The results.json document of a demo run (strict JSON types; layout in the README).
-
-    Parameters
-    ----------
-    result : DemoResult
-    files : sequence of str, optional
-        Files written beside results.json (relative paths), listed under
-        ``"files"``.
-
-    Returns
-    -------
-    dict
-        Valid against :func:`load_schema` (checked in the tests).
-    """
-    from ..lateral.characteristics import corner_differences
-
+def _radial_section(result: DemoResult) -> dict[str, Any]:
+    """``radial``: the main pressure, its checks, modes and damping, and every pressure."""
     s = result.settings
     r = result.radial
     main = r.main
@@ -248,7 +233,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     dc = r.damping_truth
     dm = r.damping
     d = dm.diagnostics
-    radial: dict[str, Any] = {
+    return {
         "pressure_bar": main.pressure_bar,
         "n_averages": main.n_periods,
         "snr_db": s.snr_db,
@@ -297,6 +282,12 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
             for run in r.runs
         ],
     }
+
+
+def _lateral_section(result: DemoResult) -> dict[str, Any]:
+    """``lateral``: every condition, the ranking, Figure 7, the vehicle and the time test."""
+    from ..lateral.characteristics import corner_differences
+
     lat = result.lateral
     conds = [_condition(c) for c in lat.conditions]
     fig7 = lat.figure7.model
@@ -305,8 +296,8 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     tt = lat.time_test
     ce = tt.causal
     ref = lat.reference
-    lateral: dict[str, Any] = {
-        "models": list(s.lateral_models),
+    return {
+        "models": list(result.settings.lateral_models),
         "criterion": lat.conditions[0].ranking.criterion,
         "wheel_mass_kg": lat.rig.wheel_mass,
         "body_mass_kg": lat.rig.body_mass,
@@ -357,6 +348,24 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
             },
         },
     }
+
+
+def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dict[str, Any]:
+    """The results.json document of a demo run (strict JSON types; layout in the README).
+
+    Parameters
+    ----------
+    result : DemoResult
+    files : sequence of str, optional
+        Files written beside results.json (relative paths), listed under
+        ``"files"``.
+
+    Returns
+    -------
+    dict
+        Valid against :func:`tyredamp.documents.demo.load_schema` (checked in the tests).
+    """
+    s = result.settings
     doc = {
         "kind": RESULTS_KIND,
         "version": RESULTS_VERSION,
@@ -367,8 +376,8 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         "elapsed_s": result.elapsed_s,
         "timings_s": dict(result.timings),
         "files": list(files or []),
-        "radial": radial,
-        "lateral": lateral,
+        "radial": _radial_section(result),
+        "lateral": _lateral_section(result),
     }
     out = finite(doc)
     assert isinstance(out, dict)
