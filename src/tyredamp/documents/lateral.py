@@ -34,7 +34,8 @@ from pathlib import Path
 from typing import Any
 
 from ..exceptions import FileFormatError
-from ..lateral.fit import LateralData, Ranking
+from ..lateral.fit import LateralData
+from ..lateral.ranking import Ranking
 from ..virtual.lateral_rig import KMH
 from .jsonfile import read_json, write_json
 

@@ -7,7 +7,8 @@
 * :mod:`.characteristics` -- corner frequency and the dB differences of
   eq. 38-40, Figure 7 data.
 * :mod:`.fit` -- weighted complex least-squares fits, standard errors, Table 1
-  figure, AIC/BIC ranking, joint fits across speeds.
+  figure; :mod:`.ranking` -- AIC/BIC ranking; :mod:`.joint` -- joint fits
+  across speeds.
 * :mod:`.vehicle` -- the single-degree-of-freedom vehicle (eq. 41-44).
 * :mod:`.timedomain` -- exact harmonic/periodic steady states, impulse
   response and non-causal precursor, causal generalised-Maxwell approximation
@@ -28,17 +29,8 @@ from .characteristics import (
     figure7_curves,
 )
 from .fiala import FialaTyre
-from .fit import (
-    DEFAULT_MODELS,
-    JointFit,
-    LateralData,
-    LateralFit,
-    Ranking,
-    fit_by_pressure,
-    fit_joint,
-    fit_model,
-    rank_models,
-)
+from .fit import DEFAULT_MODELS, LateralData, LateralFit, fit_model
+from .joint import JointFit, fit_by_pressure, fit_joint
 from .models import (
     MODELS,
     ClassicModel,
@@ -53,6 +45,7 @@ from .models import (
     get_model_class,
     ground_from_axle_accelerance,
 )
+from .ranking import Ranking, rank_models
 from .timedomain import (
     CausalError,
     GeneralizedMaxwellTyre,

@@ -14,7 +14,8 @@ from ._axes import axes_grid, single_axes
 
 if TYPE_CHECKING:
     from ..lateral.characteristics import Figure7Curves
-    from ..lateral.fit import LateralFit, Ranking
+    from ..lateral.fit import LateralFit
+    from ..lateral.ranking import Ranking
 
 __all__ = ["plot_figure7", "plot_lateral_fit", "plot_ranking", "plot_time_comparison"]
 
