@@ -2,7 +2,8 @@
 
 * :mod:`.models` -- the linear models (classic, Maxwell, visco-plastic,
   proposed hysteretic, relaxation length, stretched string) with receptance,
-  mobility and accelerance at the ground or axle force.
+  mobility and accelerance at the ground or axle force; :mod:`.response` --
+  the algebra they share (wheel mass, axle/ground force, string impedance).
 * :mod:`.fiala` -- steady-state Fiala/brush force and its non-linear damper form.
 * :mod:`.characteristics` -- corner frequency and the dB differences of
   eq. 38-40, Figure 7 data.
@@ -40,12 +41,10 @@ from .models import (
     RelaxationLengthModel,
     StretchedStringModel,
     ViscoPlasticModel,
-    attach_mass,
-    axle_from_ground_accelerance,
     get_model_class,
-    ground_from_axle_accelerance,
 )
 from .ranking import Ranking, rank_models
+from .response import attach_mass, axle_from_ground_accelerance, ground_from_axle_accelerance
 from .timedomain import (
     CausalError,
     GeneralizedMaxwellTyre,

@@ -58,13 +58,8 @@ from scipy.optimize import least_squares
 from .._validate import as_band, as_finite, check_positive
 from ..exceptions import ConvergenceError, InputError, ShapeError
 from ..frf import FRF
-from .models import (
-    ForceKind,
-    LateralModel,
-    _check_force,
-    get_model_class,
-    ground_from_axle_accelerance,
-)
+from .models import LateralModel, get_model_class
+from .response import ForceKind, _check_force, ground_from_axle_accelerance
 
 __all__ = ["DEFAULT_MODELS", "Criterion", "LateralData", "LateralFit", "Weights", "fit_model"]
 

@@ -48,8 +48,8 @@ from .models import (
     MaxwellModel,
     RelaxationLengthModel,
     ViscoPlasticModel,
-    as_freq,
 )
+from .response import as_freq
 from .vehicle import LateralVehicle
 
 __all__ = [

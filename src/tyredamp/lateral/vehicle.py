@@ -31,7 +31,8 @@ from scipy.optimize import minimize_scalar
 from .._validate import as_band, check_positive
 from ..exceptions import InputError, PhysicsError
 from ..frf import FRF, Channel, FRFKind
-from .models import LateralModel, _receptance_from_mobility, as_freq, attach_mass
+from .models import LateralModel
+from .response import _receptance_from_mobility, as_freq, attach_mass
 
 __all__ = [
     "LateralVehicle",

@@ -27,7 +27,7 @@ from ..plot import (
 from ..plot.comparison import model_color
 
 if TYPE_CHECKING:
-    from ..lateral.models import ForceKind
+    from ..lateral.response import ForceKind
     from ..studies.results import DemoResult, LateralCondition
 
 __all__ = ["PAPER_MODELS", "demo_figures"]

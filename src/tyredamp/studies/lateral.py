@@ -33,7 +33,7 @@ from ..lateral import (
     rank_models,
 )
 from ..lateral.fit import Criterion, Weights
-from ..lateral.models import ForceKind
+from ..lateral.response import ForceKind
 from ..virtual.lateral_rig import KMH, VirtualLateralRig
 from .results import LateralCondition, LateralStudy, TimeTest, VehicleStudy
 from .settings import DemoSettings

@@ -67,7 +67,8 @@ from .._validate import check_positive
 from ..exceptions import InputError
 from ..frf import FRF, Channel
 from ..lateral.fit import LateralData
-from ..lateral.models import ForceKind, LateralModel, _check_force, as_freq, string_impedance
+from ..lateral.models import LateralModel
+from ..lateral.response import ForceKind, _check_force, as_freq, string_impedance
 from ..lateral.timedomain import harmonic_response
 from ..lateral.vehicle import LateralVehicle
 from ..timedata import TimeData
