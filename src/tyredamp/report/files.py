@@ -32,8 +32,10 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .. import __version__
+from ..documents import read_document
 from ..exceptions import FileFormatError, InputError, TyredampError
 from ..frf import FRF
+from ..io import FILE_FORMATS, read
 from ..io._common import check_input_file
 from ..modal.model import ModalModel
 from ..timedata import TimeData
@@ -42,7 +44,10 @@ from .html import HtmlReport
 
 __all__ = ["ResultFile", "build_files_report", "load_result_file"]
 
-_DATA_EXT = (".uff", ".unv", ".uf", ".csv", ".npz")
+
+def _data_extensions() -> tuple[str, ...]:
+    """Extensions of the measurement formats (FRF, time data), from the io registry."""
+    return tuple(ext for f in FILE_FORMATS.values() for ext in f.extensions)
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,18 +88,15 @@ def load_result_file(path: str | Path) -> ResultFile:
         Unreadable, not JSON where JSON is expected, or not a tyredamp result.
     """
     p = check_input_file(path)
-    if p.suffix.lower() in _DATA_EXT:
-        from ..io import read
-
+    data_ext = _data_extensions()
+    if p.suffix.lower() in data_ext:
         obj = read(p)
         return ResultFile(p, "frf" if isinstance(obj, FRF) else "timedata", obj)
     if p.suffix.lower() != ".json":
         raise FileFormatError(
             f"{p}: unknown file extension {p.suffix or '(none)'!r}; expected .json (modes, "
-            f"damping, lateral fit, demo results) or {', '.join(_DATA_EXT)} (FRF, time data)"
+            f"damping, lateral fit, demo results) or {', '.join(data_ext)} (FRF, time data)"
         )
-    from ..documents import read_document
-
     try:
         kind, obj, doc = read_document(p)
     except FileFormatError as exc:
@@ -102,7 +104,7 @@ def load_result_file(path: str | Path) -> ResultFile:
             raise
         raise FileFormatError(
             f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
-            f"results JSON, or an FRF/time-data file {', '.join(_DATA_EXT)})"
+            f"results JSON, or an FRF/time-data file {', '.join(data_ext)})"
         ) from None
     short = {"lateral-fit": "lateral", "tyredamp-demo-results": "demo"}.get(kind, kind)
     return ResultFile(p, short, obj, doc)
