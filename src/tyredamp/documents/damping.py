@@ -1,6 +1,6 @@
 """The damping JSON file written by ``tyredamp damping`` (and the demo).
 
-Layout (``"kind": "damping"``, ``"version": 1``; the body is
+Layout (the envelope ``"kind": "damping"``, ``"version": 1`` around
 :meth:`tyredamp.damping.DampingModel.to_dict`; full description in
 ``docs/damping-json.md``)::
 
@@ -25,7 +25,6 @@ from pathlib import Path
 from typing import Any
 
 from ..damping import DampingModel
-from ..damping.model import SCHEMA_VERSION
 from ..exceptions import FileFormatError, InputError
 from .jsonfile import read_json, write_json
 
@@ -39,14 +38,14 @@ __all__ = [
 ]
 
 DAMPING_KIND = "damping"
-DAMPING_VERSION = SCHEMA_VERSION
+DAMPING_VERSION = 1
 
 
 def damping_document(dm: DampingModel) -> dict[str, Any]:
     """The JSON-ready damping document of ``dm`` (layout in the module docstring)."""
     if not isinstance(dm, DampingModel):
         raise InputError(f"dm: expected a DampingModel, got {type(dm).__name__}")
-    return dm.to_dict()
+    return {"kind": DAMPING_KIND, "version": DAMPING_VERSION, **dm.to_dict()}
 
 
 def damping_from_document(doc: dict[str, Any]) -> DampingModel:

@@ -19,6 +19,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from ..documents.damping import damping_document
 from ..documents.demo import RESULTS_KIND
 from ..documents.jsonfile import json_text
 from ..documents.modes import modes_document
@@ -148,7 +149,7 @@ def _save(
         (tmp / f"modes_{p0}.json").write_text(json_text(doc), encoding="utf-8")
         written.append(f"modes_{p0}.json")
         (tmp / f"damping_{p0}.json").write_text(
-            json_text(result.radial.damping.to_dict()),
+            json_text(damping_document(result.radial.damping)),
             encoding="utf-8",
         )
         written.append(f"damping_{p0}.json")
