@@ -6,10 +6,17 @@
 * :mod:`.ring` -- flexible-ring model updating (EI, tension law, foundation,
   mass per length, damping) across pressures, with standard errors and
   identifiability verdicts; predictions of modes and FRFs.
+* :mod:`.rigid` -- in-plane rigid-ring (MF-Swift) parameters from the n = 1
+  modes, with what a radial test cannot give stated.
+* :mod:`.tir` -- the in-plane ``.tir`` subset: writer and reader.
+* :mod:`.lateral` -- lateral carcass stiffness and relaxation length from the
+  lateral fits of paper 001.
 """
 
 from __future__ import annotations
 
+from .lateral import LateralCarcass, lateral_carcass, read_lateral_carcass
+from .rigid import NOT_FROM_RADIAL_TEST, RigidRingParameters, rigid_ring_from_modes
 from .ring import (
     RingFit,
     RingObservation,
@@ -18,6 +25,7 @@ from .ring import (
     ring_frequency,
     ring_observations,
 )
+from .tir import parse_tir, tir_text
 from .wavenumber import (
     ModeWaveNumber,
     WaveNumberAnalysis,
@@ -28,16 +36,24 @@ from .wavenumber import (
 )
 
 __all__ = [
+    "NOT_FROM_RADIAL_TEST",
+    "LateralCarcass",
     "ModeWaveNumber",
+    "RigidRingParameters",
     "RingFit",
     "RingObservation",
     "WaveNumberAnalysis",
     "alias_candidates",
     "fit_ring",
     "harmonic_fit",
+    "lateral_carcass",
+    "parse_tir",
+    "read_lateral_carcass",
     "resolved_wave_numbers",
+    "rigid_ring_from_modes",
     "ring_amplitude",
     "ring_frequency",
     "ring_observations",
+    "tir_text",
     "wave_number_analysis",
 ]
