@@ -45,6 +45,7 @@ def _register() -> None:
     from .modal import modal_command
     from .report import report_command
     from .simulate import simulate_group
+    from .tyremodel import tyre_model_command
 
     cli.add_command(frf_command)
     cli.add_command(check_group)
@@ -54,6 +55,7 @@ def _register() -> None:
     cli.add_command(demo_command)
     cli.add_command(simulate_group)
     cli.add_command(report_command)
+    cli.add_command(tyre_model_command)
 
 
 _register()

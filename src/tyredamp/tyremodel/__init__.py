@@ -11,11 +11,14 @@
 * :mod:`.tir` -- the in-plane ``.tir`` subset: writer and reader.
 * :mod:`.lateral` -- lateral carcass stiffness and relaxation length from the
   lateral fits of paper 001.
+* :mod:`.pipeline` -- all of it in one call (:func:`build_tyre_model`), as
+  ``tyredamp tyre-model`` runs it.
 """
 
 from __future__ import annotations
 
 from .lateral import LateralCarcass, lateral_carcass, read_lateral_carcass
+from .pipeline import TyreModelResult, build_tyre_model
 from .rigid import NOT_FROM_RADIAL_TEST, RigidRingParameters, rigid_ring_from_modes
 from .ring import (
     RingFit,
@@ -42,8 +45,10 @@ __all__ = [
     "RigidRingParameters",
     "RingFit",
     "RingObservation",
+    "TyreModelResult",
     "WaveNumberAnalysis",
     "alias_candidates",
+    "build_tyre_model",
     "fit_ring",
     "harmonic_fit",
     "lateral_carcass",

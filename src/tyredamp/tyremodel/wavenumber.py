@@ -495,7 +495,10 @@ def wave_number_analysis(
         amp = math.hypot(ar, br)
         antinode = 0.0
         if n > 0:
-            antinode = float(np.mod(np.degrees(math.atan2(br, ar)) / n, 180.0 / n))
+            period = 180.0 / n
+            antinode = float(np.mod(np.degrees(math.atan2(br, ar)) / n, period))
+            if period - antinode < 1e-9 * period:  # rounding just below the period
+                antinode = 0.0
         amp_std = None
         if sig is not None and amp > 0:
             u = np.array([ar, br]) / amp
