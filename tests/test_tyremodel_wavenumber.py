@@ -94,7 +94,7 @@ def test_wave_numbers_of_virtual_tyre(p_bar: float, imperfect: bool) -> None:
         for m in wa.modes:
             if m.n <= 7 and not m.aliased:
                 assert m.member == "cos"
-                assert min(m.antinode_deg, 180.0 / m.n - m.antinode_deg) < 1e-6
+                assert abs(m.antinode_deg) < 1e-6
 
 
 def test_aliased_modes_flagged() -> None:
@@ -125,7 +125,7 @@ def test_unequal_angles_and_orientation() -> None:
     by_f = sorted(wa.modes, key=lambda m: m.frequency_hz)
     assert [m.n for m in by_f] == [2, 3]
     assert_allclose(by_f[1].antinode_deg, 20.0, atol=1e-9)
-    assert_allclose(by_f[0].antinode_deg, np.mod(-np.degrees(0.3) / 2, 90.0), atol=1e-9)
+    assert_allclose(by_f[0].antinode_deg, -np.degrees(0.3) / 2, atol=1e-9)
     # a pure harmonic explains all of the shape; amplitude is that of the real shape
     assert_allclose([m.fraction for m in by_f], 1.0, atol=1e-12)
     assert_allclose(by_f[1].amplitude, 0.05, rtol=1e-12)

@@ -944,11 +944,16 @@ def fit_ring(
     d_names = ("c_r", "c_t", "eta_b", "c_d")[: dmat.shape[1]]
     d_units = ("N s/m^2", "N s/m^2", "s", "N s/m")[: dmat.shape[1]]
     dw = dmat / sig_d[:, None]
-    dsol, *_ = np.linalg.lstsq(dw, yd / sig_d, rcond=None)
+    # columns differ by ~1e9 in scale (eta_b against c_r): solve and invert normalised
+    cn = np.linalg.norm(dw, axis=0)
+    cn = np.where(cn > 0, cn, 1.0)
+    dsol_n, *_ = np.linalg.lstsq(dw / cn, yd / sig_d, rcond=None)
+    dsol = dsol_n / cn
     dres = yd / sig_d - dw @ dsol
     drss = float(dres @ dres)
     ddof = max(n.size - dsol.size, 1)
-    dcov = np.asarray(np.linalg.pinv(dw.T @ dw, rcond=1e-12), dtype=np.float64)
+    dwn = dw / cn
+    dcov = np.asarray(np.linalg.pinv(dwn.T @ dwn, rcond=1e-12) / np.outer(cn, cn), dtype=float)
     if not have_zstd or chi2.sf(drss, ddof) < 0.01:
         dcov = dcov * (drss / ddof)
     dse = np.sqrt(np.clip(np.diag(dcov), 0.0, None))

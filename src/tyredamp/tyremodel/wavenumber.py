@@ -44,9 +44,10 @@ Pairs
 -----
 Modes with the same label form the ring's double mode. For each member the
 antinode angle ``theta_0`` (``Psi^ ~ A cos n(theta - theta_0)`` after
-rotating the complex shape to its principal phase) is reported, modulo
-``180/n`` deg; the member whose antinode is nearer the reference angle (the
-first drive point, else 0 deg) is labelled ``"cos"``, the other ``"sin"``.
+rotating the complex shape to its principal phase) is reported, in
+``[-90/n, 90/n)`` deg (antinodes repeat every ``180/n`` deg); the member
+whose antinode is nearer the reference angle (the first drive point, else
+0 deg) is labelled ``"cos"``, the other ``"sin"``.
 The pair's splitting is ``f_sin - f_cos`` (Hz, and relative to the mean) and
 its orientation the ``cos`` member's antinode angle. A single member is
 labelled by the same rule (``"cos"`` with an antinode at the drive point:
@@ -281,7 +282,8 @@ class ModeWaveNumber:
     amplitude_std : float or None
         Its standard error.
     antinode_deg : float
-        ``theta_0`` in [0, 180/n) deg (0 for ``n = 0``).
+        ``theta_0`` in [-90/n, 90/n) deg (antinodes repeat every 180/n deg;
+        0 for ``n = 0``).
     member : {"cos", "sin", "single"}
         Pair member relative to the reference angle (module docstring);
         ``"single"`` for ``n = 0``.
@@ -495,10 +497,10 @@ def wave_number_analysis(
         amp = math.hypot(ar, br)
         antinode = 0.0
         if n > 0:
+            # antinodes repeat every 180/n deg; report the one in [-90/n, 90/n)
             period = 180.0 / n
-            antinode = float(np.mod(np.degrees(math.atan2(br, ar)) / n, period))
-            if period - antinode < 1e-9 * period:  # rounding just below the period
-                antinode = 0.0
+            raw_deg = np.degrees(math.atan2(br, ar)) / n
+            antinode = float(np.mod(raw_deg + period / 2, period) - period / 2)
         amp_std = None
         if sig is not None and amp > 0:
             u = np.array([ar, br]) / amp
