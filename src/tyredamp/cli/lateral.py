@@ -15,7 +15,8 @@ LATERAL_JSON layout (version 1; SI units; non-finite numbers as ``null``)::
       "tyredamp": "lateral-fit", "version": 1,
       "input": {"file": str, "kind": str, "n_lines": int, "band_hz": [lo, hi]},
       "conditions": {"speed_m_s": float|null, "speed_kmh": float|null,
-                     "force": "ground"|"axle", "wheel_mass_kg": float},
+                     "force": "ground"|"axle", "wheel_mass_kg": float,
+                     "pressure_bar": float|null (from the FRF's meta)},
       "criterion": "bic"|"aic",
       "order": [model names, best first],
       "table": [{"rank", "model", "n_params", "rss", "aic", "bic", "delta",
@@ -185,6 +186,7 @@ def fit_command(
             "speed_kmh": None if data.speed is None else data.speed / KMH,
             "force": data.force,
             "wheel_mass_kg": data.wheel_mass,
+            "pressure_bar": frf.meta.get("pressure_bar"),
         },
         **ranking.to_dict(),
     }
