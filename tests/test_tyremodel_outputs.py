@@ -352,3 +352,16 @@ def test_write_all_or_none(tmp_path: Path) -> None:
     assert [f.name for f in files] == ["a.txt"]
     assert (target / "a.txt").read_text() == "x"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def test_modal_command_labels_wave_numbers() -> None:
+    from tyredamp.cli.modal import _label_wave_numbers, modes_table
+    from tyredamp.plot import plot_mode_shapes_ring
+
+    mdl = truth(7.0).modal_model("visible")
+    _label_wave_numbers(mdl)
+    assert mdl.meta["wave_number"] == truth(7.0).wave_number[truth(7.0).select("visible")].tolist()
+    table = "\n".join(modes_table("complex", mdl))
+    assert "n = 1 (cos)" in table
+    axes = plot_mode_shapes_ring(mdl, modes=[2])
+    assert "n = 3" in axes[0].get_title()
