@@ -175,6 +175,12 @@ def test_single_pressure_fit_and_refusals() -> None:
     obs, _ = ring_observations(modes(7.0), 7.0 * BAR)
     with pytest.raises(InputError, match="usable values"):
         fit_ring(obs[:2], radius=0.5)
+    with pytest.raises(InputError, match="finite"):
+        fit_ring([replace(obs[0], frequency_hz=float("nan")), *obs[1:]], radius=0.5)
+    with pytest.raises(InputError, match="frequency > 0"):
+        fit_ring([replace(obs[0], frequency_hz=-1.0), *obs[1:]], radius=0.5)
+    with pytest.raises(InputError, match="pressure"):
+        ring_observations(modes(7.0), -1.0)
 
 
 def test_known_mass_per_length_fixed() -> None:

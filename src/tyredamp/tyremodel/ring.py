@@ -796,6 +796,15 @@ def fit_ring(
         skipped += s
     if not obs:
         raise InputError("data: no mode usable by the ring model (see the wave-number analysis)")
+    for i, o in enumerate(obs):
+        vals = (o.pressure, o.frequency_hz, o.amplitude, o.damping_ratio, o.drive_phi2)
+        if not all(math.isfinite(v) for v in vals):
+            raise InputError(f"observations[{i}]: expected finite values, got {o}")
+        if o.frequency_hz <= 0 or o.n < 1 or o.pressure < 0 or o.drive_phi2 < 0:
+            raise InputError(
+                f"observations[{i}]: expected n >= 1, frequency > 0, pressure >= 0 and "
+                f"drive_phi2 >= 0, got n = {o.n}, f = {o.frequency_hz}, p = {o.pressure}"
+            )
     n = np.array([o.n for o in obs], dtype=float)
     p = np.array([o.pressure for o in obs])
     f = np.array([o.frequency_hz for o in obs])
