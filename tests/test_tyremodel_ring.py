@@ -242,3 +242,23 @@ def test_ring_frf_against_exact_frf() -> None:
     # and lines below 10 % (the ring has no extensional modes and no residual terms)
     rel = np.abs(model - exact) / np.abs(exact)
     assert np.median(rel) < 0.1
+
+
+def test_verdicts_follow_what_the_modes_determine() -> None:
+    obs, _ = ring_observations(modes(7.0), 7.0 * BAR)
+    # identified modes' standard errors: 0.1 % in frequency, 1 % in shape amplitude
+    obs = [
+        replace(o, frequency_std=1e-3 * o.frequency_hz, amplitude_std=1e-2 * o.amplitude)
+        for o in obs
+    ]
+    full = fit_ring(obs, radius=0.5, attachment_mass=0.1, attachment_damping=350.0)
+    assert full.verdicts["k_t"]["verdict"] == "identified"
+    assert full.verdicts["k_r"]["verdict"] == "identified"
+    # without n = 1, 2 the tangential foundation (weight 1 against n^2 k_r in eq. (1)) is
+    # not determined by radial modes: reported, not given an arbitrary value
+    high = fit_ring(
+        [o for o in obs if o.n >= 3], radius=0.5, attachment_mass=0.1, attachment_damping=350.0
+    )
+    assert high.verdicts["k_t"]["verdict"].startswith("not identifiable")
+    assert high.verdicts["T0"]["verdict"] == "identified"
+    assert "k_r" in high.verdicts["k_t"]["correlated_with"]

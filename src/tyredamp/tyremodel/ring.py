@@ -58,8 +58,9 @@ residuals (scaled by the reduced chi-square ``RSS/dof`` when it is
 significantly above 1, p < 0.01, i.e. when the model error dominates the
 measurement error, or when there were no standard errors); correlations
 from ``cov``. Verdict per parameter from its standard error relative to its
-contribution scale (``<= 0.1`` identified, ``<= 0.5`` poorly identified,
-else not identifiable from these modes) and from the scaled Jacobian's
+value, floored at 1 % of its contribution scale (``T_c`` against the
+tension itself; ``<= 0.1`` identified, ``<= 0.5`` poorly identified, else
+not identifiable from these modes) and from the scaled Jacobian's
 singular values (collinearity index of Brun et al. 2001 above 100: the
 parameters of that near-null direction are confounded whatever the noise,
 e.g. ``c_r`` and ``c_d`` when only the driven member of each pair is
@@ -324,7 +325,7 @@ class RingFit:
     scales : ndarray, shape (P,)
         Contribution scale of each parameter (module docstring).
     verdicts : dict of str to dict
-        Per parameter: ``verdict``, ``relative_se`` (SE / scale),
+        Per parameter: ``verdict``, ``relative_se`` (SE / verdict scale, module docstring),
         ``correlated_with``.
     singular_values : ndarray
         Of the column-normalised weighted Jacobian (descending); the
@@ -796,14 +797,14 @@ def fit_ring(
         skipped += s
     if not obs:
         raise InputError("data: no mode usable by the ring model (see the wave-number analysis)")
-    for i, o in enumerate(obs):
-        vals = (o.pressure, o.frequency_hz, o.amplitude, o.damping_ratio, o.drive_phi2)
+    for i, ob in enumerate(obs):
+        vals = (ob.pressure, ob.frequency_hz, ob.amplitude, ob.damping_ratio, ob.drive_phi2)
         if not all(math.isfinite(v) for v in vals):
-            raise InputError(f"observations[{i}]: expected finite values, got {o}")
-        if o.frequency_hz <= 0 or o.n < 1 or o.pressure < 0 or o.drive_phi2 < 0:
+            raise InputError(f"observations[{i}]: expected finite values, got {ob}")
+        if ob.frequency_hz <= 0 or ob.n < 1 or ob.pressure < 0 or ob.drive_phi2 < 0:
             raise InputError(
                 f"observations[{i}]: expected n >= 1, frequency > 0, pressure >= 0 and "
-                f"drive_phi2 >= 0, got n = {o.n}, f = {o.frequency_hz}, p = {o.pressure}"
+                f"drive_phi2 >= 0, got n = {ob.n}, f = {ob.frequency_hz}, p = {ob.pressure}"
             )
     n = np.array([o.n for o in obs], dtype=float)
     p = np.array([o.pressure for o in obs])
@@ -933,7 +934,13 @@ def fit_ring(
     cov = np.asarray(cov_u * np.outer(scales, scales), dtype=np.float64)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     corr = _correlation(cov)
-    verdicts = _verdicts(lay.names, se / scales, corr, jac)
+    # verdict scale: the parameter itself, floored at 1 % of its contribution scale (a term
+    # that is zero to within 1 % of what it modifies is determined); the tension offset T_c
+    # is judged against the tension itself
+    vscale = np.maximum(np.abs(theta), 0.01 * scales)
+    if "T_c" in lay.names:
+        vscale[lay.names.index("T_c")] = scales[lay.names.index("T_c")]
+    verdicts = _verdicts(lay.names, se / vscale, corr, jac)
     fm, am = model(theta)
     # ---- damping, eq. (3), given EI and rho A
     ei_hat = float(theta[lay.names.index("EI")])
@@ -966,10 +973,11 @@ def fit_ring(
     if not have_zstd or chi2.sf(drss, ddof) < 0.01:
         dcov = dcov * (drss / ddof)
     dse = np.sqrt(np.clip(np.diag(dcov), 0.0, None))
-    # contribution scale of each damping term: the value that alone would carry the
-    # mean measured 2 zeta omega
+    # verdict scale of each damping term: its value, floored at 1 % of the value that alone
+    # would carry the mean measured 2 zeta omega
     colmean = np.mean(np.abs(dmat), axis=0)
     dscale = float(np.mean(np.abs(yd))) / np.where(colmean > 0, colmean, 1.0)
+    dscale = np.maximum(np.abs(dsol), 0.01 * dscale)
     dverd = _verdicts(d_names, dse / dscale, _correlation(dcov), dw)
     zeta_model = (dmat @ dsol + (c_known or 0.0) * phi2) / (2 * omega)
     return RingFit(
