@@ -476,7 +476,7 @@ class RingFit:
             tangential_stiffness=self.tangential_stiffness(p)[0],
             mass_per_length=ra,
         ) * np.sqrt(1.0 - self.attachment_mass * ph)
-        zeta = self._damping_model(nn, 2 * np.pi * f, ph, ei, ra) / (4 * np.pi * f)
+        zeta = self._two_zeta_omega(nn, ph, ei, ra) / (4 * np.pi * f)
         return f, zeta
 
     def drive_member_phi2(self, n: ArrayLike) -> NDArray[np.float64]:
@@ -488,18 +488,13 @@ class RingFit:
         base = ring_amplitude(nn, radius=self.radius, mass_per_length=self.mass_per_length) ** 2
         return np.asarray(base / (1.0 + self.attachment_mass * base), dtype=np.float64)
 
-    def _damping_model(
-        self,
-        n: NDArray[np.float64],
-        omega: NDArray[np.float64],
-        phi2: NDArray[np.float64],
-        ei: float,
-        rho_a: float,
+    def _two_zeta_omega(
+        self, n: NDArray[np.float64], phi2: NDArray[np.float64], ei: float, rho_a: float
     ) -> NDArray[np.float64]:
+        """``2 zeta omega`` (1/s) of eq. (3) with the fitted (and any known) dampers."""
         cols = _damping_columns(
             n, phi2, ei, rho_a, self.radius, self.attachment_mass, "c_d" in self.damping_names
         )
-        del omega
         known = (self.attachment_damping or 0.0) * phi2
         return np.asarray(cols @ self.damping_values + known, dtype=np.float64)
 
