@@ -365,3 +365,32 @@ def test_modal_command_labels_wave_numbers() -> None:
     assert "n = 1 (cos)" in table
     axes = plot_mode_shapes_ring(mdl, modes=[2])
     assert "n = 3" in axes[0].get_title()
+
+
+def test_cli_one_line_error_without_angles(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tyredamp.cli import main
+    from tyredamp.frf import Channel
+    from tyredamp.modal.model import ModalModel
+
+    mdl = truth(7.0).modal_model("visible")
+    bare = ModalModel(
+        mdl.poles,
+        mdl.psi_out,
+        mdl.psi_in,
+        outputs=[Channel(node=c.node) for c in mdl.outputs],
+        inputs=mdl.inputs,
+    )
+    path = tmp_path / "m.json"
+    write_modes_json(path, {"complex": bare})
+    out = tmp_path / "model"
+    argv = ["tyre-model", str(path), "--pressure", "7", "--radius", "0.5", "--out", str(out)]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("tyredamp: error:")
+    assert len(err.strip().splitlines()) == 1
+    assert "angle" in err
+    assert not out.exists()
