@@ -9,6 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from matplotlib.axes import Axes
 from numpy.testing import assert_allclose
 
@@ -394,3 +396,35 @@ def test_cli_one_line_error_without_angles(
     assert len(err.strip().splitlines()) == 1
     assert "angle" in err
     assert not out.exists()
+
+
+@given(
+    mass=st.floats(1e-3, 1e4),
+    freq=st.floats(1e-2, 1e4),
+    damp=st.floats(1e-6, 1.0),
+    pressure=st.floats(0.0, 1e7),
+)
+@settings(max_examples=50, deadline=None)
+def test_tir_round_trip_property(mass: float, freq: float, damp: float, pressure: float) -> None:
+    from tyredamp.tyremodel import RigidRingParameters
+
+    w = 2 * np.pi * freq
+    rr = RigidRingParameters(
+        pressure=pressure,
+        belt_mass=mass,
+        belt_mass_std=0.01 * mass,
+        freq_long=freq,
+        freq_long_std=0.0,
+        damp_long=damp,
+        damp_long_std=0.0,
+        k_long=mass * w**2,
+        k_long_std=0.0,
+        c_long=2 * damp * mass * w,
+        c_long_std=0.0,
+    )
+    doc = parse_tir(tir_text(rr))
+    # written with 10 significant digits
+    assert_allclose(doc["INERTIA"]["BELT_MASS"], mass, rtol=1e-9)
+    assert_allclose(doc["STRUCTURAL"]["FREQ_LONG"], freq, rtol=1e-9)
+    assert_allclose(doc["STRUCTURAL"]["DAMP_LONG"], damp, rtol=1e-9)
+    assert_allclose(doc["OPERATING_CONDITIONS"]["INFLPRES"], pressure, rtol=1e-9)
