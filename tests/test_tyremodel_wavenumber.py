@@ -207,3 +207,24 @@ def test_missing_angles_refused() -> None:
 def test_duplicate_angles_refused() -> None:
     with pytest.raises(InputError, match="same angle"):
         resolved_wave_numbers([0.0, 90.0, 90.0, 180.0])
+
+
+def test_output_selection_and_mixed_directions() -> None:
+    tr = truth(7.0, False)
+    mdl = tr.modal_model("visible")
+    # a model whose first output is in another direction (say tangential) is refused ...
+    outs = [Channel(node=1, direction=1, angle_deg=0.0), *mdl.outputs[1:]]
+    mixed = ModalModel(mdl.poles, mdl.psi_out, mdl.psi_in, outputs=outs, inputs=mdl.inputs)
+    with pytest.raises(InputError, match="several directions"):
+        wave_number_analysis(mixed)
+    # ... unless the rows on the circumference are chosen (15 unequal points still resolve
+    # n <= 7 here)
+    wa = wave_number_analysis(mixed, outputs=range(1, 16))
+    true_n = tr.wave_number[tr.select("visible")]
+    low = true_n <= 7
+    assert_allclose(wa.n[low], true_n[low])
+    assert all(m.member == "cos" for m in wa.modes if true_n[m.index] <= 7)
+    # n = 8 on these 15 points is no harmonic of n <= 7: flagged, not paired
+    assert all(not m.single_harmonic for m in wa.modes if true_n[m.index] == 8)
+    with pytest.raises(InputError, match="positions"):
+        wave_number_analysis(mdl, outputs=[0, 16])

@@ -57,6 +57,7 @@ the perfect ring, whose ``sin`` member has a node there and is not excited).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -411,22 +412,45 @@ class WaveNumberAnalysis:
         return "\n".join(rows)
 
 
-def _output_angles(model: ModalModel, angles_deg: ArrayLike | None) -> NDArray[np.float64]:
+def _output_angles(
+    model: ModalModel, angles_deg: ArrayLike | None, rows: NDArray[np.intp]
+) -> NDArray[np.float64]:
     if angles_deg is not None:
         a = as_finite(angles_deg, "angles_deg", ndim=1)
-        if a.size != len(model.outputs):
+        if a.size == len(model.outputs):
+            return a[rows]
+        if a.size != rows.size:
             raise ShapeError(
                 f"angles_deg: expected one angle per output ({len(model.outputs)}), got {a.size}"
             )
         return a
-    missing = [c.label for c in model.outputs if c.angle_deg is None]
+    chans = [model.outputs[int(r)] for r in rows]
+    missing = [c.label for c in chans if c.angle_deg is None]
     if missing:
         raise InputError(
             "outputs: the circumferential angle (Channel.angle_deg) of output(s) "
             f"{', '.join(missing[:5])}{' ...' if len(missing) > 5 else ''} is unknown; "
             "the wave number needs every output's angle (pass angles_deg)"
         )
-    return np.array([float(c.angle_deg) for c in model.outputs])  # type: ignore[arg-type]
+    return np.array([float(c.angle_deg) for c in chans])  # type: ignore[arg-type]
+
+
+def _output_rows(model: ModalModel, outputs: Sequence[int] | None) -> NDArray[np.intp]:
+    n_out = len(model.outputs)
+    if outputs is None:
+        dirs = {abs(c.direction) for c in model.outputs}
+        if len(dirs) > 1:
+            raise InputError(
+                f"outputs: the model's outputs have several directions {sorted(dirs)}; give "
+                "outputs= the rows of the radial points on one circumference"
+            )
+        return np.arange(n_out, dtype=np.intp)
+    rows = np.asarray(list(outputs), dtype=np.intp)
+    if rows.ndim != 1 or rows.size == 0 or np.any(rows < 0) or np.any(rows >= n_out):
+        raise InputError(f"outputs: expected positions in 0..{n_out - 1}, got {list(outputs)}")
+    if np.unique(rows).size != rows.size:
+        raise InputError(f"outputs: repeated positions in {list(outputs)}")
+    return rows
 
 
 def wave_number_analysis(
@@ -436,6 +460,7 @@ def wave_number_analysis(
     reference_deg: float | None = None,
     min_fraction: float = 0.8,
     n_limit: int | None = None,
+    outputs: Sequence[int] | None = None,
 ) -> WaveNumberAnalysis:
     """Label every mode of ``model`` with its circumferential wave number.
 
@@ -456,6 +481,11 @@ def wave_number_analysis(
     n_limit : int, optional
         Largest wave number listed among the alias candidates (default
         ``3 J``, J the number of points).
+    outputs : sequence of int, optional
+        Positions of the outputs (rows of the shapes) on one circumference
+        in one direction (the radial points); default all outputs, which
+        must then share one direction code (a model that mixes, say, radial
+        and tangential channels is refused: choose the rows).
 
     Returns
     -------
@@ -465,7 +495,8 @@ def wave_number_analysis(
         raise InputError(f"model: expected a ModalModel, got {type(model).__name__}")
     if not 0.0 < float(min_fraction) <= 1.0:
         raise InputError(f"min_fraction: expected a value in (0, 1], got {min_fraction}")
-    ang = _output_angles(model, angles_deg)
+    rows = _output_rows(model, outputs)
+    ang = _output_angles(model, angles_deg, rows)
     theta = _angles(ang)
     n_res, cos_next = resolved_wave_numbers(ang)
     n_top = n_res + 1 if cos_next else n_res
@@ -473,9 +504,11 @@ def wave_number_analysis(
     if reference_deg is None:
         ref = next((c.angle_deg for c in model.inputs if c.angle_deg is not None), 0.0)
         reference_deg = float(ref) if ref is not None else 0.0
-    shapes = model.second_order_shapes()
+    shapes = model.second_order_shapes()[rows]
     omega = model.poles.imag
     std_psi = model.std.get("psi_out")
+    if std_psi is not None and np.shape(std_psi) == model.psi_out.shape:
+        std_psi = np.asarray(std_psi, float)[rows]
     raw: list[dict[str, Any]] = []
     for k in range(model.n_modes):
         x = shapes[:, k]
@@ -584,7 +617,8 @@ def wave_number_analysis(
         return float(abs((raw[k]["antinode"] - reference_deg + period / 2) % period - period / 2))
 
     for n, idx in groups.items():
-        good = [k for k in idx if not aliased[k]]
+        # pairs of labelled, single-harmonic modes only
+        good = [k for k in idx if not aliased[k] and raw[k]["fraction"] >= min_fraction]
         if n == 0 or not good:
             continue
         if len(good) == 1:
