@@ -75,7 +75,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
@@ -358,6 +358,8 @@ class RingFit:
     fit_time_s : float
     band_loss_frequency : float
         ``omega_ref / 2 pi`` (Hz) for the band loss factor ``eta = eta_b omega_ref``.
+    foundation_law : {"linear", "constant"}
+        Pressure law of ``k_r``, ``k_t`` used (several pressures).
     """
 
     names: tuple[str, ...]
@@ -391,7 +393,7 @@ class RingFit:
     skipped: tuple[str, ...] = ()
     fit_time_s: float = 0.0
     band_loss_frequency: float = 200.0
-    _law: FoundationLaw = field(default="linear", repr=False)
+    foundation_law: FoundationLaw = "linear"
 
     # ------------------------------------------------------------ parameters
     def param(self, name: str) -> tuple[float, float]:
@@ -643,7 +645,7 @@ class RingFit:
             "attachment_damping_ns_m": self.attachment_damping,
             "mass_per_length_fixed": self.mass_per_length_fixed,
             "band_loss_frequency_hz": self.band_loss_frequency,
-            "foundation_law": self._law,
+            "foundation_law": self.foundation_law,
             "parameters": self.table(),
             "correlation": {"names": list(self.names), "matrix": self.correlation.tolist()},
             "singular_values": self.singular_values.tolist(),
@@ -1007,7 +1009,7 @@ def fit_ring(
         skipped=tuple(skipped),
         fit_time_s=time.perf_counter() - t_start,
         band_loss_frequency=float(band_loss_frequency),
-        _law=foundation_law,
+        foundation_law=foundation_law,
     )
 
 
