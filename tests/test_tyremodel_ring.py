@@ -262,3 +262,15 @@ def test_verdicts_follow_what_the_modes_determine() -> None:
     assert high.verdicts["k_t"]["verdict"].startswith("not identifiable")
     assert high.verdicts["T0"]["verdict"] == "identified"
     assert "k_r" in high.verdicts["k_t"]["correlated_with"]
+
+
+def test_updated_ring_as_finite_difference_tyre() -> None:
+    fit = fit3(350.0)
+    prm = fit.to_ring_parameters(7.0 * BAR)
+    assert_allclose(prm.hoop_tension, fit.tension(7.0 * BAR)[0], rtol=1e-12)
+    assert_allclose(prm.radial_stiffness, fit.radial_stiffness(7.0 * BAR)[0], rtol=1e-12)
+    bare = MeasurementLayout(attachment_mass=0.0, attachment_damping=0.0)
+    fd = RingTyre(prm, bare, n_ring=N_RING).ring_frequencies(6)
+    f_bare, _ = fit.predict(7.0 * BAR, np.arange(1, 7))
+    # the updated (inextensible) ring simulated by the FD ring: 0.01 %
+    assert_allclose(fd, np.column_stack([f_bare, f_bare]), rtol=1e-4)
