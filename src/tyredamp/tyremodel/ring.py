@@ -74,6 +74,7 @@ determine it poorly, and its pressure slope usually not at all.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -84,7 +85,7 @@ from scipy.optimize import least_squares
 from scipy.stats import chi2
 
 from .._validate import as_frequency, check_positive
-from ..exceptions import InputError, PhysicsError
+from ..exceptions import ConvergenceError, InputError, PhysicsError
 from ..frf import FRF, Channel, FRFKind
 from ..modal.model import ModalModel
 from .wavenumber import WaveNumberAnalysis, wave_number_analysis
@@ -763,9 +764,9 @@ def fit_ring(
     ------
     InputError
         Too few usable modes for the parameters, bad options.
+    ConvergenceError
+        The least-squares fit did not converge.
     """
-    import time
-
     t_start = time.perf_counter()
     r = check_positive(radius, "radius")
     m_a = check_positive(attachment_mass, "attachment_mass", allow_zero=True)
@@ -910,6 +911,8 @@ def fit_ring(
 
     u0 = theta0 / scales
     res = least_squares(residual, u0, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    if res.status <= 0 or not np.all(np.isfinite(res.x)):
+        raise ConvergenceError(f"fit_ring: the least-squares fit did not converge ({res.message})")
     u = np.asarray(res.x, dtype=float)
     rvec = residual(u)
     rss = float(rvec @ rvec)
