@@ -34,6 +34,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("modal", "lateral"),
     ("damping",),
     ("virtual",),
+    ("tyremodel",),
     ("io",),
     ("documents",),
     ("studies",),
@@ -55,6 +56,10 @@ LONG_PENDING = {
     ("signal/estimators.py", "cross_spectra"),
     ("signal/estimators.py", "estimate_frf"),
     ("virtual/modal_rig.py", "run_modal_test"),
+    # merged from the tyremodel branch; being split
+    ("tyremodel/rigid.py", "rigid_ring_from_modes"),
+    ("tyremodel/ring.py", "fit_ring"),
+    ("tyremodel/wavenumber.py", "wave_number_analysis"),
 }
 
 

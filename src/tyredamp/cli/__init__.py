@@ -65,6 +65,11 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
         "simulate_group",
         "Simulate tests on the built-in virtual tyres and write them as files.",
     ),
+    "tyre-model": (
+        "tyremodel",
+        "tyre_model_command",
+        "Flexible-ring and rigid-ring tyre models from modes files at one or more pressures.",
+    ),
 }
 
 

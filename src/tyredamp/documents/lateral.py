@@ -8,7 +8,8 @@ numbers as ``null``; files written before the ``"kind"`` key carry only
       "tyredamp": "lateral-fit", "kind": "lateral-fit", "version": 1,
       "input": {"file": str, "kind": str, "n_lines": int, "band_hz": [lo, hi]},
       "conditions": {"speed_m_s": float|null, "speed_kmh": float|null,
-                     "force": "ground"|"axle", "wheel_mass_kg": float},
+                     "force": "ground"|"axle", "wheel_mass_kg": float,
+                     "pressure_bar": float|null (from the FRF's meta)},
       "criterion": "bic"|"aic",
       "order": [model names, best first],
       "table": [{"rank", "model", "n_params", "rss", "aic", "bic", "delta",
@@ -84,6 +85,7 @@ def lateral_fit_document(
             "speed_kmh": None if data.speed is None else data.speed / KMH,
             "force": data.force,
             "wheel_mass_kg": data.wheel_mass,
+            "pressure_bar": data.frf.meta.get("pressure_bar"),
         },
         **ranking.to_dict(),
     }
