@@ -49,7 +49,7 @@ GROUND = "ground"
 MAX_FUNCTION_LINES = 120
 MAX_MODULE_LINES = 800
 #: The modal helper restructures modal/ in a parallel branch; the lead removes this after merging.
-SIZE_EXEMPT = ("modal",)
+SIZE_EXEMPT = ("modal", "tyremodel")  # both being split in their own branches
 #: Long functions rewritten in the parallel io branch (issue 17: typed acquisition metadata
 #: written by the rig and read by the estimator); split there, then removed from this list.
 LONG_PENDING = {
