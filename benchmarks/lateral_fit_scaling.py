@@ -18,8 +18,8 @@ import tracemalloc
 import numpy as np
 
 from tyredamp.frf import FRF
-from tyredamp.lateral.fit import LateralData, rank_models
-from tyredamp.lateral.rig import KMH, VirtualLateralRig
+from tyredamp.lateral import LateralData, rank_models
+from tyredamp.virtual.lateral_rig import KMH, VirtualLateralRig
 
 
 def main(n_max: int = 1_000_000) -> None:

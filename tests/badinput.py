@@ -38,8 +38,8 @@ import pytest
 from tyredamp.cli import main
 from tyredamp.frf import Channel
 from tyredamp.io import write_frf, write_timedata
-from tyredamp.lateral.rig import VirtualLateralRig
 from tyredamp.timedata import TimeData
+from tyredamp.virtual.lateral_rig import VirtualLateralRig
 
 from .helpers import chain_system
 

@@ -283,6 +283,41 @@ def demo_cases() -> list[Case]:
     ]
 
 
+# ----------------------------------------------------------------------------- tyre-model
+def tyremodel_cases() -> list[Case]:
+    """tyre-model writes a new or empty directory only, checked before any work."""
+
+    def argv(out: str) -> list[str]:
+        return ["tyre-model", "m.json", "--pressure", "7", "--radius", "0.5", "-o", out]
+
+    def full_dir(d: Path) -> None:
+        (d / "model").mkdir()
+        (d / "model" / "notes.txt").write_text("my notes")
+
+    files = {"m.json": "modes.json"}
+    return [
+        Case("tyre-model-dir-not-empty", argv("model"), EXIT_INPUT, "not empty", files, full_dir),
+        Case(
+            "tyre-model-link-to-dir-not-empty",
+            argv("link"),
+            EXIT_INPUT,
+            "not empty",
+            files,
+            lambda d: (full_dir(d), os.symlink("model", d / "link")),
+        ),
+        Case("tyre-model-out-empty", argv(""), EXIT_INPUT, "empty path", files),
+        Case("tyre-model-out-dot", argv("."), EXIT_INPUT, "current directory", files),
+        Case(
+            "tyre-model-out-is-file",
+            argv("f"),
+            EXIT_INPUT,
+            "is a file",
+            {**files, "f": b"a user's file"},
+        ),
+        Case("tyre-model-missing-parent", argv("nodir/model"), EXIT_INPUT, "does not exist", files),
+    ]
+
+
 # ------------------------------------------------------------------------ bad inputs
 #: (command argv with {in}, input name, valid library file for the other slots)
 SLOTS: dict[str, tuple[list[str], str, dict[str, str]]] = {
@@ -698,6 +733,7 @@ def _build_cases() -> list[Case]:
     return [
         *output_cases(),
         *demo_cases(),
+        *tyremodel_cases(),
         *malformed_cases(lib_files),
         *json_cases(lib_files),
         *hostile_cases(),
@@ -894,7 +930,7 @@ def slow(*a, **k):
     marker.write_text("writing")
     time.sleep(60)
 s._fsync_file = slow
-import tyredamp.demo as demo
+import tyredamp.studies.demo as demo
 import tyredamp.report.figures as figs
 demo.run_demo = lambda *a, **k: None
 figs.demo_figures = slow
