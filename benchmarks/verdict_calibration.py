@@ -6,7 +6,7 @@ A two-mode FRF (30 and 80 Hz, 2 % damping, 400 lines 5-100 Hz) is measured
 as an analyser does it: ``n_d`` averages of a fixed periodic force (or of a
 new random force each) with Gaussian noise on the response (SNR 300 on the
 peak), H1 and coherence from the averages. The verdict
-(:func:`tyredamp.report.verdicts.modal_fit_verdict`, test level
+(:func:`tyredamp.studies.verdicts.modal_fit_verdict`, test level
 ``alpha = 1e-3``) judges
 
 * the true model: the share of FAILED verdicts is the false-alarm rate
@@ -26,7 +26,7 @@ import numpy as np
 from tyredamp import Channel
 from tyredamp.frf import FRF
 from tyredamp.modal.model import ModalModel
-from tyredamp.report.verdicts import modal_fit_verdict
+from tyredamp.studies.verdicts import modal_fit_verdict
 
 F = np.linspace(5.0, 100.0, 400)
 

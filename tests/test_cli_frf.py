@@ -16,7 +16,7 @@ from tyredamp.cli import main
 from tyredamp.io import read_frf, write_frf, write_timedata
 from tyredamp.signal import estimate_frf
 from tyredamp.timedata import TimeData
-from tyredamp.tyre import run_modal_test
+from tyredamp.virtual import run_modal_test
 
 from .helpers import chain_system
 from .test_signal_estimators import periodic_record
@@ -267,7 +267,7 @@ def test_virtual_tyre_through_cli_within_1_percent_near_resonances(capsys, tmp_p
 def test_frf_refuses_a_reaction_force_as_second_input(capsys, tmp_path: Path) -> None:
     """The lateral time test holds body force, body acceleration and ground force."""
     from tyredamp.io import write_timedata
-    from tyredamp.lateral import VirtualLateralRig
+    from tyredamp.virtual import VirtualLateralRig
 
     td = VirtualLateralRig().time_test(seed=0)
     path = tmp_path / "time.uff"

@@ -1,6 +1,6 @@
 """The demo's own files read back whole, and ``lateral fit`` on them reproduces the demo's fits.
 
-Uses the one quick demo of the test session (:func:`tests.test_demo.quick_demo`).
+Uses the one quick demo of the test session (:func:`tests.test_studies_demo.quick_demo`).
 """
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from tyredamp.cli import main
-from tyredamp.demo import DemoResult
 from tyredamp.io import read_frf, read_timedata
 from tyredamp.lateral import DEFAULT_MODELS, LateralData, rank_models
+from tyredamp.studies.results import DemoResult
 
-from .test_demo import quick_demo
+from .test_studies_demo import quick_demo
 
 
 @pytest.fixture(scope="module")
@@ -26,7 +26,7 @@ def demo() -> tuple[DemoResult, Path]:
 
 
 def test_every_data_file_reads_back_whole(demo: tuple[DemoResult, Path]) -> None:
-    from tyredamp.demo import _data_files
+    from tyredamp.report.demo import _data_files
 
     result, out = demo
     files = _data_files(result)
@@ -45,11 +45,11 @@ def test_every_data_file_reads_back_whole(demo: tuple[DemoResult, Path]) -> None
 
 def test_json_documents_read_back(demo: tuple[DemoResult, Path]) -> None:
     from tyredamp.damping import DampingModel
-    from tyredamp.modal.io import read_modes_json
+    from tyredamp.documents.modes import read_modes_json
 
     result, out = demo
     p0 = f"{result.radial.main.pressure_bar:g}bar"
-    from tyredamp.io.jsonfile import json_text
+    from tyredamp.documents.jsonfile import json_text
 
     def same(a: object, b: object) -> None:
         # everything the documents hold, compared in their JSON form
@@ -116,7 +116,7 @@ def test_every_stage_warning_reaches_the_report_beside_its_result(
 ) -> None:
     import html
 
-    from tyredamp.report.findings import demo_findings
+    from tyredamp.studies.findings import demo_findings
 
     result, out = demo
     doc = json.loads((out / "results.json").read_text())

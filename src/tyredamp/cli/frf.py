@@ -10,8 +10,10 @@ import numpy as np
 from ..exceptions import InputError
 from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
+from ..io._safety import check_output_file
 from ..signal.checks import dependent_forces
-from ..signal.estimators import ESTIMATORS, estimate_frf
+from ..signal.estimators import ESTIMATORS
+from ..studies.radial import frf_from_time
 from ..timedata import TimeData
 from ._common import out_file_option
 
@@ -116,13 +118,12 @@ def frf_command(
       tyredamp frf tyre_test.uff --out tyre_frf.uff --estimator H1
       tyredamp frf rig.npz --out frf.csv --reference 1+Z --method welch --segment 4096
     """
-    if out.resolve() == time_file.resolve():
-        raise InputError(f"--out: {out} is the input file; choose another name")
+    check_output_file(out, [time_file])
     out_format = format_of(out, fmt)
     td = read_timedata(time_file)
     if not references and len(td.force_indices) > 1:
         _refuse_dependent_forces(td)
-    frf = estimate_frf(
+    frf = frf_from_time(
         td,
         estimator,  # type: ignore[arg-type]
         reference=list(references) or None,

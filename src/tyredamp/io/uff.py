@@ -42,14 +42,7 @@ Metadata record
 ---------------
 When ``meta`` does not fit the ID lines whole, the file also holds the whole
 ``meta`` as JSON in a chain of data sets 151 (header) placed before the data
-sets 58, so nothing is truncated (the conditions of a lateral rig FRF, the
-truth of a virtual test, a long description). Each 151 set carries
-``tyredamp1 meta K N`` (part K of N, from 1) in its model-name field and up to
-240 characters of the JSON in its description, application and program
-fields (80 each). The JSON is ASCII with every space written as the JSON
-escape ``\u0020`` (so no field begins or ends with a blank that a reader
-would strip); it decodes to the same ``meta``. Other programs see ordinary
-header sets; the ID lines still carry what fits, as before.
+sets 58, so nothing is truncated (layout in :mod:`tyredamp.io._uff_meta`).
 
 Reading other programs' files
 -----------------------------
@@ -77,13 +70,12 @@ from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
 from ._atomic import atomic_path
-from ._common import check_input_file, meta_from_json, meta_to_json, wrap_errors
+from ._common import check_input_file, meta_to_json, wrap_errors
+from ._uff_meta import meta_record, read_meta_record
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
 
 _MARK = "tyredamp1"
-_META_MARK = f"{_MARK} meta"
-_META_FIELDS = ("description", "db_app", "program")
 _SDT = {"displacement": 8, "velocity": 11, "acceleration": 12, "force": 13}
 _SDT_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 13: "force", 9: "force"}
 _KIND_QUANTITY = {
@@ -212,58 +204,6 @@ def _meta_fits(meta: dict[str, Any], lines: list[str]) -> bool:
     for line in lines:
         kept.update(_extras(line))
     return len(kept) == len(meta)
-
-
-def _meta_record(meta: dict[str, Any]) -> list[dict[str, Any]]:
-    """Data sets 151 holding the whole ``meta`` as JSON (module docs, "Metadata record")."""
-    text = meta_to_json(meta).replace(" ", "\\u0020")
-    per_set = 80 * len(_META_FIELDS)
-    chunks = [text[k : k + per_set] for k in range(0, len(text), per_set)] or ["{}"]
-    out = []
-    for k, chunk in enumerate(chunks):
-        d: dict[str, Any] = {
-            "type": 151,
-            "model_name": f"{_META_MARK} {k + 1} {len(chunks)}",
-            # fixed dates: the same data give the same file
-            "date_db_created": "",
-            "time_db_created": "",
-            "date_db_saved": "",
-            "time_db_saved": "",
-            "date_file_written": "",
-            "time_file_written": "",
-        }
-        for j, name in enumerate(_META_FIELDS):
-            d[name] = chunk[80 * j : 80 * (j + 1)] or "NONE"
-        out.append(d)
-    return out
-
-
-def _read_meta_record(p: Path, headers: list[dict[str, Any]]) -> dict[str, Any] | None:
-    """The ``meta`` of the data sets 151 written by :func:`_meta_record`, None without them."""
-    parts: dict[int, str] = {}
-    total = None
-    for h in headers:
-        tokens = str(h.get("model_name", "")).split()
-        if len(tokens) != 4 or " ".join(tokens[:2]) != _META_MARK:
-            continue
-        try:
-            k, n = int(tokens[2]), int(tokens[3])
-        except ValueError:
-            raise FileFormatError(f"{p}: corrupt tyredamp metadata record {tokens!r}") from None
-        if (total is not None and n != total) or k in parts or not 1 <= k <= n:
-            raise FileFormatError(f"{p}: corrupt tyredamp metadata record (part {k} of {n})")
-        total = n
-        parts[k] = "".join(
-            "" if str(h.get(name, "")).strip() == "NONE" else str(h.get(name, "")).strip()
-            for name in _META_FIELDS
-        )
-    if total is None:
-        return None
-    if len(parts) != total:
-        raise FileFormatError(
-            f"{p}: incomplete tyredamp metadata record: {len(parts)} of {total} parts"
-        )
-    return meta_from_json("".join(parts[k] for k in range(1, total + 1)), f"{p}: metadata record")
 
 
 def _even_axis(f: np.ndarray) -> str | None:
@@ -423,7 +363,7 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
     if not meta_ok:
-        sets = [*_meta_record(obj.meta), *sets]
+        sets = [*meta_record(obj.meta), *sets]
     with atomic_path(path) as tmp, warnings.catch_warnings():
         # pyuff's 58b writer reopens the file and leaves that handle to the garbage
         # collector: silence the ResourceWarning and collect inside this block
@@ -510,7 +450,7 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
                 f"{s.get('num_pts')} values, found {got}"
             )
         s["_index"] = k + 1
-    record = _read_meta_record(p, heads)
+    record = read_meta_record(p, heads)
     if record is not None:
         for s in sets:
             s["_meta"] = record
@@ -535,7 +475,7 @@ def _extras(line: Any) -> dict[str, Any]:
         return {}
     try:
         d = json.loads(text)
-    except json.JSONDecodeError:
+    except (json.JSONDecodeError, RecursionError):
         return {}
     return d if isinstance(d, dict) else {}
 

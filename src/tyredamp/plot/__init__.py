@@ -19,6 +19,7 @@ function                               figure
 :func:`plot_ranking`                   every ranked lateral fit (Figs. 11, 12)
 :func:`plot_lateral_models`            measured vs predictions and truth (Figs. 11-14)
 :func:`plot_time_comparison`           lateral time response (Fig. 15)
+:func:`plot_ring_frequencies`          measured vs updated-ring frequencies per n and pressure
 =====================================  =========================================
 """
 
@@ -30,6 +31,7 @@ from .frf import plot_frf, plot_frf_comparison
 from .lateral import plot_figure7, plot_lateral_fit, plot_ranking, plot_time_comparison
 from .modal import plot_discrepancy, plot_mode_shapes_ring
 from .stabilisation import plot_stabilisation
+from .tyremodel import plot_ring_frequencies
 
 __all__ = [
     "plot_discrepancy",
@@ -41,6 +43,7 @@ __all__ = [
     "plot_matrix",
     "plot_mode_shapes_ring",
     "plot_ranking",
+    "plot_ring_frequencies",
     "plot_stabilisation",
     "plot_time_comparison",
 ]

@@ -1,8 +1,8 @@
 """The demo's HTML report: results and figures into one self-contained page.
 
 :func:`build_demo_report` lays out the page from a
-:class:`~tyredamp.demo.DemoResult`, its results document
-(:func:`tyredamp.results.build_results`) and the rendered figures
+:class:`~tyredamp.studies.demo.DemoResult`, its results document
+(:func:`tyredamp.studies.document.build_results`) and the rendered figures
 (:func:`tyredamp.report.figures.demo_figures`). Sections: summary, inputs and
 settings, the radial study (checks, stabilisation, modes with standard errors
 beside the truth, real against complex fit, mode shapes, damping matrices with
@@ -23,7 +23,7 @@ from .. import __version__
 from .html import HtmlReport
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult
+    from ..studies.results import DemoResult
 
 __all__ = ["SECTIONS", "build_demo_report", "fmt_pm"]
 
@@ -395,8 +395,13 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     _image(rep, images, "mode_shapes")
     _image(rep, images, "mac")
 
+    _radial_damping(rep, doc, images)
+    _radial_pressures(rep, doc, images)
+
+
+def _radial_damping(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
+    dmp = doc["radial"]["damping"]
     rep.heading("Damping matrices", 3)
-    dmp = rad["damping"]
     rep.table(
         ["diagnostic", "value"],
         [
@@ -419,6 +424,9 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     _warnings(rep, doc, "radial:damping")
     _image(rep, images, "fig05_damping")
 
+
+def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
+    rad = doc["radial"]
     rep.heading("Inflation pressure", 3)
     rows = []
     for pr in rad["pressures"]:
@@ -487,6 +495,49 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
     )
     _image(rep, images, "fig07_corner_frequency")
 
+    _lateral_ranking(rep, lat)
+    conds = lat["conditions"]
+    rep.table(
+        [
+            "condition",
+            "best",
+            "f0 (Hz), eq. 38",
+            "C_r fitted (kN s/m)",
+            "C_alpha/V true (kN s/m)",
+            "C_r / (C_alpha/V)",
+        ],
+        [
+            [
+                c["label"],
+                c["best"],
+                fmt_pm(c["corner_frequency_hz"], c["corner_frequency_std_hz"]),
+                fmt_pm(c["road_damping"]["fitted"], c["road_damping"]["stderr"], 4, 1e-3),
+                _num(c["road_damping"]["true"] / 1e3, ".4g"),
+                _num(c["road_damping"]["ratio"], ".3g"),
+            ]
+            for c in conds
+        ],
+        caption="Corner frequency of the fitted proposed model and its tyre-road damper C_r "
+        "beside C_alpha/V of the rig's tyre (eq. 33: the low-frequency limit of its "
+        "mobility). The band starts at 0.25 Hz, near f0, so C_r is set mostly by the "
+        "transition region, where the rig's stiffening foundation and contact length depart "
+        "from the model: a model-form difference, not noise (compare the standard error).",
+    )
+    for c in conds:
+        _verdict(rep, c["verdict"])
+        _warnings(rep, doc, f"lateral:{c['label']}")
+    _lateral_parameters(rep, result)
+    speeds = result.settings.lateral_speeds_kmh
+    rep.heading("Measured against predicted FRFs (paper Figs. 11-14)", 3)
+    for force in ("ground", "axle"):
+        for v in speeds:
+            _image(rep, images, _fig_name(images, force, v))
+
+    _lateral_vehicle(rep, doc, images)
+
+
+def _lateral_ranking(rep: HtmlReport, lat: dict[str, Any]) -> None:
+    """The overall ranking and the Table 1 analogue (amplitude errors per condition)."""
     rep.heading("Model ranking", 3)
     rep.table(
         [
@@ -543,35 +594,10 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         + lat["criterion"].upper()
         + " at that condition.",
     )
-    rep.table(
-        [
-            "condition",
-            "best",
-            "f0 (Hz), eq. 38",
-            "C_r fitted (kN s/m)",
-            "C_alpha/V true (kN s/m)",
-            "C_r / (C_alpha/V)",
-        ],
-        [
-            [
-                c["label"],
-                c["best"],
-                fmt_pm(c["corner_frequency_hz"], c["corner_frequency_std_hz"]),
-                fmt_pm(c["road_damping"]["fitted"], c["road_damping"]["stderr"], 4, 1e-3),
-                _num(c["road_damping"]["true"] / 1e3, ".4g"),
-                _num(c["road_damping"]["ratio"], ".3g"),
-            ]
-            for c in conds
-        ],
-        caption="Corner frequency of the fitted proposed model and its tyre-road damper C_r "
-        "beside C_alpha/V of the rig's tyre (eq. 33: the low-frequency limit of its "
-        "mobility). The band starts at 0.25 Hz, near f0, so C_r is set mostly by the "
-        "transition region, where the rig's stiffening foundation and contact length depart "
-        "from the model: a model-form difference, not noise (compare the standard error).",
-    )
-    for c in conds:
-        _verdict(rep, c["verdict"])
-        _warnings(rep, doc, f"lateral:{c['label']}")
+
+
+def _lateral_parameters(rep: HtmlReport, result: DemoResult) -> None:
+    """Every fitted parameter at the reference condition beside the rig's own value."""
     ref = result.lateral.reference
     rep.paragraph(f"Ranking at {ref.label}:")
     rep.bullets(list(ref.ranking.reasons))
@@ -615,12 +641,11 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         )
         + f"; C_alpha/V = {ref.true_road_damping:.4g} N s/m."
     )
-    speeds = result.settings.lateral_speeds_kmh
-    rep.heading("Measured against predicted FRFs (paper Figs. 11-14)", 3)
-    for force in ("ground", "axle"):
-        for v in speeds:
-            _image(rep, images, _fig_name(images, force, v))
 
+
+def _lateral_vehicle(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
+    lat = doc["lateral"]
+    models = lat["models"]
     rep.heading("Vehicle model and time response", 3)
     veh = lat["vehicle"]
     tr = lat["time_response"]
@@ -697,7 +722,7 @@ def build_demo_report(
     ----------
     result : DemoResult
     doc : dict
-        Its results document (:func:`tyredamp.results.build_results`).
+        Its results document (:func:`tyredamp.studies.document.build_results`).
     images : mapping of str to (bytes, str)
         PNG bytes and caption of each figure by name
         (:func:`tyredamp.report.figures.demo_figures`).

@@ -22,9 +22,9 @@ A lateral file is drawn against its FRF file in the same way.
 
 from __future__ import annotations
 
-import json
+import contextlib
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,8 +33,10 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .. import __version__
+from ..documents import read_document
 from ..exceptions import FileFormatError, InputError, TyredampError
 from ..frf import FRF
+from ..io import FILE_FORMATS, read
 from ..io._common import check_input_file
 from ..modal.model import ModalModel
 from ..timedata import TimeData
@@ -43,7 +45,10 @@ from .html import HtmlReport
 
 __all__ = ["ResultFile", "build_files_report", "load_result_file"]
 
-_DATA_EXT = (".uff", ".unv", ".uf", ".csv", ".npz")
+
+def _data_extensions() -> tuple[str, ...]:
+    """Extensions of the measurement formats (FRF, time data), from the io registry."""
+    return tuple(ext for f in FILE_FORMATS.values() for ext in f.extensions)
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,53 +89,26 @@ def load_result_file(path: str | Path) -> ResultFile:
         Unreadable, not JSON where JSON is expected, or not a tyredamp result.
     """
     p = check_input_file(path)
-    if p.suffix.lower() in _DATA_EXT:
-        from ..io import read
-
+    data_ext = _data_extensions()
+    if p.suffix.lower() in data_ext:
         obj = read(p)
         return ResultFile(p, "frf" if isinstance(obj, FRF) else "timedata", obj)
     if p.suffix.lower() != ".json":
         raise FileFormatError(
             f"{p}: unknown file extension {p.suffix or '(none)'!r}; expected .json (modes, "
-            f"damping, lateral fit, demo results) or {', '.join(_DATA_EXT)} (FRF, time data)"
+            f"damping, lateral fit, demo results) or {', '.join(data_ext)} (FRF, time data)"
         )
     try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise FileFormatError(f"{p}: not a text (JSON) file") from None
-    if not text.strip():
-        raise FileFormatError(f"{p}: the file is empty")
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    if not isinstance(doc, dict):
-        raise FileFormatError(f"{p}: expected a JSON object, got {type(doc).__name__}")
-    kind = doc.get("kind")
-    try:
-        if kind == "modes":
-            from ..modal.io import read_modes_json
-
-            return ResultFile(p, "modes", read_modes_json(p), doc)
-        if kind == "damping":
-            from ..damping import DampingModel
-
-            return ResultFile(p, "damping", DampingModel.from_dict(doc), doc)
-        if kind == "tyredamp-demo-results":
-            return ResultFile(p, "demo", doc, doc)
-        if doc.get("tyredamp") == "lateral-fit":
-            _ = doc["table"], doc["fits"], doc["conditions"]
-            return ResultFile(p, "lateral", doc, doc)
-    except KeyError as exc:
-        raise FileFormatError(f"{p}: missing key {exc.args[0]!r}") from None
-    except TyredampError as exc:
-        if isinstance(exc, FileFormatError):
+        kind, obj, doc = read_document(p)
+    except FileFormatError as exc:
+        if "not a tyredamp result document" not in str(exc):
             raise
-        raise FileFormatError(f"{p}: {exc}") from None
-    raise FileFormatError(
-        f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
-        f"results JSON, or an FRF/time-data file {', '.join(_DATA_EXT)})"
-    )
+        raise FileFormatError(
+            f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
+            f"results JSON, or an FRF/time-data file {', '.join(data_ext)})"
+        ) from None
+    short = {"lateral-fit": "lateral", "tyredamp-demo-results": "demo"}.get(kind, kind)
+    return ResultFile(p, short, obj, doc)
 
 
 # ----------------------------------------------------------------------------- sections
@@ -215,7 +193,7 @@ def _time_section(rep: HtmlReport, item: ResultFile) -> None:
 
 
 def _match(freq: np.ndarray, ref: np.ndarray) -> dict[int, int]:
-    from ..demo import match_modes
+    from ..studies.radial import match_modes
 
     return {m: t for t, m in match_modes(freq, ref).matched}
 
@@ -484,7 +462,7 @@ def _num(v: Any) -> float:
 def _rig_truth(meta: dict[str, Any]) -> Any:
     """The exact tyre model a virtual lateral rig stored in an FRF's meta, or None."""
     from ..lateral.models import LateralModel
-    from ..lateral.rig import ViscoelasticStringTyre
+    from ..virtual.lateral_rig import ViscoelasticStringTyre
 
     d = meta.get("truth")
     if not isinstance(d, dict) or "params" not in d:
@@ -596,16 +574,32 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
             continue
         rep.heading(heading)
         for item in group:
-            if item.kind == "frf":
-                _frf_section(rep, item)
-            elif item.kind == "timedata":
-                _time_section(rep, item)
-            elif item.kind == "modes":
-                _modes_section(rep, item, frfs, truth)
-            elif item.kind == "damping":
-                _damping_section(rep, item)
-            elif item.kind == "lateral":
-                _lateral_section(rep, item, frfs)
-            else:
-                _demo_section(rep, item)
+            with _content_errors(item.path):
+                if item.kind == "frf":
+                    _frf_section(rep, item)
+                elif item.kind == "timedata":
+                    _time_section(rep, item)
+                elif item.kind == "modes":
+                    _modes_section(rep, item, frfs, truth)
+                elif item.kind == "damping":
+                    _damping_section(rep, item)
+                elif item.kind == "lateral":
+                    _lateral_section(rep, item, frfs)
+                else:
+                    _demo_section(rep, item)
     return rep.render()
+
+
+@contextlib.contextmanager
+def _content_errors(path: Path) -> Iterator[None]:
+    """A result JSON whose fields have the wrong type (strings for numbers, a number for a
+    list ...) is the file's fault: one FileFormatError naming it, not a traceback."""
+    try:
+        yield
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError) as exc:
+        if isinstance(exc, TyredampError):
+            raise FileFormatError(f"{path}: {exc}") from exc
+        name = type(exc).__name__
+        raise FileFormatError(
+            f"{path}: a field has the wrong type or value ({name}: {exc})"
+        ) from exc
