@@ -179,7 +179,8 @@ def _prepare(
         if frf.n_out * frf.n_in != 1:
             raise ShapeError(
                 f"channel: the FRF holds {frf.n_out}x{frf.n_in} FRFs, a lateral fit takes one; "
-                "choose it with channel=(out, in) (command line: --channel OUT IN)"
+                "choose it with channel=(out, in), counted from 0 (command line: --channel OUT IN, "
+                "counted from 1)"
             )
         channel = (0, 0)
     i, j = channel
