@@ -31,13 +31,18 @@ Time-data layout::
     # sample_rate: 2048.0
     # channel: {"node": 1, "direction": 3, "angle_deg": null, "name": "", "quantity": "force"}
     # channel: ...                   (one line per column after time_s)
-    # meta: {"period_samples": 4096}
+    # acquisition: {"period_samples": 4096, "settle_samples": 8192} (optional)
+    # meta: {"operator": "..."}      (free notes, optional)
     time_s,1+Z [N],2+Z [m/s^2],...
     0,0.5,0.001,...
 
 * ``time_s``: sample time in s (informative; ``sample_rate`` in Hz is what is
   used; without a ``sample_rate`` line it is taken from the time column).
 * one column per channel in SI units (N, m, m/s, m/s^2 by ``quantity``).
+* ``acquisition``: the fields of :class:`~tyredamp.timedata.Acquisition`
+  (``period_samples``, ``run_starts``, ``settle_samples``,
+  ``record_samples``, ``band_hz``, ``n_averages``, ``excitation``); files
+  written before it existed kept them in ``meta`` and still read the same.
 
 Channel records: ``node`` (int), ``direction`` (UFF code, 3 = +Z/radial),
 ``angle_deg`` (float or null), ``name`` (str); time-data channels add
@@ -55,7 +60,7 @@ import numpy as np
 
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, UNITS
-from ..timedata import TimeData
+from ..timedata import Acquisition, TimeData
 from ._atomic import atomic_path
 from ._common import (
     channel_from_dict,
@@ -106,6 +111,9 @@ def write_csv(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
             f"{c.label} [{u}]" for c, u in zip(obj.channels, obj.units, strict=True)
         ]
         table = np.hstack([obj.time[:, None], obj.data.T])
+        acq = obj.acquisition.to_dict()
+        if acq:
+            head.append(f"# acquisition: {meta_to_json(acq)}")
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
     if obj.meta:
@@ -233,11 +241,17 @@ def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
                 if np.any(dt <= 0) or np.ptp(dt) > 1e-6 * np.mean(dt):
                     raise FileFormatError(f"{p}: time column is not evenly increasing")
                 fs = 1.0 / float(np.mean(dt))
+            acq = None
+            if "acquisition" in fields:
+                acq = Acquisition.from_dict(
+                    meta_from_json(fields["acquisition"][0], f"{p}: acquisition")
+                )
             return TimeData(
                 table[:, 1:].T,
                 fs,
                 [channel_from_dict(r, f"{p}: channel") for r in recs],
                 [str(r.get("quantity", "")) for r in recs],
                 meta=meta,
+                acquisition=acq,
             )
     raise FileFormatError(f"{p}: type {typ!r} is not 'frf' or 'timedata'")

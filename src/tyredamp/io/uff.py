@@ -19,9 +19,10 @@ What is written
 * ID line 1: a description (``meta["description"]`` or ``"tyredamp FRF ..."``);
   ID line 2: ``tyredamp1 ...`` with the exact frequency axis or sample rate
   as Python floats (the fixed E13.5 fields of record 7 keep only 6 digits);
-  ID line 3: as much of ``meta`` as fits in 80 characters as JSON, the keys
-  the estimators use first (``period_samples``, ``settle_samples``,
-  ``record_samples``, ``run_starts``, ``band_hz`` ...);
+  ID line 3: as much of ``meta`` as fits in 80 characters as JSON, for time
+  data the acquisition fields first (``period_samples``, ``settle_samples``,
+  ``record_samples``, ``run_starts``, ``band_hz`` ..., read back into
+  ``TimeData.acquisition``);
   ID lines 4 and 5: channel name and angle of the response and reference as
   JSON (``NONE`` when there are none); time data have no reference, and ID
   line 5 continues the metadata.
@@ -153,6 +154,8 @@ _PRIORITY = (
     "record_samples",
     "run_starts",
     "band_hz",
+    "n_averages",
+    "excitation",
     "estimator",
     "method",
     "n_averages",
@@ -320,7 +323,8 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
                 sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
     elif isinstance(obj, TimeData):
         id1 = str(obj.meta.get("description", "tyredamp time data"))
-        id3, id5 = _meta_lines(obj.meta, 2)  # time data: ID line 5 continues the metadata
+        # time data: ID line 5 continues the metadata; the acquisition fields go first
+        id3, id5 = _meta_lines({**obj.acquisition.to_dict(), **obj.meta}, 2)
         t = obj.time
         for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
             d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)

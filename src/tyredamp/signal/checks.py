@@ -415,7 +415,7 @@ def quality_check(
         (the verdict figure and threshold).
     clip_run : int
         Shortest run of equal samples at a channel extreme counted as
-        clipping (see :func:`clipping`; with ``meta["period_samples"]`` one
+        clipping (see :func:`clipping`; with ``acquisition.period_samples`` one
         repeat of the extreme per period is accepted).
     passivity_floor : float
         Allowed negative ``Re Y / |Y|`` at a drive point besides the random
@@ -443,7 +443,7 @@ def quality_check(
     problems: list[str] = []
     frf: FRF | None
     if isinstance(data, TimeData):
-        period = data.meta.get("period_samples")
+        period = data.acquisition.period_samples
         reps = max(1, data.n_samples // int(period)) if period else 1
         clipped = {
             c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)

@@ -438,19 +438,19 @@ def estimate_frf(
         :func:`resolve_channels` (label ``"1+Z"``, name, node number or
         :class:`Channel`).
     method : {"cyclic", "welch", "transient"}, optional
-        Default: ``"cyclic"`` when ``timedata.meta["period_samples"]`` (or
-        ``period_samples``) is given, ``"transient"`` when
-        ``meta["record_samples"]`` is given, else ``"welch"``.
+        Default: ``"cyclic"`` when ``timedata.acquisition.period_samples``
+        (or ``period_samples``) is given, ``"transient"`` when
+        ``acquisition.record_samples`` is given, else ``"welch"``.
     outputs : sequence of channel keys, optional
         Response channels; default every non-force channel. They must all be
         the same quantity, which sets the FRF kind (acceleration ->
         accelerance, velocity -> mobility, displacement -> receptance).
     period_samples : int, optional
         Period of a periodic excitation in samples (cyclic method); default
-        ``meta["period_samples"]``.
+        ``timedata.acquisition.period_samples``.
     segment_samples : int, optional
         Segment length: Welch default ``n_samples // 8``; transient default
-        ``meta["record_samples"]``. Not used by the cyclic method.
+        ``timedata.acquisition.record_samples``. Not used by the cyclic method.
     overlap : float, optional
         Welch overlap fraction in [0, 1) (default 0.5); 0 for the other methods.
     window : str or tuple, optional
@@ -458,9 +458,9 @@ def estimate_frf(
         (the cyclic method accepts only ``"boxcar"``).
     settle_samples : int, optional
         Samples dropped at the start of the record, or of each run when
-        ``meta["run_starts"]`` lists the first samples of separately driven
-        runs (segments never straddle runs); default
-        ``meta["settle_samples"]`` or 0.
+        ``timedata.acquisition.run_starts`` lists the first samples of
+        separately driven runs (segments never straddle runs); default
+        ``acquisition.settle_samples``.
     force_window_samples : int, optional
         Transient method: flat length of the force window on the inputs (with
         a taper of a tenth of it).
@@ -470,7 +470,7 @@ def estimate_frf(
         ``1/tau`` to every modal decay rate).
     band : (float, float), optional
         Keep only lines with ``band[0] <= f <= band[1]`` (Hz); default
-        ``meta["band_hz"]`` when given, else all excited lines.
+        ``timedata.acquisition.band_hz`` when given, else all excited lines.
     min_relative_power : float
         Lines where an input's auto spectrum is below this fraction of its
         maximum are not excited and are left out (for a multisine, every line
@@ -526,17 +526,17 @@ def estimate_frf(
                 f"reference: force channel {chans[i].label} is all zeros; no excitation recorded"
             )
 
-    meta = timedata.meta
+    acq = timedata.acquisition
     if method is None:
-        if period_samples is not None or "period_samples" in meta:
+        if period_samples is not None or acq.period_samples is not None:
             method = "cyclic"
-        elif segment_samples is None and "record_samples" in meta:
+        elif segment_samples is None and acq.record_samples is not None:
             method = "transient"
         else:
             method = "welch"
     if method not in METHODS:
         raise InputError(f"method: expected one of {METHODS}, got {method!r}")
-    settle = settle_samples if settle_samples is not None else meta.get("settle_samples", 0)
+    settle = settle_samples if settle_samples is not None else acq.settle_samples
     settle = _as_count(settle, "settle_samples", minimum=0)
     fs = timedata.sample_rate
     n = timedata.n_samples
@@ -545,9 +545,11 @@ def estimate_frf(
     window_arg: Any = None
     info: dict[str, Any] = {}
     if method == "cyclic":
-        p = period_samples if period_samples is not None else meta.get("period_samples")
+        p = period_samples if period_samples is not None else acq.period_samples
         if p is None:
-            raise InputError("method: 'cyclic' needs period_samples (argument or meta)")
+            raise InputError(
+                "method: 'cyclic' needs period_samples (argument or timedata.acquisition)"
+            )
         seg = _as_count(p, "period_samples", minimum=2)
         if window not in (None, "boxcar", "rect", "rectangular"):
             raise InputError(
@@ -570,9 +572,11 @@ def estimate_frf(
         win = window if window is not None else "hann"
         detrend = True
     else:
-        rec = segment_samples if segment_samples is not None else meta.get("record_samples")
+        rec = segment_samples if segment_samples is not None else acq.record_samples
         if rec is None:
-            raise InputError("method: 'transient' needs segment_samples or meta['record_samples']")
+            raise InputError(
+                "method: 'transient' needs segment_samples or timedata.acquisition.record_samples"
+            )
         seg = _as_count(rec, "segment_samples", minimum=2)
         if overlap not in (None, 0, 0.0):
             raise InputError(f"overlap: the transient method uses whole records, got {overlap!r}")
@@ -586,7 +590,7 @@ def estimate_frf(
             ew, tau = exponential_window(seg, fs, exponential_end)
             window_arg = segment_window(win, seg) * ew
             info["exponential_tau_s"] = tau
-    seg_starts = _segment_starts(meta, n, seg, step, settle)
+    seg_starts = _segment_starts(acq.run_starts, n, seg, step, settle)
     if seg_starts.size == 0:
         raise InputError(
             f"timedata: no whole segment of {seg} samples ({method} method) in {n} samples "
@@ -606,8 +610,8 @@ def estimate_frf(
         detrend=detrend,
         full_output=mimo_h2,
     )
-    if band is None and "band_hz" in meta:
-        band = (float(meta["band_hz"][0]), float(meta["band_hz"][1]))
+    if band is None and acq.band_hz is not None:
+        band = acq.band_hz
     lines = _excited_lines(spectra, min_relative_power)
     if band is not None:
         lo, hi = float(band[0]), float(band[1])
@@ -649,21 +653,10 @@ def estimate_frf(
 
 
 def _segment_starts(
-    meta: dict[str, Any], n: int, seg: int, step: int, settle: int
+    run_starts: Sequence[int], n: int, seg: int, step: int, settle: int
 ) -> NDArray[np.intp]:
-    """First samples of the segments: within each run (``meta["run_starts"]``), after settling."""
-    runs = meta.get("run_starts", [0])
-    try:
-        r = np.asarray(runs, dtype=np.int64).ravel()
-    except (TypeError, ValueError):
-        raise InputError(
-            f"timedata.meta['run_starts']: expected sample indices, got {runs!r}"
-        ) from None
-    if r.size == 0 or r[0] != 0 or np.any(np.diff(r) <= 0) or r[-1] >= n:
-        raise InputError(
-            "timedata.meta['run_starts']: expected increasing sample indices from 0 below "
-            f"{n}, got {runs!r}"
-        )
+    """First samples of the segments: within each run (``run_starts``), after settling."""
+    r = np.asarray(run_starts, dtype=np.int64)
     stops = np.append(r[1:], n)
     out = [np.arange(a + settle, b - seg + 1, step) for a, b in zip(r, stops, strict=True)]
     return np.concatenate(out).astype(np.intp)

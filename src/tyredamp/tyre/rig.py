@@ -14,7 +14,7 @@ Excitation
 edges are moved to DFT lines so that it is continuous from period to period).
 ``"multisine"``: the band-limited Schroeder multisine of
 :func:`~tyredamp.tyre.excitation.schroeder_multisine` (flat spectrum on the
-band lines, nothing elsewhere). ``meta["lines"]`` lists the DFT lines of one
+band lines, nothing elsewhere). ``data.meta["lines"]`` lists the DFT lines of one
 period inside ``band``.
 
 Steady state
@@ -30,7 +30,7 @@ steady-state response is exactly periodic, so the record is that period
 repeated, plus independent noise. ``initial_state="rest"`` instead simulates
 every period from rest (the transient decays with the slowest mode, about
 ``1 / sigma_min`` s) and drops ``settle_periods`` leading periods, or keeps
-them and says so in ``meta["settle_samples"]``.
+them and says so in ``data.acquisition.settle_samples``.
 
 Sampling
 --------
@@ -61,13 +61,13 @@ every run with the same signal times the signs of a Hadamard matrix
 so the input cross-spectral matrix summed over the runs is diagonal. Either
 way every period of the record is a steady-state period and an H1 estimator
 over all periods (all runs) recovers every FRF column;
-``meta["run_starts"]`` gives the first sample of each run.
+``data.acquisition.run_starts`` gives the first sample of each run.
 """
 
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -79,7 +79,7 @@ from ..exceptions import InputError
 from ..frf import FRF, FRFKind
 from ..mechanics import ComplexModes, MCKSystem, step_coefficients, time_response
 from ..signal.excitation import band_lines, periodic_chirp
-from ..timedata import TimeData
+from ..timedata import Acquisition, TimeData
 from .excitation import hadamard_drive_matrix, schroeder_multisine
 from .ring import RingTyre
 from .truth import TyreTruth
@@ -100,10 +100,11 @@ class VirtualModalTest:
     data : TimeData
         Force channels (one per drive point, quantity ``"force"``, N) then
         acceleration channels (one per measured point, ``"acceleration"``,
-        m/s^2). ``data.meta`` holds ``period_samples``, ``settle_samples``,
-        ``n_periods`` (per run), ``run_starts``, ``drive_matrix``,
-        ``excitation`` (signal name), ``lines``, ``band_hz``, ``snr_db``,
-        ``noise_std``, ``seed`` and more.
+        m/s^2). ``data.acquisition`` states ``period_samples``,
+        ``settle_samples``, ``n_averages`` (periods per run), ``run_starts``,
+        ``band_hz`` and ``excitation`` (signal name); ``data.meta`` notes
+        ``drive_matrix``, ``lines``, ``snr_db``, ``noise_std``, ``seed`` and
+        more.
     truth : TyreTruth
         Exact modes, damping and FRFs of the tested tyre in the test band.
     tyre : RingTyre
@@ -118,9 +119,26 @@ class VirtualModalTest:
     drive_matrix: NDArray[np.float64]
 
     @property
+    def acquisition(self) -> Acquisition:
+        """The acquisition record of :attr:`data` (period, runs, settle samples, band)."""
+        return self.data.acquisition
+
+    @property
     def meta(self) -> dict[str, Any]:
-        """The metadata of :attr:`data`."""
-        return self.data.meta
+        """A copy of the notes of :attr:`data` with the acquisition fields as keys.
+
+        ``period_samples``, ``settle_samples``, ``run_starts``, ``band_hz``,
+        ``n_averages`` (periods per run), ``excitation`` come from
+        :attr:`acquisition`; the rest (``lines``, ``drive_matrix``,
+        ``snr_db``, ...) from ``data.meta``.
+        """
+        acq = self.data.acquisition
+        return {
+            **self.data.meta,
+            **acq.to_dict(),
+            "settle_samples": acq.settle_samples,
+            "run_starts": list(acq.run_starts),
+        }
 
     @property
     def n_runs(self) -> int:
@@ -130,7 +148,10 @@ class VirtualModalTest:
     @property
     def period_samples(self) -> int:
         """Samples per excitation period."""
-        return int(self.data.meta["period_samples"])
+        p = self.data.acquisition.period_samples
+        if p is None:  # pragma: no cover - the rig always states it
+            raise InputError("data.acquisition: no period_samples")
+        return p
 
     @property
     def frequency_lines(self) -> NDArray[np.float64]:
@@ -142,12 +163,19 @@ class VirtualModalTest:
         """The samples of one run (including its settle samples, if kept) as a TimeData."""
         if not isinstance(run, int | np.integer) or not 0 <= run < self.n_runs:
             raise InputError(f"run: expected an integer in 0..{self.n_runs - 1}, got {run!r}")
-        starts = [*self.data.meta["run_starts"], self.data.n_samples]
+        acq = self.data.acquisition
+        starts = [*acq.run_starts, self.data.n_samples]
         seg = self.data.data[:, starts[run] : starts[run + 1]]
         meta = dict(self.data.meta)
-        meta["run_starts"] = [0]
         meta["drive_matrix"] = [self.drive_matrix[run].tolist()]
-        return TimeData(seg, self.data.sample_rate, self.data.channels, self.data.quantities, meta)
+        return TimeData(
+            seg,
+            self.data.sample_rate,
+            self.data.channels,
+            self.data.quantities,
+            meta,
+            acquisition=replace(acq, run_starts=(0,)),
+        )
 
     def true_frf(self, frequency: ArrayLike, kind: FRFKind = "accelerance") -> FRF:
         """Exact FRF of the tested tyre at the points, shape (n_points, n_drive, n_freq)."""
@@ -415,16 +443,10 @@ def run_modal_test(
     settle = int(settle_periods) * p_samples if keep_settle else 0
     meta: dict[str, Any] = {
         "source": "tyredamp.tyre.run_modal_test (virtual ring tyre)",
-        "period_samples": p_samples,
-        "settle_samples": settle,
-        "n_periods": int(n_periods),
         "n_runs": n_runs,
-        "run_starts": [run * run_len for run in range(n_runs)],
         "drive_mode": drive_mode,
         "drive_matrix": drive.tolist(),
         "drive_points": list(tyre.layout.drive_points),
-        "band_hz": list(bnd),
-        "excitation": exc.name,
         "excitation_band_hz": [float(exc.band[0]), float(exc.band[1])],
         "lines": lines.tolist(),
         "force_rms": f_rms,
@@ -440,11 +462,20 @@ def run_modal_test(
         "n_ring": tyre.n_ring,
         "elapsed_s": _time.perf_counter() - t_start,
     }
+    acquisition = Acquisition(
+        period_samples=p_samples,
+        run_starts=tuple(run * run_len for run in range(n_runs)),
+        settle_samples=settle,
+        band_hz=(float(bnd[0]), float(bnd[1])),
+        n_averages=int(n_periods),
+        excitation=exc.name,
+    )
     data = TimeData(
         measured,
         fs,
         tyre.input_channels + tyre.output_channels,
         ["force"] * n_in + ["acceleration"] * len(outputs),
         meta,
+        acquisition=acquisition,
     )
     return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)
