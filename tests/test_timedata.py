@@ -72,4 +72,7 @@ def test_estimator_reads_acquisition_only() -> None:
     assert frf.meta["method"] == "cyclic"
     assert frf.meta["segment_samples"] == 256
     notes = TimeData(data, 256.0, [1, 2], ["force", "displacement"], meta={"note": 1})
-    assert estimate_frf(notes).meta["method"] == "welch"
+    assert estimate_frf(notes, detect=False).meta["method"] == "welch"  # notes are not read
+    # a misspelt field is refused rather than left as a note
+    with pytest.raises(InputError, match="period_sample"):
+        TimeData(data, 256.0, [1, 2], ["force", "displacement"], meta={"period_sample": 256})

@@ -13,7 +13,33 @@ from ..io import FORMATS, format_of, read_timedata, write_frf
 from ..signal.estimators import ESTIMATORS, estimate_frf
 from ._common import out_file_option
 
-__all__ = ["frf_command", "frf_summary"]
+__all__ = ["frf_command", "frf_summary", "samples"]
+
+
+def samples(text: str, sample_rate: float, option: str) -> int:
+    """A length given as samples (``"4096"``) or seconds (``"0.5s"``) in whole samples.
+
+    Seconds must be a whole number of samples at ``sample_rate`` (to 1e-6 of
+    a sample); otherwise, and for text that is neither, :class:`InputError`
+    names the option.
+    """
+    t = str(text).strip().lower()
+    seconds = t.endswith("s")
+    try:
+        value = float(t[:-1]) * sample_rate if seconds else float(int(t))
+    except ValueError:
+        raise InputError(
+            f"{option}: expected samples (4096) or seconds (0.5s), got {text!r}"
+        ) from None
+    n = round(value) if np.isfinite(value) else -1
+    if seconds and (n < 0 or abs(value - n) > 1e-6 * max(1.0, abs(value))):
+        raise InputError(
+            f"{option}: {text!r} is {value:.6g} samples at {sample_rate:g} Hz, not a whole "
+            "non-negative number; give samples"
+        )
+    if n < 0:
+        raise InputError(f"{option}: expected a non-negative length, got {text!r}")
+    return int(n)
 
 
 def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
@@ -27,6 +53,9 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
         f"estimator {m.get('estimator', '?')}, method {m.get('method', '?')}, "
         f"{m.get('n_averages', '?')} averages of {m.get('segment_samples', '?')} samples",
     ]
+    det = m.get("detection")
+    if isinstance(det, dict) and det.get("reason"):
+        rows.append(f"detected {det['reason']}")
     if frf.coherence is not None:
         coh = frf.coherence
         i_out, i_line = np.unravel_index(int(np.argmin(coh)), coh.shape)
@@ -61,10 +90,22 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
     type=click.Choice(["auto", "cyclic", "welch", "transient"]),
     default="auto",
     show_default=True,
-    help="auto: cyclic when the file states period_samples, transient when it states "
-    "record_samples, else Welch.",
+    help="auto: cyclic when the file states a period, transient when it states a record "
+    "length, else decided from the data (periodic: cyclic; impact: transient; random: Welch).",
 )
 @click.option("--segment", type=click.IntRange(min=2), help="Welch/transient segment in samples.")
+@click.option(
+    "--period",
+    metavar="SAMPLES|SECONDS",
+    help="Period of a periodic excitation: samples (4096) or seconds (0.5s); it must be a "
+    "whole number of samples. Default: from the file, else detected from the force.",
+)
+@click.option(
+    "--settle",
+    metavar="SAMPLES|SECONDS",
+    help="Samples (or seconds, 2s) to drop at the start (transient). Default: from the "
+    "file, else detected for periodic data.",
+)
 @click.option(
     "--band", nargs=2, type=float, metavar="F_LO F_HI", help="Keep lines in this band (Hz)."
 )
@@ -81,6 +122,8 @@ def frf_command(
     references: tuple[str, ...],
     method: str,
     segment: int | None,
+    period: str | None,
+    settle: str | None,
     band: tuple[float, float] | None,
     fmt: str | None,
 ) -> None:
@@ -106,6 +149,8 @@ def frf_command(
         reference=list(references) or None,
         method=None if method == "auto" else method,  # type: ignore[arg-type]
         segment_samples=segment,
+        period_samples=None if period is None else samples(period, td.sample_rate, "--period"),
+        settle_samples=None if settle is None else samples(settle, td.sample_rate, "--settle"),
         band=band or None,
     )
     write_frf(frf, out, out_format)

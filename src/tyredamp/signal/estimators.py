@@ -51,6 +51,7 @@ from .._validate import as_finite, check_positive
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..timedata import TimeData
+from .periodicity import ExcitationDetection, detect_excitation, transient_periods
 from .windows import exponential_window, force_window, segment_window
 
 __all__ = [
@@ -424,6 +425,7 @@ def estimate_frf(
     exponential_end: float | None = None,
     band: tuple[float, float] | None = None,
     min_relative_power: float = 1e-10,
+    detect: bool = True,
 ) -> FRF:
     """Estimate the FRF matrix of a test from its time data.
 
@@ -440,7 +442,8 @@ def estimate_frf(
     method : {"cyclic", "welch", "transient"}, optional
         Default: ``"cyclic"`` when ``timedata.acquisition.period_samples``
         (or ``period_samples``) is given, ``"transient"`` when
-        ``acquisition.record_samples`` is given, else ``"welch"``.
+        ``acquisition.record_samples`` is given, else detected from the data
+        (``detect``), else ``"welch"``.
     outputs : sequence of channel keys, optional
         Response channels; default every non-force channel. They must all be
         the same quantity, which sets the FRF kind (acceleration ->
@@ -475,6 +478,17 @@ def estimate_frf(
         Lines where an input's auto spectrum is below this fraction of its
         maximum are not excited and are left out (for a multisine, every line
         outside its band).
+    detect : bool
+        When neither ``method`` nor a period or record length is stated
+        (argument or ``timedata.acquisition``), decide from the signals with
+        :func:`~tyredamp.signal.periodicity.detect_excitation`: periodic data
+        get cyclic averaging with the detected period and start transient,
+        impact data the transient method on records starting at the hits,
+        the rest Welch. ``method="cyclic"`` without a period also detects it.
+        A period given as an argument to data that state none gets its start
+        transient detected (:func:`~tyredamp.signal.periodicity.transient_periods`)
+        unless ``settle_samples`` is given. The verdict and its reason go to
+        ``meta["detection"]``.
 
     Returns
     -------
@@ -527,6 +541,42 @@ def estimate_frf(
             )
 
     acq = timedata.acquisition
+    detection: ExcitationDetection | None = None
+    stated = (
+        period_samples is not None
+        or acq.period_samples is not None
+        or segment_samples is not None
+        or acq.record_samples is not None
+    )
+    needs_period = method == "cyclic" and period_samples is None and acq.period_samples is None
+    if detect and ((method is None and not stated) or needs_period):
+        detection = detect_excitation(data[ref_idx], data[out_idx])
+        if detection.kind == "periodic":
+            method = "cyclic"
+            period_samples = detection.period_samples
+            if settle_samples is None:
+                settle_samples = detection.settle_samples
+        elif needs_period:
+            raise InputError(
+                f"method: 'cyclic' needs a period; none stated and none found in the data "
+                f"({detection.reason})"
+            )
+        elif detection.kind == "impact" and detection.record_samples is not None:
+            method = "transient"
+            segment_samples = detection.record_samples
+    elif (
+        period_samples is not None
+        and acq.period_samples is None
+        and settle_samples is None
+        and detect
+        and method in (None, "cyclic")
+    ):
+        # a period stated by the caller for data that did not state one: find the
+        # start transient in the data
+        p_arg = _as_count(period_samples, "period_samples", minimum=2)
+        if timedata.n_samples >= 2 * p_arg and len(acq.run_starts) == 1:
+            sel = data[ref_idx + out_idx]
+            settle_samples = transient_periods(sel, p_arg) * p_arg
     if method is None:
         if period_samples is not None or acq.period_samples is not None:
             method = "cyclic"
@@ -590,7 +640,12 @@ def estimate_frf(
             ew, tau = exponential_window(seg, fs, exponential_end)
             window_arg = segment_window(win, seg) * ew
             info["exponential_tau_s"] = tau
-    seg_starts = _segment_starts(acq.run_starts, n, seg, step, settle)
+    if detection is not None and detection.kind == "impact" and method == "transient":
+        seg_starts = np.array(
+            [a for a in detection.record_starts if a >= settle and a + seg <= n], dtype=np.intp
+        )
+    else:
+        seg_starts = _segment_starts(acq.run_starts, n, seg, step, settle)
     if seg_starts.size == 0:
         raise InputError(
             f"timedata: no whole segment of {seg} samples ({method} method) in {n} samples "
@@ -641,6 +696,8 @@ def estimate_frf(
         "settle_samples": settle,
         **info,
     }
+    if detection is not None:
+        meta_out["detection"] = detection.to_dict()
     return FRF(
         spectra.frequency,
         h,
