@@ -122,6 +122,10 @@ class FRF:
         coherence when there is one input), in [0, 1].
     meta : dict, optional
         Free metadata (test description, estimator, number of averages ...).
+    variance : array_like, shape (n_out, n_in, n_freq), optional
+        Variance ``E|H_est - H|^2`` of each estimate of ``H`` (real, >= 0, in
+        the unit of ``H`` squared), as estimated from the measurement noise
+        by the FRF estimator; the weights of a maximum-likelihood fit.
     """
 
     frequency: NDArray[np.float64]
@@ -131,6 +135,7 @@ class FRF:
     inputs: tuple[Channel, ...] = ()
     coherence: NDArray[np.float64] | None = None
     meta: dict[str, Any] = field(default_factory=dict)
+    variance: NDArray[np.float64] | None = None
 
     def __init__(
         self,
@@ -141,6 +146,7 @@ class FRF:
         inputs: Sequence[Channel | int] | None = None,
         coherence: ArrayLike | None = None,
         meta: dict[str, Any] | None = None,
+        variance: ArrayLike | None = None,
     ) -> None:
         f = as_frequency(frequency, "frequency")
         h = as_finite(H, "H", dtype=complex)
@@ -170,6 +176,18 @@ class FRF:
                 raise InputError("coherence: expected values in [0, 1]")
             coh = np.clip(coh, 0.0, 1.0)
             coh.setflags(write=False)
+        var = None
+        if variance is not None:
+            var = as_finite(variance, "variance")
+            if var.shape != h.shape:
+                if var.size == h.size:
+                    var = var.reshape(h.shape)
+                else:
+                    raise ShapeError(f"variance: expected shape {h.shape} like H, got {var.shape}")
+            if np.any(var < 0):
+                raise InputError("variance: expected values >= 0")
+            var = var.copy()
+            var.setflags(write=False)
         f = f.copy()
         h = h.copy()
         f.setflags(write=False)
@@ -181,6 +199,7 @@ class FRF:
         object.__setattr__(self, "inputs", _channels(inputs, h.shape[1], "inputs"))
         object.__setattr__(self, "coherence", coh)
         object.__setattr__(self, "meta", dict(meta or {}))
+        object.__setattr__(self, "variance", var)
 
     # ------------------------------------------------------------------ views
     @property
@@ -223,6 +242,7 @@ class FRF:
             "inputs": self.inputs,
             "coherence": self.coherence,
             "meta": self.meta,
+            "variance": self.variance,
         }
         base.update(changes)
         return FRF(**base)
@@ -257,7 +277,8 @@ class FRF:
                 raise InputError("to: the only frequency line is 0 Hz, nothing left to convert")
             frf = self.select_lines(slice(1, None))
         factor = (1j * frf.omega) ** k
-        return frf._new(H=frf.H * factor, kind=kind)
+        var = None if frf.variance is None else frf.variance * np.abs(factor) ** 2
+        return frf._new(H=frf.H * factor, kind=kind, variance=var)
 
     def receptance(self) -> FRF:
         """Shorthand for ``to("receptance")``."""
@@ -278,7 +299,10 @@ class FRF:
         if idx.size == 0:
             raise InputError("select_lines: the selection holds no frequency line")
         coh = None if self.coherence is None else self.coherence[:, idx]
-        return self._new(frequency=self.frequency[idx], H=self.H[:, :, idx], coherence=coh)
+        var = None if self.variance is None else self.variance[:, :, idx]
+        return self._new(
+            frequency=self.frequency[idx], H=self.H[:, :, idx], coherence=coh, variance=var
+        )
 
     def band(self, f_lo: float, f_hi: float) -> FRF:
         """Return the lines with ``f_lo <= f <= f_hi`` (Hz)."""
@@ -311,6 +335,7 @@ class FRF:
             outputs=[self.outputs[i] for i in oi],
             inputs=[self.inputs[i] for i in ii],
             coherence=coh,
+            variance=None if self.variance is None else self.variance[np.ix_(oi, ii)],
         )
 
     def output_index(self, node: int, direction: int | None = None) -> int:
@@ -331,8 +356,8 @@ class FRF:
         return pairs
 
     def with_H(self, H: ArrayLike, kind: FRFKind | None = None) -> FRF:
-        """Return a copy with new responses on the same axis and channels."""
-        return self._new(H=H, kind=kind or self.kind, coherence=None)
+        """A copy with new responses on the same axis and channels (no coherence or variance)."""
+        return self._new(H=H, kind=kind or self.kind, coherence=None, variance=None)
 
     def plot(self, **kwargs: Any) -> Any:
         """Bode plot of the FRF; see :func:`tyredamp.plot.plot_frf` (imports matplotlib)."""

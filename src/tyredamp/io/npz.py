@@ -12,7 +12,7 @@ Layout (a NumPy ``.npz`` archive, no pickled objects):
     :class:`~tyredamp.timedata.Acquisition`; older files kept them in
     ``meta`` and read the same) and ``meta``.
 ``frequency`` (n_freq,), ``H`` (n_out, n_in, n_freq) complex, optional
-``coherence`` (n_out, n_freq)
+``coherence`` (n_out, n_freq), optional ``variance`` (n_out, n_in, n_freq)
     FRF arrays, Hz and SI units of the kind.
 ``data`` (n_channels, n_samples)
     Time data in SI units.
@@ -66,6 +66,8 @@ def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         arrays.update(frequency=obj.frequency, H=obj.H)
         if obj.coherence is not None:
             arrays["coherence"] = obj.coherence
+        if obj.variance is not None:
+            arrays["variance"] = obj.variance
     elif isinstance(obj, TimeData):
         head = {
             "type": "timedata",
@@ -122,6 +124,7 @@ def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
                 inputs=[channel_from_dict(c, f"{p}: inputs") for c in head.get("inputs", [])],
                 coherence=arrays.get("coherence"),
                 meta=meta,
+                variance=arrays.get("variance"),
             )
         if kind == "timedata":
             if "data" not in arrays:

@@ -62,6 +62,7 @@ __all__ = [
     "cross_spectra",
     "estimate_frf",
     "frf_from_spectra",
+    "frf_variance",
     "multiple_coherence",
     "ordinary_coherence",
     "resolve_channels",
@@ -322,6 +323,77 @@ def frf_from_spectra(spectra: CrossSpectra, estimator: Estimator = "H1") -> NDAr
     return out
 
 
+def frf_variance(
+    spectra: CrossSpectra, coherence: NDArray[np.float64], n_independent: float
+) -> NDArray[np.float64] | None:
+    """Variance of each FRF estimate from the residual (non-coherent) output power.
+
+    Least squares over ``n`` independent segments ``Y_k = H X_k + E_k`` gives
+    ``cov(H_j) = G_ee,j Gxx^-1 / n`` (output ``j``), with the noise density
+    estimated from the part of the output not explained by the inputs,
+    ``G_ee,j = Gyy_jj (1 - gamma_j^2) n / (n - n_in)``, so::
+
+        var(H_ji) = Gyy_jj (1 - gamma_j^2) [Gxx^-1]_ii / (n - n_in).
+
+    For one input this is ``|H|^2 (1 - gamma^2) / (gamma^2 (n - 1))``, twice
+    the squared normalised random error of ``|H|`` of Bendat and Piersol
+    (``(1 - gamma^2) / (2 n gamma^2)``) since the complex variance counts the
+    magnitude and the phase direction. For cyclic averaging the residual is
+    the period-to-period spread of ``Y - H X``. It is the variance of H1 (and
+    a first-order one of H2 and Hv with noise on the outputs).
+
+    Parameters
+    ----------
+    spectra : CrossSpectra
+        Averaged spectra on the kept lines.
+    coherence : ndarray, shape (n_out, n_freq)
+        Multiple coherence of each output.
+    n_independent : float
+        Number of statistically independent segments (the averages, reduced
+        for overlapping windows by :func:`_overlap_factor`).
+
+    Returns
+    -------
+    ndarray, shape (n_out, n_in, n_freq), or None
+        Variance in (unit of H)^2; None when ``n_independent <= n_in`` (no
+        degree of freedom left for the noise).
+    """
+    n_in = spectra.Gxx.shape[1]
+    dof = float(n_independent) - n_in
+    if dof <= 0:
+        return None
+    try:
+        inv_diag = np.real(np.diagonal(np.linalg.inv(spectra.Gxx), axis1=1, axis2=2))  # (f, in)
+    except np.linalg.LinAlgError:
+        return None
+    resid = spectra.Gyy * (1.0 - coherence.T)  # (f, out)
+    var = resid[:, :, None] * np.maximum(inv_diag, 0.0)[:, None, :] / dof  # (f, out, in)
+    var = np.moveaxis(var, 0, -1)
+    if not np.all(np.isfinite(var)):
+        return None
+    return np.maximum(var, 0.0)
+
+
+def _overlap_factor(window: ArrayLike, step: int, n_segments: int) -> float:
+    """Variance inflation of an average of ``n_segments`` overlapping windowed segments.
+
+    ``1 + 2 sum_j (1 - j/K) rho(j)^2`` with ``rho(j)`` the overlap correlation
+    ``sum w[t] w[t + j step] / sum w^2`` (Welch 1967, eq. for the variance
+    of the averaged periodogram of white noise); 1 without overlap.
+    """
+    w = np.asarray(window, dtype=float)
+    seg = w.size
+    k = int(n_segments)
+    total = float(np.sum(w * w))
+    out = 1.0
+    j = 1
+    while j < k and j * step < seg:
+        rho = float(np.sum(w[: seg - j * step] * w[j * step :])) / total
+        out += 2.0 * (1.0 - j / k) * rho * rho
+        j += 1
+    return out
+
+
 def ordinary_coherence(spectra: CrossSpectra) -> NDArray[np.float64]:
     """Ordinary coherence ``|Gyx|^2 / (Gxx Gyy)`` of each output with each input.
 
@@ -494,9 +566,10 @@ def estimate_frf(
     -------
     FRF
         ``H`` of shape (n_out, n_in, n_lines), the multiple coherence as
-        ``coherence``, and ``meta`` with ``estimator``, ``method``,
-        ``n_averages``, ``segment_samples``, ``sample_rate``, ``window``,
-        ``overlap``.
+        ``coherence``, the variance of each estimate as ``variance`` (see
+        :func:`frf_variance`; None with too few averages), and ``meta``
+        with ``estimator``, ``method``, ``n_averages``, ``segment_samples``,
+        ``sample_rate``, ``window``, ``overlap``.
 
     Raises
     ------
@@ -685,6 +758,12 @@ def estimate_frf(
         _check_input_rank(spectra, [chans[i].label for i in ref_idx])
     h = frf_from_spectra(spectra, estimator)
     coh = multiple_coherence(spectra)
+    n_eff = spectra.n_averages / _overlap_factor(
+        segment_window(win, seg) if isinstance(window_arg, str | tuple) else window_arg,
+        step,
+        spectra.n_averages,
+    )
+    variance = frf_variance(spectra, coh, n_eff)
     meta_out: dict[str, Any] = {
         "estimator": estimator,
         "method": method,
@@ -706,6 +785,7 @@ def estimate_frf(
         inputs=[chans[i] for i in ref_idx],
         coherence=coh,
         meta=meta_out,
+        variance=variance,
     )
 
 
