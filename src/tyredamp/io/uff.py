@@ -40,11 +40,13 @@ is not kept by either (use NPZ for that).
 Reading other programs' files
 -----------------------------
 The response quantity comes from the ordinate data type (8, 11, 12; 9 or 13
-for forces) or else from the ordinate units label; ``m``, ``mm``, ``um``,
-``in``, ``m/s``, ``mm/s``, ``in/s``, ``m/s^2``, ``mm/s^2``, ``g``,
-``in/s^2``, ``N``, ``kN``, ``lbf`` are converted to SI; a blank label or
-``NONE`` is taken as SI; another label is an error. An FRF label such as
-``g/N`` or ``(m/s^2)/N`` with a blank denominator is split at the last ``/``.
+for forces) or else from the ordinate units label, read by
+:mod:`tyredamp.io.units` (``m/s²``, ``m/s2``, ``ms^-2``, ``g``, ``mm/s``,
+``in``, ``µm``, ``lbf``, ``kN`` ..., converted to SI); a blank label or
+``NONE`` is taken as SI; a label that cannot be read is an error naming it.
+An FRF label may hold the whole ratio (``g/N``, ``(m/s^2)/N``,
+``(1/N)*(m/s²)``) or only the response with the force in the denominator
+label; a label and a data type that disagree are an error.
 """
 
 from __future__ import annotations
@@ -64,6 +66,7 @@ from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
 from ._atomic import atomic_path
 from ._common import check_input_file, meta_to_json, wrap_errors
+from .units import frf_units, quantity_units
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
 
@@ -85,48 +88,6 @@ _AXIS_LABEL = {
 }
 # (length exponent, force exponent) of each quantity in SI
 _EXP = {"displacement": (1, 0), "velocity": (1, 0), "acceleration": (1, 0), "force": (0, 1)}
-_LBF = 4.4482216152605
-_UNITS: dict[str, tuple[str, float]] = {
-    "m": ("displacement", 1.0),
-    "mm": ("displacement", 1e-3),
-    "um": ("displacement", 1e-6),
-    "micron": ("displacement", 1e-6),
-    "in": ("displacement", 0.0254),
-    "m/s": ("velocity", 1.0),
-    "mm/s": ("velocity", 1e-3),
-    "in/s": ("velocity", 0.0254),
-    "m/s^2": ("acceleration", 1.0),
-    "mm/s^2": ("acceleration", 1e-3),
-    "in/s^2": ("acceleration", 0.0254),
-    "g": ("acceleration", 9.80665),
-    "n": ("force", 1.0),
-    "kn": ("force", 1e3),
-    "lbf": ("force", _LBF),
-}
-
-
-def _norm_unit(label: Any) -> str:
-    s = str(label or "").strip().lower().replace(" ", "")
-    s = s.replace("²", "^2").replace("**", "^").replace("µ", "u").replace("μ", "u")
-    s = s.replace("sec", "s")
-    if s.startswith("(") and s.endswith(")"):
-        s = s[1:-1]
-    if s.endswith("/s2"):
-        s = s[:-2] + "s^2"
-    return s
-
-
-def _unit(label: Any, where: str) -> tuple[str, float] | None:
-    """(quantity, factor to SI) of a units label, None when blank."""
-    s = _norm_unit(label)
-    if s in ("", "none"):
-        return None
-    if s not in _UNITS:
-        raise FileFormatError(
-            f"{where}: unknown units label {label!r}; known: m, mm, um, in, m/s, mm/s, in/s, "
-            "m/s^2, mm/s^2, in/s^2, g, N, kN, lbf (blank or NONE = SI)"
-        )
-    return _UNITS[s]
 
 
 # ------------------------------------------------------------------ writing
@@ -464,29 +425,27 @@ def _channel(node: Any, direction: Any, extras: dict[str, Any], where: str) -> C
 
 
 def _quantity(s: dict[str, Any], where: str) -> tuple[str | None, float]:
+    """(quantity, factor to SI) of a data set from its ordinate data type and units labels."""
     sdt = int(s.get("ordinate_spec_data_type", 0) or 0)
     label = s.get("ordinate_axis_units_lab", "")
-    num = str(label or "")
-    den_label = s.get("orddenom_axis_units_lab", "")
-    if int(s.get("func_type", 0)) == 4 and _norm_unit(den_label) in ("", "none") and "/" in num:
-        head, tail = num.rsplit("/", 1)
-        if _norm_unit(tail) in ("n", "kn", "lbf"):
-            num, den_label = head, tail
-    u = _unit(num, where)
-    q = _SDT_QUANTITY.get(sdt)
-    if q is None and u is not None:
-        q = u[0]
-    if u is not None and q is not None and u[0] != q:
+    q_sdt = _SDT_QUANTITY.get(sdt)
+    q: str | None
+    try:
+        if int(s.get("func_type", 0)) == 4:
+            r = frf_units(label, s.get("orddenom_axis_units_lab", ""))
+            kind, scale = (None, 1.0) if r is None else r
+            q = None if kind is None else _KIND_QUANTITY[kind]
+        else:
+            u = quantity_units(label)
+            q, scale = (None, 1.0) if u is None else u
+    except InputError as exc:
+        raise FileFormatError(f"{where}: {exc}") from None
+    if q is None:
+        q = q_sdt
+    elif q_sdt is not None and q != q_sdt:
         raise FileFormatError(
-            f"{where}: ordinate data type {sdt} ({q}) disagrees with units label {label!r}"
+            f"{where}: ordinate data type {sdt} ({q_sdt}) disagrees with units label {label!r}"
         )
-    scale = 1.0 if u is None else u[1]
-    if int(s.get("func_type", 0)) == 4:
-        d = _unit(den_label, where)
-        if d is not None:
-            if d[0] != "force":
-                raise FileFormatError(f"{where}: FRF denominator {den_label!r} is not a force")
-            scale /= d[1]
     return q, scale
 
 
