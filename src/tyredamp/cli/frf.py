@@ -87,11 +87,12 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
 )
 @click.option(
     "--method",
-    type=click.Choice(["auto", "cyclic", "welch", "transient"]),
+    type=click.Choice(["auto", "cyclic", "welch", "transient", "lrm", "lpm"]),
     default="auto",
     show_default=True,
     help="auto: cyclic when the file states a period, transient when it states a record "
-    "length, else decided from the data (periodic: cyclic; impact: transient; random: Welch).",
+    "length, else decided from the data (periodic: cyclic; impact: transient; random: Welch). "
+    "lrm/lpm: local rational/polynomial method on the whole record (random excitation).",
 )
 @click.option("--segment", type=click.IntRange(min=2), help="Welch/transient segment in samples.")
 @click.option(

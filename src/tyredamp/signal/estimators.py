@@ -35,6 +35,9 @@ Segmenting methods:
 * ``"transient"``: consecutive non-overlapping records (burst random, impact
   hits), rectangular by default, with the optional force window on the inputs
   and the exponential window on all channels.
+* ``"lrm"``, ``"lpm"``: the local rational / polynomial method on the whole
+  record (:mod:`.lrm`), for random excitation: leakage and transients are
+  fitted away line by line, with the noise variance of every line.
 """
 
 from __future__ import annotations
@@ -51,6 +54,7 @@ from .._validate import as_finite, check_positive
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..timedata import TimeData
+from .lrm import local_frf
 from .periodicity import ExcitationDetection, detect_excitation, transient_periods
 from .windows import exponential_window, force_window, segment_window
 
@@ -69,9 +73,9 @@ __all__ = [
 ]
 
 Estimator = Literal["H1", "H2", "Hv"]
-Method = Literal["cyclic", "welch", "transient"]
+Method = Literal["cyclic", "welch", "transient", "lrm", "lpm"]
 ESTIMATORS: tuple[str, ...] = ("H1", "H2", "Hv")
-METHODS: tuple[str, ...] = ("cyclic", "welch", "transient")
+METHODS: tuple[str, ...] = ("cyclic", "welch", "transient", "lrm", "lpm")
 #: FRF kind that follows from the measured response quantity.
 RESPONSE_KIND: dict[str, FRFKind] = {
     "displacement": "receptance",
@@ -511,7 +515,7 @@ def estimate_frf(
         The input (force) channels; default every force channel. Keys as in
         :func:`resolve_channels` (label ``"1+Z"``, name, node number or
         :class:`Channel`).
-    method : {"cyclic", "welch", "transient"}, optional
+    method : {"cyclic", "welch", "transient", "lrm", "lpm"}, optional
         Default: ``"cyclic"`` when ``timedata.acquisition.period_samples``
         (or ``period_samples``) is given, ``"transient"`` when
         ``acquisition.record_samples`` is given, else detected from the data
@@ -664,6 +668,22 @@ def estimate_frf(
     fs = timedata.sample_rate
     n = timedata.n_samples
     x, y = data[ref_idx], data[out_idx]
+    if method in ("lrm", "lpm"):
+        return _local_method(
+            timedata,
+            ref_idx,
+            out_idx,
+            kind,
+            method,
+            estimator,
+            settle,
+            band,
+            min_relative_power,
+            window,
+            overlap,
+            segment_samples,
+            detection,
+        )
     input_window = None
     window_arg: Any = None
     info: dict[str, Any] = {}
@@ -786,6 +806,80 @@ def estimate_frf(
         coherence=coh,
         meta=meta_out,
         variance=variance,
+    )
+
+
+def _local_method(
+    timedata: TimeData,
+    ref_idx: list[int],
+    out_idx: list[int],
+    kind: FRFKind,
+    method: str,
+    estimator: str,
+    settle: int,
+    band: tuple[float, float] | None,
+    min_relative_power: float,
+    window: Any,
+    overlap: Any,
+    segment_samples: Any,
+    detection: ExcitationDetection | None,
+) -> FRF:
+    """``estimate_frf`` for the LRM/LPM methods (one record, local models per line)."""
+    if estimator != "H1":
+        raise InputError(
+            f"estimator: the {method} method is a least-squares (H1) fit, got {estimator!r}"
+        )
+    for name, v in (("window", window), ("overlap", overlap), ("segment_samples", segment_samples)):
+        if v not in (None, 0, 0.0, "boxcar"):
+            raise InputError(f"{name}: the {method} method uses the whole record, got {v!r}")
+    acq = timedata.acquisition
+    if len(acq.run_starts) > 1:
+        raise InputError(
+            f"method: {method} takes one record; this one holds {len(acq.run_starts)} runs"
+        )
+    chans = timedata.channels
+    data = timedata.data[:, settle:]
+    x, y = data[ref_idx], data[out_idx]
+    f, h, var = local_frf(x, y, timedata.sample_rate, rational=method == "lrm")
+    thr = float(min_relative_power)
+    if not np.isfinite(thr) or thr < 0 or thr >= 1:
+        raise InputError(
+            f"min_relative_power: expected a value in [0, 1), got {min_relative_power!r}"
+        )
+    pu = np.abs(scipy.fft.rfft(x, axis=1)) ** 2  # (in, f)
+    keep = np.all(pu > thr * pu.max(axis=1, keepdims=True), axis=0)
+    keep[0] = False  # 0 Hz: the mean is not a response to the force
+    if band is None and acq.band_hz is not None:
+        band = acq.band_hz
+    if band is not None:
+        lo, hi = float(band[0]), float(band[1])
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
+            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band!r}")
+        keep &= (f >= lo) & (f <= hi)
+    lines = np.flatnonzero(keep)
+    if lines.size == 0:
+        raise InputError("timedata: no excited frequency line for the local method")
+    meta_out: dict[str, Any] = {
+        "estimator": "H1",
+        "method": method,
+        "n_averages": 1,
+        "segment_samples": int(data.shape[1]),
+        "sample_rate": timedata.sample_rate,
+        "window": "boxcar",
+        "overlap": 0.0,
+        "settle_samples": settle,
+        "local_order": 2,
+    }
+    if detection is not None:
+        meta_out["detection"] = detection.to_dict()
+    return FRF(
+        f[lines],
+        h[:, :, lines],
+        kind=kind,
+        outputs=[chans[i] for i in out_idx],
+        inputs=[chans[i] for i in ref_idx],
+        meta=meta_out,
+        variance=var[:, :, lines],
     )
 
 
