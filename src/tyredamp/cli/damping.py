@@ -103,6 +103,10 @@ def damping_command(
 ) -> None:
     """Identify the viscous damping matrix from the complex modes in MODES_JSON.
 
+    MODES_JSON is a modes JSON file (tyredamp modal) or a UFF file (.uff,
+    .unv) of data sets 55 from another program (real or complex modes,
+    scaled by their modal mass or modal A; see tyredamp.io.uff55).
+
     Writes C' (modal coordinates) and C, M, K at the measured points, the
     point labels, diagnostics (symmetry, definiteness, truncation), the best
     proportional models, Monte Carlo standard errors and plain-English
@@ -116,7 +120,14 @@ def damping_command(
     """
     if out.resolve() == modes_json.resolve():
         raise InputError(f"--out: {out} is the input file; choose another name")
-    models = read_modes_json(check_input_file(modes_json))
+    path = check_input_file(modes_json)
+    if path.suffix.lower() in (".uff", ".unv", ".uf"):
+        from ..io.uff55 import read_uff55
+
+        uff_model = read_uff55(path)
+        models = {uff_model.mode_kind: uff_model}
+    else:
+        models = read_modes_json(path)
     if model_name not in models:
         raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")
     meta: dict[str, Any] = {"source": str(modes_json), "model": model_name}

@@ -84,6 +84,13 @@ def load_result_file(path: str | Path) -> ResultFile:
         Unreadable, not JSON where JSON is expected, or not a tyredamp result.
     """
     p = check_input_file(path)
+    if p.suffix.lower() in (".uff", ".unv", ".uf"):
+        from ..io.uff55 import read_uff55, uff_has_modes
+
+        if uff_has_modes(p):
+            model = read_uff55(p)
+            doc = {"kind": "modes", "source": str(p), "band_hz": None, "frf_kind": None}
+            return ResultFile(p, "modes", {model.mode_kind: model}, doc)
     if p.suffix.lower() in _DATA_EXT:
         from ..io import read
 
