@@ -8,6 +8,8 @@ extension                 format
 ``.uff``, ``.unv``, ``.uf``  UFF data set 58, ASCII or binary 58b (read both)
 ``.csv``                  tyredamp CSV layout (:mod:`.csv_format`)
 ``.npz``                  tyredamp NPZ layout (:mod:`.npz`)
+``.tdms``                 NI TDMS time data, read only (:mod:`.tdms`, npTDMS)
+``.mf4``, ``.mdf``        ASAM MDF time data, read only (:mod:`.mdf`, asammdf)
 ========================  ============================================
 
 Writing takes ``format`` (``"uff58b"`` binary UFF, ``"uff58"`` ASCII UFF,
@@ -69,18 +71,39 @@ def format_of(path: str | os.PathLike[str], format: str | None = None) -> Format
     return _EXT[ext]
 
 
+#: Read-only time-data formats: extension -> reader module (imported when used).
+_READ_ONLY: dict[str, str] = {".tdms": "tdms", ".mf4": "mdf", ".mdf": "mdf"}
+
+
+def _read_only(path: str | os.PathLike[str]) -> TimeData | None:
+    """Time data of a read-only acquisition format (TDMS, MDF), None for the other formats."""
+    ext = Path(path).suffix.lower()
+    if ext == ".tdms":
+        from .tdms import read_tdms
+
+        return read_tdms(path)
+    if ext in (".mf4", ".mdf"):
+        from .mdf import read_mdf
+
+        return read_mdf(path)
+    return None
+
+
 def _read_format(path: str | os.PathLike[str]) -> Format:
     ext = Path(path).suffix.lower()
     if ext not in _EXT:
         raise FileFormatError(
             f"{path}: unknown file extension {ext or '(none)'!r}; expected one of "
-            f"{', '.join(sorted(_EXT))}"
+            f"{', '.join(sorted([*_EXT, *_READ_ONLY]))}"
         )
     return _EXT[ext]
 
 
 def read(path: str | os.PathLike[str]) -> FRF | TimeData:
     """Read whatever the file holds: an FRF or time data."""
+    td = _read_only(path)
+    if td is not None:
+        return td
     fmt = _read_format(path)
     if fmt == "csv":
         return read_csv(path)
@@ -103,6 +126,8 @@ def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
     FileFormatError
         The file is empty, truncated, corrupt, or holds time data.
     """
+    if Path(path).suffix.lower() in _READ_ONLY:
+        raise FileFormatError(f"{path}: TDMS and MDF files hold time data, not an FRF")
     fmt = _read_format(path)
     obj = read_uff(path, "frf", kind) if fmt.startswith("uff") else read(path)
     if not isinstance(obj, FRF):
@@ -111,13 +136,16 @@ def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
 
 
 def read_timedata(path: str | os.PathLike[str]) -> TimeData:
-    """Read time data from a UFF, CSV or NPZ file.
+    """Read time data from a UFF, CSV, NPZ, TDMS or MDF file.
 
     Raises
     ------
     FileFormatError
         The file is empty, truncated, corrupt, or holds an FRF.
     """
+    td = _read_only(path)
+    if td is not None:
+        return td
     fmt = _read_format(path)
     obj = read_uff(path, "timedata") if fmt.startswith("uff") else read(path)
     if not isinstance(obj, TimeData):
