@@ -359,6 +359,124 @@ class FRF:
         """A copy with new responses on the same axis and channels (no coherence or variance)."""
         return self._new(H=H, kind=kind or self.kind, coherence=None, variance=None)
 
+    # ---------------------------------------------------------------- xarray
+    def to_xarray(self) -> Any:
+        """The FRF as an :class:`xarray.Dataset` with named dimensions (imports xarray).
+
+        Dimensions ``output``, ``input``, ``frequency`` (coordinate in Hz);
+        variables ``H`` (complex, the unit of :attr:`kind`), optional
+        ``coherence`` (output, frequency) and ``variance`` (output, input,
+        frequency); channel coordinates ``output_node``,
+        ``output_direction``, ``output_angle_deg`` (NaN when unknown),
+        ``output_name`` (and the same for ``input``), the labels as the
+        ``output``/``input`` coordinates; attributes ``kind``, ``unit``,
+        ``tyredamp`` (``"frf 1"``) and ``meta`` (JSON text).
+        """
+        import json
+
+        import xarray as xr
+
+        def chan(prefix: str, chs: tuple[Channel, ...]) -> dict[str, Any]:
+            return {
+                prefix: (prefix, [c.label for c in chs]),
+                f"{prefix}_node": (prefix, np.array([c.node for c in chs], dtype=np.int32)),
+                f"{prefix}_direction": (
+                    prefix,
+                    np.array([c.direction for c in chs], dtype=np.int32),
+                ),
+                f"{prefix}_angle_deg": (
+                    prefix,
+                    np.array([np.nan if c.angle_deg is None else c.angle_deg for c in chs]),
+                ),
+                f"{prefix}_name": (prefix, [c.name for c in chs]),
+            }
+
+        data: dict[str, Any] = {"H": (("output", "input", "frequency"), self.H)}
+        if self.coherence is not None:
+            data["coherence"] = (("output", "frequency"), self.coherence)
+        if self.variance is not None:
+            data["variance"] = (("output", "input", "frequency"), self.variance)
+        coords = {
+            "frequency": ("frequency", self.frequency, {"units": "Hz"}),
+            **chan("output", self.outputs),
+            **chan("input", self.inputs),
+        }
+        ds = xr.Dataset(data, coords=coords)
+        ds["H"].attrs["units"] = self.unit
+        ds.attrs.update(
+            tyredamp="frf 1",
+            kind=self.kind,
+            unit=self.unit,
+            meta=json.dumps(self.meta, default=str),
+        )
+        return ds
+
+    @classmethod
+    def from_xarray(cls, ds: Any) -> FRF:
+        """Inverse of :meth:`to_xarray` (also from ``H_real``/``H_imag`` as stored in files).
+
+        Raises
+        ------
+        InputError
+            Missing ``H`` or dimensions, or invalid values (checked as in the
+            constructor).
+        """
+        import json
+
+        names = set(getattr(ds, "data_vars", {}))
+        if "H" in names:
+            h = np.asarray(ds["H"].transpose("output", "input", "frequency").values)
+        elif {"H_real", "H_imag"} <= names:
+            order = ("output", "input", "frequency")
+            h = np.asarray(ds["H_real"].transpose(*order).values) + 1j * np.asarray(
+                ds["H_imag"].transpose(*order).values
+            )
+        else:
+            raise InputError("ds: expected a variable 'H' (or 'H_real' and 'H_imag')")
+
+        def chans(prefix: str) -> list[Channel]:
+            try:
+                node = np.asarray(ds[f"{prefix}_node"].values)
+                direc = np.asarray(ds[f"{prefix}_direction"].values)
+                ang = np.asarray(ds[f"{prefix}_angle_deg"].values, dtype=float)
+                name = [str(v) for v in np.asarray(ds[f"{prefix}_name"].values)]
+            except KeyError as exc:
+                raise InputError(f"ds: missing channel coordinate {exc.args[0]!r}") from None
+            return [
+                Channel(
+                    int(node[i]),
+                    int(direc[i]),
+                    None if np.isnan(ang[i]) else float(ang[i]),
+                    name[i],
+                )
+                for i in range(node.size)
+            ]
+
+        try:
+            meta = json.loads(str(ds.attrs.get("meta", "{}")))
+        except json.JSONDecodeError:
+            raise InputError("ds.attrs['meta']: not JSON text") from None
+        coh = (
+            ds["coherence"].transpose("output", "frequency").values
+            if "coherence" in names
+            else None
+        )
+        var = (
+            ds["variance"].transpose("output", "input", "frequency").values
+            if "variance" in names
+            else None
+        )
+        return cls(
+            np.asarray(ds["frequency"].values),
+            h,
+            kind=str(ds.attrs.get("kind", "")),  # type: ignore[arg-type]
+            outputs=chans("output"),
+            inputs=chans("input"),
+            coherence=coh,
+            meta=meta if isinstance(meta, dict) else {},
+            variance=var,
+        )
+
     def plot(self, **kwargs: Any) -> Any:
         """Bode plot of the FRF; see :func:`tyredamp.plot.plot_frf` (imports matplotlib)."""
         from .plot import plot_frf  # type: ignore[attr-defined,unused-ignore]

@@ -8,6 +8,7 @@ extension                 format
 ``.uff``, ``.unv``, ``.uf``  UFF data set 58, ASCII or binary 58b (read both)
 ``.csv``                  tyredamp CSV layout (:mod:`.csv_format`)
 ``.npz``                  tyredamp NPZ layout (:mod:`.npz`)
+``.nc``                   FRF as netCDF with named dimensions (:mod:`.netcdf`, xarray)
 ``.tdms``                 NI TDMS time data, read only (:mod:`.tdms`, npTDMS)
 ``.mf4``, ``.mdf``        ASAM MDF time data, read only (:mod:`.mdf`, asammdf)
 ========================  ============================================
@@ -44,15 +45,16 @@ __all__ = [
     "write_timedata",
 ]
 
-Format = Literal["uff58b", "uff58", "csv", "npz"]
+Format = Literal["uff58b", "uff58", "csv", "npz", "netcdf"]
 #: Formats accepted by the writers.
-FORMATS: tuple[str, ...] = ("uff58b", "uff58", "csv", "npz")
+FORMATS: tuple[str, ...] = ("uff58b", "uff58", "csv", "npz", "netcdf")
 _EXT: dict[str, Format] = {
     ".uff": "uff58b",
     ".unv": "uff58b",
     ".uf": "uff58b",
     ".csv": "csv",
     ".npz": "npz",
+    ".nc": "netcdf",
 }
 
 
@@ -109,6 +111,10 @@ def read(path: str | os.PathLike[str]) -> FRF | TimeData:
         return read_csv(path)
     if fmt == "npz":
         return read_npz(path)
+    if fmt == "netcdf":
+        from .netcdf import read_netcdf
+
+        return read_netcdf(path)
     return read_uff(path)
 
 
@@ -170,6 +176,12 @@ def write(obj: FRF | TimeData, path: str | os.PathLike[str], format: str | None 
         write_csv(obj, path)
     elif fmt == "npz":
         write_npz(obj, path)
+    elif fmt == "netcdf":
+        if not isinstance(obj, FRF):
+            raise InputError("format: netCDF (.nc) holds FRFs; write time data as NPZ, CSV or UFF")
+        from .netcdf import write_netcdf
+
+        write_netcdf(obj, path)
     else:
         write_uff(obj, path, binary=fmt == "uff58b")
     return Path(path)
