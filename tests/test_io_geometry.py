@@ -173,3 +173,38 @@ def test_geometry_object_and_bad_files(tmp_path: Path) -> None:
     )
     with pytest.raises(FileFormatError, match="coordinate system 9"):
         read_uff_geometry(bad_cs)
+
+
+def test_report_draws_modes_on_pyuff_geometry(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Modes (UFF 55) of the virtual tyre with a UFF 15 + 82 geometry from pyuff's writer."""
+    from tyredamp.cli import main
+    from tyredamp.io.uff55 import write_uff55
+    from tyredamp.plot import plot_mode_shapes_geometry
+    from tyredamp.plot.geometry import mode_displacements
+    from tyredamp.tyre import RingTyre, TyreTruth
+
+    truth = TyreTruth.from_tyre(RingTyre(), band=(0.0, 120.0))
+    model = truth.modal_model()
+    assert [c.node for c in model.outputs] == list(range(1, N + 1))
+    modes = write_uff55(model, tmp_path / "modes.unv")
+    geo = tmp_path / "geometry.unv"
+    write(geo, ring_sets(mm=True))
+    g = read_uff_geometry(geo)
+    # displacement of node 5 in mode 0 = its shape entry along global z (direction 3)
+    d = mode_displacements(model, g)
+    shapes = model.second_order_shapes()
+    assert_allclose(d[0, 4], [0.0, 0.0, shapes[4, 0]])
+    axs = plot_mode_shapes_geometry(model, g, modes=[0, 1])
+    assert len(axs) == 2
+    html = tmp_path / "report.html"
+    try:
+        main(["report", str(modes), str(geo), "--out", str(html)])
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    assert code == 0, capsys.readouterr().err
+    text = html.read_text()
+    assert "mode shapes on the test geometry" in text
+    assert "test geometry (nodes, trace lines)" in text

@@ -31,7 +31,7 @@ from ..exceptions import FileFormatError
 from ..geometry import Geometry
 from ._common import check_input_file
 
-__all__ = ["read_uff_geometry"]
+__all__ = ["read_uff_geometry", "uff_has_geometry"]
 
 _WANTED = (15, 2411, 82, 18, 2420, 164)
 
@@ -79,6 +79,19 @@ def _load(p: Any) -> list[dict[str, Any]]:
     if not any(int(s.get("type", 0)) in (15, 2411) for s in sets):
         raise FileFormatError(f"{p}: no node data set (15 or 2411) in the UFF file")
     return list(sets)
+
+
+def uff_has_geometry(path: str | os.PathLike[str]) -> bool:
+    """True when the UFF file holds nodes (15 or 2411) and no data set 58 or 55."""
+    p = check_input_file(path)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ResourceWarning)
+            types = set(pyuff.UFF(str(p)).get_set_types())
+            gc.collect()
+    except Exception:  # not a UFF file: the caller's reader reports it
+        return False
+    return bool(types & {15, 2411}) and not types & {55, 58}
 
 
 def _systems(p: Any, sets: list[dict[str, Any]]) -> dict[int, _CS]:

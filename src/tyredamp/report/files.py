@@ -91,6 +91,12 @@ def load_result_file(path: str | Path) -> ResultFile:
             model = read_uff55(p)
             doc = {"kind": "modes", "source": str(p), "band_hz": None, "frf_kind": None}
             return ResultFile(p, "modes", {model.mode_kind: model}, doc)
+        from ..io.uff_geometry import uff_has_geometry
+
+        if uff_has_geometry(p):
+            from ..io.uff_geometry import read_uff_geometry
+
+            return ResultFile(p, "geometry", read_uff_geometry(p))
     if p.suffix.lower() in _DATA_EXT:
         from ..io import read
 
@@ -228,7 +234,11 @@ def _match(freq: np.ndarray, ref: np.ndarray) -> dict[int, int]:
 
 
 def _modes_section(
-    rep: HtmlReport, item: ResultFile, frfs: list[ResultFile], truth: ResultFile | None
+    rep: HtmlReport,
+    item: ResultFile,
+    frfs: list[ResultFile],
+    truth: ResultFile | None,
+    geometry: Any = None,
 ) -> None:
     models: dict[str, ModalModel] = item.obj
     doc = item.doc or {}
@@ -291,6 +301,19 @@ def _modes_section(
     if frf is not None:
         _fit_figures(rep, frf, models)
     shapes = models.get("complex") or any_model
+    if geometry is not None and shapes.n_modes:
+        from ..plot import plot_mode_shapes_geometry
+
+        gaxs = plot_mode_shapes_geometry(shapes, geometry)
+        rep.figure(
+            gaxs[0].figure,
+            f"{item.path.name}: mode shapes on the test geometry (real part; grey undeformed)",
+        )
+        angles = geometry.ring_angles(shapes.outputs)
+        if angles is not None:  # the ring view at the measured angles of the geometry
+            from dataclasses import replace as _replace
+
+            shapes = _replace(shapes, outputs=geometry.with_angles(shapes.outputs))
     if shapes.n_modes and shapes.psi_out.shape[0] >= 3:
         from ..plot import plot_mode_shapes_ring
 
@@ -565,6 +588,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
         "demo": "demo results",
         "frf": "FRF",
         "timedata": "time data",
+        "geometry": "test geometry (nodes, trace lines)",
     }
     rep.table(
         ["file", "content"],
@@ -576,6 +600,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
     rep.paragraph(f"tyredamp {__version__}.")
     frfs = [i for i in items if i.kind == "frf"]
     truth = next((i for i in items if i.is_truth), None)
+    geometry = next((i.obj for i in items if i.kind == "geometry"), None)
     sections = [
         ("Measured data", [i for i in items if i.kind in ("frf", "timedata")]),
         ("Modal analysis", [i for i in items if i.kind == "modes"]),
@@ -593,7 +618,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
             elif item.kind == "timedata":
                 _time_section(rep, item)
             elif item.kind == "modes":
-                _modes_section(rep, item, frfs, truth)
+                _modes_section(rep, item, frfs, truth, geometry)
             elif item.kind == "damping":
                 _damping_section(rep, item)
             elif item.kind == "lateral":
