@@ -232,42 +232,7 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
             nodes0 = nodes
         elif not np.array_equal(nodes0, nodes):
             raise FileFormatError(f"{where}: mode on different nodes than the first mode")
-        if real:
-            f = _num(s, "freq", where)
-            m = _num(s, "modal_m", where)
-            zeta = _num(s, "modal_damp_vis", where)
-            if zeta == 0.0 and _num(s, "modal_damp_his", where) > 0:
-                zeta = _num(s, "modal_damp_his", where) / 2.0
-                notes.add("hysteretic loss factor eta taken as viscous zeta = eta / 2")
-            if f <= 0 or not 0.0 <= zeta < 1.0:
-                raise FileFormatError(
-                    f"{where}: expected frequency > 0 and damping ratio in [0, 1), got "
-                    f"{f} Hz, {zeta}"
-                )
-            if m == 0.0:
-                m = 1.0
-                notes.add("modal mass not given: shapes taken as mass-normalised")
-            if m < 0:
-                raise FileFormatError(f"{where}: negative modal mass {m}")
-            wn = 2 * np.pi * f
-            pole = complex(-zeta * wn, wn * np.sqrt(1 - zeta * zeta))
-            psi = np.real(vals) / np.sqrt(m * 2j * pole.imag)
-        else:
-            try:
-                pole = complex(s["eig"])
-            except (KeyError, TypeError, ValueError):
-                raise FileFormatError(f"{where}: no complex eigenvalue") from None
-            if not np.isfinite(pole) or pole.imag == 0.0:
-                raise FileFormatError(f"{where}: eigenvalue {pole} is not an oscillating pole")
-            a = complex(s.get("modal_a", 0.0) or 0.0)
-            if not np.isfinite(a):
-                raise FileFormatError(f"{where}: modal A {a} is not finite")
-            if a == 0:
-                a = 1.0
-                notes.add("modal A not given: shapes taken as unity-modal-A scaled")
-            if pole.imag < 0:  # the other pole of the pair: conjugate everything
-                pole, vals, a = pole.conjugate(), vals.conj(), a.conjugate()
-            psi = vals / np.sqrt(a)
+        pole, psi = _mode(s, vals, real, where, notes)
         poles.append(pole)
         shapes.append(psi)
     assert nodes0 is not None
@@ -305,6 +270,48 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
         inputs=[Channel(node=c.node, direction=c.direction) for c in inputs],
         meta=meta,
     )
+
+
+def _mode(
+    s: dict[str, Any], vals: np.ndarray, real: bool, where: str, notes: set[str]
+) -> tuple[complex, np.ndarray]:
+    """Pole and eq. [10] shape (3, n_nodes) of one data set 55 (module docstring)."""
+    if real:
+        f = _num(s, "freq", where)
+        m = _num(s, "modal_m", where)
+        zeta = _num(s, "modal_damp_vis", where)
+        if zeta == 0.0 and _num(s, "modal_damp_his", where) > 0:
+            zeta = _num(s, "modal_damp_his", where) / 2.0
+            notes.add("hysteretic loss factor eta taken as viscous zeta = eta / 2")
+        if f <= 0 or not 0.0 <= zeta < 1.0:
+            raise FileFormatError(
+                f"{where}: expected frequency > 0 and damping ratio in [0, 1), got {f} Hz, {zeta}"
+            )
+        if m == 0.0:
+            m = 1.0
+            notes.add("modal mass not given: shapes taken as mass-normalised")
+        if m < 0:
+            raise FileFormatError(f"{where}: negative modal mass {m}")
+        wn = 2 * np.pi * f
+        pole = complex(-zeta * wn, wn * np.sqrt(1 - zeta * zeta))
+        psi = np.real(vals) / np.sqrt(m * 2j * pole.imag)
+    else:
+        try:
+            pole = complex(s["eig"])
+        except (KeyError, TypeError, ValueError):
+            raise FileFormatError(f"{where}: no complex eigenvalue") from None
+        if not np.isfinite(pole) or pole.imag == 0.0:
+            raise FileFormatError(f"{where}: eigenvalue {pole} is not an oscillating pole")
+        a = complex(s.get("modal_a", 0.0) or 0.0)
+        if not np.isfinite(a):
+            raise FileFormatError(f"{where}: modal A {a} is not finite")
+        if a == 0:
+            a = 1.0
+            notes.add("modal A not given: shapes taken as unity-modal-A scaled")
+        if pole.imag < 0:  # the other pole of the pair: conjugate everything
+            pole, vals, a = pole.conjugate(), vals.conj(), a.conjugate()
+        psi = vals / np.sqrt(a)
+    return pole, psi
 
 
 def _stored_inputs(s: dict[str, Any]) -> list[Channel] | None:

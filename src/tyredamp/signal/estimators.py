@@ -618,42 +618,9 @@ def estimate_frf(
             )
 
     acq = timedata.acquisition
-    detection: ExcitationDetection | None = None
-    stated = (
-        period_samples is not None
-        or acq.period_samples is not None
-        or segment_samples is not None
-        or acq.record_samples is not None
+    method, period_samples, settle_samples, segment_samples, detection = _choose_method(
+        timedata, ref_idx, out_idx, method, period_samples, settle_samples, segment_samples, detect
     )
-    needs_period = method == "cyclic" and period_samples is None and acq.period_samples is None
-    if detect and ((method is None and not stated) or needs_period):
-        detection = detect_excitation(data[ref_idx], data[out_idx])
-        if detection.kind == "periodic":
-            method = "cyclic"
-            period_samples = detection.period_samples
-            if settle_samples is None:
-                settle_samples = detection.settle_samples
-        elif needs_period:
-            raise InputError(
-                f"method: 'cyclic' needs a period; none stated and none found in the data "
-                f"({detection.reason})"
-            )
-        elif detection.kind == "impact" and detection.record_samples is not None:
-            method = "transient"
-            segment_samples = detection.record_samples
-    elif (
-        period_samples is not None
-        and acq.period_samples is None
-        and settle_samples is None
-        and detect
-        and method in (None, "cyclic")
-    ):
-        # a period stated by the caller for data that did not state one: find the
-        # start transient in the data
-        p_arg = _as_count(period_samples, "period_samples", minimum=2)
-        if timedata.n_samples >= 2 * p_arg and len(acq.run_starts) == 1:
-            sel = data[ref_idx + out_idx]
-            settle_samples = transient_periods(sel, p_arg) * p_arg
     if method is None:
         if period_samples is not None or acq.period_samples is not None:
             method = "cyclic"
@@ -807,6 +774,61 @@ def estimate_frf(
         meta=meta_out,
         variance=variance,
     )
+
+
+def _choose_method(
+    timedata: TimeData,
+    ref_idx: list[int],
+    out_idx: list[int],
+    method: Method | None,
+    period_samples: int | None,
+    settle_samples: int | None,
+    segment_samples: int | None,
+    detect: bool,
+) -> tuple[Method | None, int | None, int | None, int | None, ExcitationDetection | None]:
+    """Fill the method, period, settle and record length from the data when not stated.
+
+    See ``detect`` of :func:`estimate_frf`.
+    """
+    acq = timedata.acquisition
+    data = timedata.data
+    detection: ExcitationDetection | None = None
+    stated = (
+        period_samples is not None
+        or acq.period_samples is not None
+        or segment_samples is not None
+        or acq.record_samples is not None
+    )
+    needs_period = method == "cyclic" and period_samples is None and acq.period_samples is None
+    if detect and ((method is None and not stated) or needs_period):
+        detection = detect_excitation(data[ref_idx], data[out_idx])
+        if detection.kind == "periodic":
+            method = "cyclic"
+            period_samples = detection.period_samples
+            if settle_samples is None:
+                settle_samples = detection.settle_samples
+        elif needs_period:
+            raise InputError(
+                f"method: 'cyclic' needs a period; none stated and none found in the data "
+                f"({detection.reason})"
+            )
+        elif detection.kind == "impact" and detection.record_samples is not None:
+            method = "transient"
+            segment_samples = detection.record_samples
+    elif (
+        period_samples is not None
+        and acq.period_samples is None
+        and settle_samples is None
+        and detect
+        and method in (None, "cyclic")
+    ):
+        # a period stated by the caller for data that did not state one: find the
+        # start transient in the data
+        p_arg = _as_count(period_samples, "period_samples", minimum=2)
+        if timedata.n_samples >= 2 * p_arg and len(acq.run_starts) == 1:
+            sel = data[ref_idx + out_idx]
+            settle_samples = transient_periods(sel, p_arg) * p_arg
+    return method, period_samples, settle_samples, segment_samples, detection
 
 
 def _local_method(
