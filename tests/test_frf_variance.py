@@ -47,10 +47,14 @@ def test_variance_is_validated_read_only_and_carried() -> None:
     assert frf.with_H(frf.H * 2).variance is None
 
 
-def test_variance_round_trips_through_npz(tmp_path: Path) -> None:
+@pytest.mark.parametrize("ext", [".npz", ".csv", ".uff"])
+def test_variance_round_trips_through_files(tmp_path: Path, ext: str) -> None:
     frf = _frf()
-    back = read_frf(write_frf(frf, tmp_path / "v.npz"))
-    assert_array_equal(back.variance, frf.variance)
+    back = read_frf(write_frf(frf, tmp_path / f"v{ext}"))
+    assert_array_equal(back.variance, frf.variance)  # NPZ, CSV (17 digits), UFF 58b: exact
+    assert_array_equal(back.H, frf.H)
+    plain = FRF(frf.frequency, frf.H)
+    assert read_frf(write_frf(plain, tmp_path / f"p{ext}")).variance is None
 
 
 def _monte_carlo(method: str, n_runs: int = 200) -> tuple[np.ndarray, np.ndarray]:

@@ -23,6 +23,8 @@ FRF layout::
   every output (outer loop) and input (inner loop), in the SI unit of the
   kind (``unit`` line: m/N, m/(s N) or m/(s^2 N)).
 * ``coherence[out]``: optional multiple coherence of each output (0..1).
+* ``variance[out/in]``: optional variance of each ``H`` estimate (unit of
+  ``H`` squared), last, for every output (outer) and input (inner).
 
 Time-data layout::
 
@@ -100,6 +102,9 @@ def write_csv(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         if obj.coherence is not None:
             cols += [f"coherence[{c.label}]" for c in obj.outputs]
             blocks.append(obj.coherence.T)
+        if obj.variance is not None:
+            cols += [f"variance[{co.label}/{ci.label}]" for co in obj.outputs for ci in obj.inputs]
+            blocks.append(obj.variance.reshape(-1, obj.n_freq).T)
         table = np.hstack(blocks)
     elif isinstance(obj, TimeData):
         head += ["# type: timedata", f"# sample_rate: {obj.sample_rate!r}"]
@@ -200,14 +205,24 @@ def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
             if not outs or not ins:
                 raise FileFormatError(f"{p}: expected '# output:' and '# input:' header lines")
             n_h = 2 * len(outs) * len(ins)
-            if len(cols) == 1 + n_h:
+            n_var = sum(c.startswith("variance[") for c in cols)
+            if n_var not in (0, len(outs) * len(ins)) or any(
+                c.startswith("variance[") for c in cols[: len(cols) - n_var]
+            ):
+                raise FileFormatError(
+                    f"{p}: expected {len(outs) * len(ins)} variance columns at the end, got {n_var}"
+                )
+            n_rest = len(cols) - n_var
+            var = table[:, n_rest:].T.reshape(len(outs), len(ins), -1) if n_var else None
+            if n_rest == 1 + n_h:
                 coh = None
-            elif len(cols) == 1 + n_h + len(outs):
-                coh = table[:, 1 + n_h :].T
+            elif n_rest == 1 + n_h + len(outs):
+                coh = table[:, 1 + n_h : n_rest].T
             else:
                 raise FileFormatError(
                     f"{p}: expected {1 + n_h} columns ({len(outs)} outputs x {len(ins)} inputs, "
-                    f"re and im) or {1 + n_h + len(outs)} with coherence, got {len(cols)}"
+                    f"re and im) or {1 + n_h + len(outs)} with coherence (and the variance "
+                    f"columns), got {len(cols)}"
                 )
             h = table[:, 1 : 1 + n_h : 2] + 1j * table[:, 2 : 2 + n_h : 2]
             h = h.T.reshape(len(outs), len(ins), -1)
@@ -219,6 +234,7 @@ def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
                 inputs=ins,
                 coherence=coh,
                 meta=meta,
+                variance=var,
             )
         if typ == "timedata":
             recs = [meta_from_json(v, f"{p}: channel") for v in fields.get("channel", [])]

@@ -26,6 +26,11 @@ What is written
   ID lines 4 and 5: channel name and angle of the response and reference as
   JSON (``NONE`` when there are none); time data have no reference, and ID
   line 5 continues the metadata.
+* ``FRF.variance`` (when present): one extra data set per output/input pair
+  of function type 0 ("general") with ID line 1 ``tyredamp FRF variance``,
+  the pair's response and reference nodes, and the variance of ``H`` in
+  (unit of H)^2 as ordinate; other programs see a general function, tyredamp
+  reads it back into ``FRF.variance``.
 
 Precision
 ---------
@@ -71,6 +76,8 @@ from .units import frf_units, quantity_units
 __all__ = ["read_uff", "uff_contents", "write_uff"]
 
 _MARK = "tyredamp1"
+#: ID line 1 of the extra data sets (function type 0) holding FRF.variance.
+_VARIANCE_ID = "tyredamp FRF variance"
 _SDT = {"displacement": 8, "velocity": 11, "acceleration": 12, "force": 13}
 _SDT_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 13: "force", 9: "force"}
 _KIND_QUANTITY = {
@@ -282,6 +289,28 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
                     data=np.array(obj.coherence[o], dtype=float),
                 )
                 sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+        if obj.variance is not None:
+            for o, co in enumerate(obj.outputs):
+                for i, ci in enumerate(obj.inputs):
+                    fid += 1
+                    d = _base_set(binary, q, _VARIANCE_ID, id2, id3)
+                    d.update(
+                        func_type=0,
+                        func_id=fid,
+                        rsp_node=co.node,
+                        rsp_dir=co.direction,
+                        ref_node=ci.node,
+                        ref_dir=ci.direction,
+                        id4=_extras_line(co),
+                        id5=_extras_line(ci),
+                        ordinate_spec_data_type=0,
+                        ordinate_len_unit_exp=0,
+                        ordinate_force_unit_exp=0,
+                        ordinate_axis_lab="Variance of H",
+                        ordinate_axis_units_lab=f"({obj.unit})^2"[:20],
+                        data=np.array(obj.variance[o, i], dtype=float),
+                    )
+                    sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
     elif isinstance(obj, TimeData):
         id1 = str(obj.meta.get("description", "tyredamp time data"))
         # time data: ID line 5 continues the metadata; the acquisition fields go first
@@ -577,6 +606,7 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
                 )
             h[a, b] = cells[(ko, ki)]
     coh = _read_coherence(sets, list(outs), list(ins), n)
+    var = _read_variance(sets, list(outs), list(ins), n, h.shape)
     return FRF(
         x,
         h,
@@ -585,6 +615,7 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
         inputs=list(ins.values()),
         coherence=coh,
         meta=_meta(first, tok),
+        variance=var,
     )
 
 
@@ -602,6 +633,28 @@ def _read_coherence(
     if not all(o in found for o in outs):
         return None
     return np.array([found[o] for o in outs])
+
+
+def _read_variance(
+    sets: list[dict[str, Any]],
+    outs: list[tuple[int, int]],
+    ins: list[tuple[int, int]],
+    n: int,
+    shape: tuple[int, ...],
+) -> np.ndarray | None:
+    """FRF.variance from tyredamp's extra type-0 data sets, when every pair has one."""
+    found: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray] = {}
+    for s in sets:
+        if int(s["func_type"]) != 0 or str(s.get("id1", "")).strip() != _VARIANCE_ID:
+            continue
+        if len(s["data"]) != n:
+            continue
+        ko = (int(s["rsp_node"]), int(s["rsp_dir"]))
+        ki = (int(s["ref_node"]), int(s["ref_dir"]))
+        found[(ko, ki)] = np.real(np.asarray(s["data"], dtype=float))
+    if not all((o, i) in found for o in outs for i in ins):
+        return None
+    return np.array([[found[(o, i)] for i in ins] for o in outs]).reshape(shape)
 
 
 def _read_time(p: Path, sets: list[dict[str, Any]]) -> TimeData:
