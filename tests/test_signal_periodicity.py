@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import pyuff
+import scipy.signal
 from numpy.testing import assert_allclose
 
 from tyredamp import InputError
@@ -218,3 +219,42 @@ def test_cyclic_on_random_data_names_the_reason(tmp_path: Path) -> None:
     frf = estimate_frf(td)
     assert frf.meta["method"] == "transient"
     assert frf.meta["detection"]["kind"] == "impact"
+
+
+def test_narrow_band_random_is_not_periodic() -> None:
+    """A lightly damped resonator driven by noise repeats itself over many cycles.
+
+    Neighbouring "periods" are alike (correlation time ~3000 samples), which the
+    F ratio alone would take for periodicity; the serial test of the residual
+    rejects it.
+    """
+    rng = np.random.default_rng(12)
+    w, z = 0.025, 0.0015
+    r = np.exp(-z * 2 * np.pi * w)
+    a = [1.0, -2 * r * np.cos(2 * np.pi * w), r * r]
+    bad = 0
+    for _ in range(20):
+        x = scipy.signal.lfilter([1.0], a, rng.standard_normal(25000))[5000:]
+        bad += detect_excitation(x).kind != "random"
+    assert bad == 0
+
+
+def test_period_is_not_a_fraction_of_the_true_one() -> None:
+    """A narrow-band periodic chirp nearly repeats every half period: the full one is found."""
+    from tyredamp.signal import periodic_chirp
+
+    for p in (404, 384, 216, 202):
+        e = periodic_chirp(1000.0, p, (50.0, 60.0), n_periods=30)
+        det = detect_excitation(e.signal, respond(e.signal))
+        assert det.kind == "periodic"
+        assert det.period_samples == p
+
+
+def test_burst_random_is_cut_into_its_records() -> None:
+    from tyredamp.signal import burst_random
+
+    e = burst_random(1000.0, 1000, (5.0, 300.0), n_records=12, rng=np.random.default_rng(3))
+    det = detect_excitation(e.signal, respond(e.signal))
+    assert det.kind == "impact"
+    assert det.record_starts == tuple(range(0, 12000, 1000))
+    assert det.record_samples == 1000

@@ -39,10 +39,24 @@ Method
    (two per complex line when the power is spread, few when it sits on few
    lines). ``P`` is accepted when (a) the upper tail probability of ``F``
    is below ``alpha / n_lags`` (``alpha = 1e-4``, Bonferroni over every lag
-   searched) and (b) the periodic part carries most of the force power,
+   searched), (b) the periodic part carries most of the force power,
    ``phi = (sum |Xbar|^2 - sum s^2 / M) / mean_m sum |X_m|^2 > 1/2`` (an
    unbiased estimate; with a smaller periodic share cyclic averaging would
-   throw most of the excitation away).
+   throw most of the excitation away), and (c) the residuals ``X_m - Xbar``
+   of successive periods are not serially correlated (the F ratio assumes
+   independent periods, which a narrow-band random signal with a correlation
+   time longer than ``P`` violates): the von Neumann ratio
+   ``eta = sum |r_{m+1} - r_m|^2 / (2 sum |r_m|^2)`` (1 for independent
+   periods) must not differ from 1 by more than the two-sided Gaussian
+   quantile at ``alpha / n_lags`` of its standard deviation
+   ``1 / sqrt((M - 1) L_eff)`` (``L_eff`` the Satterthwaite number of
+   residual lines; below 1: neighbouring periods alike, above 1: a
+   residual that alternates, the mark of a period twice as long); skipped
+   for ``M < 4`` and for residuals at the storage floor (noise-free data).
+   Finally (d), the candidate ``k`` whose divisor ``P`` is tried must not
+   fit significantly better (nested F test on the lines of the ``k``-period
+   that a ``P``-periodic signal leaves empty), so a period is never a
+   fraction of the true one.
 3. **Start transient** (every channel, periods aligned at the start): the
    later half of the periods gives the steady-state period ``m(t)`` and the
    noise variance ``sigma^2`` of each channel (floored at ``(1e-9 rms)^2``,
@@ -54,8 +68,12 @@ Method
    are skipped (``settle_samples``), keeping at least two periods.
 4. **Not periodic**: impact data if the force has samples beyond what a
    Gaussian signal of its robust scale (``1.4826`` times the median absolute
-   deviation) reaches in ``N`` samples at level ``alpha``; these hits split
-   the record into transient records. Otherwise random (Welch averaging).
+   deviation) reaches in ``N`` samples at level ``alpha`` (hammer hits, and
+   bursts of random noise separated by silence). Exceedances closer than
+   half the length of the run before them are one hit; a hit starts where
+   its force rises above three robust scales; the record is cut at the hit
+   starts into transient records (rectangular window). Otherwise random
+   (Welch averaging).
 """
 
 from __future__ import annotations
@@ -177,8 +195,8 @@ def _periods(x: NDArray[np.float64], p: int, align_end: bool) -> NDArray[np.floa
     return x[:, start : start + m * p].reshape(x.shape[0], m, p)
 
 
-def _periodic_test(x: NDArray[np.float64], p: int) -> tuple[float, float, float]:
-    """(phi, F, p-value) of period ``p`` for the force signals ``x`` (module step 2)."""
+def _periodic_test(x: NDArray[np.float64], p: int) -> tuple[float, float, float, float]:
+    """(phi, F, p-value, z of the serial test) of period ``p`` for the forces ``x`` (step 2)."""
     xp = _periods(x, p, align_end=True)
     m = xp.shape[1]
     spec = scipy.fft.rfft(xp, axis=2)[:, :, 1:]  # DC excluded (means removed)
@@ -186,20 +204,67 @@ def _periodic_test(x: NDArray[np.float64], p: int) -> tuple[float, float, float]
         spec[:, :, -1] /= np.sqrt(2.0)  # the Nyquist line is real: half the degrees of freedom
     mean = spec.mean(axis=1)
     pm = np.abs(mean) ** 2  # (n_ch, L)
-    s2 = np.sum(np.abs(spec - mean[:, None, :]) ** 2, axis=1) / (m - 1)
+    resid = spec - mean[:, None, :]
+    s2 = np.sum(np.abs(resid) ** 2, axis=1) / (m - 1)
     total = np.mean(np.sum(np.abs(spec) ** 2, axis=2), axis=1).sum()
     if total <= 0:
-        return 0.0, 0.0, 1.0
+        return 0.0, 0.0, 1.0, 0.0
     phi = float((pm.sum() - s2.sum() / m) / total)
     line_power = np.mean(np.abs(spec) ** 2, axis=1).ravel()
     nu = 2.0 * line_power.sum() ** 2 / max(float(np.sum(line_power**2)), 1e-300)
     den = float(s2.sum())
     num = float(m * pm.sum())
+    # serial (von Neumann) ratio of the residual: 1 for independent periods, << 1
+    # when neighbouring periods are alike because the signal is a slowly changing
+    # random one (a narrow-band process whose correlation time exceeds the period)
+    z = 0.0
+    floor = (_STORAGE_FLOOR**2) * total * m
+    if m >= 4 and float(np.sum(np.abs(resid) ** 2)) > floor:
+        succ = float(np.sum(np.abs(np.diff(resid, axis=1)) ** 2)) / (m - 1)
+        eta = succ / (2.0 * float(np.sum(np.abs(resid) ** 2)) / (m - 1))
+        rp = np.sum(np.abs(resid) ** 2, axis=1).ravel()
+        l_eff = rp.sum() ** 2 / max(float(np.sum(rp**2)), 1e-300)
+        z = (eta - 1.0) * np.sqrt((m - 1) * l_eff)
     if den <= 1e-30 * num:
-        return phi, float("inf"), 0.0
+        return phi, float("inf"), 0.0, z
     f = num / den
     pval = float(scipy.stats.f.sf(f, nu, nu * (m - 1)))
-    return phi, f, pval
+    return phi, f, pval, z
+
+
+def _multiple_fits_better(x: NDArray[np.float64], d: int, k: int, level: float) -> bool:
+    """True when period ``k`` (a multiple of ``d``) explains the forces significantly better.
+
+    Nested models: with period ``k = q d`` the DFT lines of one ``k``-period
+    that are not multiples of ``q`` hold what a ``d``-periodic signal cannot;
+    under "period ``d``" their period means are noise, so
+    ``F = sum M |Xbar|^2 / sum s^2`` over those lines is F-distributed with
+    ``(nu, nu (M - 1))`` degrees of freedom (``nu`` the Satterthwaite number
+    of their noise powers). Significant at ``level``: ``d`` is not the period.
+    Means below the storage floor of the signal power count as zero.
+    """
+    q = k // d
+    if q < 2:
+        return False
+    xp = _periods(x, k, align_end=True)
+    m = xp.shape[1]
+    spec = scipy.fft.rfft(xp, axis=2)
+    lines = np.arange(spec.shape[2])
+    extra = lines % q != 0
+    if not np.any(extra):
+        return False
+    se = spec[:, :, extra]
+    mean = se.mean(axis=1)
+    num = float(m * np.sum(np.abs(mean) ** 2))
+    s2 = np.sum(np.abs(se - mean[:, None, :]) ** 2, axis=1) / (m - 1)
+    total = float(np.mean(np.sum(np.abs(spec[:, :, 1:]) ** 2, axis=2), axis=1).sum())
+    if num <= (_STORAGE_FLOOR**2) * total * m:
+        return False
+    den = float(s2.sum())
+    if den <= 1e-30 * num:
+        return True
+    nu = 2.0 * den**2 / max(float(np.sum(s2**2)), 1e-300)
+    return bool(scipy.stats.f.sf(num / den, nu, nu * (m - 1)) < level)
 
 
 def _divisors(k: int) -> list[int]:
@@ -269,18 +334,28 @@ def _impact_records(x: NDArray[np.float64], alpha: float) -> tuple[int, ...] | N
     if not np.any(hit):
         return None
     idx = np.flatnonzero(hit)
-    # group exceedances closer than the longest exceedance run into one hit
     gaps = np.flatnonzero(np.diff(idx) > 1)
     run_starts = np.concatenate([[idx[0]], idx[gaps + 1]])
     run_ends = np.concatenate([idx[gaps], [idx[-1]]])
-    width = int(np.max(run_ends - run_starts) + 1)
-    merged = [int(run_starts[0])]
-    for a in run_starts[1:]:
-        if a - merged[-1] > 4 * width:
-            merged.append(int(a))
-    pre = max(1, width)
-    starts = tuple(max(0, a - pre) for a in merged)
-    return starts
+    # a quiet gap shorter than half the exceedance run before it belongs to the same hit
+    merged: list[list[int]] = [[int(run_starts[0]), int(run_ends[0])]]
+    for a, b in zip(run_starts[1:], run_ends[1:], strict=True):
+        last = merged[-1]
+        if a - last[1] <= max(2, (last[1] - last[0] + 1) // 2):
+            last[1] = int(b)
+        else:
+            merged.append([int(a), int(b)])
+    # each hit starts where its signal rises out of the noise (3 robust scales)
+    active = np.any(dev > 3.0 * scale[:, None], axis=0)
+    starts = []
+    prev_end = -1
+    for a, b in merged:
+        j = a
+        while j - 1 > prev_end and active[j - 1]:
+            j -= 1
+        starts.append(max(j, prev_end + 1, 0))
+        prev_end = b
+    return tuple(starts)
 
 
 def detect_excitation(
@@ -335,6 +410,7 @@ def detect_excitation(
         cands = _candidates(e, k0, max_lag)
         n_lags = max(1, max_lag - k0 + 1)
         level = float(alpha) / n_lags
+        z_level = float(scipy.special.ndtri(level / 2))  # two-sided Gaussian quantile
         tried: set[int] = set()
         for k in cands:
             for d in _divisors(k):
@@ -343,10 +419,15 @@ def detect_excitation(
                 tried.add(d)
                 if e[d] > 0.75:  # repetition error alone rules out phi > 1/2
                     continue
-                phi, f, pval = _periodic_test(xc, d)
+                phi, f, pval, z = _periodic_test(xc, d)
                 if phi > best[0]:
                     best = (phi, f, pval, d)
-                if pval < level and phi > 0.5:
+                if (
+                    pval < level
+                    and phi > 0.5
+                    and abs(z) < -z_level
+                    and not _multiple_fits_better(xc, d, k, level)
+                ):
                     settle = transient_periods(y, d, float(alpha)) * d
                     m = (n - settle) // d
                     why = (
@@ -363,8 +444,9 @@ def detect_excitation(
         ends = [*hits[1:], n]
         rec = int(min(b - a for a, b in zip(hits, ends, strict=True)))
         why = (
-            f"impact: {len(hits)} hit(s) beyond the Gaussian level of the force's robust "
-            f"scale; transient records of {rec} samples; not periodic{near}"
+            f"impact (or burst): {len(hits)} hit(s) beyond the Gaussian level of the "
+            f"force's robust scale; transient records of {rec} samples from each hit; not "
+            f"periodic{near}"
         )
         return ExcitationDetection(
             "impact", None, 0, 0, phi, f, pval, hits, rec if rec >= 2 else None, why
