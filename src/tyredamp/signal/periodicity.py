@@ -37,23 +37,20 @@ Method
    F-distributed with ``(nu, nu (M - 1))`` degrees of freedom, ``nu`` the
    Satterthwaite number ``2 (sum S)^2 / sum S^2`` of the line powers ``S``
    (two per complex line when the power is spread, few when it sits on few
-   lines). ``P`` is accepted when (a) the upper tail probability of ``F``
+   lines). ``P`` is accepted when the upper tail probability of ``F``
    is below ``alpha / n_lags`` (``alpha = 1e-4``, Bonferroni over every lag
-   searched), (b) the periodic part carries most of the force power,
+   searched) and the periodic part carries most of the force power,
    ``phi = (sum |Xbar|^2 - sum s^2 / M) / mean_m sum |X_m|^2 > 1/2`` (an
    unbiased estimate; with a smaller periodic share cyclic averaging would
-   throw most of the excitation away), and (c) the residuals ``X_m - Xbar``
-   of successive periods are not serially correlated (the F ratio assumes
-   independent periods, which a narrow-band random signal with a correlation
-   time longer than ``P`` violates): the von Neumann ratio
-   ``eta = sum |r_{m+1} - r_m|^2 / (2 sum |r_m|^2)`` (1 for independent
-   periods) must not differ from 1 by more than the two-sided Gaussian
-   quantile at ``alpha / n_lags`` of its standard deviation
-   ``1 / sqrt((M - 1) L_eff)`` (``L_eff`` the Satterthwaite number of
-   residual lines; below 1: neighbouring periods alike, above 1: a
-   residual that alternates, the mark of a period twice as long); skipped
-   for ``M < 4`` and for residuals at the storage floor (noise-free data).
-   Finally (d), the candidate ``k`` whose divisor ``P`` is tried must not
+   throw most of the excitation away). The F ratio assumes independent
+   periods, which a narrow-band random signal with a correlation time longer
+   than ``P`` violates (neighbouring periods alike): the period-to-period
+   variance is multiplied by the batch-means inflation
+   ``tau = 1 + 2 sum_j (1 - j/M) rho_j`` of the residuals' serial
+   correlation (and the denominator degrees of freedom divided by it), so
+   such a signal is not significant, while a periodic force with slow drift
+   (large ``tau`` but a tiny residual) still is.
+   Finally, the candidate ``k`` whose divisor ``P`` is tried must not
    fit significantly better (nested F test on the lines of the ``k``-period
    that a ``P``-periodic signal leaves empty), so a period is never a
    fraction of the true one.
@@ -196,7 +193,7 @@ def _periods(x: NDArray[np.float64], p: int, align_end: bool) -> NDArray[np.floa
 
 
 def _periodic_test(x: NDArray[np.float64], p: int) -> tuple[float, float, float, float]:
-    """(phi, F, p-value, z of the serial test) of period ``p`` for the forces ``x`` (step 2)."""
+    """(phi, F, p-value, tau) of period ``p`` for the forces ``x`` (module step 2)."""
     xp = _periods(x, p, align_end=True)
     m = xp.shape[1]
     spec = scipy.fft.rfft(xp, axis=2)[:, :, 1:]  # DC excluded (means removed)
@@ -208,28 +205,43 @@ def _periodic_test(x: NDArray[np.float64], p: int) -> tuple[float, float, float,
     s2 = np.sum(np.abs(resid) ** 2, axis=1) / (m - 1)
     total = np.mean(np.sum(np.abs(spec) ** 2, axis=2), axis=1).sum()
     if total <= 0:
-        return 0.0, 0.0, 1.0, 0.0
+        return 0.0, 0.0, 1.0, 1.0
     phi = float((pm.sum() - s2.sum() / m) / total)
     line_power = np.mean(np.abs(spec) ** 2, axis=1).ravel()
     nu = 2.0 * line_power.sum() ** 2 / max(float(np.sum(line_power**2)), 1e-300)
-    den = float(s2.sum())
+    tau = _inflation(resid, total * m)
+    den = float(s2.sum()) * tau
     num = float(m * pm.sum())
-    # serial (von Neumann) ratio of the residual: 1 for independent periods, << 1
-    # when neighbouring periods are alike because the signal is a slowly changing
-    # random one (a narrow-band process whose correlation time exceeds the period)
-    z = 0.0
-    floor = (_STORAGE_FLOOR**2) * total * m
-    if m >= 4 and float(np.sum(np.abs(resid) ** 2)) > floor:
-        succ = float(np.sum(np.abs(np.diff(resid, axis=1)) ** 2)) / (m - 1)
-        eta = succ / (2.0 * float(np.sum(np.abs(resid) ** 2)) / (m - 1))
-        rp = np.sum(np.abs(resid) ** 2, axis=1).ravel()
-        l_eff = rp.sum() ** 2 / max(float(np.sum(rp**2)), 1e-300)
-        z = (eta - 1.0) * np.sqrt((m - 1) * l_eff)
     if den <= 1e-30 * num:
-        return phi, float("inf"), 0.0, z
+        return phi, float("inf"), 0.0, tau
     f = num / den
-    pval = float(scipy.stats.f.sf(f, nu, nu * (m - 1)))
-    return phi, f, pval, z
+    pval = float(scipy.stats.f.sf(f, nu, nu * (m - 1) / tau))
+    return phi, f, pval, tau
+
+
+def _inflation(resid: NDArray[np.complex128], energy: float) -> float:
+    """Variance inflation ``tau`` of the period mean from serially correlated residuals.
+
+    ``Var(Xbar) = s^2 / M * tau`` with ``tau = 1 + 2 sum_j (1 - j/M) rho_j``
+    (the batch-means correction; 1 for independent periods), ``rho_j`` the
+    lag-``j`` correlation of the residuals across periods pooled over lines
+    and channels, summed while positive (Geyer's initial positive sequence).
+    A narrow-band random signal, whose neighbouring periods are alike, gets a
+    large ``tau``; so does slow drift, whose share is small beside a periodic
+    force. Residuals at the storage floor (noise-free data) give 1.
+    """
+    m = resid.shape[1]
+    r0 = float(np.sum(np.abs(resid) ** 2))
+    if m < 3 or r0 <= (_STORAGE_FLOOR**2) * energy:
+        return 1.0
+    tau = 1.0
+    for j in range(1, m - 1):
+        rho = float(np.real(np.sum(resid[:, j:] * np.conj(resid[:, :-j])))) / r0
+        rho += 1.0 / m  # the mean removed from M values biases every rho_j by -1/M
+        if rho <= 0:
+            break
+        tau += 2.0 * (1.0 - j / m) * rho
+    return max(tau, 1.0)
 
 
 def _multiple_fits_better(x: NDArray[np.float64], d: int, k: int, level: float) -> bool:
@@ -410,7 +422,6 @@ def detect_excitation(
         cands = _candidates(e, k0, max_lag)
         n_lags = max(1, max_lag - k0 + 1)
         level = float(alpha) / n_lags
-        z_level = float(scipy.special.ndtri(level / 2))  # two-sided Gaussian quantile
         tried: set[int] = set()
         for k in cands:
             for d in _divisors(k):
@@ -419,22 +430,19 @@ def detect_excitation(
                 tried.add(d)
                 if e[d] > 0.75:  # repetition error alone rules out phi > 1/2
                     continue
-                phi, f, pval, z = _periodic_test(xc, d)
+                phi, f, pval, tau = _periodic_test(xc, d)
                 if phi > best[0]:
                     best = (phi, f, pval, d)
-                if (
-                    pval < level
-                    and phi > 0.5
-                    and abs(z) < -z_level
-                    and not _multiple_fits_better(xc, d, k, level)
-                ):
+                if pval < level and phi > 0.5 and not _multiple_fits_better(xc, d, k, level):
                     settle = transient_periods(y, d, float(alpha)) * d
                     m = (n - settle) // d
                     why = (
                         f"periodic: the force repeats every {d} samples ({m} whole periods"
                         + (f" after a {settle}-sample start transient" if settle else "")
                         + f"); periodic share of the force power {phi:.4f}, period-mean to "
-                        f"spread ratio F = {f:.3g} (p = {pval:.2g} < {level:.2g})"
+                        f"spread ratio F = {f:.3g} (p = {pval:.2g} < {level:.2g}"
+                        + (f"; serial correlation inflation {tau:.3g}" if tau > 1 else "")
+                        + ")"
                     )
                     return ExcitationDetection("periodic", d, settle, m, phi, f, pval, reason=why)
     phi, f, pval, d = best
