@@ -208,3 +208,31 @@ def test_report_draws_modes_on_pyuff_geometry(
     text = html.read_text()
     assert "mode shapes on the test geometry" in text
     assert "test geometry (nodes, trace lines)" in text
+
+
+def test_modal_geometry_option_sets_ring_angles(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tyredamp.cli import main
+    from tyredamp.cli.modal import _with_geometry
+    from tyredamp.frf import FRF
+    from tyredamp.io import write_frf
+
+    geo = tmp_path / "geometry.unv"
+    write(geo, ring_sets(mm=True))
+    f = np.linspace(10.0, 100.0, 50)
+    outs = [Channel(n, 3) for n in range(1, N + 1)]
+    frf = FRF(f, np.ones((N, 1, f.size)) * (1 + 1j), "accelerance", outs, [Channel(1, 3)])
+    placed = _with_geometry(frf, geo)
+    assert [c.angle_deg for c in placed.outputs] == pytest.approx(
+        list(np.arange(N) * 22.5), abs=1e-3
+    )
+    assert placed.inputs[0].angle_deg == pytest.approx(0.0, abs=1e-3)
+    # a channel whose node the geometry lacks: one-line error, nothing written
+    path = write_frf(FRF(f, np.ones((1, 1, f.size)), "accelerance", [99], [1]), tmp_path / "x.npz")
+    out = tmp_path / "modes.json"
+    with pytest.raises(SystemExit) as info:
+        main(["modal", str(path), "--out", str(out), "--geometry", str(geo)])
+    assert info.value.code == 2
+    assert "has no node 99" in capsys.readouterr().err
+    assert not out.exists()

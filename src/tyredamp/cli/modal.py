@@ -8,6 +8,7 @@ import click
 import numpy as np
 
 from ..exceptions import InputError
+from ..frf import FRF, Channel
 from ..io import read_frf
 from ..modal.identify import ModalIdentification, identify_modes
 from ..modal.io import write_modes_json
@@ -53,6 +54,27 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     return vals
 
 
+def _with_geometry(frf: FRF, path: Path) -> FRF:
+    """The FRF with channel angles from the geometry when its points lie on a circle."""
+    from dataclasses import replace
+
+    from ..io.uff_geometry import read_uff_geometry
+
+    geo = read_uff_geometry(path)
+    missing = sorted({c.node for c in (*frf.outputs, *frf.inputs)} - set(geo.nodes))
+    if missing:
+        raise InputError(
+            f"--geometry: {path} has no node {missing[0]} ({len(missing)} channel node(s) missing)"
+        )
+    outs = geo.with_angles(frf.outputs)
+    angle = {(c.node, abs(c.direction)): c.angle_deg for c in outs}
+    ins = tuple(
+        Channel(c.node, c.direction, angle.get((c.node, abs(c.direction)), c.angle_deg), c.name)
+        for c in frf.inputs
+    )
+    return replace(frf, outputs=outs, inputs=ins)
+
+
 @click.command("modal")
 @click.argument("frf_file", type=click.Path(dir_okay=False, path_type=Path))
 @out_file_option("Modes JSON file to write (schema: docs/modes-json.md).")
@@ -85,6 +107,13 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     help="Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
 )
 @click.option("--no-residuals", is_flag=True, help="Fit without lower/upper residual terms.")
+@click.option(
+    "--geometry",
+    "geometry_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="UFF geometry (nodes 15/2411, trace lines 82, systems 18/2420): every channel's node "
+    "must be in it; points on a circle get their angles from it (ring views).",
+)
 def modal_command(
     frf_file: Path,
     out: Path,
@@ -95,6 +124,7 @@ def modal_command(
     max_order: int | None,
     order_step: int,
     no_residuals: bool,
+    geometry_file: Path | None,
 ) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
 
@@ -110,6 +140,8 @@ def modal_command(
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
     frf = read_frf(frf_file)
+    if geometry_file is not None:
+        frf = _with_geometry(frf, geometry_file)
     res: ModalIdentification = identify_modes(
         frf,
         band=None if band is None else (float(band[0]), float(band[1])),
