@@ -258,3 +258,17 @@ def test_burst_random_is_cut_into_its_records() -> None:
     assert det.kind == "impact"
     assert det.record_starts == tuple(range(0, 12000, 1000))
     assert det.record_samples == 1000
+
+
+def test_quality_check_of_periodic_data_without_metadata_is_not_clipping() -> None:
+    """Each period reaches the same extreme: not flat-topping once the period is detected."""
+    from tyredamp.signal import quality_check
+
+    x, y, _ = periodic_record("multisine", 500, 8, np.random.default_rng(0), False)
+    td = TimeData(np.vstack([x, y]), FS, [1, 2], ["force", "acceleration"])
+    res = quality_check(td)
+    assert res.figures["clipped_channels"] == 0
+    assert res.passed, res.report()
+    clipped = np.minimum(y, 0.6 * y.max())  # a real overload is still found
+    res = quality_check(TimeData(np.vstack([x, clipped]), FS, [1, 2], ["force", "acceleration"]))
+    assert res.figures["clipped_channels"] == 1

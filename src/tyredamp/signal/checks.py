@@ -39,6 +39,7 @@ from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel
 from ..timedata import TimeData
 from .estimators import estimate_frf
+from .periodicity import detect_excitation
 
 __all__ = [
     "CheckResult",
@@ -415,8 +416,10 @@ def quality_check(
         (the verdict figure and threshold).
     clip_run : int
         Shortest run of equal samples at a channel extreme counted as
-        clipping (see :func:`clipping`; with ``acquisition.period_samples`` one
-        repeat of the extreme per period is accepted).
+        clipping (see :func:`clipping`; with ``acquisition.period_samples``, or the
+        period detected from the force by
+        :func:`~tyredamp.signal.periodicity.detect_excitation`, one repeat
+        of the extreme per period is accepted).
     passivity_floor : float
         Allowed negative ``Re Y / |Y|`` at a drive point besides the random
         error (0.02 is about 1 degree of phase error).
@@ -444,6 +447,11 @@ def quality_check(
     frf: FRF | None
     if isinstance(data, TimeData):
         period = data.acquisition.period_samples
+        live = [i for i in data.force_indices if np.any(data.data[i])]
+        if period is None and live:
+            # a periodic test without metadata repeats its extreme once per period
+            det = detect_excitation(data.data[live])
+            period = det.period_samples if det.kind == "periodic" else None
         reps = max(1, data.n_samples // int(period)) if period else 1
         clipped = {
             c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)
