@@ -227,3 +227,19 @@ def test_old_files_with_acquisition_in_meta_still_read(tmp_path: Path, fmt: str)
             period_samples=500, settle_samples=100, band_hz=(2.0, 300.0)
         )
         assert back.meta == {}
+
+
+def test_uff_keeps_many_runs_or_refuses(tmp_path: Path) -> None:
+    """Evenly spaced runs fit an ID line as run_every; a field that cannot fit is an error."""
+    rng = np.random.default_rng(5)
+    d = rng.normal(size=(2, 3200))
+    acq = Acquisition(period_samples=100, run_starts=tuple(range(0, 3200, 200)), settle_samples=100)
+    td = TimeData(d, 1000.0, [1, 2], ["force", "acceleration"], acquisition=acq)
+    back = read_timedata(write_timedata(td, tmp_path / "runs.uff"))
+    assert back.acquisition == acq
+    uneven = Acquisition(run_starts=(0, *(100 * k + k * k for k in range(1, 25))))
+    td = TimeData(d, 1000.0, [1, 2], ["force", "acceleration"], acquisition=uneven)
+    with pytest.raises(InputError, match="run_starts"):
+        write_timedata(td, tmp_path / "uneven.uff")
+    assert not (tmp_path / "uneven.uff").exists()
+    assert read_timedata(write_timedata(td, tmp_path / "uneven.npz")).acquisition == uneven

@@ -21,8 +21,9 @@ What is written
   as Python floats (the fixed E13.5 fields of record 7 keep only 6 digits);
   ID line 3: as much of ``meta`` as fits in 80 characters as JSON, for time
   data the acquisition fields first (``period_samples``, ``settle_samples``,
-  ``record_samples``, ``run_starts``, ``band_hz`` ..., read back into
-  ``TimeData.acquisition``);
+  ``record_samples``, ``run_starts`` (evenly spaced runs as ``run_every``:
+  [step, count]), ``band_hz`` ..., read back into ``TimeData.acquisition``;
+  an acquisition that does not fit is an error, never silently dropped);
   ID lines 4 and 5: channel name and angle of the response and reference as
   JSON (``NONE`` when there are none); time data have no reference, and ID
   line 5 continues the metadata.
@@ -57,6 +58,7 @@ label; a label and a data type that disagree are an error.
 from __future__ import annotations
 
 import gc
+import itertools
 import json
 import os
 import warnings
@@ -314,7 +316,16 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
     elif isinstance(obj, TimeData):
         id1 = str(obj.meta.get("description", "tyredamp time data"))
         # time data: ID line 5 continues the metadata; the acquisition fields go first
-        id3, id5 = _meta_lines({**obj.acquisition.to_dict(), **obj.meta}, 2)
+        acq = _compact_acquisition(obj.acquisition.to_dict())
+        id3, id5 = _meta_lines({**acq, **obj.meta}, 2)
+        stored = {**_extras(id3), **_extras(id5)}
+        lost = [k for k in acq if k not in stored]
+        if lost:
+            raise InputError(
+                f"timedata.acquisition: {', '.join(lost)} do not fit the 80-character UFF ID "
+                "lines with the other fields; write NPZ or CSV (a dropped field would change "
+                "how the FRF is estimated)"
+            )
         t = obj.time
         for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
             d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
@@ -530,10 +541,27 @@ def read_uff(
     raise InputError(f"what: expected 'frf' or 'timedata', got {what!r}")
 
 
+def _compact_acquisition(acq: dict[str, Any]) -> dict[str, Any]:
+    """Evenly spaced ``run_starts`` as ``run_every`` (fits an ID line for many runs)."""
+    runs = acq.get("run_starts")
+    if runs is not None and len(runs) > 2:
+        step = runs[1] - runs[0]
+        if all(b - a == step for a, b in itertools.pairwise(runs)):
+            acq = {k: v for k, v in acq.items() if k != "run_starts"}
+            acq["run_every"] = [int(step), len(runs)]
+    return acq
+
+
 def _meta(s: dict[str, Any], tok: dict[str, str] | None) -> dict[str, Any]:
     meta = _extras(s.get("id3")) if tok is not None else {}
     if tok is not None and tok.get("_what") == "time":
         meta.update(_extras(s.get("id5")))
+        every = meta.pop("run_every", None)
+        if isinstance(every, list) and len(every) == 2:
+            try:
+                meta["run_starts"] = [int(every[0]) * k for k in range(int(every[1]))]
+            except (TypeError, ValueError):
+                raise FileFormatError(f"ID line: run_every {every!r} is not two integers") from None
     desc = str(s.get("id1", "")).strip()
     if desc and desc != "NONE" and not desc.startswith("tyredamp "):
         meta.setdefault("description", desc)
