@@ -80,8 +80,6 @@ from typing import Any, Literal
 
 import numpy as np
 import scipy.fft
-import scipy.special
-import scipy.stats
 from numpy.typing import ArrayLike, NDArray
 
 from .._validate import as_finite
@@ -194,6 +192,8 @@ def _periods(x: NDArray[np.float64], p: int, align_end: bool) -> NDArray[np.floa
 
 def _periodic_test(x: NDArray[np.float64], p: int) -> tuple[float, float, float, float]:
     """(phi, F, p-value, tau) of period ``p`` for the forces ``x`` (module step 2)."""
+    import scipy.stats  # lazy (scipy.stats is slow to import)
+
     xp = _periods(x, p, align_end=True)
     m = xp.shape[1]
     spec = scipy.fft.rfft(xp, axis=2)[:, :, 1:]  # DC excluded (means removed)
@@ -255,6 +255,8 @@ def _multiple_fits_better(x: NDArray[np.float64], d: int, k: int, level: float) 
     of their noise powers). Significant at ``level``: ``d`` is not the period.
     Means below the storage floor of the signal power count as zero.
     """
+    import scipy.stats  # lazy (scipy.stats is slow to import)
+
     q = k // d
     if q < 2:
         return False
@@ -301,6 +303,8 @@ def transient_periods(signals: ArrayLike, period_samples: int, alpha: float = AL
     int
         Number of leading periods to skip (at most ``M - 2`` of ``M``).
     """
+    import scipy.stats  # lazy (scipy.stats is slow to import)
+
     y = as_finite(signals, "signals")
     y = y[None, :] if y.ndim == 1 else y
     p = int(period_samples)
@@ -337,6 +341,8 @@ def transient_periods(signals: ArrayLike, period_samples: int, alpha: float = AL
 
 def _impact_records(x: NDArray[np.float64], alpha: float) -> tuple[int, ...] | None:
     """Starts of the hits when the force is impulsive (step 4), else None."""
+    import scipy.special
+
     n = x.shape[1]
     dev = np.abs(x - np.median(x, axis=1, keepdims=True))
     scale = 1.4826 * np.median(dev, axis=1)
@@ -396,6 +402,7 @@ def detect_excitation(
     ExcitationDetection
         The verdict with its figures and a one-sentence reason.
     """
+
     x = as_finite(forces, "forces")
     x = x[None, :] if x.ndim == 1 else x
     if x.ndim != 2:
