@@ -110,3 +110,15 @@ def test_noise_free_cyclic_has_zero_variance() -> None:
         period_samples=64,
     )
     assert one_period.variance is None  # one average: no degree of freedom for the noise
+
+
+def test_merge_inputs_keeps_the_variance_of_each_column() -> None:
+    from tyredamp.signal import merge_inputs
+
+    a = _frf().select(inputs=[0])
+    b = FRF(a.frequency, 2 * a.H, "receptance", a.outputs, [7], variance=3 * a.variance)
+    m = merge_inputs([a, b])
+    assert m.variance is not None
+    assert_array_equal(m.variance[:, 0], a.variance[:, 0])
+    assert_array_equal(m.variance[:, 1], 3 * a.variance[:, 0])
+    assert merge_inputs([a, FRF(a.frequency, a.H, "receptance", a.outputs, [7])]).variance is None

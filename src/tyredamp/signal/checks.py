@@ -230,7 +230,8 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     """Join FRFs of separate tests (one or more inputs each) into one matrix.
 
     All must have the same kind (others are converted), lines and outputs;
-    the inputs are concatenated. The coherence is kept only for one FRF.
+    the inputs are concatenated. The coherence is kept only for one FRF; the
+    variance when every FRF has one (each column keeps its own).
     """
     if len(frfs) == 0:
         raise InputError("frfs: expected at least one FRF")
@@ -238,6 +239,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     if len(frfs) == 1:
         return base
     hs = [base.H]
+    vs = [base.variance]
     ins = list(base.inputs)
     for i, f in enumerate(frfs[1:], start=1):
         g = f.to(base.kind) if f.kind != base.kind else f
@@ -247,6 +249,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         ):
             raise ShapeError(f"frfs[{i}]: expected the same outputs as frfs[0]")
         hs.append(g.H)
+        vs.append(g.variance)
         ins += list(g.inputs)
     return FRF(
         base.frequency,
@@ -255,6 +258,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         outputs=base.outputs,
         inputs=ins,
         meta={"merged_from": len(frfs)},
+        variance=None if any(v is None for v in vs) else np.concatenate(vs, axis=1),  # type: ignore[arg-type]
     )
 
 
