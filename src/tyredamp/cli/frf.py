@@ -69,7 +69,7 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
 
 @click.command("frf")
 @click.argument("time_file", type=click.Path(dir_okay=False, path_type=Path))
-@out_file_option("FRF file to write (.uff, .unv, .csv or .npz).")
+@out_file_option("FRF file to write (.uff, .unv, .csv, .npz or .nc).")
 @click.option(
     "--estimator",
     type=click.Choice(ESTIMATORS),
@@ -130,15 +130,20 @@ def frf_command(
 ) -> None:
     """Estimate FRFs (with coherence) from TIME_FILE and write them to --out.
 
-    TIME_FILE holds force and response channels (UFF 58 function type 1, or
-    tyredamp CSV/NPZ). The FRF kind follows the response channels
-    (acceleration gives accelerance). A short summary with coherence
-    figures is printed. Nothing is written when an error occurs.
+    TIME_FILE holds force and response channels (UFF 58 function type 1,
+    tyredamp CSV/NPZ, NI TDMS or ASAM MDF4). The FRF kind follows the
+    response channels (acceleration gives accelerance). Without a stated
+    period or record length the excitation is detected from the force
+    (periodic: cyclic averaging over whole periods after any start
+    transient; impact/burst: records from each hit; random: Welch) and the
+    verdict with its reason is printed with the coherence figures. Nothing
+    is written when an error occurs.
 
     \b
     Example:
       tyredamp frf tyre_test.uff --out tyre_frf.uff --estimator H1
       tyredamp frf rig.npz --out frf.csv --reference 1+Z --method welch --segment 4096
+      tyredamp frf daq.unv --out frf.nc --period 0.5s --settle 2s
     """
     if out.resolve() == time_file.resolve():
         raise InputError(f"--out: {out} is the input file; choose another name")
