@@ -272,3 +272,14 @@ def test_quality_check_of_periodic_data_without_metadata_is_not_clipping() -> No
     clipped = np.minimum(y, 0.6 * y.max())  # a real overload is still found
     res = quality_check(TimeData(np.vstack([x, clipped]), FS, [1, 2], ["force", "acceleration"]))
     assert res.figures["clipped_channels"] == 1
+
+
+def test_steady_data_with_noise_shared_by_channels_has_no_transient() -> None:
+    """Force noise reaches every response: channels are correlated, periods still steady."""
+    from tyredamp.signal import periodic_chirp
+
+    rng = np.random.default_rng(0)
+    x = periodic_chirp(1024.0, 3000, (1.0, 200.0), n_periods=40).signal
+    xn = x + 0.01 * rng.standard_normal(x.size)
+    y = np.tile(xn, (16, 1)) + 0.01 * rng.standard_normal((16, x.size))
+    assert transient_periods(np.vstack([xn, y]), 3000) == 0

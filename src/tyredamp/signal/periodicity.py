@@ -58,11 +58,14 @@ Method
    later half of the periods gives the steady-state period ``m(t)`` and the
    noise variance ``sigma^2`` of each channel (floored at ``(1e-9 rms)^2``,
    the storage precision of 12-digit text files and below single precision).
-   Period ``j`` is steady when ``T_j = sum_t (x_j(t) - m(t))^2 /
-   (sigma^2 (1 + 1/R))`` (``R`` reference periods) stays below the
-   ``chi^2`` quantile with ``n_channels P`` degrees of freedom at level
-   ``alpha / M``; the leading periods up to the last one that is not steady
-   are skipped (``settle_samples``), keeping at least two periods.
+   Period ``j`` is steady when, in every channel, ``T_j = sum_t (x_j(t) -
+   m(t))^2 / (sigma^2 (1 + 1/R))`` (``R`` reference periods), scaled to
+   ``nu / P``, stays below the ``chi^2_nu`` quantile at level
+   ``alpha / (M n_channels)`` (Bonferroni: channels share noise through the
+   structure); ``nu`` is the Satterthwaite number of degrees of freedom of
+   the residual's line powers (``P`` for white noise, fewer for coloured
+   noise). The leading periods up to the last one that is not steady are
+   skipped (``settle_samples``), keeping at least two periods.
 4. **Not periodic**: impact data if the force has samples beyond what a
    Gaussian signal of its robust scale (``1.4826`` times the median absolute
    deviation) reaches in ``N`` samples at level ``alpha`` (hammer hits, and
@@ -316,22 +319,29 @@ def transient_periods(signals: ArrayLike, period_samples: int, alpha: float = AL
     yp = _periods(y, p, align_end=False)  # (n_ch, M, p)
     n_ch, m, _ = yp.shape
     rms = np.sqrt(np.mean(y * y, axis=1))
+    floor = (_STORAGE_FLOOR * rms) ** 2
     s = 0
     for _ in range(m):
         ref = yp[:, s + (m - s) // 2 :, :]
         r = ref.shape[1]
         mean = ref.mean(axis=1)
+        resid = ref - mean[:, None, :]
+        var = np.sum(resid**2, axis=(1, 2)) / ((r - 1) * p) if r > 1 else np.zeros(n_ch)
+        # degrees of freedom of a period's sum of squares: p for white noise, fewer for
+        # coloured noise (Satterthwaite from the residual's line powers)
+        nu = np.full(n_ch, float(p))
         if r > 1:
-            var = np.sum((ref - mean[:, None, :]) ** 2, axis=(1, 2)) / ((r - 1) * p)
-        else:
-            var = np.zeros(n_ch)
-        var = np.maximum(var, (_STORAGE_FLOOR * rms) ** 2)
+            line = np.sum(np.abs(np.fft.fft(resid, axis=2)) ** 2, axis=1)  # (n_ch, p)
+            ok = var > floor
+            nu[ok] = line[ok].sum(axis=1) ** 2 / np.sum(line[ok] ** 2, axis=1)
+        var = np.maximum(var, floor)
         var = np.where(var > 0, var, 1.0)
         lead = yp[:, : s + (m - s) // 2, :]
-        t = np.sum((lead - mean[:, None, :]) ** 2 / var[:, None, None], axis=(0, 2))
-        t /= 1.0 + 1.0 / r
-        limit = scipy.stats.chi2.isf(alpha / m, n_ch * p)
-        bad = np.flatnonzero(t > limit)
+        # per channel (channels share noise through the structure: Bonferroni over them)
+        t = np.sum((lead - mean[:, None, :]) ** 2, axis=2) / (var[:, None] * (1.0 + 1.0 / r))
+        t = t * (nu / p)[:, None]  # ~ chi^2 with nu degrees of freedom
+        limit = scipy.stats.chi2.isf(alpha / (m * n_ch), nu)[:, None]
+        bad = np.flatnonzero(np.any(t > limit, axis=0))
         new = min(int(bad[-1]) + 1 if bad.size else 0, m - 2)
         if new <= s:
             break
