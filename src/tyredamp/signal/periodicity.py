@@ -60,7 +60,9 @@ Method
    the storage precision of 12-digit text files and below single precision).
    Period ``j`` is steady when, in every channel, ``T_j = sum_t (x_j(t) -
    m(t))^2 / (sigma^2 (1 + 1/R))`` (``R`` reference periods), scaled to
-   ``nu / P``, stays below the ``chi^2_nu`` quantile at level
+   ``nu / P``, stays below ``nu`` times the ``F(nu, nu (R - 1))`` quantile
+   (``sigma^2`` is estimated from the ``R`` reference periods; the
+   ``chi^2_nu`` quantile when ``sigma^2`` is the storage floor) at level
    ``alpha / (M n_channels)`` (Bonferroni: channels share noise through the
    structure); ``nu`` is the Satterthwaite number of degrees of freedom of
    the residual's line powers (``P`` for white noise, fewer for coloured
@@ -340,7 +342,15 @@ def transient_periods(signals: ArrayLike, period_samples: int, alpha: float = AL
         # per channel (channels share noise through the structure: Bonferroni over them)
         t = np.sum((lead - mean[:, None, :]) ** 2, axis=2) / (var[:, None] * (1.0 + 1.0 / r))
         t = t * (nu / p)[:, None]  # ~ chi^2 with nu degrees of freedom
-        limit = scipy.stats.chi2.isf(alpha / (m * n_ch), nu)[:, None]
+        level = alpha / (m * n_ch)
+        # with sigma^2 estimated from R - 1 periods, T / nu is F(nu, nu (R - 1))
+        # distributed; at the storage floor sigma^2 is known: chi^2
+        estimated = (var > floor) & (r > 1)
+        limit = np.where(
+            estimated,
+            nu * scipy.stats.f.isf(level, nu, nu * max(r - 1, 1)),
+            scipy.stats.chi2.isf(level, nu),
+        )[:, None]
         bad = np.flatnonzero(np.any(t > limit, axis=0))
         new = min(int(bad[-1]) + 1 if bad.size else 0, m - 2)
         if new <= s:
