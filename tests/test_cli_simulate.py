@@ -18,8 +18,8 @@ from numpy.testing import assert_allclose
 from threadpoolctl import threadpool_limits
 
 from tyredamp.cli import main
+from tyredamp.documents.modes import read_modes_json
 from tyredamp.io import read_frf, read_timedata
-from tyredamp.modal.io import read_modes_json
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -231,7 +231,7 @@ def test_simulated_noise_follows_snr(capsys: pytest.CaptureFixture[str], tmp_pat
     )
     assert code == 0, err
     frf = read_frf(out)
-    from tyredamp.tyre import RingTyre
+    from tyredamp.virtual import RingTyre
 
     exact = RingTyre().truth().frf(frf.frequency)
     # the first-order hold of the simulation: relative error ~ (pi f / fs_sim)^2 / 3 < 1e-3

@@ -183,7 +183,7 @@ def test_report_draws_modes_on_pyuff_geometry(
     from tyredamp.io.uff55 import write_uff55
     from tyredamp.plot import plot_mode_shapes_geometry
     from tyredamp.plot.geometry import mode_displacements
-    from tyredamp.tyre import RingTyre, TyreTruth
+    from tyredamp.virtual import RingTyre, TyreTruth
 
     truth = TyreTruth.from_tyre(RingTyre(), band=(0.0, 120.0))
     model = truth.modal_model()

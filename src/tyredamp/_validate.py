@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 from .exceptions import InputError, PhysicsError, ShapeError
 
 __all__ = [
+    "as_band",
     "as_finite",
     "as_frequency",
     "as_square_symmetric",
@@ -44,6 +45,32 @@ def as_finite(
         bad = int(np.size(arr) - np.count_nonzero(np.isfinite(arr)))
         raise InputError(f"{name}: expected finite values, got {bad} NaN or infinite entries")
     return arr
+
+
+def as_band(band: Any, name: str = "band", *, positive: bool = False) -> tuple[float, float]:
+    """A frequency band ``(f_lo, f_hi)`` in Hz: two finite numbers, ``0 <= f_lo < f_hi``.
+
+    One rule for every band of the package: frequencies are not negative and
+    a band has width. ``positive=True`` also demands ``f_lo > 0``, for the
+    uses that space frequencies logarithmically or divide by them.
+
+    Raises
+    ------
+    InputError
+        Not two numbers, not finite, ``f_lo < 0`` (``<= 0`` with
+        ``positive``) or ``f_hi <= f_lo``; the message names ``name``.
+    """
+    rule = "0 < f_lo < f_hi" if positive else "0 <= f_lo < f_hi"
+    try:
+        if isinstance(band, str) or len(band) != 2:
+            raise TypeError
+        lo, hi = float(band[0]), float(band[1])
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected (f_lo, f_hi) in Hz with {rule}, got {band!r}") from None
+    ok = np.isfinite(lo) and np.isfinite(hi) and (lo > 0 if positive else lo >= 0) and hi > lo
+    if not ok:
+        raise InputError(f"{name}: expected (f_lo, f_hi) in Hz with {rule}, got {band!r}")
+    return lo, hi
 
 
 def as_frequency(f: ArrayLike, name: str = "frequency") -> NDArray[np.float64]:

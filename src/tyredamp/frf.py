@@ -20,7 +20,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validate import as_finite, as_frequency
+from ._validate import as_band, as_finite, as_frequency
 from .exceptions import InputError, ShapeError
 
 __all__ = ["FRF", "KINDS", "UNITS", "Channel", "FRFKind"]
@@ -33,8 +33,8 @@ UNITS: dict[str, str] = {
     "mobility": "m/(s N)",
     "accelerance": "m/(s^2 N)",
 }
-#: Power of (i omega) that turns a receptance into each kind.
-_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
+#: Power ``k`` of ``(i omega)^k`` that turns a receptance into each kind (the one table).
+KIND_POWER: dict[str, int] = {"receptance": 0, "mobility": 1, "accelerance": 2}
 
 _DIRECTIONS = {
     1: "+X",
@@ -262,7 +262,7 @@ class FRF:
         """
         if kind not in KINDS:
             raise InputError(f"kind: expected one of {KINDS}, got {kind!r}")
-        k = _POWER[kind] - _POWER[self.kind]
+        k = KIND_POWER[kind] - KIND_POWER[self.kind]
         if k == 0:
             return self
         frf = self
@@ -306,8 +306,7 @@ class FRF:
 
     def band(self, f_lo: float, f_hi: float) -> FRF:
         """Return the lines with ``f_lo <= f <= f_hi`` (Hz)."""
-        if not (np.isfinite(f_lo) and np.isfinite(f_hi)) or f_hi <= f_lo:
-            raise InputError(f"band: expected f_lo < f_hi, got [{f_lo}, {f_hi}] Hz")
+        f_lo, f_hi = as_band((f_lo, f_hi))
         mask = (self.frequency >= f_lo) & (self.frequency <= f_hi)
         if not np.any(mask):
             raise InputError(

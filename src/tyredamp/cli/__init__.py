@@ -1,26 +1,123 @@
 """The ``tyredamp`` command line: parses options, calls the API, writes files.
 
-Every subcommand lives in a module of this package and is registered on
-:data:`cli` below. Errors raised on purpose (:class:`TyredampError`) and
-usage errors become one line on stderr and exit code 2; ``--debug`` shows the
-traceback instead.
+Every subcommand lives in a module of this package and is listed in
+:data:`COMMANDS` below (imported only when it runs). Errors raised on purpose
+(:class:`TyredampError`) and usage errors become one line on stderr and exit
+code 2; ``--debug`` shows the traceback instead.
 """
 
 from __future__ import annotations
 
+import importlib
 import sys
 
 import click
-from threadpoolctl import threadpool_limits
 
 from .. import __version__
 from ..exceptions import ConvergenceError, TyredampError
 from ._common import EXIT_INPUT, EXIT_RUNTIME, fail
 
-__all__ = ["cli", "main"]
+__all__ = ["COMMANDS", "LazyGroup", "cli", "main"]
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+#: Every subcommand: name -> (module, attribute, one-line summary). A module is
+#: imported only when its command runs or its own help is shown, so that
+#: ``tyredamp --help`` and ``--version`` start fast (benchmarks/startup.py);
+#: the summary is the first sentence of the command's docstring (a test checks).
+COMMANDS: dict[str, tuple[str, str, str]] = {
+    "check": (
+        "check",
+        "check_group",
+        "Linearity, reciprocity and data-quality checks, with numbers and a verdict.",
+    ),
+    "damping": (
+        "damping",
+        "damping_command",
+        "Identify the viscous damping matrix from the complex modes in MODES_JSON.",
+    ),
+    "demo": (
+        "demo",
+        "demo_command",
+        "Run both studies on the built-in virtual tyres and write a report.",
+    ),
+    "frf": (
+        "frf",
+        "frf_command",
+        "Estimate FRFs (with coherence) from TIME_FILE and write them to --out.",
+    ),
+    "lateral": (
+        "lateral",
+        "lateral_group",
+        "Lateral tyre dynamics: fit spring-damper models, simulate the rolling-tyre rig.",
+    ),
+    "modal": (
+        "modal",
+        "modal_command",
+        "Identify real and complex modes of the FRFs in FRF_FILE.",
+    ),
+    "report": (
+        "report",
+        "report_command",
+        "Build one HTML report from RESULT_FILES of the other commands.",
+    ),
+    "simulate": (
+        "simulate",
+        "simulate_group",
+        "Simulate tests on the built-in virtual tyres and write them as files.",
+    ),
+    "tyre-model": (
+        "tyremodel",
+        "tyre_model_command",
+        "Flexible-ring and rigid-ring tyre models from modes files at one or more pressures.",
+    ),
+}
+
+
+def _shorten(text: str, limit: int) -> str:
+    """``text`` cut at a word to at most ``limit`` characters with ``...`` (as click does)."""
+    if len(text) <= limit:
+        return text
+    words = text.split()
+    out = ""
+    for word in words:
+        cand = f"{out} {word}" if out else word
+        if len(cand) + 3 > limit:
+            break
+        out = cand
+    return out + "..."
+
+
+class LazyGroup(click.Group):
+    """A group whose subcommands (see :data:`COMMANDS`) are imported on first use."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted({*self.commands, *COMMANDS})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands and cmd_name in COMMANDS:
+            module, attr, _summary = COMMANDS[cmd_name]
+            mod = importlib.import_module(f"{__name__}.{module}")
+            self.add_command(getattr(mod, attr), cmd_name)
+        return self.commands.get(cmd_name)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """The command list of ``--help`` from the summaries, without importing anything."""
+        names = self.list_commands(ctx)
+        if not names:
+            return
+        limit = formatter.width - 6 - max(len(n) for n in names)
+        rows = []
+        for name in names:
+            if name in COMMANDS:
+                summary = _shorten(COMMANDS[name][2], limit)
+            else:
+                summary = self.commands[name].get_short_help_str(limit)
+            rows.append((name, summary))
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(__version__, prog_name="tyredamp")
 @click.option("--debug", is_flag=True, help="Show full tracebacks on errors.")
 @click.pass_context
@@ -35,30 +132,6 @@ def cli(ctx: click.Context, debug: bool) -> None:
     ctx.obj["debug"] = debug
 
 
-def _register() -> None:
-    """Attach the subcommands; each subcommand module adds its lines here."""
-    from .check import check_group
-    from .damping import damping_command
-    from .demo import demo_command
-    from .frf import frf_command
-    from .lateral import lateral_group
-    from .modal import modal_command
-    from .report import report_command
-    from .simulate import simulate_group
-
-    cli.add_command(frf_command)
-    cli.add_command(check_group)
-    cli.add_command(damping_command)
-    cli.add_command(lateral_group)
-    cli.add_command(modal_command)
-    cli.add_command(demo_command)
-    cli.add_command(simulate_group)
-    cli.add_command(report_command)
-
-
-_register()
-
-
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the console script."""
     args = sys.argv[1:] if argv is None else argv
@@ -66,6 +139,8 @@ def main(argv: list[str] | None = None) -> None:
     try:
         # Small dense solves dominate; several BLAS threads on busy cores make them
         # 10-15x slower (benchmarks/demo_timing.py), so the CLI uses one.
+        from threadpoolctl import threadpool_limits
+
         with threadpool_limits(limits=1, user_api="blas"):
             rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
         if isinstance(rv, int) and rv != 0:

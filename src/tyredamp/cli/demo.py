@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import click
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult
+    from ..studies.results import DemoResult
 
 __all__ = ["demo_command", "demo_summary_rows"]
 
@@ -113,14 +113,9 @@ def demo_command(out: Path, quick: bool, seed: int) -> None:
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
-    from ..demo import (
-        DemoSettings,
-        check_output_dir,
-        run_demo,
-        save_demo,
-        single_threaded_blas,
-    )
-    from ..results import build_results
+    from ..report.demo import check_output_dir, save_demo
+    from ..studies.demo import DemoSettings, run_demo, single_threaded_blas
+    from ..studies.document import build_results
 
     check_output_dir(out)
     settings = DemoSettings.quick_preset(seed) if quick else DemoSettings.full(seed)

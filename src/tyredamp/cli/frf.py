@@ -10,7 +10,8 @@ import numpy as np
 from ..exceptions import InputError
 from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
-from ..signal.estimators import ESTIMATORS, estimate_frf
+from ..signal.estimators import ESTIMATORS
+from ..studies.radial import frf_from_time
 from ._common import out_file_option
 
 __all__ = ["frf_command", "frf_summary", "samples"]
@@ -149,7 +150,7 @@ def frf_command(
         raise InputError(f"--out: {out} is the input file; choose another name")
     out_format = format_of(out, fmt)
     td = read_timedata(time_file)
-    frf = estimate_frf(
+    frf = frf_from_time(
         td,
         estimator,  # type: ignore[arg-type]
         reference=list(references) or None,

@@ -25,7 +25,10 @@ __all__ = ["read_netcdf", "write_netcdf"]
 def write_netcdf(frf: FRF, path: str | os.PathLike[str]) -> Path:
     """Write an FRF to a netCDF file (atomically); returns the path."""
     if not isinstance(frf, FRF):
-        raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
+        raise InputError(
+            f"frf: netCDF (.nc) holds FRFs, got {type(frf).__name__}; "
+            "write time data as NPZ, CSV or UFF"
+        )
     ds = frf.to_xarray()
     h = ds["H"]
     ds = ds.drop_vars("H")

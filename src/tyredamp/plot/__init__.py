@@ -20,6 +20,7 @@ function                               figure
 :func:`plot_ranking`                   every ranked lateral fit (Figs. 11, 12)
 :func:`plot_lateral_models`            measured vs predictions and truth (Figs. 11-14)
 :func:`plot_time_comparison`           lateral time response (Fig. 15)
+:func:`plot_ring_frequencies`          measured vs updated-ring frequencies per n and pressure
 =====================================  =========================================
 """
 
@@ -32,6 +33,7 @@ from .geometry import plot_mode_shapes_geometry
 from .lateral import plot_figure7, plot_lateral_fit, plot_ranking, plot_time_comparison
 from .modal import plot_discrepancy, plot_mode_shapes_ring
 from .stabilisation import plot_stabilisation
+from .tyremodel import plot_ring_frequencies
 
 __all__ = [
     "plot_discrepancy",
@@ -44,6 +46,7 @@ __all__ = [
     "plot_mode_shapes_geometry",
     "plot_mode_shapes_ring",
     "plot_ranking",
+    "plot_ring_frequencies",
     "plot_stabilisation",
     "plot_time_comparison",
 ]

@@ -393,6 +393,48 @@ def _low_bands(f: NDArray[np.float64], low: NDArray[np.bool_], limit: int = 5) -
     return out
 
 
+def _passivity(
+    frf: FRF, floor: float, ksig: float, figures: dict[str, float], notes: list[str]
+) -> float | None:
+    """Fraction of drive-point lines with ``Re Y / |Y|`` below ``-(floor + ksig eps)``.
+
+    ``eps`` is the normalised random error of the estimate from the
+    coherence and the number of averages. Adds the figures and notes; ``None``
+    without a drive point.
+    """
+    dps = frf.drive_points()
+    figures["drive_points"] = len(dps)
+    if not dps:
+        notes.append("no drive point (no output at an input's point): passivity not checked")
+        return None
+    mob = frf.to("mobility")
+    n_avg = int(frf.meta.get("n_averages", 0) or 0)
+    viol, total, worst = 0, 0, np.inf
+    for i, j in dps:
+        y = _sign(mob.outputs[i]) * _sign(mob.inputs[j]) * mob.H[i, j]
+        mag = np.abs(y)
+        r = _ratio(y.real, mag)
+        r = np.where(mag > 0, r, 0.0)
+        eps = np.zeros_like(r)
+        if mob.coherence is not None and n_avg > 0:
+            g2 = np.clip(mob.coherence[i], 1e-12, 1.0)
+            eps = np.sqrt((1 - g2) / (2 * n_avg * g2))
+        v = r < -(floor + ksig * eps)
+        viol += int(v.sum())
+        total += r.size
+        worst = min(worst, float(r.min()))
+        if v.any():
+            notes.append(
+                f"drive point {mob.outputs[i].label}: Re(mobility) < 0 beyond noise at "
+                f"{int(v.sum())} lines ({', '.join(_low_bands(mob.frequency, v, 3))})"
+            )
+    pfrac = viol / total if total else 0.0
+    figures["passivity_violations"] = viol
+    figures["passivity_fraction"] = pfrac
+    figures["min_drive_point_real_ratio"] = worst
+    return pfrac
+
+
 def quality_check(
     data: TimeData | FRF,
     *,
@@ -507,38 +549,9 @@ def quality_check(
         notes.append("no coherence available: coherence check skipped")
 
     if frf is not None:
-        dps = frf.drive_points()
-        figures["drive_points"] = len(dps)
-        if not dps:
-            notes.append("no drive point (no output at an input's point): passivity not checked")
-        else:
-            mob = frf.to("mobility")
-            n_avg = int(frf.meta.get("n_averages", 0) or 0)
-            viol, total, worst = 0, 0, np.inf
-            for i, j in dps:
-                y = _sign(mob.outputs[i]) * _sign(mob.inputs[j]) * mob.H[i, j]
-                mag = np.abs(y)
-                r = _ratio(y.real, mag)
-                r = np.where(mag > 0, r, 0.0)
-                eps = np.zeros_like(r)
-                if mob.coherence is not None and n_avg > 0:
-                    g2 = np.clip(mob.coherence[i], 1e-12, 1.0)
-                    eps = np.sqrt((1 - g2) / (2 * n_avg * g2))
-                v = r < -(floor + ksig * eps)
-                viol += int(v.sum())
-                total += r.size
-                worst = min(worst, float(r.min()))
-                if v.any():
-                    notes.append(
-                        f"drive point {mob.outputs[i].label}: Re(mobility) < 0 beyond noise at "
-                        f"{int(v.sum())} lines ({', '.join(_low_bands(mob.frequency, v, 3))})"
-                    )
-            pfrac = viol / total if total else 0.0
-            figures["passivity_violations"] = viol
-            figures["passivity_fraction"] = pfrac
-            figures["min_drive_point_real_ratio"] = worst
-            if pfrac > pthr:
-                problems.append(f"drive point not passive at {100 * pfrac:.3g} % of lines")
+        pfrac = _passivity(frf, floor, ksig, figures, notes)
+        if pfrac is not None and pfrac > pthr:
+            problems.append(f"drive point not passive at {100 * pfrac:.3g} % of lines")
     passed = not problems
     what = "; ".join(problems) if problems else "no clipping, coherence and passivity within limits"
     summary = (

@@ -50,7 +50,7 @@ import numpy as np
 import scipy.fft
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_finite, check_positive
+from .._validate import as_band, as_finite, check_positive
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..timedata import TimeData
@@ -729,9 +729,7 @@ def estimate_frf(
         band = acq.band_hz
     lines = _excited_lines(spectra, min_relative_power)
     if band is not None:
-        lo, hi = float(band[0]), float(band[1])
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
-            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band!r}")
+        lo, hi = as_band(band)
         f = spectra.frequency
         lines = lines[(f[lines] >= lo) & (f[lines] <= hi)]
     if lines.size == 0:

@@ -31,7 +31,7 @@ import numpy as np
 import scipy.signal
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_finite, check_positive
+from .._validate import as_band, as_finite, check_positive
 from ..exceptions import InputError
 from ..timedata import Acquisition
 
@@ -447,12 +447,7 @@ def _length(v: Any, name: str, minimum: int = 2) -> int:
 
 
 def _band(band: tuple[float, float], fs: float) -> tuple[float, float]:
-    try:
-        lo, hi = float(band[0]), float(band[1])
-    except (TypeError, ValueError, IndexError):
-        raise InputError(f"band: expected (f_lo, f_hi) in Hz, got {band!r}") from None
-    if not (np.isfinite(lo) and np.isfinite(hi)) or lo < 0 or hi <= lo:
-        raise InputError(f"band: expected 0 <= f_lo < f_hi in Hz, got {band!r}")
+    lo, hi = as_band(band)
     if hi > fs / 2:
         raise InputError(f"band: upper edge {hi:g} Hz is above the Nyquist frequency {fs / 2:g} Hz")
     return lo, hi

@@ -13,7 +13,7 @@ Excitation
 :func:`tyredamp.signal.periodic_chirp` (the chirp of paper 000; its band
 edges are moved to DFT lines so that it is continuous from period to period).
 ``"multisine"``: the band-limited Schroeder multisine of
-:func:`~tyredamp.tyre.excitation.schroeder_multisine` (flat spectrum on the
+:func:`~tyredamp.virtual.excitation.schroeder_multisine` (flat spectrum on the
 band lines, nothing elsewhere). ``data.meta["lines"]`` lists the DFT lines of one
 period inside ``band``.
 
@@ -57,7 +57,7 @@ and the record is a sequence of *runs*, each ``n_periods`` periods of steady
 state: ``drive_mode="sequential"`` drives one input per run (classical
 roving-shaker multi-reference test); ``"simultaneous"`` drives all inputs in
 every run with the same signal times the signs of a Hadamard matrix
-(orthogonal multisines, :func:`~tyredamp.tyre.excitation.hadamard_drive_matrix`),
+(orthogonal multisines, :func:`~tyredamp.virtual.excitation.hadamard_drive_matrix`),
 so the input cross-spectral matrix summed over the runs is diagonal. Either
 way every period of the record is a steady-state period and an H1 estimator
 over all periods (all runs) recovers every FRF column;
@@ -74,7 +74,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.signal import lfilter
 
-from .._validate import check_positive
+from .._validate import as_band, check_positive
 from ..exceptions import InputError
 from ..frf import FRF, FRFKind
 from ..mechanics import ComplexModes, MCKSystem, step_coefficients, time_response
@@ -382,12 +382,7 @@ def run_modal_test(
         raise InputError(f"excitation: expected 'chirp' or 'multisine', got {excitation!r}")
     if initial_state not in ("periodic", "rest"):
         raise InputError(f"initial_state: expected 'periodic' or 'rest', got {initial_state!r}")
-    try:
-        if len(band) != 2:
-            raise TypeError
-        bnd = (float(band[0]), float(band[1]))
-    except (TypeError, ValueError):
-        raise InputError(f"band: expected (f_lo, f_hi) in Hz, got {band!r}") from None
+    bnd = as_band(band)
     lines = band_lines(fs, p_samples, bnd)
     truth = tyre.truth(band=bnd)
     rng = np.random.default_rng(seed)
@@ -442,7 +437,7 @@ def run_modal_test(
 
     settle = int(settle_periods) * p_samples if keep_settle else 0
     meta: dict[str, Any] = {
-        "source": "tyredamp.tyre.run_modal_test (virtual ring tyre)",
+        "source": "tyredamp.virtual.run_modal_test (virtual ring tyre)",
         "n_runs": n_runs,
         "drive_mode": drive_mode,
         "drive_matrix": drive.tolist(),

@@ -1,4 +1,4 @@
-"""The demo's ``results.json``: assembly from a :class:`~tyredamp.demo.DemoResult` and its schema.
+"""The demo's ``results.json``: assembly from a :class:`~.demo.DemoResult` and its schema.
 
 The document (``"kind": "tyredamp-demo-results"``, ``"version": 1``) holds
 the settings, the radial study at the main pressure (RMSD of the real and
@@ -9,41 +9,28 @@ model and the time test). SI units unless a key says otherwise (``_hz``,
 ``_bar``, ``_kmh``, ``_pct``); non-finite numbers are written as ``null``.
 The layout is described key by key in the README ("results.json") and
 formally in ``tyredamp/schemas/results.schema.json`` (JSON Schema draft
-2020-12), which :func:`validate_results` applies. jsonschema is needed only
-for validation (a test dependency), never to write the file.
+2020-12), which :func:`tyredamp.documents.demo.validate_results` applies;
+reading and writing the file is :mod:`tyredamp.documents.demo`.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Sequence
-from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from . import __version__
-from .exceptions import InputError
-from .io.jsonfile import finite
+from .. import __version__
+from ..documents.demo import RESULTS_KIND, RESULTS_VERSION
+from ..documents.jsonfile import finite
+from ..exceptions import InputError
 
 if TYPE_CHECKING:
-    from .demo import DemoResult, LateralCondition, PressureRun
-    from .lateral.fit import LateralFit
+    from ..lateral.fit import LateralFit
+    from .results import DemoResult, LateralCondition, PressureRun
 
-__all__ = [
-    "RESULTS_KIND",
-    "RESULTS_VERSION",
-    "build_results",
-    "corner_frequency_std",
-    "finite",
-    "lateral_overall_ranking",
-    "load_schema",
-    "validate_results",
-]
-
-RESULTS_KIND = "tyredamp-demo-results"
-RESULTS_VERSION = 1
+__all__ = ["build_results", "corner_frequency_std", "lateral_overall_ranking"]
 
 
 def _matrix(a: Any) -> list[list[float]]:
@@ -237,23 +224,8 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
     return out
 
 
-def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dict[str, Any]:
-    """The results.json document of a demo run (strict JSON types; layout in the README).
-
-    Parameters
-    ----------
-    result : DemoResult
-    files : sequence of str, optional
-        Files written beside results.json (relative paths), listed under
-        ``"files"``.
-
-    Returns
-    -------
-    dict
-        Valid against :func:`load_schema` (checked in the tests).
-    """
-    from .lateral.characteristics import corner_differences
-
+def _radial_section(result: DemoResult) -> dict[str, Any]:
+    """``radial``: the main pressure, its checks, modes and damping, and every pressure."""
     s = result.settings
     r = result.radial
     main = r.main
@@ -261,7 +233,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     dc = r.damping_truth
     dm = r.damping
     d = dm.diagnostics
-    radial: dict[str, Any] = {
+    return {
         "pressure_bar": main.pressure_bar,
         "n_averages": main.n_periods,
         "snr_db": s.snr_db,
@@ -310,6 +282,12 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
             for run in r.runs
         ],
     }
+
+
+def _lateral_section(result: DemoResult) -> dict[str, Any]:
+    """``lateral``: every condition, the ranking, Figure 7, the vehicle and the time test."""
+    from ..lateral.characteristics import corner_differences
+
     lat = result.lateral
     conds = [_condition(c) for c in lat.conditions]
     fig7 = lat.figure7.model
@@ -318,8 +296,8 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
     tt = lat.time_test
     ce = tt.causal
     ref = lat.reference
-    lateral: dict[str, Any] = {
-        "models": list(s.lateral_models),
+    return {
+        "models": list(result.settings.lateral_models),
         "criterion": lat.conditions[0].ranking.criterion,
         "wheel_mass_kg": lat.rig.wheel_mass,
         "body_mass_kg": lat.rig.body_mass,
@@ -370,6 +348,24 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
             },
         },
     }
+
+
+def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dict[str, Any]:
+    """The results.json document of a demo run (strict JSON types; layout in the README).
+
+    Parameters
+    ----------
+    result : DemoResult
+    files : sequence of str, optional
+        Files written beside results.json (relative paths), listed under
+        ``"files"``.
+
+    Returns
+    -------
+    dict
+        Valid against :func:`tyredamp.documents.demo.load_schema` (checked in the tests).
+    """
+    s = result.settings
     doc = {
         "kind": RESULTS_KIND,
         "version": RESULTS_VERSION,
@@ -380,44 +376,9 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         "elapsed_s": result.elapsed_s,
         "timings_s": dict(result.timings),
         "files": list(files or []),
-        "radial": radial,
-        "lateral": lateral,
+        "radial": _radial_section(result),
+        "lateral": _lateral_section(result),
     }
     out = finite(doc)
     assert isinstance(out, dict)
     return out
-
-
-def load_schema() -> dict[str, Any]:
-    """The JSON Schema (draft 2020-12) of results.json, from the package data."""
-    text = resources.files("tyredamp").joinpath("schemas/results.schema.json").read_text("utf-8")
-    schema = json.loads(text)
-    assert isinstance(schema, dict)
-    return schema
-
-
-def validate_results(doc: Any) -> None:
-    """Validate a results document against :func:`load_schema`.
-
-    Needs the optional ``jsonschema`` package (a test dependency).
-
-    Raises
-    ------
-    InputError
-        The document does not follow the schema (the message names the first
-        offending key), or jsonschema is not installed.
-    """
-    try:
-        import jsonschema
-    except ImportError:  # pragma: no cover - jsonschema is a test dependency
-        raise InputError(
-            "validate_results: needs the jsonschema package (pip install jsonschema)"
-        ) from None
-    schema = load_schema()
-    cls = jsonschema.validators.validator_for(schema)
-    cls.check_schema(schema)
-    errors = sorted(cls(schema).iter_errors(doc), key=lambda e: list(e.absolute_path))
-    if errors:
-        e = errors[0]
-        where = "/".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise InputError(f"results: {where}: {e.message} ({len(errors)} problem(s) in all)")

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from tyredamp.cli import main
+from tyredamp.documents.jsonfile import finite, json_text, write_json
 from tyredamp.io._atomic import atomic_path
-from tyredamp.io.jsonfile import finite, json_text, write_json
 
 
 def test_nan_becomes_null_and_numpy_plain() -> None:

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from tyredamp import InputError, PhysicsError, TyredampError
-from tyredamp.tyre import (
+from tyredamp.virtual import (
     Imperfection,
     MeasurementLayout,
     RingTyre,

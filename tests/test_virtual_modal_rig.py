@@ -12,7 +12,7 @@ from tyredamp import InputError, TyredampError
 from tyredamp.mechanics import time_response
 from tyredamp.signal import band_lines
 from tyredamp.timedata import TimeData
-from tyredamp.tyre import (
+from tyredamp.virtual import (
     MeasurementLayout,
     RingTyre,
     VirtualModalTest,
@@ -213,7 +213,7 @@ def test_default_cyclic_frf_equals_true_accelerance(default_test: VirtualModalTe
     h = cyclic_frf(clean.data)
     f = clean.frequency_lines
     true = clean.true_frf(f).H
-    # FOH interpretation error (module docstring of tyredamp.tyre.rig): |dA| is about
+    # FOH interpretation error (module docstring of tyredamp.virtual.modal_rig): |dA| is about
     # (pi f / fs_sim)^2 / 3 * |A(f) - M^-1| plus folded extensional resonances; with
     # fs_sim = 16384 Hz: measured max 0.43 % of |A| (drive point at 200 Hz, where |A|
     # is smallest) and 0.07 % of max |A|; tolerances 1 % and 0.2 %

@@ -10,17 +10,19 @@ from tyredamp.exceptions import InputError
 from tyredamp.frf import FRF
 from tyredamp.lateral import (
     DEFAULT_MODELS,
-    AgriculturalTyre,
     LateralData,
-    VirtualLateralRig,
-    ViscoelasticStringTyre,
     fit_by_pressure,
     fit_joint,
     fit_model,
     rank_models,
 )
-from tyredamp.lateral.rig import KMH
 from tyredamp.timedata import TimeData
+from tyredamp.virtual.lateral_rig import (
+    KMH,
+    AgriculturalTyre,
+    VirtualLateralRig,
+    ViscoelasticStringTyre,
+)
 
 RIG = VirtualLateralRig()
 

@@ -60,11 +60,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._validate import as_finite
-from ..exceptions import InputError, PhysicsError, ShapeError
+from ..exceptions import InputError, PhysicsError
 from ..frf import Channel
 from ..mechanics import MCKSystem, proportional_part
 from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
-from .truth import TyreTruth
+from .truth import TyreTruth, wave_numbers
 
 __all__ = [
     "RingConvergence",
@@ -74,7 +74,6 @@ __all__ = [
     "ring_convergence",
     "ring_dispersion",
     "staggered_weights",
-    "wave_numbers",
 ]
 
 FDOrder = Literal[2, 4, 6]
@@ -250,61 +249,6 @@ def ring_dispersion(
     else:
         raise InputError(f"branch: expected 'flexural' or 'extensional', got {branch!r}")
     return np.sqrt(np.clip(w2, 0.0, None) / params.mass_per_length) / (2 * np.pi)
-
-
-def wave_numbers(
-    radial: ArrayLike, tangential: ArrayLike | None = None
-) -> tuple[NDArray[np.int_], NDArray[np.float64]]:
-    """Dominant circumferential wave number of each mode shape (Fourier analysis).
-
-    Parameters
-    ----------
-    radial : array_like, shape (n_nodes, m)
-        Radial shapes (real or complex) at ``n_nodes`` equally spaced angles
-        starting at 0.
-    tangential : array_like, shape (n_nodes, m), optional
-        Tangential shapes on the same (or the half-step shifted) grid; their
-        harmonic power is added (a shift does not change it). Needed to see
-        the rotation mode (``n = 0``), which has no radial motion.
-
-    Returns
-    -------
-    n : ndarray of int, shape (m,)
-        Wave number with the largest harmonic power, ``0 .. n_nodes // 2``.
-    purity : ndarray, shape (m,)
-        Share of the total power in that harmonic (1 for a pure harmonic);
-        low values flag shapes that mix harmonics (imperfect ring) or alias.
-    """
-    w = np.asarray(radial)
-    if w.ndim == 1:
-        w = w[:, None]
-    if w.ndim != 2:
-        raise ShapeError(f"radial: expected shape (n_nodes, m), got {w.shape}")
-    power = _harmonic_power(w)
-    if tangential is not None:
-        v = np.asarray(tangential)
-        if v.ndim == 1:
-            v = v[:, None]
-        if v.shape != w.shape:
-            raise ShapeError(f"tangential: expected shape {w.shape}, got {v.shape}")
-        power = power + _harmonic_power(v)
-    total = power.sum(axis=0)
-    n = np.argmax(power, axis=0)
-    purity = power[n, np.arange(power.shape[1])] / np.where(total > 0, total, 1.0)
-    return n.astype(int), purity
-
-
-def _harmonic_power(x: NDArray[np.generic]) -> NDArray[np.float64]:
-    """Power per wave number 0..N//2 of columns of ``x`` (real and imaginary parts)."""
-    n_nodes = x.shape[0]
-    xr = np.real(x).astype(float)
-    xi = np.imag(x).astype(float) if np.iscomplexobj(x) else np.zeros_like(xr)
-    p = np.abs(np.fft.rfft(xr, axis=0)) ** 2 + np.abs(np.fft.rfft(xi, axis=0)) ** 2
-    weight = np.full(p.shape[0], 2.0)
-    weight[0] = 1.0
-    if n_nodes % 2 == 0:
-        weight[-1] = 1.0
-    return p * weight[:, None]
 
 
 # -------------------------------------------------------------- discrete ring

@@ -2,7 +2,7 @@
 
 The demo runs once per test session (:func:`quick_demo`, shared with
 ``test_results_schema.py``): through the command line, with a spy on
-:func:`tyredamp.demo.run_demo` that keeps the in-memory result for the API
+:func:`tyredamp.studies.demo.run_demo` that keeps the in-memory result for the API
 tests. About 15 s on two busy cores.
 """
 
@@ -23,12 +23,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-import tyredamp.demo as demo_mod
+import tyredamp.studies.demo as demo_mod
 from tyredamp.cli import main
-from tyredamp.demo import DemoResult, DemoSettings, match_modes, save_demo
+from tyredamp.documents.demo import validate_results
 from tyredamp.io import read_frf, read_timedata
 from tyredamp.report.build import SECTIONS
-from tyredamp.results import validate_results
+from tyredamp.report.demo import save_demo
+from tyredamp.studies.demo import DemoResult, DemoSettings
+from tyredamp.studies.radial import match_modes
 
 
 @functools.lru_cache(maxsize=1)
@@ -164,7 +166,7 @@ def test_results_validate_and_agree_with_truth(demo: tuple[DemoResult, Path]) ->
 
 def test_summary_rows(demo: tuple[DemoResult, Path]) -> None:
     from tyredamp.cli.demo import demo_summary_rows
-    from tyredamp.results import build_results
+    from tyredamp.studies.document import build_results
 
     result, _ = demo
     rows = dict(demo_summary_rows(result, build_results(result)))
@@ -177,8 +179,9 @@ def test_replace_and_no_partial_output(
 ) -> None:
     from matplotlib.figure import Figure
 
-    import tyredamp.report.build as build_mod
-    import tyredamp.report.figures as fig_mod
+    import tyredamp.report.demo as build_mod  # save_demo's names for the report and figures
+
+    fig_mod = build_mod
 
     result, _ = demo
 

@@ -66,11 +66,12 @@ from numpy.typing import ArrayLike, NDArray
 from .._validate import check_positive
 from ..exceptions import InputError
 from ..frf import FRF, Channel
+from ..lateral.fit import LateralData
+from ..lateral.models import LateralModel
+from ..lateral.response import ForceKind, _check_force, as_freq, string_impedance
+from ..lateral.timedomain import harmonic_response
+from ..lateral.vehicle import LateralVehicle
 from ..timedata import TimeData
-from .fit import LateralData
-from .models import ForceKind, LateralModel, _check_force, as_freq, string_impedance
-from .timedomain import harmonic_response
-from .vehicle import LateralVehicle
 
 __all__ = [
     "KMH",
@@ -370,7 +371,7 @@ class VirtualLateralRig:
             inputs=[Channel(node=1, direction=2, name=f"{force} force")],
             coherence=coh,
             meta={
-                "source": "tyredamp.lateral.rig.VirtualLateralRig",
+                "source": "tyredamp.virtual.lateral_rig.VirtualLateralRig",
                 "speed_m_s": truth.speed,
                 "speed_kmh": float(speed_kmh),
                 "pressure_bar": float(pressure_bar),

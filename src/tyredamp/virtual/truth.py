@@ -10,22 +10,19 @@ damping matrix reduced to the measured points, and the exact FRFs.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
+from typing import Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from .._validate import as_finite
+from .._validate import as_band, as_finite
 from ..exceptions import InputError, PhysicsError, ShapeError
 from ..frf import FRF, Channel, FRFKind
-from ..mechanics import MCKSystem
+from ..mechanics import MCKSystem, pole_quantities
 from ..modal.model import ModalModel
 
-if TYPE_CHECKING:
-    from .ring import RingTyre
-
-__all__ = ["TyreTruth", "modal_phase_collinearity"]
+__all__ = ["MeasuredRing", "TyreTruth", "modal_phase_collinearity", "wave_numbers"]
 
 ModeSet = Literal["visible", "measurable", "all"]
 
@@ -33,6 +30,92 @@ ModeSet = Literal["visible", "measurable", "all"]
 RADIAL_THRESHOLD = 0.01
 #: Drive-point amplitude, relative to the largest point amplitude, for a mode to be visible.
 VISIBLE_THRESHOLD = 0.01
+
+
+def wave_numbers(
+    radial: ArrayLike, tangential: ArrayLike | None = None
+) -> tuple[NDArray[np.int_], NDArray[np.float64]]:
+    """Dominant circumferential wave number of each mode shape (Fourier analysis).
+
+    Parameters
+    ----------
+    radial : array_like, shape (n_nodes, m)
+        Radial shapes (real or complex) at ``n_nodes`` equally spaced angles
+        starting at 0.
+    tangential : array_like, shape (n_nodes, m), optional
+        Tangential shapes on the same (or the half-step shifted) grid; their
+        harmonic power is added (a shift does not change it). Needed to see
+        the rotation mode (``n = 0``), which has no radial motion.
+
+    Returns
+    -------
+    n : ndarray of int, shape (m,)
+        Wave number with the largest harmonic power, ``0 .. n_nodes // 2``.
+    purity : ndarray, shape (m,)
+        Share of the total power in that harmonic (1 for a pure harmonic);
+        low values flag shapes that mix harmonics (imperfect ring) or alias.
+    """
+    w = np.asarray(radial)
+    if w.ndim == 1:
+        w = w[:, None]
+    if w.ndim != 2:
+        raise ShapeError(f"radial: expected shape (n_nodes, m), got {w.shape}")
+    power = _harmonic_power(w)
+    if tangential is not None:
+        v = np.asarray(tangential)
+        if v.ndim == 1:
+            v = v[:, None]
+        if v.shape != w.shape:
+            raise ShapeError(f"tangential: expected shape {w.shape}, got {v.shape}")
+        power = power + _harmonic_power(v)
+    total = power.sum(axis=0)
+    n = np.argmax(power, axis=0)
+    purity = power[n, np.arange(power.shape[1])] / np.where(total > 0, total, 1.0)
+    return n.astype(int), purity
+
+
+def _harmonic_power(x: NDArray[np.generic]) -> NDArray[np.float64]:
+    """Power per wave number 0..N//2 of columns of ``x`` (real and imaginary parts)."""
+    n_nodes = x.shape[0]
+    xr = np.real(x).astype(float)
+    xi = np.imag(x).astype(float) if np.iscomplexobj(x) else np.zeros_like(xr)
+    p = np.abs(np.fft.rfft(xr, axis=0)) ** 2 + np.abs(np.fft.rfft(xi, axis=0)) ** 2
+    weight = np.full(p.shape[0], 2.0)
+    weight[0] = 1.0
+    if n_nodes % 2 == 0:
+        weight[-1] = 1.0
+    return p * weight[:, None]
+
+
+class MeasuredRing(Protocol):
+    """What :meth:`TyreTruth.from_tyre` needs of a ring tyre (:class:`~tyredamp.virtual.RingTyre`).
+
+    The ring's DOFs are ordered ``n_ring`` radial then ``n_ring`` tangential.
+    """
+
+    @property
+    def system(self) -> MCKSystem:
+        """The ``M``, ``C``, ``K`` system of the whole ring."""
+
+    @property
+    def n_ring(self) -> int:
+        """Number of ring nodes."""
+
+    @property
+    def point_dofs(self) -> NDArray[np.intp]:
+        """DOF index of each measured point (radial)."""
+
+    @property
+    def drive_dofs(self) -> NDArray[np.intp]:
+        """DOF index of each drive point (radial)."""
+
+    @property
+    def output_channels(self) -> tuple[Channel, ...]:
+        """Acceleration channels of the measured points."""
+
+    @property
+    def input_channels(self) -> tuple[Channel, ...]:
+        """Force channels of the drive points."""
 
 
 def modal_phase_collinearity(shapes: ArrayLike) -> NDArray[np.float64]:
@@ -143,7 +226,7 @@ class TyreTruth:
     modal_damping: NDArray[np.float64]
 
     @classmethod
-    def from_tyre(cls, tyre: RingTyre, band: tuple[float, float] = (0.0, 200.0)) -> TyreTruth:
+    def from_tyre(cls, tyre: MeasuredRing, band: tuple[float, float] = (0.0, 200.0)) -> TyreTruth:
         """Compute the truth of ``tyre`` in ``band`` (Hz).
 
         Raises
@@ -154,11 +237,7 @@ class TyreTruth:
             An overdamped mode in the discretisation (too much band loss for
             this ``n_ring``), where complex modes in pairs do not exist.
         """
-        from .ring import wave_numbers
-
-        b = as_finite(band, "band", ndim=1)
-        if b.size != 2 or not 0 <= b[0] < b[1]:
-            raise InputError(f"band: expected (f_lo, f_hi) in Hz with 0 <= f_lo < f_hi, got {band}")
+        b = as_band(band)
         system = tyre.system
         try:
             cm = system.complex_modes()
@@ -229,12 +308,12 @@ class TyreTruth:
     @property
     def frequency_hz(self) -> NDArray[np.float64]:
         """Natural frequencies ``|p_n| / 2 pi`` in Hz, shape (m,)."""
-        return np.abs(self.poles) / (2 * np.pi)
+        return pole_quantities(self.poles)[0]
 
     @property
     def damping_ratio(self) -> NDArray[np.float64]:
         """Damping ratios ``-Re p_n / |p_n|``, shape (m,)."""
-        return -self.poles.real / np.abs(self.poles)
+        return pole_quantities(self.poles)[1]
 
     def select(self, modes: ModeSet = "visible") -> NDArray[np.intp]:
         """Indices of the ``"visible"``, ``"measurable"`` or ``"all"`` in-band modes."""

@@ -4,7 +4,7 @@ Schema (all frequencies in Hz, complex numbers as ``[re, im]``)::
 
     {
       "tyredamp_version": "0.1.0",
-      "kind": "modes",
+      "kind": "modes", "version": 1,        # files before version 1 had no "version"
       "source": "tyre.uff",                 # name of the FRF file (or "")
       "band_hz": [f_lo, f_hi],              # analysis band
       "frf_kind": "accelerance",            # kind of the fitted FRFs
@@ -31,17 +31,28 @@ human-readable description is ``docs/modes-json.md``.
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
 
 from .. import __version__
 from ..exceptions import FileFormatError, InputError
-from ..io.jsonfile import write_json
-from .model import ModalModel
+from ..io import FILE_FORMATS
+from ..modal.model import ModalModel
+from .jsonfile import read_json, write_json
 
-__all__ = ["modes_document", "read_modes_json", "write_modes_json"]
+__all__ = [
+    "MODES_KIND",
+    "MODES_VERSION",
+    "models_from_document",
+    "modes_document",
+    "read_modes",
+    "read_modes_json",
+    "write_modes_json",
+]
+
+MODES_KIND = "modes"
+MODES_VERSION = 1
 
 _KINDS = ("complex", "real")
 
@@ -83,7 +94,8 @@ def modes_document(
     band = band_hz if band_hz is not None else first.meta.get("band_hz")
     return {
         "tyredamp_version": __version__,
-        "kind": "modes",
+        "kind": MODES_KIND,
+        "version": MODES_VERSION,
         "source": str(source),
         "band_hz": None if band is None else [float(band[0]), float(band[1])],
         "frf_kind": frf_kind if frf_kind is not None else first.meta.get("frf_kind"),
@@ -118,28 +130,49 @@ def read_modes_json(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise FileFormatError(f"{p}: not a text (JSON) file") from None
-    if not text.strip():
-        raise FileFormatError(f"{p}: the file is empty")
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    if not isinstance(doc, dict) or doc.get("kind") != "modes":
-        raise FileFormatError(f'{p}: expected a modes document with "kind": "modes"')
+        return models_from_document(read_json(p))
+    except FileFormatError as exc:
+        msg = str(exc)
+        raise FileFormatError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
+
+
+def read_modes(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
+    """Modes from a modes JSON file or a UFF file of data sets 55 (another program's modes).
+
+    A UFF file (``.uff``, ``.unv``, ``.uf``) is read by
+    :func:`tyredamp.io.uff55.read_uff55` (real or complex modes, scaled by
+    their modal mass or modal A) into ``{mode_kind: ModalModel}``; anything
+    else by :func:`read_modes_json`.
+
+    Raises
+    ------
+    FileFormatError
+        Not a modes JSON, or a UFF file without (or with malformed) data sets 55.
+    """
+    p = Path(path)
+    if p.suffix.lower() in FILE_FORMATS["uff58b"].extensions:
+        from ..io.uff55 import read_uff55
+
+        model = read_uff55(p)
+        return {model.mode_kind: model}
+    return read_modes_json(p)
+
+
+def models_from_document(doc: dict[str, Any]) -> dict[str, ModalModel]:
+    """The models of a parsed modes document (see :func:`read_modes_json`)."""
+    if doc.get("kind") != MODES_KIND:
+        raise FileFormatError('expected a modes document with "kind": "modes"')
     models = doc.get("models")
     if not isinstance(models, dict) or not models:
-        raise FileFormatError(f'{p}: expected a non-empty "models" object')
+        raise FileFormatError('expected a non-empty "models" object')
     out: dict[str, ModalModel] = {}
     for key, d in models.items():
         if key not in _KINDS or not isinstance(d, dict):
-            raise FileFormatError(f"{p}: models: unexpected entry {key!r}")
+            raise FileFormatError(f"models: unexpected entry {key!r}")
         try:
             mdl = ModalModel.from_dict(d)
         except InputError as exc:
-            raise FileFormatError(f"{p}: models[{key!r}]: {exc}") from None
+            raise FileFormatError(f"models[{key!r}]: {exc}") from None
         for extra in ("rmsd", "relative_error"):
             if extra in d and extra not in mdl.meta:
                 mdl.meta[extra] = d[extra]
