@@ -70,7 +70,7 @@ def test_netcdf_file_round_trip(tmp_path: Path) -> None:
 
 def test_netcdf_bad_input(tmp_path: Path) -> None:
     td = TimeData(np.ones((2, 10)), 1.0, [1, 2], ["force", "acceleration"])
-    with pytest.raises(InputError, match="netCDF"):
+    with pytest.raises(InputError, match=r"netcdf \(\.nc\) holds FRFs, not TimeData"):
         write(td, tmp_path / "td.nc")
     assert not (tmp_path / "td.nc").exists()
     bad = tmp_path / "bad.nc"

@@ -78,6 +78,10 @@ class FileFormat:
         The reader can pick FRF or time data out of a file holding both.
     write_options : mapping
         Fixed keyword arguments of the writer.
+    holds : {"any", "frf", "timedata"}
+        What the format can hold: FRFs and time data, or only one of them
+        (reading the other kind from it, or writing it, is an error before
+        any I/O).
     """
 
     name: str
@@ -87,6 +91,7 @@ class FileFormat:
     writer: str | None
     selects: bool = False
     write_options: Mapping[str, Any] = field(default_factory=dict)
+    holds: Literal["any", "frf", "timedata"] = "any"
 
     def _function(self, name: str) -> Callable[..., Any]:
         fn: Callable[..., Any] = getattr(importlib.import_module(self.module, __name__), name)
@@ -96,6 +101,10 @@ class FileFormat:
         self, path: str | os.PathLike[str], what: str | None = None, kind: FRFKind | None = None
     ) -> FRF | TimeData:
         """Read ``path`` in this format (``what``/``kind`` only where the reader selects)."""
+        if what is not None and self.holds not in ("any", what):
+            held = "an FRF" if self.holds == "frf" else "time data"
+            asked = "an FRF" if what == "frf" else "time data"
+            raise FileFormatError(f"{path}: {self.name} files hold {held}, not {asked}")
         if self.selects:
             obj: FRF | TimeData = self._function(self.reader)(path, what, kind)
         else:
@@ -106,6 +115,12 @@ class FileFormat:
         """Write ``obj`` to ``path`` in this format."""
         if self.writer is None:
             raise InputError(f"format: {self.name} is read only; write as one of {FORMATS}")
+        if self.holds != "any" and isinstance(obj, FRF) != (self.holds == "frf"):
+            held = "FRFs" if self.holds == "frf" else "time data"
+            raise InputError(
+                f"format: {self.name} ({', '.join(self.extensions)}) holds {held}, "
+                f"not {type(obj).__name__}"
+            )
         self._function(self.writer)(obj, path, **self.write_options)
 
 
@@ -125,9 +140,9 @@ FILE_FORMATS: dict[str, FileFormat] = {
         FileFormat("uff58", (), ".uff", "read_uff", "write_uff", True, {"binary": False}),
         FileFormat("csv", (".csv",), ".csv_format", "read_csv", "write_csv"),
         FileFormat("npz", (".npz",), ".npz", "read_npz", "write_npz"),
-        FileFormat("netcdf", (".nc",), ".netcdf", "read_netcdf", "write_netcdf"),
-        FileFormat("tdms", (".tdms",), ".tdms", "read_tdms", None),
-        FileFormat("mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None),
+        FileFormat("netcdf", (".nc",), ".netcdf", "read_netcdf", "write_netcdf", holds="frf"),
+        FileFormat("tdms", (".tdms",), ".tdms", "read_tdms", None, holds="timedata"),
+        FileFormat("mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None, holds="timedata"),
     )
 }
 #: The built-in formats that can be written (choices of the command line).

@@ -50,13 +50,22 @@ import numpy as np
 import scipy.fft
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_band, as_finite, check_positive
+from .._validate import as_band, as_count, as_finite, check_positive
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..timedata import TimeData
-from .lrm import local_frf
-from .periodicity import ExcitationDetection, detect_excitation, transient_periods
-from .windows import exponential_window, force_window, segment_window
+from .lrm import local_method_frf
+from .segmenting import (
+    METHODS,
+    Method,
+    MethodChoice,
+    SegmentPlan,
+    checked_starts,
+    choose_method,
+    plan_starts,
+    segment_plan,
+    segment_windows,
+)
 
 __all__ = [
     "ESTIMATORS",
@@ -73,9 +82,7 @@ __all__ = [
 ]
 
 Estimator = Literal["H1", "H2", "Hv"]
-Method = Literal["cyclic", "welch", "transient", "lrm", "lpm"]
 ESTIMATORS: tuple[str, ...] = ("H1", "H2", "Hv")
-METHODS: tuple[str, ...] = ("cyclic", "welch", "transient", "lrm", "lpm")
 #: FRF kind that follows from the measured response quantity.
 RESPONSE_KIND: dict[str, FRFKind] = {
     "displacement": "receptance",
@@ -183,6 +190,39 @@ def cross_spectra(
         One-sided densities scaled as :func:`scipy.signal.csd` with
         ``scaling="density"`` (the scale cancels in every FRF estimator).
     """
+    x, y = _signals(inputs, outputs)
+    fs = check_positive(sample_rate, "sample_rate")
+    seg = as_count(segment_samples, "segment_samples", minimum=2)
+    step = seg if step_samples is None else as_count(step_samples, "step_samples", minimum=1)
+    st0 = as_count(start, "start", minimum=0)
+    seg_starts = checked_starts(x.shape[1], seg, step, st0, starts)
+    w, w_in = segment_windows(window, input_window, seg)
+    gxx, gyx, gyy, gyy_full = _accumulate(x, y, seg_starts, w, w_in, detrend, full_output)
+    n_f = seg // 2 + 1
+    # one-sided density scaling (as scipy.signal.csd): 2 / (fs sum w^2 n_avg)
+    scale = np.full(n_f, 2.0 / (fs * float(np.sum(w * w)) * seg_starts.size))
+    scale[0] /= 2
+    if seg % 2 == 0:
+        scale[-1] /= 2
+    gxx *= scale[:, None, None]
+    gyx *= scale[:, None, None]
+    gyy *= scale[:, None]
+    if gyy_full is not None:
+        gyy_full *= scale[:, None, None]
+    return CrossSpectra(
+        frequency=np.arange(n_f, dtype=float) * (fs / seg),
+        Gxx=gxx,
+        Gyx=gyx,
+        Gyy=gyy,
+        Gyy_full=gyy_full,
+        n_averages=int(seg_starts.size),
+        segment_samples=seg,
+        sample_rate=fs,
+    )
+
+
+def _signals(inputs: ArrayLike, outputs: ArrayLike) -> tuple[NDArray[Any], NDArray[Any]]:
+    """Inputs and outputs as finite 2-D arrays (n_channels, n_samples) of equal length."""
     x = as_finite(inputs, "inputs")
     y = as_finite(outputs, "outputs")
     x = x[None, :] if x.ndim == 1 else x
@@ -194,36 +234,20 @@ def cross_spectra(
             f"inputs, outputs: expected the same number of samples, got {x.shape[1]} and "
             f"{y.shape[1]}"
         )
-    fs = check_positive(sample_rate, "sample_rate")
-    seg = _as_count(segment_samples, "segment_samples", minimum=2)
-    step = seg if step_samples is None else _as_count(step_samples, "step_samples", minimum=1)
-    st0 = _as_count(start, "start", minimum=0)
-    n = x.shape[1]
-    if starts is None:
-        seg_starts = np.arange(st0, n - seg + 1, step)
-    else:
-        seg_starts = np.asarray(starts)
-        if seg_starts.ndim != 1 or not np.issubdtype(seg_starts.dtype, np.integer):
-            raise InputError("starts: expected a 1-D array of integer sample indices")
-        if seg_starts.size and (seg_starts.min() < 0 or seg_starts.max() > n - seg):
-            raise InputError(f"starts: every segment of {seg} samples must lie in 0..{n}")
-    if seg_starts.size == 0:
-        raise InputError(
-            f"segment_samples: a segment of {seg} samples from sample {st0} does not fit in "
-            f"{n} samples"
-        )
-    if isinstance(window, str | tuple):
-        w = segment_window(window, seg)
-    else:
-        w = as_finite(window, "window", ndim=1)
-        if w.size != seg:
-            raise ShapeError(f"window: expected {seg} samples, got {w.size}")
-    w_in = w
-    if input_window is not None:
-        wi = as_finite(input_window, "input_window", ndim=1)
-        if wi.size != seg:
-            raise ShapeError(f"input_window: expected {seg} samples, got {wi.size}")
-        w_in = w * wi
+    return x, y
+
+
+def _accumulate(
+    x: NDArray[Any],
+    y: NDArray[Any],
+    seg_starts: NDArray[np.intp],
+    w: NDArray[np.float64],
+    w_in: NDArray[np.float64],
+    detrend: bool,
+    full_output: bool,
+) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any], NDArray[Any] | None]:
+    """Unscaled sums of ``X X^H``, ``Y X^H``, ``|Y|^2`` (and ``Y Y^H``) over the segments."""
+    seg = w.size
     n_in, n_out = x.shape[0], y.shape[0]
     n_f = seg // 2 + 1
     gxx = np.zeros((n_f, n_in, n_in), dtype=complex)
@@ -246,26 +270,7 @@ def cross_spectra(
         gyy += np.sum(yf.real**2 + yf.imag**2, axis=2)
         if gyy_full is not None:
             gyy_full += yf @ yf.conj().transpose(0, 2, 1)
-    # one-sided density scaling (as scipy.signal.csd): 2 / (fs sum w^2 n_avg)
-    scale = np.full(n_f, 2.0 / (fs * float(np.sum(w * w)) * seg_starts.size))
-    scale[0] /= 2
-    if seg % 2 == 0:
-        scale[-1] /= 2
-    gxx *= scale[:, None, None]
-    gyx *= scale[:, None, None]
-    gyy *= scale[:, None]
-    if gyy_full is not None:
-        gyy_full *= scale[:, None, None]
-    return CrossSpectra(
-        frequency=np.arange(n_f, dtype=float) * (fs / seg),
-        Gxx=gxx,
-        Gyx=gyx,
-        Gyy=gyy,
-        Gyy_full=gyy_full,
-        n_averages=int(seg_starts.size),
-        segment_samples=seg,
-        sample_rate=fs,
-    )
+    return gxx, gyx, gyy, gyy_full
 
 
 def frf_from_spectra(spectra: CrossSpectra, estimator: Estimator = "H1") -> NDArray[np.complex128]:
@@ -478,12 +483,6 @@ def resolve_channels(
     return out
 
 
-def _as_count(v: Any, name: str, minimum: int) -> int:
-    if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < minimum:
-        raise InputError(f"{name}: expected an integer >= {minimum}, got {v!r}")
-    return int(v)
-
-
 # --------------------------------------------------------------- entry point
 def estimate_frf(
     timedata: TimeData,
@@ -581,6 +580,38 @@ def estimate_frf(
         Unknown options, no force channel, a force channel of zeros, mixed
         response quantities, fully correlated inputs (MIMO), too few samples.
     """
+    ref_idx, out_idx, kind = _resolve_io(timedata, estimator, reference, outputs)
+    choice = choose_method(
+        timedata, ref_idx, out_idx, method, period_samples, settle_samples, segment_samples, detect
+    )
+    if choice.method in ("lrm", "lpm"):
+        return local_method_frf(
+            timedata,
+            ref_idx,
+            out_idx,
+            kind,
+            choice.method,
+            estimator,
+            choice.settle_samples,
+            band,
+            min_relative_power,
+            window,
+            overlap,
+            segment_samples,
+            choice.detection,
+        )
+    plan = segment_plan(timedata, choice, window, overlap, force_window_samples, exponential_end)
+    io = (ref_idx, out_idx, kind)
+    return _segmented_frf(timedata, io, estimator, choice, plan, band, min_relative_power)
+
+
+def _resolve_io(
+    timedata: TimeData,
+    estimator: str,
+    reference: Sequence[Channel | int | str] | Channel | int | str | None,
+    outputs: Sequence[Channel | int | str] | None,
+) -> tuple[list[int], list[int], FRFKind]:
+    """Positions of the force and response channels and the FRF kind of ``estimate_frf``."""
     if not isinstance(timedata, TimeData):
         raise InputError(f"timedata: expected a TimeData, got {type(timedata).__name__}")
     if estimator not in ESTIMATORS:
@@ -609,124 +640,78 @@ def estimate_frf(
             f"outputs: expected one response quantity, got {sorted(quantities)}; select "
             "outputs of one quantity"
         )
-    kind = RESPONSE_KIND[quantities.pop()]
-    data = timedata.data
     for i in ref_idx:
-        if not np.any(data[i]):
+        if not np.any(timedata.data[i]):
             raise InputError(
                 f"reference: force channel {chans[i].label} is all zeros; no excitation recorded"
             )
+    return ref_idx, out_idx, RESPONSE_KIND[quantities.pop()]
 
-    acq = timedata.acquisition
-    method, period_samples, settle_samples, segment_samples, detection = _choose_method(
-        timedata, ref_idx, out_idx, method, period_samples, settle_samples, segment_samples, detect
-    )
-    if method is None:
-        if period_samples is not None or acq.period_samples is not None:
-            method = "cyclic"
-        elif segment_samples is None and acq.record_samples is not None:
-            method = "transient"
-        else:
-            method = "welch"
-    if method not in METHODS:
-        raise InputError(f"method: expected one of {METHODS}, got {method!r}")
-    settle = settle_samples if settle_samples is not None else acq.settle_samples
-    settle = _as_count(settle, "settle_samples", minimum=0)
-    fs = timedata.sample_rate
-    n = timedata.n_samples
-    x, y = data[ref_idx], data[out_idx]
-    if method in ("lrm", "lpm"):
-        return _local_method(
-            timedata,
-            ref_idx,
-            out_idx,
-            kind,
-            method,
-            estimator,
-            settle,
-            band,
-            min_relative_power,
-            window,
-            overlap,
-            segment_samples,
-            detection,
-        )
-    input_window = None
-    window_arg: Any = None
-    info: dict[str, Any] = {}
-    if method == "cyclic":
-        p = period_samples if period_samples is not None else acq.period_samples
-        if p is None:
-            raise InputError(
-                "method: 'cyclic' needs period_samples (argument or timedata.acquisition)"
-            )
-        seg = _as_count(p, "period_samples", minimum=2)
-        if window not in (None, "boxcar", "rect", "rectangular"):
-            raise InputError(
-                f"window: the cyclic method uses whole periods unwindowed, got {window!r}"
-            )
-        if overlap not in (None, 0, 0.0):
-            raise InputError(f"overlap: the cyclic method uses whole periods, got {overlap!r}")
-        win: str | tuple[str, float] = "boxcar"
-        step, detrend, ov = seg, False, 0.0
-    elif method == "welch":
-        seg = _as_count(
-            segment_samples if segment_samples is not None else max(n // 8, 2),
-            "segment_samples",
-            minimum=2,
-        )
-        ov = 0.5 if overlap is None else float(overlap)
-        if not 0.0 <= ov < 1.0:
-            raise InputError(f"overlap: expected a fraction in [0, 1), got {overlap!r}")
-        step = max(1, round(seg * (1 - ov)))
-        win = window if window is not None else "hann"
-        detrend = True
-    else:
-        rec = segment_samples if segment_samples is not None else acq.record_samples
-        if rec is None:
-            raise InputError(
-                "method: 'transient' needs segment_samples or timedata.acquisition.record_samples"
-            )
-        seg = _as_count(rec, "segment_samples", minimum=2)
-        if overlap not in (None, 0, 0.0):
-            raise InputError(f"overlap: the transient method uses whole records, got {overlap!r}")
-        step, detrend, ov = seg, False, 0.0
-        win = window if window is not None else "boxcar"
-        if force_window_samples is not None:
-            fw = _as_count(force_window_samples, "force_window_samples", minimum=1)
-            input_window = force_window(seg, min(fw, seg), min(max(fw // 10, 0), seg))
-            info["force_window_samples"] = fw
-        if exponential_end is not None:
-            ew, tau = exponential_window(seg, fs, exponential_end)
-            window_arg = segment_window(win, seg) * ew
-            info["exponential_tau_s"] = tau
-    if detection is not None and detection.kind == "impact" and method == "transient":
-        seg_starts = np.array(
-            [a for a in detection.record_starts if a >= settle and a + seg <= n], dtype=np.intp
-        )
-    else:
-        seg_starts = _segment_starts(acq.run_starts, n, seg, step, settle)
-    if seg_starts.size == 0:
-        raise InputError(
-            f"timedata: no whole segment of {seg} samples ({method} method) in {n} samples "
-            f"after dropping {settle} settle samples"
-        )
-    if window_arg is None:
-        window_arg = win
-    mimo_h2 = estimator == "H2" and len(ref_idx) > 1
+
+def _segmented_frf(
+    timedata: TimeData,
+    io: tuple[list[int], list[int], FRFKind],
+    estimator: Estimator,
+    choice: MethodChoice,
+    plan: SegmentPlan,
+    band: tuple[float, float] | None,
+    min_relative_power: float,
+) -> FRF:
+    """``estimate_frf`` by the cyclic, Welch or transient method (segment averages)."""
+    ref_idx, out_idx, kind = io
+    chans = timedata.channels
+    seg = plan.segment_samples
     spectra = cross_spectra(
-        x,
-        y,
-        fs,
+        timedata.data[ref_idx],
+        timedata.data[out_idx],
+        timedata.sample_rate,
         seg,
-        starts=seg_starts,
-        window=window_arg,
-        input_window=input_window,
-        detrend=detrend,
-        full_output=mimo_h2,
+        starts=plan_starts(timedata, choice, plan),
+        window=plan.window_values,
+        input_window=plan.input_window,
+        detrend=plan.detrend,
+        full_output=estimator == "H2" and len(ref_idx) > 1,
     )
-    if band is None and acq.band_hz is not None:
-        band = acq.band_hz
+    if band is None:
+        band = timedata.acquisition.band_hz
+    spectra = _band_lines(spectra, band, min_relative_power)
+    if len(ref_idx) > 1:
+        _check_input_rank(spectra, [chans[i].label for i in ref_idx])
+    h = frf_from_spectra(spectra, estimator)
+    coh = multiple_coherence(spectra)
+    n_eff = spectra.n_averages / _overlap_factor(
+        plan.window_values, plan.step_samples, spectra.n_averages
+    )
+    win = plan.window
+    meta_out: dict[str, Any] = {
+        "estimator": estimator,
+        "method": choice.method,
+        "n_averages": spectra.n_averages,
+        "segment_samples": seg,
+        "sample_rate": timedata.sample_rate,
+        "window": win if isinstance(win, str) else list(win),
+        "overlap": plan.overlap,
+        "settle_samples": choice.settle_samples,
+        **plan.info,
+    }
+    if choice.detection is not None:
+        meta_out["detection"] = choice.detection.to_dict()
+    return FRF(
+        spectra.frequency,
+        h,
+        kind=kind,
+        outputs=[chans[i] for i in out_idx],
+        inputs=[chans[i] for i in ref_idx],
+        coherence=coh,
+        meta=meta_out,
+        variance=frf_variance(spectra, coh, n_eff),
+    )
+
+
+def _band_lines(
+    spectra: CrossSpectra, band: tuple[float, float] | None, min_relative_power: float
+) -> CrossSpectra:
+    """The spectra on the excited lines inside ``band``."""
     lines = _excited_lines(spectra, min_relative_power)
     if band is not None:
         lo, hi = as_band(band)
@@ -738,179 +723,7 @@ def estimate_frf(
             + (f" in band {band!r} Hz" if band is not None else "")
             + f" (input power above {min_relative_power:g} of its maximum)"
         )
-    spectra = spectra.select_lines(lines)
-    if len(ref_idx) > 1:
-        _check_input_rank(spectra, [chans[i].label for i in ref_idx])
-    h = frf_from_spectra(spectra, estimator)
-    coh = multiple_coherence(spectra)
-    n_eff = spectra.n_averages / _overlap_factor(
-        segment_window(win, seg) if isinstance(window_arg, str | tuple) else window_arg,
-        step,
-        spectra.n_averages,
-    )
-    variance = frf_variance(spectra, coh, n_eff)
-    meta_out: dict[str, Any] = {
-        "estimator": estimator,
-        "method": method,
-        "n_averages": spectra.n_averages,
-        "segment_samples": seg,
-        "sample_rate": fs,
-        "window": win if isinstance(win, str) else list(win),
-        "overlap": ov,
-        "settle_samples": settle,
-        **info,
-    }
-    if detection is not None:
-        meta_out["detection"] = detection.to_dict()
-    return FRF(
-        spectra.frequency,
-        h,
-        kind=kind,
-        outputs=[chans[i] for i in out_idx],
-        inputs=[chans[i] for i in ref_idx],
-        coherence=coh,
-        meta=meta_out,
-        variance=variance,
-    )
-
-
-def _choose_method(
-    timedata: TimeData,
-    ref_idx: list[int],
-    out_idx: list[int],
-    method: Method | None,
-    period_samples: int | None,
-    settle_samples: int | None,
-    segment_samples: int | None,
-    detect: bool,
-) -> tuple[Method | None, int | None, int | None, int | None, ExcitationDetection | None]:
-    """Fill the method, period, settle and record length from the data when not stated.
-
-    See ``detect`` of :func:`estimate_frf`.
-    """
-    acq = timedata.acquisition
-    data = timedata.data
-    detection: ExcitationDetection | None = None
-    stated = (
-        period_samples is not None
-        or acq.period_samples is not None
-        or segment_samples is not None
-        or acq.record_samples is not None
-    )
-    needs_period = method == "cyclic" and period_samples is None and acq.period_samples is None
-    if detect and ((method is None and not stated) or needs_period):
-        detection = detect_excitation(data[ref_idx], data[out_idx])
-        if detection.kind == "periodic":
-            method = "cyclic"
-            period_samples = detection.period_samples
-            if settle_samples is None:
-                settle_samples = detection.settle_samples
-        elif needs_period:
-            raise InputError(
-                f"method: 'cyclic' needs a period; none stated and none found in the data "
-                f"({detection.reason})"
-            )
-        elif detection.kind == "impact" and detection.record_samples is not None:
-            method = "transient"
-            segment_samples = detection.record_samples
-    elif (
-        period_samples is not None
-        and acq.period_samples is None
-        and settle_samples is None
-        and detect
-        and method in (None, "cyclic")
-    ):
-        # a period stated by the caller for data that did not state one: find the
-        # start transient in the data
-        p_arg = _as_count(period_samples, "period_samples", minimum=2)
-        if timedata.n_samples >= 2 * p_arg and len(acq.run_starts) == 1:
-            sel = data[ref_idx + out_idx]
-            settle_samples = transient_periods(sel, p_arg) * p_arg
-    return method, period_samples, settle_samples, segment_samples, detection
-
-
-def _local_method(
-    timedata: TimeData,
-    ref_idx: list[int],
-    out_idx: list[int],
-    kind: FRFKind,
-    method: str,
-    estimator: str,
-    settle: int,
-    band: tuple[float, float] | None,
-    min_relative_power: float,
-    window: Any,
-    overlap: Any,
-    segment_samples: Any,
-    detection: ExcitationDetection | None,
-) -> FRF:
-    """``estimate_frf`` for the LRM/LPM methods (one record, local models per line)."""
-    if estimator != "H1":
-        raise InputError(
-            f"estimator: the {method} method is a least-squares (H1) fit, got {estimator!r}"
-        )
-    for name, v in (("window", window), ("overlap", overlap), ("segment_samples", segment_samples)):
-        if v not in (None, 0, 0.0, "boxcar"):
-            raise InputError(f"{name}: the {method} method uses the whole record, got {v!r}")
-    acq = timedata.acquisition
-    if len(acq.run_starts) > 1:
-        raise InputError(
-            f"method: {method} takes one record; this one holds {len(acq.run_starts)} runs"
-        )
-    chans = timedata.channels
-    data = timedata.data[:, settle:]
-    x, y = data[ref_idx], data[out_idx]
-    f, h, var = local_frf(x, y, timedata.sample_rate, rational=method == "lrm")
-    thr = float(min_relative_power)
-    if not np.isfinite(thr) or thr < 0 or thr >= 1:
-        raise InputError(
-            f"min_relative_power: expected a value in [0, 1), got {min_relative_power!r}"
-        )
-    pu = np.abs(scipy.fft.rfft(x, axis=1)) ** 2  # (in, f)
-    keep = np.all(pu > thr * pu.max(axis=1, keepdims=True), axis=0)
-    keep[0] = False  # 0 Hz: the mean is not a response to the force
-    if band is None and acq.band_hz is not None:
-        band = acq.band_hz
-    if band is not None:
-        lo, hi = float(band[0]), float(band[1])
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
-            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band!r}")
-        keep &= (f >= lo) & (f <= hi)
-    lines = np.flatnonzero(keep)
-    if lines.size == 0:
-        raise InputError("timedata: no excited frequency line for the local method")
-    meta_out: dict[str, Any] = {
-        "estimator": "H1",
-        "method": method,
-        "n_averages": 1,
-        "segment_samples": int(data.shape[1]),
-        "sample_rate": timedata.sample_rate,
-        "window": "boxcar",
-        "overlap": 0.0,
-        "settle_samples": settle,
-        "local_order": 2,
-    }
-    if detection is not None:
-        meta_out["detection"] = detection.to_dict()
-    return FRF(
-        f[lines],
-        h[:, :, lines],
-        kind=kind,
-        outputs=[chans[i] for i in out_idx],
-        inputs=[chans[i] for i in ref_idx],
-        meta=meta_out,
-        variance=var[:, :, lines],
-    )
-
-
-def _segment_starts(
-    run_starts: Sequence[int], n: int, seg: int, step: int, settle: int
-) -> NDArray[np.intp]:
-    """First samples of the segments: within each run (``run_starts``), after settling."""
-    r = np.asarray(run_starts, dtype=np.int64)
-    stops = np.append(r[1:], n)
-    out = [np.arange(a + settle, b - seg + 1, step) for a, b in zip(r, stops, strict=True)]
-    return np.concatenate(out).astype(np.intp)
+    return spectra.select_lines(lines)
 
 
 def _excited_lines(spectra: CrossSpectra, min_relative_power: float) -> NDArray[np.intp]:

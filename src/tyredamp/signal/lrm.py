@@ -29,14 +29,19 @@ remains is the bias of the local model over the window.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import scipy.fft
 from numpy.typing import ArrayLike, NDArray
 
 from .._validate import as_finite, check_positive
 from ..exceptions import InputError, ShapeError
+from ..frf import FRF, FRFKind
+from ..timedata import TimeData
+from .periodicity import ExcitationDetection
 
-__all__ = ["local_frf"]
+__all__ = ["local_frf", "local_method_frf"]
 
 
 def _windows(n_lines: int, half: int) -> NDArray[np.intp]:
@@ -144,3 +149,93 @@ def local_frf(
         h_out[j] = theta[:, :n_in].T
         var[j] = (s2[:, None] * cov_diag[:, :n_in]).T
     return np.arange(n_f) * (fs / n), h_out, var
+
+
+def _local_lines(
+    x: NDArray[np.float64],
+    f: NDArray[np.float64],
+    band: tuple[float, float] | None,
+    min_relative_power: float,
+) -> NDArray[np.intp]:
+    """Lines of a local estimate: every input excited (relative power), not 0 Hz, in ``band``."""
+    thr = float(min_relative_power)
+    if not np.isfinite(thr) or thr < 0 or thr >= 1:
+        raise InputError(
+            f"min_relative_power: expected a value in [0, 1), got {min_relative_power!r}"
+        )
+    pu = np.abs(scipy.fft.rfft(x, axis=1)) ** 2  # (in, f)
+    keep = np.all(pu > thr * pu.max(axis=1, keepdims=True), axis=0)
+    keep[0] = False  # 0 Hz: the mean is not a response to the force
+    if band is not None:
+        lo, hi = float(band[0]), float(band[1])
+        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
+            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band!r}")
+        keep &= (f >= lo) & (f <= hi)
+    lines = np.flatnonzero(keep)
+    if lines.size == 0:
+        raise InputError("timedata: no excited frequency line for the local method")
+    return lines
+
+
+def local_method_frf(
+    timedata: TimeData,
+    ref_idx: list[int],
+    out_idx: list[int],
+    kind: FRFKind,
+    method: str,
+    estimator: str,
+    settle: int,
+    band: tuple[float, float] | None,
+    min_relative_power: float,
+    window: Any,
+    overlap: Any,
+    segment_samples: Any,
+    detection: ExcitationDetection | None,
+) -> FRF:
+    """:func:`~tyredamp.signal.estimate_frf` by the LRM/LPM methods (one record, local models).
+
+    ``ref_idx``, ``out_idx``: positions of the force and response channels;
+    ``settle`` samples are dropped; ``band`` defaults to
+    ``timedata.acquisition.band_hz``. Segment options (``window``,
+    ``overlap``, ``segment_samples``) and estimators other than H1 are
+    errors: the local methods fit the whole record by least squares.
+    """
+    if estimator != "H1":
+        raise InputError(
+            f"estimator: the {method} method is a least-squares (H1) fit, got {estimator!r}"
+        )
+    for name, v in (("window", window), ("overlap", overlap), ("segment_samples", segment_samples)):
+        if v not in (None, 0, 0.0, "boxcar"):
+            raise InputError(f"{name}: the {method} method uses the whole record, got {v!r}")
+    acq = timedata.acquisition
+    if len(acq.run_starts) > 1:
+        raise InputError(
+            f"method: {method} takes one record; this one holds {len(acq.run_starts)} runs"
+        )
+    chans = timedata.channels
+    data = timedata.data[:, settle:]
+    x, y = data[ref_idx], data[out_idx]
+    f, h, var = local_frf(x, y, timedata.sample_rate, rational=method == "lrm")
+    lines = _local_lines(x, f, band if band is not None else acq.band_hz, min_relative_power)
+    meta_out: dict[str, Any] = {
+        "estimator": "H1",
+        "method": method,
+        "n_averages": 1,
+        "segment_samples": int(data.shape[1]),
+        "sample_rate": timedata.sample_rate,
+        "window": "boxcar",
+        "overlap": 0.0,
+        "settle_samples": settle,
+        "local_order": 2,
+    }
+    if detection is not None:
+        meta_out["detection"] = detection.to_dict()
+    return FRF(
+        f[lines],
+        h[:, :, lines],
+        kind=kind,
+        outputs=[chans[i] for i in out_idx],
+        inputs=[chans[i] for i in ref_idx],
+        meta=meta_out,
+        variance=var[:, :, lines],
+    )
