@@ -224,123 +224,10 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
         ASCII with an uneven frequency axis; channel names too long for an ID
         line; metadata that is not JSON-compatible.
     """
-    sets: list[dict[str, Any]] = []
     if isinstance(obj, FRF):
-        q = _KIND_QUANTITY[obj.kind]
-        axis = _even_axis(obj.frequency)
-        if not binary and axis is None:
-            raise InputError(
-                "frf: ASCII UFF keeps an uneven frequency axis to 6 digits only; write binary "
-                "UFF (uff58b), CSV or NPZ"
-            )
-        id1 = str(obj.meta.get("description", f"tyredamp FRF {obj.kind}"))
-        # binary: uneven abscissa, every frequency stored as a float64 (pyuff needs
-        # two abscissa values, so a single line goes the even way with ID-line 2)
-        uneven = binary and obj.n_freq > 1
-        id2 = f"{_MARK} frf {obj.kind}" + ("" if uneven else f" {axis}")
-        (id3,) = _meta_lines(obj.meta, 1)
-        x = obj.frequency
-        fid = 0
-        for o, co in enumerate(obj.outputs):
-            for i, ci in enumerate(obj.inputs):
-                fid += 1
-                d = _base_set(binary, q, id1, id2, id3)
-                d.update(
-                    func_type=4,
-                    func_id=fid,
-                    rsp_node=co.node,
-                    rsp_dir=co.direction,
-                    ref_node=ci.node,
-                    ref_dir=ci.direction,
-                    id4=_extras_line(co),
-                    id5=_extras_line(ci),
-                    orddenom_spec_data_type=13,
-                    orddenom_len_unit_exp=0,
-                    orddenom_force_unit_exp=1,
-                    orddenom_temp_unit_exp=0,
-                    orddenom_axis_lab="Force",
-                    orddenom_axis_units_lab="N",
-                    data=np.array(obj.H[o, i], dtype=complex),
-                )
-                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
-        if obj.coherence is not None:
-            ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
-            for o, co in enumerate(obj.outputs):
-                fid += 1
-                d = _base_set(
-                    binary,
-                    q,
-                    "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence",
-                    id2,
-                    id3,
-                )
-                d.update(
-                    func_type=6,
-                    func_id=fid,
-                    rsp_node=co.node,
-                    rsp_dir=co.direction,
-                    ref_node=ref.node,
-                    ref_dir=ref.direction,
-                    id4=_extras_line(co),
-                    id5=_extras_line(ref),
-                    ordinate_spec_data_type=0,
-                    ordinate_len_unit_exp=0,
-                    ordinate_force_unit_exp=0,
-                    ordinate_axis_lab="Coherence",
-                    ordinate_axis_units_lab="NONE",
-                    data=np.array(obj.coherence[o], dtype=float),
-                )
-                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
-        if obj.variance is not None:
-            for o, co in enumerate(obj.outputs):
-                for i, ci in enumerate(obj.inputs):
-                    fid += 1
-                    d = _base_set(binary, q, _VARIANCE_ID, id2, id3)
-                    d.update(
-                        func_type=0,
-                        func_id=fid,
-                        rsp_node=co.node,
-                        rsp_dir=co.direction,
-                        ref_node=ci.node,
-                        ref_dir=ci.direction,
-                        id4=_extras_line(co),
-                        id5=_extras_line(ci),
-                        ordinate_spec_data_type=0,
-                        ordinate_len_unit_exp=0,
-                        ordinate_force_unit_exp=0,
-                        ordinate_axis_lab="Variance of H",
-                        ordinate_axis_units_lab=f"({obj.unit})^2"[:20],
-                        data=np.array(obj.variance[o, i], dtype=float),
-                    )
-                    sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+        sets = _frf_sets(obj, binary)
     elif isinstance(obj, TimeData):
-        id1 = str(obj.meta.get("description", "tyredamp time data"))
-        # time data: ID line 5 continues the metadata; the acquisition fields go first
-        acq = _compact_acquisition(obj.acquisition.to_dict())
-        id3, id5 = _meta_lines({**acq, **obj.meta}, 2)
-        stored = {**_extras(id3), **_extras(id5)}
-        lost = [k for k in acq if k not in stored]
-        if lost:
-            raise InputError(
-                f"timedata.acquisition: {', '.join(lost)} do not fit the 80-character UFF ID "
-                "lines with the other fields; write NPZ or CSV (a dropped field would change "
-                "how the FRF is estimated)"
-            )
-        t = obj.time
-        for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
-            d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
-            d.update(
-                func_type=1,
-                func_id=k + 1,
-                rsp_node=c.node,
-                rsp_dir=c.direction,
-                ref_node=0,
-                ref_dir=0,
-                id4=_extras_line(c),
-                id5=id5,
-                data=np.array(obj.data[k], dtype=float),
-            )
-            sets.append(_abscissa(d, t, False, 17, "Time", "s"))
+        sets = _timedata_sets(obj, binary)
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
     with atomic_path(path) as tmp, warnings.catch_warnings():
@@ -355,6 +242,132 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
             raise FileFormatError(f"{path}: pyuff could not write the data sets ({exc})") from exc
         finally:
             gc.collect()
+
+
+def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
+    """The UFF 58 data sets of an FRF: H per pair, coherence per output, variance per pair."""
+    sets: list[dict[str, Any]] = []
+    q = _KIND_QUANTITY[obj.kind]
+    axis = _even_axis(obj.frequency)
+    if not binary and axis is None:
+        raise InputError(
+            "frf: ASCII UFF keeps an uneven frequency axis to 6 digits only; write binary "
+            "UFF (uff58b), CSV or NPZ"
+        )
+    id1 = str(obj.meta.get("description", f"tyredamp FRF {obj.kind}"))
+    # binary: uneven abscissa, every frequency stored as a float64 (pyuff needs
+    # two abscissa values, so a single line goes the even way with ID-line 2)
+    uneven = binary and obj.n_freq > 1
+    id2 = f"{_MARK} frf {obj.kind}" + ("" if uneven else f" {axis}")
+    (id3,) = _meta_lines(obj.meta, 1)
+    x = obj.frequency
+    fid = 0
+    for o, co in enumerate(obj.outputs):
+        for i, ci in enumerate(obj.inputs):
+            fid += 1
+            d = _base_set(binary, q, id1, id2, id3)
+            d.update(
+                func_type=4,
+                func_id=fid,
+                rsp_node=co.node,
+                rsp_dir=co.direction,
+                ref_node=ci.node,
+                ref_dir=ci.direction,
+                id4=_extras_line(co),
+                id5=_extras_line(ci),
+                orddenom_spec_data_type=13,
+                orddenom_len_unit_exp=0,
+                orddenom_force_unit_exp=1,
+                orddenom_temp_unit_exp=0,
+                orddenom_axis_lab="Force",
+                orddenom_axis_units_lab="N",
+                data=np.array(obj.H[o, i], dtype=complex),
+            )
+            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+    if obj.coherence is not None:
+        ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
+        for o, co in enumerate(obj.outputs):
+            fid += 1
+            d = _base_set(
+                binary,
+                q,
+                "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence",
+                id2,
+                id3,
+            )
+            d.update(
+                func_type=6,
+                func_id=fid,
+                rsp_node=co.node,
+                rsp_dir=co.direction,
+                ref_node=ref.node,
+                ref_dir=ref.direction,
+                id4=_extras_line(co),
+                id5=_extras_line(ref),
+                ordinate_spec_data_type=0,
+                ordinate_len_unit_exp=0,
+                ordinate_force_unit_exp=0,
+                ordinate_axis_lab="Coherence",
+                ordinate_axis_units_lab="NONE",
+                data=np.array(obj.coherence[o], dtype=float),
+            )
+            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+    if obj.variance is not None:
+        for o, co in enumerate(obj.outputs):
+            for i, ci in enumerate(obj.inputs):
+                fid += 1
+                d = _base_set(binary, q, _VARIANCE_ID, id2, id3)
+                d.update(
+                    func_type=0,
+                    func_id=fid,
+                    rsp_node=co.node,
+                    rsp_dir=co.direction,
+                    ref_node=ci.node,
+                    ref_dir=ci.direction,
+                    id4=_extras_line(co),
+                    id5=_extras_line(ci),
+                    ordinate_spec_data_type=0,
+                    ordinate_len_unit_exp=0,
+                    ordinate_force_unit_exp=0,
+                    ordinate_axis_lab="Variance of H",
+                    ordinate_axis_units_lab=f"({obj.unit})^2"[:20],
+                    data=np.array(obj.variance[o, i], dtype=float),
+                )
+                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+    return sets
+
+
+def _timedata_sets(obj: TimeData, binary: bool) -> list[dict[str, Any]]:
+    """The UFF 58 data sets of time data: one per channel, the acquisition record on ID lines."""
+    sets: list[dict[str, Any]] = []
+    id1 = str(obj.meta.get("description", "tyredamp time data"))
+    # time data: ID line 5 continues the metadata; the acquisition fields go first
+    acq = _compact_acquisition(obj.acquisition.to_dict())
+    id3, id5 = _meta_lines({**acq, **obj.meta}, 2)
+    stored = {**_extras(id3), **_extras(id5)}
+    lost = [k for k in acq if k not in stored]
+    if lost:
+        raise InputError(
+            f"timedata.acquisition: {', '.join(lost)} do not fit the 80-character UFF ID "
+            "lines with the other fields; write NPZ or CSV (a dropped field would change "
+            "how the FRF is estimated)"
+        )
+    t = obj.time
+    for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
+        d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
+        d.update(
+            func_type=1,
+            func_id=k + 1,
+            rsp_node=c.node,
+            rsp_dir=c.direction,
+            ref_node=0,
+            ref_dir=0,
+            id4=_extras_line(c),
+            id5=id5,
+            data=np.array(obj.data[k], dtype=float),
+        )
+        sets.append(_abscissa(d, t, False, 17, "Time", "s"))
+    return sets
 
 
 def _abscissa(

@@ -435,6 +435,31 @@ def _passivity(
     return pfrac
 
 
+def _clipping_and_dead(
+    data: TimeData, clip_run: int, figures: dict[str, float], problems: list[str], notes: list[str]
+) -> None:
+    """Clipped and dead channels of ``quality_check`` into its figures, problems and notes."""
+    period = data.acquisition.period_samples
+    live = [i for i in data.force_indices if np.any(data.data[i])]
+    if period is None and live:
+        # a periodic test without metadata repeats its extreme once per period
+        det = detect_excitation(data.data[live])
+        period = det.period_samples if det.kind == "periodic" else None
+    reps = max(1, data.n_samples // int(period)) if period else 1
+    clipped = {c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)}
+    bad = {k: v for k, v in clipped.items() if v > 0}
+    dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
+    figures["clipped_channels"] = len(bad)
+    figures["clipped_samples"] = int(sum(bad.values()))
+    figures["dead_channels"] = len(dead)
+    if bad:
+        problems.append(f"{len(bad)} clipped channel(s)")
+        notes += [f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()]
+    if dead:
+        problems.append(f"{len(dead)} channel(s) of zeros")
+        notes.append(f"channels of zeros: {', '.join(dead)}")
+
+
 def quality_check(
     data: TimeData | FRF,
     *,
@@ -492,29 +517,7 @@ def quality_check(
     problems: list[str] = []
     frf: FRF | None
     if isinstance(data, TimeData):
-        period = data.acquisition.period_samples
-        live = [i for i in data.force_indices if np.any(data.data[i])]
-        if period is None and live:
-            # a periodic test without metadata repeats its extreme once per period
-            det = detect_excitation(data.data[live])
-            period = det.period_samples if det.kind == "periodic" else None
-        reps = max(1, data.n_samples // int(period)) if period else 1
-        clipped = {
-            c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)
-        }
-        bad = {k: v for k, v in clipped.items() if v > 0}
-        dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
-        figures["clipped_channels"] = len(bad)
-        figures["clipped_samples"] = int(sum(bad.values()))
-        figures["dead_channels"] = len(dead)
-        if bad:
-            problems.append(f"{len(bad)} clipped channel(s)")
-            notes += [
-                f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()
-            ]
-        if dead:
-            problems.append(f"{len(dead)} channel(s) of zeros")
-            notes.append(f"channels of zeros: {', '.join(dead)}")
+        _clipping_and_dead(data, clip_run, figures, problems, notes)
         dead_force = [i for i in data.force_indices if not np.any(data.data[i])]
         if dead_force or not data.force_indices or not data.response_indices:
             frf = None
