@@ -44,7 +44,8 @@ def test_pyuff_loads_only_for_uff_files() -> None:
 
 
 def test_read_only_and_one_kind_formats(tmp_path: Path) -> None:
-    assert "tdms" in tio.FILE_FORMATS and "tdms" not in tio.FORMATS  # not a write choice
+    assert "tdms" in tio.FILE_FORMATS
+    assert "tdms" not in tio.FORMATS  # not a write choice
     assert "netcdf" in tio.FORMATS
     f = np.array([1.0, 2.0])
     frf = FRF(f, np.ones((1, 1, 2), complex), outputs=[Channel(1)], inputs=[Channel(1)])
