@@ -81,7 +81,11 @@ def test_simulate_radial_writes_uff58(radial_files: dict[str, Path]) -> None:
     assert td.quantities.count("force") == 1
     assert td.sample_rate == 1024.0
     sets = pyuff.UFF(str(radial_files["frf"])).read_sets()
-    assert {s["func_type"] for s in sets if s["type"] == 58} == {4, 6}  # FRFs, coherence
+    # FRFs, their coherence and (type 0, "tyredamp FRF variance") their variance; the
+    # metadata record (data sets 151) before them
+    data = [s for s in sets if s["type"] == 58]
+    assert {s["func_type"] for s in data} == {0, 4, 6}
+    assert {s["id1"].strip() for s in data if s["func_type"] == 0} == {"tyredamp FRF variance"}
     frf = read_frf(radial_files["frf"])
     assert frf.H.shape[:2] == (16, 1)
     assert frf.kind == "accelerance"

@@ -41,3 +41,19 @@ def test_pyuff_loads_only_for_uff_files() -> None:
         "assert tyredamp.io.format_of('a.uff') == 'uff58b'\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_read_only_and_one_kind_formats(tmp_path: Path) -> None:
+    assert "tdms" in tio.FILE_FORMATS
+    assert "tdms" not in tio.FORMATS  # not a write choice
+    assert "netcdf" in tio.FORMATS
+    f = np.array([1.0, 2.0])
+    frf = FRF(f, np.ones((1, 1, 2), complex), outputs=[Channel(1)], inputs=[Channel(1)])
+    with pytest.raises(InputError, match="tdms is read only"):
+        tio.write(frf, tmp_path / "a.tdms")
+    assert not (tmp_path / "a.tdms").exists()
+    # asking a time-data-only format for an FRF fails before the file is opened
+    with pytest.raises(FileFormatError, match="tdms files hold time data, not an FRF"):
+        tio.read_frf(tmp_path / "missing.tdms")
+    with pytest.raises(FileFormatError, match="netcdf files hold an FRF, not time data"):
+        tio.read_timedata(tmp_path / "missing.nc")

@@ -38,7 +38,7 @@ def default_test() -> VirtualModalTest:
 
 def cyclic_frf(data: TimeData, run_starts: list[int] | None = None) -> np.ndarray:
     """H1 over whole periods: S_yf S_ff^-1 per line, shape (n_out, n_in, n_lines)."""
-    p = int(data.meta["period_samples"])
+    p = int(data.acquisition.period_samples or 0)
     fi, ri = data.force_indices, data.response_indices
     x = data.data.reshape(data.n_channels, -1, p)  # every period is steady state
     spec = np.fft.rfft(x, axis=2)
@@ -137,7 +137,7 @@ def test_rest_start_settles_to_periodic(small_tyre: RingTyre) -> None:
         keep_settle=True,
         **SMALL,
     )
-    assert kept.meta["settle_samples"] == 2 * 512
+    assert kept.data.acquisition.settle_samples == 2 * 512
     assert kept.data.n_samples == 6 * 512
     # the settle periods hold the transient: they differ from the steady state
     assert np.max(np.abs(kept.data.data[1:, :512] - a[1:, :512])) > 1e-3 * np.abs(a).max()
@@ -255,7 +255,7 @@ def test_multi_reference(mode: str) -> None:
     assert_allclose(t[3, 0], t[0, 1], rtol=1e-9)
     run1 = vt.run_data(1)
     assert run1.n_samples == 4 * 512
-    assert run1.meta["run_starts"] == [0]
+    assert run1.acquisition.run_starts == (0,)
 
 
 # ---------------------------------------------------------------- bad input

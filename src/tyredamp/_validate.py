@@ -15,6 +15,7 @@ from .exceptions import InputError, PhysicsError, ShapeError
 
 __all__ = [
     "as_band",
+    "as_count",
     "as_finite",
     "as_frequency",
     "as_square_symmetric",
@@ -153,3 +154,10 @@ def check_positive(value: float, name: str, *, allow_zero: bool = False) -> floa
         bound = ">= 0" if allow_zero else "> 0"
         raise PhysicsError(f"{name}: expected a value {bound}, got {v:g}")
     return v
+
+
+def as_count(value: Any, name: str, minimum: int = 0) -> int:
+    """``int(value)`` for an integer (not a bool) ``>= minimum``; else :class:`InputError`."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    return int(value)

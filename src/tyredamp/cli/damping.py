@@ -16,7 +16,7 @@ import numpy as np
 
 from ..damping import METHODS, DampingModel
 from ..documents.damping import write_damping_json
-from ..documents.modes import read_modes_json
+from ..documents.modes import read_modes
 from ..exceptions import InputError
 from ..io._common import check_input_file
 from ..io._safety import check_output_file
@@ -88,6 +88,10 @@ def damping_command(
 ) -> None:
     """Identify the viscous damping matrix from the complex modes in MODES_JSON.
 
+    MODES_JSON is a modes JSON file (tyredamp modal) or a UFF file (.uff,
+    .unv) of data sets 55 from another program (real or complex modes,
+    scaled by their modal mass or modal A; see tyredamp.io.uff55).
+
     Writes C' (modal coordinates) and C, M, K at the measured points, the
     point labels, diagnostics (symmetry, definiteness, truncation), the best
     proportional models, Monte Carlo standard errors and plain-English
@@ -100,7 +104,7 @@ def damping_command(
       tyredamp damping tyre_modes.json -o damping.json --method refined --samples 500
     """
     check_output_file(out, [modes_json])
-    models = read_modes_json(check_input_file(modes_json))
+    models = read_modes(check_input_file(modes_json))
     if model_name not in models:
         raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")
     meta: dict[str, Any] = {"source": str(modes_json), "model": model_name}

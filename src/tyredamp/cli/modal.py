@@ -9,7 +9,7 @@ import numpy as np
 
 from ..documents.modes import write_modes_json
 from ..exceptions import InputError
-from ..frf import FRF
+from ..frf import FRF, Channel
 from ..io import read_frf
 from ..io._safety import check_output_file
 from ..modal.identify import ModalIdentification
@@ -62,6 +62,27 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     return vals
 
 
+def _with_geometry(frf: FRF, path: Path) -> FRF:
+    """The FRF with channel angles from the geometry when its points lie on a circle."""
+    from dataclasses import replace
+
+    from ..io.uff_geometry import read_uff_geometry
+
+    geo = read_uff_geometry(path)
+    missing = sorted({c.node for c in (*frf.outputs, *frf.inputs)} - set(geo.nodes))
+    if missing:
+        raise InputError(
+            f"--geometry: {path} has no node {missing[0]} ({len(missing)} channel node(s) missing)"
+        )
+    outs = geo.with_angles(frf.outputs)
+    angle = {(c.node, abs(c.direction)): c.angle_deg for c in outs}
+    ins = tuple(
+        Channel(c.node, c.direction, angle.get((c.node, abs(c.direction)), c.angle_deg), c.name)
+        for c in frf.inputs
+    )
+    return replace(frf, outputs=outs, inputs=ins)
+
+
 def _label_wave_numbers(model: ModalModel) -> None:
     """Put each mode's circumferential wave number into ``model.meta`` when the outputs
     carry their angles (``wave_number``, ``wave_number_label``, ``wave_number_fraction``;
@@ -111,6 +132,13 @@ def _label_wave_numbers(model: ModalModel) -> None:
     help="Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
 )
 @click.option("--no-residuals", is_flag=True, help="Fit without lower/upper residual terms.")
+@click.option(
+    "--geometry",
+    "geometry_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="UFF geometry (nodes 15/2411, trace lines 82, systems 18/2420): every channel's node "
+    "must be in it; points on a circle get their angles from it (ring views).",
+)
 def modal_command(
     frf_file: Path,
     out: Path,
@@ -121,6 +149,7 @@ def modal_command(
     max_order: int | None,
     order_step: int,
     no_residuals: bool,
+    geometry_file: Path | None,
 ) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
 
@@ -137,6 +166,8 @@ def modal_command(
     """
     check_output_file(out, [frf_file])
     frf = read_frf(frf_file)
+    if geometry_file is not None:
+        frf = _with_geometry(frf, geometry_file)
     res: ModalIdentification = modes_from_frf(
         frf,
         band=None if band is None else (float(band[0]), float(band[1])),

@@ -37,6 +37,7 @@ from typing import Any
 
 from .. import __version__
 from ..exceptions import FileFormatError, InputError
+from ..io import FILE_FORMATS
 from ..modal.model import ModalModel
 from .jsonfile import read_json, write_json
 
@@ -45,6 +46,7 @@ __all__ = [
     "MODES_VERSION",
     "models_from_document",
     "modes_document",
+    "read_modes",
     "read_modes_json",
     "write_modes_json",
 ]
@@ -132,6 +134,28 @@ def read_modes_json(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
     except FileFormatError as exc:
         msg = str(exc)
         raise FileFormatError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
+
+
+def read_modes(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
+    """Modes from a modes JSON file or a UFF file of data sets 55 (another program's modes).
+
+    A UFF file (``.uff``, ``.unv``, ``.uf``) is read by
+    :func:`tyredamp.io.uff55.read_uff55` (real or complex modes, scaled by
+    their modal mass or modal A) into ``{mode_kind: ModalModel}``; anything
+    else by :func:`read_modes_json`.
+
+    Raises
+    ------
+    FileFormatError
+        Not a modes JSON, or a UFF file without (or with malformed) data sets 55.
+    """
+    p = Path(path)
+    if p.suffix.lower() in FILE_FORMATS["uff58b"].extensions:
+        from ..io.uff55 import read_uff55
+
+        model = read_uff55(p)
+        return {model.mode_kind: model}
+    return read_modes_json(p)
 
 
 def models_from_document(doc: dict[str, Any]) -> dict[str, ModalModel]:

@@ -11,6 +11,9 @@ extension                 format
 ``.uff``, ``.unv``, ``.uf``  UFF data set 58, ASCII or binary 58b (read both)
 ``.csv``                  tyredamp CSV layout (:mod:`.csv_format`)
 ``.npz``                  tyredamp NPZ layout (:mod:`.npz`)
+``.nc``                   FRF as netCDF with named dimensions (:mod:`.netcdf`, xarray)
+``.tdms``                 NI TDMS time data, read only (:mod:`.tdms`, npTDMS)
+``.mf4``, ``.mdf``        ASAM MDF time data, read only (:mod:`.mdf`, asammdf)
 ========================  ============================================
 
 Writing takes ``format`` (``"uff58b"`` binary UFF, ``"uff58"`` ASCII UFF,
@@ -48,7 +51,7 @@ __all__ = [
     "write_timedata",
 ]
 
-Format = Literal["uff58b", "uff58", "csv", "npz"]
+Format = Literal["uff58b", "uff58", "csv", "npz", "netcdf", "tdms", "mdf"]
 
 
 @dataclass(frozen=True)
@@ -64,23 +67,31 @@ class FileFormat:
     module : str
         Module holding the reader and writer: ``".uff"`` (relative to this
         package) or an absolute module name.
-    reader, writer : str
-        Their names: ``reader(path)`` returns an FRF or TimeData (with
+    reader : str
+        Its name: ``reader(path)`` returns an FRF or TimeData (with
         ``selects=True``: ``reader(path, what, kind)``, ``what`` in
-        ``{"frf", "timedata", None}``); ``writer(obj, path, **write_options)``.
+        ``{"frf", "timedata", None}``).
+    writer : str or None
+        Its name, ``writer(obj, path, **write_options)``; None for a read-only
+        format (acquisition files such as TDMS and MDF).
     selects : bool
         The reader can pick FRF or time data out of a file holding both.
     write_options : mapping
         Fixed keyword arguments of the writer.
+    holds : {"any", "frf", "timedata"}
+        What the format can hold: FRFs and time data, or only one of them
+        (reading the other kind from it, or writing it, is an error before
+        any I/O).
     """
 
     name: str
     extensions: tuple[str, ...]
     module: str
     reader: str
-    writer: str
+    writer: str | None
     selects: bool = False
     write_options: Mapping[str, Any] = field(default_factory=dict)
+    holds: Literal["any", "frf", "timedata"] = "any"
 
     def _function(self, name: str) -> Callable[..., Any]:
         fn: Callable[..., Any] = getattr(importlib.import_module(self.module, __name__), name)
@@ -90,6 +101,10 @@ class FileFormat:
         self, path: str | os.PathLike[str], what: str | None = None, kind: FRFKind | None = None
     ) -> FRF | TimeData:
         """Read ``path`` in this format (``what``/``kind`` only where the reader selects)."""
+        if what is not None and self.holds not in ("any", what):
+            held = "an FRF" if self.holds == "frf" else "time data"
+            asked = "an FRF" if what == "frf" else "time data"
+            raise FileFormatError(f"{path}: {self.name} files hold {held}, not {asked}")
         if self.selects:
             obj: FRF | TimeData = self._function(self.reader)(path, what, kind)
         else:
@@ -98,6 +113,14 @@ class FileFormat:
 
     def write(self, obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         """Write ``obj`` to ``path`` in this format."""
+        if self.writer is None:
+            raise InputError(f"format: {self.name} is read only; write as one of {FORMATS}")
+        if self.holds != "any" and isinstance(obj, FRF) != (self.holds == "frf"):
+            held = "FRFs" if self.holds == "frf" else "time data"
+            raise InputError(
+                f"format: {self.name} ({', '.join(self.extensions)}) holds {held}, "
+                f"not {type(obj).__name__}"
+            )
         self._function(self.writer)(obj, path, **self.write_options)
 
 
@@ -117,10 +140,13 @@ FILE_FORMATS: dict[str, FileFormat] = {
         FileFormat("uff58", (), ".uff", "read_uff", "write_uff", True, {"binary": False}),
         FileFormat("csv", (".csv",), ".csv_format", "read_csv", "write_csv"),
         FileFormat("npz", (".npz",), ".npz", "read_npz", "write_npz"),
+        FileFormat("netcdf", (".nc",), ".netcdf", "read_netcdf", "write_netcdf", holds="frf"),
+        FileFormat("tdms", (".tdms",), ".tdms", "read_tdms", None, holds="timedata"),
+        FileFormat("mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None, holds="timedata"),
     )
 }
-#: The built-in formats (choices of the command line).
-FORMATS: tuple[str, ...] = tuple(FILE_FORMATS)
+#: The built-in formats that can be written (choices of the command line).
+FORMATS: tuple[str, ...] = tuple(n for n, f in FILE_FORMATS.items() if f.writer is not None)
 
 
 def _extensions() -> dict[str, str]:
@@ -161,7 +187,7 @@ def read(path: str | os.PathLike[str]) -> FRF | TimeData:
 
 
 def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
-    """Read an FRF matrix from a UFF, CSV or NPZ file.
+    """Read an FRF matrix from a UFF, CSV, NPZ or netCDF file.
 
     Parameters
     ----------
@@ -181,7 +207,7 @@ def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
 
 
 def read_timedata(path: str | os.PathLike[str]) -> TimeData:
-    """Read time data from a UFF, CSV or NPZ file.
+    """Read time data from a UFF, CSV, NPZ, TDMS or MDF file.
 
     Raises
     ------
@@ -201,7 +227,7 @@ def write(obj: FRF | TimeData, path: str | os.PathLike[str], format: str | None 
     ----------
     obj : FRF or TimeData
     path : path-like
-    format : {"uff58b", "uff58", "csv", "npz"}, optional
+    format : {"uff58b", "uff58", "csv", "npz", "netcdf"}, optional
         Default from the extension (``.uff``/``.unv``: ``"uff58b"``).
     """
     fmt = format_of(path, format)

@@ -52,8 +52,14 @@ def meta_record(meta: dict[str, Any]) -> list[dict[str, Any]]:
     return out
 
 
-def read_meta_record(p: Path, headers: list[dict[str, Any]]) -> dict[str, Any] | None:
-    """The ``meta`` of the data sets 151 written by :func:`meta_record`, None without them."""
+def read_meta_record(p: Path, uff: Any, types: list[int]) -> dict[str, Any] | None:
+    """The ``meta`` of the data sets 151 written by :func:`meta_record`, None without them.
+
+    ``uff`` is the open :class:`pyuff.UFF` of ``p`` and ``types`` its data-set types.
+    """
+    idx = [k for k, t in enumerate(types) if t == 151]
+    read = uff.read_sets(idx) if idx else []
+    headers: list[dict[str, Any]] = [read] if isinstance(read, dict) else list(read)
     parts: dict[int, str] = {}
     total = None
     for h in headers:

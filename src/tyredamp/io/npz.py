@@ -7,10 +7,12 @@ Layout (a NumPy ``.npz`` archive, no pickled objects):
     ``version`` (1), ``type`` ("frf" or "timedata") and, for an FRF,
     ``kind``, ``outputs``, ``inputs`` (lists of channel records ``{"node",
     "direction", "angle_deg", "name"}``) and ``meta``; for time data
-    ``sample_rate`` (Hz), ``channels`` (channel records with ``quantity``)
-    and ``meta``.
+    ``sample_rate`` (Hz), ``channels`` (channel records with ``quantity``),
+    ``acquisition`` (the stated fields of
+    :class:`~tyredamp.timedata.Acquisition`; older files kept them in
+    ``meta`` and read the same) and ``meta``.
 ``frequency`` (n_freq,), ``H`` (n_out, n_in, n_freq) complex, optional
-``coherence`` (n_out, n_freq)
+``coherence`` (n_out, n_freq), optional ``variance`` (n_out, n_in, n_freq)
     FRF arrays, Hz and SI units of the kind.
 ``data`` (n_channels, n_samples)
     Time data in SI units.
@@ -28,7 +30,7 @@ import numpy as np
 
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF
-from ..timedata import TimeData
+from ..timedata import Acquisition, TimeData
 from ._atomic import atomic_path
 from ._common import (
     channel_from_dict,
@@ -64,6 +66,8 @@ def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         arrays.update(frequency=obj.frequency, H=obj.H)
         if obj.coherence is not None:
             arrays["coherence"] = obj.coherence
+        if obj.variance is not None:
+            arrays["variance"] = obj.variance
     elif isinstance(obj, TimeData):
         head = {
             "type": "timedata",
@@ -74,6 +78,7 @@ def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
             ],
         }
         arrays["data"] = obj.data
+        head["acquisition"] = obj.acquisition.to_dict()
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
     text = meta_to_json({"format": "tyredamp", "version": _VERSION, **head, "meta": obj.meta})
@@ -194,16 +199,21 @@ def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
                 inputs=[channel_from_dict(c, f"{p}: inputs") for c in head.get("inputs", [])],
                 coherence=arrays.get("coherence"),
                 meta=meta,
+                variance=arrays.get("variance"),
             )
         if kind == "timedata":
             if "data" not in arrays:
                 raise FileFormatError(f"{p}: missing array 'data'")
             chans = head.get("channels", [])
+            acq = head.get("acquisition")
+            if acq is not None and not isinstance(acq, dict):
+                raise FileFormatError(f"{p}: header 'acquisition' is not a JSON object")
             return TimeData(
                 arrays["data"],
                 head.get("sample_rate", 0.0),
                 [channel_from_dict(c, f"{p}: channels") for c in chans],
                 [str(c.get("quantity", "")) if isinstance(c, dict) else "" for c in chans],
                 meta=meta,
+                acquisition=None if acq is None else Acquisition.from_dict(acq),
             )
     raise FileFormatError(f"{p}: header 'type' is {kind!r}, expected 'frf' or 'timedata'")

@@ -13,6 +13,7 @@ function                               figure
 :func:`plot_discrepancy`               discrepancy against frequency (Fig. 4)
 :func:`plot_matrix`                    damping matrices as heat maps (Fig. 5)
 :func:`plot_mode_shapes_ring`          mode shapes around the circumference
+:func:`plot_mode_shapes_geometry`      mode shapes on the test geometry (wireframe)
 :func:`plot_stabilisation`             stabilisation diagram of the pole search
 :func:`plot_figure7`                   lateral amplitude ratio, asymptotes, f0 (Fig. 7)
 :func:`plot_lateral_fit`               one lateral fit (Figs. 11-14)
@@ -28,6 +29,7 @@ from __future__ import annotations
 from .comparison import plot_lateral_models
 from .damping import plot_matrix
 from .frf import plot_frf, plot_frf_comparison
+from .geometry import plot_mode_shapes_geometry
 from .lateral import plot_figure7, plot_lateral_fit, plot_ranking, plot_time_comparison
 from .modal import plot_discrepancy, plot_mode_shapes_ring
 from .stabilisation import plot_stabilisation
@@ -41,6 +43,7 @@ __all__ = [
     "plot_lateral_fit",
     "plot_lateral_models",
     "plot_matrix",
+    "plot_mode_shapes_geometry",
     "plot_mode_shapes_ring",
     "plot_ranking",
     "plot_ring_frequencies",

@@ -9,7 +9,9 @@ modes JSON (``"kind": "modes"``)        ``tyredamp modal`` (and ``simulate radia
 damping JSON (``"kind": "damping"``)    ``tyredamp damping``
 lateral JSON (``"tyredamp": "lateral-fit"``)  ``tyredamp lateral fit``
 demo results (``"kind": "tyredamp-demo-results"``)  ``tyredamp demo``
-FRF or time data (.uff .unv .uf .csv .npz)  ``tyredamp frf``, ``simulate``, a DAQ
+FRF or time data (extensions of :data:`tyredamp.io.FILE_FORMATS`)  ``tyredamp frf``, a DAQ
+UFF modes (data sets 55)   another modal program
+UFF test geometry (data sets 15, 82)  another modal program (mode shapes drawn on it)
 ===========================  ==============================================
 
 Modes files are drawn against an FRF file of the same channels (the one
@@ -34,6 +36,7 @@ from matplotlib.figure import Figure
 
 from .. import __version__
 from ..documents import read_document
+from ..documents.modes import read_modes
 from ..exceptions import FileFormatError, InputError, TyredampError
 from ..frf import FRF
 from ..io import FILE_FORMATS, read
@@ -80,6 +83,22 @@ class ResultFile:
         return self.kind == "modes" and str((self.doc or {}).get("source", "")).startswith("truth")
 
 
+def _uff_modes_or_geometry(p: Path) -> ResultFile | None:
+    """A UFF file of modes (data sets 55) or test geometry (15, 82), else None."""
+    if p.suffix.lower() not in FILE_FORMATS["uff58b"].extensions:
+        return None
+    from ..io.uff55 import uff_has_modes
+    from ..io.uff_geometry import read_uff_geometry, uff_has_geometry
+
+    if uff_has_modes(p):
+        models = read_modes(p)
+        doc = {"kind": "modes", "source": str(p), "band_hz": None, "frf_kind": None}
+        return ResultFile(p, "modes", models, doc)
+    if uff_has_geometry(p):
+        return ResultFile(p, "geometry", read_uff_geometry(p))
+    return None
+
+
 def load_result_file(path: str | Path) -> ResultFile:
     """Read and classify one result file.
 
@@ -90,6 +109,9 @@ def load_result_file(path: str | Path) -> ResultFile:
     """
     p = check_input_file(path)
     data_ext = _data_extensions()
+    special = _uff_modes_or_geometry(p)
+    if special is not None:
+        return special
     if p.suffix.lower() in data_ext:
         obj = read(p)
         return ResultFile(p, "frf" if isinstance(obj, FRF) else "timedata", obj)
@@ -199,7 +221,11 @@ def _match(freq: np.ndarray, ref: np.ndarray) -> dict[int, int]:
 
 
 def _modes_section(
-    rep: HtmlReport, item: ResultFile, frfs: list[ResultFile], truth: ResultFile | None
+    rep: HtmlReport,
+    item: ResultFile,
+    frfs: list[ResultFile],
+    truth: ResultFile | None,
+    geometry: Any = None,
 ) -> None:
     models: dict[str, ModalModel] = item.obj
     doc = item.doc or {}
@@ -267,6 +293,19 @@ def _modes_section(
     if frf is not None:
         _fit_figures(rep, frf, models)
     shapes = models.get("complex") or any_model
+    if geometry is not None and shapes.n_modes:
+        from ..plot import plot_mode_shapes_geometry
+
+        gaxs = plot_mode_shapes_geometry(shapes, geometry)
+        rep.figure(
+            gaxs[0].figure,
+            f"{item.path.name}: mode shapes on the test geometry (real part; grey undeformed)",
+        )
+        angles = geometry.ring_angles(shapes.outputs)
+        if angles is not None:  # the ring view at the measured angles of the geometry
+            from dataclasses import replace as _replace
+
+            shapes = _replace(shapes, outputs=geometry.with_angles(shapes.outputs))
     if shapes.n_modes and shapes.psi_out.shape[0] >= 3:
         from ..plot import plot_mode_shapes_ring
 
@@ -551,6 +590,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
         "demo": "demo results",
         "frf": "FRF",
         "timedata": "time data",
+        "geometry": "test geometry (nodes, trace lines)",
     }
     rep.table(
         ["file", "content"],
@@ -562,6 +602,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
     rep.paragraph(f"tyredamp {__version__}.")
     frfs = [i for i in items if i.kind == "frf"]
     truth = next((i for i in items if i.is_truth), None)
+    geometry = next((i.obj for i in items if i.kind == "geometry"), None)
     sections = [
         ("Measured data", [i for i in items if i.kind in ("frf", "timedata")]),
         ("Modal analysis", [i for i in items if i.kind == "modes"]),
@@ -580,7 +621,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
                 elif item.kind == "timedata":
                     _time_section(rep, item)
                 elif item.kind == "modes":
-                    _modes_section(rep, item, frfs, truth)
+                    _modes_section(rep, item, frfs, truth, geometry)
                 elif item.kind == "damping":
                     _damping_section(rep, item)
                 elif item.kind == "lateral":

@@ -39,6 +39,7 @@ from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel
 from ..timedata import TimeData
 from .estimators import estimate_frf
+from .periodicity import detect_excitation
 
 __all__ = [
     "CheckResult",
@@ -230,7 +231,8 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     """Join FRFs of separate tests (one or more inputs each) into one matrix.
 
     All must have the same kind (others are converted), lines and outputs;
-    the inputs are concatenated. The coherence is kept only for one FRF.
+    the inputs are concatenated. The coherence is kept only for one FRF; the
+    variance when every FRF has one (each column keeps its own).
     """
     if len(frfs) == 0:
         raise InputError("frfs: expected at least one FRF")
@@ -238,6 +240,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     if len(frfs) == 1:
         return base
     hs = [base.H]
+    vs = [base.variance]
     ins = list(base.inputs)
     for i, f in enumerate(frfs[1:], start=1):
         g = f.to(base.kind) if f.kind != base.kind else f
@@ -247,6 +250,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         ):
             raise ShapeError(f"frfs[{i}]: expected the same outputs as frfs[0]")
         hs.append(g.H)
+        vs.append(g.variance)
         ins += list(g.inputs)
     return FRF(
         base.frequency,
@@ -255,6 +259,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         outputs=base.outputs,
         inputs=ins,
         meta={"merged_from": len(frfs)},
+        variance=None if any(v is None for v in vs) else np.concatenate(vs, axis=1),  # type: ignore[arg-type]
     )
 
 
@@ -434,6 +439,31 @@ def _passivity(
     return pfrac
 
 
+def _clipping_and_dead(
+    data: TimeData, clip_run: int, figures: dict[str, float], problems: list[str], notes: list[str]
+) -> None:
+    """Clipped and dead channels of ``quality_check`` into its figures, problems and notes."""
+    period = data.acquisition.period_samples
+    live = [i for i in data.force_indices if np.any(data.data[i])]
+    if period is None and live:
+        # a periodic test without metadata repeats its extreme once per period
+        det = detect_excitation(data.data[live])
+        period = det.period_samples if det.kind == "periodic" else None
+    reps = max(1, data.n_samples // int(period)) if period else 1
+    clipped = {c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)}
+    bad = {k: v for k, v in clipped.items() if v > 0}
+    dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
+    figures["clipped_channels"] = len(bad)
+    figures["clipped_samples"] = int(sum(bad.values()))
+    figures["dead_channels"] = len(dead)
+    if bad:
+        problems.append(f"{len(bad)} clipped channel(s)")
+        notes += [f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()]
+    if dead:
+        problems.append(f"{len(dead)} channel(s) of zeros")
+        notes.append(f"channels of zeros: {', '.join(dead)}")
+
+
 def quality_check(
     data: TimeData | FRF,
     *,
@@ -461,8 +491,10 @@ def quality_check(
         (the verdict figure and threshold).
     clip_run : int
         Shortest run of equal samples at a channel extreme counted as
-        clipping (see :func:`clipping`; with ``meta["period_samples"]`` one
-        repeat of the extreme per period is accepted).
+        clipping (see :func:`clipping`; with ``acquisition.period_samples``, or the
+        period detected from the force by
+        :func:`~tyredamp.signal.periodicity.detect_excitation`, one repeat
+        of the extreme per period is accepted).
     passivity_floor : float
         Allowed negative ``Re Y / |Y|`` at a drive point besides the random
         error (0.02 is about 1 degree of phase error).
@@ -489,24 +521,7 @@ def quality_check(
     problems: list[str] = []
     frf: FRF | None
     if isinstance(data, TimeData):
-        period = data.meta.get("period_samples")
-        reps = max(1, data.n_samples // int(period)) if period else 1
-        clipped = {
-            c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)
-        }
-        bad = {k: v for k, v in clipped.items() if v > 0}
-        dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
-        figures["clipped_channels"] = len(bad)
-        figures["clipped_samples"] = int(sum(bad.values()))
-        figures["dead_channels"] = len(dead)
-        if bad:
-            problems.append(f"{len(bad)} clipped channel(s)")
-            notes += [
-                f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()
-            ]
-        if dead:
-            problems.append(f"{len(dead)} channel(s) of zeros")
-            notes.append(f"channels of zeros: {', '.join(dead)}")
+        _clipping_and_dead(data, clip_run, figures, problems, notes)
         dead_force = [i for i in data.force_indices if not np.any(data.data[i])]
         if dead_force or not data.force_indices or not data.response_indices:
             frf = None

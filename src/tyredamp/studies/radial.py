@@ -63,7 +63,10 @@ def frf_from_time(
     reference: Sequence[Channel | int | str] | None = None,
     method: FRFMethod | None = None,
     segment_samples: int | None = None,
+    period_samples: int | None = None,
+    settle_samples: int | None = None,
     band: tuple[float, float] | None = None,
+    detect: bool = True,
 ) -> FRF:
     """FRFs with coherence from force and response time data (spec step 2).
 
@@ -75,13 +78,23 @@ def frf_from_time(
         FRF estimator.
     reference : sequence of Channel, int or str, optional
         Force channels; default: every force channel.
-    method : str, optional
-        Averaging method; default chosen from the data (cyclic for periodic
+    method : {"cyclic", "welch", "transient", "lrm", "lpm"}, optional
+        Averaging method; default chosen from the data's acquisition record
+        or, when ``detect``, from the force itself (cyclic for periodic
         excitation); see :func:`tyredamp.signal.estimate_frf`.
     segment_samples : int, optional
         Segment length of Welch/transient averaging, samples.
+    period_samples : int, optional
+        Excitation period, samples (overrides the acquisition record).
+    settle_samples : int, optional
+        Samples dropped at the start of the record or of each run (start
+        transient); default from the record or detected.
     band : (float, float), optional
         Lines to keep, Hz.
+    detect : bool
+        Detect periodicity and the start transient from the data when the
+        acquisition record does not state them
+        (:mod:`tyredamp.signal.periodicity`).
     """
     return estimate_frf(
         data,
@@ -89,7 +102,10 @@ def frf_from_time(
         reference=list(reference) if reference else None,
         method=method,
         segment_samples=segment_samples,
+        period_samples=period_samples,
+        settle_samples=settle_samples,
         band=band,
+        detect=detect,
     )
 
 

@@ -2,7 +2,9 @@
 
 * :mod:`.wavenumber` -- circumferential wave number of every identified mode
   from its shape (spatial Fourier fit over the measured angles), cos/sin
-  members, pair splitting and orientation, spatial aliasing.
+  members, pair splitting and orientation, spatial aliasing; on
+  :mod:`.harmonics` (what the measured angles resolve, aliases, the
+  single-harmonic fit).
 * :mod:`.ring` -- flexible-ring model updating (EI, tension law, foundation,
   mass per length, damping) across pressures, with standard errors and
   identifiability verdicts; predictions of modes and FRFs.
@@ -17,6 +19,7 @@
 
 from __future__ import annotations
 
+from .harmonics import alias_candidates, harmonic_fit, resolved_wave_numbers
 from .lateral import LateralCarcass, lateral_carcass, read_lateral_carcass
 from .pipeline import TyreModelResult, build_tyre_model
 from .rigid import NOT_FROM_RADIAL_TEST, RigidRingParameters, rigid_ring_from_modes
@@ -29,14 +32,7 @@ from .ring import (
     ring_observations,
 )
 from .tir import parse_tir, tir_text
-from .wavenumber import (
-    ModeWaveNumber,
-    WaveNumberAnalysis,
-    alias_candidates,
-    harmonic_fit,
-    resolved_wave_numbers,
-    wave_number_analysis,
-)
+from .wavenumber import ModeWaveNumber, WaveNumberAnalysis, wave_number_analysis
 
 __all__ = [
     "NOT_FROM_RADIAL_TEST",

@@ -182,6 +182,57 @@ def rigid_ring_from_modes(
     m_a = check_positive(attachment_mass, "attachment_mass", allow_zero=True)
     c_a = check_positive(attachment_damping, "attachment_damping", allow_zero=True)
     wa = analysis if analysis is not None else wave_number_analysis(model)
+    rows = _n1_members(model, wa, m_a, c_a)
+    if not rows:
+        raise InputError(
+            "model: no n = 1 mode (belt translation) among the identified modes; the rigid-ring "
+            "in-plane parameters need it"
+        )
+    rows = sorted(rows, key=lambda r: float(r["frequency_hz"]))[:2]
+    f, sf_ = _mean(rows, "frequency_hz", "frequency_std")
+    z, sz_ = _mean(rows, "damping_ratio", "damping_std")
+    mb, smb = _mean(rows, "belt_mass", "belt_mass_std")
+    w = 2 * math.pi * f
+    sw = 2 * math.pi * sf_
+    kk = mb * w**2
+    skk = kk * math.sqrt((smb / mb) ** 2 + (2 * sw / w) ** 2)
+    cc = 2 * z * mb * w
+    scc = cc * math.sqrt((sz_ / z) ** 2 + (smb / mb) ** 2 + (sw / w) ** 2) if z > 0 else math.nan
+    split = None
+    if len(rows) == 2:
+        split = float(rows[1]["frequency_hz"]) - float(rows[0]["frequency_hz"])
+    iyy = None
+    if radius is not None:
+        iyy = mb * check_positive(radius, "radius") ** 2
+    return RigidRingParameters(
+        pressure=None if pressure is None else float(pressure),
+        belt_mass=mb,
+        belt_mass_std=smb,
+        freq_long=f,
+        freq_long_std=sf_,
+        damp_long=z,
+        damp_long_std=sz_,
+        k_long=kk,
+        k_long_std=skk,
+        c_long=cc,
+        c_long_std=scc,
+        members=rows,
+        splitting_hz=split,
+        thin_ring_iyy=iyy,
+        notes=_notes(rows, c_a),
+    )
+
+
+def _n1_members(
+    model: ModalModel, wa: WaveNumberAnalysis, m_a: float, c_a: float
+) -> list[dict[str, Any]]:
+    """The usable ``n = 1`` modes as bare-belt quantities (module docstring).
+
+    One dictionary per mode: index, member, frequency and damping ratio of the
+    bare belt (attachment mass and known damper removed) with standard errors,
+    belt mass ``(1 - m_a phi_d^2) / A^2`` (kg) with its standard error, and
+    the amplitude ``A``.
+    """
     sf = model.std.get("frequency_hz")
     sz = model.std.get("damping_ratio")
     omega_d = model.poles.imag
@@ -220,30 +271,20 @@ def rigid_ring_from_modes(
                 "amplitude": a,
             }
         )
-    if not rows:
-        raise InputError(
-            "model: no n = 1 mode (belt translation) among the identified modes; the rigid-ring "
-            "in-plane parameters need it"
-        )
-    rows = sorted(rows, key=lambda r: float(r["frequency_hz"]))[:2]
-    k_use = len(rows)
+    return rows
 
-    def mean(key: str, std_key: str) -> tuple[float, float]:
-        v = float(np.mean([float(r[key]) for r in rows]))
-        s = math.sqrt(sum(float(r[std_key]) ** 2 for r in rows)) / k_use
-        return v, s
 
-    f, sf_ = mean("frequency_hz", "frequency_std")
-    z, sz_ = mean("damping_ratio", "damping_std")
-    mb, smb = mean("belt_mass", "belt_mass_std")
-    w = 2 * math.pi * f
-    sw = 2 * math.pi * sf_
-    kk = mb * w**2
-    skk = kk * math.sqrt((smb / mb) ** 2 + (2 * sw / w) ** 2)
-    cc = 2 * z * mb * w
-    scc = cc * math.sqrt((sz_ / z) ** 2 + (smb / mb) ** 2 + (sw / w) ** 2) if z > 0 else math.nan
+def _mean(rows: list[dict[str, Any]], key: str, std_key: str) -> tuple[float, float]:
+    """Mean of ``key`` over the members and its standard error (independent members)."""
+    v = float(np.mean([float(r[key]) for r in rows]))
+    s = math.sqrt(sum(float(r[std_key]) ** 2 for r in rows)) / len(rows)
+    return v, s
+
+
+def _notes(rows: list[dict[str, Any]], c_a: float) -> list[str]:
+    """Plain-language remarks on what the members and the options leave open."""
     notes = []
-    if k_use == 1:
+    if len(rows) == 1:
         notes.append(
             f"one n = 1 member identified ({rows[0]['member']}); with one drive point the other "
             "member of a perfect ring has a node there and is not excited"
@@ -255,26 +296,4 @@ def rigid_ring_from_modes(
             "DAMP_LONG includes every loss of the test set-up at the drive point (shaker "
             "attachment); give attachment_damping to remove a known local damper"
         )
-    split = None
-    if k_use == 2:
-        split = float(rows[1]["frequency_hz"]) - float(rows[0]["frequency_hz"])
-    iyy = None
-    if radius is not None:
-        iyy = mb * check_positive(radius, "radius") ** 2
-    return RigidRingParameters(
-        pressure=None if pressure is None else float(pressure),
-        belt_mass=mb,
-        belt_mass_std=smb,
-        freq_long=f,
-        freq_long_std=sf_,
-        damp_long=z,
-        damp_long_std=sz_,
-        k_long=kk,
-        k_long_std=skk,
-        c_long=cc,
-        c_long_std=scc,
-        members=rows,
-        splitting_hz=split,
-        thin_ring_iyy=iyy,
-        notes=notes,
-    )
+    return notes

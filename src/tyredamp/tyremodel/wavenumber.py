@@ -25,20 +25,16 @@ imperfect tyre; the label may still be right).
 
 Spatial aliasing
 ----------------
-On ``J`` equally spaced points, ``cos(n theta)`` and ``sin(n theta)`` sample
-to the same vectors (up to the sign of the sine) as those of ``|k J +- n|``:
-the points resolve both members of every ``n < J/2`` (16 points: ``n <= 7``);
-at ``n = J/2`` only the cosine member is seen. For arbitrary angles the same
-is decided numerically: wave numbers ``m`` whose sampled two-dimensional
-subspace equals that of ``n`` (projector difference below ``1e-8``) are its
-aliases (:func:`alias_candidates`), and the resolved range is the set of
-``n`` whose columns are linearly independent of all lower ones
-(:func:`resolved_wave_numbers`). Every mode carries the list of wave numbers
-it could alias to. Aliasing is *flagged* when the labels contradict a ring
-(each ``n >= 1`` carries one pair, cos and sin, and the flexural frequency
-rises with ``n``): more than two modes with one label, or a label at a
-higher frequency than a pair of a higher label. The flagged mode is then
-likely one of its alias candidates above the resolved range.
+The angles resolve a range of wave numbers, and each wave number has
+aliases that the angles cannot tell from it (:mod:`.harmonics`:
+:func:`resolved_wave_numbers`, :func:`alias_candidates`; on ``J`` equal
+points ``|k J +- n|``, both members resolved for ``n < J/2``). Every mode
+carries the list of wave numbers it could alias to. Aliasing is *flagged*
+when the labels contradict a ring (each ``n >= 1`` carries one pair, cos and
+sin, and the flexural frequency rises with ``n``): more than two modes with
+one label, or a label at a higher frequency than a pair of a higher label.
+The flagged mode is then likely one of its alias candidates above the
+resolved range.
 
 Pairs
 -----
@@ -68,8 +64,16 @@ from scipy.stats import chi2
 from .._validate import as_finite
 from ..exceptions import InputError, ShapeError
 from ..modal.model import ModalModel
+from .harmonics import (
+    HarmonicFit,
+    alias_candidates,
+    as_angles,
+    harmonic_fit,
+    resolved_wave_numbers,
+)
 
 __all__ = [
+    "HarmonicFit",
     "ModeWaveNumber",
     "WaveNumberAnalysis",
     "alias_candidates",
@@ -79,180 +83,6 @@ __all__ = [
 ]
 
 Member = Literal["cos", "sin", "single"]
-_ALIAS_TOL = 1e-8
-
-
-def _columns(theta: NDArray[np.float64], n: int) -> NDArray[np.float64]:
-    """Sampled ``[cos n theta, sin n theta]`` (only the non-vanishing ones)."""
-    if n == 0:
-        return np.ones((theta.size, 1))
-    c = np.cos(n * theta)
-    s = np.sin(n * theta)
-    cols = [c]
-    if np.linalg.norm(s) > 1e-9 * math.sqrt(theta.size):
-        cols.append(s)
-    return np.column_stack(cols)
-
-
-def _projector(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    q, r = np.linalg.qr(a)
-    keep = np.abs(np.diag(r)) > 1e-9 * max(1.0, float(np.abs(r).max()))
-    q = q[:, keep]
-    return np.asarray(q @ q.T, dtype=np.float64)
-
-
-def _angles(angles_deg: ArrayLike) -> NDArray[np.float64]:
-    a = as_finite(angles_deg, "angles_deg", ndim=1)
-    if a.size < 3:
-        raise InputError(f"angles_deg: expected at least 3 measured angles, got {a.size}")
-    wrapped = np.mod(a, 360.0)
-    d = np.abs(wrapped[:, None] - wrapped[None, :])
-    d = np.minimum(d, 360.0 - d)
-    np.fill_diagonal(d, np.inf)
-    if np.any(d < 1e-9):
-        raise InputError("angles_deg: two outputs are at the same angle; expected distinct points")
-    return np.deg2rad(a)
-
-
-def resolved_wave_numbers(angles_deg: ArrayLike) -> tuple[int, bool]:
-    """Largest wave number whose cos and sin members the angles resolve.
-
-    ``n`` is resolved when the sampled columns ``1, cos theta, sin theta, ...,
-    cos n theta, sin n theta`` are linearly independent (full column rank).
-
-    Parameters
-    ----------
-    angles_deg : array_like, shape (J,)
-        Measured angles in deg.
-
-    Returns
-    -------
-    n_max : int
-        Largest fully resolved wave number (``J`` equal points: ``ceil(J/2) - 1``;
-        16 points: 7).
-    cos_only_next : bool
-        Whether the cosine member of ``n_max + 1`` is still independent (the
-        Nyquist wave number ``J/2`` of an even number of equal points).
-    """
-    th = _angles(angles_deg)
-    cols = [np.ones(th.size)]
-    n = 0
-    while True:
-        m = n + 1
-        trial = np.column_stack([*cols, np.cos(m * th), np.sin(m * th)])
-        if trial.shape[1] > th.size or np.linalg.matrix_rank(trial, tol=1e-8) < trial.shape[1]:
-            cos_only = np.column_stack([*cols, np.cos(m * th)])
-            ok = cos_only.shape[1] <= th.size and (
-                np.linalg.matrix_rank(cos_only, tol=1e-8) == cos_only.shape[1]
-            )
-            return n, bool(ok)
-        cols += [np.cos(m * th), np.sin(m * th)]
-        n = m
-
-
-def alias_candidates(angles_deg: ArrayLike, n: int, n_limit: int) -> list[int]:
-    """Wave numbers ``m <= n_limit`` (``m != n``) that the angles cannot tell from ``n``.
-
-    ``m`` aliases ``n`` when its sampled cos/sin columns span the same space
-    as those of ``n`` (equal orthogonal projectors, tolerance 1e-8); on ``J``
-    equal points these are ``|k J +- n|``.
-
-    Parameters
-    ----------
-    angles_deg : array_like, shape (J,)
-    n : int
-        Wave number (>= 0).
-    n_limit : int
-        Largest wave number considered.
-
-    Returns
-    -------
-    list of int
-        Ascending.
-    """
-    if n < 0 or n_limit < 0:
-        raise InputError(f"n, n_limit: expected integers >= 0, got {n}, {n_limit}")
-    th = _angles(angles_deg)
-    p_n = _projector(_columns(th, n))
-    out = []
-    for m in range(n_limit + 1):
-        if m == n:
-            continue
-        if np.linalg.norm(_projector(_columns(th, m)) - p_n) < _ALIAS_TOL * th.size:
-            out.append(m)
-    return out
-
-
-@dataclass(frozen=True)
-class HarmonicFit:
-    """Single-harmonic fit of one shape (see :func:`harmonic_fit`).
-
-    Attributes
-    ----------
-    n : int
-        Wave number fitted.
-    coefficients : ndarray, complex, shape (2,)
-        ``a``, ``b`` of ``a cos n theta + b sin n theta`` (``b = 0`` for ``n = 0``).
-    fraction : float
-        Energy fraction explained, ``1 - ||r||_W^2 / ||x||_W^2`` in [0, 1].
-    chi2 : float or None
-        ``2 sum |r_j|^2 / sigma_j^2`` (with standard errors).
-    dof : int
-        ``2 (J - k)``.
-    covariance : ndarray, shape (k, k)
-        ``(A^T W A)^-1`` of the coefficients (complex variance; units of x^2
-        when unweighted with unit weights).
-    """
-
-    n: int
-    coefficients: NDArray[np.complex128]
-    fraction: float
-    chi2: float | None
-    dof: int
-    covariance: NDArray[np.float64]
-
-
-def harmonic_fit(
-    theta: NDArray[np.float64],
-    x: NDArray[np.complex128],
-    n: int,
-    sigma: NDArray[np.float64] | None = None,
-) -> HarmonicFit:
-    """Weighted least-squares fit of ``a cos n theta + b sin n theta`` to ``x``.
-
-    Parameters
-    ----------
-    theta : ndarray, shape (J,)
-        Angles in rad.
-    x : ndarray, complex, shape (J,)
-        Shape values.
-    n : int
-        Wave number.
-    sigma : ndarray, shape (J,), optional
-        Standard errors ``sqrt(E|dx|^2)``; unit weights when absent.
-    """
-    a = _columns(theta, n)
-    w = np.ones(theta.size) if sigma is None else 1.0 / np.asarray(sigma, float)
-    aw = a * w[:, None]
-    xw = x * w
-    coef, *_ = np.linalg.lstsq(aw, xw, rcond=None)
-    r = xw - aw @ coef
-    tot = float(np.vdot(xw, xw).real)
-    res = float(np.vdot(r, r).real)
-    frac = 1.0 - res / tot if tot > 0 else 0.0
-    cov = np.linalg.pinv(aw.T @ aw)
-    full = np.zeros(2, dtype=complex)
-    full[: coef.size] = coef
-    if a.shape[1] == 1 and n > 0:
-        cov = np.diag([cov[0, 0], 0.0])
-    return HarmonicFit(
-        n=n,
-        coefficients=full,
-        fraction=float(np.clip(frac, 0.0, 1.0)),
-        chi2=None if sigma is None else 2.0 * res,
-        dof=2 * (theta.size - a.shape[1]),
-        covariance=np.asarray(cov, dtype=float),
-    )
 
 
 @dataclass(frozen=True)
@@ -453,6 +283,46 @@ def _output_rows(model: ModalModel, outputs: Sequence[int] | None) -> NDArray[np
     return rows
 
 
+@dataclass(frozen=True)
+class _Circumference:
+    """The measured points on the circumference and what they resolve."""
+
+    rows: NDArray[np.intp]  # rows of the shapes used
+    angles_deg: NDArray[np.float64]  # their angles, shape (J,)
+    theta: NDArray[np.float64]  # the same in rad
+    n_resolved: int  # largest wave number with both members resolved
+    cos_next: bool  # the cos member of n_resolved + 1 (Nyquist) is observable
+    n_limit: int  # largest wave number among the alias candidates
+
+    @property
+    def n_top(self) -> int:
+        """Largest wave number fitted to the shapes."""
+        return self.n_resolved + 1 if self.cos_next else self.n_resolved
+
+
+@dataclass(frozen=True)
+class _ShapeLabel:
+    """The single-harmonic label of one shape, before the pairs (module docstring)."""
+
+    n: int
+    fraction: float
+    second_n: int
+    second_fraction: float
+    p_value: float | None
+    amplitude: float  # 1/sqrt(kg)
+    amplitude_std: float | None
+    antinode: float  # deg, in [-90/n, 90/n)
+
+
+@dataclass
+class _Pairs:
+    """Pair members and the pairs' splitting and orientation."""
+
+    members: list[Member]
+    pair_of: dict[int, tuple[int, ...]]
+    pairs: list[dict[str, Any]]
+
+
 def wave_number_analysis(
     model: ModalModel,
     *,
@@ -495,76 +365,151 @@ def wave_number_analysis(
         raise InputError(f"model: expected a ModalModel, got {type(model).__name__}")
     if not 0.0 < float(min_fraction) <= 1.0:
         raise InputError(f"min_fraction: expected a value in (0, 1], got {min_fraction}")
-    rows = _output_rows(model, outputs)
-    ang = _output_angles(model, angles_deg, rows)
-    theta = _angles(ang)
-    n_res, cos_next = resolved_wave_numbers(ang)
-    n_top = n_res + 1 if cos_next else n_res
-    limit = 3 * theta.size if n_limit is None else int(n_limit)
+    circ = _circumference(model, angles_deg, outputs, n_limit)
     if reference_deg is None:
         ref = next((c.angle_deg for c in model.inputs if c.angle_deg is not None), 0.0)
         reference_deg = float(ref) if ref is not None else 0.0
-    shapes = model.second_order_shapes()[rows]
+    shapes = model.second_order_shapes()[circ.rows]
+    raw = [
+        _label_shape(circ.theta, shapes[:, k], sig, circ.n_top)
+        for k, sig in enumerate(_shape_sigmas(model, circ.rows, shapes))
+    ]
+    freq = model.frequency_hz
+    zeta = model.damping_ratio
+    groups: dict[int, list[int]] = {}
+    for k, r in enumerate(raw):
+        groups.setdefault(int(r.n), []).append(k)
+    alias_lists = {n: alias_candidates(circ.angles_deg, n, circ.n_limit) for n in groups}
+    aliased, notes = _flag_aliases(raw, groups, alias_lists, freq)
+    for k, r in enumerate(raw):
+        notes[k] += _shape_notes(r, circ, min_fraction)
+    pairs = _pair_members(raw, groups, aliased, freq, reference_deg, min_fraction, notes)
+    out = tuple(
+        ModeWaveNumber(
+            index=k,
+            frequency_hz=float(freq[k]),
+            damping_ratio=float(zeta[k]),
+            n=int(r.n),
+            fraction=float(r.fraction),
+            second_n=int(r.second_n),
+            second_fraction=float(r.second_fraction),
+            p_value=r.p_value,
+            single_harmonic=bool(r.fraction >= min_fraction),
+            amplitude=float(r.amplitude),
+            amplitude_std=r.amplitude_std,
+            antinode_deg=float(r.antinode),
+            member=pairs.members[k],
+            pair=pairs.pair_of[k],
+            aliases=tuple(alias_lists[int(r.n)]),
+            aliased=bool(aliased[k]),
+            notes=tuple(notes[k]),
+        )
+        for k, r in enumerate(raw)
+    )
+    return WaveNumberAnalysis(
+        modes=out,
+        angles_deg=circ.angles_deg,
+        n_resolved=circ.n_resolved,
+        reference_deg=float(reference_deg),
+        pairs=sorted(pairs.pairs, key=lambda p: p["n"]),
+        warnings=_warnings(model.n_modes, int(aliased.sum()), circ),
+    )
+
+
+def _circumference(
+    model: ModalModel,
+    angles_deg: ArrayLike | None,
+    outputs: Sequence[int] | None,
+    n_limit: int | None,
+) -> _Circumference:
+    """The rows and angles of the points, and the wave numbers they resolve."""
+    rows = _output_rows(model, outputs)
+    ang = _output_angles(model, angles_deg, rows)
+    theta = as_angles(ang)
+    n_res, cos_next = resolved_wave_numbers(ang)
+    return _Circumference(
+        rows=rows,
+        angles_deg=ang,
+        theta=theta,
+        n_resolved=n_res,
+        cos_next=cos_next,
+        n_limit=3 * theta.size if n_limit is None else int(n_limit),
+    )
+
+
+def _shape_sigmas(
+    model: ModalModel, rows: NDArray[np.intp], shapes: NDArray[np.complex128]
+) -> list[NDArray[np.float64] | None]:
+    """Standard errors of each mode's second-order shape at ``rows`` (None where unknown)."""
     omega = model.poles.imag
     std_psi = model.std.get("psi_out")
     if std_psi is not None and np.shape(std_psi) == model.psi_out.shape:
         std_psi = np.asarray(std_psi, float)[rows]
-    raw: list[dict[str, Any]] = []
+    out: list[NDArray[np.float64] | None] = []
     for k in range(model.n_modes):
-        x = shapes[:, k]
         sig = None
         if std_psi is not None and np.shape(std_psi) == shapes.shape:
             s = np.asarray(std_psi, float)[:, k] * math.sqrt(2.0 * omega[k])
             if np.all(s > 0) and np.all(np.isfinite(s)):
                 sig = s
-        fits = [harmonic_fit(theta, x, n, sig) for n in range(n_top + 1)]
-        fr = np.array([f.fraction for f in fits])
-        order = np.argsort(-fr, kind="stable")
-        best = fits[int(order[0])]
-        second = fits[int(order[1])] if len(order) > 1 else best
-        n = best.n
-        # principal phase, then real coefficients
-        alpha = 0.5 * np.angle(np.sum(x**2)) if np.any(x) else 0.0
-        ab = best.coefficients * np.exp(-1j * alpha)
-        ar, br = float(ab[0].real), float(ab[1].real)
-        amp = math.hypot(ar, br)
-        antinode = 0.0
-        if n > 0:
-            # antinodes repeat every 180/n deg; report the one in [-90/n, 90/n)
-            period = 180.0 / n
-            raw_deg = np.degrees(math.atan2(br, ar)) / n
-            antinode = float(np.mod(raw_deg + period / 2, period) - period / 2)
-        amp_std = None
-        if sig is not None and amp > 0:
-            u = np.array([ar, br]) / amp
-            cov_real = 0.5 * best.covariance
-            amp_std = float(math.sqrt(max(float(u @ cov_real @ u), 0.0)))
-        pval = None
-        if best.chi2 is not None and best.dof > 0:
-            pval = float(chi2.sf(best.chi2, best.dof))
-        raw.append(
-            {
-                "n": n,
-                "fraction": best.fraction,
-                "second_n": second.n,
-                "second_fraction": second.fraction,
-                "p_value": pval,
-                "amplitude": amp,
-                "amplitude_std": amp_std,
-                "antinode": antinode,
-            }
-        )
-    freq = model.frequency_hz
-    zeta = model.damping_ratio
-    # ---- pairs and aliasing flags
-    labels = np.array([r["n"] for r in raw], dtype=int)
-    aliased = np.zeros(model.n_modes, dtype=bool)
-    notes: list[list[str]] = [[] for _ in range(model.n_modes)]
-    groups: dict[int, list[int]] = {}
-    for k, n in enumerate(labels):
-        groups.setdefault(int(n), []).append(k)
-    warnings: list[str] = []
-    alias_lists = {n: alias_candidates(ang, n, limit) for n in groups}
+        out.append(sig)
+    return out
+
+
+def _label_shape(
+    theta: NDArray[np.float64],
+    x: NDArray[np.complex128],
+    sig: NDArray[np.float64] | None,
+    n_top: int,
+) -> _ShapeLabel:
+    """Best single harmonic ``n <= n_top`` of one shape, its amplitude and antinode."""
+    fits = [harmonic_fit(theta, x, n, sig) for n in range(n_top + 1)]
+    fr = np.array([f.fraction for f in fits])
+    order = np.argsort(-fr, kind="stable")
+    best = fits[int(order[0])]
+    second = fits[int(order[1])] if len(order) > 1 else best
+    n = best.n
+    # principal phase, then real coefficients
+    alpha = 0.5 * np.angle(np.sum(x**2)) if np.any(x) else 0.0
+    ab = best.coefficients * np.exp(-1j * alpha)
+    ar, br = float(ab[0].real), float(ab[1].real)
+    amp = math.hypot(ar, br)
+    antinode = 0.0
+    if n > 0:
+        # antinodes repeat every 180/n deg; report the one in [-90/n, 90/n)
+        period = 180.0 / n
+        raw_deg = np.degrees(math.atan2(br, ar)) / n
+        antinode = float(np.mod(raw_deg + period / 2, period) - period / 2)
+    amp_std = None
+    if sig is not None and amp > 0:
+        u = np.array([ar, br]) / amp
+        cov_real = 0.5 * best.covariance
+        amp_std = float(math.sqrt(max(float(u @ cov_real @ u), 0.0)))
+    pval = None
+    if best.chi2 is not None and best.dof > 0:
+        pval = float(chi2.sf(best.chi2, best.dof))
+    return _ShapeLabel(
+        n=n,
+        fraction=best.fraction,
+        second_n=second.n,
+        second_fraction=second.fraction,
+        p_value=pval,
+        amplitude=amp,
+        amplitude_std=amp_std,
+        antinode=antinode,
+    )
+
+
+def _flag_aliases(
+    raw: Sequence[_ShapeLabel],
+    groups: dict[int, list[int]],
+    alias_lists: dict[int, list[int]],
+    freq: NDArray[np.float64],
+) -> tuple[NDArray[np.bool_], list[list[str]]]:
+    """Modes whose labels contradict a ring (module docstring), with a note for each."""
+    labels = np.array([r.n for r in raw], dtype=int)
+    aliased = np.zeros(len(raw), dtype=bool)
+    notes: list[list[str]] = [[] for _ in raw]
     for n, idx in groups.items():
         cap = 2  # a ring has one pair (cos, sin) per wave number
         if len(idx) > cap:
@@ -589,36 +534,50 @@ def wave_number_analysis(
                     f"labelled n = {labels[k]} but above the n = {top} modes: probably aliased "
                     f"from n in {alias_lists[int(labels[k])][:4]}"
                 )
-    for k, r in enumerate(raw):
-        n = r["n"]
-        if cos_next and n == n_top and n > 0:
-            notes[k].append(
-                f"n = {n} is the Nyquist wave number of these points: only its cos member is "
-                "observable"
-            )
-        if r["fraction"] < min_fraction:
-            notes[k].append(
-                f"not a single harmonic: {100 * r['fraction']:.0f} % of the shape in n = {n}, "
-                f"{100 * r['second_fraction']:.0f} % in n = {r['second_n']}"
-            )
-    n_alias = int(aliased.sum())
-    if n_alias:
-        warnings.append(
-            f"{n_alias} mode(s) flagged as spatially aliased: the {theta.size} points resolve "
-            f"wave numbers up to n = {n_res}; modes of higher n fold onto lower ones"
+    return aliased, notes
+
+
+def _shape_notes(r: _ShapeLabel, circ: _Circumference, min_fraction: float) -> list[str]:
+    """Notes on one shape: the Nyquist wave number, not a single harmonic."""
+    notes = []
+    n = r.n
+    if circ.cos_next and n == circ.n_top and n > 0:
+        notes.append(
+            f"n = {n} is the Nyquist wave number of these points: only its cos member is observable"
         )
-    members: list[Member] = ["single"] * model.n_modes
+    if r.fraction < min_fraction:
+        notes.append(
+            f"not a single harmonic: {100 * r.fraction:.0f} % of the shape in n = {n}, "
+            f"{100 * r.second_fraction:.0f} % in n = {r.second_n}"
+        )
+    return notes
+
+
+def _pair_members(
+    raw: Sequence[_ShapeLabel],
+    groups: dict[int, list[int]],
+    aliased: NDArray[np.bool_],
+    freq: NDArray[np.float64],
+    reference_deg: float,
+    min_fraction: float,
+    notes: list[list[str]],
+) -> _Pairs:
+    """cos/sin members of each wave number's pair, with the pairs' splitting (module docstring).
+
+    A note is appended to ``notes`` for a member whose partner was not identified.
+    """
+    members: list[Member] = ["single"] * len(raw)
     pairs_out: list[dict[str, Any]] = []
-    pair_of: dict[int, tuple[int, ...]] = {k: (k,) for k in range(model.n_modes)}
+    pair_of: dict[int, tuple[int, ...]] = {k: (k,) for k in range(len(raw))}
 
     def dist(k: int, n: int) -> float:
         # distance of the nearest antinode (every 180/n deg) from the reference
         period = 180.0 / n
-        return float(abs((raw[k]["antinode"] - reference_deg + period / 2) % period - period / 2))
+        return float(abs((raw[k].antinode - reference_deg + period / 2) % period - period / 2))
 
     for n, idx in groups.items():
         # pairs of labelled, single-harmonic modes only
-        good = [k for k in idx if not aliased[k] and raw[k]["fraction"] >= min_fraction]
+        good = [k for k in idx if not aliased[k] and raw[k].fraction >= min_fraction]
         if n == 0 or not good:
             continue
         if len(good) == 1:
@@ -643,48 +602,31 @@ def wave_number_analysis(
                 "f_sin_hz": float(freq[s_idx]),
                 "splitting_hz": float(freq[s_idx] - freq[c_idx]),
                 "relative_splitting": float((freq[s_idx] - freq[c_idx]) / fm),
-                "orientation_deg": float(raw[c_idx]["antinode"]),
+                "orientation_deg": float(raw[c_idx].antinode),
                 "member_angle_deg": float(
                     abs(
-                        (raw[s_idx]["antinode"] - raw[c_idx]["antinode"] + 90.0 / n) % (180.0 / n)
+                        (raw[s_idx].antinode - raw[c_idx].antinode + 90.0 / n) % (180.0 / n)
                         - 90.0 / n
                     )
                 ),
             }
         )
-    n_modes_resolvable = 1 + 2 * n_res + (1 if cos_next else 0)
-    if model.n_modes > n_modes_resolvable:
+    return _Pairs(members=members, pair_of=pair_of, pairs=pairs_out)
+
+
+def _warnings(n_modes: int, n_alias: int, circ: _Circumference) -> tuple[str, ...]:
+    """Global remarks: aliased modes, more modes than the points resolve."""
+    warnings: list[str] = []
+    n_res, j = circ.n_resolved, circ.theta.size
+    if n_alias:
         warnings.append(
-            f"{model.n_modes} modes but {theta.size} points resolve at most "
+            f"{n_alias} mode(s) flagged as spatially aliased: the {j} points resolve "
+            f"wave numbers up to n = {n_res}; modes of higher n fold onto lower ones"
+        )
+    n_modes_resolvable = 1 + 2 * n_res + (1 if circ.cos_next else 0)
+    if n_modes > n_modes_resolvable:
+        warnings.append(
+            f"{n_modes} modes but {j} points resolve at most "
             f"{n_modes_resolvable} independent shapes (n <= {n_res}): some modes must alias"
         )
-    out = tuple(
-        ModeWaveNumber(
-            index=k,
-            frequency_hz=float(freq[k]),
-            damping_ratio=float(zeta[k]),
-            n=int(r["n"]),
-            fraction=float(r["fraction"]),
-            second_n=int(r["second_n"]),
-            second_fraction=float(r["second_fraction"]),
-            p_value=r["p_value"],
-            single_harmonic=bool(r["fraction"] >= min_fraction),
-            amplitude=float(r["amplitude"]),
-            amplitude_std=r["amplitude_std"],
-            antinode_deg=float(r["antinode"]),
-            member=members[k],
-            pair=pair_of[k],
-            aliases=tuple(alias_lists[int(r["n"])]),
-            aliased=bool(aliased[k]),
-            notes=tuple(notes[k]),
-        )
-        for k, r in enumerate(raw)
-    )
-    return WaveNumberAnalysis(
-        modes=out,
-        angles_deg=ang,
-        n_resolved=n_res,
-        reference_deg=float(reference_deg),
-        pairs=sorted(pairs_out, key=lambda p: p["n"]),
-        warnings=tuple(warnings),
-    )
+    return tuple(warnings)

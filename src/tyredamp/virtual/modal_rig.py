@@ -14,7 +14,7 @@ Excitation
 edges are moved to DFT lines so that it is continuous from period to period).
 ``"multisine"``: the band-limited Schroeder multisine of
 :func:`~tyredamp.virtual.excitation.schroeder_multisine` (flat spectrum on the
-band lines, nothing elsewhere). ``meta["lines"]`` lists the DFT lines of one
+band lines, nothing elsewhere). ``data.meta["lines"]`` lists the DFT lines of one
 period inside ``band``.
 
 Steady state
@@ -30,7 +30,7 @@ steady-state response is exactly periodic, so the record is that period
 repeated, plus independent noise. ``initial_state="rest"`` instead simulates
 every period from rest (the transient decays with the slowest mode, about
 ``1 / sigma_min`` s) and drops ``settle_periods`` leading periods, or keeps
-them and says so in ``meta["settle_samples"]``.
+them and says so in ``data.acquisition.settle_samples``.
 
 Sampling
 --------
@@ -61,13 +61,13 @@ every run with the same signal times the signs of a Hadamard matrix
 so the input cross-spectral matrix summed over the runs is diagonal. Either
 way every period of the record is a steady-state period and an H1 estimator
 over all periods (all runs) recovers every FRF column;
-``meta["run_starts"]`` gives the first sample of each run.
+``data.acquisition.run_starts`` gives the first sample of each run.
 """
 
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -79,7 +79,7 @@ from ..exceptions import InputError
 from ..frf import FRF, FRFKind
 from ..mechanics import ComplexModes, MCKSystem, step_coefficients, time_response
 from ..signal.excitation import band_lines, periodic_chirp
-from ..timedata import TimeData
+from ..timedata import Acquisition, TimeData
 from .excitation import hadamard_drive_matrix, schroeder_multisine
 from .ring import RingTyre
 from .truth import TyreTruth
@@ -100,10 +100,11 @@ class VirtualModalTest:
     data : TimeData
         Force channels (one per drive point, quantity ``"force"``, N) then
         acceleration channels (one per measured point, ``"acceleration"``,
-        m/s^2). ``data.meta`` holds ``period_samples``, ``settle_samples``,
-        ``n_periods`` (per run), ``run_starts``, ``drive_matrix``,
-        ``excitation`` (signal name), ``lines``, ``band_hz``, ``snr_db``,
-        ``noise_std``, ``seed`` and more.
+        m/s^2). ``data.acquisition`` states ``period_samples``,
+        ``settle_samples``, ``n_averages`` (periods per run), ``run_starts``,
+        ``band_hz`` and ``excitation`` (signal name); ``data.meta`` notes
+        ``drive_matrix``, ``lines``, ``snr_db``, ``noise_std``, ``seed`` and
+        more.
     truth : TyreTruth
         Exact modes, damping and FRFs of the tested tyre in the test band.
     tyre : RingTyre
@@ -118,9 +119,26 @@ class VirtualModalTest:
     drive_matrix: NDArray[np.float64]
 
     @property
+    def acquisition(self) -> Acquisition:
+        """The acquisition record of :attr:`data` (period, runs, settle samples, band)."""
+        return self.data.acquisition
+
+    @property
     def meta(self) -> dict[str, Any]:
-        """The metadata of :attr:`data`."""
-        return self.data.meta
+        """A copy of the notes of :attr:`data` with the acquisition fields as keys.
+
+        ``period_samples``, ``settle_samples``, ``run_starts``, ``band_hz``,
+        ``n_averages`` (periods per run), ``excitation`` come from
+        :attr:`acquisition`; the rest (``lines``, ``drive_matrix``,
+        ``snr_db``, ...) from ``data.meta``.
+        """
+        acq = self.data.acquisition
+        return {
+            **self.data.meta,
+            **acq.to_dict(),
+            "settle_samples": acq.settle_samples,
+            "run_starts": list(acq.run_starts),
+        }
 
     @property
     def n_runs(self) -> int:
@@ -130,7 +148,10 @@ class VirtualModalTest:
     @property
     def period_samples(self) -> int:
         """Samples per excitation period."""
-        return int(self.data.meta["period_samples"])
+        p = self.data.acquisition.period_samples
+        if p is None:  # pragma: no cover - the rig always states it
+            raise InputError("data.acquisition: no period_samples")
+        return p
 
     @property
     def frequency_lines(self) -> NDArray[np.float64]:
@@ -142,12 +163,19 @@ class VirtualModalTest:
         """The samples of one run (including its settle samples, if kept) as a TimeData."""
         if not isinstance(run, int | np.integer) or not 0 <= run < self.n_runs:
             raise InputError(f"run: expected an integer in 0..{self.n_runs - 1}, got {run!r}")
-        starts = [*self.data.meta["run_starts"], self.data.n_samples]
+        acq = self.data.acquisition
+        starts = [*acq.run_starts, self.data.n_samples]
         seg = self.data.data[:, starts[run] : starts[run + 1]]
         meta = dict(self.data.meta)
-        meta["run_starts"] = [0]
         meta["drive_matrix"] = [self.drive_matrix[run].tolist()]
-        return TimeData(seg, self.data.sample_rate, self.data.channels, self.data.quantities, meta)
+        return TimeData(
+            seg,
+            self.data.sample_rate,
+            self.data.channels,
+            self.data.quantities,
+            meta,
+            acquisition=replace(acq, run_starts=(0,)),
+        )
 
     def true_frf(self, frequency: ArrayLike, kind: FRFKind = "accelerance") -> FRF:
         """Exact FRF of the tested tyre at the points, shape (n_points, n_drive, n_freq)."""
@@ -307,8 +335,9 @@ def run_modal_test(
     settle_periods : int
         Periods simulated before the recorded ones in each run (default 0).
     keep_settle : bool
-        Keep the settle periods in the record (``meta["settle_samples"]``
-        says how many samples of each run to drop) instead of dropping them.
+        Keep the settle periods in the record
+        (``data.acquisition.settle_samples`` says how many samples of each
+        run to drop) instead of dropping them.
 
     Returns
     -------
@@ -321,6 +350,109 @@ def run_modal_test(
         argument).
     """
     t_start = _time.perf_counter()
+    tyre, fs, p_samples, f_rms = _checked_options(
+        tyre, sample_rate, period, n_periods, settle_periods, oversample, force_rms, snr_db
+    )
+    _check_choices(drive_mode, excitation, initial_state)
+    bnd = as_band(band)
+    lines = band_lines(fs, p_samples, bnd)
+    truth = tyre.truth(band=bnd)
+    rng = np.random.default_rng(seed)
+
+    n_in = len(tyre.layout.drive_points)
+    drive = np.eye(n_in) if drive_mode == "sequential" else hadamard_drive_matrix(n_in)
+    r = int(oversample)
+    make = periodic_chirp if excitation == "chirp" else schroeder_multisine
+    exc = make(fs * r, p_samples * r, bnd, rms=f_rms)
+    n_keep = int(n_periods) + (int(settle_periods) if keep_settle else 0)
+    periods = (int(settle_periods), int(n_periods), keep_settle)
+    run_len = n_keep * p_samples
+    n_runs = drive.shape[0]
+    clean = np.concatenate(
+        [
+            _simulate_run(
+                tyre, drive[run][:, None] * exc.signal[None, :], fs * r, r, initial_state, periods
+            )
+            for run in range(n_runs)
+        ],
+        axis=1,
+    )
+    measured, noise_std = _add_noise(clean, snr_db, rng)
+    meta = _notes(tyre, drive, drive_mode, exc, lines, (f_rms, snr_db, noise_std), seed, r)
+    meta["initial_state"] = initial_state
+    meta["elapsed_s"] = _time.perf_counter() - t_start
+    acquisition = Acquisition(
+        period_samples=p_samples,
+        run_starts=tuple(run * run_len for run in range(n_runs)),
+        settle_samples=int(settle_periods) * p_samples if keep_settle else 0,
+        band_hz=(float(bnd[0]), float(bnd[1])),
+        n_averages=int(n_periods),
+        excitation=exc.name,
+    )
+    data = TimeData(
+        measured,
+        fs,
+        tyre.input_channels + tyre.output_channels,
+        ["force"] * n_in + ["acceleration"] * len(tyre.point_dofs),
+        meta,
+        acquisition=acquisition,
+    )
+    return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)
+
+
+def _check_choices(drive_mode: str, excitation: str, initial_state: str) -> None:
+    if drive_mode not in ("sequential", "simultaneous"):
+        raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
+    if excitation not in ("chirp", "multisine"):
+        raise InputError(f"excitation: expected 'chirp' or 'multisine', got {excitation!r}")
+    if initial_state not in ("periodic", "rest"):
+        raise InputError(f"initial_state: expected 'periodic' or 'rest', got {initial_state!r}")
+
+
+def _notes(
+    tyre: RingTyre,
+    drive: NDArray[np.float64],
+    drive_mode: str,
+    exc: Any,
+    lines: NDArray[Any],
+    levels: tuple[float, float | None, NDArray[np.float64]],
+    seed: int | np.random.Generator | None,
+    r: int,
+) -> dict[str, Any]:
+    """``data.meta`` of a virtual test; ``levels`` = (force RMS, SNR in dB, noise std)."""
+    f_rms, snr_db, noise_std = levels
+    return {
+        "source": "tyredamp.virtual.run_modal_test (virtual ring tyre)",
+        "n_runs": drive.shape[0],
+        "drive_mode": drive_mode,
+        "drive_matrix": drive.tolist(),
+        "drive_points": list(tyre.layout.drive_points),
+        "excitation_band_hz": [float(exc.band[0]), float(exc.band[1])],
+        "lines": lines.tolist(),
+        "force_rms": f_rms,
+        "snr_db": None if snr_db is None else float(snr_db),
+        "noise_std": noise_std.tolist(),
+        "seed": int(seed) if isinstance(seed, int | np.integer) else None,
+        "oversample": r,
+        "hold": "foh",
+        "anti_alias": "ideal low-pass at sample_rate/2 (per simulated period)",
+        "pressure_pa": tyre.params.pressure,
+        "nonproportionality": tyre.nonproportionality,
+        "n_ring": tyre.n_ring,
+    }
+
+
+def _checked_options(
+    tyre: RingTyre | None,
+    sample_rate: float,
+    period: float,
+    n_periods: int,
+    settle_periods: int,
+    oversample: int,
+    force_rms: float,
+    snr_db: float | None,
+) -> tuple[RingTyre, float, int, float]:
+    """The tyre, sample rate (Hz), samples per period and force RMS (N) of ``run_modal_test``."""
     if tyre is None:
         tyre = RingTyre()
     if not isinstance(tyre, RingTyre):
@@ -348,98 +480,55 @@ def run_modal_test(
             raise InputError(f"snr_db: expected a number in dB or None, got {snr_db!r}") from None
         if not (snr > -300.0):  # NaN, -inf (infinite noise) or noise 1e15 x the signal
             raise InputError(f"snr_db: expected a ratio in dB > -300 (inf: no noise), got {snr:g}")
-    if drive_mode not in ("sequential", "simultaneous"):
-        raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
-    if excitation not in ("chirp", "multisine"):
-        raise InputError(f"excitation: expected 'chirp' or 'multisine', got {excitation!r}")
-    if initial_state not in ("periodic", "rest"):
-        raise InputError(f"initial_state: expected 'periodic' or 'rest', got {initial_state!r}")
-    bnd = as_band(band)
-    lines = band_lines(fs, p_samples, bnd)
-    truth = tyre.truth(band=bnd)
-    rng = np.random.default_rng(seed)
+    return tyre, fs, p_samples, f_rms
 
-    n_in = len(tyre.layout.drive_points)
-    drive = np.eye(n_in) if drive_mode == "sequential" else hadamard_drive_matrix(n_in)
-    r = int(oversample)
-    fs_sim = fs * r
-    if excitation == "chirp":
-        exc = periodic_chirp(fs_sim, p_samples * r, bnd, rms=f_rms)
-    else:
-        exc = schroeder_multisine(fs_sim, p_samples * r, bnd, rms=f_rms)
-    base = exc.signal
+
+def _simulate_run(
+    tyre: RingTyre,
+    force_sim: NDArray[np.float64],
+    fs_sim: float,
+    r: int,
+    initial_state: str,
+    periods: tuple[int, int, bool],
+) -> NDArray[np.float64]:
+    """Forces then accelerations of one run, sampled at ``fs_sim / r``.
+
+    ``force_sim`` (n_in, P r) is one period of the drive forces at the
+    simulation rate; ``periods`` = (settle periods, recorded periods, keep
+    the settle periods).
+    """
+    settle_periods, n_periods, keep_settle = periods
+    n_keep = n_periods + (settle_periods if keep_settle else 0)
     system = tyre.system
-    cm = system.complex_modes()
     inputs = tyre.drive_dofs.tolist()
     outputs = tyre.point_dofs.tolist()
-    n_keep = int(n_periods) + (int(settle_periods) if keep_settle else 0)
-    run_len = n_keep * p_samples
-    n_runs = drive.shape[0]
-    clean = np.empty((n_in + len(outputs), n_runs * run_len))
-    for run in range(n_runs):
-        force_sim = drive[run][:, None] * base[None, :]  # (n_in, P r), one period
-        if initial_state == "periodic":
-            x0, v0 = periodic_initial_state(system, force_sim, fs_sim, inputs)
-            resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
-            acc = np.tile(_acquire(resp.acceleration, r), (1, n_keep))
-        else:
-            blocks = []
-            q = np.zeros(cm.poles.size, dtype=complex)
-            ext = np.concatenate([force_sim, force_sim[:, :1]], axis=1)
-            psi_in = cm.psi[inputs]
-            for k in range(int(settle_periods) + int(n_periods)):
-                x0, v0 = _modal_to_physical(cm, q)
-                resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
-                if k >= int(settle_periods) or keep_settle:
-                    blocks.append(_acquire(resp.acceleration, r))
-                q = _modal_propagate(cm, psi_in, ext, 1.0 / fs_sim, q)
-            acc = np.concatenate(blocks, axis=1)
-        force = np.tile(_acquire(force_sim, r), (1, n_keep))
-        sl = slice(run * run_len, (run + 1) * run_len)
-        clean[:n_in, sl] = force
-        clean[n_in:, sl] = acc
-
-    if snr_db is None or np.isinf(float(snr_db)):
-        noise_std = np.zeros(clean.shape[0])
-        measured = clean
+    if initial_state == "periodic":
+        x0, v0 = periodic_initial_state(system, force_sim, fs_sim, inputs)
+        resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
+        acc = np.tile(_acquire(resp.acceleration, r), (1, n_keep))
     else:
-        rms = np.sqrt(np.mean(clean**2, axis=1))
-        noise_std = rms * 10.0 ** (-float(snr_db) / 20.0)
-        measured = clean + noise_std[:, None] * rng.standard_normal(clean.shape)
+        cm = system.complex_modes()
+        blocks = []
+        q = np.zeros(cm.poles.size, dtype=complex)
+        ext = np.concatenate([force_sim, force_sim[:, :1]], axis=1)
+        psi_in = cm.psi[inputs]
+        for k in range(settle_periods + n_periods):
+            x0, v0 = _modal_to_physical(cm, q)
+            resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
+            if k >= settle_periods or keep_settle:
+                blocks.append(_acquire(resp.acceleration, r))
+            q = _modal_propagate(cm, psi_in, ext, 1.0 / fs_sim, q)
+        acc = np.concatenate(blocks, axis=1)
+    force = np.tile(_acquire(force_sim, r), (1, n_keep))
+    return np.concatenate([force, acc], axis=0)
 
-    settle = int(settle_periods) * p_samples if keep_settle else 0
-    meta: dict[str, Any] = {
-        "source": "tyredamp.virtual.run_modal_test (virtual ring tyre)",
-        "period_samples": p_samples,
-        "settle_samples": settle,
-        "n_periods": int(n_periods),
-        "n_runs": n_runs,
-        "run_starts": [run * run_len for run in range(n_runs)],
-        "drive_mode": drive_mode,
-        "drive_matrix": drive.tolist(),
-        "drive_points": list(tyre.layout.drive_points),
-        "band_hz": list(bnd),
-        "excitation": exc.name,
-        "excitation_band_hz": [float(exc.band[0]), float(exc.band[1])],
-        "lines": lines.tolist(),
-        "force_rms": f_rms,
-        "snr_db": None if snr_db is None else float(snr_db),
-        "noise_std": noise_std.tolist(),
-        "seed": int(seed) if isinstance(seed, int | np.integer) else None,
-        "oversample": r,
-        "hold": "foh",
-        "anti_alias": "ideal low-pass at sample_rate/2 (per simulated period)",
-        "initial_state": initial_state,
-        "pressure_pa": tyre.params.pressure,
-        "nonproportionality": tyre.nonproportionality,
-        "n_ring": tyre.n_ring,
-        "elapsed_s": _time.perf_counter() - t_start,
-    }
-    data = TimeData(
-        measured,
-        fs,
-        tyre.input_channels + tyre.output_channels,
-        ["force"] * n_in + ["acceleration"] * len(outputs),
-        meta,
-    )
-    return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)
+
+def _add_noise(
+    clean: NDArray[np.float64], snr_db: float | None, rng: np.random.Generator
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The record with Gaussian noise at ``snr_db`` on every channel, and the noise std."""
+    if snr_db is None or np.isinf(float(snr_db)):
+        return clean, np.zeros(clean.shape[0])
+    rms = np.sqrt(np.mean(clean**2, axis=1))
+    noise_std = rms * 10.0 ** (-float(snr_db) / 20.0)
+    return clean + noise_std[:, None] * rng.standard_normal(clean.shape), noise_std
