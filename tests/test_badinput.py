@@ -206,7 +206,10 @@ def output_cases() -> list[Case]:
 
 
 # ----------------------------------------------------------------------------- demo
-def _demo_dir(extra: dict[str, str], marker: bool = True) -> Any:
+def _demo_dir(extra: dict[str, str], marker: bool = True, edited: bool = False) -> Any:
+    """An earlier demo output (its files, results.json and the manifest written with them),
+    then ``extra`` files of the user's; ``edited``: the user changed report.html."""
+
     def setup(d: Path) -> None:
         out = d / "demo"
         (out / "figures").mkdir(parents=True)
@@ -215,9 +218,12 @@ def _demo_dir(extra: dict[str, str], marker: bool = True) -> Any:
         if marker:
             doc = {
                 "kind": "tyredamp-demo-results",
-                "files": ["figures/a.png", "report.html", "results.json"],
+                "files": ["figures/a.png", "report.html", "results.json", safety.MANIFEST_NAME],
             }
             (out / "results.json").write_text(json.dumps(doc))
+            safety._write_manifest(out)
+        if edited:
+            (out / "report.html").write_text("<html><p>my notes</p></html>")
         for k, v in extra.items():
             (out / k).parent.mkdir(parents=True, exist_ok=True)
             (out / k).write_text(v)
@@ -236,6 +242,13 @@ def demo_cases() -> list[Case]:
             EXIT_INPUT,
             "notes.txt",
             setup=_demo_dir({"notes.txt": "my notes"}),
+        ),
+        Case(
+            "demo-user-edited-its-report",
+            ["demo", "--quick", "-o", "demo"],
+            EXIT_INPUT,
+            "changed since tyredamp wrote it",
+            setup=_demo_dir({}, edited=True),
         ),
         Case(
             "demo-user-file-in-subdir",
@@ -1087,3 +1100,30 @@ def test_fsync_before_rename(
     assert renamed
     for p in renamed:
         assert events.index(("fsync", p)) < events.index(("replace", p))
+
+
+def test_an_output_changed_since_it_was_written_is_not_replaced(tmp_path: Path) -> None:
+    """A file of an earlier output that the user edited (notes in report.html) counts as
+    the user's: the manifest written with the output tells it apart (issue 15)."""
+    from tyredamp.exceptions import InputError
+    from tyredamp.io._safety import MANIFEST_NAME, atomic_dir, check_output_dir
+
+    out = tmp_path / "out"
+    with atomic_dir(out) as tmp:
+        (tmp / "report.html").write_text("<p>result</p>", encoding="utf-8")
+        (tmp / "data").mkdir()
+        (tmp / "data" / "a.uff").write_bytes(b"\x00\x01")
+    assert (out / MANIFEST_NAME).is_file()
+    owned = ["report.html", "data/a.uff"]
+    # unchanged: an earlier output may be replaced
+    assert check_output_dir(out, lambda _root: owned) == out.resolve()
+    # edited by the user: refused, naming the file, and nothing is touched
+    (out / "report.html").write_text("<p>result</p><p>my notes</p>", encoding="utf-8")
+    with pytest.raises(InputError, match=r"report\.html changed since tyredamp wrote it"):
+        check_output_dir(out, lambda _root: owned)
+    assert "my notes" in (out / "report.html").read_text(encoding="utf-8")
+    # without a readable manifest nothing proves the files are ours
+    (out / "report.html").write_text("<p>result</p>", encoding="utf-8")
+    (out / MANIFEST_NAME).write_text("{", encoding="utf-8")
+    with pytest.raises(InputError, match="changed since tyredamp wrote it"):
+        check_output_dir(out, lambda _root: owned)

@@ -275,6 +275,7 @@ def test_cli_tyre_model(tmp_path: Path, modes_files: list[Path]) -> None:
             "tyre_inplane_6bar.tir",
             "tyre_inplane_9bar.tir",
             "ring_frequencies.png",
+            ".tyredamp-manifest.json",
         ]
     )
     ring = json.loads((out / "ring.json").read_text())

@@ -30,6 +30,8 @@ The promises (stated in the README's "Safety" section and tested by
 from __future__ import annotations
 
 import contextlib
+import hashlib
+import json
 import os
 import re
 import secrets
@@ -44,6 +46,7 @@ from pathlib import Path
 from ..exceptions import InputError
 
 __all__ = [
+    "MANIFEST_NAME",
     "PROCESS_START",
     "atomic_dir",
     "atomic_path",
@@ -305,14 +308,69 @@ def check_output_dir(
         parts = Path(f).parts
         for k in range(1, len(parts) + 1):
             allowed.add(Path(*parts[:k]).as_posix())
+    allowed.add(MANIFEST_NAME)
     extra = sorted(x for x in present if x not in allowed)
     if extra:
-        shown = ", ".join(extra[:3]) + (f" and {len(extra) - 3} more" if len(extra) > 3 else "")
         raise InputError(
-            f"{option}: {text} holds files an earlier {what} did not write ({shown}); "
+            f"{option}: {text} holds files an earlier {what} did not write ({_few(extra)}); "
             "not replaced: choose another directory or move them"
         )
+    mine = [f for f in owned if f != MANIFEST_NAME and (real / f).is_file()]
+    changed = changed_since_written(real, mine)
+    if changed:
+        raise InputError(
+            f"{option}: {text}: {_few(changed)} changed since tyredamp wrote it; "
+            "not replaced: choose another directory or move the changed files"
+        )
     return real
+
+
+def _few(names: Sequence[str]) -> str:
+    return ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+
+
+#: Written last into every directory that :func:`atomic_dir` puts in place: the
+#: SHA-256 of each file, so that a later run replaces only files nobody has changed.
+MANIFEST_NAME = ".tyredamp-manifest.json"
+
+
+def _sha256(p: Path) -> str:
+    h = hashlib.sha256()
+    with open(p, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _write_manifest(root: Path) -> None:
+    """Record the SHA-256 of every file under ``root`` in ``root/MANIFEST_NAME``."""
+    files: dict[str, str] = {}
+    for dirpath, _dirnames, filenames in os.walk(root):
+        for f in filenames:
+            p = Path(dirpath) / f
+            rel = p.relative_to(root).as_posix()
+            if rel != MANIFEST_NAME:
+                files[rel] = _sha256(p)
+    doc = {"kind": "tyredamp-manifest", "version": 1, "sha256": dict(sorted(files.items()))}
+    (root / MANIFEST_NAME).write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+
+
+def changed_since_written(root: Path, files: Sequence[str]) -> list[str]:
+    """The files of ``files`` (relative to ``root``) that are not as tyredamp wrote them.
+
+    A file counts as changed when the directory's manifest (:data:`MANIFEST_NAME`)
+    gives it another SHA-256, or does not list it; without a readable manifest
+    (an output of an older tyredamp, or a damaged manifest) every file counts as
+    changed, since nothing proves it is not the user's.
+    """
+    try:
+        doc = json.loads((root / MANIFEST_NAME).read_text(encoding="utf-8"))
+        known = doc["sha256"]
+        if not isinstance(known, dict):
+            raise TypeError("sha256")
+    except (OSError, ValueError, RecursionError, TypeError, KeyError):
+        return sorted(files)
+    return sorted(f for f in files if known.get(f) != _sha256(root / f))
 
 
 def _listing(root: Path) -> set[str]:
@@ -545,6 +603,7 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     names = {str(tmp): given}
     try:
         yield tmp
+        _write_manifest(tmp)
         for dirpath, dirnames, filenames in os.walk(tmp):
             for f in filenames:
                 _fsync_file(Path(dirpath) / f)

@@ -24,7 +24,7 @@ from ..documents.jsonfile import json_text
 from ..documents.modes import modes_document
 from ..frf import FRF
 from ..io import write_frf, write_timedata
-from ..io._safety import atomic_dir
+from ..io._safety import MANIFEST_NAME, atomic_dir
 from ..io._safety import check_output_dir as _check_output_dir
 from ..studies.demo import ProgressCallback, single_threaded_blas
 from ..studies.document import build_results
@@ -156,7 +156,7 @@ def _save(
         written.append(f"damping_{p0}.json")
 
         step("results.json")
-        files = sorted([*written, "report.html", "results.json"])
+        files = sorted([*written, "report.html", "results.json", MANIFEST_NAME])
         results = build_results(result, files=files)
         (tmp / "results.json").write_text(json_text(results), encoding="utf-8")
 
