@@ -37,6 +37,7 @@ def cli(ctx: click.Context, debug: bool) -> None:
 
 def _register() -> None:
     """Attach the subcommands; each subcommand module adds its lines here."""
+    from .campaign import campaign_command
     from .check import check_group
     from .damping import damping_command
     from .demo import demo_command
@@ -45,6 +46,7 @@ def _register() -> None:
     from .modal import modal_command
     from .report import report_command
     from .simulate import simulate_group
+    from .simulate_campaign import simulate_campaign_command
 
     cli.add_command(frf_command)
     cli.add_command(check_group)
@@ -54,6 +56,8 @@ def _register() -> None:
     cli.add_command(demo_command)
     cli.add_command(simulate_group)
     cli.add_command(report_command)
+    cli.add_command(campaign_command)
+    simulate_group.add_command(simulate_campaign_command)
 
 
 _register()

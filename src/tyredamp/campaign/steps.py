@@ -1,0 +1,702 @@
+"""The one place where the campaign knows how a test is processed.
+
+A *study* (``"radial"`` or ``"lateral"``) is a chain of named *steps*; each
+step takes the test file, the documents of the steps before it and its own
+settings, and returns one JSON-ready document. The rest of
+:mod:`tyredamp.campaign` (spec, cache, runner, tracking, outputs) only sees
+step names, settings dictionaries and documents, never the processing
+itself, so pointing this module at :mod:`tyredamp.studies` changes nothing
+else.
+
+Today the steps call the same public library functions, with the same
+defaults, as the single-test commands:
+
+* radial ``modal``: :func:`tyredamp.io.read` (time data or FRFs); for time
+  data :func:`tyredamp.signal.estimate_frf` as ``tyredamp frf`` and
+  :func:`tyredamp.signal.quality_check` as ``tyredamp check quality``; then
+  :func:`tyredamp.modal.identify.identify_modes` as ``tyredamp modal``; the
+  document is :func:`tyredamp.modal.io.modes_document` (the modes JSON of
+  ``tyredamp modal``, ``docs/modes-json.md``) with a ``"campaign"`` entry
+  holding the FRF summary and the quality check;
+* radial ``damping``: :func:`tyredamp.damping.identify_damping` on the chosen
+  model as ``tyredamp damping``; the document is
+  :meth:`tyredamp.damping.DampingModel.to_dict` (``docs/damping-json.md``);
+* lateral ``fit``: :meth:`tyredamp.lateral.fit.LateralData.from_frf` and
+  :func:`tyredamp.lateral.fit.rank_models` as ``tyredamp lateral fit``, in the
+  lateral-fit JSON layout of that command.
+
+Settings
+--------
+Each study's settings are a nested dictionary ``{step: {key: value}}`` with
+the defaults of :data:`DEFAULTS` (the single-test commands' defaults); see
+``docs/campaign.md``. :func:`validate_settings` checks a campaign file's
+table against them.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import InputError
+
+__all__ = [
+    "DEFAULTS",
+    "STUDIES",
+    "StudySteps",
+    "TestResult",
+    "mode_records",
+    "process_lateral_test",
+    "process_radial_test",
+    "run_step",
+    "step_settings",
+    "validate_settings",
+]
+
+_ESTIMATORS = ("H1", "H2", "Hv")
+_FRF_METHODS = ("auto", "cyclic", "welch", "transient")
+_MODAL_MODELS = ("both", "real", "complex")
+_DAMPING_METHODS = ("first", "improved", "refined")
+_WEIGHTS = ("auto", "relative", "coherence", "uniform")
+
+#: Default settings of each study (the defaults of the single-test commands).
+DEFAULTS: dict[str, dict[str, dict[str, Any]]] = {
+    "radial": {
+        "frf": {"estimator": "H1", "method": "auto", "segment": None, "band": None},
+        "checks": {"quality": True, "coherence_min": 0.9, "max_low_fraction": 0.1},
+        "modal": {
+            "band": None,
+            "model": "both",
+            "n_modes": None,
+            "frequencies": None,
+            "max_order": None,
+            "order_step": 2,
+            "residuals": True,
+        },
+        "damping": {
+            "enabled": True,
+            "method": "improved",
+            "model": "complex",
+            "samples": 200,
+            "seed": 0,
+            "normalise": True,
+        },
+    },
+    "lateral": {
+        "fit": {
+            "models": None,
+            "force": None,
+            "wheel_mass_kg": None,
+            "band": None,
+            "weights": "auto",
+            "criterion": "bic",
+            "channel": [0, 0],
+        },
+    },
+}
+
+
+@dataclass(frozen=True)
+class StudySteps:
+    """The chain of steps of one study.
+
+    Attributes
+    ----------
+    name : str
+        ``"radial"`` or ``"lateral"``.
+    steps : tuple of str
+        Step names in order; a step's cache key includes the keys of the steps
+        before it.
+    settings_of : dict of str to tuple of str
+        For each step, the settings sections (keys of the study's settings)
+        its result depends on.
+    optional : frozenset of str
+        Steps that are skipped when their ``enabled`` setting is false.
+    conditions_of : dict of str to tuple of str
+        For each step, the test conditions its result depends on (part of its
+        cache key; the lateral fit uses the speed).
+    """
+
+    name: str
+    steps: tuple[str, ...]
+    settings_of: dict[str, tuple[str, ...]]
+    optional: frozenset[str] = field(default_factory=frozenset)
+    conditions_of: dict[str, tuple[str, ...]] = field(default_factory=dict)
+
+
+#: The studies a campaign test can belong to.
+STUDIES: dict[str, StudySteps] = {
+    "radial": StudySteps(
+        "radial",
+        ("modal", "damping"),
+        {"modal": ("frf", "checks", "modal"), "damping": ("damping",)},
+        frozenset({"damping"}),
+    ),
+    "lateral": StudySteps(
+        "lateral", ("fit",), {"fit": ("fit",)}, conditions_of={"fit": ("speed_kmh",)}
+    ),
+}
+
+
+# ------------------------------------------------------------------ settings
+def _band(value: Any, where: str) -> list[float] | None:
+    if value is None:
+        return None
+    if (
+        not isinstance(value, list | tuple)
+        or len(value) != 2
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+    ):
+        raise InputError(f"{where}: expected [f_lo, f_hi] in Hz, got {value!r}")
+    lo, hi = float(value[0]), float(value[1])
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
+        raise InputError(f"{where}: expected 0 <= f_lo < f_hi, got {value!r}")
+    return [lo, hi]
+
+
+def _choice(options: Sequence[str]) -> Callable[[Any, str], Any]:
+    def check(value: Any, where: str) -> Any:
+        if value not in options:
+            raise InputError(f"{where}: expected one of {list(options)}, got {value!r}")
+        return value
+
+    return check
+
+
+def _boolean(value: Any, where: str) -> bool:
+    if not isinstance(value, bool):
+        raise InputError(f"{where}: expected true or false, got {value!r}")
+    return value
+
+
+def _int_min(lo: int, optional: bool = True) -> Callable[[Any, str], Any]:
+    def check(value: Any, where: str) -> Any:
+        if value is None and optional:
+            return None
+        if not isinstance(value, int) or isinstance(value, bool) or value < lo:
+            raise InputError(f"{where}: expected an integer >= {lo}, got {value!r}")
+        return value
+
+    return check
+
+
+def _fraction(value: Any, where: str) -> float:
+    if not isinstance(value, int | float) or isinstance(value, bool) or not 0 <= value <= 1:
+        raise InputError(f"{where}: expected a number in [0, 1], got {value!r}")
+    return float(value)
+
+
+def _positive_list(value: Any, where: str) -> list[float] | None:
+    if value is None:
+        return None
+    ok = isinstance(value, list) and len(value) > 0
+    ok = ok and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+    if not ok or not all(math.isfinite(v) and v > 0 for v in value):
+        raise InputError(f"{where}: expected a non-empty list of frequencies > 0 Hz, got {value!r}")
+    return [float(v) for v in value]
+
+
+def _models(value: Any, where: str) -> list[str] | None:
+    if value is None:
+        return None
+    from ..lateral.models import get_model_class
+
+    if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
+        raise InputError(f"{where}: expected a non-empty list of model names, got {value!r}")
+    try:
+        return [get_model_class(v).name for v in value]
+    except (InputError, KeyError, ValueError) as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _nonneg_or_none(value: Any, where: str) -> float | None:
+    if value is None:
+        return None
+    if not isinstance(value, int | float) or isinstance(value, bool) or not value >= 0:
+        raise InputError(f"{where}: expected a number >= 0, got {value!r}")
+    return float(value)
+
+
+def _channel(value: Any, where: str) -> list[int]:
+    if (
+        not isinstance(value, list)
+        or len(value) != 2
+        or not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in value)
+    ):
+        raise InputError(f"{where}: expected [output, input] positions >= 0, got {value!r}")
+    return [int(v) for v in value]
+
+
+_CHECKS: dict[str, dict[str, dict[str, Callable[[Any, str], Any]]]] = {
+    "radial": {
+        "frf": {
+            "estimator": _choice(_ESTIMATORS),
+            "method": _choice(_FRF_METHODS),
+            "segment": _int_min(2),
+            "band": _band,
+        },
+        "checks": {
+            "quality": _boolean,
+            "coherence_min": _fraction,
+            "max_low_fraction": _fraction,
+        },
+        "modal": {
+            "band": _band,
+            "model": _choice(_MODAL_MODELS),
+            "n_modes": _int_min(1),
+            "frequencies": _positive_list,
+            "max_order": _int_min(2),
+            "order_step": _int_min(1, optional=False),
+            "residuals": _boolean,
+        },
+        "damping": {
+            "enabled": _boolean,
+            "method": _choice(_DAMPING_METHODS),
+            "model": _choice(("complex", "real")),
+            "samples": _int_min(0, optional=False),
+            "seed": _int_min(0, optional=False),
+            "normalise": _boolean,
+        },
+    },
+    "lateral": {
+        "fit": {
+            "models": _models,
+            "force": _choice(("ground", "axle", None)),  # type: ignore[arg-type]
+            "wheel_mass_kg": _nonneg_or_none,
+            "band": _band,
+            "weights": _choice(_WEIGHTS),
+            "criterion": _choice(("bic", "aic")),
+            "channel": _channel,
+        },
+    },
+}
+
+
+def validate_settings(study: str, table: Any, where: str) -> dict[str, dict[str, Any]]:
+    """Check one study's settings table and fill in the defaults.
+
+    Parameters
+    ----------
+    study : str
+        ``"radial"`` or ``"lateral"``.
+    table : dict or None
+        ``{section: {key: value}}`` from the campaign file (missing sections
+        and keys take the defaults of :data:`DEFAULTS`).
+    where : str
+        Prefix for error messages (file and key path).
+
+    Returns
+    -------
+    dict
+        The complete settings, ``{section: {key: value}}``.
+
+    Raises
+    ------
+    InputError
+        Unknown study, section or key, or a bad value (the message names it).
+    """
+    if study not in DEFAULTS:
+        raise InputError(f"{where}: unknown study {study!r}; expected one of {sorted(DEFAULTS)}")
+    table = {} if table is None else table
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: expected a table of sections, got {table!r}")
+    out: dict[str, dict[str, Any]] = {}
+    for section, defaults in DEFAULTS[study].items():
+        given = table.get(section, {})
+        if not isinstance(given, dict):
+            raise InputError(f"{where}.{section}: expected a table, got {given!r}")
+        unknown = sorted(set(given) - set(defaults))
+        if unknown:
+            raise InputError(
+                f"{where}.{section}: unknown key {unknown[0]!r}; expected one of {sorted(defaults)}"
+            )
+        sec: dict[str, Any] = {}
+        for key, default in defaults.items():
+            value = given.get(key, default)
+            sec[key] = _CHECKS[study][section][key](value, f"{where}.{section}.{key}")
+        out[section] = sec
+    unknown = sorted(set(table) - set(DEFAULTS[study]))
+    if unknown:
+        raise InputError(
+            f"{where}: unknown section {unknown[0]!r}; expected one of {sorted(DEFAULTS[study])}"
+        )
+    return out
+
+
+def step_settings(study: str, step: str, settings: Mapping[str, Any]) -> dict[str, Any]:
+    """The part of a study's ``settings`` that ``step``'s result depends on (for its key)."""
+    return {s: settings[s] for s in STUDIES[study].settings_of[step]}
+
+
+def step_conditions(study: str, step: str, conditions: Mapping[str, Any]) -> dict[str, Any]:
+    """The test conditions that ``step``'s result depends on (for its key)."""
+    return {c: conditions.get(c) for c in STUDIES[study].conditions_of.get(step, ())}
+
+
+def step_enabled(study: str, step: str, settings: Mapping[str, Any]) -> bool:
+    """False when an optional step is switched off in ``settings``."""
+    if step not in STUDIES[study].optional:
+        return True
+    return bool(settings[step].get("enabled", True))
+
+
+# ------------------------------------------------------------------ steps
+def plain(doc: Any) -> Any:
+    """``doc`` as it reads back from its strict JSON file (NaN as None, plain types).
+
+    Every step document passes through this at once, so a result computed now
+    and one read from the cache are the same objects, bit for bit.
+    """
+    from ..io.jsonfile import json_text
+
+    return json.loads(json_text(doc, indent=0))
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+def _check_dict(res: Any) -> dict[str, Any]:
+    return {
+        "name": str(res.name),
+        "passed": bool(res.passed),
+        "figure": float(res.figure),
+        "threshold": float(res.threshold),
+        "summary": str(res.summary),
+        "figures": {k: float(v) for k, v in res.figures.items()},
+        "notes": list(res.notes),
+    }
+
+
+def _radial_modal(
+    path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
+) -> dict[str, Any]:
+    from ..frf import FRF
+    from ..io import read
+    from ..modal.identify import identify_modes
+    from ..modal.io import modes_document
+    from ..signal import estimate_frf, quality_check
+
+    fs, cs, ms = settings["frf"], settings["checks"], settings["modal"]
+    obj = read(path)
+    quality = None
+    if isinstance(obj, FRF):
+        frf = obj
+        source_kind = "frf"
+    else:
+        frf = estimate_frf(
+            obj,
+            fs["estimator"],
+            method=None if fs["method"] == "auto" else fs["method"],
+            segment_samples=fs["segment"],
+            band=None if fs["band"] is None else tuple(fs["band"]),
+        )
+        source_kind = "time"
+    if cs["quality"]:
+        quality = _check_dict(
+            quality_check(
+                obj,
+                coherence_min=cs["coherence_min"],
+                max_low_coherence_fraction=cs["max_low_fraction"],
+            )
+        )
+    res = identify_modes(
+        frf,
+        band=None if ms["band"] is None else (ms["band"][0], ms["band"][1]),
+        model=ms["model"],
+        n_modes=ms["n_modes"],
+        frequencies=ms["frequencies"],
+        max_order=ms["max_order"],
+        order_step=ms["order_step"],
+        residuals=ms["residuals"],
+    )
+    doc = modes_document(res.models, source=path.name, band_hz=res.band_hz, frf_kind=res.frf_kind)
+    doc["campaign"] = {
+        "input": source_kind,
+        "n_out": frf.n_out,
+        "n_in": frf.n_in,
+        "n_lines": int(res.frequency.size),
+        "quality": quality,
+        "warnings": list(res.warnings),
+    }
+    return doc
+
+
+def _radial_damping(
+    path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
+) -> dict[str, Any]:
+    from ..damping import identify_damping
+    from ..modal.model import ModalModel
+
+    ds = settings["damping"]
+    models = upstream["modal"]["models"]
+    if ds["model"] not in models:
+        raise InputError(
+            f"settings.radial.damping.model: the modes hold models {sorted(models)}, "
+            f"not {ds['model']!r}"
+        )
+    d = models[ds["model"]]
+    model = ModalModel.from_dict(d)
+    for extra in ("rmsd", "relative_error"):  # as read_modes_json does
+        if extra in d and extra not in model.meta:
+            model.meta[extra] = d[extra]
+    dm = identify_damping(
+        model,
+        ds["method"],
+        normalise=ds["normalise"],
+        n_samples=ds["samples"],
+        seed=ds["seed"],
+        meta={"source": path.name, "model": ds["model"]},
+    )
+    return dm.to_dict()
+
+
+def _lateral_fit(
+    path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
+) -> dict[str, Any]:
+    from ..io import read_frf
+    from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
+    from ..lateral.rig import KMH
+
+    s = settings["fit"]
+    frf = read_frf(path)
+    speed_kmh = None if conditions is None else conditions.get("speed_kmh")
+    data = LateralData.from_frf(
+        frf,
+        speed=None if speed_kmh is None else float(speed_kmh) * KMH,
+        force=s["force"],
+        wheel_mass=s["wheel_mass_kg"],
+    )
+    ranking = rank_models(
+        data,
+        s["models"] or list(DEFAULT_MODELS),
+        criterion=s["criterion"],
+        band=None if s["band"] is None else (s["band"][0], s["band"][1]),
+        weights=s["weights"],
+        channel=(s["channel"][0], s["channel"][1]),
+    )
+    best = ranking.best
+    # the layout of ``tyredamp lateral fit`` (cli/lateral.py)
+    return {
+        "tyredamp": "lateral-fit",
+        "version": 1,
+        "input": {
+            "file": path.name,
+            "kind": frf.kind,
+            "n_lines": best.n_lines,
+            "band_hz": [float(best.frequency[0]), float(best.frequency[-1])],
+        },
+        "conditions": {
+            "speed_m_s": data.speed,
+            "speed_kmh": None if data.speed is None else data.speed / KMH,
+            "force": data.force,
+            "wheel_mass_kg": data.wheel_mass,
+        },
+        **ranking.to_dict(),
+    }
+
+
+_STEP_FUNCTIONS: dict[tuple[str, str], Callable[..., dict[str, Any]]] = {
+    ("radial", "modal"): _radial_modal,
+    ("radial", "damping"): _radial_damping,
+    ("lateral", "fit"): _lateral_fit,
+}
+
+
+def run_step(
+    study: str,
+    step: str,
+    path: str | Path,
+    upstream: Mapping[str, Any],
+    settings: Mapping[str, Any],
+    conditions: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """Run one step of a study on one test file; returns its JSON-ready document.
+
+    Parameters
+    ----------
+    study, step : str
+        A study of :data:`STUDIES` and one of its steps.
+    path : path
+        The test file (read only).
+    upstream : dict of str to dict
+        Documents of the earlier steps of this test, by step name.
+    settings : dict
+        The study's complete settings (:func:`validate_settings`).
+    conditions : dict, optional
+        The test's conditions (the lateral fit uses ``speed_kmh``).
+    """
+    fn = _STEP_FUNCTIONS[(study, step)]
+    return fn(Path(path), upstream, settings, conditions)
+
+
+@dataclass(frozen=True)
+class TestResult:
+    """The documents of one test, by step name (``modal``, ``damping`` or ``fit``)."""
+
+    study: str
+    documents: dict[str, dict[str, Any]]
+
+
+def _process(
+    study: str, path: str | Path, conditions: Mapping[str, Any] | None, settings: Any
+) -> TestResult:
+    full = validate_settings(study, settings, f"settings.{study}")
+    docs: dict[str, dict[str, Any]] = {}
+    for step in STUDIES[study].steps:
+        if step_enabled(study, step, full):
+            docs[step] = plain(run_step(study, step, path, docs, full, conditions))
+    return TestResult(study, docs)
+
+
+def process_radial_test(
+    path: str | Path, conditions: Mapping[str, Any] | None = None, settings: Any = None
+) -> TestResult:
+    """Process one radial modal test (time data or FRFs) without any cache.
+
+    ``settings`` is the radial settings table (``{section: {key: value}}``,
+    defaults of :data:`DEFAULTS`). Returns the ``modal`` and ``damping``
+    documents.
+    """
+    return _process("radial", path, conditions, settings)
+
+
+def process_lateral_test(
+    path: str | Path, conditions: Mapping[str, Any] | None = None, settings: Any = None
+) -> TestResult:
+    """Process one lateral FRF test without any cache; returns the ``fit`` document."""
+    return _process("lateral", path, conditions, settings)
+
+
+def run_steps_from_bytes(
+    study: str,
+    name: str,
+    data: bytes,
+    steps: Sequence[str],
+    upstream: Mapping[str, Any],
+    settings: Mapping[str, Any],
+    conditions: Mapping[str, Any] | None,
+) -> tuple[dict[str, dict[str, Any]], tuple[str, str] | None]:
+    """Run ``steps`` on a test given as its bytes (written to a private temporary file).
+
+    The file gets its original base name ``name`` so that readers which
+    dispatch on the extension, and documents that record the source name,
+    see the same thing wherever this runs (in-process or on any worker).
+
+    Returns
+    -------
+    documents : dict of str to dict
+        The documents of the steps that finished (as :func:`plain` gives them).
+    failure : (str, str) or None
+        The step that failed and its one-line reason; the later steps are not run.
+    """
+    docs: dict[str, dict[str, Any]] = dict(upstream)
+    new: dict[str, dict[str, Any]] = {}
+    with tempfile.TemporaryDirectory(prefix="tyredamp-campaign-") as tmp:
+        path = Path(tmp) / Path(name).name
+        path.write_bytes(data)
+        for step in steps:
+            try:
+                doc = plain(run_step(study, step, path, docs, settings, conditions))
+            except Exception as exc:  # any failure of one test is that test's result
+                # name the test file as the campaign knows it, not the temporary copy
+                reason = _one_line(exc).replace(str(path), name).replace(tmp, "")
+                return new, (step, reason)
+            docs[step] = doc
+            new[step] = doc
+    return new, None
+
+
+# ------------------------------------------------------------------ results as rows
+def _complex_vec(rows: Any) -> NDArray:
+    a = np.asarray(rows, dtype=float).reshape(-1, 2)
+    return a[:, 0] + 1j * a[:, 1]
+
+
+def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex") -> list[dict]:
+    """One record per identified mode of a test (for the tidy table and the tracking).
+
+    Each record: ``mode`` (1-based), ``model``, ``frequency_hz``,
+    ``frequency_std_hz``, ``damping_ratio``, ``damping_ratio_std``, ``mpc``,
+    ``modal_damping`` and ``modal_damping_std`` (the diagonal ``C'_nn`` in 1/s
+    and its standard error, from the damping step when there is one),
+    ``points`` (output labels) and ``shape`` (complex, one per point). A
+    lateral test has no modes (empty list).
+    """
+    if study != "radial" or "modal" not in documents:
+        return []
+    models = documents["modal"]["models"]
+    name = model if model in models else sorted(models)[0]
+    m = models[name]
+    points = [
+        str(o.get("name") or f"{o.get('node')}{o.get('direction', '')}") for o in m["outputs"]
+    ]
+    damp = documents.get("damping")
+    cdiag: list[float] | None = None
+    cstd: list[float] | None = None
+    if damp is not None and damp.get("meta", {}).get("model") == name:
+        cp = np.asarray(damp["modal"], dtype=float)
+        if cp.shape == (len(m["modes"]), len(m["modes"])):
+            cdiag = np.diag(cp).tolist()
+            std = damp.get("std", {}).get("modal")
+            if std is not None:
+                cstd = np.diag(np.asarray(std, dtype=float)).tolist()
+    mpc = m.get("meta", {}).get("mpc") or [None] * len(m["modes"])
+    out = []
+    for i, md in enumerate(m["modes"]):
+        std = md.get("std", {})
+        out.append(
+            {
+                "mode": i + 1,
+                "model": name,
+                "frequency_hz": md["frequency_hz"],
+                "frequency_std_hz": std.get("frequency_hz"),
+                "damping_ratio": md["damping_ratio"],
+                "damping_ratio_std": std.get("damping_ratio"),
+                "mpc": mpc[i],
+                "modal_damping": None if cdiag is None else cdiag[i],
+                "modal_damping_std": None if cstd is None else cstd[i],
+                "points": points,
+                "shape": _complex_vec(md["shape"]),
+            }
+        )
+    return out
+
+
+def lateral_records(documents: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """One record per fitted lateral model of a test: rank, name, BIC/AIC, parameters."""
+    doc = documents.get("fit")
+    if doc is None:
+        return []
+    ranks = {row["model"]: row for row in doc["table"]}
+    out = []
+    for f in doc["fits"]:
+        row = ranks.get(f["model"], {})
+        out.append(
+            {
+                "model": f["model"],
+                "rank": row.get("rank"),
+                "aic": f.get("aic"),
+                "bic": f.get("bic"),
+                "amplitude_error": f.get("amplitude_error"),
+                "params": dict(f.get("params", {})),
+                "stderr": dict(f.get("stderr", {})),
+                "units": dict(f.get("units", {})),
+            }
+        )
+    return out
+
+
+def failure_reason(exc: BaseException) -> str:
+    """The one-line reason of a failed step."""
+    return _one_line(exc)
+
+
+NDArray = np.ndarray

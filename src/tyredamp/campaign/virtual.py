@@ -1,0 +1,305 @@
+"""A virtual test campaign: several truck tyres x pressures x loads, plus the lateral rig.
+
+Each virtual tyre is the ring tyre of :mod:`tyredamp.tyre` with
+*manufacturing scatter*: its bending stiffness, band mass, radial sidewall
+stiffness and radial damping are drawn around the defaults (relative standard
+deviations 3, 1, 5 and 5 %, seeded per tyre).
+
+Load
+----
+The ring tyre has no contact model, so a load ``F`` (N) on a flat surface is
+modelled as a small documented change: a *contact-patch foundation* of
+radial stiffness ``k_c`` per unit length (N/m^2, default 1e6, two thirds of
+the sidewall ``k_r``) over the arc of the contact patch at 180 deg (the
+bottom; the shaker is at point 1, 0 deg). The patch length is
+``2 a = F / (p b)`` (contact pressure equal to the inflation pressure ``p``
+over the belt width ``b``); each ring node gets ``k_c`` times the length of
+its cell inside the patch (:func:`contact_patch`), so the stiffness changes
+smoothly with load and pressure. Rolling, tread deflection and the change of
+the hoop tension by the load are not modelled.
+
+The truth of every test (exact modes at the 16 points) is written beside it,
+and also the truth at *held-out* pressures (the midpoints between tested
+pressures, no test there) so that a campaign's pressure trends can be
+checked where no test was made.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..exceptions import InputError
+from ..io import write_frf
+from ..io.jsonfile import write_json
+from ..tyre import Imperfection, RingTyre, RingTyreParameters
+
+__all__ = ["VirtualCampaign", "contact_patch", "tyre_truth", "write_virtual_campaign"]
+
+BAR = 1.0e5
+#: Default contact-patch foundation stiffness per unit length, N/m^2.
+CONTACT_STIFFNESS = 1.0e6
+
+
+@dataclass(frozen=True)
+class VirtualCampaign:
+    """The sizes of a virtual campaign.
+
+    Attributes
+    ----------
+    n_tyres : int
+        Tyres (each with its own manufacturing scatter).
+    pressures_bar : tuple of float
+        Tested inflation pressures, bar (increasing).
+    loads_n : tuple of float
+        Tested loads, N.
+    lateral_speeds_kmh : tuple of float
+        Speeds of the lateral rolling-rig tests (at ``lateral_pressure_bar``).
+    periods : int
+        Chirp periods (averages) per radial test.
+    seed : int
+        Seed of the scatter and of every noise generator.
+    """
+
+    n_tyres: int = 3
+    pressures_bar: tuple[float, ...] = (6.0, 6.75, 7.5, 8.25, 9.0)
+    loads_n: tuple[float, ...] = (10000.0, 20000.0, 30000.0)
+    lateral_speeds_kmh: tuple[float, ...] = (5.0, 10.0, 15.0)
+    lateral_pressure_bar: float = 1.7
+    periods: int = 8
+    seed: int = 0
+
+    @classmethod
+    def quick(cls, seed: int = 0) -> VirtualCampaign:
+        """A small campaign for tests: 2 tyres x 3 pressures x 1 load, 2 lateral speeds."""
+        return cls(2, (6.0, 7.5, 9.0), (20000.0,), (5.0, 10.0), 1.7, 4, seed)
+
+    @property
+    def held_out_bar(self) -> tuple[float, ...]:
+        """Midpoints between the tested pressures (truth only)."""
+        p = self.pressures_bar
+        return tuple(0.5 * (a + b) for a, b in itertools.pairwise(p))
+
+
+def tyre_parameters(index: int, seed: int = 0) -> RingTyreParameters:
+    """The parameters of virtual tyre ``index`` with its manufacturing scatter."""
+    rng = np.random.default_rng([seed, 9173, index])
+    z = rng.standard_normal(4)
+    base = RingTyreParameters()
+    return replace(
+        base,
+        bending_stiffness=base.bending_stiffness * (1 + 0.03 * z[0]),
+        mass_per_length=base.mass_per_length * (1 + 0.01 * z[1]),
+        radial_stiffness_base=base.radial_stiffness_base * (1 + 0.05 * z[2]),
+        radial_damping=base.radial_damping * (1 + 0.05 * z[3]),
+    )
+
+
+def contact_patch(
+    params: RingTyreParameters,
+    load_n: float,
+    n_ring: int = 64,
+    stiffness: float = CONTACT_STIFFNESS,
+) -> tuple[Imperfection, ...]:
+    """Radial springs of the contact patch of a load ``load_n`` (N) at 180 deg.
+
+    The patch half-angle is ``a / R`` with ``2 a = F / (p b)``; node ``i`` (at
+    ``360 i / n_ring`` deg, cell of width ``2 pi R / n_ring``) gets the spring
+    ``stiffness * (length of its cell inside the patch)`` in N/m.
+
+    Raises
+    ------
+    InputError
+        A negative or non-finite load, or a load on an uninflated tyre.
+    """
+    if not (math.isfinite(load_n) and load_n >= 0):
+        raise InputError(f"load_n: expected a load >= 0 N, got {load_n}")
+    if load_n == 0:
+        return ()
+    if params.pressure <= 0:
+        raise InputError("load_n: a loaded tyre needs an inflation pressure > 0")
+    r = params.radius
+    half = load_n / (2 * params.pressure * params.width) / r  # patch half-angle, rad
+    h = 2 * np.pi / n_ring
+    out = []
+    for i in range(n_ring):
+        theta = i * h
+        lo = max(theta - h / 2, np.pi - half)
+        hi = min(theta + h / 2, np.pi + half)
+        if hi > lo:
+            out.append(Imperfection(math.degrees(theta), stiffness=stiffness * r * (hi - lo)))
+    return tuple(out)
+
+
+def _tyre(params: RingTyreParameters, pressure_bar: float, load_n: float) -> RingTyre:
+    p = params.with_pressure(pressure_bar * BAR)
+    return RingTyre(p, imperfections=contact_patch(p, load_n))
+
+
+def tyre_truth(params: RingTyreParameters, pressure_bar: float, load_n: float) -> list[dict]:
+    """The exact visible modes of a virtual tyre at one condition (0-200 Hz).
+
+    One dict per mode: ``wave_number``, ``frequency_hz``, ``damping_ratio``
+    and ``shape`` (complex mode at the 16 points as ``[re, im]`` pairs).
+    """
+    truth = _tyre(params, pressure_bar, load_n).truth()
+    out = []
+    for i in truth.select("visible"):
+        psi = truth.psi_points[:, i]
+        out.append(
+            {
+                "wave_number": int(truth.wave_number[i]),
+                "frequency_hz": float(truth.frequency_hz[i]),
+                "damping_ratio": float(truth.damping_ratio[i]),
+                "shape": [[float(z.real), float(z.imag)] for z in psi],
+            }
+        )
+    return out
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return repr(float(v))
+
+
+def write_virtual_campaign(
+    out: str | Path,
+    spec: VirtualCampaign | None = None,
+    progress: Any = None,
+) -> dict[str, Any]:
+    """Write the virtual campaign into the folder ``out``.
+
+    Writes ``data/T{k}_{p}bar_{F}N.uff`` (radial H1 FRFs, UFF 58b, of the
+    virtual modal test: 16 points, drive at point 1, periodic chirp 0-200 Hz,
+    40 dB SNR), ``data/lateral_{v}kmh.npz`` (lateral rig, ground force),
+    ``truth.json`` and ``campaign.toml``. Returns the truth document.
+
+    Parameters
+    ----------
+    out : path
+        Folder to write into (created; files of the same names are replaced).
+    spec : VirtualCampaign, optional
+        Sizes (default the full campaign: 3 tyres x 5 pressures x 3 loads).
+    progress : callable, optional
+        ``progress(done, total)`` after each test written.
+    """
+    from ..demo import single_threaded_blas
+    from ..lateral.rig import VirtualLateralRig
+    from ..signal import estimate_frf
+    from ..tyre import run_modal_test
+
+    s = spec if spec is not None else VirtualCampaign()
+    root = Path(out)
+    data = root / "data"
+    data.mkdir(parents=True, exist_ok=True)
+    total = s.n_tyres * len(s.pressures_bar) * len(s.loads_n) + len(s.lateral_speeds_kmh)
+    done = 0
+    tests: list[dict[str, Any]] = []
+    held: list[dict[str, Any]] = []
+    tyres: dict[str, Any] = {}
+    with single_threaded_blas():
+        for t in range(s.n_tyres):
+            tid = f"T{t + 1}"
+            params = tyre_parameters(t, s.seed)
+            tyres[tid] = {
+                k: getattr(params, k)
+                for k in (
+                    "bending_stiffness",
+                    "mass_per_length",
+                    "radial_stiffness_base",
+                    "radial_damping",
+                )
+            }
+            for load in s.loads_n:
+                for p in s.pressures_bar:
+                    name = f"{tid}_{p:g}bar_{load:g}N.uff"
+                    seed = len(tests) + 1 + 1000 * s.seed
+                    test = run_modal_test(_tyre(params, p, load), n_periods=s.periods, seed=seed)
+                    write_frf(estimate_frf(test.data, "H1"), data / name)
+                    tests.append(
+                        {
+                            "file": f"data/{name}",
+                            "study": "radial",
+                            "tyre": tid,
+                            "pressure_bar": p,
+                            "load_n": load,
+                            "modes": tyre_truth(params, p, load),
+                        }
+                    )
+                    done += 1
+                    if progress is not None:
+                        progress(done, total)
+                for p in s.held_out_bar:
+                    held.append(
+                        {
+                            "tyre": tid,
+                            "pressure_bar": p,
+                            "load_n": load,
+                            "modes": tyre_truth(params, p, load),
+                        }
+                    )
+        rig = VirtualLateralRig()
+        for v in s.lateral_speeds_kmh:
+            name = f"lateral_{v:g}kmh.npz"
+            meas = rig.measure(v, s.lateral_pressure_bar, "ground", s.seed)
+            write_frf(meas.frf, data / name)
+            tests.append(
+                {
+                    "file": f"data/{name}",
+                    "study": "lateral",
+                    "tyre": "rig",
+                    "pressure_bar": s.lateral_pressure_bar,
+                    "speed_kmh": v,
+                    "truth": meas.frf.meta.get("truth"),
+                }
+            )
+            done += 1
+            if progress is not None:
+                progress(done, total)
+    doc = {
+        "kind": "tyredamp-virtual-campaign-truth",
+        "version": 1,
+        "contact_stiffness_n_m2": CONTACT_STIFFNESS,
+        "spec": {
+            "n_tyres": s.n_tyres,
+            "pressures_bar": list(s.pressures_bar),
+            "loads_n": list(s.loads_n),
+            "lateral_speeds_kmh": list(s.lateral_speeds_kmh),
+            "periods": s.periods,
+            "seed": s.seed,
+        },
+        "tyres": tyres,
+        "tests": tests,
+        "held_out": held,
+    }
+    write_json(doc, root / "truth.json")
+    lines = [
+        "# tyredamp campaign file of the virtual campaign (tyredamp simulate campaign)",
+        f'name = "virtual truck tyres: {s.n_tyres} tyres x {len(s.pressures_bar)} pressures'
+        f' x {len(s.loads_n)} loads"',
+        "",
+        "[settings.radial.modal]",
+        "band = [30.0, 180.0]",
+        "",
+        "[settings.radial.damping]",
+        "samples = 50",
+        "",
+    ]
+    for entry in tests:
+        lines.append("[[tests]]")
+        lines.append(f"files = {_toml_value(entry['file'])}")
+        for k in ("study", "tyre", "pressure_bar", "load_n", "speed_kmh"):
+            if k in entry:
+                lines.append(f"{k} = {_toml_value(entry[k])}")
+        lines.append("")
+    from ..io._atomic import atomic_path
+
+    with atomic_path(root / "campaign.toml") as tmp:
+        tmp.write_text("\n".join(lines), encoding="utf-8")
+    return doc

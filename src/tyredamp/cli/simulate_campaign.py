@@ -1,0 +1,80 @@
+"""``tyredamp simulate campaign``: a virtual test campaign with its truth and campaign file."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import click
+
+from ..exceptions import InputError
+from ._common import seed_option
+
+__all__ = ["simulate_campaign_command"]
+
+
+def _check_out(out: Path) -> None:
+    if not out.exists():
+        return
+    if not out.is_dir():
+        raise InputError(f"--out: {out} exists and is not a folder")
+    if not any(out.iterdir()):
+        return
+    try:
+        kind = json.loads((out / "truth.json").read_text(encoding="utf-8")).get("kind")
+    except (OSError, ValueError, AttributeError):
+        kind = None
+    if kind != "tyredamp-virtual-campaign-truth":
+        raise InputError(
+            f"--out: {out} is not empty and holds no earlier virtual campaign; choose another folder"
+        )
+
+
+@click.command("campaign")
+@click.option(
+    "--out",
+    "-o",
+    "out",
+    required=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Folder to write (data/, truth.json, campaign.toml).",
+)
+@click.option(
+    "--quick",
+    is_flag=True,
+    help="Small campaign for tests: 2 tyres x 3 pressures x 1 load, 2 lateral speeds.",
+)
+@seed_option("Seed of the manufacturing scatter and of the noise.")
+def simulate_campaign_command(out: Path, quick: bool, seed: int) -> None:
+    """Write a virtual test campaign of the truck tyre, its truth and a campaign file.
+
+    3 tyres with manufacturing scatter x 5 pressures (6-9 bar) x 3 loads
+    (10-30 kN, a contact-patch foundation; see tyredamp.campaign.virtual):
+    radial modal tests as UFF FRF files (16 points, drive point 1, 40 dB);
+    the lateral rolling rig at 5, 10 and 15 km/h; truth.json with the exact
+    modes of every test and at held-out pressures; campaign.toml for
+    'tyredamp campaign'.
+
+    \b
+    Example:
+      tyredamp simulate campaign --out virtual
+      tyredamp campaign virtual/campaign.toml --out results
+    """
+    from ..campaign.virtual import VirtualCampaign, write_virtual_campaign
+
+    _check_out(out)
+    spec = VirtualCampaign.quick(seed) if quick else VirtualCampaign(seed=seed)
+
+    def progress(done: int, total: int) -> None:
+        if sys.stderr.isatty():
+            click.echo(f"\rtest {done}/{total}", nl=done == total, err=True)
+
+    doc = write_virtual_campaign(out, spec, progress)
+    n_r = sum(t["study"] == "radial" for t in doc["tests"])
+    n_l = len(doc["tests"]) - n_r
+    click.echo(
+        f"virtual campaign: {spec.n_tyres} tyres x {len(spec.pressures_bar)} pressures x "
+        f"{len(spec.loads_n)} loads = {n_r} radial tests, {n_l} lateral tests"
+    )
+    click.echo(f"wrote {out}/ (data/, truth.json, campaign.toml)")

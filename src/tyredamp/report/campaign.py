@@ -1,0 +1,158 @@
+"""The campaign report: one self-contained HTML page (figures embedded, works offline).
+
+Sections: the campaign in numbers, failed tests with their one-line reasons,
+mode families, trend plots per family (frequency, damping ratio and modal
+damping against pressure, load, speed and temperature, one series per tyre
+and fixed conditions, with the fitted trend and its 95 % band), the lateral
+ranking per test, and every test with links to its documents.
+"""
+
+from __future__ import annotations
+
+import html
+from collections import defaultdict
+from pathlib import Path
+from typing import Any
+
+from ..io._atomic import atomic_path
+from .html import HtmlReport
+
+__all__ = ["campaign_report", "write_campaign_report"]
+
+_QLABELS: dict[str, tuple[str, float]] = {
+    "frequency_hz": ("natural frequency [Hz]", 1.0),
+    "damping_ratio": ("damping ratio [%]", 100.0),
+    "modal_damping": ("modal damping C'_nn [1/s]", 1.0),
+}
+_LABELS: dict[str, str] = {
+    "pressure_bar": "pressure [bar]",
+    "load_n": "load [N]",
+    "speed_kmh": "speed [km/h]",
+    "temperature_c": "temperature [degC]",
+}
+
+
+def _trend_figures(rep: HtmlReport, fits: list[Any]) -> None:
+    from matplotlib.figure import Figure
+
+    from ..plot.campaign import plot_trend
+
+    groups: dict[tuple[str, str, str], list[Any]] = defaultdict(list)
+    for about, fit, pts in fits:
+        groups[(about["family"], about["slot"], about["condition"])].append((about, fit, pts))
+    order = sorted(groups, key=lambda k: (int(k[0][1:]), k[1], k[2]))
+    for fam, slot, cond in order:
+        items = groups[(fam, slot, cond)]
+        fig = Figure(figsize=(11, 3.2), layout="constrained")
+        axes = fig.subplots(1, 3)
+        for ax, q in zip(axes, ("frequency_hz", "damping_ratio", "modal_damping"), strict=True):
+            ylabel, scale = _QLABELS[q]
+            series = [it for it in items if it[0]["quantity"] == q]
+            for k, (about, fit, pts) in enumerate(series):
+                plot_trend(
+                    pts, fit, cond, q, ax=ax, label=about["series"], color=f"C{k % 10}", scale=scale
+                )
+            ax.set_xlabel(_LABELS.get(cond, cond))
+            ax.set_ylabel(ylabel)
+            if not series:
+                ax.set_axis_off()
+        if len(items) <= 24:
+            axes[0].legend(fontsize=6)
+        name = fam + (slot and f" ({slot})")
+        rep.figure(
+            fig,
+            f"family {name}: against {_LABELS.get(cond, cond)}; line: fitted trend "
+            "(degree by AICc), band: 95 %",
+            dpi=80,
+        )
+
+
+def campaign_report(results: Any) -> str:
+    """The HTML text of the campaign report of ``results`` (``CampaignResults``)."""
+    s = results.summary
+    rep = HtmlReport(f"tyredamp campaign: {s['name']}")
+    rep.heading("The campaign")
+    rep.table(
+        ["", "value"],
+        [
+            ["tests", s["n_tests"]],
+            ["succeeded", s["n_ok"]],
+            ["failed", s["n_failed"]],
+            ["steps computed in this run", s["steps_computed"]],
+            ["steps read from the cache", s["steps_reused"]],
+            ["mode families", len(s["families"])],
+            ["tyredamp", s["tyredamp_version"]],
+        ],
+    )
+    rep.heading("Failed tests")
+    failed = [t for t in s["tests"] if t["status"] != "ok"]
+    if failed:
+        rep.table(
+            ["test", "file", "step", "reason"],
+            [[t["test_id"], t["file"], t["failed_step"] or "", t["reason"] or ""] for t in failed],
+        )
+    else:
+        rep.paragraph("None: every test was processed.", "ok")
+    rep.heading("Mode families")
+    rep.paragraph(
+        "Modes matched across tests by the MAC of their shapes at the common points and "
+        "their frequency (an assignment per test against the nearest observed state of each "
+        "family); doubled modes (overlapping half-power bands) are matched as pairs by the "
+        "subspace MAC and reported as slots a (lower) and b (upper)."
+    )
+    rep.table(
+        ["family", "median f [Hz]", "modes", "tests", "pair"],
+        [
+            [
+                f["family"],
+                f["median_frequency_hz"],
+                f["n_modes"],
+                f["n_tests"],
+                "yes" if f["pair"] else "",
+            ]
+            for f in s["families"]
+        ],
+    )
+    if results.fits:
+        rep.heading("Trends")
+        _trend_figures(rep, results.fits)
+    if results.lateral:
+        rep.heading("Lateral tests")
+        best: dict[str, dict[str, Any]] = {}
+        for r in results.lateral:
+            if r["rank"] == 1:
+                best.setdefault(r["test_id"], r)
+        rep.table(
+            ["test", "speed [km/h]", "pressure [bar]", "best model", "BIC"],
+            [[t, r["speed_kmh"], r["pressure_bar"], r["model"], r["bic"]] for t, r in best.items()],
+        )
+    rep.heading("Tests")
+    rows = []
+    for t in s["tests"]:
+        links = " ".join(
+            f'<a href="{html.escape(p)}">{html.escape(Path(p).name)}</a>'
+            for p in t["documents"].values()
+        )
+        c = t["conditions"]
+        cond = ", ".join(f"{k} {v}" for k, v in c.items() if v is not None)
+        rows.append(
+            f'<tr><td class="l">{html.escape(t["test_id"])}</td>'
+            f'<td class="l">{html.escape(cond)}</td><td class="l">{html.escape(t["status"])}'
+            f'</td><td class="l">{links}</td></tr>'
+        )
+    rep.raw(
+        '<table><thead><tr><th class="l">test</th><th class="l">conditions</th>'
+        '<th class="l">status</th><th class="l">documents</th></tr></thead><tbody>'
+        + "".join(rows)
+        + "</tbody></table>"
+    )
+    return rep.render()
+
+
+def write_campaign_report(results: Any, out_dir: str | Path) -> Path:
+    """Write ``out_dir/report.html`` atomically; returns its path."""
+    path = Path(out_dir) / "report.html"
+    text = campaign_report(results)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path
