@@ -23,10 +23,12 @@ physical mode seen at different pressures, loads, speeds, tyres):
 3. The match is an assignment problem (:func:`scipy.optimize.linear_sum_assignment`,
    one-to-one) with cost ``(1 - MAC) + (Delta f / gap)^2``, where ``gap`` is
    the distance from the family's representative to the nearest other mode
-   of its test. A match is admissible only when ``MAC >= 0.5`` (the shapes
-   share more than they do not) and ``Delta f < gap`` (the new mode is closer
-   to this family than the neighbouring mode was); modes left over start new
-   families. Shapes are compared at the points common to both tests.
+   of its test with a *similar shape* (MAC >= 0.5 with it; modes of other
+   shapes may cross freely). A match is admissible only when ``MAC >= 0.5``
+   (the shapes share more than they do not) and ``Delta f < gap`` (the new
+   mode is closer to this family than its look-alike neighbour was, which
+   also keeps spatially aliased wave numbers apart); modes left over start
+   new families. Shapes are compared at the points common to both tests.
 
 Trends
 ------
@@ -287,8 +289,13 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
         macs = np.zeros((len(reps), len(cur)))
         for a, rep in enumerate(reps):
             rs = sets[rep.test]
-            others = [u.frequency for u in units[rep.test] if u is not rep]
-            gap = min((abs(rep.frequency - f) for f in others), default=math.inf)
+            own = rs.shapes[:, list(rep.modes)]
+            alike = [
+                u.frequency
+                for u in units[rep.test]
+                if u is not rep and subspace_mac(own, rs.shapes[:, list(u.modes)]) >= MAC_MIN
+            ]
+            gap = min((abs(rep.frequency - f) for f in alike), default=math.inf)
             common = [p for p in rs.points if p in s.points]
             if len(common) < 2:
                 continue

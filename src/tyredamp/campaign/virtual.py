@@ -33,13 +33,20 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import InputError
 from ..io import write_frf
 from ..io.jsonfile import write_json
 from ..tyre import Imperfection, RingTyre, RingTyreParameters
 
-__all__ = ["VirtualCampaign", "contact_patch", "tyre_truth", "write_virtual_campaign"]
+__all__ = [
+    "VirtualCampaign",
+    "compare_with_truth",
+    "contact_patch",
+    "tyre_truth",
+    "write_virtual_campaign",
+]
 
 BAR = 1.0e5
 #: Default contact-patch foundation stiffness per unit length, N/m^2.
@@ -303,3 +310,115 @@ def write_virtual_campaign(
     with atomic_path(root / "campaign.toml") as tmp:
         tmp.write_text("\n".join(lines), encoding="utf-8")
     return doc
+
+
+def _true_match(
+    freqs: NDArray[np.float64], shapes: NDArray[np.complex128], truth: list[dict[str, Any]]
+) -> list[int | None]:
+    """Wave number of the true mode matched to each identified mode (assignment on MAC, f)."""
+    from scipy.optimize import linear_sum_assignment
+
+    from .tracking import MAC_MIN, subspace_mac
+
+    if not truth or freqs.size == 0:
+        return [None] * int(freqs.size)
+    cost = np.full((freqs.size, len(truth)), 1e6)
+    for i in range(freqs.size):
+        for j, t in enumerate(truth):
+            psi = np.array([complex(a, b) for a, b in t["shape"]])
+            mac = subspace_mac(shapes[:, i], psi)
+            rel = abs(freqs[i] - t["frequency_hz"]) / t["frequency_hz"]
+            if mac >= MAC_MIN and rel < 0.05:
+                cost[i, j] = (1 - mac) + rel
+    out: list[int | None] = [None] * int(freqs.size)
+    for i, j in zip(*linear_sum_assignment(cost), strict=True):
+        if cost[i, j] < 1e6:
+            out[int(i)] = int(truth[int(j)]["wave_number"])
+    return out
+
+
+def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[str, Any]:
+    """Check a campaign's results on the virtual campaign against its truth.
+
+    Parameters
+    ----------
+    results : CampaignResults
+        From :func:`tyredamp.campaign.outputs.write_outputs`.
+    truth : dict
+        The ``truth.json`` document of :func:`write_virtual_campaign`.
+    runs : sequence of TestRun
+        The runs (their mode shapes are matched to the true shapes).
+
+    Returns
+    -------
+    dict
+        ``families``: family -> {tyre: set of true wave numbers} (one number
+        each when there is no swap); ``unmatched``: identified modes with no
+        true mode; ``swaps``: families holding two wave numbers for one tyre;
+        ``held_out``: one row per (family, tyre, load, held-out pressure) with
+        the trend, the truth and the relative error; ``max_held_out_error``.
+    """
+    from . import steps
+
+    by_file = {t["file"]: t for t in truth["tests"] if t["study"] == "radial"}
+    wave: dict[tuple[str, int], int | None] = {}
+    for r in runs:
+        t = by_file.get(r.spec.rel)
+        recs = steps.mode_records(r.spec.study, r.documents)
+        if t is None or not recs:
+            continue
+        freqs = np.array([m["frequency_hz"] for m in recs], dtype=float)
+        shapes = np.column_stack([m["shape"] for m in recs])
+        for k, n in enumerate(_true_match(freqs, shapes, t["modes"])):
+            wave[(r.spec.test_id, k + 1)] = n
+    families: dict[str, dict[str, set[int | None]]] = {}
+    unmatched = []
+    for row in results.modes:
+        n = wave.get((row["test_id"], row["mode"]))
+        if n is None:
+            unmatched.append((row["test_id"], row["mode"], row["frequency_hz"]))
+        families.setdefault(row["family"], {}).setdefault(row["tyre"], set()).add(n)
+    swaps = [
+        (fam, tyre, sorted(v, key=str))
+        for fam, d in families.items()
+        for tyre, v in d.items()
+        if len(v - {None}) > 1
+    ]
+    fam_wave = {
+        fam: next(iter(set().union(*d.values()) - {None}), None) for fam, d in families.items()
+    }
+    held = []
+    for about, fit, _ in results.fits:
+        if about["quantity"] != "frequency_hz" or about["condition"] != "pressure_bar":
+            continue
+        n = fam_wave.get(about["family"])
+        load = about["fixed"].get("load_n")
+        for h in truth["held_out"]:
+            if h["tyre"] != about["tyre"] or h["load_n"] != load:
+                continue
+            if not fit.x0 - fit.xs <= h["pressure_bar"] <= fit.x0 + fit.xs:
+                continue  # only inside the tested range of this series
+            true = [m["frequency_hz"] for m in h["modes"] if m["wave_number"] == n]
+            if len(true) != 1:
+                continue
+            f, sf = fit.predict([h["pressure_bar"]])
+            held.append(
+                {
+                    "family": about["family"],
+                    "wave_number": n,
+                    "tyre": about["tyre"],
+                    "load_n": load,
+                    "pressure_bar": h["pressure_bar"],
+                    "trend_hz": float(f[0]),
+                    "trend_std_hz": float(sf[0]),
+                    "true_hz": true[0],
+                    "relative_error": float(f[0] / true[0] - 1),
+                }
+            )
+    return {
+        "families": families,
+        "unmatched": unmatched,
+        "swaps": swaps,
+        "held_out": held,
+        "max_held_out_error": max((abs(h["relative_error"]) for h in held), default=float("nan")),
+    }
