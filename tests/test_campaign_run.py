@@ -31,6 +31,7 @@ from tyredamp.campaign.outputs import write_outputs
 from tyredamp.campaign.runner import run_tests
 from tyredamp.campaign.virtual import compare_with_truth
 from tyredamp.cli import cli
+from tyredamp.report.campaign import write_campaign_report
 
 pytestmark = pytest.mark.slow
 
@@ -54,6 +55,7 @@ def serial(virtual: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str,
     campaign = load_campaign(virtual / "campaign.toml")
     runs = run_tests(campaign, out, mode="serial")
     results = write_outputs(campaign, runs, out)
+    write_campaign_report(results, out)
     return {"out": out, "campaign": campaign, "runs": runs, "results": results}
 
 
@@ -62,7 +64,7 @@ def cluster() -> Iterator[Any]:
     from distributed import LocalCluster
 
     with LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
     ) as c:
         yield c
 

@@ -249,7 +249,7 @@ def dask_client(
         n_workers=n,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        dashboard_address=":0",  # the HTTP server always starts; any free port
         silence_logs=logging.ERROR,
     )
     return Client(cluster), cluster
