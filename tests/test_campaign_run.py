@@ -286,3 +286,32 @@ def test_without_the_campaign_extra_the_command_says_what_to_install(
         main(["campaign", str(virtual / "campaign.toml"), "--out", str(tmp_path / "o")])
     assert exc.value.code == 2
     assert not (tmp_path / "o").exists()
+
+
+def test_the_adapter_gives_the_documents_of_the_single_test_commands(
+    virtual: Path, tmp_path: Path
+) -> None:
+    from tyredamp.campaign.steps import process_lateral_test, process_radial_test
+
+    f = virtual / "data" / "T1_6bar_20000N.uff"
+    invoke("modal", str(f), "--out", str(tmp_path / "m.json"), "--band", "30", "180")
+    invoke(
+        "damping", str(tmp_path / "m.json"), "--out", str(tmp_path / "d.json"), "--samples", "50"
+    )
+    res = process_radial_test(
+        f, settings={"modal": {"band": [30.0, 180.0]}, "damping": {"samples": 50}}
+    )
+    modes = dict(res.documents["modal"])
+    assert modes.pop("campaign")["input"] == "frf"
+    assert modes == json.loads((tmp_path / "m.json").read_text("utf-8"))
+    damping = dict(res.documents["damping"])
+    cli_damping = json.loads((tmp_path / "d.json").read_text("utf-8"))
+    assert damping.pop("meta")["model"] == cli_damping.pop("meta")["model"] == "complex"
+    assert damping == cli_damping
+    lat = virtual / "data" / "lateral_5kmh.npz"
+    invoke("lateral", "fit", str(lat), "--out", str(tmp_path / "l.json"), "--speed", "5")
+    doc = dict(process_lateral_test(lat, {"speed_kmh": 5.0}).documents["fit"])
+    cli_doc = json.loads((tmp_path / "l.json").read_text("utf-8"))
+    assert doc.pop("input")["file"] == "lateral_5kmh.npz"
+    cli_doc.pop("input")
+    assert doc == cli_doc

@@ -1,0 +1,95 @@
+"""Wall time of one campaign serially and on 1, 2, ... local Dask workers; parallel efficiency.
+
+Run: ``python benchmarks/campaign_scaling.py [--data DIR] [--workers 1 2] [--samples 200]``.
+
+Without ``--data`` a virtual campaign of 2 tyres x 5 pressures at one load
+plus one lateral test (11 tests) is written to a temporary folder first (not
+timed); ``--data`` reuses the folder of ``tyredamp simulate campaign``. Every
+configuration starts from an empty output folder (no cache). The cluster's
+start-up is timed apart from the run. Printed per configuration: start-up,
+run wall time, speed-up and parallel efficiency ``T_serial / (N T_N)``, and
+whether the tidy mode table is identical to the serial one byte for byte.
+BLAS is limited to one thread in every task (as the campaign always does).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import re
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from tyredamp.campaign import load_campaign
+from tyredamp.campaign.outputs import write_outputs
+from tyredamp.campaign.runner import run_tests
+from tyredamp.campaign.virtual import VirtualCampaign, write_virtual_campaign
+
+
+def _campaign_file(data: Path, samples: int) -> Path:
+    text = (data / "campaign.toml").read_text(encoding="utf-8")
+    text = re.sub(r"samples = \d+", f"samples = {samples}", text)
+    path = data / f"bench_{samples}.toml"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--data", type=Path, help="folder of an existing virtual campaign")
+    ap.add_argument("--workers", type=int, nargs="+", default=[1, 2], help="worker counts")
+    ap.add_argument("--samples", type=int, default=200, help="Monte Carlo samples of damping")
+    args = ap.parse_args()
+    from distributed import Client, LocalCluster
+
+    with tempfile.TemporaryDirectory() as tmp_name:
+        tmp = Path(tmp_name)
+        data = args.data
+        if data is None:
+            data = tmp / "virtual"
+            spec = VirtualCampaign(2, (6.0, 6.75, 7.5, 8.25, 9.0), (20000.0,), (5.0,), 1.7, 4)
+            write_virtual_campaign(data, spec)
+        campaign = load_campaign(_campaign_file(data, args.samples))
+        n = len(campaign.tests)
+        print(f"campaign: {n} tests ({campaign.name}), damping samples {args.samples}")
+        print(f"machine: {os.cpu_count()} cores (shared with other jobs)")
+        t0 = time.perf_counter()
+        runs = run_tests(campaign, tmp / "serial", mode="serial")
+        t_serial = time.perf_counter() - t0
+        write_outputs(campaign, runs, tmp / "serial", report=False)
+        ref = (tmp / "serial" / "modes.csv").read_bytes()
+        rows = [("serial", 0.0, t_serial, 1.0, 1.0, "yes")]
+        for w in args.workers:
+            t0 = time.perf_counter()
+            cluster = LocalCluster(
+                n_workers=w,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",
+                silence_logs=logging.ERROR,
+            )
+            client = Client(cluster)
+            t_start = time.perf_counter() - t0
+            out = tmp / f"w{w}"
+            t0 = time.perf_counter()
+            runs = run_tests(campaign, out, mode="local", client=client)
+            t_run = time.perf_counter() - t0
+            client.close()
+            cluster.close()
+            write_outputs(campaign, runs, out, report=False)
+            same = "yes" if (out / "modes.csv").read_bytes() == ref else "NO"
+            rows.append(
+                (f"{w} worker(s)", t_start, t_run, t_serial / t_run, t_serial / (w * t_run), same)
+            )
+        head = ("run", "start [s]", "wall [s]", "speed-up", "efficiency", "same table")
+        print(f"{head[0]:<12} " + " ".join(f"{h:>10}" for h in head[1:]))
+        for name, ts, tr, su, eff, same in rows:
+            print(f"{name:<12} {ts:>10.2f} {tr:>10.2f} {su:>10.2f} {100 * eff:>9.0f}% {same:>10}")
+
+
+if __name__ == "__main__":
+    main()
