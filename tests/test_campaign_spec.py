@@ -165,3 +165,16 @@ def test_schema_rejects_what_the_reader_rejects() -> None:
     bad = tomllib.loads(GOOD.replace('tyre = "A"', 'tyre = "A"\nspeed = 3'))
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(bad, SCHEMA)
+
+
+def test_schema_and_reader_know_the_same_settings() -> None:
+    props = SCHEMA["properties"]["settings"]["properties"]
+    assert set(props) == set(DEFAULTS)
+    for study, sections in DEFAULTS.items():
+        assert set(props[study]["properties"]) == set(sections)
+        for section, keys in sections.items():
+            assert set(props[study]["properties"][section]["properties"]) == set(keys)
+    from tyredamp.campaign.spec import CONDITIONS
+
+    test_props = SCHEMA["properties"]["tests"]["items"]["properties"]
+    assert set(test_props) == {"files", "study", *CONDITIONS}

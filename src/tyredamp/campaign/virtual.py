@@ -196,7 +196,8 @@ def write_virtual_campaign(
     progress : callable, optional
         ``progress(done, total)`` after each test written.
     """
-    from ..demo import single_threaded_blas
+    from threadpoolctl import threadpool_limits
+
     from ..lateral.rig import VirtualLateralRig
     from ..signal import estimate_frf
     from ..tyre import run_modal_test
@@ -210,7 +211,7 @@ def write_virtual_campaign(
     tests: list[dict[str, Any]] = []
     held: list[dict[str, Any]] = []
     tyres: dict[str, Any] = {}
-    with single_threaded_blas():
+    with threadpool_limits(limits=1, user_api="blas"):  # small matrices: one thread is fastest
         for t in range(s.n_tyres):
             tid = f"T{t + 1}"
             params = tyre_parameters(t, s.seed)

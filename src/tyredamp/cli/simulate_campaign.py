@@ -27,7 +27,8 @@ def _check_out(out: Path) -> None:
         kind = None
     if kind != "tyredamp-virtual-campaign-truth":
         raise InputError(
-            f"--out: {out} is not empty and holds no earlier virtual campaign; choose another folder"
+            f"--out: {out} is not empty and holds no earlier virtual campaign; "
+            "choose another folder"
         )
 
 

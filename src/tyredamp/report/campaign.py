@@ -56,7 +56,8 @@ def _trend_figures(rep: HtmlReport, fits: list[Any]) -> None:
             ax.set_ylabel(ylabel)
             if not series:
                 ax.set_axis_off()
-        if len(items) <= 24:
+        n_series = sum(it[0]["quantity"] == "frequency_hz" for it in items)
+        if n_series <= 12:
             axes[0].legend(fontsize=6)
         name = fam + (slot and f" ({slot})")
         rep.figure(
