@@ -7,8 +7,11 @@ plus one lateral test (11 tests) is written to a temporary folder first (not
 timed); ``--data`` reuses the folder of ``tyredamp simulate campaign``. Every
 configuration starts from an empty output folder (no cache). The cluster's
 start-up is timed apart from the run. Printed per configuration: start-up,
-run wall time, speed-up and parallel efficiency ``T_serial / (N T_N)``, and
-whether the tidy mode table is identical to the serial one byte for byte.
+run wall time, speed-up and parallel efficiency ``T_serial / (N T_N)``, the
+CPU time the tasks got over the wall time (the cores actually obtained: on a
+machine shared with other jobs this, not N, bounds the speed-up), the load
+average, and whether the tidy mode table is identical to the serial one byte
+for byte.
 BLAS is limited to one thread in every task (as the campaign always does).
 """
 
@@ -60,9 +63,10 @@ def main() -> None:
         t0 = time.perf_counter()
         runs = run_tests(campaign, tmp / "serial", mode="serial")
         t_serial = time.perf_counter() - t0
+        cpu = sum(r.cpu_seconds for r in runs)
         write_outputs(campaign, runs, tmp / "serial", report=False)
         ref = (tmp / "serial" / "modes.csv").read_bytes()
-        rows = [("serial", 0.0, t_serial, 1.0, 1.0, "yes")]
+        rows = [("serial", 0.0, t_serial, 1.0, 1.0, cpu / t_serial, os.getloadavg()[0], "yes")]
         for w in args.workers:
             t0 = time.perf_counter()
             cluster = LocalCluster(
@@ -78,17 +82,40 @@ def main() -> None:
             t0 = time.perf_counter()
             runs = run_tests(campaign, out, mode="local", client=client)
             t_run = time.perf_counter() - t0
+            load = os.getloadavg()[0]
+            cpu = sum(r.cpu_seconds for r in runs)
             client.close()
             cluster.close()
             write_outputs(campaign, runs, out, report=False)
             same = "yes" if (out / "modes.csv").read_bytes() == ref else "NO"
             rows.append(
-                (f"{w} worker(s)", t_start, t_run, t_serial / t_run, t_serial / (w * t_run), same)
+                (
+                    f"{w} worker(s)",
+                    t_start,
+                    t_run,
+                    t_serial / t_run,
+                    t_serial / (w * t_run),
+                    cpu / t_run,
+                    load,
+                    same,
+                )
             )
-        head = ("run", "start [s]", "wall [s]", "speed-up", "efficiency", "same table")
+        head = (
+            "run",
+            "start [s]",
+            "wall [s]",
+            "speed-up",
+            "efficiency",
+            "cores got",
+            "load avg",
+            "same table",
+        )
         print(f"{head[0]:<12} " + " ".join(f"{h:>10}" for h in head[1:]))
-        for name, ts, tr, su, eff, same in rows:
-            print(f"{name:<12} {ts:>10.2f} {tr:>10.2f} {su:>10.2f} {100 * eff:>9.0f}% {same:>10}")
+        for name, ts, tr, su, eff, got, load, same in rows:
+            print(
+                f"{name:<12} {ts:>10.2f} {tr:>10.2f} {su:>10.2f} {100 * eff:>9.0f}% "
+                f"{got:>10.2f} {load:>10.1f} {same:>10}"
+            )
 
 
 if __name__ == "__main__":

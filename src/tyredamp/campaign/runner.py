@@ -50,6 +50,13 @@ class Task:
     upstream: dict[str, dict[str, Any]]
     settings: dict[str, Any]
     conditions: dict[str, Any]
+    step_keys: tuple[str, ...] = ()
+
+    @property
+    def key(self) -> str:
+        """Dask key: the same only for the same computation (the cache keys of its steps)."""
+        digest = hashlib.sha256("".join(self.step_keys).encode("ascii")).hexdigest()[:20]
+        return f"tyredamp-campaign-{self.test_id}-{digest}"
 
 
 @dataclass(frozen=True)
@@ -61,6 +68,7 @@ class Outcome:
     failed_step: str | None = None
     reason: str | None = None
     seconds: float = 0.0
+    cpu_seconds: float = 0.0
 
 
 @dataclass
@@ -77,6 +85,8 @@ class TestRun:
         The step documents available (from the cache or computed now).
     computed, reused : list of str
         Steps computed in this run and steps read from the cache.
+    seconds, cpu_seconds : float
+        Wall and CPU time of the task in this run (0 when nothing ran).
     failed_step, reason : str or None
         The failing step and its one-line reason (None when the test succeeded).
     """
@@ -92,6 +102,7 @@ class TestRun:
     reason: str | None = None
     digest: str | None = None
     seconds: float = 0.0
+    cpu_seconds: float = 0.0
 
     @property
     def ok(self) -> bool:
@@ -108,7 +119,7 @@ def execute(task: Task) -> Outcome:
     """
     from threadpoolctl import threadpool_limits
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         data = Path(task.path).read_bytes()
     except OSError as exc:
@@ -127,10 +138,10 @@ def execute(task: Task) -> Outcome:
             task.settings,
             task.conditions,
         )
-    dt = time.perf_counter() - t0
+    dt, dc = time.perf_counter() - t0, time.process_time() - c0
     if failure is not None:
-        return Outcome(task.test_id, docs, failure[0], failure[1], dt)
-    return Outcome(task.test_id, docs, None, None, dt)
+        return Outcome(task.test_id, docs, failure[0], failure[1], dt, dc)
+    return Outcome(task.test_id, docs, None, None, dt, dc)
 
 
 def plan_tests(campaign: Campaign, cache: ResultCache) -> tuple[list[TestRun], list[Task]]:
@@ -180,6 +191,7 @@ def plan_tests(campaign: Campaign, cache: ResultCache) -> tuple[list[TestRun], l
                     {s: run.documents[s] for s in run.reused},
                     settings,
                     dict(spec.conditions),
+                    tuple(run.keys[s] for s in todo),
                 )
             )
     return runs, tasks
@@ -192,7 +204,8 @@ def _record(run: TestRun, out: Outcome, cache: ResultCache) -> None:
         )
         run.documents[step] = doc
         run.computed.append(step)
-    run.failed_step, run.reason, run.seconds = out.failed_step, out.reason, out.seconds
+    run.failed_step, run.reason = out.failed_step, out.reason
+    run.seconds, run.cpu_seconds = out.seconds, out.cpu_seconds
 
 
 def _serial(tasks: Iterable[Task]) -> Iterable[Outcome]:
@@ -203,12 +216,7 @@ def _serial(tasks: Iterable[Task]) -> Iterable[Outcome]:
 def _dask(tasks: list[Task], client: Any) -> Iterable[Outcome]:
     from distributed import as_completed
 
-    futures = {
-        client.submit(
-            execute, t, key=f"tyredamp-campaign-{t.test_id}-{t.digest[:12]}", retries=2
-        ): t
-        for t in tasks
-    }
+    futures = {client.submit(execute, t, key=t.key, retries=2): t for t in tasks}
     for fut in as_completed(list(futures)):
         task = futures[fut]
         try:
