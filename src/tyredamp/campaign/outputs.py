@@ -25,7 +25,9 @@ Files written into the output folder ``DIR`` (each atomically):
 
 from __future__ import annotations
 
+import json
 import math
+import re
 from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -116,9 +118,9 @@ def check_output_dir(out: Path) -> None:
     """Refuse an output folder that holds anything but an earlier campaign output.
 
     The campaign writes only its own files; it never deletes or changes a
-    file it did not write, so a non-empty folder without ``campaign.json`` of
-    kind ``tyredamp-campaign`` (and without a ``cache`` folder of its own) is
-    refused.
+    file it did not write, so a non-empty folder is refused unless it holds
+    a ``campaign.json`` of kind ``tyredamp-campaign`` or, after an
+    interruption, a ``cache`` folder holding only cache entries.
     """
     if not out.exists():
         return
@@ -128,16 +130,25 @@ def check_output_dir(out: Path) -> None:
     if not entries:
         return
     marker = out / "campaign.json"
-    import json
-
     try:
         ok = json.loads(marker.read_text(encoding="utf-8")).get("kind") == KIND
     except (OSError, ValueError, AttributeError):
         ok = False
-    if not ok and not (out / "cache").is_dir():
+    if not ok and not _our_cache(out / "cache"):
         raise InputError(
             f"--out: {out} is not empty and holds no earlier campaign output; choose another folder"
         )
+
+
+def _our_cache(folder: Path) -> bool:
+    """True for a cache folder of an interrupted campaign (only our entries in it)."""
+    if not folder.is_dir():
+        return False
+    names = [p.name for p in folder.iterdir()]
+    return bool(names) and all(_CACHE_NAME.fullmatch(n) for n in names)
+
+
+_CACHE_NAME = re.compile(r"[0-9a-f]{64}\.json|\.[0-9a-f]{64}\.json\..*\.tmp")
 
 
 def _float(v: Any) -> float:
