@@ -248,11 +248,15 @@ def _series_label(key: tuple[Any, ...]) -> str:
 
 def trend_fits(
     rows: Sequence[dict[str, Any]],
+    quantities: Sequence[tuple[str, str]] = _QUANTITIES,
 ) -> list[tuple[dict[str, Any], TrendFit, list[dict[str, Any]]]]:
     """Fit every (family, slot, quantity, condition, series) with >= 3 distinct condition values.
 
+    ``quantities`` lists ``(value key, standard-error key)`` of the rows
+    (default: frequency, damping ratio and modal damping of the mode table).
     Returns ``(about, fit, points)`` for each: ``about`` names the family,
-    slot, quantity, condition and series; ``points`` are the rows used.
+    slot, quantity (and its ``std_key``), condition and series; ``points``
+    are the rows used.
     """
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = defaultdict(list)
     for r in rows:
@@ -266,21 +270,22 @@ def trend_fits(
     for (fam, slot, cond, key), pts in sorted(groups.items(), key=lambda kv: str(kv[0])):
         if len({p[cond] for p in pts}) < 3:
             continue
-        for q, qs in _QUANTITIES:
-            use = [p for p in pts if math.isfinite(p[q])]
+        for q, qs in quantities:
+            use = [p for p in pts if p.get(q) is not None and math.isfinite(p[q])]
             if len({p[cond] for p in use}) < 3:
                 continue
             transform = "square" if (q == "frequency_hz" and cond == "pressure_bar") else "none"
             fit = fit_trend(
                 [p[cond] for p in use],
                 [p[q] for p in use],
-                [p[qs] for p in use],
+                [_float(p.get(qs)) for p in use],
                 transform=transform,
             )
             about = {
                 "family": fam,
                 "slot": slot,
                 "quantity": q,
+                "std_key": qs,
                 "condition": cond,
                 "series": _series_label(key),
                 "tyre": key[0],
@@ -297,14 +302,14 @@ def trend_rows(
     out = []
     for about, fit, pts in fits:
         cond, q = about["condition"], about["quantity"]
-        qs = dict(_QUANTITIES)[q]
+        qs = about["std_key"]
         by_x: dict[float, list[dict[str, Any]]] = defaultdict(list)
         for p in pts:
             by_x[float(p[cond])].append(p)
         for x in sorted(by_x):
             obs = by_x[x]
             vals = np.array([p[q] for p in obs])
-            ses = np.array([p[qs] for p in obs])
+            ses = np.array([_float(p.get(qs)) for p in obs])
             if len(obs) > 1:
                 se = float(np.std(vals, ddof=1) / math.sqrt(len(obs)))
             else:
@@ -328,6 +333,32 @@ def trend_rows(
                 }
             )
     return out
+
+
+def lateral_trend_rows(lrows: Sequence[dict[str, Any]]) -> tuple[list[dict[str, Any]], list]:
+    """Lateral parameters as trend observations: family ``lateral <model>``, one key per parameter.
+
+    Returns the rows and their ``(value key, standard-error key)`` quantities
+    for :func:`trend_fits` (so each model parameter gets its trend against
+    speed, pressure, ... like the modal quantities).
+    """
+    out: dict[tuple[str, str], dict[str, Any]] = {}
+    params: list[str] = []
+    for r in lrows:
+        row = out.setdefault(
+            (r["test_id"], r["model"]),
+            {
+                "test_id": r["test_id"],
+                "family": f"lateral {r['model']}",
+                "slot": "",
+                **{c: r.get(c) for c in CONDITIONS},
+            },
+        )
+        row[r["parameter"]] = r["value"]
+        row[f"{r['parameter']}_std"] = r["stderr"]
+        if r["parameter"] not in params:
+            params.append(r["parameter"])
+    return list(out.values()), [(p, f"{p}_std") for p in params]
 
 
 def _write_table(rows: Sequence[dict[str, Any]], columns: dict[str, str], stem: Path) -> None:
@@ -374,9 +405,10 @@ def write_outputs(
     out = Path(out_dir)
     model = campaign.tracking.get("model", "complex")
     rows = mode_rows(runs, model)
-    fits = trend_fits(rows)
-    trows = trend_rows(fits)
     lrows = lateral_rows(runs)
+    lat_obs, lat_quantities = lateral_trend_rows(lrows)
+    fits = trend_fits(rows) + trend_fits(lat_obs, lat_quantities)
+    trows = trend_rows(fits)
     _write_table(rows, MODE_COLUMNS, out / "modes")
     _write_table(trows, TREND_COLUMNS, out / "trends")
     _write_table(lrows, LATERAL_COLUMNS, out / "lateral")

@@ -32,6 +32,10 @@ _LABELS: dict[str, str] = {
 }
 
 
+def _family_order(name: str) -> tuple[int, str]:
+    return (int(name[1:]), "") if name[:1] == "F" and name[1:].isdigit() else (10**9, name)
+
+
 def _trend_figures(rep: HtmlReport, fits: list[Any]) -> None:
     from matplotlib.figure import Figure
 
@@ -40,29 +44,42 @@ def _trend_figures(rep: HtmlReport, fits: list[Any]) -> None:
     groups: dict[tuple[str, str, str], list[Any]] = defaultdict(list)
     for about, fit, pts in fits:
         groups[(about["family"], about["slot"], about["condition"])].append((about, fit, pts))
-    order = sorted(groups, key=lambda k: (int(k[0][1:]), k[1], k[2]))
+    order = sorted(groups, key=lambda k: (_family_order(k[0]), k[1], k[2]))
     for fam, slot, cond in order:
         items = groups[(fam, slot, cond)]
-        fig = Figure(figsize=(11, 3.2), layout="constrained")
-        axes = fig.subplots(1, 3)
-        for ax, q in zip(axes, ("frequency_hz", "damping_ratio", "modal_damping"), strict=True):
-            ylabel, scale = _QLABELS[q]
+        quantities: list[str] = []
+        for about, _, _ in items:
+            if about["quantity"] not in quantities:
+                quantities.append(about["quantity"])
+        ncol = min(len(quantities), 3)
+        nrow = -(-len(quantities) // ncol)
+        fig = Figure(figsize=(11, 3.2 * nrow), layout="constrained")
+        axes = fig.subplots(nrow, ncol, squeeze=False).ravel()
+        for ax, q in zip(axes, quantities, strict=False):
+            ylabel, scale = _QLABELS.get(q, (q, 1.0))
             series = [it for it in items if it[0]["quantity"] == q]
             for k, (about, fit, pts) in enumerate(series):
                 plot_trend(
-                    pts, fit, cond, q, ax=ax, label=about["series"], color=f"C{k % 10}", scale=scale
+                    pts,
+                    fit,
+                    cond,
+                    q,
+                    ax=ax,
+                    label=about["series"],
+                    color=f"C{k % 10}",
+                    scale=scale,
                 )
             ax.set_xlabel(_LABELS.get(cond, cond))
             ax.set_ylabel(ylabel)
-            if not series:
-                ax.set_axis_off()
-        n_series = sum(it[0]["quantity"] == "frequency_hz" for it in items)
+        for ax in axes[len(quantities) :]:
+            ax.set_axis_off()
+        n_series = sum(it[0]["quantity"] == quantities[0] for it in items)
         if n_series <= 12:
             axes[0].legend(fontsize=6)
         name = fam + (slot and f" ({slot})")
         rep.figure(
             fig,
-            f"family {name}: against {_LABELS.get(cond, cond)}; line: fitted trend "
+            f"{name}: against {_LABELS.get(cond, cond)}; line: fitted trend "
             "(degree by AICc), band: 95 %",
             dpi=80,
         )
