@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import InputError
 from ..io import write_frf
+from ..io._atomic import atomic_path
 from ..io.jsonfile import write_json
 from ..tyre import Imperfection, RingTyre, RingTyreParameters
 
@@ -287,10 +288,25 @@ def write_virtual_campaign(
         "held_out": held,
     }
     write_json(doc, root / "truth.json")
+    with atomic_path(root / "campaign.toml") as tmp:
+        tmp.write_text(campaign_file_text(s, tests), encoding="utf-8")
+    return doc
+
+
+def campaign_file_text(spec: VirtualCampaign, tests: list[dict[str, Any]]) -> str:
+    """The campaign file (TOML) of a virtual campaign: its settings and one entry per test.
+
+    The modal band is 30-180 Hz: every band edge cuts some mode somewhere in a
+    sweep; this one keeps at least 3 Hz (about the half-power half-width
+    ``zeta f`` there) between the edge and the nearest true mode at every
+    pressure and load of the default campaign (183.0 Hz, tyre 3 at 7.5 bar).
+    An edge through a resonance biases the identification (a mode 0.3 Hz
+    inside the 200 Hz edge moved the fit of the 51 Hz mode by 0.4 %).
+    """
     lines = [
         "# tyredamp campaign file of the virtual campaign (tyredamp simulate campaign)",
-        f'name = "virtual truck tyres: {s.n_tyres} tyres x {len(s.pressures_bar)} pressures'
-        f' x {len(s.loads_n)} loads"',
+        f'name = "virtual truck tyres: {spec.n_tyres} tyres x {len(spec.pressures_bar)} '
+        f'pressures x {len(spec.loads_n)} loads"',
         "",
         "[settings.radial.modal]",
         "band = [30.0, 180.0]",
@@ -306,11 +322,7 @@ def write_virtual_campaign(
             if k in entry:
                 lines.append(f"{k} = {_toml_value(entry[k])}")
         lines.append("")
-    from ..io._atomic import atomic_path
-
-    with atomic_path(root / "campaign.toml") as tmp:
-        tmp.write_text("\n".join(lines), encoding="utf-8")
-    return doc
+    return "\n".join(lines)
 
 
 def _true_match(
