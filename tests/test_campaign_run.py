@@ -108,7 +108,14 @@ def test_virtual_campaign_end_to_end(virtual: Path, serial: dict[str, Any]) -> N
     for t in results.summary["tests"]:
         for p in t["documents"].values():
             assert json.loads((out / p).read_text("utf-8"))
+    damping = pq.read_table(out / "damping.parquet").to_pylist()
+    # one row per entry of each test's C' (5 or 6 modes), labelled by families
+    assert len(damping) == sum(
+        len(r.documents["damping"]["modal"]) ** 2 for r in runs if "damping" in r.documents
+    )
+    assert all(d["family_k"] and d["family_n"] for d in damping)
     html = (out / "report.html").read_text("utf-8")
+    assert "Damping matrix across conditions" in html
     assert "data:image/png;base64," in html
     assert 'href="tests/' in html
 
@@ -154,7 +161,7 @@ def test_scheduler_and_one_worker_give_the_serial_results(
         "--no-report",
     )
     assert (tmp_path / "one" / "modes.csv").read_bytes() == ref
-    for name in ("modes.csv", "trends.csv", "lateral.csv"):
+    for name in ("modes.csv", "damping.csv", "trends.csv", "lateral.csv"):
         assert (tmp_path / "one" / name).read_bytes() == (tmp_path / "two" / name).read_bytes()
     s = json.loads((tmp_path / "two" / "campaign.json").read_text("utf-8"))
     assert s["steps_computed"] == 6 * 2 + 2

@@ -10,6 +10,10 @@ Files written into the output folder ``DIR`` (each atomically):
     the observed mean and standard error and the fitted trend with its
     standard error (:data:`TREND_COLUMNS`); ``trend_fits.json`` holds the
     fitted polynomials.
+``damping.parquet``, ``damping.csv``
+    One row per entry ``C'_kn`` of the modal damping matrix of every radial
+    test, labelled by the families of modes ``k`` and ``n`` (the matrix's
+    change across conditions, couplings included).
 ``lateral.parquet``, ``lateral.csv``
     One row per fitted parameter of every lateral model of every lateral test.
 ``tests/<test_id>/modes.json``, ``damping.json``, ``lateral.json``
@@ -30,7 +34,7 @@ import math
 import re
 from collections import defaultdict
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -92,6 +96,20 @@ TREND_COLUMNS: dict[str, str] = {
     "trend": "float",
     "trend_std": "float",
     "degree": "int",
+}
+#: Columns of the damping-matrix table.
+DAMPING_COLUMNS: dict[str, str] = {
+    "test_id": "string",
+    "file": "string",
+    **_COND_TYPES,
+    "mode_k": "int",
+    "mode_n": "int",
+    "family_k": "string",
+    "slot_k": "string",
+    "family_n": "string",
+    "slot_n": "string",
+    "value": "float",
+    "std": "float",
 }
 LATERAL_COLUMNS: dict[str, str] = {
     "test_id": "string",
@@ -205,6 +223,47 @@ def mode_rows(runs: Sequence[TestRun], model: str = "complex") -> list[dict[str,
                 row[k] = _float(m[k])
             rows.append(row)
     return rows
+
+
+def damping_rows(runs: Sequence[TestRun], modes: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The modal damping matrix ``C'`` of every test, one row per entry, by mode family.
+
+    ``C'_kn`` (1/s) with its Monte Carlo standard error, for the modes ``k``
+    and ``n`` of the tracked model, labelled by their families and slots, so
+    the change of the damping matrix (couplings included) across conditions
+    can be followed.
+    """
+    label = {(r["test_id"], r["mode"]): (r["family"], r["slot"]) for r in modes}
+    model = {r["test_id"]: r["model"] for r in modes}
+    out = []
+    for run in runs:
+        doc = run.documents.get("damping")
+        tid = run.spec.test_id
+        if doc is None or doc.get("meta", {}).get("model") != model.get(tid):
+            continue
+        cp = np.asarray(doc["modal"], dtype=float)
+        std = doc.get("std", {}).get("modal")
+        sd = np.full(cp.shape, np.nan) if std is None else np.asarray(std, dtype=float)
+        for k in range(cp.shape[0]):
+            for n in range(cp.shape[1]):
+                fk, sk = label.get((tid, k + 1), (None, ""))
+                fn, sn = label.get((tid, n + 1), (None, ""))
+                row: dict[str, Any] = {"test_id": tid, "file": run.spec.rel}
+                row.update({c: run.spec.conditions.get(c) for c in CONDITIONS})
+                row.update(
+                    {
+                        "mode_k": k + 1,
+                        "mode_n": n + 1,
+                        "family_k": fk,
+                        "slot_k": sk,
+                        "family_n": fn,
+                        "slot_n": sn,
+                        "value": float(cp[k, n]),
+                        "std": float(sd[k, n]),
+                    }
+                )
+                out.append(row)
+    return out
 
 
 def lateral_rows(runs: Sequence[TestRun]) -> list[dict[str, Any]]:
@@ -409,7 +468,9 @@ def write_outputs(
     lat_obs, lat_quantities = lateral_trend_rows(lrows)
     fits = trend_fits(rows) + trend_fits(lat_obs, lat_quantities)
     trows = trend_rows(fits)
+    drows = damping_rows(runs, rows)
     _write_table(rows, MODE_COLUMNS, out / "modes")
+    _write_table(drows, DAMPING_COLUMNS, out / "damping")
     _write_table(trows, TREND_COLUMNS, out / "trends")
     _write_table(lrows, LATERAL_COLUMNS, out / "lateral")
     write_json([{**about, "fit": fit.to_dict()} for about, fit, _ in fits], out / "trend_fits.json")
@@ -474,6 +535,8 @@ def write_outputs(
         "files": [
             "modes.parquet",
             "modes.csv",
+            "damping.parquet",
+            "damping.csv",
             "trends.parquet",
             "trends.csv",
             "lateral.parquet",
@@ -484,7 +547,7 @@ def write_outputs(
         + (["report.html"] if report else []),
     }
     write_json(summary, out / "campaign.json")
-    return CampaignResults(summary, rows, fits, lrows)
+    return CampaignResults(summary, rows, fits, lrows, drows)
 
 
 @dataclass(frozen=True)
@@ -495,3 +558,4 @@ class CampaignResults:
     modes: list[dict[str, Any]]
     fits: list[tuple[dict[str, Any], TrendFit, list[dict[str, Any]]]]
     lateral: list[dict[str, Any]]
+    damping: list[dict[str, Any]] = field(default_factory=list)

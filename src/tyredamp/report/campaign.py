@@ -14,6 +14,8 @@ from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..io._atomic import atomic_path
 from .html import HtmlReport
 
@@ -85,6 +87,67 @@ def _trend_figures(rep: HtmlReport, fits: list[Any]) -> None:
         )
 
 
+def _label(family: str | None, slot: str) -> str:
+    return f"{family}{slot}" if family else "?"
+
+
+def _damping_figures(rep: HtmlReport, rows: list[dict[str, Any]]) -> int:
+    """C' at the two ends of the longest sweep of the first tyre, per condition; their change."""
+    from matplotlib.figure import Figure
+
+    from ..plot.damping import plot_matrix
+
+    by_test: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for r in rows:
+        by_test[r["test_id"]].append(r)
+    if not by_test:
+        return 0
+    tyres = sorted({str(v[0]["tyre"] or "") for v in by_test.values()})
+    first = {t: v for t, v in by_test.items() if str(v[0]["tyre"] or "") == tyres[0]}
+    n = 0
+    for cond in ("pressure_bar", "load_n", "speed_kmh", "temperature_c"):
+        series: dict[tuple[Any, ...], dict[float, str]] = defaultdict(dict)
+        for tid, v in first.items():
+            c = v[0]
+            if c[cond] is None:
+                continue
+            others = tuple((k, c[k]) for k in _LABELS if k != cond)
+            series[others].setdefault(float(c[cond]), tid)
+        best = max(series.values(), key=len, default={})
+        if len(best) < 2:
+            continue
+        lo, hi = min(best), max(best)
+        mats = []
+        for x in (lo, hi):
+            entries = {
+                (_label(r["family_k"], r["slot_k"]), _label(r["family_n"], r["slot_n"])): r["value"]
+                for r in by_test[best[x]]
+            }
+            mats.append(entries)
+        labels = sorted(
+            {k for k, _ in mats[0]} & {k for k, _ in mats[1]},
+            key=lambda s: (_family_order(s.rstrip("ab"))[0], s),
+        )
+        if not labels:
+            continue
+        a, b = (np.array([[m[(i, j)] for j in labels] for i in labels]) for m in mats)
+        fig = Figure(figsize=(13, 3.9), layout="constrained")
+        axes = fig.subplots(1, 3)
+        unit = "1/s"
+        name = _LABELS[cond]
+        plot_matrix(a, labels, f"C' at {name} = {lo:g}", unit, ax=axes[0])
+        plot_matrix(b, labels, f"C' at {name} = {hi:g}", unit, ax=axes[1])
+        plot_matrix(b - a, labels, "change", unit, ax=axes[2])
+        rep.figure(
+            fig,
+            f"modal damping matrix C' of tyre {tyres[0] or '-'} by mode family at the two ends "
+            f"of its longest {name} sweep, and the change (damping.csv has every test)",
+            dpi=80,
+        )
+        n += 1
+    return n
+
+
 def campaign_report(results: Any) -> str:
     """The HTML text of the campaign report of ``results`` (``CampaignResults``)."""
     s = results.summary
@@ -134,6 +197,10 @@ def campaign_report(results: Any) -> str:
     if results.fits:
         rep.heading("Trends")
         _trend_figures(rep, results.fits)
+    if results.damping:
+        rep.heading("Damping matrix across conditions")
+        if not _damping_figures(rep, results.damping):
+            rep.paragraph("No sweep with two or more values of a condition.")
     if results.lateral:
         rep.heading("Lateral tests")
         best: dict[str, dict[str, Any]] = {}
