@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from tyredamp.campaign.tracking import (
@@ -185,3 +187,15 @@ def test_trend_rejects_too_little_data() -> None:
         fit_trend([1.0, 2.0], [1.0, 2.0])
     with pytest.raises(InputError, match="transform"):
         fit_trend([1.0, 2.0, 3.0], [1.0, 2.0, 3.0], transform="log")
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.permutations(list(range(10))))
+def test_tracking_does_not_depend_on_the_order_of_the_tests(perm: list[int]) -> None:
+    labels: dict[str, list[int]] = {}
+    p = np.linspace(5, 9, 5)
+    sets = _sweep(p, labels) + _sweep(p[::-1], labels, tyre="B")
+    ref = track_modes(sets)
+    got = track_modes([sets[i] for i in perm])
+    assert got.family == ref.family
+    assert got.slot == ref.slot
