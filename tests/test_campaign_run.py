@@ -324,3 +324,19 @@ def test_the_adapter_gives_the_documents_of_the_single_test_commands(
     assert doc.pop("input")["file"] == "lateral_5kmh.npz"
     cli_doc.pop("input")
     assert doc == cli_doc
+
+
+def test_time_data_goes_through_the_frf_step_of_tyredamp_frf(tmp_path: Path) -> None:
+    from tyredamp.campaign.steps import process_radial_test
+
+    td = tmp_path / "t.uff"
+    invoke("simulate", "radial", "--out", str(td), "--periods", "2", "--seed", "3")
+    invoke("frf", str(td), "--out", str(tmp_path / "f.uff"))
+    invoke("modal", str(tmp_path / "f.uff"), "--out", str(tmp_path / "m.json"))
+    res = process_radial_test(td, settings={"damping": {"enabled": False}})
+    assert set(res.documents) == {"modal"}  # damping switched off
+    doc = res.documents["modal"]
+    assert doc["campaign"]["input"] == "time"
+    assert doc["campaign"]["quality"]["name"]  # the data-quality check of the time data
+    cli_doc = json.loads((tmp_path / "m.json").read_text("utf-8"))
+    assert doc["models"] == cli_doc["models"]  # the FRF file is lossless (binary UFF 58b)
