@@ -14,6 +14,7 @@ error of the frequency-against-pressure trends at the held-out pressures
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import tempfile
@@ -34,6 +35,11 @@ def main() -> None:
     ap.add_argument("--out", type=Path, help="results folder (default: temporary)")
     ap.add_argument("--quick", action="store_true", help="the small campaign of the tests")
     ap.add_argument("--workers", type=int, help="local Dask workers (default: serial)")
+    ap.add_argument(
+        "--pairs",
+        action="store_true",
+        help="drive points 1 and 5 (doubled modes seen as pairs; with --quick: 1 tyre)",
+    )
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp_name:
         tmp = Path(tmp_name)
@@ -42,6 +48,9 @@ def main() -> None:
             data = tmp / "virtual"
             t0 = time.perf_counter()
             spec = VirtualCampaign.quick() if args.quick else VirtualCampaign()
+            if args.pairs:
+                n_tyres = 1 if args.quick else spec.n_tyres
+                spec = dataclasses.replace(spec, n_tyres=n_tyres, drive_points=(1, 5))
             write_virtual_campaign(data, spec)
             print(f"virtual campaign written in {time.perf_counter() - t0:.1f} s")
         out = args.out if args.out is not None else tmp / "out"
@@ -64,6 +73,8 @@ def main() -> None:
             print(f"{fam:<7} {n_tests[fam]:>5}  {waves}")
         print(f"swaps (a family with two wave numbers for one tyre): {check['swaps'] or 'none'}")
         print(f"identified modes with no true mode: {check['unmatched'] or 'none'}")
+        print(f"families tracked as pairs (slots a, b): {check['pairs'] or 'none'}")
+        print(f"pair slots holding both true members: {check['slot_swaps'] or 'none'}")
         held = check["held_out"]
         print(
             f"held-out pressure trends: {len(held)} points, max |relative error| "

@@ -340,3 +340,28 @@ def test_time_data_goes_through_the_frf_step_of_tyredamp_frf(tmp_path: Path) -> 
     assert doc["campaign"]["quality"]["name"]  # the data-quality check of the time data
     cli_doc = json.loads((tmp_path / "m.json").read_text("utf-8"))
     assert doc["models"] == cli_doc["models"]  # the FRF file is lossless (binary UFF 58b)
+
+
+def test_doubled_modes_are_tracked_as_pairs_without_swaps(tmp_path: Path) -> None:
+    from tyredamp.campaign.virtual import VirtualCampaign, write_virtual_campaign
+
+    # shakers at points 1 and 5 (90 deg apart) see both members of the odd wave numbers,
+    # split by the contact patch: the pairs n = 1, 3, 5 with their members a (lower), b
+    spec = VirtualCampaign(1, (6.0, 7.5, 9.0), (20000.0,), (), 1.7, 4, 0, (1, 5))
+    truth = write_virtual_campaign(tmp_path / "v", spec)
+    campaign = load_campaign(tmp_path / "v" / "campaign.toml")
+    runs = run_tests(campaign, tmp_path / "out", mode="serial")
+    assert all(r.ok for r in runs)
+    results = write_outputs(campaign, runs, tmp_path / "out", report=False)
+    check = compare_with_truth(results, truth, runs)
+    assert check["unmatched"] == []
+    assert check["swaps"] == []
+    assert check["slot_swaps"] == []
+    pairs = {f: check["families"][f]["T1"] for f in check["pairs"]}
+    assert sorted(next(iter(v)) for v in pairs.values()) == [1, 3, 5]
+    # the members of each pair are tracked through all three pressures
+    n_tests = {f["family"]: f["n_tests"] for f in results.summary["families"]}
+    assert all(n_tests[f] == 3 for f in pairs)
+    held = [h for h in check["held_out"] if h["slot"]]
+    assert len(held) == 3 * 2 * 2  # 3 pairs x 2 members x 2 held-out pressures
+    assert check["max_held_out_error"] < 0.005

@@ -28,6 +28,9 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
+import shutil
+import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -39,7 +42,7 @@ from ..exceptions import InputError
 from ..io import write_frf
 from ..io._atomic import atomic_path
 from ..io.jsonfile import write_json
-from ..tyre import Imperfection, RingTyre, RingTyreParameters
+from ..tyre import Imperfection, MeasurementLayout, RingTyre, RingTyreParameters
 
 __all__ = [
     "VirtualCampaign",
@@ -72,6 +75,12 @@ class VirtualCampaign:
         Chirp periods (averages) per radial test.
     seed : int
         Seed of the scatter and of every noise generator.
+    drive_points : tuple of int
+        Shaker points of the radial tests (default point 1, as in paper 000,
+        which sees only the member of each doubled mode with an antinode
+        there; ``(1, 5)``, 90 deg apart, sees both members of the odd wave
+        numbers, split by the contact patch: a multi-reference campaign with
+        doubled modes as pairs).
     """
 
     n_tyres: int = 3
@@ -81,6 +90,7 @@ class VirtualCampaign:
     lateral_pressure_bar: float = 1.7
     periods: int = 8
     seed: int = 0
+    drive_points: tuple[int, ...] = (1,)
 
     @classmethod
     def quick(cls, seed: int = 0) -> VirtualCampaign:
@@ -144,18 +154,30 @@ def contact_patch(
     return tuple(out)
 
 
-def _tyre(params: RingTyreParameters, pressure_bar: float, load_n: float) -> RingTyre:
+def _tyre(
+    params: RingTyreParameters,
+    pressure_bar: float,
+    load_n: float,
+    drive_points: tuple[int, ...] = (1,),
+) -> RingTyre:
     p = params.with_pressure(pressure_bar * BAR)
-    return RingTyre(p, imperfections=contact_patch(p, load_n))
+    return RingTyre(
+        p, MeasurementLayout(drive_points=drive_points), imperfections=contact_patch(p, load_n)
+    )
 
 
-def tyre_truth(params: RingTyreParameters, pressure_bar: float, load_n: float) -> list[dict]:
+def tyre_truth(
+    params: RingTyreParameters,
+    pressure_bar: float,
+    load_n: float,
+    drive_points: tuple[int, ...] = (1,),
+) -> list[dict]:
     """The exact visible modes of a virtual tyre at one condition (0-200 Hz).
 
     One dict per mode: ``wave_number``, ``frequency_hz``, ``damping_ratio``
     and ``shape`` (complex mode at the 16 points as ``[re, im]`` pairs).
     """
-    truth = _tyre(params, pressure_bar, load_n).truth()
+    truth = _tyre(params, pressure_bar, load_n, drive_points).truth()
     out = []
     for i in truth.select("visible"):
         psi = truth.psi_points[:, i]
@@ -184,9 +206,12 @@ def write_virtual_campaign(
     """Write the virtual campaign into the folder ``out``.
 
     Writes ``data/T{k}_{p}bar_{F}N.uff`` (radial H1 FRFs, UFF 58b, of the
-    virtual modal test: 16 points, drive at point 1, periodic chirp 0-200 Hz,
-    40 dB SNR), ``data/lateral_{v}kmh.npz`` (lateral rig, ground force),
-    ``truth.json`` and ``campaign.toml``. Returns the truth document.
+    virtual modal test: 16 points, the spec's drive points, periodic chirp
+    0-200 Hz, 40 dB SNR), ``data/lateral_{v}kmh.npz`` (lateral rig, ground
+    force), ``truth.json`` and ``campaign.toml``. Everything is written into
+    a temporary folder beside ``out`` first and moved in at the end
+    (``truth.json`` last), so an error leaves ``out`` as it was. Returns the
+    truth document.
 
     Parameters
     ----------
@@ -197,14 +222,34 @@ def write_virtual_campaign(
     progress : callable, optional
         ``progress(done, total)`` after each test written.
     """
+    s = spec if spec is not None else VirtualCampaign()
+    MeasurementLayout(drive_points=s.drive_points)  # bad drive points fail before any output
+    for p in s.pressures_bar:
+        if not (math.isfinite(p) and p > 0):
+            raise InputError(f"pressures_bar: expected pressures > 0 bar, got {p}")
+    final = Path(out)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    # written into a private folder beside ``out`` and moved in at the end: an error or an
+    # interruption leaves nothing half-written in ``out``
+    root = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
+    try:
+        doc = _write(s, root, progress)
+        for f in sorted(p for p in root.rglob("*") if p.is_file()):
+            target = final / f.relative_to(root)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(f, target)
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+    return doc
+
+
+def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
     from threadpoolctl import threadpool_limits
 
     from ..lateral.rig import VirtualLateralRig
     from ..signal import estimate_frf
     from ..tyre import run_modal_test
 
-    s = spec if spec is not None else VirtualCampaign()
-    root = Path(out)
     data = root / "data"
     data.mkdir(parents=True, exist_ok=True)
     total = s.n_tyres * len(s.pressures_bar) * len(s.loads_n) + len(s.lateral_speeds_kmh)
@@ -229,7 +274,8 @@ def write_virtual_campaign(
                 for p in s.pressures_bar:
                     name = f"{tid}_{p:g}bar_{load:g}N.uff"
                     seed = len(tests) + 1 + 1000 * s.seed
-                    test = run_modal_test(_tyre(params, p, load), n_periods=s.periods, seed=seed)
+                    tyre = _tyre(params, p, load, s.drive_points)
+                    test = run_modal_test(tyre, n_periods=s.periods, seed=seed)
                     write_frf(estimate_frf(test.data, "H1"), data / name)
                     tests.append(
                         {
@@ -238,7 +284,7 @@ def write_virtual_campaign(
                             "tyre": tid,
                             "pressure_bar": p,
                             "load_n": load,
-                            "modes": tyre_truth(params, p, load),
+                            "modes": tyre_truth(params, p, load, s.drive_points),
                         }
                     )
                     done += 1
@@ -250,7 +296,7 @@ def write_virtual_campaign(
                             "tyre": tid,
                             "pressure_bar": p,
                             "load_n": load,
-                            "modes": tyre_truth(params, p, load),
+                            "modes": tyre_truth(params, p, load, s.drive_points),
                         }
                     )
         rig = VirtualLateralRig()
@@ -282,6 +328,7 @@ def write_virtual_campaign(
             "lateral_speeds_kmh": list(s.lateral_speeds_kmh),
             "periods": s.periods,
             "seed": s.seed,
+            "drive_points": list(s.drive_points),
         },
         "tyres": tyres,
         "tests": tests,
@@ -327,8 +374,12 @@ def campaign_file_text(spec: VirtualCampaign, tests: list[dict[str, Any]]) -> st
 
 def _true_match(
     freqs: NDArray[np.float64], shapes: NDArray[np.complex128], truth: list[dict[str, Any]]
-) -> list[int | None]:
-    """Wave number of the true mode matched to each identified mode (assignment on MAC, f)."""
+) -> list[tuple[int, int] | None]:
+    """The true mode matched to each identified mode (assignment on MAC and frequency).
+
+    Each match is ``(wave number, rank)``, ``rank`` the position of the true
+    mode among the true modes of that wave number by frequency (0 lower).
+    """
     from scipy.optimize import linear_sum_assignment
 
     from .tracking import MAC_MIN, subspace_mac
@@ -343,10 +394,12 @@ def _true_match(
             rel = abs(freqs[i] - t["frequency_hz"]) / t["frequency_hz"]
             if mac >= MAC_MIN and rel < 0.05:
                 cost[i, j] = (1 - mac) + rel
-    out: list[int | None] = [None] * int(freqs.size)
+    out: list[tuple[int, int] | None] = [None] * int(freqs.size)
     for i, j in zip(*linear_sum_assignment(cost), strict=True):
         if cost[i, j] < 1e6:
-            out[int(i)] = int(truth[int(j)]["wave_number"])
+            t = truth[int(j)]
+            same = sorted(u["frequency_hz"] for u in truth if u["wave_number"] == t["wave_number"])
+            out[int(i)] = (int(t["wave_number"]), same.index(t["frequency_hz"]))
     return out
 
 
@@ -368,13 +421,15 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
         ``families``: family -> {tyre: set of true wave numbers} (one number
         each when there is no swap); ``unmatched``: identified modes with no
         true mode; ``swaps``: families holding two wave numbers for one tyre;
+        ``pairs``: families tracked as pairs; ``slot_swaps``: a pair's slot
+        (``a``/``b``) holding both true members of the pair for one tyre;
         ``held_out``: one row per (family, tyre, load, held-out pressure) with
         the trend, the truth and the relative error; ``max_held_out_error``.
     """
     from . import steps
 
     by_file = {t["file"]: t for t in truth["tests"] if t["study"] == "radial"}
-    wave: dict[tuple[str, int], int | None] = {}
+    wave: dict[tuple[str, int], tuple[int, int] | None] = {}
     for r in runs:
         t = by_file.get(r.spec.rel)
         recs = steps.mode_records(r.spec.study, r.documents)
@@ -382,15 +437,20 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
             continue
         freqs = np.array([m["frequency_hz"] for m in recs], dtype=float)
         shapes = np.column_stack([m["shape"] for m in recs])
-        for k, n in enumerate(_true_match(freqs, shapes, t["modes"])):
-            wave[(r.spec.test_id, k + 1)] = n
+        for k, found in enumerate(_true_match(freqs, shapes, t["modes"])):
+            wave[(r.spec.test_id, k + 1)] = found
     families: dict[str, dict[str, set[int | None]]] = {}
+    slots: dict[tuple[str, str, str], set[int]] = {}
     unmatched = []
     for row in results.modes:
-        n = wave.get((row["test_id"], row["mode"]))
-        if n is None:
+        match = wave.get((row["test_id"], row["mode"]))
+        if match is None:
             unmatched.append((row["test_id"], row["mode"], row["frequency_hz"]))
-        families.setdefault(row["family"], {}).setdefault(row["tyre"], set()).add(n)
+        wn = None if match is None else match[0]
+        families.setdefault(row["family"], {}).setdefault(row["tyre"], set()).add(wn)
+        if match is not None and row["slot"]:
+            slots.setdefault((row["family"], row["slot"], row["tyre"]), set()).add(match[1])
+    slot_swaps = [(k, sorted(v)) for k, v in slots.items() if len(v) > 1]
     swaps = [
         (fam, tyre, sorted(v, key=str))
         for fam, d in families.items()
@@ -404,21 +464,25 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
     for about, fit, _ in results.fits:
         if about["quantity"] != "frequency_hz" or about["condition"] != "pressure_bar":
             continue
-        n = fam_wave.get(about["family"])
+        n_true = fam_wave.get(about["family"])
         load = about["fixed"].get("load_n")
         for h in truth["held_out"]:
             if h["tyre"] != about["tyre"] or h["load_n"] != load:
                 continue
             if not fit.x0 - fit.xs <= h["pressure_bar"] <= fit.x0 + fit.xs:
                 continue  # only inside the tested range of this series
-            true = [m["frequency_hz"] for m in h["modes"] if m["wave_number"] == n]
+            true = sorted(m["frequency_hz"] for m in h["modes"] if m["wave_number"] == n_true)
+            slot = about["slot"]
+            if slot and len(true) == 2:
+                true = [true["ab".index(slot)]]  # a pair: slot a is the lower member
             if len(true) != 1:
                 continue
             f, sf = fit.predict([h["pressure_bar"]])
             held.append(
                 {
                     "family": about["family"],
-                    "wave_number": n,
+                    "slot": about["slot"],
+                    "wave_number": n_true,
                     "tyre": about["tyre"],
                     "load_n": load,
                     "pressure_bar": h["pressure_bar"],
@@ -432,6 +496,8 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
         "families": families,
         "unmatched": unmatched,
         "swaps": swaps,
+        "pairs": sorted({k[0] for k in slots}, key=lambda f: int(f[1:])),
+        "slot_swaps": slot_swaps,
         "held_out": held,
         "max_held_out_error": max((abs(h["relative_error"]) for h in held), default=float("nan")),
     }

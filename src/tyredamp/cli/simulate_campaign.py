@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -46,8 +47,16 @@ def _check_out(out: Path) -> None:
     is_flag=True,
     help="Small campaign for tests: 2 tyres x 3 pressures x 1 load, 2 lateral speeds.",
 )
+@click.option(
+    "--drive-points",
+    "drive_points",
+    default="1",
+    show_default=True,
+    metavar="P1,P2,...",
+    help="Shaker points of the radial tests; 1,5 sees both members of the doubled modes.",
+)
 @seed_option("Seed of the manufacturing scatter and of the noise.")
-def simulate_campaign_command(out: Path, quick: bool, seed: int) -> None:
+def simulate_campaign_command(out: Path, quick: bool, drive_points: str, seed: int) -> None:
     """Write a virtual test campaign of the truck tyre, its truth and a campaign file.
 
     3 tyres with manufacturing scatter x 5 pressures (6-9 bar) x 3 loads
@@ -61,11 +70,15 @@ def simulate_campaign_command(out: Path, quick: bool, seed: int) -> None:
     Example:
       tyredamp simulate campaign --out virtual
       tyredamp campaign virtual/campaign.toml --out results
+      tyredamp simulate campaign --out pairs --quick --drive-points 1,5
     """
     from ..campaign.virtual import VirtualCampaign, write_virtual_campaign
+    from .simulate import _points
 
+    points = _points((drive_points,))
     _check_out(out)
     spec = VirtualCampaign.quick(seed) if quick else VirtualCampaign(seed=seed)
+    spec = dataclasses.replace(spec, drive_points=points)
 
     def progress(done: int, total: int) -> None:
         if sys.stderr.isatty():
