@@ -19,7 +19,6 @@ BLAS is limited to one thread in every task (as the campaign always does).
 from __future__ import annotations
 
 import argparse
-import logging
 import os
 import re
 import tempfile
@@ -30,7 +29,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from tyredamp.campaign import load_campaign
 from tyredamp.campaign.outputs import write_outputs
-from tyredamp.campaign.runner import run_tests
+from tyredamp.campaign.runner import dask_client, run_tests
 from tyredamp.campaign.virtual import VirtualCampaign, write_virtual_campaign
 
 
@@ -58,8 +57,6 @@ def main() -> None:
     ap.add_argument("--workers", type=int, nargs="+", default=[1, 2], help="worker counts")
     ap.add_argument("--samples", type=int, default=200, help="Monte Carlo samples of damping")
     args = ap.parse_args()
-    from distributed import Client, LocalCluster
-
     with tempfile.TemporaryDirectory() as tmp_name:
         tmp = Path(tmp_name)
         data = args.data
@@ -81,14 +78,7 @@ def main() -> None:
         rows = [("serial", 0.0, t_serial, 1.0, 1.0, cpu / t_serial, os.getloadavg()[0], "yes")]
         for w in args.workers:
             t0 = time.perf_counter()
-            cluster = LocalCluster(
-                n_workers=w,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=":0",
-                silence_logs=logging.ERROR,
-            )
-            client = Client(cluster)
+            client, cluster = dask_client("local", w)
             client.run(_warm)
             t_start = time.perf_counter() - t0
             out = tmp / f"w{w}"
