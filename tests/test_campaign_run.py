@@ -365,3 +365,15 @@ def test_doubled_modes_are_tracked_as_pairs_without_swaps(tmp_path: Path) -> Non
     held = [h for h in check["held_out"] if h["slot"]]
     assert len(held) == 3 * 2 * 2  # 3 pairs x 2 members x 2 held-out pressures
     assert check["max_held_out_error"] < 0.005
+
+
+def test_the_output_folder_can_come_from_the_campaign_file(
+    virtual: Path, serial: dict[str, Any]
+) -> None:
+    text = 'output = "from_file"\n' + (virtual / "campaign.toml").read_text("utf-8")
+    (virtual / "with_output.toml").write_text(text, encoding="utf-8")
+    shutil.copytree(serial["out"] / "cache", virtual / "from_file" / "cache")
+    invoke("campaign", str(virtual / "with_output.toml"), "--serial", "--no-report")
+    s = json.loads((virtual / "from_file" / "campaign.json").read_text("utf-8"))
+    assert s["n_ok"] == 8
+    assert s["steps_computed"] == 0
