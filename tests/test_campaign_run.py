@@ -251,7 +251,10 @@ def test_a_corrupt_file_is_reported_and_the_others_complete(
     bad.write_bytes(bad.read_bytes()[:1000])
     out = tmp_path / "out"
     shutil.copytree(serial["out"] / "cache", out / "cache")  # same files: reused
-    res = invoke("campaign", str(camp / "campaign.toml"), "--out", str(out), "--serial")
+    res = CliRunner().invoke(
+        cli, ["campaign", str(camp / "campaign.toml"), "--out", str(out), "--serial"]
+    )
+    assert res.exit_code == 1  # the campaign ran; a test failed
     assert "1 failed" in res.output
     failed = [line for line in res.output.splitlines() if line.startswith("failed: ")]
     assert len(failed) == 1

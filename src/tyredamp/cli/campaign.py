@@ -12,7 +12,10 @@ import click
 
 from ..exceptions import InputError
 
-__all__ = ["campaign_command"]
+__all__ = ["EXIT_FAILED_TESTS", "campaign_command"]
+
+#: Exit code when the campaign ran but some tests failed (listed on stdout).
+EXIT_FAILED_TESTS = 1
 
 
 def _need(modules: list[str]) -> None:
@@ -108,8 +111,9 @@ def campaign_command(
     cached in DIR/cache by the hash of its input file, settings and tyredamp
     version: a rerun recomputes only what changed, and an interrupted
     campaign resumes. A test that fails is reported with its reason and does
-    not stop the others. Writes the tidy mode table (Parquet and CSV), the
-    mode families' trends, each test's documents and report.html.
+    not stop the others (exit code 1 when any failed, after every result is
+    written). Writes the tidy mode table (Parquet and CSV), the mode
+    families' trends, each test's documents and report.html.
 
     \b
     Example:
@@ -167,3 +171,6 @@ def campaign_command(
         + ("" if no_report else ", report.html")
         + ")"
     )
+    if s["n_failed"]:
+        # everything else is written; the exit code tells scripts that some tests failed
+        click.get_current_context().exit(EXIT_FAILED_TESTS)
