@@ -165,7 +165,11 @@ def campaign_command(
     )
     for t in s["tests"]:
         if t["status"] != "ok":
-            click.echo(f"failed: {t['file']}: {t['reason']}")
+            reason = str(t["reason"])
+            # the reason names the file when the reader raised it; say it once
+            click.echo(
+                f"failed: {reason if reason.startswith(t['file']) else t['file'] + ': ' + reason}"
+            )
     click.echo(
         f"wrote {out_dir}/ (modes.parquet, modes.csv, trends.csv, campaign.json"
         + ("" if no_report else ", report.html")
