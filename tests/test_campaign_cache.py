@@ -52,3 +52,21 @@ def test_cache_round_trip_and_bad_entries(tmp_path: Path) -> None:
     assert cache.get(key) is None
     cache.path(key).write_text('{"key": "other", "document": {}}', encoding="utf-8")
     assert cache.get(key) is None
+
+
+def test_a_task_on_a_missing_or_changed_file_fails_with_its_reason(tmp_path: Path) -> None:
+    from tyredamp.campaign.runner import Task, execute
+
+    settings: dict[str, object] = {}
+    missing = Task(
+        "t", "radial", str(tmp_path / "x.uff"), "x.uff", "0" * 64, ("modal",), {}, settings, {}
+    )
+    out = execute(missing)
+    assert out.failed_step == "modal"
+    assert out.reason is not None
+    assert out.reason.startswith("x.uff: cannot read")
+    assert "shared file system" in out.reason
+    (tmp_path / "x.uff").write_bytes(b"new bytes")
+    out = execute(missing)  # the digest is not the one planned
+    assert out.reason == "x.uff: the file changed during the campaign"
+    assert out.documents == {}

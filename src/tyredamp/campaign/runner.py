@@ -17,6 +17,7 @@ is read back through the same strict-JSON round trip.
 from __future__ import annotations
 
 import hashlib
+import socket
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -123,7 +124,14 @@ def execute(task: Task) -> Outcome:
     try:
         data = Path(task.path).read_bytes()
     except OSError as exc:
-        return Outcome(task.test_id, {}, task.steps[0], f"{task.rel}: cannot read ({exc.strerror})")
+        where = socket.gethostname()
+        return Outcome(
+            task.test_id,
+            {},
+            task.steps[0],
+            f"{task.rel}: cannot read on {where} ({exc.strerror}; a cluster needs the test "
+            "files at the same path on every worker, e.g. a shared file system)",
+        )
     if hashlib.sha256(data).hexdigest() != task.digest:
         return Outcome(
             task.test_id, {}, task.steps[0], f"{task.rel}: the file changed during the campaign"
