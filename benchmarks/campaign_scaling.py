@@ -35,12 +35,10 @@ from tyredamp.campaign.virtual import VirtualCampaign, write_virtual_campaign
 
 def _warm() -> None:
     """Import what the steps use (so that no run pays the imports inside its timing)."""
-    import tyredamp.damping
+    import tyredamp.documents
     import tyredamp.io
-    import tyredamp.lateral.fit
-    import tyredamp.modal.identify
-    import tyredamp.modal.io
-    import tyredamp.signal  # noqa: F401
+    import tyredamp.studies.lateral
+    import tyredamp.studies.radial  # noqa: F401
 
 
 def _campaign_file(data: Path, samples: int) -> Path:

@@ -15,7 +15,7 @@ from tyredamp.campaign.virtual import (
     tyre_parameters,
 )
 from tyredamp.exceptions import InputError
-from tyredamp.tyre import RingTyreParameters
+from tyredamp.virtual import RingTyreParameters
 
 
 @pytest.mark.parametrize("load", [5000.0, 20000.0, 30000.0])

@@ -16,7 +16,7 @@ from tyredamp.cli import main
 from tyredamp.io import read_frf, write_frf, write_timedata
 from tyredamp.signal import estimate_frf
 from tyredamp.timedata import TimeData
-from tyredamp.tyre import run_modal_test
+from tyredamp.virtual import run_modal_test
 
 from .helpers import chain_system
 from .test_signal_estimators import periodic_record

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from tyredamp import Channel, FileFormatError, InputError
 from tyredamp.frf import FRF
 from tyredamp.io import read, read_frf, read_timedata, write_frf, write_timedata
-from tyredamp.timedata import TimeData
+from tyredamp.timedata import Acquisition, TimeData
 
 LOSSLESS = ["uff58b", "csv", "npz"]
 EXT = {"uff58b": ".uff", "uff58": ".unv", "csv": ".csv", "npz": ".npz"}
@@ -42,6 +43,7 @@ def assert_same_timedata(a: TimeData, b: TimeData, rtol: float = 0.0) -> None:
     assert b.channels == a.channels
     assert b.quantities == a.quantities
     assert b.meta == a.meta
+    assert b.acquisition == a.acquisition
     if rtol == 0.0:
         assert_array_equal(b.data, a.data)
     else:
@@ -66,7 +68,15 @@ def sample_timedata(rng: np.random.Generator) -> TimeData:
         2048.0,
         chans,
         ["force", "acceleration", "velocity", "displacement"],
-        meta={"period_samples": 500, "settle_samples": 0},
+        meta={"operator": "io"},
+        acquisition=Acquisition(
+            period_samples=500,
+            run_starts=(0, 500),
+            settle_samples=0,
+            band_hz=(2.0, 300.0),
+            n_averages=1,
+            excitation="pseudo_random",
+        ),
     )
 
 
@@ -185,3 +195,51 @@ def test_writes_are_atomic_and_inputs_untouched(tmp_path: Path, monkeypatch) -> 
     with pytest.raises(InputError, match="JSON-compatible"):
         write_frf(FRF(frf.frequency, frf.H, meta={"bad": object()}), tmp_path / "m.npz")
     assert not (tmp_path / "m.npz").exists()
+
+
+@pytest.mark.parametrize("fmt", [*LOSSLESS, "uff58"])
+def test_old_files_with_acquisition_in_meta_still_read(tmp_path: Path, fmt: str) -> None:
+    """Files written before ``Acquisition`` kept its fields in ``meta``: they read the same."""
+    td = sample_timedata(np.random.default_rng(4))
+    legacy = {"period_samples": 500, "settle_samples": 100, "band_hz": [2.0, 300.0]}
+    path = tmp_path / f"old{EXT[fmt]}"
+    if fmt == "csv":
+        write_timedata(TimeData(td.data, td.sample_rate, td.channels, td.quantities), path, fmt)
+        text = path.read_text().replace(
+            "# sample_rate", f"# meta: {json.dumps(legacy)}\n# sample_rate"
+        )
+        path.write_text(text)
+    elif fmt == "npz":
+        write_timedata(TimeData(td.data, td.sample_rate, td.channels, td.quantities), path, fmt)
+        with np.load(path) as z:
+            head = json.loads(str(z["header"][()]))
+            data = z["data"]
+        head.pop("acquisition", None)
+        head["meta"] = legacy
+        np.savez(path, header=np.array(json.dumps(head)), data=data)
+    else:  # UFF always kept them as meta keys on an ID line
+        write_timedata(td, path, fmt)
+    back = read_timedata(path)
+    if fmt.startswith("uff"):
+        assert back.acquisition == td.acquisition
+    else:
+        assert back.acquisition == Acquisition(
+            period_samples=500, settle_samples=100, band_hz=(2.0, 300.0)
+        )
+        assert back.meta == {}
+
+
+def test_uff_keeps_many_runs_or_refuses(tmp_path: Path) -> None:
+    """Evenly spaced runs fit an ID line as run_every; a field that cannot fit is an error."""
+    rng = np.random.default_rng(5)
+    d = rng.normal(size=(2, 3200))
+    acq = Acquisition(period_samples=100, run_starts=tuple(range(0, 3200, 200)), settle_samples=100)
+    td = TimeData(d, 1000.0, [1, 2], ["force", "acceleration"], acquisition=acq)
+    back = read_timedata(write_timedata(td, tmp_path / "runs.uff"))
+    assert back.acquisition == acq
+    uneven = Acquisition(run_starts=(0, *(100 * k + k * k for k in range(1, 25))))
+    td = TimeData(d, 1000.0, [1, 2], ["force", "acceleration"], acquisition=uneven)
+    with pytest.raises(InputError, match="run_starts"):
+        write_timedata(td, tmp_path / "uneven.uff")
+    assert not (tmp_path / "uneven.uff").exists()
+    assert read_timedata(write_timedata(td, tmp_path / "uneven.npz")).acquisition == uneven

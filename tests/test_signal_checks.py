@@ -168,21 +168,21 @@ def test_quality_clean_clipped_reversed_noisy(chain: MCKSystem) -> None:
     d = td.data.copy()
     top = 0.7 * d[2].max()
     d[2] = np.minimum(d[2], top)  # overloaded amplifier on one accelerometer
-    clipped = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta))
+    clipped = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta, td.acquisition))
     assert not clipped.passed
     assert clipped.figures["clipped_channels"] == 1
     assert "clipped" in clipped.summary
 
     d = td.data.copy()
     d[0] *= -1  # force transducer mounted the wrong way round
-    rev = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta))
+    rev = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta, td.acquisition))
     assert not rev.passed
     assert rev.figures["passivity_fraction"] > 0.5
     assert "not passive" in rev.summary
 
     d = td.data.copy()
     d[1:] += 3 * d[1:].std(axis=1, keepdims=True) * rng.normal(size=d[1:].shape)
-    noisy = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta))
+    noisy = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta, td.acquisition))
     assert not noisy.passed
     assert noisy.figure > noisy.threshold
     assert noisy.frequency is not None

@@ -2,7 +2,7 @@
 
 Each step result of each test is stored as one JSON file
 ``DIR/cache/<key>.json``, written atomically
-(:func:`tyredamp.io._atomic.atomic_path`), where ``key`` is the SHA-256 of
+(:func:`tyredamp.io._safety.atomic_path`), where ``key`` is the SHA-256 of
 
 * the SHA-256 of the test file's bytes,
 * the step (study and name), the settings it depends on and the test
@@ -25,8 +25,8 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__
-from ..io._atomic import atomic_path
-from ..io.jsonfile import json_text
+from ..documents.jsonfile import json_text
+from ..io._safety import atomic_path
 
 __all__ = ["CACHE_FORMAT", "ResultCache", "file_digest", "step_key"]
 

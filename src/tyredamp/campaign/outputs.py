@@ -41,9 +41,9 @@ from typing import Any
 import numpy as np
 
 from .. import __version__
+from ..documents.jsonfile import write_json
 from ..exceptions import InputError
-from ..io._atomic import atomic_path
-from ..io.jsonfile import write_json
+from ..io._safety import atomic_path
 from . import steps
 from .runner import TestRun
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign

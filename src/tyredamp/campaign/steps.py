@@ -354,7 +354,7 @@ def plain(doc: Any) -> Any:
     Every step document passes through this at once, so a result computed now
     and one read from the cache are the same objects, bit for bit.
     """
-    from ..io.jsonfile import json_text
+    from ..documents.jsonfile import json_text
 
     return json.loads(json_text(doc, indent=0))
 
@@ -378,10 +378,10 @@ def _check_dict(res: Any) -> dict[str, Any]:
 def _radial_modal(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
+    from ..documents.modes import modes_document
     from ..frf import FRF
     from ..io import read
     from ..modal.identify import identify_modes
-    from ..modal.io import modes_document
     from ..signal import estimate_frf, quality_check
 
     fs, cs, ms = settings["frf"], settings["checks"], settings["modal"]
@@ -462,8 +462,8 @@ def _lateral_fit(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
     from ..io import read_frf
-    from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
-    from ..lateral.rig import KMH
+    from ..lateral import DEFAULT_MODELS, LateralData, rank_models
+    from ..virtual.lateral_rig import KMH
 
     s = settings["fit"]
     frf = read_frf(path)

@@ -1,6 +1,6 @@
 """A virtual test campaign: several truck tyres x pressures x loads, plus the lateral rig.
 
-Each virtual tyre is the ring tyre of :mod:`tyredamp.tyre` with
+Each virtual tyre is the ring tyre of :mod:`tyredamp.virtual` with
 *manufacturing scatter*: its bending stiffness, band mass, radial sidewall
 stiffness and radial damping are drawn around the defaults (relative standard
 deviations 3, 1, 5 and 5 %, seeded per tyre).
@@ -38,11 +38,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..documents.jsonfile import write_json
 from ..exceptions import InputError
 from ..io import write_frf
-from ..io._atomic import atomic_path
-from ..io.jsonfile import write_json
-from ..tyre import Imperfection, MeasurementLayout, RingTyre, RingTyreParameters
+from ..io._safety import atomic_path
+from ..virtual import Imperfection, MeasurementLayout, RingTyre, RingTyreParameters
 
 __all__ = [
     "VirtualCampaign",
@@ -246,9 +246,9 @@ def write_virtual_campaign(
 def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
     from threadpoolctl import threadpool_limits
 
-    from ..lateral.rig import VirtualLateralRig
     from ..signal import estimate_frf
-    from ..tyre import run_modal_test
+    from ..virtual import run_modal_test
+    from ..virtual.lateral_rig import VirtualLateralRig
 
     data = root / "data"
     data.mkdir(parents=True, exist_ok=True)

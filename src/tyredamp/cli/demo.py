@@ -9,7 +9,9 @@ from typing import TYPE_CHECKING, Any
 import click
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult
+    from ..studies.results import DemoResult
+
+from ._common import OutPath
 
 __all__ = ["demo_command", "demo_summary_rows"]
 
@@ -71,7 +73,7 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
     "out",
     default="tyredamp-demo",
     show_default=True,
-    type=click.Path(path_type=Path),
+    type=OutPath(path_type=Path),
     metavar="DIR",
     help="Directory to write (replaced only if empty or an earlier demo output).",
 )
@@ -109,18 +111,20 @@ def demo_command(out: Path, quick: bool, seed: int) -> None:
       tyredamp demo
       tyredamp demo --out demo-quick --quick --seed 3
     """
+    from ..io._safety import private_matplotlib_config
+
+    with private_matplotlib_config():
+        _demo(out, quick, seed)
+
+
+def _demo(out: Path, quick: bool, seed: int) -> None:
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
-    from ..demo import (
-        DemoSettings,
-        check_output_dir,
-        run_demo,
-        save_demo,
-        single_threaded_blas,
-    )
-    from ..results import build_results
+    from ..report.demo import check_output_dir, save_demo
+    from ..studies.demo import DemoSettings, run_demo, single_threaded_blas
+    from ..studies.document import build_results
 
     check_output_dir(out)
     settings = DemoSettings.quick_preset(seed) if quick else DemoSettings.full(seed)

@@ -7,11 +7,14 @@ from pathlib import Path
 import click
 import numpy as np
 
+from ..documents.modes import write_modes_json
 from ..exceptions import InputError
+from ..frf import FRF, Channel
 from ..io import read_frf
-from ..modal.identify import ModalIdentification, identify_modes
-from ..modal.io import write_modes_json
+from ..io._safety import check_output_file
+from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
+from ..studies.radial import modes_from_frf
 from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
@@ -22,14 +25,19 @@ def modes_table(name: str, model: ModalModel) -> list[str]:
     sf = model.std.get("frequency_hz", np.full(model.n_modes, np.nan))
     sz = model.std.get("damping_ratio", np.full(model.n_modes, np.nan))
     mpc = np.asarray(model.meta.get("mpc", np.full(model.n_modes, np.nan)), float)
+    labels = model.meta.get("wave_number_label")
+    if not isinstance(labels, list) or len(labels) != model.n_modes:
+        labels = None
     rows = [
         f"{name} modes ({model.n_modes}):",
-        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7}",
+        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7}"
+        + ("  wave number" if labels else ""),
     ]
     for n in range(model.n_modes):
         rows.append(
             f"  {n + 1:>3} {model.frequency_hz[n]:>10.3f} {sf[n]:>8.3g} "
             f"{100 * model.damping_ratio[n]:>9.4f} {100 * sz[n]:>8.3g} {mpc[n]:>7.4f}"
+            + (f"  {labels[n]}" if labels else "")
         )
     rmsd = model.meta.get("rmsd", float("nan"))
     rel = model.meta.get("relative_error", float("nan"))
@@ -51,6 +59,44 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     if not vals:
         raise InputError("--frequencies: expected at least one frequency")
     return vals
+
+
+def _with_geometry(frf: FRF, path: Path) -> FRF:
+    """The FRF with channel angles from the geometry when its points lie on a circle."""
+    from dataclasses import replace
+
+    from ..io.uff_geometry import read_uff_geometry
+
+    geo = read_uff_geometry(path)
+    missing = sorted({c.node for c in (*frf.outputs, *frf.inputs)} - set(geo.nodes))
+    if missing:
+        raise InputError(
+            f"--geometry: {path} has no node {missing[0]} ({len(missing)} channel node(s) missing)"
+        )
+    outs = geo.with_angles(frf.outputs)
+    angle = {(c.node, abs(c.direction)): c.angle_deg for c in outs}
+    ins = tuple(
+        Channel(c.node, c.direction, angle.get((c.node, abs(c.direction)), c.angle_deg), c.name)
+        for c in frf.inputs
+    )
+    return replace(frf, outputs=outs, inputs=ins)
+
+
+def _label_wave_numbers(model: ModalModel) -> None:
+    """Put each mode's circumferential wave number into ``model.meta`` when the outputs
+    carry their angles (``wave_number``, ``wave_number_label``, ``wave_number_fraction``;
+    :func:`tyredamp.tyremodel.wave_number_analysis`); nothing otherwise."""
+    from ..tyremodel.wavenumber import wave_number_analysis
+
+    if model.n_modes == 0 or any(c.angle_deg is None for c in model.outputs):
+        return
+    try:
+        wa = wave_number_analysis(model)
+    except InputError:
+        return  # angles that cannot carry a Fourier fit (too few, repeated)
+    model.meta["wave_number"] = [m.n for m in wa.modes]
+    model.meta["wave_number_label"] = [m.label for m in wa.modes]
+    model.meta["wave_number_fraction"] = [m.fraction for m in wa.modes]
 
 
 @click.command("modal")
@@ -85,6 +131,13 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     help="Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
 )
 @click.option("--no-residuals", is_flag=True, help="Fit without lower/upper residual terms.")
+@click.option(
+    "--geometry",
+    "geometry_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="UFF geometry (nodes 15/2411, trace lines 82, systems 18/2420): every channel's node "
+    "must be in it; points on a circle get their angles from it (ring views).",
+)
 def modal_command(
     frf_file: Path,
     out: Path,
@@ -95,6 +148,7 @@ def modal_command(
     max_order: int | None,
     order_step: int,
     no_residuals: bool,
+    geometry_file: Path | None,
 ) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
 
@@ -109,8 +163,11 @@ def modal_command(
       tyredamp modal tyre_frf.uff --out modes.json --band 0 200
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
+    check_output_file(out, [frf_file])
     frf = read_frf(frf_file)
-    res: ModalIdentification = identify_modes(
+    if geometry_file is not None:
+        frf = _with_geometry(frf, geometry_file)
+    res: ModalIdentification = modes_from_frf(
         frf,
         band=None if band is None else (float(band[0]), float(band[1])),
         model=model,  # type: ignore[arg-type]
@@ -120,6 +177,8 @@ def modal_command(
         order_step=order_step,
         residuals=not no_residuals,
     )
+    for mdl in res.models.values():
+        _label_wave_numbers(mdl)
     write_modes_json(
         out, res.models, source=frf_file.name, band_hz=res.band_hz, frf_kind=res.frf_kind
     )

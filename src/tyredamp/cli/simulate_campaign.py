@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 
 from ..exceptions import InputError
-from ._common import seed_option
+from ._common import parse_drive_points, seed_option
 
 __all__ = ["simulate_campaign_command"]
 
@@ -73,9 +73,8 @@ def simulate_campaign_command(out: Path, quick: bool, drive_points: str, seed: i
       tyredamp simulate campaign --out pairs --quick --drive-points 1,5
     """
     from ..campaign.virtual import VirtualCampaign, write_virtual_campaign
-    from .simulate import _points
 
-    points = _points((drive_points,))
+    points = parse_drive_points((drive_points,))
     _check_out(out)
     spec = VirtualCampaign.quick(seed) if quick else VirtualCampaign(seed=seed)
     spec = dataclasses.replace(spec, drive_points=points)

@@ -4,8 +4,8 @@ The usual entry point is :func:`identify_modes` (FRFs in, real and complex
 :class:`ModalModel` out, with standard errors); the stages are public too:
 :func:`plscf` (poles over model orders), :func:`stability_flags` and
 :func:`cluster_poles` (automatic selection), :class:`ModalFitter` (LSFD and
-variable-projection refinement), :mod:`.indicators` and the modes JSON
-(:func:`read_modes_json`, :func:`write_modes_json`).
+variable-projection refinement), and :mod:`.indicators`. The modes JSON
+file is :mod:`tyredamp.documents.modes`.
 """
 
 from __future__ import annotations
@@ -22,7 +22,6 @@ from .indicators import (
     relative_error,
     rmsd,
 )
-from .io import modes_document, read_modes_json, write_modes_json
 from .lscf import PoleSet, plscf
 from .model import ModalModel, ModeKind
 from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
@@ -44,11 +43,8 @@ __all__ = [
     "mac",
     "mean_phase_deviation",
     "modal_phase_collinearity",
-    "modes_document",
     "plscf",
-    "read_modes_json",
     "relative_error",
     "rmsd",
     "stability_flags",
-    "write_modes_json",
 ]

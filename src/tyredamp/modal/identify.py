@@ -62,9 +62,9 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_finite
+from .._validate import as_band, as_finite
 from ..exceptions import ConvergenceError, InputError
-from ..frf import FRF
+from ..frf import FRF, KIND_POWER
 from .fit import FitResult, ModalFitter, _compress, combine_outputs
 from .indicators import mean_phase_deviation, modal_phase_collinearity
 from .lscf import PoleSet, plscf
@@ -76,7 +76,6 @@ __all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
 ModelChoice = Literal["real", "complex", "both"]
 #: a stabilisation diagram: poles of all orders, their flags, kept and weak clusters
 _Diagram = tuple[PoleSet, StabilityFlags, list[Cluster], list[Cluster]]
-_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 #: convergence thresholds of the intermediate fits, in units of the residual
 #: variance s^2 (ModalFitter.fit ``tol``): the joint fits of the search and of the
 #: rejection stop when a further step would lower the cost by less than 10 s^2, a
@@ -249,9 +248,7 @@ def identify_modes(
         raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
     if model not in ("both", "complex", "real"):
         raise InputError(f"model: expected 'both', 'complex' or 'real', got {model!r}")
-    lo, hi = (float(frf.frequency[0]), float(frf.frequency[-1])) if band is None else band
-    if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo or lo < 0:
-        raise InputError(f"band: expected 0 <= f_lo < f_hi in Hz, got [{lo}, {hi}]")
+    lo, hi = (float(frf.frequency[0]), float(frf.frequency[-1])) if band is None else as_band(band)
     fa = frf.frequency
     lines = np.flatnonzero((fa >= lo) & (fa <= hi) & (fa > 0))  # 0 Hz lines are skipped
     if lines.size == 0:
@@ -262,7 +259,7 @@ def identify_modes(
     f = fa[lines]
     H = np.asarray(frf.H) if lines.size == fa.size else np.asarray(frf.H[:, :, lines])
     n_out, n_in, n_f = H.shape
-    power = _POWER[data.kind]
+    power = KIND_POWER[data.kind]
     if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
         raise InputError(f"n_modes: expected a positive integer, got {n_modes!r}")
     fr = None

@@ -6,8 +6,10 @@ from collections.abc import Sequence
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
+
+from ..exceptions import InputError
+from ._axes import single_axes
 
 __all__ = ["plot_matrix"]
 
@@ -27,9 +29,8 @@ def plot_matrix(
     """
     a = np.asarray(matrix, dtype=float)
     if a.ndim != 2:
-        raise ValueError(f"matrix: expected a 2-D array, got shape {a.shape}")
-    if ax is None:
-        ax = Figure(figsize=(4.6, 3.9), layout="constrained").subplots()
+        raise InputError(f"matrix: expected a 2-D array, got shape {a.shape}")
+    ax = single_axes(ax, (4.6, 3.9))
     lim = float(np.max(np.abs(a))) or 1.0
     vmin, vmax = (-lim, lim) if symmetric_colors else (None, None)
     im = ax.imshow(a, cmap="RdBu_r", vmin=vmin, vmax=vmax)

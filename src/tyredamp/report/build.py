@@ -1,8 +1,8 @@
 """The demo's HTML report: results and figures into one self-contained page.
 
 :func:`build_demo_report` lays out the page from a
-:class:`~tyredamp.demo.DemoResult`, its results document
-(:func:`tyredamp.results.build_results`) and the rendered figures
+:class:`~tyredamp.studies.demo.DemoResult`, its results document
+(:func:`tyredamp.studies.document.build_results`) and the rendered figures
 (:func:`tyredamp.report.figures.demo_figures`). Sections: summary, inputs and
 settings, the radial study (checks, stabilisation, modes with standard errors
 beside the truth, real against complex fit, mode shapes, damping matrices with
@@ -22,7 +22,7 @@ from .. import __version__
 from .html import HtmlReport
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult
+    from ..studies.results import DemoResult
 
 __all__ = ["SECTIONS", "build_demo_report", "fmt_pm"]
 
@@ -295,8 +295,12 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     rep.heading("Mode shapes", 3)
     _image(rep, images, "mode_shapes")
 
+    _radial_damping(rep, rad["damping"], images)
+    _radial_pressures(rep, rad["pressures"], images)
+
+
+def _radial_damping(rep: HtmlReport, dmp: dict[str, Any], images: Any) -> None:
     rep.heading("Damping matrices", 3)
-    dmp = rad["damping"]
     rep.table(
         ["diagnostic", "value"],
         [
@@ -318,9 +322,11 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     rep.bullets(dmp["findings"])
     _image(rep, images, "fig05_damping")
 
+
+def _radial_pressures(rep: HtmlReport, pressures: list[dict[str, Any]], images: Any) -> None:
     rep.heading("Inflation pressure", 3)
     rows = []
-    for pr in rad["pressures"]:
+    for pr in pressures:
         ident_n = sum(1 for m in pr["modes"] if m["complex"])
         true_n = sum(1 for m in pr["modes"] if m["true"])
         fr = ", ".join(
@@ -457,6 +463,11 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         for v in speeds:
             _image(rep, images, _fig_name(images, force, v))
 
+    _lateral_vehicle(rep, lat, images)
+
+
+def _lateral_vehicle(rep: HtmlReport, lat: dict[str, Any], images: Any) -> None:
+    models = lat["models"]
     rep.heading("Vehicle model and time response", 3)
     veh = lat["vehicle"]
     tr = lat["time_response"]
@@ -509,7 +520,7 @@ def build_demo_report(
     ----------
     result : DemoResult
     doc : dict
-        Its results document (:func:`tyredamp.results.build_results`).
+        Its results document (:func:`tyredamp.studies.document.build_results`).
     images : mapping of str to (bytes, str)
         PNG bytes and caption of each figure by name
         (:func:`tyredamp.report.figures.demo_figures`).

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..io._atomic import atomic_path
+from ..io._safety import atomic_path
 from .html import HtmlReport
 
 __all__ = ["campaign_report", "write_campaign_report"]

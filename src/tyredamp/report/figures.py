@@ -1,4 +1,4 @@
-"""The figures of the demo report, built from a :class:`~tyredamp.demo.DemoResult`.
+"""The figures of the demo report, built from a :class:`~tyredamp.studies.demo.DemoResult`.
 
 :func:`demo_figures` returns ``{name: (Figure, caption)}`` in report order;
 names are the PNG file stems (``fig02_real_fit`` ... ``fig15_time_response``;
@@ -27,8 +27,8 @@ from ..plot import (
 from ..plot.comparison import model_color
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult, LateralCondition
-    from ..lateral.models import ForceKind
+    from ..lateral.response import ForceKind
+    from ..studies.results import DemoResult, LateralCondition
 
 __all__ = ["PAPER_MODELS", "demo_figures"]
 
@@ -88,6 +88,30 @@ def _radial(result: DemoResult) -> FigureSet:
         "noise level no fit can beat.",
     )
 
+    figs["fig05_damping"] = _damping_figure(result)
+
+    ident = main.identification
+    ax2 = plot_stabilisation(ident.poles, ident.flags, meas, mc.frequency_hz)
+    figs["stabilisation"] = (
+        _figure(ax2),
+        f"Stabilisation diagram (pLSCF poles of every model order) at {p}; dashed lines: "
+        "the modes selected automatically; grey curve: summed FRF amplitude.",
+    )
+    axs3 = plot_mode_shapes_ring(mc)
+    figs["mode_shapes"] = (
+        _figure(axs3[0]),
+        "Complex mode shapes around the circumference (16 points): real part of the "
+        "second-order shape (solid) and imaginary part (dashed), normalised.",
+    )
+
+    figs["checks"] = _checks_figure(result)
+    figs["pressures"] = _pressures_figure(result)
+    return figs
+
+
+def _damping_figure(result: DemoResult) -> tuple[Figure, str]:
+    r = result.radial
+    p = f"{r.main.pressure_bar:g} bar"
     dm = r.damping
     dc = r.damping_truth
     fig = Figure(figsize=(10.0, 8.4), layout="constrained")
@@ -114,27 +138,16 @@ def _radial(result: DemoResult) -> FigureSet:
         )
     else:
         axs[1, 1].set_visible(False)
-    figs["fig05_damping"] = (
+    return (
         fig,
         f"Paper Fig. 5: damping matrices at {p} ({dm.method} method, eq. [18]) as heat maps, "
         "identified beside the truth. Negative (blue) entries of the physical matrix come "
         "from projecting on few modes ('power leakage'), as in the paper.",
     )
 
-    ident = main.identification
-    ax2 = plot_stabilisation(ident.poles, ident.flags, meas, mc.frequency_hz)
-    figs["stabilisation"] = (
-        _figure(ax2),
-        f"Stabilisation diagram (pLSCF poles of every model order) at {p}; dashed lines: "
-        "the modes selected automatically; grey curve: summed FRF amplitude.",
-    )
-    axs3 = plot_mode_shapes_ring(mc)
-    figs["mode_shapes"] = (
-        _figure(axs3[0]),
-        "Complex mode shapes around the circumference (16 points): real part of the "
-        "second-order shape (solid) and imaginary part (dashed), normalised.",
-    )
 
+def _checks_figure(result: DemoResult) -> tuple[Figure, str]:
+    r = result.radial
     fig = Figure(figsize=(9.0, 3.2), layout="constrained")
     axs = fig.subplots(1, 2)
     for ax_, res, name in ((axs[0], r.linearity, "linearity"), (axs[1], r.reciprocity, "")):
@@ -149,7 +162,7 @@ def _radial(result: DemoResult) -> FigureSet:
         )
         ax_.grid(True, which="both", alpha=0.3)
         ax_.legend(fontsize="x-small")
-    figs["checks"] = (
+    return (
         fig,
         f"Linearity (FRFs at {result.settings.force_levels_n[0]:g} N and "
         f"{result.settings.force_levels_n[1]:g} N RMS) and reciprocity (H between drive points "
@@ -157,6 +170,9 @@ def _radial(result: DemoResult) -> FigureSet:
         "relative difference per line and overall.",
     )
 
+
+def _pressures_figure(result: DemoResult) -> tuple[Figure, str]:
+    r = result.radial
     fig = Figure(figsize=(9.0, 3.4), layout="constrained")
     axs = fig.subplots(1, 2)
     for i, run in enumerate(r.runs):
@@ -185,12 +201,11 @@ def _radial(result: DemoResult) -> FigureSet:
     axs[0].legend(fontsize="x-small")
     for a in axs:
         a.grid(True, alpha=0.3)
-    figs["pressures"] = (
+    return (
         fig,
         "Inflation pressure: natural frequencies against wave number and damping ratios, "
         "identified (circles, complex-mode fit) against the exact modes (lines).",
     )
-    return figs
 
 
 def _ground_axle(

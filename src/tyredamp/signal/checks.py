@@ -39,6 +39,7 @@ from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel
 from ..timedata import TimeData
 from .estimators import estimate_frf
+from .periodicity import detect_excitation
 
 __all__ = [
     "CheckResult",
@@ -229,7 +230,8 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     """Join FRFs of separate tests (one or more inputs each) into one matrix.
 
     All must have the same kind (others are converted), lines and outputs;
-    the inputs are concatenated. The coherence is kept only for one FRF.
+    the inputs are concatenated. The coherence is kept only for one FRF; the
+    variance when every FRF has one (each column keeps its own).
     """
     if len(frfs) == 0:
         raise InputError("frfs: expected at least one FRF")
@@ -237,6 +239,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     if len(frfs) == 1:
         return base
     hs = [base.H]
+    vs = [base.variance]
     ins = list(base.inputs)
     for i, f in enumerate(frfs[1:], start=1):
         g = f.to(base.kind) if f.kind != base.kind else f
@@ -246,6 +249,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         ):
             raise ShapeError(f"frfs[{i}]: expected the same outputs as frfs[0]")
         hs.append(g.H)
+        vs.append(g.variance)
         ins += list(g.inputs)
     return FRF(
         base.frequency,
@@ -254,6 +258,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         outputs=base.outputs,
         inputs=ins,
         meta={"merged_from": len(frfs)},
+        variance=None if any(v is None for v in vs) else np.concatenate(vs, axis=1),  # type: ignore[arg-type]
     )
 
 
@@ -388,6 +393,73 @@ def _low_bands(f: NDArray[np.float64], low: NDArray[np.bool_], limit: int = 5) -
     return out
 
 
+def _passivity(
+    frf: FRF, floor: float, ksig: float, figures: dict[str, float], notes: list[str]
+) -> float | None:
+    """Fraction of drive-point lines with ``Re Y / |Y|`` below ``-(floor + ksig eps)``.
+
+    ``eps`` is the normalised random error of the estimate from the
+    coherence and the number of averages. Adds the figures and notes; ``None``
+    without a drive point.
+    """
+    dps = frf.drive_points()
+    figures["drive_points"] = len(dps)
+    if not dps:
+        notes.append("no drive point (no output at an input's point): passivity not checked")
+        return None
+    mob = frf.to("mobility")
+    n_avg = int(frf.meta.get("n_averages", 0) or 0)
+    viol, total, worst = 0, 0, np.inf
+    for i, j in dps:
+        y = _sign(mob.outputs[i]) * _sign(mob.inputs[j]) * mob.H[i, j]
+        mag = np.abs(y)
+        r = _ratio(y.real, mag)
+        r = np.where(mag > 0, r, 0.0)
+        eps = np.zeros_like(r)
+        if mob.coherence is not None and n_avg > 0:
+            g2 = np.clip(mob.coherence[i], 1e-12, 1.0)
+            eps = np.sqrt((1 - g2) / (2 * n_avg * g2))
+        v = r < -(floor + ksig * eps)
+        viol += int(v.sum())
+        total += r.size
+        worst = min(worst, float(r.min()))
+        if v.any():
+            notes.append(
+                f"drive point {mob.outputs[i].label}: Re(mobility) < 0 beyond noise at "
+                f"{int(v.sum())} lines ({', '.join(_low_bands(mob.frequency, v, 3))})"
+            )
+    pfrac = viol / total if total else 0.0
+    figures["passivity_violations"] = viol
+    figures["passivity_fraction"] = pfrac
+    figures["min_drive_point_real_ratio"] = worst
+    return pfrac
+
+
+def _clipping_and_dead(
+    data: TimeData, clip_run: int, figures: dict[str, float], problems: list[str], notes: list[str]
+) -> None:
+    """Clipped and dead channels of ``quality_check`` into its figures, problems and notes."""
+    period = data.acquisition.period_samples
+    live = [i for i in data.force_indices if np.any(data.data[i])]
+    if period is None and live:
+        # a periodic test without metadata repeats its extreme once per period
+        det = detect_excitation(data.data[live])
+        period = det.period_samples if det.kind == "periodic" else None
+    reps = max(1, data.n_samples // int(period)) if period else 1
+    clipped = {c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)}
+    bad = {k: v for k, v in clipped.items() if v > 0}
+    dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
+    figures["clipped_channels"] = len(bad)
+    figures["clipped_samples"] = int(sum(bad.values()))
+    figures["dead_channels"] = len(dead)
+    if bad:
+        problems.append(f"{len(bad)} clipped channel(s)")
+        notes += [f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()]
+    if dead:
+        problems.append(f"{len(dead)} channel(s) of zeros")
+        notes.append(f"channels of zeros: {', '.join(dead)}")
+
+
 def quality_check(
     data: TimeData | FRF,
     *,
@@ -415,8 +487,10 @@ def quality_check(
         (the verdict figure and threshold).
     clip_run : int
         Shortest run of equal samples at a channel extreme counted as
-        clipping (see :func:`clipping`; with ``meta["period_samples"]`` one
-        repeat of the extreme per period is accepted).
+        clipping (see :func:`clipping`; with ``acquisition.period_samples``, or the
+        period detected from the force by
+        :func:`~tyredamp.signal.periodicity.detect_excitation`, one repeat
+        of the extreme per period is accepted).
     passivity_floor : float
         Allowed negative ``Re Y / |Y|`` at a drive point besides the random
         error (0.02 is about 1 degree of phase error).
@@ -443,24 +517,7 @@ def quality_check(
     problems: list[str] = []
     frf: FRF | None
     if isinstance(data, TimeData):
-        period = data.meta.get("period_samples")
-        reps = max(1, data.n_samples // int(period)) if period else 1
-        clipped = {
-            c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)
-        }
-        bad = {k: v for k, v in clipped.items() if v > 0}
-        dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
-        figures["clipped_channels"] = len(bad)
-        figures["clipped_samples"] = int(sum(bad.values()))
-        figures["dead_channels"] = len(dead)
-        if bad:
-            problems.append(f"{len(bad)} clipped channel(s)")
-            notes += [
-                f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()
-            ]
-        if dead:
-            problems.append(f"{len(dead)} channel(s) of zeros")
-            notes.append(f"channels of zeros: {', '.join(dead)}")
+        _clipping_and_dead(data, clip_run, figures, problems, notes)
         dead_force = [i for i in data.force_indices if not np.any(data.data[i])]
         if dead_force or not data.force_indices or not data.response_indices:
             frf = None
@@ -495,38 +552,9 @@ def quality_check(
         notes.append("no coherence available: coherence check skipped")
 
     if frf is not None:
-        dps = frf.drive_points()
-        figures["drive_points"] = len(dps)
-        if not dps:
-            notes.append("no drive point (no output at an input's point): passivity not checked")
-        else:
-            mob = frf.to("mobility")
-            n_avg = int(frf.meta.get("n_averages", 0) or 0)
-            viol, total, worst = 0, 0, np.inf
-            for i, j in dps:
-                y = _sign(mob.outputs[i]) * _sign(mob.inputs[j]) * mob.H[i, j]
-                mag = np.abs(y)
-                r = _ratio(y.real, mag)
-                r = np.where(mag > 0, r, 0.0)
-                eps = np.zeros_like(r)
-                if mob.coherence is not None and n_avg > 0:
-                    g2 = np.clip(mob.coherence[i], 1e-12, 1.0)
-                    eps = np.sqrt((1 - g2) / (2 * n_avg * g2))
-                v = r < -(floor + ksig * eps)
-                viol += int(v.sum())
-                total += r.size
-                worst = min(worst, float(r.min()))
-                if v.any():
-                    notes.append(
-                        f"drive point {mob.outputs[i].label}: Re(mobility) < 0 beyond noise at "
-                        f"{int(v.sum())} lines ({', '.join(_low_bands(mob.frequency, v, 3))})"
-                    )
-            pfrac = viol / total if total else 0.0
-            figures["passivity_violations"] = viol
-            figures["passivity_fraction"] = pfrac
-            figures["min_drive_point_real_ratio"] = worst
-            if pfrac > pthr:
-                problems.append(f"drive point not passive at {100 * pfrac:.3g} % of lines")
+        pfrac = _passivity(frf, floor, ksig, figures, notes)
+        if pfrac is not None and pfrac > pthr:
+            problems.append(f"drive point not passive at {100 * pfrac:.3g} % of lines")
     passed = not problems
     what = "; ".join(problems) if problems else "no clipping, coherence and passivity within limits"
     summary = (
