@@ -275,7 +275,7 @@ def test_output_folder_of_someone_else_is_refused(virtual: Path, tmp_path: Path)
         cli, ["campaign", str(virtual / "campaign.toml"), "--out", str(tmp_path), "--serial"]
     )
     assert res.exit_code != 0
-    assert "not empty" in str(res.exception) or "not empty" in res.output
+    assert "not an earlier campaign output" in str(res.exception)
     assert (tmp_path / "notes.txt").read_text("utf-8") == "mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cache", "notes.txt"]
     assert [p.name for p in (tmp_path / "cache").iterdir()] == ["mine.json"]
@@ -318,14 +318,16 @@ def test_the_adapter_gives_the_documents_of_the_single_test_commands(
     assert modes == json.loads((tmp_path / "m.json").read_text("utf-8"))
     damping = dict(res.documents["damping"])
     cli_damping = json.loads((tmp_path / "d.json").read_text("utf-8"))
+    assert damping["kind"] == cli_damping["kind"] == "damping"  # the documents' own layout
     assert damping.pop("meta")["model"] == cli_damping.pop("meta")["model"] == "complex"
     assert damping == cli_damping
     lat = virtual / "data" / "lateral_5kmh.npz"
     invoke("lateral", "fit", str(lat), "--out", str(tmp_path / "l.json"), "--speed", "5")
     doc = dict(process_lateral_test(lat, {"speed_kmh": 5.0}).documents["fit"])
     cli_doc = json.loads((tmp_path / "l.json").read_text("utf-8"))
+    assert doc["kind"] == cli_doc["kind"] == "lateral-fit"
     assert doc.pop("input")["file"] == "lateral_5kmh.npz"
-    cli_doc.pop("input")
+    assert cli_doc.pop("input")["file"] == str(lat)
     assert doc == cli_doc
 
 

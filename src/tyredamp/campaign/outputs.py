@@ -31,9 +31,10 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -43,7 +44,7 @@ import numpy as np
 from .. import __version__
 from ..documents.jsonfile import write_json
 from ..exceptions import InputError
-from ..io._safety import atomic_path
+from ..io._safety import atomic_path, check_output_dir
 from . import steps
 from .runner import TestRun
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign
@@ -53,7 +54,8 @@ __all__ = [
     "MODE_COLUMNS",
     "TREND_COLUMNS",
     "CampaignResults",
-    "check_output_dir",
+    "campaign_files",
+    "check_campaign_output",
     "lateral_rows",
     "mode_rows",
     "trend_rows",
@@ -132,41 +134,109 @@ _QUANTITIES = (
 )
 
 
-def check_output_dir(out: Path) -> None:
-    """Refuse an output folder that holds anything but an earlier campaign output.
+def check_campaign_output(
+    out: str | os.PathLike[str], inputs: Iterable[str | os.PathLike[str]] = ()
+) -> Path:
+    """Refuse an output folder that is not new, empty or an earlier campaign output; before work.
 
-    The campaign writes only its own files; it never deletes or changes a
-    file it did not write, so a non-empty folder is refused unless it holds
-    a ``campaign.json`` of kind ``tyredamp-campaign`` or, after an
-    interruption, a ``cache`` folder holding only cache entries.
+    The campaign writes only its own files and never deletes or changes a
+    file it did not write: a non-empty folder is accepted only when it holds
+    nothing but what earlier campaign runs wrote there (:func:`campaign_files`:
+    the files its ``campaign.json`` lists, cache entries, and temporaries of
+    our own pattern left by a killed run). A folder that is, or holds, one
+    of the ``inputs`` (the campaign file, the test files) is refused. The
+    rest of the rules (not the current directory, a writable parent, links
+    followed) are those of :func:`tyredamp.io._safety.check_output_dir`.
+
+    Returns
+    -------
+    Path
+        The real folder (links followed).
+
+    Raises
+    ------
+    InputError
+        The message names the folder and the reason.
     """
-    if not out.exists():
-        return
-    if not out.is_dir():
-        raise InputError(f"--out: {out} exists and is not a folder")
-    entries = list(out.iterdir())
-    if not entries:
-        return
-    marker = out / "campaign.json"
+    text = os.fspath(out)
+    real = Path(os.path.realpath(text)) if text else Path()
+    for inp in inputs:
+        r = Path(os.path.realpath(inp))
+        if text and (r == real or real in r.parents):
+            raise InputError(
+                f"--out: {text} is or holds the input file {os.fspath(inp)}; "
+                "choose another directory"
+            )
+    return check_output_dir(out, campaign_files, what="campaign output")
+
+
+def _listed(doc: dict[str, Any]) -> list[str]:
+    """The relative paths a ``campaign.json`` says its campaign wrote."""
+    files = doc.get("written")
+    if not isinstance(files, list):
+        files = list(doc.get("files") or [])
+        for t in doc.get("tests") or []:
+            if isinstance(t, dict) and isinstance(t.get("documents"), dict):
+                files += list(t["documents"].values())
+    ok = []
+    for f in files:
+        if isinstance(f, str) and f and not Path(f).is_absolute() and ".." not in Path(f).parts:
+            ok.append(Path(f).as_posix())
+    return ok
+
+
+def _summary(root: Path) -> dict[str, Any] | None:
     try:
-        ok = json.loads(marker.read_text(encoding="utf-8")).get("kind") == KIND
-    except (OSError, ValueError, AttributeError):
-        ok = False
-    if not ok and not _our_cache(out / "cache"):
-        raise InputError(
-            f"--out: {out} is not empty and holds no earlier campaign output; choose another folder"
+        doc = json.loads((root / "campaign.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    return doc if isinstance(doc, dict) and doc.get("kind") == KIND else None
+
+
+def _temporaries(root: Path, names: Iterable[str]) -> list[str]:
+    """Temporaries of our own pattern beside ``names`` (left by a killed run)."""
+    out = []
+    by_dir: dict[str, list[str]] = defaultdict(list)
+    for n in names:
+        p = Path(n)
+        by_dir[p.parent.as_posix()].append(p.name)
+    for d, base in by_dir.items():
+        pat = re.compile(
+            r"^\.(?:"
+            + "|".join(re.escape(b) for b in base)
+            + r")\.tyredamp-\d+-[0-9a-f]+\.(?:tmp|old)$"
         )
+        try:
+            entries = [e.name for e in os.scandir(root / d)]
+        except OSError:
+            continue
+        out += [(Path(d) / e).as_posix() for e in entries if pat.match(e)]
+    return out
 
 
-def _our_cache(folder: Path) -> bool:
-    """True for a cache folder of an interrupted campaign (only our entries in it)."""
-    if not folder.is_dir():
-        return False
-    names = [p.name for p in folder.iterdir()]
-    return bool(names) and all(_CACHE_NAME.fullmatch(n) for n in names)
+def campaign_files(root: Path) -> list[str] | None:
+    """What earlier campaign runs wrote in ``root`` (relative paths), or None if nothing.
+
+    The files the ``campaign.json`` of the last run lists (every file any run
+    wrote there), the entries of ``cache/`` with the cache's own names, and
+    temporaries of our own pattern beside them. None when ``root`` holds
+    neither a campaign summary nor a cache entry (not a campaign output).
+    """
+    doc = _summary(root)
+    owned = [] if doc is None else _listed(doc)
+    cache = root / "cache"
+    try:
+        entries = [e.name for e in os.scandir(cache)]
+    except OSError:
+        entries = []
+    ours = [f"cache/{n}" for n in entries if _CACHE_NAME.fullmatch(n)]
+    if doc is None and not ours:
+        return None
+    owned += ours
+    return [*owned, *_temporaries(root, owned)]
 
 
-_CACHE_NAME = re.compile(r"[0-9a-f]{64}\.json|\.[0-9a-f]{64}\.json\..*\.tmp")
+_CACHE_NAME = re.compile(r"[0-9a-f]{64}\.json|\.[0-9a-f]{64}\.json\.tyredamp-\d+-[0-9a-f]+\.tmp")
 
 
 def _float(v: Any) -> float:
@@ -450,6 +520,18 @@ def _write_table(rows: Sequence[dict[str, Any]], columns: dict[str, str], stem: 
         tmp.write_text(buf.getvalue(), encoding="utf-8")
 
 
+_FILES = (
+    "modes.parquet",
+    "modes.csv",
+    "damping.parquet",
+    "damping.csv",
+    "trends.parquet",
+    "trends.csv",
+    "lateral.parquet",
+    "lateral.csv",
+    "trend_fits.json",
+    "campaign.json",
+)
 _DOC_FILES = {"modal": "modes.json", "damping": "damping.json", "fit": "lateral.json"}
 
 
@@ -462,6 +544,8 @@ def write_outputs(
     page itself is written by :func:`tyredamp.report.campaign.write_campaign_report`.
     """
     out = Path(out_dir)
+    earlier = _summary(out)
+    written = set() if earlier is None else set(_listed(earlier))
     model = campaign.tracking.get("model", "complex")
     rows = mode_rows(runs, model)
     lrows = lateral_rows(runs)
@@ -469,6 +553,18 @@ def write_outputs(
     fits = trend_fits(rows) + trend_fits(lat_obs, lat_quantities)
     trows = trend_rows(fits)
     drows = damping_rows(runs, rows)
+    files = [*_FILES, *(["report.html"] if report else [])]
+    docs = {
+        (r.spec.test_id, step): f"tests/{r.spec.test_id}/{_DOC_FILES[step]}"
+        for r in runs
+        for step in r.documents
+    }
+    written |= {*files, *docs.values()}
+    # claimed before any is written: an interrupted run leaves an output a rerun accepts
+    write_json(
+        {"kind": KIND, "version": 1, "complete": False, "written": sorted(written)},
+        out / "campaign.json",
+    )
     _write_table(rows, MODE_COLUMNS, out / "modes")
     _write_table(drows, DAMPING_COLUMNS, out / "damping")
     _write_table(trows, TREND_COLUMNS, out / "trends")
@@ -476,11 +572,11 @@ def write_outputs(
     write_json([{**about, "fit": fit.to_dict()} for about, fit, _ in fits], out / "trend_fits.json")
     tests = []
     for r in runs:
-        files = {}
+        test_docs = {}
         for step, doc in r.documents.items():
-            p = out / "tests" / r.spec.test_id / _DOC_FILES[step]
-            write_json(doc, p)
-            files[step] = p.relative_to(out).as_posix()
+            rel = docs[(r.spec.test_id, step)]
+            write_json(doc, out / rel)
+            test_docs[step] = rel
         tests.append(
             {
                 "test_id": r.spec.test_id,
@@ -493,7 +589,7 @@ def write_outputs(
                 "reason": r.reason,
                 "computed": r.computed,
                 "reused": r.reused,
-                "documents": files,
+                "documents": test_docs,
             }
         )
     families: dict[str, dict[str, Any]] = {}
@@ -532,20 +628,12 @@ def write_outputs(
         "tracking_model": model,
         "families": fam_list,
         "tests": tests,
-        "files": [
-            "modes.parquet",
-            "modes.csv",
-            "damping.parquet",
-            "damping.csv",
-            "trends.parquet",
-            "trends.csv",
-            "lateral.parquet",
-            "lateral.csv",
-            "trend_fits.json",
-            "campaign.json",
-        ]
-        + (["report.html"] if report else []),
+        "complete": True,
+        "files": files,
+        # every file any run wrote here: a later run may replace these, and nothing else
+        "written": sorted(written),
     }
+
     write_json(summary, out / "campaign.json")
     return CampaignResults(summary, rows, fits, lrows, drows)
 

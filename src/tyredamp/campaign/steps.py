@@ -8,22 +8,27 @@ step names, settings dictionaries and documents, never the processing
 itself, so pointing this module at :mod:`tyredamp.studies` changes nothing
 else.
 
-Today the steps call the same public library functions, with the same
-defaults, as the single-test commands:
+The steps are those of :mod:`tyredamp.studies`, called with the same
+arguments and defaults as the single-test commands, and their documents are
+those of :mod:`tyredamp.documents` (the files the commands write):
 
 * radial ``modal``: :func:`tyredamp.io.read` (time data or FRFs); for time
-  data :func:`tyredamp.signal.estimate_frf` as ``tyredamp frf`` and
-  :func:`tyredamp.signal.quality_check` as ``tyredamp check quality``; then
-  :func:`tyredamp.modal.identify.identify_modes` as ``tyredamp modal``; the
-  document is :func:`tyredamp.modal.io.modes_document` (the modes JSON of
-  ``tyredamp modal``, ``docs/modes-json.md``) with a ``"campaign"`` entry
-  holding the FRF summary and the quality check;
-* radial ``damping``: :func:`tyredamp.damping.identify_damping` on the chosen
-  model as ``tyredamp damping``; the document is
-  :meth:`tyredamp.damping.DampingModel.to_dict` (``docs/damping-json.md``);
-* lateral ``fit``: :meth:`tyredamp.lateral.fit.LateralData.from_frf` and
-  :func:`tyredamp.lateral.fit.rank_models` as ``tyredamp lateral fit``, in the
-  lateral-fit JSON layout of that command.
+  data :func:`tyredamp.studies.radial.frf_from_time` as ``tyredamp frf``;
+  :func:`tyredamp.studies.radial.check_quality` as ``tyredamp check
+  quality``; :func:`tyredamp.studies.radial.modes_from_frf` and
+  :func:`tyredamp.studies.radial.label_wave_numbers` as ``tyredamp modal``;
+  the document is :func:`tyredamp.documents.modes.modes_document` (the modes
+  JSON, ``docs/modes-json.md``) with a ``"campaign"`` entry holding the FRF
+  summary and the quality check;
+* radial ``damping``: :func:`tyredamp.studies.radial.damping_from_modes` on
+  the models of that modes document
+  (:func:`tyredamp.documents.modes.models_from_document`), as ``tyredamp
+  damping``; the document is
+  :func:`tyredamp.documents.damping.damping_document` (``docs/damping-json.md``);
+* lateral ``fit``: :func:`tyredamp.studies.lateral.lateral_data` and
+  :func:`tyredamp.studies.lateral.fit_models` as ``tyredamp lateral fit``
+  (a test where no model fits fails with the reasons); the document is
+  :func:`tyredamp.documents.lateral.lateral_fit_document`.
 
 Settings
 --------
@@ -61,7 +66,7 @@ __all__ = [
 ]
 
 _ESTIMATORS = ("H1", "H2", "Hv")
-_FRF_METHODS = ("auto", "cyclic", "welch", "transient")
+_FRF_METHODS = ("auto", "cyclic", "welch", "transient", "lrm", "lpm")
 _MODAL_MODELS = ("both", "real", "complex")
 _DAMPING_METHODS = ("first", "improved", "refined")
 _WEIGHTS = ("auto", "relative", "coherence", "uniform")
@@ -378,36 +383,32 @@ def _check_dict(res: Any) -> dict[str, Any]:
 def _radial_modal(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
+    """``tyredamp frf`` (time data only), ``check quality`` and ``tyredamp modal``."""
     from ..documents.modes import modes_document
     from ..frf import FRF
     from ..io import read
-    from ..modal.identify import identify_modes
-    from ..signal import estimate_frf, quality_check
+    from ..studies.radial import check_quality, frf_from_time, label_wave_numbers, modes_from_frf
 
     fs, cs, ms = settings["frf"], settings["checks"], settings["modal"]
     obj = read(path)
-    quality = None
     if isinstance(obj, FRF):
         frf = obj
         source_kind = "frf"
     else:
-        frf = estimate_frf(
+        frf = frf_from_time(
             obj,
             fs["estimator"],
             method=None if fs["method"] == "auto" else fs["method"],
             segment_samples=fs["segment"],
-            band=None if fs["band"] is None else tuple(fs["band"]),
+            band=None if fs["band"] is None else (fs["band"][0], fs["band"][1]),
         )
         source_kind = "time"
+    quality = None
     if cs["quality"]:
-        quality = _check_dict(
-            quality_check(
-                obj,
-                coherence_min=cs["coherence_min"],
-                max_low_coherence_fraction=cs["max_low_fraction"],
-            )
+        quality = check_quality(
+            obj, coherence_min=cs["coherence_min"], max_low_fraction=cs["max_low_fraction"]
         )
-    res = identify_modes(
+    res = modes_from_frf(
         frf,
         band=None if ms["band"] is None else (ms["band"][0], ms["band"][1]),
         model=ms["model"],
@@ -417,13 +418,15 @@ def _radial_modal(
         order_step=ms["order_step"],
         residuals=ms["residuals"],
     )
+    for mdl in res.models.values():
+        label_wave_numbers(mdl)
     doc = modes_document(res.models, source=path.name, band_hz=res.band_hz, frf_kind=res.frf_kind)
     doc["campaign"] = {
         "input": source_kind,
         "n_out": frf.n_out,
         "n_in": frf.n_in,
         "n_lines": int(res.frequency.size),
-        "quality": quality,
+        "quality": None if quality is None else _check_dict(quality),
         "warnings": list(res.warnings),
     }
     return doc
@@ -432,49 +435,49 @@ def _radial_modal(
 def _radial_damping(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
-    from ..damping import identify_damping
-    from ..modal.model import ModalModel
+    """``tyredamp damping`` on the modes document of the modal step."""
+    from ..documents.damping import damping_document
+    from ..documents.modes import models_from_document
+    from ..studies.radial import damping_from_modes
 
     ds = settings["damping"]
-    models = upstream["modal"]["models"]
+    models = models_from_document(dict(upstream["modal"]))
     if ds["model"] not in models:
         raise InputError(
             f"settings.radial.damping.model: the modes hold models {sorted(models)}, "
             f"not {ds['model']!r}"
         )
-    d = models[ds["model"]]
-    model = ModalModel.from_dict(d)
-    for extra in ("rmsd", "relative_error"):  # as read_modes_json does
-        if extra in d and extra not in model.meta:
-            model.meta[extra] = d[extra]
-    dm = identify_damping(
-        model,
-        ds["method"],
+    dm = damping_from_modes(
+        models,
+        model=ds["model"],
+        method=ds["method"],
         normalise=ds["normalise"],
         n_samples=ds["samples"],
         seed=ds["seed"],
         meta={"source": path.name, "model": ds["model"]},
     )
-    return dm.to_dict()
+    return damping_document(dm)
 
 
 def _lateral_fit(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
+    """``tyredamp lateral fit`` with the test's speed."""
+    from ..documents.lateral import lateral_fit_document
     from ..io import read_frf
-    from ..lateral import DEFAULT_MODELS, LateralData, rank_models
-    from ..virtual.lateral_rig import KMH
+    from ..lateral import DEFAULT_MODELS
+    from ..studies.lateral import fit_models, lateral_data
 
     s = settings["fit"]
     frf = read_frf(path)
     speed_kmh = None if conditions is None else conditions.get("speed_kmh")
-    data = LateralData.from_frf(
+    data = lateral_data(
         frf,
-        speed=None if speed_kmh is None else float(speed_kmh) * KMH,
+        speed_kmh=None if speed_kmh is None else float(speed_kmh),
         force=s["force"],
         wheel_mass=s["wheel_mass_kg"],
     )
-    ranking = rank_models(
+    ranking = fit_models(
         data,
         s["models"] or list(DEFAULT_MODELS),
         criterion=s["criterion"],
@@ -482,25 +485,8 @@ def _lateral_fit(
         weights=s["weights"],
         channel=(s["channel"][0], s["channel"][1]),
     )
-    best = ranking.best
-    # the layout of ``tyredamp lateral fit`` (cli/lateral.py)
-    return {
-        "tyredamp": "lateral-fit",
-        "version": 1,
-        "input": {
-            "file": path.name,
-            "kind": frf.kind,
-            "n_lines": best.n_lines,
-            "band_hz": [float(best.frequency[0]), float(best.frequency[-1])],
-        },
-        "conditions": {
-            "speed_m_s": data.speed,
-            "speed_kmh": None if data.speed is None else data.speed / KMH,
-            "force": data.force,
-            "wheel_mass_kg": data.wheel_mass,
-        },
-        **ranking.to_dict(),
-    }
+    ranking.check()  # no model fits: the test fails with the reasons, as the command does
+    return lateral_fit_document(ranking, data, source=path.name, frf_kind=frf.kind)
 
 
 _STEP_FUNCTIONS: dict[tuple[str, str], Callable[..., dict[str, Any]]] = {

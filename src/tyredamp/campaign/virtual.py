@@ -27,10 +27,9 @@ checked where no test was made.
 from __future__ import annotations
 
 import itertools
+import json
 import math
 import os
-import shutil
-import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -41,11 +40,13 @@ from numpy.typing import NDArray
 from ..documents.jsonfile import write_json
 from ..exceptions import InputError
 from ..io import write_frf
-from ..io._safety import atomic_path
+from ..io._safety import atomic_dir, atomic_path, check_output_dir
 from ..virtual import Imperfection, MeasurementLayout, RingTyre, RingTyreParameters
 
 __all__ = [
+    "TRUTH_KIND",
     "VirtualCampaign",
+    "check_virtual_output",
     "compare_with_truth",
     "contact_patch",
     "tyre_truth",
@@ -53,6 +54,8 @@ __all__ = [
 ]
 
 BAR = 1.0e5
+#: ``kind`` of the truth.json of a virtual campaign.
+TRUTH_KIND = "tyredamp-virtual-campaign-truth"
 #: Default contact-patch foundation stiffness per unit length, N/m^2.
 CONTACT_STIFFNESS = 1.0e6
 
@@ -208,15 +211,16 @@ def write_virtual_campaign(
     Writes ``data/T{k}_{p}bar_{F}N.uff`` (radial H1 FRFs, UFF 58b, of the
     virtual modal test: 16 points, the spec's drive points, periodic chirp
     0-200 Hz, 40 dB SNR), ``data/lateral_{v}kmh.npz`` (lateral rig, ground
-    force), ``truth.json`` and ``campaign.toml``. Everything is written into
-    a temporary folder beside ``out`` first and moved in at the end
-    (``truth.json`` last), so an error leaves ``out`` as it was. Returns the
-    truth document.
+    force), ``truth.json`` and ``campaign.toml``. ``out`` must be new, empty
+    or an earlier virtual campaign holding only its own files
+    (:func:`check_virtual_output`); everything is written into a temporary
+    folder beside it and renamed into place whole, so an error leaves ``out``
+    as it was. Returns the truth document.
 
     Parameters
     ----------
     out : path
-        Folder to write into (created; files of the same names are replaced).
+        Folder to write (created, or an earlier virtual campaign replaced whole).
     spec : VirtualCampaign, optional
         Sizes (default the full campaign: 3 tyres x 5 pressures x 3 loads).
     progress : callable, optional
@@ -227,20 +231,41 @@ def write_virtual_campaign(
     for p in s.pressures_bar:
         if not (math.isfinite(p) and p > 0):
             raise InputError(f"pressures_bar: expected pressures > 0 bar, got {p}")
-    final = Path(out)
-    final.parent.mkdir(parents=True, exist_ok=True)
-    # written into a private folder beside ``out`` and moved in at the end: an error or an
-    # interruption leaves nothing half-written in ``out``
-    root = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
-    try:
+    check_virtual_output(out)
+    # written into a private folder beside ``out`` and renamed into place whole: an error
+    # or an interruption leaves ``out`` as it was
+    with atomic_dir(out) as root:
         doc = _write(s, root, progress)
-        for f in sorted(p for p in root.rglob("*") if p.is_file()):
-            target = final / f.relative_to(root)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(f, target)
-    finally:
-        shutil.rmtree(root, ignore_errors=True)
     return doc
+
+
+def check_virtual_output(out: str | os.PathLike[str]) -> Path:
+    """Refuse an output folder that is not new, empty or an earlier virtual campaign; before work.
+
+    An earlier virtual campaign (a ``truth.json`` of kind
+    ``tyredamp-virtual-campaign-truth``) is replaced only when the folder holds
+    nothing but the files it wrote (its data files, ``truth.json`` and
+    ``campaign.toml``); anything else (a campaign's results, a file of yours)
+    stops it, and nothing is deleted. See
+    :func:`tyredamp.io._safety.check_output_dir`. Returns the real folder.
+    """
+    return check_output_dir(out, _virtual_files, what="virtual campaign")
+
+
+def _virtual_files(root: Path) -> list[str] | None:
+    try:
+        doc = json.loads((root / "truth.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    if not isinstance(doc, dict) or doc.get("kind") != TRUTH_KIND:
+        return None
+    files = [t.get("file") for t in doc.get("tests") or [] if isinstance(t, dict)]
+    ok = [
+        f
+        for f in files
+        if isinstance(f, str) and f and not Path(f).is_absolute() and ".." not in Path(f).parts
+    ]
+    return [*ok, "truth.json", "campaign.toml"]
 
 
 def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
@@ -318,7 +343,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
             if progress is not None:
                 progress(done, total)
     doc = {
-        "kind": "tyredamp-virtual-campaign-truth",
+        "kind": TRUTH_KIND,
         "version": 1,
         "contact_stiffness_n_m2": CONTACT_STIFFNESS,
         "spec": {

@@ -120,7 +120,7 @@ def campaign_command(
       tyredamp simulate campaign --out virtual --quick
       tyredamp campaign virtual/campaign.toml --out results --workers 2
     """
-    from ..campaign.outputs import check_output_dir, write_outputs
+    from ..campaign.outputs import check_campaign_output, write_outputs
     from ..campaign.runner import run_tests
     from ..campaign.spec import load_campaign
 
@@ -135,7 +135,7 @@ def campaign_command(
     out_dir = out if out is not None else campaign.output
     if out_dir is None:
         raise InputError(f"--out: not given and {campaign_file} has no 'output'")
-    check_output_dir(out_dir)
+    check_campaign_output(out_dir, [campaign_file, *(t.path for t in campaign.tests)])
     mode = "serial" if serial else ("scheduler" if scheduler else "local")
     progress = _Progress(sys.stderr.isatty())
     t0 = time.perf_counter()

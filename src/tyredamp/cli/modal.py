@@ -14,7 +14,7 @@ from ..io import read_frf
 from ..io._safety import check_output_file
 from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
-from ..studies.radial import modes_from_frf
+from ..studies.radial import label_wave_numbers, modes_from_frf
 from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
@@ -80,23 +80,6 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
         for c in frf.inputs
     )
     return replace(frf, outputs=outs, inputs=ins)
-
-
-def _label_wave_numbers(model: ModalModel) -> None:
-    """Put each mode's circumferential wave number into ``model.meta`` when the outputs
-    carry their angles (``wave_number``, ``wave_number_label``, ``wave_number_fraction``;
-    :func:`tyredamp.tyremodel.wave_number_analysis`); nothing otherwise."""
-    from ..tyremodel.wavenumber import wave_number_analysis
-
-    if model.n_modes == 0 or any(c.angle_deg is None for c in model.outputs):
-        return
-    try:
-        wa = wave_number_analysis(model)
-    except InputError:
-        return  # angles that cannot carry a Fourier fit (too few, repeated)
-    model.meta["wave_number"] = [m.n for m in wa.modes]
-    model.meta["wave_number_label"] = [m.label for m in wa.modes]
-    model.meta["wave_number_fraction"] = [m.fraction for m in wa.modes]
 
 
 @click.command("modal")
@@ -178,7 +161,7 @@ def modal_command(
         residuals=not no_residuals,
     )
     for mdl in res.models.values():
-        _label_wave_numbers(mdl)
+        label_wave_numbers(mdl)
     write_modes_json(
         out, res.models, source=frf_file.name, band_hz=res.band_hz, frf_kind=res.frf_kind
     )

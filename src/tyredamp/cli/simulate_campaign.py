@@ -3,34 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
-import json
 import sys
 from pathlib import Path
 
 import click
 
-from ..exceptions import InputError
 from ._common import parse_drive_points, seed_option
 
 __all__ = ["simulate_campaign_command"]
-
-
-def _check_out(out: Path) -> None:
-    if not out.exists():
-        return
-    if not out.is_dir():
-        raise InputError(f"--out: {out} exists and is not a folder")
-    if not any(out.iterdir()):
-        return
-    try:
-        kind = json.loads((out / "truth.json").read_text(encoding="utf-8")).get("kind")
-    except (OSError, ValueError, AttributeError):
-        kind = None
-    if kind != "tyredamp-virtual-campaign-truth":
-        raise InputError(
-            f"--out: {out} is not empty and holds no earlier virtual campaign; "
-            "choose another folder"
-        )
 
 
 @click.command("campaign")
@@ -72,10 +52,10 @@ def simulate_campaign_command(out: Path, quick: bool, drive_points: str, seed: i
       tyredamp campaign virtual/campaign.toml --out results
       tyredamp simulate campaign --out pairs --quick --drive-points 1,5
     """
-    from ..campaign.virtual import VirtualCampaign, write_virtual_campaign
+    from ..campaign.virtual import VirtualCampaign, check_virtual_output, write_virtual_campaign
 
     points = parse_drive_points((drive_points,))
-    _check_out(out)
+    check_virtual_output(out)
     spec = VirtualCampaign.quick(seed) if quick else VirtualCampaign(seed=seed)
     spec = dataclasses.replace(spec, drive_points=points)
 
