@@ -70,3 +70,48 @@ def test_a_task_on_a_missing_or_changed_file_fails_with_its_reason(tmp_path: Pat
     out = execute(missing)  # the digest is not the one planned
     assert out.reason == "x.uff: the file changed during the campaign"
     assert out.documents == {}
+
+
+def test_what_an_earlier_campaign_wrote_may_be_replaced_and_nothing_else(tmp_path: Path) -> None:
+    import json
+
+    import pytest
+
+    from tyredamp.campaign.outputs import campaign_files, check_campaign_output
+    from tyredamp.exceptions import InputError
+
+    out = tmp_path / "res"
+    assert campaign_files(out) is None  # nothing there
+    (out / "cache").mkdir(parents=True)
+    key = "ab" * 32
+    (out / "cache" / f"{key}.json").write_text("{}")
+    # an interrupted first run: only cache entries and a killed write's temporary
+    (out / "cache" / f".{key}.json.tyredamp-123-0a1b2c3d.tmp").write_text("")
+    assert check_campaign_output(out) == out.resolve()
+    # the claim written before the tables: the files it is about to write are its own
+    doc = {"kind": "tyredamp-campaign", "version": 1, "written": ["campaign.json", "modes.csv"]}
+    (out / "campaign.json").write_text(json.dumps(doc))
+    (out / "modes.csv").write_text("x\n")
+    (out / ".modes.csv.tyredamp-99-deadbeef.tmp").write_text("")
+    assert set(campaign_files(out) or []) >= {
+        "campaign.json",
+        "modes.csv",
+        f"cache/{key}.json",
+        ".modes.csv.tyredamp-99-deadbeef.tmp",
+    }
+    check_campaign_output(out)
+    # a file the campaign did not write stops it, and stays
+    (out / "modes.parquet.bak").write_text("mine")
+    with pytest.raises(InputError, match=r"modes\.parquet\.bak"):
+        check_campaign_output(out)
+    assert (out / "modes.parquet.bak").read_text() == "mine"
+    # a summary that is not ours makes the folder someone else's
+    (out / "modes.parquet.bak").unlink()
+    (out / "campaign.json").write_text(json.dumps({"kind": "other"}))
+    (out / "cache" / f"{key}.json").unlink()
+    (out / "cache" / f".{key}.json.tyredamp-123-0a1b2c3d.tmp").unlink()
+    with pytest.raises(InputError, match="not an earlier campaign output"):
+        check_campaign_output(out)
+    # an output folder that holds an input is refused
+    with pytest.raises(InputError, match="holds the input file"):
+        check_campaign_output(tmp_path, [out / "modes.csv"])

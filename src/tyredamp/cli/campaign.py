@@ -11,6 +11,7 @@ from typing import Any
 import click
 
 from ..exceptions import InputError
+from ._common import OutPath
 
 __all__ = ["EXIT_FAILED_TESTS", "campaign_command"]
 
@@ -77,7 +78,7 @@ class _Progress:
     "--out",
     "-o",
     "out",
-    type=click.Path(file_okay=False, path_type=Path),
+    type=OutPath(path_type=Path),
     help="Output folder (default: 'output' of the campaign file). Holds the cache, so a "
     "rerun recomputes only what changed.",
 )

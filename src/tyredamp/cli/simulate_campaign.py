@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from ._common import parse_drive_points, seed_option
+from ._common import OutPath, parse_drive_points, seed_option
 
 __all__ = ["simulate_campaign_command"]
 
@@ -19,7 +19,7 @@ __all__ = ["simulate_campaign_command"]
     "-o",
     "out",
     required=True,
-    type=click.Path(file_okay=False, path_type=Path),
+    type=OutPath(path_type=Path),
     help="Folder to write (data/, truth.json, campaign.toml).",
 )
 @click.option(
