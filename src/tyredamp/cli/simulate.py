@@ -5,7 +5,9 @@
 function type 1) or, with ``--frf``, the H1 FRFs estimated from it (function
 type 4); ``--truth`` also writes the exact modes as a modes JSON file.
 ``simulate lateral`` is the rolling-tyre rig; it is the same command as
-``tyredamp lateral simulate`` (same options, same output).
+``tyredamp lateral simulate`` (same options, same output). ``simulate
+campaign`` (:mod:`.simulate_campaign`) writes a whole virtual test campaign
+and its campaign file for ``tyredamp campaign``.
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ def simulate_group() -> None:
       tyredamp simulate radial --out tyre_test.uff --pressure 7.5 --seed 1
       tyredamp simulate radial --out tyre_frf.uff --frf --truth truth.json
       tyredamp simulate lateral --out rig.npz --speed 5 --pressure 1.7
+      tyredamp simulate campaign --out virtual
     """
 
 
