@@ -11,7 +11,7 @@ Prints
    predicted frequencies at the held-out pressures 6 and 8 bar;
 3. the coverage of the 1-sigma intervals over 200 noise seeds: modes generated
    from the analytic ring (spec ``virtual-tyre.md``, via
-   ``tyredamp.tyre.analytic_ring_frequencies``) at the true parameters, n =
+   ``tyredamp.virtual.analytic_ring_frequencies``) at the true parameters, n =
    1..7 at 5, 7, 9 bar, the driven member with the 0.1 kg / 350 N s/m shaker
    attachment, plus Gaussian noise (frequency 0.1 %, shape amplitude 1 %,
    damping ratio 2 %) given to the fit as the modal standard errors;

@@ -243,3 +243,65 @@ def test_uff_keeps_many_runs_or_refuses(tmp_path: Path) -> None:
         write_timedata(td, tmp_path / "uneven.uff")
     assert not (tmp_path / "uneven.uff").exists()
     assert read_timedata(write_timedata(td, tmp_path / "uneven.npz")).acquisition == uneven
+
+
+@pytest.mark.parametrize("fmt", [*LOSSLESS, "uff58"])
+def test_long_meta_round_trips_in_every_writer(tmp_path: Path, fmt: str) -> None:
+    """Metadata longer than the UFF ID lines (a lateral rig's conditions and truth) survive."""
+    rng = np.random.default_rng(4)
+    meta = {
+        "speed_m_s": 5 / 3.6,
+        "speed_kmh": 5.0,
+        "pressure_bar": 1.7,
+        "force": "axle",
+        "wheel_mass_kg": 100.0,
+        "label": "  1.7 bar, 5 km/h  ",  # leading/trailing blanks kept
+        "truth": {"params": {"C_alpha": 8e4, "sigma": 0.5932605191260101}, "units": ["N/rad"]},
+        "description": "a description " * 12 + "ünïcode \\u0020 NONE",
+        "estimator": "H1",
+    }
+    frf = sample_frf(rng, n_out=2, n_in=1)
+    frf = FRF(frf.frequency, frf.H, frf.kind, frf.outputs, frf.inputs, frf.coherence, meta)
+    back = read_frf(write_frf(frf, tmp_path / f"frf{EXT[fmt]}", fmt))
+    assert back.meta == meta
+    td = sample_timedata(rng)
+    td = TimeData(
+        td.data,
+        td.sample_rate,
+        td.channels,
+        td.quantities,
+        meta={**meta, "x": [1] * 99},
+        acquisition=td.acquisition,
+    )
+    back_t = read_timedata(write_timedata(td, tmp_path / f"td{EXT[fmt]}", fmt))
+    assert back_t.meta == td.meta
+    assert back_t.acquisition == td.acquisition  # typed, beside the metadata record
+
+
+def test_uff_meta_record_is_deterministic_and_readable_by_pyuff(tmp_path: Path) -> None:
+    import pyuff
+
+    rng = np.random.default_rng(5)
+    frf = sample_frf(rng, n_out=1, n_in=1)
+    frf.meta["truth"] = {"params": list(range(200))}
+    a = write_frf(frf, tmp_path / "a.uff").read_bytes()
+    b = write_frf(frf, tmp_path / "b.uff").read_bytes()
+    assert a == b
+    sets = pyuff.UFF(str(tmp_path / "a.uff")).read_sets()
+    heads = [s for s in sets if s["type"] == 151]
+    assert len(heads) >= 2
+    assert heads[0]["model_name"].startswith("tyredamp1 meta 1 ")
+    assert [s["func_type"] for s in sets if s["type"] == 58] == [4, 6]
+    # a missing part is an error, not a silent loss
+    raw = (tmp_path / "a.uff").read_bytes()
+    first = raw.index(b"    -1\n   151")
+    second = raw.index(b"    -1\n   151", first + 10)
+    (tmp_path / "c.uff").write_bytes(raw[:first] + raw[second:])
+    with pytest.raises(FileFormatError, match="incomplete tyredamp metadata record"):
+        read_frf(tmp_path / "c.uff")
+    # a damaged record is an error naming it, and the file is left as it was
+    bad = raw.replace(b'{"estimator"', b'{"estimator"}}', 1)
+    (tmp_path / "d.uff").write_bytes(bad)
+    with pytest.raises(FileFormatError, match="metadata record"):
+        read_frf(tmp_path / "d.uff")
+    assert (tmp_path / "d.uff").read_bytes() == bad

@@ -225,3 +225,39 @@ def test_clipping_counter() -> None:
     assert clipping(per, repeats=5) == 0
     with pytest.raises(InputError, match="min_run"):
         clipping(x, 1)
+
+
+def test_low_coherence_bands_print_single_lines_once() -> None:
+    from tyredamp.signal.checks import _low_bands
+
+    f = np.array([25.0, 25.5, 26.0, 26.5, 27.0])
+    low = np.array([False, True, False, True, True])
+    assert _low_bands(f, low) == ["25.5 Hz", "26.5-27 Hz"]
+
+
+def test_dependent_forces_finds_a_reaction_force_not_a_second_shaker() -> None:
+    from tyredamp.signal.checks import dependent_forces
+    from tyredamp.timedata import TimeData
+
+    rng = np.random.default_rng(0)
+    n = 4000
+    body = rng.standard_normal(n)
+    acc = np.convolve(body, np.exp(-np.arange(50) / 8.0), "same") / 5.0  # a dynamic response
+    ground = body - 2.0 * acc  # reaction under a driven 2 kg body
+    chans = [Channel(1, 2, name="body force"), Channel(1, 2, name="acc"), Channel(2, 2, name="g")]
+
+    def td(rows: list[np.ndarray]) -> TimeData:
+        noisy = [r + 0.01 * r.std() * rng.standard_normal(n) for r in rows]
+        return TimeData(np.array(noisy), 100.0, chans, ["force", "acceleration", "force"])
+
+    dep = dependent_forces(td([body, acc, ground]))
+    assert {k for k, _, _ in dep} == {0, 2}
+    for _, r2, uses in dep:
+        assert r2 > 0.99
+        assert 1 in uses  # the response is part of the combination
+    # two independent shakers and a response to both: no instantaneous relation
+    other = rng.standard_normal(n)
+    resp = np.convolve(body + other, np.exp(-np.arange(50) / 8.0), "same")
+    assert dependent_forces(td([body, resp, other])) == []
+    with pytest.raises(InputError, match="min_r2"):
+        dependent_forces(td([body, acc, ground]), min_r2=1.5)

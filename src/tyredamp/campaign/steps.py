@@ -15,8 +15,9 @@ those of :mod:`tyredamp.documents` (the files the commands write):
 * radial ``modal``: :func:`tyredamp.io.read` (time data or FRFs); for time
   data :func:`tyredamp.studies.radial.frf_from_time` as ``tyredamp frf``;
   :func:`tyredamp.studies.radial.check_quality` as ``tyredamp check
-  quality``; :func:`tyredamp.studies.radial.modes_from_frf` and
-  :func:`tyredamp.studies.radial.label_wave_numbers` as ``tyredamp modal``;
+  quality``; :func:`tyredamp.studies.radial.modes_from_frf`,
+  :func:`tyredamp.studies.radial.label_wave_numbers` and
+  :func:`tyredamp.studies.verdicts.modal_verdicts` as ``tyredamp modal``;
   the document is :func:`tyredamp.documents.modes.modes_document` (the modes
   JSON, ``docs/modes-json.md``) with a ``"campaign"`` entry holding the FRF
   summary and the quality check;
@@ -102,7 +103,7 @@ DEFAULTS: dict[str, dict[str, dict[str, Any]]] = {
             "band": None,
             "weights": "auto",
             "criterion": "bic",
-            "channel": [0, 0],
+            "channel": None,
         },
     },
 }
@@ -229,13 +230,17 @@ def _nonneg_or_none(value: Any, where: str) -> float | None:
     return float(value)
 
 
-def _channel(value: Any, where: str) -> list[int]:
+def _channel(value: Any, where: str) -> list[int] | None:
+    if value is None:
+        return None
     if (
         not isinstance(value, list)
         or len(value) != 2
-        or not all(isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in value)
+        or not all(isinstance(v, int) and not isinstance(v, bool) and v >= 1 for v in value)
     ):
-        raise InputError(f"{where}: expected [output, input] positions >= 0, got {value!r}")
+        raise InputError(
+            f"{where}: expected [output, input] counted from 1 (as --channel), got {value!r}"
+        )
     return [int(v) for v in value]
 
 
@@ -387,7 +392,9 @@ def _radial_modal(
     from ..documents.modes import modes_document
     from ..frf import FRF
     from ..io import read
+    from ..signal.checks import dependent_forces
     from ..studies.radial import check_quality, frf_from_time, label_wave_numbers, modes_from_frf
+    from ..studies.verdicts import modal_verdicts
 
     fs, cs, ms = settings["frf"], settings["checks"], settings["modal"]
     obj = read(path)
@@ -395,6 +402,16 @@ def _radial_modal(
         frf = obj
         source_kind = "frf"
     else:
+        dep = dependent_forces(obj) if len(obj.force_indices) > 1 else []
+        if dep:  # every force channel is an input: refused as 'tyredamp frf' does
+            k, r2, uses = dep[0]
+            lab = obj.channels
+            raise InputError(
+                f"{path.name}: force {lab[k].label} is {100 * r2:.4g} % a linear combination "
+                f"of {' and '.join(lab[i].label for i in uses)}: the forces are not "
+                "independent excitations (one is a reaction); give the FRFs, or time data "
+                "with the excitation forces only"
+            )
         frf = frf_from_time(
             obj,
             fs["estimator"],
@@ -420,6 +437,8 @@ def _radial_modal(
     )
     for mdl in res.models.values():
         label_wave_numbers(mdl)
+    for name, v in modal_verdicts(frf, res).items():  # meta.verdict, as 'tyredamp modal'
+        res.models[name].meta["verdict"] = v.to_dict()
     doc = modes_document(res.models, source=path.name, band_hz=res.band_hz, frf_kind=res.frf_kind)
     doc["campaign"] = {
         "input": source_kind,
@@ -466,10 +485,23 @@ def _lateral_fit(
     from ..documents.lateral import lateral_fit_document
     from ..io import read_frf
     from ..lateral import DEFAULT_MODELS
+    from ..lateral.models import get_model_class
     from ..studies.lateral import fit_models, lateral_data
 
     s = settings["fit"]
     frf = read_frf(path)
+    channel = s["channel"]
+    where = "settings.lateral.fit"
+    if channel is not None and (channel[0] > frf.n_out or channel[1] > frf.n_in):
+        raise InputError(
+            f"{where}.channel: expected an output 1..{frf.n_out} and an input 1..{frf.n_in} "
+            f"of {path.name}, got {channel}"
+        )
+    if channel is None and frf.n_out * frf.n_in != 1:
+        raise InputError(
+            f"{where}.channel: {path.name} holds {frf.n_out}x{frf.n_in} FRFs and a lateral "
+            "fit takes one; choose it with channel = [OUT, IN] (counted from 1)"
+        )
     speed_kmh = None if conditions is None else conditions.get("speed_kmh")
     data = lateral_data(
         frf,
@@ -477,13 +509,21 @@ def _lateral_fit(
         force=s["force"],
         wheel_mass=s["wheel_mass_kg"],
     )
+    names = s["models"] or list(DEFAULT_MODELS)
+    if data.speed is None:
+        need = [n for n in names if "speed" in get_model_class(n).condition_names]
+        if need:
+            raise InputError(
+                f"speed_kmh: the {', '.join(need)} model(s) need the travel speed and "
+                f"{path.name} does not store it; give the test's speed_kmh"
+            )
     ranking = fit_models(
         data,
-        s["models"] or list(DEFAULT_MODELS),
+        names,
         criterion=s["criterion"],
         band=None if s["band"] is None else (s["band"][0], s["band"][1]),
         weights=s["weights"],
-        channel=(s["channel"][0], s["channel"][1]),
+        channel=None if channel is None else (channel[0] - 1, channel[1] - 1),
     )
     ranking.check()  # no model fits: the test fails with the reasons, as the command does
     return lateral_fit_document(ranking, data, source=path.name, frf_kind=frf.kind)

@@ -11,8 +11,10 @@ from ..exceptions import InputError
 from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
 from ..io._safety import check_output_file
+from ..signal.checks import dependent_forces
 from ..signal.estimators import ESTIMATORS
 from ..studies.radial import frf_from_time
+from ..timedata import TimeData
 from ._common import out_file_option
 
 __all__ = ["frf_command", "frf_summary", "samples"]
@@ -67,6 +69,24 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
             f"{100 * np.mean(coh < coherence_min):.3g} % of lines below {coherence_min:g}"
         )
     return rows
+
+
+def _refuse_dependent_forces(td: TimeData) -> None:
+    """Every force channel would be an input: refuse when one follows from the others."""
+    dep = dependent_forces(td)
+    if not dep:
+        return
+    k, r2, uses = dep[0]
+    lab = td.channels
+    forces = ", ".join(f"{lab[i].label}" for i in td.force_indices)
+    raise InputError(
+        f"--reference: every force channel would be an input ({forces}), but "
+        f"{lab[k].label} is {100 * r2:.4g} % a linear combination of "
+        f"{' and '.join(lab[i].label for i in uses)}: the forces are not independent "
+        "excitations (one is a reaction, such as the ground force under a driven body, "
+        "F_ground = F_body - m a); choose the excitation with --reference, for example "
+        f"--reference '{lab[td.force_indices[0]].label}'"
+    )
 
 
 @click.command("frf")
@@ -150,6 +170,8 @@ def frf_command(
     check_output_file(out, [time_file])
     out_format = format_of(out, fmt)
     td = read_timedata(time_file)
+    if not references and len(td.force_indices) > 1:
+        _refuse_dependent_forces(td)
     frf = frf_from_time(
         td,
         estimator,  # type: ignore[arg-type]

@@ -41,6 +41,11 @@ def _model_list(values: tuple[str, ...]) -> list[str]:
     return [get_model_class(n).name for n in names]
 
 
+def _with_unit(name: str, value: float, unit: str) -> str:
+    """``"sigma = 0.5933 m"``; dimensionless values (unit ``-``) without a unit."""
+    return f"{name} = {value:.4g}" + ("" if unit in ("", "-") else f" {unit}")
+
+
 @click.group("lateral")
 def lateral_group() -> None:
     """Lateral tyre dynamics: fit spring-damper models, simulate the rolling-tyre rig.
@@ -103,11 +108,11 @@ def lateral_group() -> None:
 @click.option(
     "--channel",
     nargs=2,
-    type=int,
+    type=click.IntRange(min=1),
     default=None,
     metavar="OUT IN",
-    help="Output and input positions of the FRF to fit (needed when the file holds "
-    "more than one FRF).",
+    help="Output and input of the FRF to fit, counted from 1 like every other option "
+    "(needed when the file holds more than one FRF).",
 )
 def fit_command(
     frf_file: Path,
@@ -136,23 +141,51 @@ def fit_command(
     names = _model_list(models)
     if speed is not None and not (math.isfinite(speed) and speed > 0):
         raise InputError(f"--speed: expected a speed > 0 km/h, got {speed}")
+    if channel is not None and (channel[0] > frf.n_out or channel[1] > frf.n_in):
+        raise InputError(
+            f"--channel: expected an output 1..{frf.n_out} and an input 1..{frf.n_in} of "
+            f"{frf_file}, got {channel[0]} {channel[1]}"
+        )
+    if channel is None and frf.n_out * frf.n_in != 1:
+        raise InputError(
+            f"--channel: {frf_file} holds {frf.n_out}x{frf.n_in} FRFs and a lateral fit takes "
+            "one; choose it with --channel OUT IN (counted from 1)"
+        )
     data = lateral_data(
         frf,
         speed_kmh=speed,
         force=force,  # type: ignore[arg-type]
         wheel_mass=wheel_mass,
     )
+    if data.speed is None:
+        need = [n for n in names if "speed" in get_model_class(n).condition_names]
+        if need:
+            raise InputError(
+                f"--speed: the {', '.join(need)} model{'s' if len(need) > 1 else ''} "
+                f"need{'' if len(need) > 1 else 's'} the travel speed and {frf_file} does not "
+                "store it; give --speed KMH"
+            )
     ranking = fit_models(
         data,
         names,
         criterion=criterion,  # type: ignore[arg-type]
         band=band,
         weights=weights,
-        channel=channel,
+        channel=None if channel is None else (channel[0] - 1, channel[1] - 1),
     )
     ranking.check()  # no model fits: exit 3 with the reasons, nothing written
     best = ranking.best
     write_lateral_fit(out, ranking, data, source=str(frf_file), frf_kind=frf.kind)
+    assumed = []
+    if force is None and "force" not in frf.meta:
+        assumed.append(
+            "the file does not say which force the FRF refers to: ground assumed "
+            "(give --force axle for an axle-force FRF)"
+        )
+    if wheel_mass is None and "wheel_mass_kg" not in frf.meta and data.force == "axle":
+        assumed.append("the file gives no wheel mass: 0 kg assumed (give --wheel-mass KG)")
+    for a in assumed:
+        click.echo(f"note: {a}", err=True)
     sp = "?" if data.speed is None else f"{data.speed / KMH:g} km/h"
     click.echo(
         f"{frf_file}: {best.n_lines} lines {best.frequency[0]:.3g}-{best.frequency[-1]:.3g} Hz, "
@@ -232,9 +265,10 @@ def simulate_command(
     data = rig.measure(speed, pressure, force, seed)  # type: ignore[arg-type]
     path = write_frf(data.frf, out, fmt)
     truth = data.frf.meta["truth"]["params"]
+    units = data.frf.meta["truth"].get("units", {})
     click.echo(
         f"virtual rig: {data.label}, {force} force, wheel mass {rig.wheel_mass:g} kg, "
         f"{data.frf.n_freq} lines {data.frf.frequency[0]:g}-{data.frf.frequency[-1]:g} Hz; "
-        "truth " + ", ".join(f"{k} = {v:.4g}" for k, v in truth.items())
+        "truth " + ", ".join(_with_unit(k, v, units.get(k, "")) for k, v in truth.items())
     )
     click.echo(f"wrote {path}")

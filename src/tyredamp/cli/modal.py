@@ -15,6 +15,7 @@ from ..io._safety import check_output_file
 from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
 from ..studies.radial import label_wave_numbers, modes_from_frf
+from ..studies.verdicts import modal_verdicts
 from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
@@ -162,6 +163,9 @@ def modal_command(
     )
     for mdl in res.models.values():
         label_wave_numbers(mdl)
+    verdicts = modal_verdicts(frf, res)
+    for name, v in verdicts.items():  # stored with the model: meta.verdict of the modes JSON
+        res.models[name].meta["verdict"] = v.to_dict()
     write_modes_json(
         out, res.models, source=frf_file.name, band_hz=res.band_hz, frf_kind=res.frf_kind
     )
@@ -180,4 +184,8 @@ def modal_command(
         click.echo(f"RMSD real / complex = {ratio:.3g}")
     for w in res.warnings:
         click.echo(f"warning: {w}")
+    for v in verdicts.values():
+        click.echo(f"verdict: {v.summary()}")
+        for c in v.cautions:
+            click.echo(f"  caution: {c}")
     click.echo(f"wrote {out}")

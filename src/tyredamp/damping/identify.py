@@ -411,7 +411,8 @@ def _refine(
             raise ConvergenceError(
                 "refined damping estimate: the bias-correction equations have no solution "
                 "near the first-order estimate (modes too strongly coupled or inconsistent); "
-                "use method='improved' and read the diagnostics"
+                "use the improved method (--method improved; method='improved' in Python) "
+                "and read the diagnostics"
             ) from None
         x = sol.x * scale
         it += int(sol.nfev)

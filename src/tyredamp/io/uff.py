@@ -23,7 +23,10 @@ What is written
   data the acquisition fields first (``period_samples``, ``settle_samples``,
   ``record_samples``, ``run_starts`` (evenly spaced runs as ``run_every``:
   [step, count]), ``band_hz`` ..., read back into ``TimeData.acquisition``;
-  an acquisition that does not fit is an error, never silently dropped);
+  an acquisition that does not fit is an error, never silently dropped),
+  then the operating conditions of a lateral rig FRF (``speed_m_s``,
+  ``force``, ``wheel_mass_kg``, ``pressure_bar``); the whole ``meta`` is in
+  the metadata record below when it does not fit;
   ID lines 4 and 5: channel name and angle of the response and reference as
   JSON (``NONE`` when there are none); time data have no reference, and ID
   line 5 continues the metadata.
@@ -40,8 +43,13 @@ stores every value as a float64 and the frequencies as uneven abscissa
 values: FRF and time data round-trip bit for bit. ASCII 58 (format
 ``"uff58"``) stores values in E20.12 fields, 12 significant digits, relative
 error up to 5e-12; the frequency axis must then be evenly spaced (it is
-rebuilt exactly from ID line 2). Free metadata beyond 80 characters of JSON
-is not kept by either (use NPZ for that).
+rebuilt exactly from ID line 2).
+
+Metadata record
+---------------
+When ``meta`` does not fit the ID lines whole, the file also holds the whole
+``meta`` as JSON in a chain of data sets 151 (header) placed before the data
+sets 58, so nothing is truncated (layout in :mod:`tyredamp.io._uff_meta`).
 
 Reading other programs' files
 -----------------------------
@@ -73,6 +81,7 @@ from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
 from ._atomic import atomic_path
 from ._common import check_input_file, meta_to_json, wrap_errors
+from ._uff_meta import meta_record, read_meta_record
 from .units import frf_units, quantity_units
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
@@ -130,6 +139,11 @@ _PRIORITY = (
     "method",
     "n_averages",
     "exponential_tau_s",
+    # operating conditions of a lateral rig FRF, readable in the ID lines by other programs
+    "speed_m_s",
+    "force",
+    "wheel_mass_kg",
+    "pressure_bar",
     "description",
 )
 
@@ -155,6 +169,14 @@ def _meta_lines(meta: dict[str, Any], n_lines: int) -> list[str]:
         lines.append(meta_to_json(kept) if kept else "NONE")
         left = rest
     return lines
+
+
+def _meta_fits(meta: dict[str, Any], lines: list[str]) -> bool:
+    """True when the ID ``lines`` written by :func:`_meta_lines` hold every key of ``meta``."""
+    kept: dict[str, Any] = {}
+    for line in lines:
+        kept.update(_extras(line))
+    return all(k in kept for k in meta)
 
 
 def _even_axis(f: np.ndarray) -> str | None:
@@ -226,10 +248,14 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
     """
     if isinstance(obj, FRF):
         sets = _frf_sets(obj, binary)
+        id_lines = [sets[0]["id3"]]
     elif isinstance(obj, TimeData):
         sets = _timedata_sets(obj, binary)
+        id_lines = [sets[0]["id3"], sets[0]["id5"]]  # time data: ID line 5 continues them
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
+    if not _meta_fits(obj.meta, id_lines):
+        sets = [*meta_record(obj.meta), *sets]
     with atomic_path(path) as tmp, warnings.catch_warnings():
         # pyuff's 58b writer reopens the file and leaves that handle to the garbage
         # collector: silence the ResourceWarning and collect inside this block
@@ -423,6 +449,7 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
                 f"{p}: no data set 58 (function at nodal DOF); found types {sorted(set(types))}"
             )
         sets = uff.read_sets(idx)
+        record = read_meta_record(p, uff, types)
     except FileFormatError:
         raise
     except Exception as exc:  # pyuff raises bare Exception, and others on garbage
@@ -438,6 +465,9 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
                 f"{s.get('num_pts')} values, found {got}"
             )
         s["_index"] = k + 1
+    if record is not None:
+        for s in sets:
+            s["_meta"] = record
     return sets
 
 
@@ -578,6 +608,8 @@ def _meta(s: dict[str, Any], tok: dict[str, str] | None) -> dict[str, Any]:
     desc = str(s.get("id1", "")).strip()
     if desc and desc != "NONE" and not desc.startswith("tyredamp "):
         meta.setdefault("description", desc)
+    if "_meta" in s:  # the whole meta from the metadata record (the acquisition stays above)
+        meta.update(s["_meta"])
     return meta
 
 
@@ -619,7 +651,8 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
             if q is None:
                 raise FileFormatError(
                     f"{where}: cannot tell the response quantity (ordinate data type "
-                    f"{s.get('ordinate_spec_data_type')}, no units label); pass kind="
+                    f"{s.get('ordinate_spec_data_type')}, no units label); give the ordinate "
+                    "data type or units label in the file, or kind= to read_frf (Python)"
                 )
             if q == "force":
                 raise FileFormatError(f"{where}: the ordinate is a force, not a response")

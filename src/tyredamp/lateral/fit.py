@@ -179,7 +179,8 @@ def _prepare(
         if frf.n_out * frf.n_in != 1:
             raise ShapeError(
                 f"channel: the FRF holds {frf.n_out}x{frf.n_in} FRFs, a lateral fit takes one; "
-                "choose it with channel=(out, in) (command line: --channel OUT IN)"
+                "choose it with channel=(out, in), counted from 0 (command line: --channel OUT IN, "
+                "counted from 1)"
             )
         channel = (0, 0)
     i, j = channel
@@ -506,8 +507,9 @@ def _conditions(cls: type[LateralModel], data: LateralData) -> dict[str, float]:
         if n == "speed":
             if data.speed is None:
                 raise InputError(
-                    f"speed: the {cls.name!r} model needs the travel speed (m/s); "
-                    f"give speed= or set frf.meta['speed_m_s']"
+                    f"speed: the {cls.name!r} model needs the travel speed: give speed= in "
+                    "m/s (Python), --speed KMH (command line), or store it with the FRF "
+                    "(meta key speed_m_s, as tyredamp's rig files do)"
                 )
             cond["speed"] = float(data.speed)
         else:  # pragma: no cover - no other condition exists yet

@@ -43,7 +43,7 @@ from ..io import FILE_FORMATS, read
 from ..io._common import check_input_file
 from ..modal.model import ModalModel
 from ..timedata import TimeData
-from .build import fmt_pm
+from .build import _verdict, fmt_pm
 from .html import HtmlReport
 
 __all__ = ["ResultFile", "build_files_report", "load_result_file"]
@@ -270,6 +270,11 @@ def _modes_section(
             caption=f"{name}-mode model ({m.n_modes} modes): value ± standard error"
             + ("; truth of the virtual tyre beside" if tmodel is not None else ""),
         )
+        v = m.meta.get("verdict")
+        if isinstance(v, dict) and "summary" in v and "passed" in v:
+            _verdict(rep, v)  # written by tyredamp modal
+        for w in m.meta.get("warnings", []):
+            rep.paragraph(f"warning ({name}-mode fit): {w}", css_class="bad")
     if len(models) > 1:
         rep.table(
             ["model", "RMSD (eq. [19])", "relative error"],
@@ -525,6 +530,16 @@ def _demo_section(rep: HtmlReport, item: ResultFile) -> None:
         f"{100 * rad['damping']['modal_error']:.3g} % of the truth."
     )
     _modes_table(rep, rad["modes"], "Modes identified beside the truth.")
+    for pr in rad.get("pressures", []):
+        for v in (pr.get("verdict") or {}).values():
+            _verdict(rep, v)
+    for c in lat.get("conditions", []):
+        if c.get("verdict"):
+            _verdict(rep, c["verdict"])
+    ws = doc.get("warnings", [])
+    if ws:
+        rep.paragraph(f"Warnings of every stage of the run ({len(ws)}):")
+        rep.bullets([f"{w['stage']}: {w['message']}" for w in ws])
     rep.table(
         ["rank", "model", "mean rank", "best at", "amplitude error (%)"],
         [

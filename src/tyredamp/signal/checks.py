@@ -44,6 +44,7 @@ from .periodicity import detect_excitation
 __all__ = [
     "CheckResult",
     "clipping",
+    "dependent_forces",
     "linearity_check",
     "merge_inputs",
     "quality_check",
@@ -387,7 +388,10 @@ def _low_bands(f: NDArray[np.float64], low: NDArray[np.bool_], limit: int = 5) -
     at = np.concatenate(([0], low.astype(np.int8), [0]))
     e = np.diff(at)
     starts, stops = np.flatnonzero(e == 1), np.flatnonzero(e == -1) - 1
-    out = [f"{f[a]:.4g}-{f[b]:.4g} Hz" for a, b in zip(starts, stops, strict=True)]
+    out = [
+        f"{f[a]:.4g} Hz" if a == b else f"{f[a]:.4g}-{f[b]:.4g} Hz"
+        for a, b in zip(starts, stops, strict=True)
+    ]
     if len(out) > limit:
         out = [*out[:limit], f"... ({len(out) - limit} more)"]
     return out
@@ -564,3 +568,56 @@ def quality_check(
     return CheckResult(
         "quality", passed, low_frac, thr, figures, summary, freq, per_line, tuple(notes)
     )
+
+
+def dependent_forces(
+    data: TimeData, channels: Sequence[int] | None = None, min_r2: float = 0.95
+) -> list[tuple[int, float, list[int]]]:
+    """Force channels that are an instantaneous linear combination of other channels.
+
+    An excitation force is independent of the other channels sample by
+    sample; a reaction force measured beside it (the ground force of a
+    vehicle body driven by a shaker: ``F_ground = F_body - m a``) is a linear
+    combination of the excitation and a response. Each force channel is
+    regressed by least squares on every other channel (and a constant); a
+    coefficient of determination ``R^2`` above ``min_r2`` (default 0.95:
+    what is left is at most 5 % of its variance, the noise of a measured
+    channel) marks it as dependent. Dynamic relations (a response to several
+    shakers) are not instantaneous and give low ``R^2`` (about 0.5 on the
+    virtual tyre driven at two points).
+
+    Parameters
+    ----------
+    data : TimeData
+    channels : sequence of int, optional
+        Force channels to test (indices); default every force channel.
+    min_r2 : float
+        Threshold of ``R^2``, 0 < min_r2 < 1.
+
+    Returns
+    -------
+    list of (int, float, list of int)
+        ``(channel, R^2, channels of the combination)`` for each dependent
+        force; the combination lists the channels whose coefficients carry
+        at least 1 % of the fitted variance.
+    """
+    if not 0 < min_r2 < 1:
+        raise InputError(f"min_r2: expected 0 < min_r2 < 1, got {min_r2}")
+    idx = list(data.force_indices) if channels is None else [int(c) for c in channels]
+    out = []
+    x_all = data.data
+    for k in idx:
+        y = x_all[k] - x_all[k].mean()
+        vy = float(np.mean(y**2))
+        if vy == 0:
+            continue
+        others = [i for i in range(data.n_channels) if i != k]
+        x = np.column_stack([x_all[i] - x_all[i].mean() for i in others])
+        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+        fit = x @ coef
+        r2 = 1.0 - float(np.mean((y - fit) ** 2)) / vy
+        if r2 > min_r2:
+            part = (coef * np.sqrt(np.mean(x**2, axis=0))) ** 2
+            uses = [others[j] for j in np.flatnonzero(part >= 0.01 * part.sum())]
+            out.append((k, r2, uses))
+    return out

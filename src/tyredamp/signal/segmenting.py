@@ -188,7 +188,10 @@ class SegmentPlan:
 
 def _cyclic_plan(period: int | None, window: Any, overlap: Any) -> SegmentPlan:
     if period is None:
-        raise InputError("method: 'cyclic' needs period_samples (argument or timedata.acquisition)")
+        raise InputError(
+            "method: 'cyclic' needs the period length: period_samples= (Python) or the period "
+            "stored with the time data (acquisition metadata)"
+        )
     seg = as_count(period, "period_samples", minimum=2)
     if window not in (None, "boxcar", "rect", "rectangular"):
         raise InputError(f"window: the cyclic method uses whole periods unwindowed, got {window!r}")
@@ -217,7 +220,8 @@ def _transient_plan(
 ) -> SegmentPlan:
     if record is None:
         raise InputError(
-            "method: 'transient' needs segment_samples or timedata.acquisition.record_samples"
+            "method: 'transient' needs the record length: --segment N (command line), "
+            "segment_samples= (Python) or the record length stored with the time data"
         )
     seg = as_count(record, "segment_samples", minimum=2)
     if overlap not in (None, 0, 0.0):

@@ -20,17 +20,25 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from .. import __version__
 from ..documents.demo import RESULTS_KIND, RESULTS_VERSION
 from ..documents.jsonfile import finite
 from ..exceptions import InputError
+from .findings import DemoFindings, demo_findings, lateral_key, radial_key
 
 if TYPE_CHECKING:
     from ..lateral.fit import LateralFit
     from .results import DemoResult, LateralCondition, PressureRun
 
-__all__ = ["build_results", "corner_frequency_std", "lateral_overall_ranking"]
+__all__ = [
+    "build_results",
+    "corner_frequency_std",
+    "equivalent_models",
+    "lateral_overall_ranking",
+    "time_test_truth",
+]
 
 
 def _matrix(a: Any) -> list[list[float]]:
@@ -119,6 +127,77 @@ def _fit_quality(run: PressureRun) -> dict[str, Any]:
     }
 
 
+def time_test_truth(result: DemoResult) -> tuple[NDArray[np.float64], dict[str, float]]:
+    """The rig's own steady-state body acceleration in the time test and the gaps it shows.
+
+    Returns
+    -------
+    (ndarray, dict)
+        The exact body acceleration of the rig's vehicle (m/s^2, on
+        ``time_test.data.time``) and ``{"truth_vs_measured": e, <model>: g}``:
+        RMS of truth minus measurement over RMS of the measurement in the
+        window (the noise alone), and for each fitted model the RMS of its
+        prediction minus the truth over RMS of the truth (its own error,
+        free of noise).
+    """
+    from ..lateral import harmonic_response
+
+    tt = result.lateral.time_test
+    t = tt.data.time
+    truth = harmonic_response(
+        result.lateral.vehicle.truth, tt.frequency_hz, tt.force_amplitude, t, "acceleration"
+    )
+    win = (t >= tt.window_s[0]) & (t <= tt.window_s[1])
+    meas = tt.data.data[1]
+
+    def rel(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+        return float(np.sqrt(np.mean((a[win] - b[win]) ** 2) / np.mean(b[win] ** 2)))
+
+    gaps = {"truth_vs_measured": rel(truth, meas)}
+    for name, pred in tt.predictions.items():
+        gaps[name] = rel(pred, truth)
+    return np.asarray(truth, dtype=float), gaps
+
+
+def equivalent_models(conditions: Sequence[LateralCondition]) -> list[list[str]]:
+    """Groups of fitted models that are the same model in other parameters.
+
+    Two fits are the same model when they have the same number of parameters
+    and their fitted FRFs agree to 1e-6 (relative, every line) at every
+    condition: for example the first-order relaxation-length model with the
+    speed known is the Maxwell model with ``k = C_alpha/sigma``,
+    ``c = C_alpha/V`` (:meth:`~tyredamp.lateral.models.RelaxationLengthModel.maxwell`).
+    Their ranking order is then decided by rounding alone.
+    """
+    if not conditions:
+        return []
+    names = [f.name for f in conditions[0].ranking.fits]
+    groups: list[list[str]] = []
+    seen: set[str] = set()
+    for i, a in enumerate(names):
+        if a in seen:
+            continue
+        group = [a]
+        for b in names[i + 1 :]:
+            if b in seen:
+                continue
+            same = True
+            for c in conditions:
+                fa, fb = c.fit(a), c.fit(b)
+                scale = float(np.max(np.abs(fa.fitted)))
+                if fa.n_params != fb.n_params or not np.all(
+                    np.abs(fa.fitted - fb.fitted) <= 1e-6 * scale
+                ):
+                    same = False
+                    break
+            if same:
+                group.append(b)
+        if len(group) > 1:
+            groups.append(sorted(group))
+            seen.update(group)
+    return groups
+
+
 def corner_frequency_std(fit: LateralFit) -> float:
     """Standard error of ``f0 = K / (2 pi C_r)`` of a hysteretic fit (delta method), Hz.
 
@@ -177,6 +256,7 @@ def _condition(cond: LateralCondition) -> dict[str, Any]:
             "fitted": hy.params["C_r"],
             "stderr": hy.stderr["C_r"],
             "true": cond.true_road_damping,
+            "ratio": hy.params["C_r"] / cond.true_road_damping,
             "unit": "N s/m",
         },
         "params": params,
@@ -192,9 +272,13 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
     list of dict
         ``model``, ``mean_rank``, ``wins`` (conditions where it is best),
         ``n_conditions``, ``mean_delta``, ``mean_amplitude_error_pct``,
-        ``mean_amplitude_bias_pct``, ``mean_axle_amplitude_error_pct``.
+        ``mean_amplitude_bias_pct``, ``mean_axle_amplitude_error_pct``,
+        ``equivalent`` (the models of the entry: models that are the same
+        model in other parameters, :func:`equivalent_models`, share one
+        entry named ``"a = b"`` with their best mean rank, so that rounding
+        cannot order them).
     """
-    stats: dict[str, dict[str, list[float]]] = {}
+    stats: dict[str, dict[str, list[float]]] = {}  # per model, one value per condition
     for c in conditions:
         for row, fit in zip(c.ranking.rows(), c.ranking.fits, strict=True):
             s = stats.setdefault(
@@ -205,9 +289,19 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
             s["err"].append(row["amplitude_error_pct"])
             s["bias"].append(row["amplitude_bias_pct"])
             s["axle"].append(100 * _axle_errors(c, fit)[0])
-    out = [
+    groups = equivalent_models(conditions)
+    for group in groups:  # one model in other parameters: one entry, its best rank per condition
+        parts = [stats.pop(g) for g in group if g in stats]
+        if not parts:
+            continue
+        merged = {k: list(v) for k, v in parts[0].items()}
+        merged["rank"] = [float(min(x)) for x in zip(*(p["rank"] for p in parts), strict=True)]
+        merged["delta"] = [float(min(x)) for x in zip(*(p["delta"] for p in parts), strict=True)]
+        stats[" = ".join(group)] = merged
+    out: list[dict[str, Any]] = [
         {
             "model": name,
+            "equivalent": next((list(g) for g in groups if " = ".join(g) == name), [name]),
             "mean_rank": float(np.mean(s["rank"])),
             "wins": int(sum(1 for r in s["rank"] if r == 1)),
             "n_conditions": len(s["rank"]),
@@ -224,7 +318,7 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
     return out
 
 
-def _radial_section(result: DemoResult) -> dict[str, Any]:
+def _radial_section(result: DemoResult, fnd: DemoFindings) -> dict[str, Any]:
     """``radial``: the main pressure, its checks, modes and damping, and every pressure."""
     s = result.settings
     r = result.radial
@@ -250,6 +344,7 @@ def _radial_section(result: DemoResult) -> dict[str, Any]:
             "nonproportionality": tyre.nonproportionality,
         },
         **_fit_quality(main),
+        "verdict": {k: v.to_dict() for k, v in fnd.radial[radial_key(main)].items()},
         "checks": {
             "linearity": _check(r.linearity),
             "reciprocity": _check(r.reciprocity),
@@ -277,6 +372,7 @@ def _radial_section(result: DemoResult) -> dict[str, Any]:
                 "pressure_bar": run.pressure_bar,
                 "n_averages": run.n_periods,
                 **_fit_quality(run),
+                "verdict": {k: v.to_dict() for k, v in fnd.radial[radial_key(run)].items()},
                 "modes": _modes(run),
             }
             for run in r.runs
@@ -284,18 +380,23 @@ def _radial_section(result: DemoResult) -> dict[str, Any]:
     }
 
 
-def _lateral_section(result: DemoResult) -> dict[str, Any]:
+def _lateral_section(result: DemoResult, fnd: DemoFindings) -> dict[str, Any]:
     """``lateral``: every condition, the ranking, Figure 7, the vehicle and the time test."""
     from ..lateral.characteristics import corner_differences
 
     lat = result.lateral
     conds = [_condition(c) for c in lat.conditions]
+    for c, cd_ in zip(lat.conditions, conds, strict=True):
+        vs = fnd.lateral[lateral_key(c)]
+        cd_["verdict"] = vs[c.ranking.best.name].to_dict()
+        cd_["verdicts"] = {k: v.to_dict() for k, v in vs.items()}
     fig7 = lat.figure7.model
     cd = corner_differences(fig7)
     veh = lat.vehicle
     tt = lat.time_test
     ce = tt.causal
     ref = lat.reference
+    _, tt_gaps = time_test_truth(result)
     return {
         "models": list(result.settings.lateral_models),
         "criterion": lat.conditions[0].ranking.criterion,
@@ -332,8 +433,11 @@ def _lateral_section(result: DemoResult) -> dict[str, Any]:
                 None if veh.truth_resonance is None else veh.truth_resonance.frequency
             ),
         },
+        "equivalent_models": equivalent_models(lat.conditions),
         "time_response": {
             "frequency_hz": tt.frequency_hz,
+            "truth_error": tt_gaps["truth_vs_measured"],
+            "error_to_truth": {k: v for k, v in tt_gaps.items() if k != "truth_vs_measured"},
             "force_amplitude_n": tt.force_amplitude,
             "window_s": list(tt.window_s),
             "relative_error": dict(tt.errors),
@@ -366,6 +470,7 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         Valid against :func:`tyredamp.documents.demo.load_schema` (checked in the tests).
     """
     s = result.settings
+    fnd = demo_findings(result)
     doc = {
         "kind": RESULTS_KIND,
         "version": RESULTS_VERSION,
@@ -376,8 +481,9 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         "elapsed_s": result.elapsed_s,
         "timings_s": dict(result.timings),
         "files": list(files or []),
-        "radial": _radial_section(result),
-        "lateral": _lateral_section(result),
+        "radial": _radial_section(result, fnd),
+        "lateral": _lateral_section(result, fnd),
+        "warnings": [f.to_dict() for f in fnd.findings],
     }
     out = finite(doc)
     assert isinstance(out, dict)

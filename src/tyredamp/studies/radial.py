@@ -388,7 +388,7 @@ def run_radial(s: DemoSettings, stage: StageCallback | None = None) -> RadialStu
     )
     frf_high = frf_from_time(high.data, "H1")
     lin = check_linearity([main.frf, frf_high], band=s.check_band_hz)
-    quality = check_quality(main.test.data)
+    quality = check_quality(main.test.data, band=s.check_band_hz)  # the band of the other checks
 
     start(f"radial: reciprocity check, drive points {s.reciprocity_points}")
     recip_test = run_modal_test(

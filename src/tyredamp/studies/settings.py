@@ -46,8 +46,8 @@ class DemoSettings:
     snr_db : float
         Signal-to-noise ratio of every channel of the modal tests, dB.
     check_band_hz : (float, float)
-        Band of the linearity and reciprocity figures, Hz (below it the
-        accelerance of a free tread band is tiny and noise dominates).
+        Band of the linearity, reciprocity and data-quality checks, Hz (below
+        it the accelerance of a free tread band is tiny and noise dominates).
     damping_method : {"first", "improved", "refined"}
         Estimator of ``C'`` (eq. [16], [18] or bias-corrected).
     damping_samples : int

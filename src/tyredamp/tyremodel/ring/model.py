@@ -7,7 +7,7 @@ Dynamics*, ch. 9; Gong 1993) has, for wave number ``n >= 1``,
 ``omega_n^2 = [EI n^2 (n^2-1)^2/R^4 + T0 n^2 (n^2-1)/R^2 + k_r n^2 + k_t]
 / [rho A (1 + n^2)]``                                                    (1)
 
-(the same formula as :func:`tyredamp.tyre.analytic_ring_frequencies`), and
+(the same formula as :func:`tyredamp.virtual.analytic_ring_frequencies`), and
 its mass-normalised radial shape ``A cos n(theta - theta_0)`` has
 
 ``A^2 = n^2 / (pi R rho A (1 + n^2))``                                     (2)
@@ -33,7 +33,7 @@ Damping: modal viscous damping of the ring with radial and tangential
 foundation dampers ``c_r``, ``c_t`` (N s/m^2), a band loss on the bending
 stiffness only (``eta_b K_bend``, ``eta_b = eta / omega_ref`` in s) and a
 local radial damper ``c_d`` (N s/m) at the drive point(s), as in the virtual
-tyre (:class:`tyredamp.tyre.RingTyreParameters`):
+tyre (:class:`tyredamp.virtual.RingTyreParameters`):
 
 ``2 zeta_n omega_n = [c_r n^2 + c_t + eta_b EI n^2 (n^2-1)^2/R^4] (1 - m_a phi_d^2)
 / [rho A (1 + n^2)] + c_d phi_d^2``                                      (3)

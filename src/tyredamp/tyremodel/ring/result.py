@@ -256,7 +256,7 @@ class RingFit:
         return rec.to(kind)
 
     def to_ring_parameters(self, pressure: float, membrane_stiffness: float = 2.0e9) -> Any:
-        """The updated ring at ``pressure`` as :class:`tyredamp.tyre.RingTyreParameters`.
+        """The updated ring at ``pressure`` as :class:`tyredamp.virtual.RingTyreParameters`.
 
         ``T0``, ``k_r``, ``k_t`` are evaluated at ``pressure`` (the width is
         ``T0 / (p R)``, the foundation pressure slopes zero), damping as fitted
