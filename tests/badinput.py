@@ -160,6 +160,129 @@ def nested_json(depth: int = 100_000) -> bytes:
     return ("[" * depth + "]" * depth).encode()
 
 
+# ----------------------------------------------------------------------------- campaign
+CAMPAIGN_TOML = b"""name = "bad-input corpus"
+[[tests]]
+files = "data/frf.npz"
+tyre = "A"
+pressure_bar = 7.5
+"""
+
+
+def _campaign_output(extra: dict[str, str]) -> Setup:
+    """An earlier campaign output ``res/`` (its summary lists what it wrote) plus ``extra``."""
+
+    def setup(d: Path) -> None:
+        out = d / "res"
+        (out / "tests" / "frf").mkdir(parents=True)
+        (out / "modes.csv").write_text("test_id\n")
+        (out / "tests" / "frf" / "modes.json").write_text("{}")
+        doc = {
+            "kind": "tyredamp-campaign",
+            "version": 1,
+            "written": ["campaign.json", "modes.csv", "tests/frf/modes.json"],
+        }
+        (out / "campaign.json").write_text(json.dumps(doc))
+        for k, v in extra.items():
+            (out / k).parent.mkdir(parents=True, exist_ok=True)
+            (out / k).write_text(v)
+
+    return setup
+
+
+def campaign_cases() -> list[Case]:
+    """``campaign`` and ``simulate campaign``: bad campaign files and refused output folders.
+
+    The campaign writes into a new or empty folder, or one holding nothing but
+    what earlier campaign runs wrote; ``simulate campaign`` likewise with an
+    earlier virtual campaign. Everything is checked before any test runs.
+    """
+    files: dict[str, str | bytes] = {"c.toml": CAMPAIGN_TOML, "data/frf.npz": "frf.npz"}
+
+    def argv(*rest: str) -> list[str]:
+        return ["campaign", "c.toml", "--serial", *rest]
+
+    def user_dir(name: str) -> Setup:
+        return lambda d: ((d / name).mkdir(), (d / name / "notes.txt").write_text("my notes"))
+
+    sim = ["simulate", "campaign", "--quick"]
+    return [
+        Case(
+            "campaign-bad-toml",
+            argv("-o", "res"),
+            2,
+            "not valid TOML",
+            {**files, "c.toml": b"name = [unclosed\n"},
+        ),
+        Case(
+            "campaign-bad-setting",
+            argv("-o", "res"),
+            2,
+            "settings.radial.modal.model",
+            {**files, "c.toml": CAMPAIGN_TOML + b'[settings.radial.modal]\nmodel = "x"\n'},
+        ),
+        Case("campaign-missing-file", ["campaign", "none.toml", "-o", "res"], 2, "not found"),
+        Case(
+            "campaign-missing-test-file",
+            argv("-o", "res"),
+            2,
+            "data/frf.npz",
+            {"c.toml": CAMPAIGN_TOML},
+        ),
+        Case(
+            "campaign-out-is-campaign-file", argv("-o", "c.toml"), 2, "is or holds the input", files
+        ),
+        Case(
+            "campaign-out-is-file",
+            argv("-o", "f"),
+            2,
+            "not a directory",
+            {**files, "f": b"a user's file"},
+        ),
+        Case("campaign-out-holds-input", argv("-o", "data"), 2, "holds the input file", files),
+        Case(
+            "campaign-dir-with-user-files",
+            argv("-o", "res"),
+            2,
+            "not an earlier campaign output",
+            files,
+            user_dir("res"),
+        ),
+        Case(
+            "campaign-earlier-output-with-user-file",
+            argv("-o", "res"),
+            2,
+            "notes.txt",
+            files,
+            _campaign_output({"notes.txt": "my notes"}),
+        ),
+        Case(
+            "campaign-foreign-file-in-cache",
+            argv("-o", "res"),
+            2,
+            "cache/mine.json",
+            files,
+            _campaign_output({"cache/mine.json": "{}"}),
+        ),
+        Case("campaign-out-dot", argv("-o", "."), 2, "input file", files),
+        Case(
+            "simulate-campaign-dir-with-user-files",
+            [*sim, "-o", "v"],
+            2,
+            "not an earlier virtual campaign",
+            setup=user_dir("v"),
+        ),
+        Case(
+            "simulate-campaign-out-is-file",
+            [*sim, "-o", "f"],
+            2,
+            "not a directory",
+            {"f": b"a user's file"},
+        ),
+        Case("simulate-campaign-missing-parent", [*sim, "-o", "nodir/v"], 2, "does not exist"),
+    ]
+
+
 # ----------------------------------------------------------------------------- runner
 def snapshot(root: Path) -> dict[str, tuple[Any, ...]]:
     """Every entry under ``root`` (links not followed): type and content hash / target."""

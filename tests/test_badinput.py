@@ -25,6 +25,7 @@ import tyredamp.io._safety as safety
 
 from .badinput import (
     Case,
+    campaign_cases,
     check_one_error_line,
     frf_header,
     frf_npz,
@@ -747,6 +748,7 @@ def _build_cases() -> list[Case]:
         *output_cases(),
         *demo_cases(),
         *tyremodel_cases(),
+        *campaign_cases(),
         *malformed_cases(lib_files),
         *json_cases(lib_files),
         *hostile_cases(),

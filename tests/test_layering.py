@@ -38,6 +38,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("io",),
     ("documents",),
     ("studies",),
+    ("campaign",),
     ("plot",),
     ("report",),
     ("cli",),

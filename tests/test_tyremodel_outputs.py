@@ -358,11 +358,12 @@ def test_write_all_or_none(tmp_path: Path) -> None:
 
 
 def test_modal_command_labels_wave_numbers() -> None:
-    from tyredamp.cli.modal import _label_wave_numbers, modes_table
+    from tyredamp.cli.modal import modes_table
     from tyredamp.plot import plot_mode_shapes_ring
+    from tyredamp.studies.radial import label_wave_numbers
 
     mdl = truth(7.0).modal_model("visible")
-    _label_wave_numbers(mdl)
+    label_wave_numbers(mdl)
     assert mdl.meta["wave_number"] == truth(7.0).wave_number[truth(7.0).select("visible")].tolist()
     table = "\n".join(modes_table("complex", mdl))
     assert "n = 1 (cos)" in table

@@ -39,6 +39,11 @@ __all__ = ["COMMANDS", "LazyGroup", "cli", "main"]
 #: ``tyredamp --help`` and ``--version`` start fast (benchmarks/startup.py);
 #: the summary is the first sentence of the command's docstring (a test checks).
 COMMANDS: dict[str, tuple[str, str, str]] = {
+    "campaign": (
+        "campaign",
+        "campaign_command",
+        "Process every test of CAMPAIGN_FILE and track the modes across conditions.",
+    ),
     "check": (
         "check",
         "check_group",

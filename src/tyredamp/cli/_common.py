@@ -9,6 +9,8 @@ from typing import Any, NoReturn, TypeVar
 
 import click
 
+from ..exceptions import InputError
+
 __all__ = [
     "EXIT_INPUT",
     "EXIT_INTERNAL",
@@ -19,6 +21,7 @@ __all__ = [
     "OutPath",
     "fail",
     "out_file_option",
+    "parse_drive_points",
     "seed_option",
 ]
 
@@ -77,3 +80,19 @@ def seed_option(help_text: str = "Noise seed.") -> Callable[[F], F]:
     return click.option(
         "--seed", type=click.IntRange(min=0), default=0, show_default=True, help=help_text
     )
+
+
+def parse_drive_points(values: tuple[str, ...]) -> tuple[int, ...]:
+    """Point numbers of ``--drive-points`` (``1,5``, repeatable); default ``(1,)``."""
+    out: list[int] = []
+    for v in values:
+        for s in v.replace(";", ",").split(","):
+            if not s.strip():
+                continue
+            try:
+                out.append(int(s))
+            except ValueError:
+                raise InputError(
+                    f"--drive-points: expected point numbers like 1,5, got {v!r}"
+                ) from None
+    return tuple(out) or (1,)

@@ -14,8 +14,8 @@ from ..io import read_frf
 from ..io._safety import check_output_file
 from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
-from ..studies.radial import modes_from_frf
-from ..studies.verdicts import FitVerdict, modal_fit_verdict
+from ..studies.radial import label_wave_numbers, modes_from_frf
+from ..studies.verdicts import modal_verdicts
 from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
@@ -81,23 +81,6 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
         for c in frf.inputs
     )
     return replace(frf, outputs=outs, inputs=ins)
-
-
-def _label_wave_numbers(model: ModalModel) -> None:
-    """Put each mode's circumferential wave number into ``model.meta`` when the outputs
-    carry their angles (``wave_number``, ``wave_number_label``, ``wave_number_fraction``;
-    :func:`tyredamp.tyremodel.wave_number_analysis`); nothing otherwise."""
-    from ..tyremodel.wavenumber import wave_number_analysis
-
-    if model.n_modes == 0 or any(c.angle_deg is None for c in model.outputs):
-        return
-    try:
-        wa = wave_number_analysis(model)
-    except InputError:
-        return  # angles that cannot carry a Fourier fit (too few, repeated)
-    model.meta["wave_number"] = [m.n for m in wa.modes]
-    model.meta["wave_number_label"] = [m.label for m in wa.modes]
-    model.meta["wave_number_fraction"] = [m.fraction for m in wa.modes]
 
 
 @click.command("modal")
@@ -179,8 +162,8 @@ def modal_command(
         residuals=not no_residuals,
     )
     for mdl in res.models.values():
-        _label_wave_numbers(mdl)
-    verdicts = _verdicts(frf, res)
+        label_wave_numbers(mdl)
+    verdicts = modal_verdicts(frf, res)
     for name, v in verdicts.items():  # stored with the model: meta.verdict of the modes JSON
         res.models[name].meta["verdict"] = v.to_dict()
     write_modes_json(
@@ -206,17 +189,3 @@ def modal_command(
         for c in v.cautions:
             click.echo(f"  caution: {c}")
     click.echo(f"wrote {out}")
-
-
-def _verdicts(frf: FRF, res: ModalIdentification) -> dict[str, FitVerdict]:
-    """Verdict of each fitted model against the noise of the fitted lines."""
-    keep = np.flatnonzero(np.isin(frf.frequency, res.frequency))
-    meas = frf.select_lines(keep).to(res.frf_kind)  # type: ignore[arg-type]
-    out: dict[str, FitVerdict] = {}
-    if "complex" in res.models:
-        out["complex"] = modal_fit_verdict(res.models["complex"], meas, subject="complex-mode fit")
-    if "real" in res.models:
-        out["real"] = modal_fit_verdict(
-            res.models["real"], meas, subject="real-mode fit", better=out.get("complex")
-        )
-    return out

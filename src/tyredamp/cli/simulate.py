@@ -5,7 +5,9 @@
 function type 1) or, with ``--frf``, the H1 FRFs estimated from it (function
 type 4); ``--truth`` also writes the exact modes as a modes JSON file.
 ``simulate lateral`` is the rolling-tyre rig; it is the same command as
-``tyredamp lateral simulate`` (same options, same output).
+``tyredamp lateral simulate`` (same options, same output). ``simulate
+campaign`` (:mod:`.simulate_campaign`) writes a whole virtual test campaign
+and its campaign file for ``tyredamp campaign``.
 """
 
 from __future__ import annotations
@@ -19,25 +21,11 @@ from ..documents.jsonfile import json_text
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
 from ..io._safety import atomic_paths, check_distinct, check_output_file
-from ._common import OutPath, out_file_option, seed_option
+from ._common import OutPath, out_file_option, parse_drive_points, seed_option
 from .lateral import lateral_group
+from .simulate_campaign import simulate_campaign_command
 
 __all__ = ["simulate_group"]
-
-
-def _points(values: tuple[str, ...]) -> tuple[int, ...]:
-    out: list[int] = []
-    for v in values:
-        for s in v.replace(";", ",").split(","):
-            if not s.strip():
-                continue
-            try:
-                out.append(int(s))
-            except ValueError:
-                raise InputError(
-                    f"--drive-points: expected point numbers like 1,5, got {v!r}"
-                ) from None
-    return tuple(out) or (1,)
 
 
 @click.group("simulate")
@@ -52,6 +40,7 @@ def simulate_group() -> None:
       tyredamp simulate radial --out tyre_test.uff --pressure 7.5 --seed 1
       tyredamp simulate radial --out tyre_frf.uff --frf --truth truth.json
       tyredamp simulate lateral --out rig.npz --speed 5 --pressure 1.7
+      tyredamp simulate campaign --out virtual
     """
 
 
@@ -147,7 +136,7 @@ def radial_command(
         check_output_file(truth_out, option="--truth")
         check_distinct([("--out", out), ("--truth", truth_out)])
     out_format = format_of(out, fmt)
-    points = _points(drive_points)
+    points = parse_drive_points(drive_points)
     tyre = virtual_tyre(pressure, points)
     with single_threaded_blas():
         test = run_modal_test(tyre, n_periods=periods, force_rms=force_rms, snr_db=snr, seed=seed)
@@ -229,3 +218,4 @@ simulate_group.add_command(
         short_help="Write the lateral FRF of the virtual rolling-tyre rig.",
     )
 )
+simulate_group.add_command(simulate_campaign_command)

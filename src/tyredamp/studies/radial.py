@@ -44,6 +44,7 @@ __all__ = [
     "compare_damping",
     "damping_from_modes",
     "frf_from_time",
+    "label_wave_numbers",
     "match_modes",
     "modes_from_frf",
     "run_pressure",
@@ -167,6 +168,27 @@ def modes_from_frf(
         order_step=order_step,
         residuals=residuals,
     )
+
+
+def label_wave_numbers(model: ModalModel) -> None:
+    """Put each mode's circumferential wave number into ``model.meta`` (in place).
+
+    Only when every output carries its angle on the ring (``Channel.angle_deg``):
+    ``wave_number``, ``wave_number_label`` and ``wave_number_fraction`` from
+    :func:`tyredamp.tyremodel.wave_number_analysis`; nothing otherwise, nor
+    when the angles cannot carry a Fourier fit (too few, repeated).
+    """
+    from ..tyremodel.wavenumber import wave_number_analysis
+
+    if model.n_modes == 0 or any(c.angle_deg is None for c in model.outputs):
+        return
+    try:
+        wa = wave_number_analysis(model)
+    except InputError:
+        return
+    model.meta["wave_number"] = [m.n for m in wa.modes]
+    model.meta["wave_number_label"] = [m.label for m in wa.modes]
+    model.meta["wave_number_fraction"] = [m.fraction for m in wa.modes]
 
 
 def damping_from_modes(

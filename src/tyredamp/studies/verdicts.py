@@ -65,6 +65,7 @@ from scipy import stats
 
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF
+from ..modal.identify import ModalIdentification
 
 __all__ = [
     "ALPHA",
@@ -73,6 +74,7 @@ __all__ = [
     "frf_noise_variance",
     "lateral_fit_verdict",
     "modal_fit_verdict",
+    "modal_verdicts",
     "noise_test",
 ]
 
@@ -473,3 +475,22 @@ def lateral_fit_verdict(
             f"the model form misses the measured tyre{where} (noise does not explain it)"
         )
     return FitVerdict(name, "ok" if not reasons else "failed", tuple(reasons), (), test)
+
+
+def modal_verdicts(frf: FRF, res: ModalIdentification) -> dict[str, FitVerdict]:
+    """Verdict of each fitted model of ``res`` against the noise of the fitted lines of ``frf``.
+
+    The complex-mode fit is judged first; the real-mode fit is judged with it
+    as the better model (:func:`modal_fit_verdict`). ``tyredamp modal`` and
+    the campaign store these as ``meta["verdict"]`` of each model.
+    """
+    keep = np.flatnonzero(np.isin(frf.frequency, res.frequency))
+    meas = frf.select_lines(keep).to(res.frf_kind)  # type: ignore[arg-type]
+    out: dict[str, FitVerdict] = {}
+    if "complex" in res.models:
+        out["complex"] = modal_fit_verdict(res.models["complex"], meas, subject="complex-mode fit")
+    if "real" in res.models:
+        out["real"] = modal_fit_verdict(
+            res.models["real"], meas, subject="real-mode fit", better=out.get("complex")
+        )
+    return out
