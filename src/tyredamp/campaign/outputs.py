@@ -167,7 +167,7 @@ def check_campaign_output(
                 f"--out: {text} is or holds the input file {os.fspath(inp)}; "
                 "choose another directory"
             )
-    return check_output_dir(out, campaign_files, what="campaign output")
+    return check_output_dir(out, campaign_files, what="campaign output", manifest=False)
 
 
 def _listed(doc: dict[str, Any]) -> list[str]:

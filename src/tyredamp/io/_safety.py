@@ -249,6 +249,7 @@ def check_output_dir(
     owned_files: Callable[[Path], Sequence[str] | None],
     option: str = "--out",
     what: str = "tyredamp output",
+    manifest: bool = True,
 ) -> Path:
     """Refuse an output directory that cannot work or holds data that is not ours; before work.
 
@@ -264,6 +265,11 @@ def check_output_dir(
         Name of the option, for the message.
     what : str
         What an earlier output is called, for the message.
+    manifest : bool
+        The earlier output was written whole by :func:`atomic_dir`: its files must
+        also be unchanged according to its manifest (:data:`MANIFEST_NAME`). False
+        for outputs that grow file by file (a campaign's cache), whose files are
+        only ever added or rewritten by the same content-keyed step.
 
     Returns
     -------
@@ -316,7 +322,7 @@ def check_output_dir(
             "not replaced: choose another directory or move them"
         )
     mine = [f for f in owned if f != MANIFEST_NAME and (real / f).is_file()]
-    changed = changed_since_written(real, mine)
+    changed = changed_since_written(real, mine) if manifest else []
     if changed:
         raise InputError(
             f"{option}: {text}: {_few(changed)} changed since tyredamp wrote it; "
