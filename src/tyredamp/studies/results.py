@@ -21,7 +21,7 @@ from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
 from ..signal import CheckResult
 from ..timedata import TimeData
-from ..tyremodel import RigidRingParameters, TyreModelResult
+from ..tyremodel import RigidRingParameters, RingFit, TyreModelResult
 from ..virtual import MeasurementLayout, RingTyreParameters, TyreTruth
 from ..virtual.lateral_rig import VirtualLateralRig, ViscoelasticStringTyre
 from ..virtual.modal_rig import VirtualModalTest
@@ -179,6 +179,11 @@ class TyreModelStudy:
         pressure (same formulas), None where they cannot be computed.
     models : tuple of str
         Which modal model of each run was used (``"complex"`` or ``"real"``).
+    exact_ring : RingFit or None
+        The same ring fit on the exact modes of the tested tyres: what the
+        method gives without noise, so that a gap to the tyre's parameters
+        splits into the finite-difference ring's discretisation (in this one
+        too) and the identification (the difference between the two fits).
     """
 
     result: TyreModelResult | None
@@ -188,6 +193,7 @@ class TyreModelStudy:
     layout: MeasurementLayout | None
     rigid_truth: tuple[RigidRingParameters | None, ...] | None
     models: tuple[str, ...]
+    exact_ring: RingFit | None = None
 
     @property
     def ok(self) -> bool:
