@@ -52,8 +52,14 @@ def _gap_cells(c: dict[str, Any]) -> list[str]:
     return [true, rel, sig]
 
 
-def _tyre_model_rigid(rep: HtmlReport, tm: dict[str, Any]) -> None:
+def _tyre_model_rigid(rep: HtmlReport, tm: dict[str, Any], doc: dict[str, Any]) -> None:
     """The rigid ring per pressure beside the values from the exact modes."""
+    failed = [
+        f"{pr['pressure_bar']:g} bar"
+        for pr in doc["radial"]["pressures"]
+        if pr["pressure_bar"] in tm["pressures_bar"]
+        and not pr["verdict"].get("complex", {"passed": True})["passed"]
+    ]
     rows = []
     for rr in tm["rigid_ring"]:
         for key in ("BELT_MASS", "FREQ_LONG", "DAMP_LONG", "k_long", "c_long"):
@@ -82,7 +88,14 @@ def _tyre_model_rigid(rep: HtmlReport, tm: dict[str, Any]) -> None:
         "beside the same quantities computed from the exact modes of the virtual tyre "
         "(attachment mass and damper removed). FREQ_WINDUP, DAMP_WINDUP and BELT_IYY are not "
         "given: the wind-up mode (n = 0) has no radial motion, so radial accelerometers "
-        "cannot see it.",
+        "cannot see it."
+        + (
+            f" The complex-mode fit at {', '.join(failed)} did not pass its verdict (see the "
+            "radial study): its modes, and what is derived from them here, carry more error "
+            "than the noise explains."
+            if failed
+            else ""
+        ),
     )
 
 
@@ -181,7 +194,7 @@ def tyre_model_report(
             "even when their pressure laws are not (two pressures cannot separate a law's "
             "slope from its constant and the tension's share from the foundation's)."
         )
-    _tyre_model_rigid(rep, tm)
+    _tyre_model_rigid(rep, tm, doc)
     res = result.radial.tyre_model.result
     if res is not None:
         name, text = next(iter(res.tir_files().items()))
