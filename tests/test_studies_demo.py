@@ -233,6 +233,23 @@ def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> No
     assert "FREQ_LONG = " in section
 
 
+def test_tyre_model_single_pressure(demo: tuple[DemoResult, Path]) -> None:
+    """One pressure: T0, k_r, k_t are parameters of their own, each beside its true value."""
+    from tyredamp.studies.tyremodel import tyre_model_from_runs, tyre_model_section
+    from tyredamp.virtual import RingTyreParameters
+
+    result, _ = demo
+    main = result.radial.main
+    sec = tyre_model_section(tyre_model_from_runs([main]))
+    assert sec["status"] == "ok"
+    par = {p["name"]: p for p in sec["parameters"]}
+    tp = RingTyreParameters(pressure=main.pressure_bar * 1e5)
+    assert_allclose(par["T0"]["true"], tp.hoop_tension, rtol=1e-12)
+    assert_allclose(par["T0"]["value"], tp.hoop_tension, rtol=0.02)
+    assert_allclose(par["k_r"]["value"], tp.radial_stiffness, rtol=0.02)
+    assert_allclose(par["EI"]["value"], tp.bending_stiffness, rtol=0.05)
+
+
 def test_tyre_model_failure_is_reported_not_raised(
     demo: tuple[DemoResult, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:

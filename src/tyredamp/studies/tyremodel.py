@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..exceptions import TyredampError
+from ..exceptions import InputError, TyredampError
 from ..tyremodel import RigidRingParameters, build_tyre_model, rigid_ring_from_modes
 from ..virtual import MeasurementLayout, RingTyreParameters
 from .results import TyreModelStudy
@@ -97,7 +97,10 @@ def ring_truth(params: RingTyreParameters, fit: RingFit) -> dict[str, float | No
 
 
 def _modes(run: PressureRun) -> ModalModel:
-    return run.models["complex"] if "complex" in run.models else run.models["real"]
+    for name in ("complex", "real"):
+        if name in run.models:
+            return run.models[name]
+    raise InputError(f"{run.pressure_bar:g} bar: no modal model identified")
 
 
 def tyre_model_from_runs(runs: Sequence[PressureRun]) -> TyreModelStudy:
