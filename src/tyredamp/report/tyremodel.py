@@ -191,8 +191,14 @@ def tyre_model_report(
         rep.paragraph(
             "Confounded parameters are determined only in combination: the tension and the "
             "foundation stiffness at each tested pressure (table above) are well determined "
-            "even when their pressure laws are not (two pressures cannot separate a law's "
-            "slope from its constant and the tension's share from the foundation's)."
+            "even when their pressure laws are not (few pressures cannot tell a law's slope "
+            "from its constant, nor the tension's share from the foundation's)."
+        )
+    else:
+        rep.paragraph(
+            "Every ring parameter is identified from these modes (standard error within 10 % "
+            "of its scale, no confounded combination). What a radial test cannot give at all "
+            "(wind-up, lateral, footprint) is listed with the rigid ring below."
         )
     _tyre_model_rigid(rep, tm, doc)
     res = result.radial.tyre_model.result
