@@ -86,6 +86,7 @@ def test_files_exist(demo: tuple[DemoResult, Path]) -> None:
         "fig15_time_response.png",
         "residual_zoom.png",
         "mac.png",
+        "ring_frequencies.png",
     ):
         assert name in pngs
         assert (out / "figures" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -169,6 +170,125 @@ def test_results_validate_and_agree_with_truth(demo: tuple[DemoResult, Path]) ->
         assert_allclose(c["corner_frequency_hz"], f0, rtol=1e-12)  # eq. 38, same numbers
 
 
+def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> None:
+    """Issue 18: the demo fits the tyre model on its pressures; files, results.json, report."""
+    from tyredamp.tyremodel import parse_tir
+    from tyredamp.virtual import RingTyreParameters
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    tm = doc["radial"]["tyre_model"]
+    assert tm["status"] == "ok"
+    assert tm["error"] is None
+    pressures = list(result.settings.radial_pressures_bar)
+    assert tm["pressures_bar"] == pressures
+    # the files: listed under both keys and written
+    tirs = [f"tyre_model/tyre_inplane_{p:g}bar.tir" for p in pressures]
+    expected = {"tyre_model/ring.json", "tyre_model/rigid_ring.json", *tirs}
+    assert set(tm["files"]) == expected
+    assert expected | {"figures/ring_frequencies.png"} <= set(doc["files"])
+    ring_doc = json.loads((out / "tyre_model" / "ring.json").read_text())
+    rigid_doc = json.loads((out / "tyre_model" / "rigid_ring.json").read_text())
+    assert ring_doc["kind"] == "tyre-ring-model"
+    assert rigid_doc["kind"] == "tyre-rigid-ring"
+    assert [i["pressure_bar"] for i in ring_doc["inputs"]] == pressures
+    # the .tir subset parses back to the numbers of results.json
+    for path, rr in zip(tirs, tm["rigid_ring"], strict=True):
+        tir = parse_tir((out / path).read_text())
+        assert_allclose(tir["INERTIA"]["BELT_MASS"], rr["BELT_MASS"]["value"], rtol=1e-8)
+        assert_allclose(tir["STRUCTURAL"]["FREQ_LONG"], rr["FREQ_LONG"]["value"], rtol=1e-8)
+    # recovered against the virtual tyre's own parameters (taken here from the defaults,
+    # not from the document): EI within 5 % (the 64-node finite-difference ring alone reads
+    # as 3 % less EI, see from_exact_modes), tension and k_r within 2 % at every pressure
+    true = RingTyreParameters()
+    par = {p["name"]: p for p in tm["parameters"]}
+    assert_allclose(par["EI"]["value"], true.bending_stiffness, rtol=0.05)
+    assert par["EI"]["true"] == true.bending_stiffness
+    assert_allclose(par["EI"]["from_exact_modes"], true.bending_stiffness, rtol=0.04)
+    assert par["EI"]["verdict"] == "identified"
+    for pp, p in zip(tm["per_pressure"], pressures, strict=True):
+        tp = true.with_pressure(p * 1e5)
+        assert_allclose(pp["T0"]["value"], tp.hoop_tension, rtol=0.02)
+        assert_allclose(pp["k_r"]["value"], tp.radial_stiffness, rtol=0.02)
+        assert_allclose(pp["k_r"]["true"], tp.radial_stiffness, rtol=1e-12)
+    # what two pressures cannot separate is reported as such, with its verdict
+    assert tm["not_identifiable"]
+    for name in tm["not_identifiable"]:
+        assert par[name]["verdict"] != "identified"
+    # rigid ring at the main pressure equals the one from the exact modes within 2 %
+    main = tm["rigid_ring"][0]
+    for key in ("BELT_MASS", "FREQ_LONG", "DAMP_LONG"):
+        assert abs(main[key]["relative_gap"]) < 0.02, key
+    assert_allclose(main["BELT_MASS"]["value"], true.band_mass, rtol=0.02)
+    # the report: figure, table against the truth, non-identifiable parameters, .tir text
+    html = (out / "report.html").read_text(encoding="utf-8")
+    start = html.index(f">{SECTIONS[3]}</h2>")
+    section = html[start : html.index("<h2", start + 10)]
+    assert "Tyre model: natural frequencies identified" in section  # figure caption
+    assert "fit to exact modes" in section
+    assert "Not identified from these modes" in section
+    for name in tm["not_identifiable"]:
+        assert f"<li>{name}: " in section
+    assert "[STRUCTURAL]" in section
+    assert "FREQ_LONG = " in section
+
+
+def test_tyre_model_single_pressure(demo: tuple[DemoResult, Path]) -> None:
+    """One pressure: T0, k_r, k_t are parameters of their own, each beside its true value."""
+    from tyredamp.studies.tyremodel import tyre_model_from_runs, tyre_model_section
+    from tyredamp.virtual import RingTyreParameters
+
+    result, _ = demo
+    main = result.radial.main
+    sec = tyre_model_section(tyre_model_from_runs([main]))
+    assert sec["status"] == "ok"
+    par = {p["name"]: p for p in sec["parameters"]}
+    tp = RingTyreParameters(pressure=main.pressure_bar * 1e5)
+    assert_allclose(par["T0"]["true"], tp.hoop_tension, rtol=1e-12)
+    assert_allclose(par["T0"]["value"], tp.hoop_tension, rtol=0.02)
+    assert_allclose(par["k_r"]["value"], tp.radial_stiffness, rtol=0.02)
+    assert_allclose(par["EI"]["value"], tp.bending_stiffness, rtol=0.05)
+
+
+def test_tyre_model_failure_is_reported_not_raised(
+    demo: tuple[DemoResult, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A tyre-model fit that cannot be made leaves the demo running and says why."""
+    from dataclasses import replace
+
+    import tyredamp.studies.tyremodel as tm_mod
+    from tyredamp.exceptions import InputError
+    from tyredamp.report.build import build_demo_report
+    from tyredamp.studies.document import build_results
+
+    def refuse(*args: Any, **kwargs: Any) -> Any:
+        raise InputError("model: no n = 1 mode (belt translation) among the identified modes")
+
+    result, _ = demo
+    monkeypatch.setattr(tm_mod, "build_tyre_model", refuse)
+    failed = tm_mod.tyre_model_from_runs(result.radial.runs)
+    assert failed.result is None
+    assert "no n = 1 mode" in (failed.error or "")
+    assert tm_mod.tyre_model_files(failed) == {}
+    res2 = replace(result, radial=replace(result.radial, tyre_model=failed))
+    doc = build_results(res2)
+    validate_results(doc)
+    tm = doc["radial"]["tyre_model"]
+    assert tm["status"] == "failed"
+    assert "no n = 1 mode" in tm["error"]
+    assert tm["parameters"] == []
+    assert tm["files"] == []
+    w = [x for x in doc["warnings"] if x["about"] == "radial:tyre_model"]
+    assert len(w) == 1
+    assert w[0]["severity"] == "failed"
+    html = build_demo_report(res2, doc, {})
+    assert html.count("Tyre model not fitted: InputError: model: no n = 1 mode") == 2
+    from tyredamp.cli.demo import demo_summary_rows
+
+    rows = dict(demo_summary_rows(res2, doc))
+    assert rows["tyre model"].startswith("FAILED: InputError")
+
+
 def test_summary_rows(demo: tuple[DemoResult, Path]) -> None:
     from tyredamp.cli.demo import demo_summary_rows
     from tyredamp.studies.document import build_results
@@ -176,6 +296,8 @@ def test_summary_rows(demo: tuple[DemoResult, Path]) -> None:
     result, _ = demo
     rows = dict(demo_summary_rows(result, build_results(result)))
     assert "lateral ranking" in rows
+    assert "EI" in rows["tyre model"]
+    assert "k_r" in rows["tyre model"]
     assert "RMSD" in " ".join(rows)
 
 

@@ -48,6 +48,7 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
             f"{100 * rad['damping']['modal_error_symmetric']:.3g} %), "
             f"{rad['damping']['definiteness_modal']}",
         ),
+        ("tyre model", _tyre_model_row(rad["tyre_model"])),
         (
             "lateral ranking",
             " > ".join(x["model"] for x in lat["ranking"]),
@@ -74,6 +75,31 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
     for k, w in enumerate(warns):
         rows.append((f"warning {k + 1} ({w['stage']})", w["message"]))
     return rows
+
+
+def _tyre_model_row(tm: dict[str, Any]) -> str:
+    """EI and the tension and k_r at the first pressure beside the truth, or FAILED and why."""
+    if tm["status"] != "ok":
+        return f"FAILED: {tm['error']}"
+    par = {p["name"]: p for p in tm["parameters"]}
+    pp = tm["per_pressure"][0] if tm["per_pressure"] else None
+    items = [("EI", par.get("EI"))]
+    if pp is not None:
+        items += [(f"T0 {pp['pressure_bar']:g} bar", pp["T0"]), ("k_r", pp["k_r"])]
+    parts = [
+        f"{name} {100 * c['relative_gap']:+.2g} %"
+        for name, c in items
+        if c is not None and c["relative_gap"] is not None
+    ]
+    return (
+        f"flexible ring at {len(tm['pressures_bar'])} pressures, against the virtual tyre: "
+        + ", ".join(parts)
+        + (
+            f"; not identified: {', '.join(tm['not_identifiable'])}"
+            if tm["not_identifiable"]
+            else ""
+        )
+    )
 
 
 def _verdict_rows(doc: dict[str, Any]) -> list[tuple[str, str]]:

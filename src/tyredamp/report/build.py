@@ -6,7 +6,9 @@
 (:func:`tyredamp.report.figures.demo_figures`). Sections: summary, inputs and
 settings, the radial study (checks, stabilisation, modes with standard errors
 beside the truth, real against complex fit, mode shapes, damping matrices with
-diagnostics in words, pressures) and the lateral study (Figure 7, ranking,
+diagnostics in words, pressures), the tyre model (flexible ring across the
+pressures and rigid ring beside the virtual tyre's values, the ``.tir``
+subset) and the lateral study (Figure 7, ranking,
 parameters beside the truth, Figures 11-14, vehicle model and Figure 15).
 The report for result files of the other commands is
 :func:`tyredamp.report.files.build_files_report`.
@@ -20,7 +22,9 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from .. import __version__
+from ._cells import _image, _num, _warnings, fmt_pm
 from .html import HtmlReport
+from .tyremodel import tyre_model_brief, tyre_model_report
 
 if TYPE_CHECKING:
     from ..studies.results import DemoResult
@@ -32,37 +36,16 @@ SECTIONS = (
     "Summary",
     "Inputs and settings",
     "Radial study: modal test of the virtual truck tyre",
+    "Tyre model: flexible ring and rigid ring from the modes",
     "Lateral study: rolling-tyre rig",
     "Files",
 )
-
-
-def fmt_pm(value: float | None, std: float | None, digits: int = 4, scale: float = 1.0) -> str:
-    """``"47.91 ± 0.012"``: a value with its standard error (``-`` when missing)."""
-    if value is None or not math.isfinite(value):
-        return "-"
-    v = value * scale
-    if std is None or not math.isfinite(std):
-        return f"{v:.{digits}g}"
-    return f"{v:.{digits}g} ± {std * scale:.2g}"
-
-
-def _num(v: Any, spec: str = ".4g") -> str:
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "-"
-    return format(v, spec)
 
 
 def _pct(v: Any, digits: str = ".3g") -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "-"
     return f"{100 * v:{digits}} %"
-
-
-def _image(rep: HtmlReport, images: Mapping[str, tuple[bytes, str]], name: str) -> None:
-    if name in images:
-        png, caption = images[name]
-        rep.image(png, caption)
 
 
 def _fallback_mark(doc: dict[str, Any], pressure_bar: float) -> str:
@@ -81,23 +64,6 @@ def _verdict(rep: HtmlReport, v: dict[str, Any] | None) -> None:
         return
     cls = "verdict" if v["passed"] else "verdict bad"
     rep.raw(f'<div class="{cls}">{html.escape(v["summary"])}</div>')
-
-
-def _warnings(rep: HtmlReport, doc: dict[str, Any], about: str) -> None:
-    """The warnings of the stage that produced a result, beside that result."""
-    ws = [w for w in doc.get("warnings", []) if w["about"] == about]
-    if not ws:
-        return
-    bad = any(w["severity"] == "failed" for w in ws)
-    items = "".join(
-        f"<li>{'<b>FAILED</b> ' if w['severity'] == 'failed' else ''}{html.escape(w['message'])}"
-        "</li>"
-        for w in ws
-    )
-    rep.raw(
-        f'<div class="warn{" bad" if bad else ""}"><b>Warnings ({html.escape(ws[0]["stage"])})'
-        f"</b><ul>{items}</ul></div>"
-    )
 
 
 def _modes_table(rep: HtmlReport, modes: list[dict[str, Any]], caption: str) -> None:
@@ -192,9 +158,15 @@ def _summary(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
                 f"{best['model']} ({best['mean_rank']:.2g}, best at {best['wins']} of "
                 f"{best['n_conditions']} conditions)",
             ],
+            ["tyre model (flexible ring, all pressures)", tyre_model_brief(rad["tyre_model"])],
             ["computation time", f"{result.elapsed_s:.1f} s"],
         ],
     )
+    if rad["tyre_model"]["status"] != "ok":
+        rep.raw(
+            '<div class="verdict bad">Tyre model not fitted: '
+            f"{html.escape(str(rad['tyre_model']['error']))}</div>"
+        )
     _summary_verdicts(rep, doc)
 
 
@@ -481,7 +453,7 @@ def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None
 
 def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: Any) -> None:
     lat = doc["lateral"]
-    rep.heading(SECTIONS[3])
+    rep.heading(SECTIONS[4])
     f7 = lat["figure7"]
     rep.heading("Corner frequency and asymptotes (eq. 38-40)", 3)
     r = f7["h"] / f7["K"]
@@ -738,14 +710,16 @@ def build_demo_report(
     _summary(rep, result, doc)
     _settings(rep, result, doc)
     _radial(rep, result, doc, images)
+    tyre_model_report(rep, result, doc, images, SECTIONS[3])
     _lateral(rep, result, doc, images)
-    rep.heading(SECTIONS[4])
+    rep.heading(SECTIONS[5])
     listed = doc.get("files", []) if files is None else files
     rep.paragraph(
         "Written beside this report: results.json (all numbers; schema in the README), the "
         "figures as PNG, the generated data as UFF 58 (binary 58b: time data function type 1, "
-        "FRFs type 4) and the modes and damping JSON files, which the other commands read "
-        "(tyredamp damping, tyredamp report)."
+        "FRFs type 4), the modes and damping JSON files, which the other commands read "
+        "(tyredamp damping, tyredamp report), and the tyre model of all pressures "
+        "(tyre_model/: ring.json, rigid_ring.json and the in-plane .tir subsets)."
     )
     rep.bullets(list(listed))
     return rep.render()

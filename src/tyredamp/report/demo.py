@@ -3,8 +3,10 @@
 :func:`save_demo` writes what :func:`tyredamp.studies.demo.run_demo`
 returned: ``report.html`` (self-contained), ``results.json`` (schema
 ``tyredamp/schemas/results.schema.json``, described in the README), the
-figures as PNG, the generated data as UFF 58 (binary 58b) and the modes and
-damping JSON files of the main pressure. It writes into a temporary directory
+figures as PNG, the generated data as UFF 58 (binary 58b), the modes and
+damping JSON files of the main pressure and the tyre model of all pressures
+(``tyre_model/``: ``ring.json``, ``rigid_ring.json``, ``.tir`` subsets; none
+when its fit failed). It writes into a temporary directory
 beside the target and renames it into place at the end
 (:func:`tyredamp.io._safety.atomic_dir`), so a failure leaves no partial
 output; an existing directory is replaced only when it is empty or an earlier
@@ -29,6 +31,7 @@ from ..io._safety import check_output_dir as _check_output_dir
 from ..studies.demo import ProgressCallback, single_threaded_blas
 from ..studies.document import build_results
 from ..studies.results import DemoResult
+from ..studies.tyremodel import tyre_model_files
 from ..timedata import TimeData
 from .build import build_demo_report
 from .figures import demo_figures
@@ -110,7 +113,7 @@ def _save(
     written: list[str] = []
     with atomic_dir(out) as tmp:
         figs = demo_figures(result)
-        total = len(figs) + 4
+        total = len(figs) + 5
         done = 0
 
         def step(name: str) -> None:
@@ -154,6 +157,13 @@ def _save(
             encoding="utf-8",
         )
         written.append(f"damping_{p0}.json")
+
+        step("tyre model (ring, rigid ring, .tir)")
+        for rel, content in tyre_model_files(result.radial.tyre_model).items():
+            (tmp / rel).parent.mkdir(parents=True, exist_ok=True)
+            text = content if isinstance(content, str) else json_text(content, indent=1)
+            (tmp / rel).write_text(text, encoding="utf-8")
+            written.append(rel)
 
         step("results.json")
         files = sorted([*written, "report.html", "results.json", MANIFEST_NAME])

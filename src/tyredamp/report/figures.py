@@ -25,6 +25,7 @@ from ..plot import (
     plot_time_comparison,
 )
 from ..plot.comparison import model_color
+from ..plot.tyremodel import plot_ring_frequencies
 from ..studies.document import time_test_truth
 
 if TYPE_CHECKING:
@@ -123,6 +124,9 @@ def _radial(result: DemoResult) -> FigureSet:
 
     figs["checks"] = _checks_figure(result)
     figs["pressures"] = _pressures_figure(result)
+    tm = _ring_frequencies_figure(result)
+    if tm is not None:
+        figs["ring_frequencies"] = tm
     return figs
 
 
@@ -238,6 +242,23 @@ def _pressures_figure(result: DemoResult) -> tuple[Figure, str]:
         fig,
         "Inflation pressure: natural frequencies against wave number and damping ratios, "
         "identified (circles, complex-mode fit) against the exact modes (lines).",
+    )
+
+
+def _ring_frequencies_figure(result: DemoResult) -> tuple[Figure, str] | None:
+    """Identified against updated-ring frequencies per n and pressure (None: no fit)."""
+    res = result.radial.tyre_model.result
+    if res is None:
+        return None
+    fig = Figure(figsize=(6.5, 4.0), layout="constrained")
+    plot_ring_frequencies(res.ring, ax=fig.subplots())
+    pressures = ", ".join(f"{p / 1e5:g}" for p in res.ring.pressures)
+    return (
+        fig,
+        f"Tyre model: natural frequencies identified at {pressures} bar (markers, 1-sigma "
+        "bars; hollow: the member of a pair away from the drive point) and of the flexible "
+        "ring updated jointly across the pressures (lines, with the shaker's attachment "
+        "mass), against the circumferential wave number n.",
     )
 
 

@@ -9,7 +9,9 @@
   a linearity check at two force levels, a reciprocity check with two drive
   points, a data-quality check, the real-mode (eq. [2]/[3]) and complex-mode
   (eq. [10]) fits with their RMSD (eq. [19]) and the damping identification
-  (eq. [14]-[18]); every identified value is paired with the exact value of
+  (eq. [14]-[18]) and the tyre model (flexible ring across the pressures,
+  rigid ring per pressure, ``.tir`` subsets; :mod:`.tyremodel`); every
+  identified value is paired with the exact value of
   the tyre (:class:`~tyredamp.virtual.TyreTruth`);
 * the **lateral study** (paper 001, spec ``lateral-models.md``;
   :func:`.lateral.run_lateral`) on the virtual rolling-tyre rig
@@ -128,7 +130,7 @@ def run_demo(
 
 def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
     t_start = time.perf_counter()
-    n_stages = len(s.radial_pressures_bar) + 3 + len(conditions(s)) + 1
+    n_stages = len(s.radial_pressures_bar) + 4 + len(conditions(s)) + 1
     st = _Stages(n_stages, progress)
     radial = run_radial(s, st.start)
     lateral = run_lateral(s, st.start)

@@ -3,7 +3,9 @@
 The document (``"kind": "tyredamp-demo-results"``, ``"version": 1``) holds
 the settings, the radial study at the main pressure (RMSD of the real and
 complex fits, the modes identified beside the true ones, the checks, the
-damping matrix against the truth), the other pressures, and the lateral
+damping matrix against the truth), the other pressures, the tyre model
+(flexible ring across the pressures and rigid ring per pressure beside the
+virtual tyre's values), and the lateral
 study (ranking per condition and overall, corner frequencies, the vehicle
 model and the time test). SI units unless a key says otherwise (``_hz``,
 ``_bar``, ``_kmh``, ``_pct``); non-finite numbers are written as ``null``.
@@ -27,6 +29,7 @@ from ..documents.demo import RESULTS_KIND, RESULTS_VERSION
 from ..documents.jsonfile import finite
 from ..exceptions import InputError
 from .findings import DemoFindings, demo_findings, lateral_key, radial_key
+from .tyremodel import tyre_model_section
 
 if TYPE_CHECKING:
     from ..lateral.fit import LateralFit
@@ -377,6 +380,7 @@ def _radial_section(result: DemoResult, fnd: DemoFindings) -> dict[str, Any]:
             }
             for run in r.runs
         ],
+        "tyre_model": tyre_model_section(r.tyre_model),
     }
 
 

@@ -8,7 +8,7 @@ tagged with the result it concerns (``about``), so that the report can show
 it beside that result and the summary can list it.
 
 ``about`` keys: ``"radial:<p>"`` (the run at pressure ``p`` bar, ``%g``),
-``"radial:checks"``, ``"radial:damping"``, ``"lateral:<label>"`` (a rig
+``"radial:checks"``, ``"radial:damping"``, ``"radial:tyre_model"``, ``"lateral:<label>"`` (a rig
 condition, ``"1.7 bar, 5 km/h"``), ``"lateral:time"`` (vehicle and time test).
 """
 
@@ -169,6 +169,16 @@ def demo_findings(result: DemoResult) -> DemoFindings:
                 "radial:damping",
                 "radial damping",
                 f"C' in modal coordinates is {d.definiteness_modal}: not a passive damping",
+            )
+        )
+    tm = r.tyre_model
+    if tm.error is not None:
+        findings.append(
+            Finding(
+                "radial:tyre_model",
+                "tyre model",
+                f"tyre model not fitted: {tm.error}",
+                "failed",
             )
         )
     lateral: dict[str, dict[str, FitVerdict]] = {}

@@ -36,6 +36,7 @@ from ..timedata import TimeData
 from ..virtual import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
 from .results import DampingComparison, ModeMatch, PressureRun, RadialStudy
 from .settings import BAR, DemoSettings
+from .tyremodel import tyre_model_from_runs
 
 __all__ = [
     "check_linearity",
@@ -349,7 +350,7 @@ def compare_damping(run: PressureRun, dm: DampingModel) -> DampingComparison:
 
 
 def run_radial(s: DemoSettings, stage: StageCallback | None = None) -> RadialStudy:
-    """The radial study of the demo: tests at every pressure, checks, damping.
+    """The radial study of the demo: tests at every pressure, checks, damping, tyre model.
 
     Parameters
     ----------
@@ -410,6 +411,9 @@ def run_radial(s: DemoSettings, stage: StageCallback | None = None) -> RadialStu
         seed=s.seed,
         meta={"source": f"demo, virtual truck tyre at {p0:g} bar", "model": "complex"},
     )
+
+    start(f"radial: tyre model (flexible ring, rigid ring) at {len(runs)} pressure(s)")
+    tyre_model = tyre_model_from_runs(runs)
     return RadialStudy(
         runs=runs,
         linearity=lin,
@@ -419,4 +423,5 @@ def run_radial(s: DemoSettings, stage: StageCallback | None = None) -> RadialStu
         reciprocity_frf=recip_frf,
         damping=dm,
         damping_truth=compare_damping(main, dm),
+        tyre_model=tyre_model,
     )

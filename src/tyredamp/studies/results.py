@@ -21,7 +21,8 @@ from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
 from ..signal import CheckResult
 from ..timedata import TimeData
-from ..virtual import TyreTruth
+from ..tyremodel import RigidRingParameters, RingFit, TyreModelResult
+from ..virtual import MeasurementLayout, RingTyreParameters, TyreTruth
 from ..virtual.lateral_rig import VirtualLateralRig, ViscoelasticStringTyre
 from ..virtual.modal_rig import VirtualModalTest
 from .settings import DemoSettings
@@ -35,6 +36,7 @@ __all__ = [
     "PressureRun",
     "RadialStudy",
     "TimeTest",
+    "TyreModelStudy",
     "VehicleStudy",
 ]
 
@@ -154,6 +156,52 @@ class DampingComparison:
 
 
 @dataclass(frozen=True, eq=False)
+class TyreModelStudy:
+    """Flexible and rigid ring from the modes at every pressure, beside the tyre's own values.
+
+    Filled by :func:`tyredamp.studies.tyremodel.tyre_model_from_runs`.
+
+    Attributes
+    ----------
+    result : TyreModelResult or None
+        :func:`tyredamp.tyremodel.build_tyre_model` on the runs' modes; None
+        when the fit could not be made.
+    error : str or None
+        Why there is no result (the exception's type and message).
+    pressures_bar : tuple of float
+        Pressures of the runs fitted, bar.
+    params : RingTyreParameters or None
+        The tested virtual tyre (its ring parameters are the truth).
+    layout : MeasurementLayout or None
+        Its measurement layout (radius and attachment given to the fit).
+    rigid_truth : tuple of (RigidRingParameters or None) or None
+        Rigid-ring parameters from the exact modes of the tyre at each
+        pressure (same formulas), None where they cannot be computed.
+    models : tuple of str
+        Which modal model of each run was used (``"complex"`` or ``"real"``).
+    exact_ring : RingFit or None
+        The same ring fit on the exact modes of the tested tyres: what the
+        method gives without noise, so that a gap to the tyre's parameters
+        splits into the finite-difference ring's discretisation (in this one
+        too) and the identification (the difference between the two fits).
+    """
+
+    result: TyreModelResult | None
+    error: str | None
+    pressures_bar: tuple[float, ...]
+    params: RingTyreParameters | None
+    layout: MeasurementLayout | None
+    rigid_truth: tuple[RigidRingParameters | None, ...] | None
+    models: tuple[str, ...]
+    exact_ring: RingFit | None = None
+
+    @property
+    def ok(self) -> bool:
+        """True when the fit was made."""
+        return self.result is not None
+
+
+@dataclass(frozen=True, eq=False)
 class RadialStudy:
     """Everything of the radial study (paper 000).
 
@@ -170,6 +218,9 @@ class RadialStudy:
     damping : DampingModel
         From the complex modes at the main pressure.
     damping_truth : DampingComparison
+    tyre_model : TyreModelStudy
+        Flexible ring across the pressures and rigid ring per pressure
+        (:func:`tyredamp.studies.tyremodel.tyre_model_from_runs`).
     """
 
     runs: list[PressureRun]
@@ -180,6 +231,7 @@ class RadialStudy:
     reciprocity_frf: FRF
     damping: DampingModel
     damping_truth: DampingComparison
+    tyre_model: TyreModelStudy
 
     @property
     def main(self) -> PressureRun:

@@ -1,0 +1,51 @@
+"""Cells and blocks shared by the demo report's sections (values with errors, warnings)."""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from .html import HtmlReport
+
+__all__ = ["fmt_pm"]
+
+
+def fmt_pm(value: float | None, std: float | None, digits: int = 4, scale: float = 1.0) -> str:
+    """``"47.91 ± 0.012"``: a value with its standard error (``-`` when missing)."""
+    if value is None or not math.isfinite(value):
+        return "-"
+    v = value * scale
+    if std is None or not math.isfinite(std):
+        return f"{v:.{digits}g}"
+    return f"{v:.{digits}g} ± {std * scale:.2g}"
+
+
+def _num(v: Any, spec: str = ".4g") -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    return format(v, spec)
+
+
+def _image(rep: HtmlReport, images: Mapping[str, tuple[bytes, str]], name: str) -> None:
+    if name in images:
+        png, caption = images[name]
+        rep.image(png, caption)
+
+
+def _warnings(rep: HtmlReport, doc: dict[str, Any], about: str) -> None:
+    """The warnings of the stage that produced a result, beside that result."""
+    ws = [w for w in doc.get("warnings", []) if w["about"] == about]
+    if not ws:
+        return
+    bad = any(w["severity"] == "failed" for w in ws)
+    items = "".join(
+        f"<li>{'<b>FAILED</b> ' if w['severity'] == 'failed' else ''}{html.escape(w['message'])}"
+        "</li>"
+        for w in ws
+    )
+    rep.raw(
+        f'<div class="warn{" bad" if bad else ""}"><b>Warnings ({html.escape(ws[0]["stage"])})'
+        f"</b><ul>{items}</ul></div>"
+    )
