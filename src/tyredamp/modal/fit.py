@@ -103,7 +103,11 @@ class FitResult:
     status: str
     warnings: list[str] = field(default_factory=list)
     contribution: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    #: extra-sum-of-squares statistic of each mode (:func:`_extra_ss` / s^2)
     significance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    #: number of (weighted) real observations and of fitted parameters
+    n_obs: int = 0
+    n_par: int = 0
     theta: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     participation: NDArray[np.complex128] = field(default_factory=lambda: np.zeros((0, 0), complex))
     drive_phi2: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(0, complex))
@@ -129,6 +133,13 @@ class ModalFitter:
     unit_weights : bool
         Weight every output row by 1 in every pass (for rows that are already
         normalised combinations of outputs, see :func:`compress_outputs`).
+    line_weights : ndarray, shape (n_freq,), optional
+        Weight of each line (``1 / sigma_f`` of a per-line noise model
+        ``Var H_jk(f) = sigma_j^2 sigma_f^2``): data and basis rows of line
+        ``f`` are multiplied by it, so that the least-squares cost is the
+        Gaussian negative log-likelihood of that noise model (maximum
+        likelihood). Default 1 for every line. ``FitResult.model`` is
+        returned unweighted.
     """
 
     def __init__(
@@ -142,6 +153,7 @@ class ModalFitter:
         upper: bool = True,
         lower: bool = True,
         unit_weights: bool = False,
+        line_weights: NDArray[np.float64] | None = None,
     ) -> None:
         if mode_kind not in ("complex", "real"):
             raise InputError(f"mode_kind: expected 'complex' or 'real', got {mode_kind!r}")
@@ -159,6 +171,20 @@ class ModalFitter:
         self.s = 1j * w
         self.kappa = (1j * w) ** power
         self.kappa_low = (1j * w) ** (power - 2)
+        self.line_weights: NDArray[np.float64] | None = None
+        if line_weights is not None:
+            lw = np.asarray(line_weights, float)
+            if lw.shape != frequency.shape or not np.all(np.isfinite(lw) & (lw > 0)):
+                raise InputError(
+                    f"line_weights: expected {frequency.size} finite positive values, got "
+                    f"shape {lw.shape}"
+                )
+            self.line_weights = lw
+            # every basis column is kappa or kappa_low times a function of s: weighting
+            # the two factors weights every basis and derivative row of the line
+            self.kappa = self.kappa * lw
+            self.kappa_low = self.kappa_low * lw
+            H = H * lw[None, None, :]
         self._kap2 = 2.0 * self.kappa[None, :]
         self.w_ref = float(w[-1])
         # theta, ref, Phi, R and Q (None when not formed) of the latest fit's
@@ -965,6 +991,8 @@ class ModalFitter:
         if uncertainty:
             hw = np.ascontiguousarray((C / w[None, :]).T @ phi.T)  # (n_out, n_rows)
             model = hw.view(np.complex128).reshape(self.n_out, self.n_in, self.n_f)
+            if self.line_weights is not None:
+                model = model / self.line_weights[None, None, :]
         per = 2 if self.kind == "complex" else 1
         data_ss = self.data_ss
         # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's
@@ -974,7 +1002,7 @@ class ModalFitter:
         cb = C[: per * m].reshape(m, per, self.n_out)
         ss = np.sum(cb * np.matmul(gram, cb), axis=1)  # (m, n_out)
         contrib = np.sqrt(np.sum(ss / w[None, :] ** 2, axis=1) / max(data_ss, 1e-300))
-        signif = np.sum(ss, axis=1) / (s2 * (per * self.n_out + 2))
+        signif = _extra_ss(sol["R"], C, per, m) / max(s2, 1e-300)
         return FitResult(
             poles=poles,
             psi_out=psi_out,
@@ -993,6 +1021,8 @@ class ModalFitter:
             warnings=warn,
             contribution=contrib,
             significance=signif,
+            n_obs=n_obs,
+            n_par=q * self.n_out + n_par,
             theta=th,
             participation=self.unpack(th, m, ref)[1],
             drive_phi2=phi2,
@@ -1123,6 +1153,34 @@ _CANCEL_TOL = 1e-6
 #: fit_added: an added column whose squared norm drops below this fraction when the
 #: fixed basis is projected out is projected explicitly
 _PROJ_TOL = 1e-4
+
+
+def _extra_ss(
+    R: NDArray[np.float64], C: NDArray[np.float64], per: int, m: int
+) -> NDArray[np.float64]:
+    """Extra sum of squares of each mode: the rise of the (weighted) cost when
+    the ``per`` columns of mode ``n`` are removed and the other linear
+    coefficients refitted at the same poles, summed over the outputs.
+
+    With ``Phi = Q R`` and ``F = (Phi^T Phi)^-1 = R^-1 R^-T``, the rise for
+    output ``j`` is ``c_nj^T (F_nn)^-1 c_nj`` (``c_nj`` the coefficients of
+    mode ``n``, ``F_nn`` their block; the partial F-test numerator, e.g.
+    Seber & Lee, *Linear Regression Analysis*, 2003, sec. 4.3). Returns shape (m,).
+    """
+    out = np.zeros(m)
+    if m == 0:
+        return out
+    rinv = lapack.dtrtri(R)[0]
+    for n in range(m):
+        a = slice(per * n, per * n + per)
+        rb = rinv[a]  # rows of R^-1 for the mode's columns: F_nn = rb rb^T
+        fnn = rb @ rb.T
+        cn = C[a]  # (per, n_out)
+        try:
+            out[n] = float(np.sum(cn * np.linalg.solve(fnn, cn)))
+        except np.linalg.LinAlgError:
+            out[n] = 0.0
+    return out
 
 
 def _gram_chol(
