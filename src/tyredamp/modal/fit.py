@@ -76,6 +76,12 @@ __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
 
 ModelKind = Literal["complex", "real"]
 
+#: noise floor of the mode statistics, relative to the RMS of each output: the
+#: noise can never be below the rounding of the data and of the fit (synthesised
+#: double-precision FRFs and the fit's arithmetic carry 1e-13..1e-11); without
+#: it, noise-free data would make structure at the level of rounding "significant"
+NOISE_FLOOR = 1e-10
+
 #: derivative-column layouts (ModalFitter._layout) per (kind, m, n_in, q, w_ref)
 _LAYOUTS: dict[tuple[str, int, int, int, float], _Layout] = {}
 
@@ -197,6 +203,8 @@ class ModalFitter:
         self.n_rows = self.Y.shape[0]
         self.data_ss = float(np.sum(self.Y**2))
         self._rms = np.sqrt(np.mean(self.Y**2, axis=0))  # RMS per output row
+        #: noise floor per output (units of the data; NOISE_FLOOR)
+        self.noise_floor = NOISE_FLOOR * self._rms
         # weights of a first pass (fit without sigma, fit_added): 1 / RMS per output
         self._w1 = (
             np.ones_like(self._rms)
@@ -1002,7 +1010,8 @@ class ModalFitter:
         cb = C[: per * m].reshape(m, per, self.n_out)
         ss = np.sum(cb * np.matmul(gram, cb), axis=1)  # (m, n_out)
         contrib = np.sqrt(np.sum(ss / w[None, :] ** 2, axis=1) / max(data_ss, 1e-300))
-        signif = _extra_ss(sol["R"], C, per, m) / max(s2, 1e-300)
+        s2_floor = float(np.mean((w * self.noise_floor) ** 2))
+        signif = _extra_ss(sol["R"], C, per, m) / max(s2, s2_floor, 1e-300)
         return FitResult(
             poles=poles,
             psi_out=psi_out,

@@ -42,6 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._validate import as_finite, as_frequency
 from ..exceptions import InputError, ShapeError
+from .problem import check_uniform
 
 __all__ = ["PoleSet", "plscf"]
 
@@ -110,7 +111,8 @@ def plscf(
     Parameters
     ----------
     frequency : array_like, shape (n_freq,)
-        Frequency lines in Hz (strictly increasing).
+        Frequency lines in Hz (strictly increasing and uniformly spaced in the
+        band: the z-domain basis assumes it; a non-uniform axis is refused).
     H : array_like, complex, shape (n_out, n_in, n_freq)
         FRFs of any kind; the rational model absorbs the kind.
     max_order : int
@@ -167,6 +169,7 @@ def plscf(
     sel = (f >= lo) & (f <= hi)
     if not sel.all():  # (no copy when the band holds every line)
         f, h = f[sel], h[:, :, sel]
+    check_uniform(f)
     n_out, n_in, n_f = h.shape
     if n_f * 2 <= (p_max + 1) * (n_in + 1):
         raise InputError(

@@ -73,6 +73,8 @@ class FitProblem:
         ``1 / sqrt(g_f)`` of the separable per-line noise model (mean square 1).
     variance : ndarray, shape (n_out, n_in, n_freq) or None
         Per-line variance in the normalised units (known noise only).
+    lines : slice
+        The band's lines in ``frf.frequency``.
     """
 
     frequency: NDArray[np.float64]
@@ -87,6 +89,7 @@ class FitProblem:
     sigma_out: NDArray[np.float64] | None
     line_weights: NDArray[np.float64] | None
     variance: NDArray[np.float64] | None
+    lines: slice
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -111,7 +114,8 @@ def max_modes(n_out: int, n_in: int, n_f: int) -> int:
     return int(max(min(by_order, by_data), 0))
 
 
-def _check_uniform(f: NDArray[np.float64]) -> None:
+def check_uniform(f: NDArray[np.float64]) -> None:
+    """Raise :class:`InputError` unless the lines ``f`` (Hz) are uniformly spaced."""
     if f.size < 3:
         return
     df = np.diff(f)
@@ -213,7 +217,7 @@ def build_problem(
         )
     lines = np.arange(i0, i1)
     f = np.ascontiguousarray(fa[i0:i1])
-    _check_uniform(f)
+    check_uniform(f)
     Hb = np.asarray(frf.H[:, :, i0:i1])
     # scale by the largest magnitude first (no overflow of the squares), then the RMS
     peak = float(np.max(np.abs(Hb)))
@@ -232,7 +236,7 @@ def build_problem(
             source, vn = "residual", None
         else:
             sig, lw = sep
-    for a in (f, Hn) + tuple(x for x in (sig, lw, vn) if x is not None):
+    for a in (f, Hn, *(x for x in (sig, lw, vn) if x is not None)):
         a.setflags(write=False)
     return FitProblem(
         frequency=f,
@@ -247,4 +251,5 @@ def build_problem(
         sigma_out=sig,
         line_weights=lw,
         variance=vn,
+        lines=slice(i0, i1),
     )

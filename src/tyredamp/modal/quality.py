@@ -14,7 +14,7 @@ __all__ = ["FitQuality", "RejectedMode"]
 
 
 def _ro(x: ArrayLike, dtype: type = float) -> NDArray[Any]:
-    a = np.array(x, dtype=dtype)
+    a: NDArray[Any] = np.array(x, dtype=dtype)
     a.setflags(write=False)
     return a
 

@@ -156,7 +156,5 @@ def goodness_of_fit(
             if n_rejected
             else "the model is incomplete"
         )
-        verdict = (
-            f"structure is left: chi2/dof = {ratio:.3g} (p = {p:.2g}; noise {noise}); {why}"
-        )
+        verdict = f"structure is left: chi2/dof = {ratio:.3g} (p = {p:.2g}; noise {noise}); {why}"
     return GoodnessOfFit(chi2=chi2, dof=dof, p_value=p, noise=noise, passed=passed, verdict=verdict)
