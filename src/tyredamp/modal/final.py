@@ -117,9 +117,7 @@ def fit_real(
         if why:
             break
         # the evaluation limit bounds the time spent on data that real modes cannot fit
-        res = fitter.fit(
-            start_p, start_l, max_nfev=100, tol=FINAL_TOL, sigma=sigma, passes=passes
-        )
+        res = fitter.fit(start_p, start_l, max_nfev=100, tol=FINAL_TOL, sigma=sigma, passes=passes)
         why, bad = _problem(res, m, nf, problem.band)
         if not why:
             return res, m, []
