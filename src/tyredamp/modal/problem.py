@@ -11,9 +11,12 @@ and states the noise model of the fit:
   by the FRF (``FRF.variance``);
 * ``"coherence"``: derived from the coherence ``gamma^2`` and the number of
   averages ``n_d`` (``meta["n_averages"]``) with the H1 estimator's random
-  error ``Var H = |H|^2 (1 - gamma^2) / (gamma^2 n_d)`` (Bendat & Piersol,
-  *Random Data*, 4th ed. 2010, eq. 9.73 for the magnitude and phase, whose
-  sum gives the complex variance);
+  error ``Var H = |H|^2 (1 - gamma^2) / (gamma^2 (n_d - 1))``: the noise
+  spectrum ``(1 - gamma^2) G_yy`` over ``sum |X|^2``, whose expectation for
+  random inputs holds ``n_d - 1`` (Bendat & Piersol, *Random Data*, 4th ed.
+  2010, sec. 9.2.3, the magnitude and phase errors of eq. 9.73 summed; the
+  estimated coherence of ``n_d`` averages is biased towards 1 by about ``(1 -
+  gamma^2) / n_d``, which ``n_d - 1`` offsets to first order);
 * ``"residual"``: none is known, the noise level per output is estimated
   from the residual of a generous model during the fit.
 
@@ -146,7 +149,7 @@ def _line_variance(
     n_avg = frf.meta.get("n_averages") if isinstance(frf.meta, dict) else None
     if coh is not None and isinstance(n_avg, int | float) and n_avg >= 2:
         g2 = np.clip(np.asarray(coh)[:, lines], 1e-6, 1.0)
-        v = np.abs(H) ** 2 * ((1.0 - g2) / (g2 * float(n_avg)))[:, None, :]
+        v = np.abs(H) ** 2 * ((1.0 - g2) / (g2 * (float(n_avg) - 1.0)))[:, None, :]
         return "coherence", v
     return "residual", None
 

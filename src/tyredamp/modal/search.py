@@ -367,18 +367,24 @@ def residual_search(
     pending = list(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
     for _ in range(MAX_ROUNDS):
-        starts = list(pending)
-        pending = []
+        # the residual's peaks first (where the structure is), then the diagram's
+        starts: list[tuple[complex, NDArray[np.complex128]]] = []
         for fpk in _residual_peaks(fitter, res, MAX_TRIALS):
             w = 2 * np.pi * fpk
             starts.append(
                 (complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), np.ones(fitter.n_in, complex))
             )
+        starts += pending
+        pending = []
         added = False
-        for p0, l0 in starts[: 2 * MAX_TRIALS]:
+        n_tried = 0
+        for p0, l0 in starts:
             p_all = np.concatenate([cur.all()[0], np.asarray(seen, complex)])
             if p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE:
                 continue
+            if n_tried >= 2 * MAX_TRIALS:
+                break
+            n_tried += 1
             seen.append(complex(p0))
             w_lim = (
                 max(abs(p0.imag) * (1 - TRIAL_SPAN), 2 * np.pi * lo),
