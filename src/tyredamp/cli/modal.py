@@ -16,24 +16,42 @@ from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
 
+_NOISE = {
+    "variance": "per-line variance carried by the FRF",
+    "coherence": "per-line variance from the coherence and the number of averages",
+    "residual": "noise level per output estimated from the residual of the fit",
+}
+
 
 def modes_table(name: str, model: ModalModel) -> list[str]:
-    """Text table of one model: frequency, damping (with standard errors), MPC, RMSD."""
+    """Text table of one model: frequency, damping (with standard errors), MPC, the
+    mode test's statistic, RMSD and the goodness-of-fit verdict."""
     sf = model.std.get("frequency_hz", np.full(model.n_modes, np.nan))
     sz = model.std.get("damping_ratio", np.full(model.n_modes, np.nan))
     mpc = np.asarray(model.meta.get("mpc", np.full(model.n_modes, np.nan)), float)
+    q = model.quality
+    stat = q.statistic if q is not None else np.full(model.n_modes, np.nan)
+    thr = f" (threshold {q.threshold:.3g}, false-alarm rate {q.false_alarm:g})" if q else ""
     rows = [
         f"{name} modes ({model.n_modes}):",
-        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7}",
+        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7} {'T':>9}{thr}",
     ]
     for n in range(model.n_modes):
         rows.append(
             f"  {n + 1:>3} {model.frequency_hz[n]:>10.3f} {sf[n]:>8.3g} "
-            f"{100 * model.damping_ratio[n]:>9.4f} {100 * sz[n]:>8.3g} {mpc[n]:>7.4f}"
+            f"{100 * model.damping_ratio[n]:>9.4f} {100 * sz[n]:>8.3g} {mpc[n]:>7.4f} "
+            f"{stat[n]:>9.3g}"
         )
     rmsd = model.meta.get("rmsd", float("nan"))
     rel = model.meta.get("relative_error", float("nan"))
     rows.append(f"  RMSD (eq. 19) {rmsd:.4g}, relative error {100 * rel:.3g} %")
+    if q is not None:
+        rows.append(f"  fit: {q.verdict}")
+        if q.rejected:
+            rows.append(
+                f"  {len(q.rejected)} candidate(s) rejected; first: "
+                + "; ".join(f"{r.frequency_hz:.2f} Hz ({r.reason})" for r in q.rejected[:3])
+            )
     for w in model.meta.get("warnings", []):
         rows.append(f"  warning: {w}")
     return rows
@@ -85,6 +103,15 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     help="Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
 )
 @click.option("--no-residuals", is_flag=True, help="Fit without lower/upper residual terms.")
+@click.option(
+    "--false-alarm",
+    type=click.FloatRange(min=0.0, max=1.0, min_open=True, max_open=True),
+    default=0.01,
+    show_default=True,
+    help="False-alarm rate of the mode test: probability that a fit of pure noise keeps a "
+    "noise mode (also the level of the goodness-of-fit test).",
+)
+@click.option("--no-search", is_flag=True, help="Skip the residual-driven search for missed modes.")
 def modal_command(
     frf_file: Path,
     out: Path,
@@ -95,6 +122,8 @@ def modal_command(
     max_order: int | None,
     order_step: int,
     no_residuals: bool,
+    false_alarm: float,
+    no_search: bool,
 ) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
 
@@ -102,7 +131,10 @@ def modal_command(
     selection (no frequencies needed); residues, poles and participation are
     then refined together over all FRFs, shapes are mass-normalised from the
     drive point(s), and every frequency, damping ratio and shape entry gets a
-    standard error. Prints a table per model with the RMSD of eq. 19.
+    standard error. The mode count is decided by a likelihood-ratio test
+    against the noise (statistic T per mode, threshold from --false-alarm),
+    and a search of the residual adds missed modes that pass it. Prints a
+    table per model with the RMSD of eq. 19 and a goodness-of-fit verdict.
 
     \b
     Example:
@@ -119,6 +151,8 @@ def modal_command(
         max_order=max_order,
         order_step=order_step,
         residuals=not no_residuals,
+        false_alarm=false_alarm,
+        search=not no_search,
     )
     write_modes_json(
         out, res.models, source=frf_file.name, band_hz=res.band_hz, frf_kind=res.frf_kind
@@ -127,6 +161,7 @@ def modal_command(
         f"FRF {frf_file.name}: {frf.n_out} output(s) x {frf.n_in} input(s), {res.frf_kind}, "
         f"band {res.band_hz[0]:g}-{res.band_hz[1]:g} Hz, {res.frequency.size} lines"
     )
+    click.echo(f"noise model: {res.noise_source} ({_NOISE[res.noise_source]})")
     for name in ("complex", "real"):
         if name in res.models:
             for row in modes_table(name, res.models[name]):
