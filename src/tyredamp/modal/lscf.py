@@ -184,23 +184,13 @@ def plscf(
         w = as_finite(output_weights, "output_weights", ndim=1)
         if w.size != n_out:
             raise ShapeError(f"output_weights: expected {n_out} values, got {w.size}")
-    # weighted real and imaginary parts, each contiguous for the matrix products
-    h_re = h.real * w[:, None, None]
-    h_im = h.imag * w[:, None, None]
     dt = np.pi / (2 * np.pi * (hi - lo))
-    theta = 2 * np.pi * (f - lo) * dt  # in [0, pi]
     P = p_max
-    zc, zs = _unit_powers(theta, P)  # Re and Im of z^d, d = 0..P, shape (P+1, n_f)
     lag = np.arange(P + 1)[None, :] - np.arange(P + 1)[:, None]  # r' - r
+    z0, c, t = _lag_sums(f, h, w, lo, dt, P)
     # R[r, r'] = Re sum_f z^(r'-r)    (common to all outputs)
-    R = zc.sum(axis=1)[np.abs(lag)]
-    # c_ok(d) = Re sum_f z^d H_ok(f), d = -P..P (index d + P): two real products
-    c = _real_lag_sums(h_re.reshape(n_out * n_in, n_f), h_im.reshape(n_out * n_in, n_f), zc, zs)
+    R = z0[np.abs(lag)]
     c = c.reshape(n_out, n_in * (2 * P + 1))
-    # sum_o T_o[(r,k),(r',k')] = Re sum_f z^(r'-r) q_kk'(f),  q_kk' = sum_o conj(H_ok) H_ok'
-    q_re = np.einsum("okf,olf->klf", h_re, h_re) + np.einsum("okf,olf->klf", h_im, h_im)
-    q_im = np.einsum("okf,olf->klf", h_re, h_im) - np.einsum("okf,olf->klf", h_im, h_re)
-    t = _real_lag_sums(q_re.reshape(n_in * n_in, n_f), q_im.reshape(n_in * n_in, n_f), zc, zs)
     t = t.reshape(n_in, n_in, 2 * P + 1)
     T = t[:, :, lag + P].transpose(2, 0, 3, 1).reshape((P + 1) * n_in, (P + 1) * n_in)
     # sum_o S_o^T R^-1 S_o is a quadratic form in the rows c_o: with more outputs
@@ -282,6 +272,50 @@ def plscf(
         orders=orders.astype(np.int64),
         band_hz=(lo, hi),
     )
+
+
+#: lines per block of the lag sums (:func:`_lag_sums`): the power tables of a
+#: block hold ``3 (P + 1) _BLOCK`` floats (24 MB at P = 60), whatever the length
+#: of the axis
+_BLOCK = 16384
+
+
+def _lag_sums(
+    f: NDArray[np.float64],
+    h: NDArray[np.complex128],
+    w: NDArray[np.float64],
+    lo: float,
+    dt: float,
+    P: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The sums over lines of the normal equations, accumulated block by block.
+
+    Returns ``Re sum_f z^d`` (d = 0..P), ``c_ok(d) = Re sum_f z^d w_o H_ok(f)``
+    (rows ``(o, k)``, columns ``d = -P..P``) and ``Re sum_f z^d q_kk'(f)`` with
+    ``q_kk' = sum_o w_o^2 conj(H_ok) H_ok'`` (rows ``(k, k')``). Blocks of
+    ``_BLOCK`` lines keep the memory of the power tables independent of the
+    number of lines (the sums are the same to rounding).
+    """
+    n_out, n_in, n_f = h.shape
+    z0 = np.zeros(P + 1)
+    c = np.zeros((n_out * n_in, 2 * P + 1))
+    t = np.zeros((n_in * n_in, 2 * P + 1))
+    for a in range(0, n_f, _BLOCK):
+        b = min(a + _BLOCK, n_f)
+        # weighted real and imaginary parts, each contiguous for the matrix products
+        h_re = h[:, :, a:b].real * w[:, None, None]
+        h_im = h[:, :, a:b].imag * w[:, None, None]
+        theta = 2 * np.pi * (f[a:b] - lo) * dt  # in [0, pi]
+        zc, zs = _unit_powers(theta, P)  # Re and Im of z^d, d = 0..P, shape (P+1, n)
+        z0 += zc.sum(axis=1)
+        n = b - a
+        # c_ok(d) = Re sum_f z^d H_ok(f), d = -P..P (index d + P): two real products
+        c += _real_lag_sums(h_re.reshape(n_out * n_in, n), h_im.reshape(n_out * n_in, n), zc, zs)
+        # sum_o T_o[(r,k),(r',k')] = Re sum_f z^(r'-r) q_kk'(f)
+        q_re = np.einsum("okf,olf->klf", h_re, h_re) + np.einsum("okf,olf->klf", h_im, h_im)
+        q_im = np.einsum("okf,olf->klf", h_re, h_im) - np.einsum("okf,olf->klf", h_im, h_re)
+        t += _real_lag_sums(q_re.reshape(n_in * n_in, n), q_im.reshape(n_in * n_in, n), zc, zs)
+    return z0, c, t
 
 
 def _unit_powers(
