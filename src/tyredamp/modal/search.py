@@ -55,6 +55,8 @@ MIN_LOW_LINES = 10
 MERGE = 5e-4
 #: residual search: a candidate's frequency stays within this factor of its start
 TRIAL_SPAN = 0.03
+#: evaluation limit of a trial mode (a mode that is there converges in a few steps)
+TRIAL_NFEV = 30
 #: residual search: most candidates tried per round, and rounds
 MAX_TRIALS = 12
 MAX_ROUNDS = 4
@@ -170,7 +172,14 @@ def _trial(
     p_all, l_all = modes.all()
     try:
         p_t, l_t, sig_t = fitter.fit_added(
-            p_all, l_all, pole, part, omega_bounds=w_lim, tol=TRIAL_TOL, theta=res.theta
+            p_all,
+            l_all,
+            pole,
+            part,
+            omega_bounds=w_lim,
+            tol=TRIAL_TOL,
+            theta=res.theta,
+            max_nfev=TRIAL_NFEV,
         )
     except (np.linalg.LinAlgError, ValueError):
         return None
@@ -283,10 +292,14 @@ def reject_by_test(
     out: list[RejectedMode] = []
     cur = modes
     res = last
-    for _ in range(modes.m + 1):
+    for i in range(modes.m + 1):
         if res is None:
+            # after a removal the others barely move: the residues are refitted at
+            # the current poles (the final fit refines them all)
             p0, l0 = cur.all()
-            res = fitter.fit(p0, l0, refine=refine, passes=1, tol=SEARCH_TOL, uncertainty=False)
+            res = fitter.fit(
+                p0, l0, refine=refine and i == 0, passes=1, tol=SEARCH_TOL, uncertainty=False
+            )
         cur = cur.take(res)
         m = cur.m
         t, con = res.significance[:m], res.contribution[:m]
@@ -312,7 +325,9 @@ def reject_by_test(
     return res, cur, out
 
 
-def _residual_peaks(fitter: ModalFitter, res: FitResult, n_max: int) -> NDArray[np.float64]:
+def _residual_peaks(
+    fitter: ModalFitter, res: FitResult, n_max: int, threshold: float
+) -> NDArray[np.float64]:
     """Frequencies (Hz) of the largest peaks of the residual power per line.
 
     The residual of the fit (weighted as the fit weights it) is summed over
@@ -342,7 +357,11 @@ def _residual_peaks(fitter: ModalFitter, res: FitResult, n_max: int) -> NDArray[
     if sm.size < 3:
         return np.zeros(0)
     peak = np.flatnonzero((sm[1:-1] > sm[:-2]) & (sm[1:-1] >= sm[2:])) + 1
-    peak = peak[sm[peak] > 2.0 * np.median(sm)]
+    # a missed mode explains at least the residual power it leaves above the noise
+    # level: peaks whose excess over the median within the window is below a
+    # quarter of the test's threshold cannot hold a significant mode
+    excess = k * (sm[peak] - np.median(sm))
+    peak = peak[(sm[peak] > 2.0 * np.median(sm)) & (excess > 0.25 * threshold)]
     order = np.argsort(-sm[peak])[:n_max]
     return np.asarray(fitter.f[peak[order]])
 
@@ -369,7 +388,7 @@ def residual_search(
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
-        for fpk in _residual_peaks(fitter, res, MAX_TRIALS):
+        for fpk in _residual_peaks(fitter, res, MAX_TRIALS, threshold):
             w = 2 * np.pi * fpk
             starts.append(
                 (complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), np.ones(fitter.n_in, complex))
@@ -382,7 +401,7 @@ def residual_search(
             p_all = np.concatenate([cur.all()[0], np.asarray(seen, complex)])
             if p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE:
                 continue
-            if n_tried >= 2 * MAX_TRIALS:
+            if n_tried >= MAX_TRIALS:
                 break
             n_tried += 1
             seen.append(complex(p0))
