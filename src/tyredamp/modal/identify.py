@@ -76,9 +76,10 @@ from numpy.typing import ArrayLike, NDArray
 from .._validate import as_finite
 from ..exceptions import InputError
 from ..frf import FRF
+from .compress import _compress, combine_outputs
 from .estimators import PoleEstimator
 from .final import ModelContext, final_complex, fit_real, to_model
-from .fit import FitResult, ModalFitter, _compress, combine_outputs
+from .fit import FitResult, ModalFitter
 from .lscf import PoleSet, plscf
 from .model import ModalModel
 from .order import Diagram, SelectionRules, default_order, settle_order
