@@ -82,7 +82,7 @@ def test_fit_added_reuses_the_latest_fit_basis_with_the_same_result(
     monkeypatch.setattr(fit_mod, "_orth", counted)
     a = fit.fit_added(*args, omega_bounds=(lo, hi))
     n_plain = len(calls)
-    b = fit.fit_added(*args, omega_bounds=(lo, hi), theta=res.theta)  # cached basis
+    b = fit.fit_added(*args, omega_bounds=(lo, hi), fixed=res)  # the fit's basis, reused
     assert len(calls) - n_plain == n_plain - 1  # the fixed modes' basis is not redone
     assert_allclose(b[0], a[0], rtol=1e-12)
     assert_allclose(b[2], a[2], rtol=1e-9)

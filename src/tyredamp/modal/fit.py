@@ -122,6 +122,9 @@ class FitResult:
     theta: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     participation: NDArray[np.complex128] = field(default_factory=lambda: np.zeros((0, 0), complex))
     drive_phi2: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(0, complex))
+    #: theta, ref, Phi, R and Q (None when not formed) of the fit's projection, which
+    #: :meth:`ModalFitter.fit_added` reuses (``fixed=``); the fitter keeps no state
+    projection: tuple[Any, ...] | None = None
 
 
 class ModalFitter:
@@ -198,9 +201,6 @@ class ModalFitter:
             H = H * lw[None, None, :]
         self._kap2 = 2.0 * self.kappa[None, :]
         self.w_ref = float(w[-1])
-        # theta, ref, Phi, R and Q (None when not formed) of the latest fit's
-        # projection, reused by fit_added(theta=...)
-        self._last_q: tuple[Any, ...] | None = None
         # data: rows (k, f) complex, real and imaginary part interleaved (row 2i:
         # Re, row 2i + 1: Im of line i); the basis columns use the same layout
         hc = H.transpose(1, 2, 0).reshape(self.n_in * self.n_f, self.n_out)
@@ -402,9 +402,10 @@ class ModalFitter:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
-        # the projection at the result, for fit_added(theta=...) on these modes
-        self._last_q = (th.copy(), ref.copy(), sol["phi"], sol["R"], sol["Q"])
-        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        # the projection at the result, for fit_added(fixed=res) on these modes
+        res.projection = (th.copy(), ref.copy(), sol["phi"], sol["R"], sol["Q"])
+        return res
 
     def fit_added(
         self,
@@ -416,7 +417,7 @@ class ModalFitter:
         omega_bounds: tuple[float, float] | None = None,
         max_nfev: int = 200,
         tol: float = 1e-6,
-        theta: NDArray[np.float64] | None = None,
+        fixed: FitResult | None = None,
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
@@ -431,9 +432,9 @@ class ModalFitter:
         accuracy (columns or data mostly in the span of ``Qf``).
         ``omega_bounds`` (rad/s, lower < upper) limits the damped natural
         frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
-        ``theta``: the parameter vector of the fixed modes when they come from
-        this fitter's latest :meth:`fit` (``FitResult.theta``), whose
-        orthonormal basis is then reused.
+        ``fixed``: the :meth:`fit` of this fitter that gave the fixed modes
+        (``poles``, ``part`` its poles and participation), whose orthonormal
+        basis is then reused (no state is kept between the calls).
 
         Returns
         -------
@@ -459,36 +460,7 @@ class ModalFitter:
         w = self._w1
         Yw = self.Y * w[None, :]
         yy = np.einsum("ij,ij->j", Yw, Yw)
-        last = self._last_q
-        if (
-            theta is not None
-            and last is not None
-            and np.array_equal(theta, last[0])
-            and np.array_equal(ref, last[1])
-        ):
-            phi_f, r_f, q_f = last[2], last[3], last[4]
-        else:
-            phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
-            q_f, r_f = _orth(phi_f)
-        # products with the fixed modes' orthonormal basis Qf (Qf = Phi_f R_f^-1 when
-        # the latest fit did not form it)
-        if q_f is None:
-
-            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(lapack.dtrtrs(r_f, phi_f.T @ X, trans=1)[0])
-
-            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(phi_f @ lapack.dtrtrs(r_f, QX)[0])
-
-        else:
-            qf = q_f
-
-            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(qf.T @ X)
-
-            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(qf @ QX)
-
+        qt, back = self._fixed_projector(poles, part, ref, fixed)
         # the data projected on the complement of the fixed basis, Yp = Yw - Qf Qf^T Yw,
         # enters through Qf^T Yw only (formed when ||Yp||^2 would lose accuracy)
         qty = qt(Yw)
@@ -553,6 +525,46 @@ class ModalFitter:
         res_ss = np.maximum(sol["cost_out"], 0.0) / w**2
         return complex(p_out[0]), l_out[0], np.sqrt(res_ss / max(dof, 1))
 
+    def _fixed_projector(
+        self,
+        poles: NDArray[np.complex128],
+        part: NDArray[np.complex128],
+        ref: NDArray[np.intp],
+        fixed: FitResult | None,
+    ) -> tuple[Any, Any]:
+        """``X -> Qf^T X`` and ``QX -> Qf QX`` for the orthonormal basis ``Qf`` of the
+        fixed modes (``Qf = Phi_f R_f^-1`` when the fit ``fixed`` did not form it)."""
+        m = poles.size
+        last = None if fixed is None else fixed.projection
+        if (
+            fixed is not None
+            and last is not None
+            and np.array_equal(fixed.poles, poles)
+            and np.array_equal(ref, last[1])
+        ):
+            phi_f, r_f, q_f = last[2], last[3], last[4]
+        else:
+            phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
+            q_f, r_f = _orth(phi_f)
+        if q_f is None:
+
+            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(lapack.dtrtrs(r_f, phi_f.T @ X, trans=1)[0])
+
+            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(phi_f @ lapack.dtrtrs(r_f, QX)[0])
+
+            return qt, back
+        qf = q_f
+
+        def qt2(X: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.asarray(qf.T @ X)
+
+        def back2(QX: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.asarray(qf @ QX)
+
+        return qt2, back2
+
     def _refine(
         self,
         th0: NDArray[np.float64],
@@ -604,6 +616,50 @@ class ModalFitter:
     _scale = _scaling.scale
     _scale_jacobian = _scaling.scale_jacobian
     _shape_std = _scaling.shape_std
+
+    def _pole_std(
+        self,
+        th: NDArray[np.float64],
+        m: int,
+        ref: NDArray[np.intp],
+        w: NDArray[np.float64],
+        sol: dict[str, Any],
+        s2: float,
+        shapes: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.intp]],
+        uncertainty: bool,
+    ) -> tuple[
+        NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64]
+    ]:
+        """Standard errors of f, zeta, the pole and the shapes (NaN without ``uncertainty``):
+        Gauss-Newton covariance ``s^2 (J^T J)^-1`` at the optimum and the delta method."""
+        b, u, didx = shapes
+        n_par = th.size
+        poles = self.unpack(th, m, ref)[0]
+        nan = np.full(m, np.nan)
+        std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
+        std_psi = np.full((self.n_out, m), np.nan)
+        if uncertainty:
+            jtj = sol["jtj"] if "jtj" in sol else self._normal(sol, n_par)[0]
+            cth = s2 * np.linalg.pinv(jtj, hermitian=True)
+            x1 = th[0 : 2 * m : 2]
+            sig = self.w_ref * np.exp(x1)
+            om = poles.imag
+            mag = np.abs(poles)
+            jf = np.zeros((m, n_par))
+            jz = np.zeros((m, n_par))
+            ar = np.arange(m)
+            jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
+            jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
+            jz[ar, 2 * ar] = (om**2 / mag**3) * sig
+            jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
+            std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
+            std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
+            std_pole = (
+                np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
+                + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
+            )
+            std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
+        return std_f, std_z, std_pole, std_psi
 
     def _result(
         self,
@@ -662,30 +718,9 @@ class ModalFitter:
         n_obs = self.n_rows * self.n_out
         dof = max(n_obs - q * self.n_out - n_par, 1)
         s2 = sol["cost"] / dof
-        nan = np.full(m, np.nan)
-        std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
-        std_psi = np.full((self.n_out, m), np.nan)
-        if uncertainty:
-            jtj = sol["jtj"] if "jtj" in sol else self._normal(sol, n_par)[0]
-            cth = s2 * np.linalg.pinv(jtj, hermitian=True)
-            x1 = th[0 : 2 * m : 2]
-            sig = self.w_ref * np.exp(x1)
-            om = poles.imag
-            mag = np.abs(poles)
-            jf = np.zeros((m, n_par))
-            jz = np.zeros((m, n_par))
-            ar = np.arange(m)
-            jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
-            jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
-            jz[ar, 2 * ar] = (om**2 / mag**3) * sig
-            jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
-            std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
-            std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
-            std_pole = (
-                np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
-                + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
-            )
-            std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
+        std_f, std_z, std_pole, std_psi = self._pole_std(
+            th, m, ref, w, sol, s2, (b, u, didx), uncertainty
+        )
         # ---- model (final fits only), contributions
         phi = sol["phi"]
         model = np.zeros((0, self.n_in, self.n_f), complex)

@@ -177,78 +177,58 @@ def identify_modes(
     estimator: PoleEstimator | None = None,
     search: bool = True,
 ) -> ModalIdentification:
-    """Identify modes from measured FRFs without hand-holding.
+    """Identify modes from measured FRFs without hand-holding (module docstring).
 
     Parameters
     ----------
     frf : FRF
-        Measured FRFs, shape (n_out, n_in, n_freq), any kind, on a uniform
-        frequency axis. Drive points (an output at the node and direction of
-        an input) fix the mass normalisation; without one the shapes are
-        unscaled (a warning says so).
+        FRFs, shape (n_out, n_in, n_freq), any kind, uniform axis. Drive points
+        (output at the node and direction of an input) fix the mass
+        normalisation; without one the shapes are unscaled (a warning says so).
     band : (float, float), optional
-        Analysis band in Hz; default the whole axis (0 Hz lines are skipped).
-        The data are cut to it before anything else.
+        Band in Hz (default the whole axis, 0 Hz skipped); cut before anything else.
     model : {"both", "complex", "real"}
-        Which modal models to fit (default both).
+        Modal models to fit (default both).
     n_modes : int, optional
-        Number of modes to keep (the most persistent clusters); default
-        automatic (the statistical test). At most what the band's data can
-        support (:func:`~tyredamp.modal.problem.max_modes`).
+        Modes to keep (the most persistent clusters); default automatic (the
+        mode test). At most :func:`~tyredamp.modal.problem.max_modes`.
     frequencies : array_like of float, optional
-        Approximate natural frequencies (Hz) of the wanted modes; the nearest
-        stable pole of each is used. Overrides ``n_modes``.
+        Approximate natural frequencies (Hz) of the wanted modes; overrides ``n_modes``.
     max_order : int, optional
-        Highest estimator order, used as given. Default automatic: from
-        ``ceil(60 / n_in)`` (or more when ``n_modes`` is large), raised while
-        the highest order has fewer than two roots per mode found plus two,
-        or while the diagram is unsettled (fewer than two thirds of its
-        stable poles in persistent clusters) and a trial at about twice the
-        order finds more persistent modes in a more settled diagram (module
-        docstring); capped by the number of lines.
+        Highest estimator order, used as given; default automatic (module docstring).
     order_step : int
-        Orders of the stabilisation diagram: every ``order_step``-th from
-        ``max_order`` down to ``max_order / 4`` (default 2; 1 for every
-        order). Stability is judged against the previous computed order.
+        Every ``order_step``-th order from ``max_order`` down to ``max_order / 4``.
     residuals : bool
-        Fit upper and lower residual terms (default True).
+        Upper and lower residual terms (default True).
     refine : bool
-        Non-linear refinement of poles and residues (default True); without
-        it the poles stay at their estimator values (the standard errors then
-        still come from the Gauss-Newton covariance at those values).
+        Non-linear refinement (default True); without it the poles stay at the
+        estimator's values (standard errors still from the Gauss-Newton covariance).
     max_damping, cluster_distance, min_fraction : float
         Selection rules, see :mod:`tyredamp.modal.selection`.
     false_alarm : float
-        False-alarm rate of the mode test (probability that a fit of pure
-        noise keeps a noise mode; default 0.01) and level of the
-        goodness-of-fit test (:mod:`tyredamp.modal.stats`).
+        False-alarm rate of the mode test and level of the goodness-of-fit
+        test (default 0.01; :mod:`tyredamp.modal.stats`).
     min_contribution : float
-        Optional extra rule: also drop modes whose synthesised FRFs have an
-        RMS below this fraction of the data's (default 0: off).
+        Optional extra rule: drop modes whose synthesised FRFs have an RMS below
+        this fraction of the data's (default 0: off).
     max_helpers : int
-        Largest number of out-of-band residual modes on each side of the band
-        (default 4; 0 for none). They are kept in ``ModalModel.residual_modes``.
+        Most out-of-band residual modes per side (default 4; 0 for none), kept
+        in ``ModalModel.residual_modes``.
     variance : array_like, shape (n_out, n_in, n_freq), optional
         Variance of each line of ``frf.H``; default ``frf.variance`` when
         present, else from the coherence and ``meta["n_averages"]``, else
         estimated from the residual (:mod:`tyredamp.modal.problem`).
     estimator : PoleEstimator, optional
-        Pole estimator of the stabilisation diagram (default
-        :func:`~tyredamp.modal.lscf.plscf`; protocol in
-        :mod:`tyredamp.modal.estimators`).
+        Pole estimator (default :func:`~tyredamp.modal.lscf.plscf`; protocol
+        in :mod:`tyredamp.modal.estimators`).
     search : bool
-        Residual-driven search for missed modes (default True; automatic mode
-        count only).
+        Residual-driven search for missed modes (default True; automatic count).
 
     Returns
     -------
     ModalIdentification
-
-    Raises
-    ------
-    InputError
-        Bad arguments, a band without lines, a non-uniform axis, more modes
-        asked than the data support, or no mode found.
+        Raises :class:`InputError` on bad arguments, a band without lines, a
+        non-uniform axis, more modes than the data support, or no mode found.
     """
     if model not in ("both", "complex", "real"):
         raise InputError(f"model: expected 'both', 'complex' or 'real', got {model!r}")
@@ -262,24 +242,8 @@ def identify_modes(
     p_start = default_order(n_in, n_f, nm_hint) if max_order is None else int(max_order)
     dg = settle_order(problem, est, p_start, rules, automatic=max_order is None)
     auto = fr is None and n_modes is None
-    rej = [
-        rejected(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}")
-        for c in dg.weak
-    ]
     warnings: list[str] = []
-    cand, extra, rej = _candidates(dg, fr, n_modes, rej, warnings)
-    if not cand:
-        raise InputError(
-            f"no stable mode found in [{lo:g}, {hi:g}] Hz up to order {dg.order}; raise "
-            "--max-order, widen the band or give --frequencies"
-        )
-    modes = ModeSet(
-        np.array([c.pole for c in cand]),
-        np.array([c.participation for c in cand]).reshape(len(cand), n_in),
-        np.array([c.pole for c in extra], dtype=complex),
-        np.array([c.participation for c in extra], dtype=complex).reshape(len(extra), n_in),
-        n_free=len(extra),
-    )
+    modes, rej = _start_modes(problem, dg, fr, n_modes, min_fraction, warnings)
     fitters = _Fitters.build(problem, residuals, modes, max_helpers)
     thr = mode_threshold(mode_parameters(n_out, n_in, "complex"), n_f, false_alarm)
     last, modes, more = _select(
@@ -312,6 +276,37 @@ def identify_modes(
         warnings=warnings,
         noise_source=problem.noise_source,
     )
+
+
+def _start_modes(
+    problem: FitProblem,
+    dg: Diagram,
+    fr: NDArray[np.float64] | None,
+    n_modes: int | None,
+    min_fraction: float,
+    warnings: list[str],
+) -> tuple[ModeSet, list[RejectedMode]]:
+    """The modes to start from (chosen clusters, then others as residual modes)."""
+    rej = [
+        rejected(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}")
+        for c in dg.weak
+    ]
+    cand, extra, rej = _candidates(dg, fr, n_modes, rej, warnings)
+    if not cand:
+        lo, hi = problem.band
+        raise InputError(
+            f"no stable mode found in [{lo:g}, {hi:g}] Hz up to order {dg.order}; raise "
+            "--max-order, widen the band or give --frequencies"
+        )
+    n_in = problem.shape[1]
+    modes = ModeSet(
+        np.array([c.pole for c in cand]),
+        np.array([c.participation for c in cand]).reshape(len(cand), n_in),
+        np.array([c.pole for c in extra], dtype=complex),
+        np.array([c.participation for c in extra], dtype=complex).reshape(len(extra), n_in),
+        n_free=len(extra),
+    )
+    return modes, rej
 
 
 def _asked(fr: NDArray[np.float64] | None) -> str:

@@ -178,7 +178,7 @@ def _trial(
             part,
             omega_bounds=w_lim,
             tol=TRIAL_TOL,
-            theta=res.theta,
+            fixed=res,
             max_nfev=TRIAL_NFEV,
         )
     except (np.linalg.LinAlgError, ValueError):
