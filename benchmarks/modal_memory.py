@@ -66,21 +66,29 @@ def main() -> None:
     ap.add_argument("--long", type=float, default=2e6, help="lines of the narrow-band run")
     args = ap.parse_args()
     print("peak memory of identify_modes (1 x 1 FRF, whole axis, complex modes)")
-    print(f"{'lines':>10} {'modes':>5} {'time [s]':>9} {'peak-base [MB]':>15} {'B/line':>8} "
-          f"{'B/line above data':>18}")
+    print(
+        f"{'lines':>10} {'modes':>5} {'time [s]':>9} {'peak-base [MB]':>15} {'B/line':>8} "
+        f"{'B/line above data':>18}"
+    )
     for n in args.lines:
         r = run(n, None)
         extra = r["peak"] - r["base"]
-        print(f"{int(r['n']):>10} {int(r['modes']):>5} {r['time']:>9.2f} {extra / 1e6:>15.1f} "
-              f"{extra / r['n']:>8.0f} {extra / r['n'] - 24:>18.0f}")
+        print(
+            f"{int(r['n']):>10} {int(r['modes']):>5} {r['time']:>9.2f} {extra / 1e6:>15.1f} "
+            f"{extra / r['n']:>8.0f} {extra / r['n'] - 24:>18.0f}"
+        )
     print(f"\nnarrow band of a long FRF ({args.long:.0e} lines)")
     whole = run(args.long, None)
     narrow = run(args.long, (40.0, 60.0))
     for name, r in (("whole axis", whole), ("band 40-60 Hz", narrow)):
-        print(f"{name:>14}: {int(r['band_lines']):>9} lines in the band, {r['time']:7.2f} s, "
-              f"peak above data {(r['peak'] - r['base']) / 1e6:8.1f} MB")
+        print(
+            f"{name:>14}: {int(r['band_lines']):>9} lines in the band, {r['time']:7.2f} s, "
+            f"peak above data {(r['peak'] - r['base']) / 1e6:8.1f} MB"
+        )
     ratio = narrow["time"] / whole["time"]
-    print(f"time ratio {ratio:.3f} for a line ratio {narrow['band_lines'] / whole['band_lines']:.3f}")
+    print(
+        f"time ratio {ratio:.3f} for a line ratio {narrow['band_lines'] / whole['band_lines']:.3f}"
+    )
 
 
 if __name__ == "__main__":

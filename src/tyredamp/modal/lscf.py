@@ -193,10 +193,36 @@ def plscf(
     c = c.reshape(n_out, n_in * (2 * P + 1))
     t = t.reshape(n_in, n_in, 2 * P + 1)
     T = t[:, :, lag + P].transpose(2, 0, 3, 1).reshape((P + 1) * n_in, (P + 1) * n_in)
+    U = _whitened(c, R, P, n_in)
+
+    orders = np.arange(P, p_min - 1, -step)[::-1]
+    w_lo = 2 * np.pi * lo
+    z_up, l_up = _roots_of_orders(U, T, orders, n_in)
+    # the poles of all orders at once
+    zv = np.concatenate(z_up)
+    if zv.size == 0:
+        raise InputError("plscf: no pole found in the band at any order")
+    pole = np.asarray(1j * w_lo + np.log(zv) / dt, dtype=complex)
+    order = np.repeat(orders.astype(np.int64), [z.size for z in z_up])
+    lvec = np.ones((zv.size, 1), complex) if n_in == 1 else np.concatenate(l_up)
+    pos = pole.imag > 0
+    return PoleSet(
+        order=order[pos],
+        poles=pole[pos],
+        participation=lvec[pos],
+        orders=orders.astype(np.int64),
+        band_hz=(lo, hi),
+    )
+
+
+def _whitened(
+    c: NDArray[np.float64], R: NDArray[np.float64], P: int, n_in: int
+) -> NDArray[np.float64]:
+    """``U_o = L^-1 S_o`` of every output (``R = L L^T``), shape (P+1, n_v, (P+1) n_in)."""
     # sum_o S_o^T R^-1 S_o is a quadratic form in the rows c_o: with more outputs
     # than entries of c_o, any rows with the same Gram matrix sum_o c_o c_o^T give
     # the same sum; its scaled eigenvectors are the fewest such rows (exact)
-    if n_out > c.shape[1]:
+    if c.shape[0] > c.shape[1]:
         lam, vec = np.linalg.eigh(c.T @ c)
         keep = lam > lam[-1] * 1e-15
         c = (vec[:, keep] * np.sqrt(lam[keep])).T
@@ -212,11 +238,18 @@ def plscf(
     # solved in place, no copy of S, and U comes out C-ordered
     U = sla.blas.dtrsm(1.0, L, S.T, side=1, lower=1, trans_a=1, overwrite_b=1).T
     U = U.reshape(P + 1, n_v, (P + 1) * n_in)
+    return U
 
-    orders = np.arange(P, p_min - 1, -step)[::-1]
+
+def _roots_of_orders(
+    U: NDArray[np.float64], T: NDArray[np.float64], orders: NDArray[np.int64], n_in: int
+) -> tuple[list[NDArray[np.complex128]], list[NDArray[np.complex128]]]:
+    """Upper-half-plane roots ``z`` of the denominator of every order, and their
+    participation vectors (``n_in > 1``), from the reduced normal equations
+    (``U`` the whitened numerator blocks, ``T`` the denominator block)."""
+    P = int(orders[-1])
     z_up: list[NDArray[np.complex128]] = []  # upper-half-plane roots of each order
     l_up: list[NDArray[np.complex128]] = []  # their participation vectors (n_in > 1)
-    w_lo = 2 * np.pi * lo
     # the reduced matrix of order p uses the leading p + 1 rows of every U_o:
     # sum_o U_o^T U_o accumulates row block by row block up the orders (lower
     # triangle only, F-ordered, updated in place by BLAS dsyrk)
@@ -257,21 +290,7 @@ def plscf(
         z_up.append(zval)
         if n_in > 1:
             l_up.append(_participation(alpha, zval, n_in))
-    # the poles of all orders at once
-    zv = np.concatenate(z_up)
-    if zv.size == 0:
-        raise InputError("plscf: no pole found in the band at any order")
-    pole = np.asarray(1j * w_lo + np.log(zv) / dt, dtype=complex)
-    order = np.repeat(orders.astype(np.int64), [z.size for z in z_up])
-    lvec = np.ones((zv.size, 1), complex) if n_in == 1 else np.concatenate(l_up)
-    pos = pole.imag > 0
-    return PoleSet(
-        order=order[pos],
-        poles=pole[pos],
-        participation=lvec[pos],
-        orders=orders.astype(np.int64),
-        band_hz=(lo, hi),
-    )
+    return z_up, l_up
 
 
 #: lines per block of the lag sums (:func:`_lag_sums`): the power tables of a
