@@ -16,12 +16,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
 import subprocess
 import sys
-import time
-
-import numpy as np
 
 CHILD = r"""
 import json, resource, sys, time
