@@ -26,14 +26,17 @@ from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
 
 n = int(float(sys.argv[1])); band = json.loads(sys.argv[2])
-fn = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0]); z = np.array([0.03, 0.02, 0.02, 0.015, 0.012, 0.01])
+fn = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0])
+z = np.array([0.03, 0.02, 0.02, 0.015, 0.012, 0.01])
 w = 2 * np.pi * fn
 p = -z * w + 1j * w * np.sqrt(1 - z**2)
 m = ModalModel(p, np.ones((1, 6)) + 0.1j, np.ones((1, 6)))
 f = np.linspace(0.0, 200.0, n)
 h = m.frf(f[1:], "accelerance").H
 rng = np.random.default_rng(0)
-h = h + 1e-2 * np.sqrt(np.mean(np.abs(h) ** 2)) * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
+e = (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
+h = h + 1e-2 * np.sqrt(np.mean(np.abs(h) ** 2)) * e
+del e
 frf = FRF(f[1:], h, kind="accelerance")
 del h
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
