@@ -4,6 +4,7 @@ Levenberg-Marquardt iteration (used by :class:`~tyredamp.modal.fit.ModalFitter`)
 
 from __future__ import annotations
 
+import contextlib
 import math
 from typing import Any
 
@@ -35,20 +36,20 @@ def _extra_ss(
     mode ``n``, ``F_nn`` their block; the partial F-test numerator, e.g.
     Seber & Lee, *Linear Regression Analysis*, 2003, sec. 4.3). Returns shape (m,).
     """
-    out = np.zeros(m)
     if m == 0:
-        return out
+        return np.zeros(0)
     rinv = lapack.dtrtri(R)[0]
-    for n in range(m):
-        a = slice(per * n, per * n + per)
-        rb = rinv[a]  # rows of R^-1 for the mode's columns: F_nn = rb rb^T
-        fnn = rb @ rb.T
-        cn = C[a]  # (per, n_out)
-        try:
-            out[n] = float(np.sum(cn * np.linalg.solve(fnn, cn)))
-        except np.linalg.LinAlgError:
-            out[n] = 0.0
-    return out
+    rb = rinv[: per * m].reshape(m, per, -1)  # rows of R^-1 of each mode: F_nn = rb rb^T
+    fnn = np.matmul(rb, rb.transpose(0, 2, 1))
+    cn = C[: per * m].reshape(m, per, -1)  # (m, per, n_out)
+    try:
+        sol = np.linalg.solve(fnn, cn)
+    except np.linalg.LinAlgError:  # a singular block: mode by mode, 0 where singular
+        sol = np.zeros_like(cn)
+        for n in range(m):
+            with contextlib.suppress(np.linalg.LinAlgError):
+                sol[n] = np.linalg.solve(fnn[n], cn[n])
+    return np.asarray(np.sum(cn * sol, axis=(1, 2)))
 
 
 def _gram_chol(

@@ -327,12 +327,13 @@ def reject_by_test(
 
 def _residual_peaks(
     fitter: ModalFitter, res: FitResult, n_max: int, threshold: float
-) -> NDArray[np.float64]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Frequencies (Hz) of the largest peaks of the residual power per line.
 
     The residual of the fit (weighted as the fit weights it) is summed over
     the FRFs in units of each output's noise variance and smoothed over 5
-    lines; its local maxima, largest first.
+    lines; its local maxima, largest first. Also returns the residual power
+    per line above its median (the excess a missed mode could explain).
     """
     m_all = res.poles.size
     s = fitter.s
@@ -355,7 +356,7 @@ def _residual_peaks(
     k = min(5, pw.size)
     sm = np.convolve(pw, np.ones(k) / k, mode="same")
     if sm.size < 3:
-        return np.zeros(0)
+        return np.zeros(0), pw - np.median(pw)
     peak = np.flatnonzero((sm[1:-1] > sm[:-2]) & (sm[1:-1] >= sm[2:])) + 1
     # a missed mode explains at least the residual power it leaves above the noise
     # level: peaks whose excess over the median within the window is below a
@@ -363,7 +364,17 @@ def _residual_peaks(
     excess = k * (sm[peak] - np.median(sm))
     peak = peak[(sm[peak] > 2.0 * np.median(sm)) & (excess > 0.25 * threshold)]
     order = np.argsort(-sm[peak])[:n_max]
-    return np.asarray(fitter.f[peak[order]])
+    return np.asarray(fitter.f[peak[order]]), pw - np.median(pw)
+
+
+def _room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> float:
+    """Residual power above the noise (units of the noise variance) within the
+    half-power band ``+-2 zeta f`` of a candidate pole ``p`` (at least 5 lines)."""
+    fc = abs(p.imag) / (2 * np.pi)
+    z = -p.real / max(abs(p), 1e-300)
+    half = max(2 * z * fc, 2.5 * (f[-1] - f[0]) / max(f.size - 1, 1))
+    sel = (f >= fc - half) & (f <= fc + half)
+    return float(np.sum(excess[sel]))
 
 
 def residual_search(
@@ -388,12 +399,15 @@ def residual_search(
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
-        for fpk in _residual_peaks(fitter, res, MAX_TRIALS, threshold):
+        peaks, excess = _residual_peaks(fitter, res, MAX_TRIALS, threshold)
+        for fpk in peaks:
             w = 2 * np.pi * fpk
             starts.append(
                 (complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), np.ones(fitter.n_in, complex))
             )
-        starts += pending
+        # a diagram candidate can explain at most the residual power above the noise
+        # within its half-power band (+-2 zeta f): skipped when that cannot pass
+        starts += [c for c in pending if _room(fitter.f, excess, c[0]) > 0.25 * threshold]
         pending = []
         added = False
         n_tried = 0
