@@ -434,7 +434,7 @@ def _select(
         out += dropped
     if not auto:
         return last, modes, out
-    last, modes, dropped = reject_by_test(sfit, modes, last, thr, refine, min_contribution)
+    last, modes, dropped = reject_by_test(sfit, modes, problem_band, thr, refine, min_contribution)
     out += dropped
     if search and refine:
         cands = [(c.pole, c.participation) for c in dg.weak] + [

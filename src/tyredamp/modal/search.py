@@ -55,6 +55,9 @@ MIN_LOW_LINES = 10
 MERGE = 5e-4
 #: residual search: a candidate's frequency stays within this factor of its start
 TRIAL_SPAN = 0.03
+#: evaluation limit of the joint refit after an accepted trial (it only decides
+#: whether the mode stays; the final fit converges)
+JOINT_NFEV = 30
 #: evaluation limit of a trial mode (a mode that is there converges in a few steps)
 TRIAL_NFEV = 30
 #: residual search: most candidates tried per round, and rounds
@@ -123,40 +126,33 @@ def fit_checked(
         free = np.zeros(cur.hp.size, bool)
         free[: cur.n_free] = True
         wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
-        bad: int | None = None
-        why = ""
-        if wrong.size:
-            bad = int(wrong[0])
-            why = f"crossed the band edge during refinement ({fd[bad]:.2f} Hz)"
-        else:
+        why = "crossed the band edge during refinement"
+        if not wrong.size:
             d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
             np.fill_diagonal(d, np.inf)
             if d.size and d.min() < MERGE:
                 i, j = np.unravel_index(np.argmin(d), d.shape)
-                bad = int(i if res.contribution[i] < res.contribution[j] else j)
+                wrong = np.array([i if res.contribution[i] < res.contribution[j] else j])
                 why = "merged with another mode during refinement"
-        if bad is None:
+        if not wrong.size:
             return res, cur.take(res), dropped
-        if bad < m:
-            if m == 1:
-                raise ConvergenceError(f"the only mode {why}")
-            dropped.append(rejected(complex(cur.poles[bad]), f"complex fit: {why}"))
-            cur = ModeSet(
-                np.delete(cur.poles, bad),
-                np.delete(cur.part, bad, axis=0),
-                cur.hp,
-                cur.hl,
-                cur.n_free,
-            )
-        else:
-            k = bad - m
-            cur = ModeSet(
-                cur.poles,
-                cur.part,
-                np.delete(cur.hp, k),
-                np.delete(cur.hl, k, axis=0),
-                cur.n_free - (1 if k < cur.n_free else 0),
-            )
+        # every mode that crossed a band edge is dropped at once (one refit)
+        inband = wrong[wrong < m]
+        if inband.size >= m:
+            raise ConvergenceError(f"every mode {why}")
+        dropped += [
+            rejected(complex(cur.poles[i]), f"complex fit: {why} ({fd[i]:.2f} Hz)") for i in inband
+        ]
+        out = wrong[wrong >= m] - m
+        keep_m = np.setdiff1d(np.arange(m), inband)
+        keep_h = np.setdiff1d(np.arange(cur.hp.size), out)
+        cur = ModeSet(
+            cur.poles[keep_m],
+            cur.part[keep_m],
+            cur.hp[keep_h],
+            cur.hl[keep_h],
+            int(np.count_nonzero(keep_h < cur.n_free)),
+        )
     raise ConvergenceError("refinement kept losing modes")
 
 
@@ -278,28 +274,33 @@ def _with_helper(
 def reject_by_test(
     fitter: ModalFitter,
     modes: ModeSet,
-    last: FitResult | None,
+    band: tuple[float, float],
     threshold: float,
     refine: bool,
     min_contribution: float = 0.0,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Drop the weakest mode that fails the mode test, refit; until every mode passes.
 
-    ``last`` is a fit of ``modes`` on ``fitter`` when one is at hand.
+    The first fit refines every mode jointly (and drops modes that leave the
+    band); after each removal the residues are refitted at the current poles.
     ``min_contribution`` (default 0: off) also drops modes whose synthesised
     FRFs have an RMS below that fraction of the data's.
     """
     out: list[RejectedMode] = []
     cur = modes
-    res = last
+    res: FitResult | None = None
     for i in range(modes.m + 1):
-        if res is None:
+        if i == 0 and refine:
+            # a converged joint fit first (modes that leave the band are dropped)
+            res, cur, gone = fit_checked(
+                fitter, cur, True, band, passes=1, tol=SEARCH_TOL, uncertainty=False
+            )
+            out += gone
+        elif res is None:
             # after a removal the others barely move: the residues are refitted at
             # the current poles (the final fit refines them all)
             p0, l0 = cur.all()
-            res = fitter.fit(
-                p0, l0, refine=refine and i == 0, passes=1, tol=SEARCH_TOL, uncertainty=False
-            )
+            res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
         cur = cur.take(res)
         m = cur.m
         t, con = res.significance[:m], res.contribution[:m]
@@ -321,7 +322,9 @@ def reject_by_test(
             cur.n_free,
         )
         res = None
-    assert res is not None
+    if res is None:
+        p0, l0 = cur.all()
+        res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
     return res, cur, out
 
 
@@ -443,7 +446,14 @@ def residual_search(
             )
             try:
                 r1, c1, drop = fit_checked(
-                    fitter, new, True, band, passes=1, tol=SEARCH_TOL, uncertainty=False
+                    fitter,
+                    new,
+                    True,
+                    band,
+                    passes=1,
+                    tol=SEARCH_TOL,
+                    uncertainty=False,
+                    max_nfev=JOINT_NFEV,
                 )
             except (ConvergenceError, np.linalg.LinAlgError, ValueError):
                 continue
