@@ -163,8 +163,11 @@ def _trial(
     pole: complex,
     part: NDArray[np.complex128],
     w_lim: tuple[float, float],
+    strict: bool = True,
 ) -> tuple[complex, NDArray[np.complex128], float] | None:
-    """Refine one added mode alone; its statistic ``T`` (None when it stopped at a limit)."""
+    """Refine one added mode alone; its statistic ``T``. ``strict``: None when it
+    stopped at a limit of ``w_lim`` (an out-of-band residual mode that runs into
+    the band edge is not there); otherwise the limit only localises the trial."""
     p_all, l_all = modes.all()
     try:
         p_t, l_t, sig_t = fitter.fit_added(
@@ -180,7 +183,7 @@ def _trial(
     except (np.linalg.LinAlgError, ValueError):
         return None
     tol = 1e-4 * (w_lim[1] - w_lim[0])
-    if not (w_lim[0] + tol < p_t.imag < w_lim[1] - tol):
+    if strict and not (w_lim[0] + tol < p_t.imag < w_lim[1] - tol):
         return None  # a trial pole stopped at a limit did not find a mode there
     n_all = p_all.size
     dof0 = max(fitter.n_rows - fitter.n_cols(n_all), 1)
@@ -366,8 +369,15 @@ def _residual_peaks(
     # quarter of the test's threshold cannot hold a significant mode
     excess = k * (sm[peak] - np.median(sm))
     peak = peak[(sm[peak] > 2.0 * np.median(sm)) & (excess > 0.25 * threshold)]
-    order = np.argsort(-sm[peak])[:n_max]
-    return np.asarray(fitter.f[peak[order]]), pw - np.median(pw)
+    # largest first; a peak within 1 % of a larger one is the same structure
+    out: list[float] = []
+    for i in peak[np.argsort(-sm[peak])]:
+        fi = float(fitter.f[i])
+        if all(abs(fi - g) > 0.01 * g for g in out):
+            out.append(fi)
+        if len(out) >= n_max:
+            break
+    return np.asarray(out), pw - np.median(pw)
 
 
 def _room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> float:
@@ -428,7 +438,7 @@ def residual_search(
             )
             if not w_lim[0] < w_lim[1]:
                 continue
-            got = _trial(fitter, res, cur, p0, np.asarray(l0, complex), w_lim)
+            got = _trial(fitter, res, cur, p0, np.asarray(l0, complex), w_lim, strict=False)
             if got is None:
                 continue
             p_t, l_t, t = got
