@@ -440,7 +440,9 @@ def _select(
         cands = [(c.pole, c.participation) for c in dg.weak] + [
             (_pole_of(r), np.ones(sfit.n_in, complex)) for r in rej + out
         ]
-        last, modes, tried = residual_search(sfit, last, modes, cands, problem_band, thr)
+        last, modes, tried = residual_search(
+            sfit, last, modes, cands, problem_band, thr, dg.max_damping
+        )
         out += tried
     return last, modes, out
 

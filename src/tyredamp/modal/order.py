@@ -44,6 +44,7 @@ class Diagram:
     flags: StabilityFlags
     kept: list[Cluster]
     weak: list[Cluster]
+    max_damping: float = 0.2
 
     def persistent_share(self) -> float:
         """Share of the stable poles in the persistent clusters (0 when none is stable)."""
@@ -82,7 +83,7 @@ def diagram(
     kept, weak = cluster_poles(
         ps, flags, cluster_distance=rules.cluster_distance, min_fraction=rules.min_fraction
     )
-    return Diagram(p, ps, flags, kept, weak)
+    return Diagram(p, ps, flags, kept, weak, rules.max_damping)
 
 
 def settle_order(

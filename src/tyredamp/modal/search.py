@@ -397,8 +397,12 @@ def residual_search(
     candidates: list[tuple[complex, NDArray[np.complex128]]],
     band: tuple[float, float],
     threshold: float,
+    max_damping: float = 0.2,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
+
+    A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
+    of the diagram) is not a mode: it is rejected whatever its statistic.
 
     ``candidates`` are starting poles and participation vectors from the
     diagram; each round adds the peaks of the current residual.
@@ -442,6 +446,11 @@ def residual_search(
             if got is None:
                 continue
             p_t, l_t, t = got
+            if -p_t.real > max_damping * abs(p_t):
+                tried.append(
+                    rejected(p_t, f"damping above the admissible {max_damping:.0%}", t, threshold)
+                )
+                continue
             if t <= threshold:
                 tried.append(
                     rejected(p_t, f"not significant: T = {t:.3g} <= {threshold:.3g}", t, threshold)
