@@ -18,6 +18,7 @@ import argparse
 import json
 import subprocess
 import sys
+from typing import Any
 
 CHILD = r"""
 import json, resource, sys, time
@@ -49,13 +50,16 @@ print(json.dumps({"n": frf.frequency.size, "base": base, "peak": peak, "time": d
 """
 
 
-def run(n: float, band: tuple[float, float] | None) -> dict[str, float]:
+def run(n: float, band: tuple[float, float] | None) -> dict[str, Any]:
     out = subprocess.run(
         [sys.executable, "-c", CHILD, str(n), json.dumps(band)],
-        check=True,
+        check=False,
         capture_output=True,
         text=True,
     )
+    if out.returncode != 0:
+        last = (out.stderr.strip().splitlines() or ["?"])[-1]
+        return {"error": last}
     return dict(json.loads(out.stdout.strip().splitlines()[-1]))
 
 
@@ -71,6 +75,9 @@ def main() -> None:
     )
     for n in args.lines:
         r = run(n, None)
+        if "error" in r:
+            print(f"{int(n):>10} failed: {r['error']}")
+            continue
         extra = r["peak"] - r["base"]
         print(
             f"{int(r['n']):>10} {int(r['modes']):>5} {r['time']:>9.2f} {extra / 1e6:>15.1f} "
@@ -79,6 +86,9 @@ def main() -> None:
     print(f"\nnarrow band of a long FRF ({args.long:.0e} lines)")
     whole = run(args.long, None)
     narrow = run(args.long, (40.0, 60.0))
+    if "error" in whole or "error" in narrow:
+        print(f"failed: {whole.get('error', '')} {narrow.get('error', '')}")
+        return
     for name, r in (("whole axis", whole), ("band 40-60 Hz", narrow)):
         print(
             f"{name:>14}: {int(r['band_lines']):>9} lines in the band, {r['time']:7.2f} s, "
