@@ -24,7 +24,7 @@ import numpy as np
 
 from tyredamp.damping import DampingModel, identify_damping
 from tyredamp.signal.estimators import estimate_frf
-from tyredamp.tyre import RingTyre, TyreTruth, run_modal_test
+from tyredamp.virtual import RingTyre, TyreTruth, run_modal_test
 
 METHODS = ("first", "improved", "refined")
 

@@ -2,8 +2,8 @@
 
 Run: ``python benchmarks/demo_timing.py [--quick] [--compare-threads]``.
 
-Prints one row per stage of :func:`tyredamp.demo.run_demo` and of
-:func:`tyredamp.demo.save_demo` (figures, data files, report) with its wall
+Prints one row per stage of :func:`tyredamp.studies.demo.run_demo` and of
+:func:`tyredamp.report.demo.save_demo` (figures, data files, report) with its wall
 time. ``--compare-threads`` also runs the computation with the BLAS thread
 pool left at its default (``run_demo`` limits it to one thread), to show why
 the demo does so.
@@ -16,7 +16,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from tyredamp.demo import DemoSettings, _run, run_demo, save_demo
+from tyredamp.report.demo import save_demo
+from tyredamp.studies.demo import DemoSettings, _run, run_demo
 
 
 def _timed_progress(rows: list[tuple[str, float]]) -> object:

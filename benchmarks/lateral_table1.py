@@ -30,11 +30,11 @@ import numpy as np
 from tyredamp.lateral import (
     DEFAULT_MODELS,
     LateralVehicle,
-    VirtualLateralRig,
     fit_joint,
     harmonic_response,
     rank_models,
 )
+from tyredamp.virtual import VirtualLateralRig
 
 
 def main() -> None:

@@ -17,7 +17,7 @@ import numpy as np
 from tyredamp.frf import FRF
 from tyredamp.modal.identify import identify_modes
 from tyredamp.modal.indicators import mac
-from tyredamp.tyre import Imperfection, MeasurementLayout, RingTyre
+from tyredamp.virtual import Imperfection, MeasurementLayout, RingTyre
 
 F = np.arange(0.25, 200.01, 0.25)
 
@@ -73,7 +73,7 @@ def accuracy(label: str, tyre: RingTyre, seed: int = 1) -> None:
 def virtual_test() -> None:
     """The full chain: simulated chirp test (time data, 40 dB on every channel), H1 FRFs."""
     from tyredamp.signal.estimators import estimate_frf
-    from tyredamp.tyre import run_modal_test
+    from tyredamp.virtual import run_modal_test
 
     t0 = time.perf_counter()
     vt = run_modal_test(seed=0)

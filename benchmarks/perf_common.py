@@ -203,7 +203,7 @@ def tyre_case(snr_db: float = 40.0, seed: int = 1) -> Case:
     Band 0.25-199.75 Hz (799 lines, the 200 Hz line is the extra one), six
     visible modes (n = 1..6) with 2-4 % non-proportional damping.
     """
-    from tyredamp.tyre import RingTyre
+    from tyredamp.virtual import RingTyre
 
     tyre = RingTyre()
     tr = tyre.truth((0.0, 200.0))
@@ -226,7 +226,7 @@ def tyre_case(snr_db: float = 40.0, seed: int = 1) -> Case:
 def tyre_test_case(seed: int = 0) -> Case:
     """The virtual modal test of the tyre (time data, 40 dB per channel, 8 averages), H1 FRFs."""
     from tyredamp.signal.estimators import estimate_frf
-    from tyredamp.tyre import run_modal_test
+    from tyredamp.virtual import run_modal_test
 
     t0 = time.perf_counter()
     vt = run_modal_test(seed=seed)

@@ -51,7 +51,7 @@ from perf_common import (
 )
 
 from tyredamp.modal import identify_modes
-from tyredamp.tyre import RingTyre
+from tyredamp.virtual import RingTyre
 
 POWER = 2  # accelerance
 

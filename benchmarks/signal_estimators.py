@@ -3,7 +3,7 @@
 Run:  python benchmarks/signal_estimators.py [--quick]
 
 Table 1: H1 (cyclic) against the exact FRF of the virtual tyre
-(``tyredamp.tyre.run_modal_test``), largest relative error in the half-power
+(``tyredamp.virtual.run_modal_test``), largest relative error in the half-power
 band of every visible mode at outputs whose |H| is >= 30 % of their maximum,
 and the median over all lines of 1-200 Hz, for several averages and SNRs.
 
@@ -23,7 +23,7 @@ import scipy.signal
 
 from tyredamp.signal import estimate_frf
 from tyredamp.timedata import TimeData
-from tyredamp.tyre import run_modal_test
+from tyredamp.virtual import run_modal_test
 
 
 def near_resonance_error(vt, estimator: str = "H1") -> tuple[float, float, float]:

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from tyredamp.tyre import RingTyre, ring_convergence
+from tyredamp.virtual import RingTyre, ring_convergence
 
 N_RINGS = (16, 32, 48, 64, 96, 128, 192, 256)
 

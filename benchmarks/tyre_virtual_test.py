@@ -29,7 +29,7 @@ import time
 import numpy as np
 
 from tyredamp.timedata import TimeData
-from tyredamp.tyre import RingTyre, RingTyreParameters, analytic_ring_frequencies, run_modal_test
+from tyredamp.virtual import RingTyre, RingTyreParameters, analytic_ring_frequencies, run_modal_test
 
 
 def cyclic_h1(data: TimeData) -> tuple[np.ndarray, np.ndarray]:

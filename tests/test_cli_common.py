@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import click
 import pytest
 
 from tyredamp import __version__
+from tyredamp.cli import COMMANDS as LAZY
 from tyredamp.cli import cli, main
 
 
@@ -23,7 +26,10 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
 
 def _commands(group: click.Group, prefix: tuple[str, ...] = ()) -> list[tuple[str, ...]]:
     out: list[tuple[str, ...]] = []
-    for name, cmd in sorted(group.commands.items()):
+    ctx = click.Context(group)
+    for name in group.list_commands(ctx):  # imports the lazy subcommands
+        cmd = group.get_command(ctx, name)
+        assert cmd is not None
         out.append((*prefix, name))
         if isinstance(cmd, click.Group):
             out += _commands(cmd, (*prefix, name))
@@ -106,9 +112,41 @@ def test_bad_input_is_one_line_and_exit_2(
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
-def test_debug_shows_the_traceback(tmp_path: Path) -> None:
-    from tyredamp.exceptions import FileFormatError
-
+def test_debug_shows_the_traceback(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # --debug adds the traceback; the exit code and the last line stay the same (issue 15)
     (tmp_path / "other.json").write_text('{"kind": "something else"}')
-    with pytest.raises(FileFormatError):
-        main(["--debug", "report", str(tmp_path / "other.json"), "--out", str(tmp_path / "r.html")])
+    argv = ["report", str(tmp_path / "other.json"), "--out", str(tmp_path / "r.html")]
+    code, _, err = run(capsys, "--debug", *argv)
+    assert code == 2
+    assert "Traceback" in err
+    assert "FileFormatError" in err
+    assert err.strip().splitlines()[-1].startswith("tyredamp: error: ")
+    code2, _, err2 = run(capsys, *argv)
+    assert code2 == code
+    assert err2.strip() == err.strip().splitlines()[-1]
+
+
+def test_lazy_summaries_are_the_docstrings() -> None:
+    # tyredamp --help prints LAZY's summaries without importing the commands
+    ctx = click.Context(cli)
+    for name, (_module, _attr, summary) in LAZY.items():
+        cmd = cli.get_command(ctx, name)
+        assert cmd is not None
+        assert cmd.get_short_help_str(limit=1000) == summary
+
+
+def test_start_imports_no_subcommand_and_modal_no_io() -> None:
+    # a fresh interpreter: --help loads no subcommand (nor NumPy); the modal
+    # package loads neither pyuff nor matplotlib
+    code = (
+        "import sys, contextlib, io\n"
+        "from tyredamp.cli import main\n"
+        "with contextlib.suppress(SystemExit), contextlib.redirect_stdout(io.StringIO()):\n"
+        "    main(['--help'])\n"
+        "cmds = [m for m in sys.modules if m.startswith('tyredamp.cli.')]\n"
+        "bad = [m for m in cmds if m != 'tyredamp.cli._common']\n"
+        "assert not bad and 'numpy' not in sys.modules, (bad, 'numpy' in sys.modules)\n"
+        "import tyredamp.modal\n"
+        "assert 'pyuff' not in sys.modules and 'matplotlib' not in sys.modules\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

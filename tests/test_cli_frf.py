@@ -16,7 +16,7 @@ from tyredamp.cli import main
 from tyredamp.io import read_frf, write_frf, write_timedata
 from tyredamp.signal import estimate_frf
 from tyredamp.timedata import TimeData
-from tyredamp.tyre import run_modal_test
+from tyredamp.virtual import run_modal_test
 
 from .helpers import chain_system
 from .test_signal_estimators import periodic_record
@@ -262,3 +262,21 @@ def test_virtual_tyre_through_cli_within_1_percent_near_resonances(capsys, tmp_p
         assert err.max() < 0.01, f"mode at {fn:.1f} Hz: {err.max():.4f}"
         checked += 1
     assert checked >= 8  # the visible pairs from n = 2 to n = 6
+
+
+def test_frf_refuses_a_reaction_force_as_second_input(capsys, tmp_path: Path) -> None:
+    """The lateral time test holds body force, body acceleration and ground force."""
+    from tyredamp.io import write_timedata
+    from tyredamp.virtual import VirtualLateralRig
+
+    td = VirtualLateralRig().time_test(seed=0)
+    path = tmp_path / "time.uff"
+    write_timedata(td, path)
+    out = tmp_path / "frf.uff"
+    code, _, err = run(capsys, "frf", str(path), "--out", str(out))
+    assert_input_error(code, err, out)
+    assert "not independent excitations" in err
+    assert "--reference" in err
+    code, stdout, _ = run(capsys, "frf", str(path), "--out", str(out), "--reference", "body force")
+    assert code == 0
+    assert "1 input(s)" in stdout

@@ -18,9 +18,9 @@ from numpy.testing import assert_allclose
 from threadpoolctl import threadpool_limits
 
 from tyredamp.cli import main
+from tyredamp.documents.modes import read_modes_json
 from tyredamp.io import read_frf, write_timedata
 from tyredamp.mechanics import time_response
-from tyredamp.modal.io import read_modes_json
 from tyredamp.timedata import TimeData
 
 from .helpers import chain_system

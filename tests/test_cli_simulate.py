@@ -18,8 +18,8 @@ from numpy.testing import assert_allclose
 from threadpoolctl import threadpool_limits
 
 from tyredamp.cli import main
+from tyredamp.documents.modes import read_modes_json
 from tyredamp.io import read_frf, read_timedata
-from tyredamp.modal.io import read_modes_json
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -74,13 +74,18 @@ def radial_files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 def test_simulate_radial_writes_uff58(radial_files: dict[str, Path]) -> None:
     sets = pyuff.UFF(str(radial_files["time"])).read_sets()
-    assert {s["func_type"] for s in sets} == {1}  # time histories
-    assert len(sets) == 17  # 1 force + 16 accelerations
+    # time histories; the whole meta in data sets 151 (io.uff "Metadata record")
+    assert {s["func_type"] for s in sets if s["type"] == 58} == {1}
+    assert sum(s["type"] == 58 for s in sets) == 17  # 1 force + 16 accelerations
     td = read_timedata(radial_files["time"])
     assert td.quantities.count("force") == 1
     assert td.sample_rate == 1024.0
     sets = pyuff.UFF(str(radial_files["frf"])).read_sets()
-    assert {s["func_type"] for s in sets} == {4, 6}  # FRFs and their coherence
+    # FRFs, their coherence and (type 0, "tyredamp FRF variance") their variance; the
+    # metadata record (data sets 151) before them
+    data = [s for s in sets if s["type"] == 58]
+    assert {s["func_type"] for s in data} == {0, 4, 6}
+    assert {s["id1"].strip() for s in data if s["func_type"] == 0} == {"tyredamp FRF variance"}
     frf = read_frf(radial_files["frf"])
     assert frf.H.shape[:2] == (16, 1)
     assert frf.kind == "accelerance"
@@ -229,7 +234,7 @@ def test_simulated_noise_follows_snr(capsys: pytest.CaptureFixture[str], tmp_pat
     )
     assert code == 0, err
     frf = read_frf(out)
-    from tyredamp.tyre import RingTyre
+    from tyredamp.virtual import RingTyre
 
     exact = RingTyre().truth().frf(frf.frequency)
     # the first-order hold of the simulation: relative error ~ (pi f / fs_sim)^2 / 3 < 1e-3

@@ -1,6 +1,6 @@
 """Damping identification on the virtual truck tyre (spec step 7 on the ring model).
 
-Truth: :class:`tyredamp.tyre.TyreTruth` (exact modes of the 128-DOF ring,
+Truth: :class:`tyredamp.virtual.TyreTruth` (exact modes of the 128-DOF ring,
 ``C'`` of eq. [14] on the undamped modes, the damping reduced to the 16
 points by the same modal projection). Only the cos-type member of each
 double mode (antinode at the drive point) is visible from one radial shaker,
@@ -32,11 +32,11 @@ from numpy.testing import assert_allclose
 
 from tyredamp.cli import main
 from tyredamp.damping import DampingModel, identify_damping
+from tyredamp.documents.modes import write_modes_json
 from tyredamp.modal import ModalModel
 from tyredamp.modal.identify import identify_modes
-from tyredamp.modal.io import write_modes_json
 from tyredamp.signal.estimators import estimate_frf
-from tyredamp.tyre import RingTyre, TyreTruth, VirtualModalTest, run_modal_test
+from tyredamp.virtual import RingTyre, TyreTruth, VirtualModalTest, run_modal_test
 
 
 @pytest.fixture(scope="module")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from tyredamp import Channel, FileFormatError, InputError
 from tyredamp.frf import FRF
 from tyredamp.io import read, read_frf, read_timedata, write_frf, write_timedata
-from tyredamp.timedata import TimeData
+from tyredamp.timedata import Acquisition, TimeData
 
 LOSSLESS = ["uff58b", "csv", "npz"]
 EXT = {"uff58b": ".uff", "uff58": ".unv", "csv": ".csv", "npz": ".npz"}
@@ -42,6 +43,7 @@ def assert_same_timedata(a: TimeData, b: TimeData, rtol: float = 0.0) -> None:
     assert b.channels == a.channels
     assert b.quantities == a.quantities
     assert b.meta == a.meta
+    assert b.acquisition == a.acquisition
     if rtol == 0.0:
         assert_array_equal(b.data, a.data)
     else:
@@ -66,7 +68,15 @@ def sample_timedata(rng: np.random.Generator) -> TimeData:
         2048.0,
         chans,
         ["force", "acceleration", "velocity", "displacement"],
-        meta={"period_samples": 500, "settle_samples": 0},
+        meta={"operator": "io"},
+        acquisition=Acquisition(
+            period_samples=500,
+            run_starts=(0, 500),
+            settle_samples=0,
+            band_hz=(2.0, 300.0),
+            n_averages=1,
+            excitation="pseudo_random",
+        ),
     )
 
 
@@ -185,3 +195,113 @@ def test_writes_are_atomic_and_inputs_untouched(tmp_path: Path, monkeypatch) -> 
     with pytest.raises(InputError, match="JSON-compatible"):
         write_frf(FRF(frf.frequency, frf.H, meta={"bad": object()}), tmp_path / "m.npz")
     assert not (tmp_path / "m.npz").exists()
+
+
+@pytest.mark.parametrize("fmt", [*LOSSLESS, "uff58"])
+def test_old_files_with_acquisition_in_meta_still_read(tmp_path: Path, fmt: str) -> None:
+    """Files written before ``Acquisition`` kept its fields in ``meta``: they read the same."""
+    td = sample_timedata(np.random.default_rng(4))
+    legacy = {"period_samples": 500, "settle_samples": 100, "band_hz": [2.0, 300.0]}
+    path = tmp_path / f"old{EXT[fmt]}"
+    if fmt == "csv":
+        write_timedata(TimeData(td.data, td.sample_rate, td.channels, td.quantities), path, fmt)
+        text = path.read_text().replace(
+            "# sample_rate", f"# meta: {json.dumps(legacy)}\n# sample_rate"
+        )
+        path.write_text(text)
+    elif fmt == "npz":
+        write_timedata(TimeData(td.data, td.sample_rate, td.channels, td.quantities), path, fmt)
+        with np.load(path) as z:
+            head = json.loads(str(z["header"][()]))
+            data = z["data"]
+        head.pop("acquisition", None)
+        head["meta"] = legacy
+        np.savez(path, header=np.array(json.dumps(head)), data=data)
+    else:  # UFF always kept them as meta keys on an ID line
+        write_timedata(td, path, fmt)
+    back = read_timedata(path)
+    if fmt.startswith("uff"):
+        assert back.acquisition == td.acquisition
+    else:
+        assert back.acquisition == Acquisition(
+            period_samples=500, settle_samples=100, band_hz=(2.0, 300.0)
+        )
+        assert back.meta == {}
+
+
+def test_uff_keeps_many_runs_or_refuses(tmp_path: Path) -> None:
+    """Evenly spaced runs fit an ID line as run_every; a field that cannot fit is an error."""
+    rng = np.random.default_rng(5)
+    d = rng.normal(size=(2, 3200))
+    acq = Acquisition(period_samples=100, run_starts=tuple(range(0, 3200, 200)), settle_samples=100)
+    td = TimeData(d, 1000.0, [1, 2], ["force", "acceleration"], acquisition=acq)
+    back = read_timedata(write_timedata(td, tmp_path / "runs.uff"))
+    assert back.acquisition == acq
+    uneven = Acquisition(run_starts=(0, *(100 * k + k * k for k in range(1, 25))))
+    td = TimeData(d, 1000.0, [1, 2], ["force", "acceleration"], acquisition=uneven)
+    with pytest.raises(InputError, match="run_starts"):
+        write_timedata(td, tmp_path / "uneven.uff")
+    assert not (tmp_path / "uneven.uff").exists()
+    assert read_timedata(write_timedata(td, tmp_path / "uneven.npz")).acquisition == uneven
+
+
+@pytest.mark.parametrize("fmt", [*LOSSLESS, "uff58"])
+def test_long_meta_round_trips_in_every_writer(tmp_path: Path, fmt: str) -> None:
+    """Metadata longer than the UFF ID lines (a lateral rig's conditions and truth) survive."""
+    rng = np.random.default_rng(4)
+    meta = {
+        "speed_m_s": 5 / 3.6,
+        "speed_kmh": 5.0,
+        "pressure_bar": 1.7,
+        "force": "axle",
+        "wheel_mass_kg": 100.0,
+        "label": "  1.7 bar, 5 km/h  ",  # leading/trailing blanks kept
+        "truth": {"params": {"C_alpha": 8e4, "sigma": 0.5932605191260101}, "units": ["N/rad"]},
+        "description": "a description " * 12 + "ünïcode \\u0020 NONE",
+        "estimator": "H1",
+    }
+    frf = sample_frf(rng, n_out=2, n_in=1)
+    frf = FRF(frf.frequency, frf.H, frf.kind, frf.outputs, frf.inputs, frf.coherence, meta)
+    back = read_frf(write_frf(frf, tmp_path / f"frf{EXT[fmt]}", fmt))
+    assert back.meta == meta
+    td = sample_timedata(rng)
+    td = TimeData(
+        td.data,
+        td.sample_rate,
+        td.channels,
+        td.quantities,
+        meta={**meta, "x": [1] * 99},
+        acquisition=td.acquisition,
+    )
+    back_t = read_timedata(write_timedata(td, tmp_path / f"td{EXT[fmt]}", fmt))
+    assert back_t.meta == td.meta
+    assert back_t.acquisition == td.acquisition  # typed, beside the metadata record
+
+
+def test_uff_meta_record_is_deterministic_and_readable_by_pyuff(tmp_path: Path) -> None:
+    import pyuff
+
+    rng = np.random.default_rng(5)
+    frf = sample_frf(rng, n_out=1, n_in=1)
+    frf.meta["truth"] = {"params": list(range(200))}
+    a = write_frf(frf, tmp_path / "a.uff").read_bytes()
+    b = write_frf(frf, tmp_path / "b.uff").read_bytes()
+    assert a == b
+    sets = pyuff.UFF(str(tmp_path / "a.uff")).read_sets()
+    heads = [s for s in sets if s["type"] == 151]
+    assert len(heads) >= 2
+    assert heads[0]["model_name"].startswith("tyredamp1 meta 1 ")
+    assert [s["func_type"] for s in sets if s["type"] == 58] == [4, 6]
+    # a missing part is an error, not a silent loss
+    raw = (tmp_path / "a.uff").read_bytes()
+    first = raw.index(b"    -1\n   151")
+    second = raw.index(b"    -1\n   151", first + 10)
+    (tmp_path / "c.uff").write_bytes(raw[:first] + raw[second:])
+    with pytest.raises(FileFormatError, match="incomplete tyredamp metadata record"):
+        read_frf(tmp_path / "c.uff")
+    # a damaged record is an error naming it, and the file is left as it was
+    bad = raw.replace(b'{"estimator"', b'{"estimator"}}', 1)
+    (tmp_path / "d.uff").write_bytes(bad)
+    with pytest.raises(FileFormatError, match="metadata record"):
+        read_frf(tmp_path / "d.uff")
+    assert (tmp_path / "d.uff").read_bytes() == bad

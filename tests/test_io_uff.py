@@ -89,7 +89,7 @@ def test_foreign_units_are_converted_to_si(tmp_path: Path) -> None:
     assert read_frf(tmp_path / "lab.uff").kind == "accelerance"
     sets, _ = foreign_frf_sets(0, units=("furlong", "N"))
     write_foreign(tmp_path / "bad.uff", sets)
-    with pytest.raises(FileFormatError, match="unknown units label 'furlong'"):
+    with pytest.raises(FileFormatError, match="units label 'furlong': unknown unit 'furlong'"):
         read_frf(tmp_path / "bad.uff")
 
 
@@ -269,3 +269,29 @@ def test_non_increasing_frequency_and_nan_in_csv(tmp_path: Path) -> None:
     (tmp_path / "cut.npz").write_bytes(npz.read_bytes()[:200])
     with pytest.raises(FileFormatError, match=r"cut\.npz"):
         read(tmp_path / "cut.npz")
+
+
+@pytest.mark.parametrize(
+    ("num", "den", "factor"),
+    [
+        ("(1/N)*(m/s²)", "NONE", 1.0),
+        ("m/s2", "N", 1.0),
+        ("m/s²", "N", 1.0),
+        ("(m/s^2)/N", "", 1.0),
+        ("g/N", "NONE", 9.80665),
+        ("m/s2/N", "NONE", 1.0),
+        ("mm/s/N", "NONE", 1e-3),
+    ],
+)
+@pytest.mark.parametrize("binary", [0, 1])
+def test_vendor_units_labels(
+    tmp_path: Path, num: str, den: str, factor: float, binary: int
+) -> None:
+    """FRF labels of real exports (superscripts, whole ratios) read to SI."""
+    sets, truth = foreign_frf_sets(binary, units=(num, den))
+    for d in sets:
+        d["ordinate_spec_data_type"] = 0  # the label alone tells the kind
+    write_foreign(tmp_path / "v.uff", sets)
+    frf = read_frf(tmp_path / "v.uff")
+    assert frf.kind == ("mobility" if num.startswith("mm/s/") else "accelerance")
+    assert_allclose(frf.H[0, 0], truth["H"][11] * factor, rtol=1e-11)

@@ -124,8 +124,68 @@ def test_errors_are_one_line_exit_2(tmp_path: Path, capsys: pytest.CaptureFixtur
     with pytest.raises(SystemExit) as exc:
         main(["lateral", "fit", str(bare), "--out", str(out), "--models", "relaxation"])
     assert exc.value.code == 2
-    assert "speed" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "give --speed KMH" in err  # the CLI option, not a Python keyword
+    assert "meta[" not in err
+    assert "speed=" not in err
     assert not out.exists()
+    # --channel counts from 1 like every other option; 0 and out-of-range are errors
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(bare), "--out", str(out), "--channel", "2", "1"])
+    assert exc.value.code == 2
+    assert "--channel: expected an output 1..1" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(bare), "--out", str(out), "--channel", "0", "0"])
+    assert exc.value.code == 2
+    capsys.readouterr()
+    main(["lateral", "fit", str(bare), "--out", str(out), "--channel", "1", "1"])
+    assert json.loads(out.read_text())["fits"]
+    # a file without its conditions: the assumption is said, not silent
+    assert "note: the file does not say which force" in capsys.readouterr().err
+    out.unlink()
     with pytest.raises(SystemExit) as exc:
         main(["lateral", "fit", str(bare), "--out", str(out), "--models", "nonsense"])
     assert exc.value.code == 2
+
+
+def test_channel_counts_from_one_and_is_needed_for_several_frfs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One FRF needs no --channel; a file with several needs it, counted from 1."""
+    import numpy as np
+
+    from tyredamp.frf import FRF, Channel
+    from tyredamp.io import write_frf
+
+    single = tmp_path / "single.npz"
+    assert CliRunner().invoke(cli, ["lateral", "simulate", "-o", str(single)]).exit_code == 0
+    frf = read_frf(single)
+    # output 1: the rig's FRF scaled by 10 (a different tyre), output 2: the rig's FRF
+    h = np.concatenate([10 * frf.H, frf.H], axis=0)
+    coh = None if frf.coherence is None else np.concatenate([frf.coherence] * 2, axis=0)
+    two = FRF(
+        frf.frequency,
+        h,
+        frf.kind,
+        outputs=(frf.outputs[0], Channel(node=2, direction=frf.outputs[0].direction)),
+        inputs=frf.inputs,
+        coherence=coh,
+        meta=frf.meta,
+    )
+    pair = tmp_path / "pair.npz"
+    write_frf(two, pair)
+    out = tmp_path / "fit.json"
+    with pytest.raises(SystemExit) as exc:
+        main(["lateral", "fit", str(pair), "--out", str(out)])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--channel" in err
+    assert "counted from 1" in err
+    assert not out.exists()
+    ref = tmp_path / "ref.json"
+    main(["lateral", "fit", str(single), "--out", str(ref)])
+    main(["lateral", "fit", str(pair), "--out", str(out), "--channel", "2", "1"])
+    a, b = json.loads(ref.read_text()), json.loads(out.read_text())
+    assert a["order"] == b["order"]
+    for fa, fb in zip(a["fits"], b["fits"], strict=True):
+        assert fa["params"] == pytest.approx(fb["params"], rel=1e-9)

@@ -30,7 +30,7 @@ from tyredamp.lateral import (
     get_model_class,
     ground_from_axle_accelerance,
 )
-from tyredamp.lateral.models import string_impedance
+from tyredamp.lateral.response import string_impedance
 
 F = np.linspace(0.0, 9.0, 46)
 FPOS = F[1:]

@@ -5,13 +5,14 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.axes import Axes
 
-from tyredamp.lateral import HystereticModel, VirtualLateralRig, fit_model, rank_models
+from tyredamp.lateral import HystereticModel, fit_model, rank_models
 from tyredamp.plot.lateral import (
     plot_figure7,
     plot_lateral_fit,
     plot_ranking,
     plot_time_comparison,
 )
+from tyredamp.virtual import VirtualLateralRig
 
 
 def test_figure7() -> None:

@@ -176,7 +176,7 @@ def test_given_frequencies_and_mode_count() -> None:
 
 
 def test_virtual_tyre_default() -> None:
-    tyre_mod = pytest.importorskip("tyredamp.tyre")
+    tyre_mod = pytest.importorskip("tyredamp.virtual")
     tyre = tyre_mod.RingTyre()
     tr = tyre.truth((0.0, 200.0))
     vis = tr.select("visible")

@@ -10,9 +10,9 @@ import pytest
 from numpy.testing import assert_allclose
 
 from tyredamp.cli import main
+from tyredamp.documents.modes import modes_document, read_modes_json, write_modes_json
 from tyredamp.exceptions import FileFormatError, InputError
 from tyredamp.io import write_frf
-from tyredamp.modal.io import modes_document, read_modes_json, write_modes_json
 from tyredamp.modal.model import ModalModel
 
 from .helpers import chain_system

@@ -13,16 +13,17 @@ from numpy.testing import assert_allclose
 
 from tyredamp import Channel
 from tyredamp.damping import identify_damping
+from tyredamp.documents.damping import damping_document
+from tyredamp.documents.jsonfile import finite
+from tyredamp.documents.modes import modes_document
 from tyredamp.exceptions import FileFormatError, InputError
 from tyredamp.io import write_frf, write_timedata
 from tyredamp.mechanics import time_response
 from tyredamp.modal import ModalModel
-from tyredamp.modal.io import modes_document
 from tyredamp.plot import plot_lateral_models, plot_stabilisation
 from tyredamp.report.build import fmt_pm
 from tyredamp.report.files import build_files_report, load_result_file
 from tyredamp.report.html import HtmlReport
-from tyredamp.results import finite
 from tyredamp.timedata import TimeData
 
 from .helpers import chain_system
@@ -63,7 +64,7 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         json.dumps(finite(modes_document({"complex": truth}, source="truth: chain")))
     )
     dm = identify_damping(model, n_samples=0)
-    paths["damping"].write_text(json.dumps(dm.to_dict()))
+    paths["damping"].write_text(json.dumps(damping_document(dm)))
     write_frf(frf.with_H(h), paths["frf"])
     force = np.random.default_rng(0).standard_normal((1, 4000))
     resp = time_response(s, force, 200.0, [0], [0, 3])

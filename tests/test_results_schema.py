@@ -11,10 +11,12 @@ from typing import Any
 import jsonschema
 import pytest
 
+from tyredamp.documents.demo import load_schema, validate_results
+from tyredamp.documents.jsonfile import finite
 from tyredamp.exceptions import InputError
-from tyredamp.results import build_results, finite, load_schema, validate_results
+from tyredamp.studies.document import build_results
 
-from .test_demo import quick_demo
+from .test_studies_demo import quick_demo
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 

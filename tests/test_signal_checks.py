@@ -168,21 +168,21 @@ def test_quality_clean_clipped_reversed_noisy(chain: MCKSystem) -> None:
     d = td.data.copy()
     top = 0.7 * d[2].max()
     d[2] = np.minimum(d[2], top)  # overloaded amplifier on one accelerometer
-    clipped = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta))
+    clipped = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta, td.acquisition))
     assert not clipped.passed
     assert clipped.figures["clipped_channels"] == 1
     assert "clipped" in clipped.summary
 
     d = td.data.copy()
     d[0] *= -1  # force transducer mounted the wrong way round
-    rev = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta))
+    rev = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta, td.acquisition))
     assert not rev.passed
     assert rev.figures["passivity_fraction"] > 0.5
     assert "not passive" in rev.summary
 
     d = td.data.copy()
     d[1:] += 3 * d[1:].std(axis=1, keepdims=True) * rng.normal(size=d[1:].shape)
-    noisy = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta))
+    noisy = quality_check(TimeData(d, 200.0, td.channels, td.quantities, td.meta, td.acquisition))
     assert not noisy.passed
     assert noisy.figure > noisy.threshold
     assert noisy.frequency is not None
@@ -225,3 +225,39 @@ def test_clipping_counter() -> None:
     assert clipping(per, repeats=5) == 0
     with pytest.raises(InputError, match="min_run"):
         clipping(x, 1)
+
+
+def test_low_coherence_bands_print_single_lines_once() -> None:
+    from tyredamp.signal.checks import _low_bands
+
+    f = np.array([25.0, 25.5, 26.0, 26.5, 27.0])
+    low = np.array([False, True, False, True, True])
+    assert _low_bands(f, low) == ["25.5 Hz", "26.5-27 Hz"]
+
+
+def test_dependent_forces_finds_a_reaction_force_not_a_second_shaker() -> None:
+    from tyredamp.signal.checks import dependent_forces
+    from tyredamp.timedata import TimeData
+
+    rng = np.random.default_rng(0)
+    n = 4000
+    body = rng.standard_normal(n)
+    acc = np.convolve(body, np.exp(-np.arange(50) / 8.0), "same") / 5.0  # a dynamic response
+    ground = body - 2.0 * acc  # reaction under a driven 2 kg body
+    chans = [Channel(1, 2, name="body force"), Channel(1, 2, name="acc"), Channel(2, 2, name="g")]
+
+    def td(rows: list[np.ndarray]) -> TimeData:
+        noisy = [r + 0.01 * r.std() * rng.standard_normal(n) for r in rows]
+        return TimeData(np.array(noisy), 100.0, chans, ["force", "acceleration", "force"])
+
+    dep = dependent_forces(td([body, acc, ground]))
+    assert {k for k, _, _ in dep} == {0, 2}
+    for _, r2, uses in dep:
+        assert r2 > 0.99
+        assert 1 in uses  # the response is part of the combination
+    # two independent shakers and a response to both: no instantaneous relation
+    other = rng.standard_normal(n)
+    resp = np.convolve(body + other, np.exp(-np.arange(50) / 8.0), "same")
+    assert dependent_forces(td([body, resp, other])) == []
+    with pytest.raises(InputError, match="min_r2"):
+        dependent_forces(td([body, acc, ground]), min_r2=1.5)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -125,8 +126,8 @@ def _noisy_siso(chain, rng, in_noise: float, out_noise: float) -> tuple[TimeData
     d[1] += out_noise * d[1].std() * rng.normal(size=d.shape[1])
     f = lines * 100.0 / 256
     ref = chain.frf(f, outputs=[0], inputs=[0]).H[0, 0]
-    meta = {**td.meta, "band_hz": [f[0], f[-1]]}  # noise excites every line: keep the band
-    return TimeData(d, td.sample_rate, td.channels, td.quantities, meta), ref
+    acq = replace(td.acquisition, band_hz=(f[0], f[-1]))  # noise excites every line: keep the band
+    return TimeData(d, td.sample_rate, td.channels, td.quantities, td.meta, acq), ref
 
 
 def test_input_noise_biases_h1_low_and_not_h2(chain: MCKSystem, rng) -> None:
@@ -315,7 +316,7 @@ def test_errors(chain: MCKSystem, rng) -> None:
     zero = td.data.copy()
     zero[0] = 0.0
     with pytest.raises(InputError, match="all zeros"):
-        estimate_frf(TimeData(zero, 200.0, td.channels, td.quantities, td.meta))
+        estimate_frf(TimeData(zero, 200.0, td.channels, td.quantities, td.meta, td.acquisition))
     with pytest.raises(InputError, match="no force channel"):
         estimate_frf(TimeData(td.data[2:], 200.0, td.channels[2:], td.quantities[2:]))
     mixed = TimeData(

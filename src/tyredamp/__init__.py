@@ -1,6 +1,13 @@
-"""tyredamp: measuring, identifying and modelling vibration damping in pneumatic tyres."""
+"""tyredamp: measuring, identifying and modelling vibration damping in pneumatic tyres.
+
+The package namespace is light: :class:`FRF` and :class:`Channel` (which
+need NumPy) are imported on first access, so that ``tyredamp --version`` and
+``--help`` start without NumPy (``benchmarks/startup.py``).
+"""
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
 
 from .exceptions import (
     ConvergenceError,
@@ -10,7 +17,9 @@ from .exceptions import (
     ShapeError,
     TyredampError,
 )
-from .frf import FRF, Channel
+
+if TYPE_CHECKING:
+    from .frf import FRF, Channel
 
 __version__ = "0.1.0"
 
@@ -25,3 +34,12 @@ __all__ = [
     "TyredampError",
     "__version__",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """``FRF`` and ``Channel`` on first access (PEP 562)."""
+    if name in ("FRF", "Channel"):
+        from . import frf
+
+        return getattr(frf, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

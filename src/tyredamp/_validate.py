@@ -14,6 +14,8 @@ from numpy.typing import ArrayLike, NDArray
 from .exceptions import InputError, PhysicsError, ShapeError
 
 __all__ = [
+    "as_band",
+    "as_count",
     "as_finite",
     "as_frequency",
     "as_square_symmetric",
@@ -33,8 +35,18 @@ def as_finite(
 ) -> NDArray[Any]:
     """Return ``x`` as an array of ``dtype``; reject NaN, inf and wrong ``ndim``."""
     try:
-        arr = np.asarray(x, dtype=dtype)
-    except (TypeError, ValueError) as exc:
+        raw = np.asarray(x)
+        if np.iscomplexobj(raw) and not np.issubdtype(np.dtype(dtype), np.complexfloating):
+            if np.any(raw.imag != 0):
+                raise InputError(
+                    f"{name}: expected real values, got complex numbers "
+                    f"({int(np.count_nonzero(raw.imag))} with a non-zero imaginary part)"
+                )
+            raw = raw.real
+        arr = np.asarray(raw, dtype=dtype)
+    except InputError:
+        raise
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{name}: expected numbers, got {type(x).__name__} ({exc})") from None
     if ndim is not None and arr.ndim != ndim:
         raise ShapeError(f"{name}: expected a {ndim}-D array, got shape {arr.shape}")
@@ -44,6 +56,32 @@ def as_finite(
         bad = int(np.size(arr) - np.count_nonzero(np.isfinite(arr)))
         raise InputError(f"{name}: expected finite values, got {bad} NaN or infinite entries")
     return arr
+
+
+def as_band(band: Any, name: str = "band", *, positive: bool = False) -> tuple[float, float]:
+    """A frequency band ``(f_lo, f_hi)`` in Hz: two finite numbers, ``0 <= f_lo < f_hi``.
+
+    One rule for every band of the package: frequencies are not negative and
+    a band has width. ``positive=True`` also demands ``f_lo > 0``, for the
+    uses that space frequencies logarithmically or divide by them.
+
+    Raises
+    ------
+    InputError
+        Not two numbers, not finite, ``f_lo < 0`` (``<= 0`` with
+        ``positive``) or ``f_hi <= f_lo``; the message names ``name``.
+    """
+    rule = "0 < f_lo < f_hi" if positive else "0 <= f_lo < f_hi"
+    try:
+        if isinstance(band, str) or len(band) != 2:
+            raise TypeError
+        lo, hi = float(band[0]), float(band[1])
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected (f_lo, f_hi) in Hz with {rule}, got {band!r}") from None
+    ok = np.isfinite(lo) and np.isfinite(hi) and (lo > 0 if positive else lo >= 0) and hi > lo
+    if not ok:
+        raise InputError(f"{name}: expected (f_lo, f_hi) in Hz with {rule}, got {band!r}")
+    return lo, hi
 
 
 def as_frequency(f: ArrayLike, name: str = "frequency") -> NDArray[np.float64]:
@@ -116,3 +154,10 @@ def check_positive(value: float, name: str, *, allow_zero: bool = False) -> floa
         bound = ">= 0" if allow_zero else "> 0"
         raise PhysicsError(f"{name}: expected a value {bound}, got {v:g}")
     return v
+
+
+def as_count(value: Any, name: str, minimum: int = 0) -> int:
+    """``int(value)`` for an integer (not a bool) ``>= minimum``; else :class:`InputError`."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise InputError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+    return int(value)

@@ -20,7 +20,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._validate import as_finite, as_frequency
+from ._validate import as_band, as_finite, as_frequency
 from .exceptions import InputError, ShapeError
 
 __all__ = ["FRF", "KINDS", "UNITS", "Channel", "FRFKind"]
@@ -33,8 +33,8 @@ UNITS: dict[str, str] = {
     "mobility": "m/(s N)",
     "accelerance": "m/(s^2 N)",
 }
-#: Power of (i omega) that turns a receptance into each kind.
-_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
+#: Power ``k`` of ``(i omega)^k`` that turns a receptance into each kind (the one table).
+KIND_POWER: dict[str, int] = {"receptance": 0, "mobility": 1, "accelerance": 2}
 
 _DIRECTIONS = {
     1: "+X",
@@ -122,6 +122,10 @@ class FRF:
         coherence when there is one input), in [0, 1].
     meta : dict, optional
         Free metadata (test description, estimator, number of averages ...).
+    variance : array_like, shape (n_out, n_in, n_freq), optional
+        Variance ``E|H_est - H|^2`` of each estimate of ``H`` (real, >= 0, in
+        the unit of ``H`` squared), as estimated from the measurement noise
+        by the FRF estimator; the weights of a maximum-likelihood fit.
     """
 
     frequency: NDArray[np.float64]
@@ -131,6 +135,7 @@ class FRF:
     inputs: tuple[Channel, ...] = ()
     coherence: NDArray[np.float64] | None = None
     meta: dict[str, Any] = field(default_factory=dict)
+    variance: NDArray[np.float64] | None = None
 
     def __init__(
         self,
@@ -141,6 +146,7 @@ class FRF:
         inputs: Sequence[Channel | int] | None = None,
         coherence: ArrayLike | None = None,
         meta: dict[str, Any] | None = None,
+        variance: ArrayLike | None = None,
     ) -> None:
         f = as_frequency(frequency, "frequency")
         h = as_finite(H, "H", dtype=complex)
@@ -170,6 +176,18 @@ class FRF:
                 raise InputError("coherence: expected values in [0, 1]")
             coh = np.clip(coh, 0.0, 1.0)
             coh.setflags(write=False)
+        var = None
+        if variance is not None:
+            var = as_finite(variance, "variance")
+            if var.shape != h.shape:
+                if var.size == h.size:
+                    var = var.reshape(h.shape)
+                else:
+                    raise ShapeError(f"variance: expected shape {h.shape} like H, got {var.shape}")
+            if np.any(var < 0):
+                raise InputError("variance: expected values >= 0")
+            var = var.copy()
+            var.setflags(write=False)
         f = f.copy()
         h = h.copy()
         f.setflags(write=False)
@@ -181,6 +199,7 @@ class FRF:
         object.__setattr__(self, "inputs", _channels(inputs, h.shape[1], "inputs"))
         object.__setattr__(self, "coherence", coh)
         object.__setattr__(self, "meta", dict(meta or {}))
+        object.__setattr__(self, "variance", var)
 
     # ------------------------------------------------------------------ views
     @property
@@ -223,6 +242,7 @@ class FRF:
             "inputs": self.inputs,
             "coherence": self.coherence,
             "meta": self.meta,
+            "variance": self.variance,
         }
         base.update(changes)
         return FRF(**base)
@@ -242,7 +262,7 @@ class FRF:
         """
         if kind not in KINDS:
             raise InputError(f"kind: expected one of {KINDS}, got {kind!r}")
-        k = _POWER[kind] - _POWER[self.kind]
+        k = KIND_POWER[kind] - KIND_POWER[self.kind]
         if k == 0:
             return self
         frf = self
@@ -257,7 +277,8 @@ class FRF:
                 raise InputError("to: the only frequency line is 0 Hz, nothing left to convert")
             frf = self.select_lines(slice(1, None))
         factor = (1j * frf.omega) ** k
-        return frf._new(H=frf.H * factor, kind=kind)
+        var = None if frf.variance is None else frf.variance * np.abs(factor) ** 2
+        return frf._new(H=frf.H * factor, kind=kind, variance=var)
 
     def receptance(self) -> FRF:
         """Shorthand for ``to("receptance")``."""
@@ -278,12 +299,14 @@ class FRF:
         if idx.size == 0:
             raise InputError("select_lines: the selection holds no frequency line")
         coh = None if self.coherence is None else self.coherence[:, idx]
-        return self._new(frequency=self.frequency[idx], H=self.H[:, :, idx], coherence=coh)
+        var = None if self.variance is None else self.variance[:, :, idx]
+        return self._new(
+            frequency=self.frequency[idx], H=self.H[:, :, idx], coherence=coh, variance=var
+        )
 
     def band(self, f_lo: float, f_hi: float) -> FRF:
         """Return the lines with ``f_lo <= f <= f_hi`` (Hz)."""
-        if not (np.isfinite(f_lo) and np.isfinite(f_hi)) or f_hi <= f_lo:
-            raise InputError(f"band: expected f_lo < f_hi, got [{f_lo}, {f_hi}] Hz")
+        f_lo, f_hi = as_band((f_lo, f_hi))
         mask = (self.frequency >= f_lo) & (self.frequency <= f_hi)
         if not np.any(mask):
             raise InputError(
@@ -311,6 +334,7 @@ class FRF:
             outputs=[self.outputs[i] for i in oi],
             inputs=[self.inputs[i] for i in ii],
             coherence=coh,
+            variance=None if self.variance is None else self.variance[np.ix_(oi, ii)],
         )
 
     def output_index(self, node: int, direction: int | None = None) -> int:
@@ -331,8 +355,126 @@ class FRF:
         return pairs
 
     def with_H(self, H: ArrayLike, kind: FRFKind | None = None) -> FRF:
-        """Return a copy with new responses on the same axis and channels."""
-        return self._new(H=H, kind=kind or self.kind, coherence=None)
+        """A copy with new responses on the same axis and channels (no coherence or variance)."""
+        return self._new(H=H, kind=kind or self.kind, coherence=None, variance=None)
+
+    # ---------------------------------------------------------------- xarray
+    def to_xarray(self) -> Any:
+        """The FRF as an :class:`xarray.Dataset` with named dimensions (imports xarray).
+
+        Dimensions ``output``, ``input``, ``frequency`` (coordinate in Hz);
+        variables ``H`` (complex, the unit of :attr:`kind`), optional
+        ``coherence`` (output, frequency) and ``variance`` (output, input,
+        frequency); channel coordinates ``output_node``,
+        ``output_direction``, ``output_angle_deg`` (NaN when unknown),
+        ``output_name`` (and the same for ``input``), the labels as the
+        ``output``/``input`` coordinates; attributes ``kind``, ``unit``,
+        ``tyredamp`` (``"frf 1"``) and ``meta`` (JSON text).
+        """
+        import json
+
+        import xarray as xr
+
+        def chan(prefix: str, chs: tuple[Channel, ...]) -> dict[str, Any]:
+            return {
+                prefix: (prefix, [c.label for c in chs]),
+                f"{prefix}_node": (prefix, np.array([c.node for c in chs], dtype=np.int32)),
+                f"{prefix}_direction": (
+                    prefix,
+                    np.array([c.direction for c in chs], dtype=np.int32),
+                ),
+                f"{prefix}_angle_deg": (
+                    prefix,
+                    np.array([np.nan if c.angle_deg is None else c.angle_deg for c in chs]),
+                ),
+                f"{prefix}_name": (prefix, [c.name for c in chs]),
+            }
+
+        data: dict[str, Any] = {"H": (("output", "input", "frequency"), self.H)}
+        if self.coherence is not None:
+            data["coherence"] = (("output", "frequency"), self.coherence)
+        if self.variance is not None:
+            data["variance"] = (("output", "input", "frequency"), self.variance)
+        coords = {
+            "frequency": ("frequency", self.frequency, {"units": "Hz"}),
+            **chan("output", self.outputs),
+            **chan("input", self.inputs),
+        }
+        ds = xr.Dataset(data, coords=coords)
+        ds["H"].attrs["units"] = self.unit
+        ds.attrs.update(
+            tyredamp="frf 1",
+            kind=self.kind,
+            unit=self.unit,
+            meta=json.dumps(self.meta, default=str),
+        )
+        return ds
+
+    @classmethod
+    def from_xarray(cls, ds: Any) -> FRF:
+        """Inverse of :meth:`to_xarray` (also from ``H_real``/``H_imag`` as stored in files).
+
+        Raises
+        ------
+        InputError
+            Missing ``H`` or dimensions, or invalid values (checked as in the
+            constructor).
+        """
+        import json
+
+        names = set(getattr(ds, "data_vars", {}))
+        if "H" in names:
+            h = np.asarray(ds["H"].transpose("output", "input", "frequency").values)
+        elif {"H_real", "H_imag"} <= names:
+            order = ("output", "input", "frequency")
+            h = np.asarray(ds["H_real"].transpose(*order).values) + 1j * np.asarray(
+                ds["H_imag"].transpose(*order).values
+            )
+        else:
+            raise InputError("ds: expected a variable 'H' (or 'H_real' and 'H_imag')")
+
+        def chans(prefix: str) -> list[Channel]:
+            try:
+                node = np.asarray(ds[f"{prefix}_node"].values)
+                direc = np.asarray(ds[f"{prefix}_direction"].values)
+                ang = np.asarray(ds[f"{prefix}_angle_deg"].values, dtype=float)
+                name = [str(v) for v in np.asarray(ds[f"{prefix}_name"].values)]
+            except KeyError as exc:
+                raise InputError(f"ds: missing channel coordinate {exc.args[0]!r}") from None
+            return [
+                Channel(
+                    int(node[i]),
+                    int(direc[i]),
+                    None if np.isnan(ang[i]) else float(ang[i]),
+                    name[i],
+                )
+                for i in range(node.size)
+            ]
+
+        try:
+            meta = json.loads(str(ds.attrs.get("meta", "{}")))
+        except json.JSONDecodeError:
+            raise InputError("ds.attrs['meta']: not JSON text") from None
+        coh = (
+            ds["coherence"].transpose("output", "frequency").values
+            if "coherence" in names
+            else None
+        )
+        var = (
+            ds["variance"].transpose("output", "input", "frequency").values
+            if "variance" in names
+            else None
+        )
+        return cls(
+            np.asarray(ds["frequency"].values),
+            h,
+            kind=str(ds.attrs.get("kind", "")),  # type: ignore[arg-type]
+            outputs=chans("output"),
+            inputs=chans("input"),
+            coherence=coh,
+            meta=meta if isinstance(meta, dict) else {},
+            variance=var,
+        )
 
     def plot(self, **kwargs: Any) -> Any:
         """Bode plot of the FRF; see :func:`tyredamp.plot.plot_frf` (imports matplotlib)."""

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+import difflib
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
 from typing import Any, Literal
 
 import numpy as np
@@ -13,7 +16,7 @@ from ._validate import as_finite, check_positive
 from .exceptions import InputError, ShapeError
 from .frf import Channel
 
-__all__ = ["QUANTITY_UNITS", "Quantity", "TimeData"]
+__all__ = ["ACQUISITION_KEYS", "QUANTITY_UNITS", "Acquisition", "Quantity", "TimeData"]
 
 Quantity = Literal["force", "displacement", "velocity", "acceleration"]
 #: SI unit of each measured quantity.
@@ -22,6 +25,197 @@ QUANTITY_UNITS: dict[str, str] = {
     "displacement": "m",
     "velocity": "m/s",
     "acceleration": "m/s^2",
+}
+
+
+def _count(v: Any, name: str, minimum: int) -> int:
+    if isinstance(v, bool) or not isinstance(v, int | np.integer):
+        if isinstance(v, float) and v.is_integer():
+            v = int(v)
+        else:
+            raise InputError(f"{name}: expected an integer >= {minimum}, got {v!r}")
+    if v < minimum:
+        raise InputError(f"{name}: expected an integer >= {minimum}, got {v!r}")
+    return int(v)
+
+
+@dataclass(frozen=True)
+class Acquisition:
+    """How a test was acquired: what the FRF estimators need to choose their method.
+
+    Written by the virtual rigs and by the file readers, read by
+    :func:`tyredamp.signal.estimate_frf`. Every field is optional: ``None``
+    means "not stated" (then the estimator uses its defaults or detects the
+    property from the data).
+
+    Parameters
+    ----------
+    period_samples : int or None
+        Samples per period of a periodic excitation (>= 2); selects cyclic
+        averaging over whole periods.
+    run_starts : tuple of int
+        First sample of each separately driven run, increasing from 0
+        (default ``(0,)``: one run). Segments never straddle runs.
+    settle_samples : int
+        Samples to drop at the start of every run (transient), default 0.
+    record_samples : int or None
+        Record length of burst or impact excitation (transient method).
+    band_hz : (float, float) or None
+        Excited band in Hz (``f_lo < f_hi``); the estimators keep only its lines.
+    n_averages : int or None
+        Periods (periodic) or records (burst) per run, as acquired.
+    excitation : str
+        Name of the excitation signal (``"periodic_chirp"``, ...; "" unknown).
+    """
+
+    period_samples: int | None = None
+    run_starts: tuple[int, ...] = (0,)
+    settle_samples: int = 0
+    record_samples: int | None = None
+    band_hz: tuple[float, float] | None = None
+    n_averages: int | None = None
+    excitation: str = ""
+
+    def __post_init__(self) -> None:
+        if self.period_samples is not None:
+            object.__setattr__(
+                self, "period_samples", _count(self.period_samples, "period_samples", 2)
+            )
+        if self.record_samples is not None:
+            object.__setattr__(
+                self, "record_samples", _count(self.record_samples, "record_samples", 2)
+            )
+        if self.n_averages is not None:
+            object.__setattr__(self, "n_averages", _count(self.n_averages, "n_averages", 1))
+        object.__setattr__(self, "settle_samples", _count(self.settle_samples, "settle_samples", 0))
+        if isinstance(self.run_starts, str | bytes) or not isinstance(
+            self.run_starts, Sequence | np.ndarray
+        ):
+            raise InputError(
+                f"run_starts: expected a sequence of sample indices, got {self.run_starts!r}"
+            )
+        runs = tuple(_count(r, "run_starts", 0) for r in self.run_starts)
+        if not runs or runs[0] != 0 or any(b <= a for a, b in itertools.pairwise(runs)):
+            raise InputError(
+                "run_starts: expected increasing sample indices starting at 0, got "
+                f"{self.run_starts!r}"
+            )
+        object.__setattr__(self, "run_starts", runs)
+        if self.band_hz is not None:
+            try:
+                lo, hi = (float(b) for b in self.band_hz)
+            except (TypeError, ValueError):
+                raise InputError(
+                    f"band_hz: expected (f_lo, f_hi) in Hz, got {self.band_hz!r}"
+                ) from None
+            if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or hi <= lo:
+                raise InputError(f"band_hz: expected 0 <= f_lo < f_hi in Hz, got {self.band_hz!r}")
+            object.__setattr__(self, "band_hz", (lo, hi))
+        if not isinstance(self.excitation, str):
+            raise InputError(f"excitation: expected a name, got {self.excitation!r}")
+
+    def check_length(self, n_samples: int) -> None:
+        """Raise :class:`InputError` when the fields do not fit a record of ``n_samples``."""
+        if self.run_starts[-1] >= n_samples:
+            raise InputError(
+                f"acquisition.run_starts: last run starts at sample {self.run_starts[-1]}, "
+                f"the record has {n_samples} samples"
+            )
+        for name in ("period_samples", "record_samples"):
+            v = getattr(self, name)
+            if v is not None and v > n_samples:
+                raise InputError(
+                    f"acquisition.{name}: {v} samples is longer than the record ({n_samples})"
+                )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The stated fields as a JSON-ready dict (the keys of :data:`ACQUISITION_KEYS`)."""
+        out: dict[str, Any] = {}
+        if self.period_samples is not None:
+            out["period_samples"] = self.period_samples
+        if self.settle_samples:
+            out["settle_samples"] = self.settle_samples
+        if self.record_samples is not None:
+            out["record_samples"] = self.record_samples
+        if self.run_starts != (0,):
+            out["run_starts"] = list(self.run_starts)
+        if self.band_hz is not None:
+            out["band_hz"] = list(self.band_hz)
+        if self.n_averages is not None:
+            out["n_averages"] = self.n_averages
+        if self.excitation:
+            out["excitation"] = self.excitation
+        return out
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> Acquisition:
+        """Inverse of :meth:`to_dict`; an unknown (misspelt) key is an error, never ignored."""
+        unknown = [k for k in d if k not in ACQUISITION_KEYS]
+        if unknown:
+            raise InputError(
+                f"acquisition: unknown field(s) {unknown}; expected {sorted(ACQUISITION_KEYS)}"
+            )
+        kw: dict[str, Any] = dict(d)
+        if "run_starts" in kw and kw["run_starts"] is not None:
+            rs = kw["run_starts"]
+            kw["run_starts"] = (
+                tuple(rs)
+                if isinstance(rs, Sequence | np.ndarray) and not isinstance(rs, str)
+                else rs
+            )
+        if kw.get("band_hz") is not None:
+            b = kw["band_hz"]
+            kw["band_hz"] = (
+                tuple(b) if isinstance(b, Sequence | np.ndarray) and not isinstance(b, str) else b
+            )
+        if kw.get("run_starts") is None:
+            kw.pop("run_starts", None)
+        if kw.get("settle_samples") is None:
+            kw.pop("settle_samples", None)
+        if kw.get("excitation") is None:
+            kw.pop("excitation", None)
+        return cls(**kw)
+
+    @classmethod
+    def split_meta(cls, meta: Mapping[str, Any]) -> tuple[Acquisition, dict[str, Any]]:
+        """Split a legacy metadata dict into the acquisition fields and the free notes.
+
+        Files and code written before :class:`Acquisition` existed kept these
+        fields as ``meta`` keys (``period_samples``, ``run_starts``,
+        ``settle_samples``, ``record_samples``, ``band_hz``, ``n_periods``,
+        ``excitation``); they are taken out of ``meta`` here. A key that
+        looks like a misspelling of one of them raises :class:`InputError`
+        instead of being kept as a note.
+        """
+        acq: dict[str, Any] = {}
+        notes: dict[str, Any] = {}
+        for k, v in meta.items():
+            key = _LEGACY.get(k, k)
+            if key in ACQUISITION_KEYS:
+                acq[key] = v
+                continue
+            close = difflib.get_close_matches(str(k), list(_LEGACY), n=1, cutoff=0.9)
+            if close and str(k) != close[0]:
+                raise InputError(
+                    f"meta: key {k!r} looks like the acquisition field {close[0]!r}; "
+                    "state acquisition fields with TimeData(acquisition=Acquisition(...))"
+                )
+            notes[k] = v
+        return cls.from_dict(acq), notes
+
+
+#: Field names of :class:`Acquisition` (also its keys in files).
+ACQUISITION_KEYS: frozenset[str] = frozenset(f.name for f in fields(Acquisition))
+#: Legacy ``meta`` keys and the field each one fills.
+_LEGACY: dict[str, str] = {
+    "period_samples": "period_samples",
+    "run_starts": "run_starts",
+    "settle_samples": "settle_samples",
+    "record_samples": "record_samples",
+    "band_hz": "band_hz",
+    "n_periods": "n_averages",
+    "n_averages": "n_averages",
+    "excitation": "excitation",
 }
 
 
@@ -41,9 +235,15 @@ class TimeData:
         ``"force"``, ``"displacement"``, ``"velocity"`` or ``"acceleration"``
         per channel.
     meta : dict, optional
-        Free metadata. Keys used by the estimators: ``"period_samples"``
-        (int, length of one period of a periodic excitation),
-        ``"settle_samples"`` (int, samples to drop at the start).
+        Free notes (test description, operator ...); never read by the
+        estimators. Legacy acquisition keys (``"period_samples"``,
+        ``"run_starts"``, ``"settle_samples"``, ``"record_samples"``,
+        ``"band_hz"``, ``"n_periods"``, ``"excitation"``) are moved into
+        ``acquisition`` (see :meth:`Acquisition.split_meta`), so files and
+        code from before keep working.
+    acquisition : Acquisition, optional
+        How the test was acquired (period, runs, settle and record lengths,
+        band); default from the legacy ``meta`` keys, else nothing stated.
     """
 
     data: NDArray[np.float64]
@@ -51,6 +251,7 @@ class TimeData:
     channels: tuple[Channel, ...]
     quantities: tuple[str, ...]
     meta: dict[str, Any] = field(default_factory=dict)
+    acquisition: Acquisition = field(default_factory=Acquisition)
 
     def __init__(
         self,
@@ -59,6 +260,7 @@ class TimeData:
         channels: Sequence[Channel | int],
         quantities: Sequence[str],
         meta: dict[str, Any] | None = None,
+        acquisition: Acquisition | None = None,
     ) -> None:
         d = as_finite(data, "data")
         if d.ndim == 1:
@@ -83,7 +285,21 @@ class TimeData:
         object.__setattr__(self, "sample_rate", fs)
         object.__setattr__(self, "channels", ch)
         object.__setattr__(self, "quantities", q)
-        object.__setattr__(self, "meta", dict(meta or {}))
+        legacy, notes = Acquisition.split_meta(meta or {})
+        if acquisition is None:
+            acquisition = legacy
+        elif not isinstance(acquisition, Acquisition):
+            raise InputError(
+                f"acquisition: expected an Acquisition, got {type(acquisition).__name__}"
+            )
+        elif legacy != Acquisition():
+            raise InputError(
+                "meta: holds acquisition keys "
+                f"{sorted(legacy.to_dict())} as well as acquisition=; give them once"
+            )
+        acquisition.check_length(d.shape[1])
+        object.__setattr__(self, "meta", notes)
+        object.__setattr__(self, "acquisition", acquisition)
 
     @property
     def n_channels(self) -> int:

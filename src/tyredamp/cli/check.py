@@ -14,13 +14,8 @@ import click
 
 from ..exceptions import InputError
 from ..io import read, read_frf
-from ..signal.checks import (
-    CheckResult,
-    linearity_check,
-    merge_inputs,
-    quality_check,
-    reciprocity_check,
-)
+from ..signal.checks import CheckResult
+from ..studies.radial import check_linearity, check_quality, check_reciprocity
 
 __all__ = ["check_group"]
 
@@ -90,7 +85,7 @@ def linearity_cmd(
     if len(frf_files) < 2:
         raise InputError(f"linearity: expected two or more FRF files, got {len(frf_files)}")
     frfs = [read_frf(p) for p in frf_files]
-    _finish(ctx, linearity_check(frfs, threshold, band or None), strict)
+    _finish(ctx, check_linearity(frfs, threshold, band or None), strict)
 
 
 @check_group.command("reciprocity")
@@ -121,8 +116,8 @@ def reciprocity_cmd(
     """
     if not frf_files:
         raise InputError("reciprocity: expected one or more FRF files")
-    frf = merge_inputs([read_frf(p) for p in frf_files])
-    _finish(ctx, reciprocity_check(frf, threshold, band or None), strict)
+    frfs = [read_frf(p) for p in frf_files]
+    _finish(ctx, check_reciprocity(frfs, threshold, band or None), strict)
 
 
 @check_group.command("quality")
@@ -162,10 +157,10 @@ def quality_cmd(
       tyredamp check quality tyre_test.uff --coherence-min 0.9 --band 30 200 --strict
     """
     obj = read(data_file)
-    result = quality_check(
+    result = check_quality(
         obj,
         coherence_min=coherence_min,
-        max_low_coherence_fraction=max_low_fraction,
+        max_low_fraction=max_low_fraction,
         band=band or None,
     )
     _finish(ctx, result, strict)

@@ -1,26 +1,9 @@
 """``tyredamp damping``: the damping matrix from identified complex modes (spec step 7).
 
-Reads a modes JSON file (``{"kind": "modes", "models": {"complex": {...},
-"real": {...}}}``, each model in the layout of
-:meth:`tyredamp.modal.ModalModel.to_dict`; read by
-:func:`tyredamp.modal.io.read_modes_json`), identifies the damping with
-:func:`tyredamp.damping.identify_damping` and writes a damping JSON file.
-
-Damping JSON schema (``"kind": "damping"``, ``"version": 1``; full
-description in ``docs/damping-json.md``)::
-
-    {"kind": "damping", "version": 1,
-     "method": "first" | "improved" | "refined", "normalised": bool,
-     "modes": {"frequency_hz": [m], "damping_ratio": [m], "poles": [[re, im]] x m},
-     "points": [{"node", "direction", "angle_deg", "name"}] x N,
-     "modal": m x m (C', 1/s), "modal_symmetric": m x m,
-     "physical": N x N (C, N s/m), "physical_symmetric": N x N,
-     "mass": N x N (kg), "stiffness": N x N (N/m), "basis": N x m (1/sqrt(kg)),
-     "lancaster_physical": N x N | null,
-     "std": {"modal": m x m, "physical": N x N} | {},
-     "uncertainty": {"method": "monte_carlo", "n_samples", "n_failed", "seed"} | {},
-     "diagnostics": {...}, "proportional": {...}, "findings": [str],
-     "meta": {"source": path, "model": "complex" | "real", ...}}
+Reads a modes JSON file (:mod:`tyredamp.documents.modes`), identifies the
+damping with :func:`tyredamp.studies.radial.damping_from_modes` and writes a
+damping JSON file (layout in :mod:`tyredamp.documents.damping`, full
+description in ``docs/damping-json.md``).
 """
 
 from __future__ import annotations
@@ -31,11 +14,13 @@ from typing import Any
 import click
 import numpy as np
 
-from ..damping import METHODS, DampingModel, identify_damping
+from ..damping import METHODS, DampingModel
+from ..documents.damping import write_damping_json
+from ..documents.modes import read_modes
 from ..exceptions import InputError
 from ..io._common import check_input_file
-from ..io.jsonfile import write_json
-from ..modal.io import read_modes_json
+from ..io._safety import check_output_file
+from ..studies.radial import damping_from_modes
 from ._common import out_file_option, seed_option
 
 __all__ = ["damping_command", "damping_summary"]
@@ -103,6 +88,10 @@ def damping_command(
 ) -> None:
     """Identify the viscous damping matrix from the complex modes in MODES_JSON.
 
+    MODES_JSON is a modes JSON file (tyredamp modal) or a UFF file (.uff,
+    .unv) of data sets 55 from another program (real or complex modes,
+    scaled by their modal mass or modal A; see tyredamp.io.uff55).
+
     Writes C' (modal coordinates) and C, M, K at the measured points, the
     point labels, diagnostics (symmetry, definiteness, truncation), the best
     proportional models, Monte Carlo standard errors and plain-English
@@ -114,21 +103,21 @@ def damping_command(
       tyredamp damping tyre_modes.json --out tyre_damping.json
       tyredamp damping tyre_modes.json -o damping.json --method refined --samples 500
     """
-    if out.resolve() == modes_json.resolve():
-        raise InputError(f"--out: {out} is the input file; choose another name")
-    models = read_modes_json(check_input_file(modes_json))
+    check_output_file(out, [modes_json])
+    models = read_modes(check_input_file(modes_json))
     if model_name not in models:
         raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")
     meta: dict[str, Any] = {"source": str(modes_json), "model": model_name}
-    dm = identify_damping(
-        models[model_name],
-        method,  # type: ignore[arg-type]
+    dm = damping_from_modes(
+        models,
+        model=model_name,
+        method=method,  # type: ignore[arg-type]
         normalise=not no_normalise,
         n_samples=samples,
         seed=seed,
         meta=meta,
     )
-    write_json(dm.to_dict(), out)
+    write_damping_json(out, dm)
     for row in damping_summary(dm):
         click.echo(row)
     click.echo(f"wrote {out}")

@@ -9,7 +9,9 @@ from typing import TYPE_CHECKING, Any
 import click
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult
+    from ..studies.results import DemoResult
+
+from ._common import OutPath
 
 __all__ = ["demo_command", "demo_summary_rows"]
 
@@ -35,8 +37,11 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
             "checks",
             f"linearity {'PASS' if r.linearity.passed else 'FAIL'} "
             f"{100 * r.linearity.figure:.2g} %, reciprocity "
-            f"{'PASS' if r.reciprocity.passed else 'FAIL'} {100 * r.reciprocity.figure:.2g} %",
+            f"{'PASS' if r.reciprocity.passed else 'FAIL'} {100 * r.reciprocity.figure:.2g} %, "
+            f"quality {'PASS' if r.quality.passed else 'FAIL'} {100 * r.quality.figure:.2g} % "
+            "low-coherence lines",
         ),
+        *_verdict_rows(doc),
         (
             "damping C' vs truth",
             f"{100 * rad['damping']['modal_error']:.3g} % (symmetric part "
@@ -50,17 +55,36 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
         (
             "corner frequency f0",
             ", ".join(
-                f"{c['value']:.3g} Hz ({c['pressure_bar']:g} bar, {c['speed_kmh']:g} km/h)"
-                for c in lat["corner_frequency_hz"]
+                f"{c['corner_frequency_hz']:.3g} Hz at {c['label']} (its C_r = "
+                f"{c['road_damping']['ratio']:.3g} x the rig's C_alpha/V)"
+                for c in lat["conditions"]
             ),
         ),
         (
             f"{lat['time_response']['frequency_hz']:g} Hz response error",
             ", ".join(
                 f"{k} {100 * v:.3g} %" for k, v in lat["time_response"]["relative_error"].items()
-            ),
+            )
+            + f" (rig's exact response {100 * lat['time_response']['truth_error']:.3g} %: "
+            "the rest is model error)",
         ),
     ]
+    # the warnings that are not failures shown above, each with its stage
+    warns = [w for w in doc.get("warnings", []) if w["severity"] == "warning"]
+    for k, w in enumerate(warns):
+        rows.append((f"warning {k + 1} ({w['stage']})", w["message"]))
+    return rows
+
+
+def _verdict_rows(doc: dict[str, Any]) -> list[tuple[str, str]]:
+    """One row per identification: within the noise, or FAILED and why."""
+    rows = []
+    for pr in doc["radial"]["pressures"]:
+        v = pr["verdict"]
+        for name in ("complex", "real"):
+            rows.append((f"{name}-mode fit {pr['pressure_bar']:g} bar", v[name]["brief"]))
+    for c in doc["lateral"]["conditions"]:
+        rows.append((f"{c['best']} fit {c['label']}", c["verdict"]["brief"]))
     return rows
 
 
@@ -71,7 +95,7 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
     "out",
     default="tyredamp-demo",
     show_default=True,
-    type=click.Path(path_type=Path),
+    type=OutPath(path_type=Path),
     metavar="DIR",
     help="Directory to write (replaced only if empty or an earlier demo output).",
 )
@@ -91,10 +115,10 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
 def demo_command(out: Path, quick: bool, seed: int) -> None:
     """Run both studies on the built-in virtual tyres and write a report.
 
-    Radial study (paper 000): modal test of the virtual truck tyre at 7.5
+    Radial study (Popov & Geng 2005): modal test of the virtual truck tyre at 7.5
     bar and two other pressures, FRFs, linearity (two force levels) and
     reciprocity (two drive points) checks, real- and complex-mode fits with
-    RMSD, damping matrix. Lateral study (paper 001): the rolling-tyre rig at
+    RMSD, damping matrix. Lateral study (Peng et al.): the rolling-tyre rig at
     5 and 10 km/h and 1.28, 1.7 and 2.4 bar, every model fitted and ranked,
     corner frequency, vehicle model and the 2.73 Hz time response. Every
     identified value is shown beside the truth of the virtual tyre.
@@ -109,18 +133,20 @@ def demo_command(out: Path, quick: bool, seed: int) -> None:
       tyredamp demo
       tyredamp demo --out demo-quick --quick --seed 3
     """
+    from ..io._safety import private_matplotlib_config
+
+    with private_matplotlib_config():
+        _demo(out, quick, seed)
+
+
+def _demo(out: Path, quick: bool, seed: int) -> None:
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
     from rich.table import Table
 
-    from ..demo import (
-        DemoSettings,
-        check_output_dir,
-        run_demo,
-        save_demo,
-        single_threaded_blas,
-    )
-    from ..results import build_results
+    from ..report.demo import check_output_dir, save_demo
+    from ..studies.demo import DemoSettings, run_demo, single_threaded_blas
+    from ..studies.document import build_results
 
     check_output_dir(out)
     settings = DemoSettings.quick_preset(seed) if quick else DemoSettings.full(seed)
@@ -131,22 +157,30 @@ def demo_command(out: Path, quick: bool, seed: int) -> None:
         Progress(
             TextColumn("{task.description:<62}"),
             BarColumn(bar_width=24),
-            TextColumn("{task.completed}/{task.total}"),
+            TextColumn("{task.fields[count]}"),  # blank until the total is known
             TimeElapsedColumn(),
             console=err,
             disable=not err.is_terminal,
         ) as prog,
     ):
-        task = prog.add_task("starting", total=None)
+        task = prog.add_task("starting", total=None, count="")
 
         def report(desc: str, done: int, total: int) -> None:
-            prog.update(task, description=desc, completed=done, total=total)
+            prog.update(
+                task, description=desc, completed=done, total=total, count=f"{done}/{total}"
+            )
 
         result = run_demo(settings, report)
-        wtask = prog.add_task("writing", total=None)
+        wtask = prog.add_task("writing", total=None, count="")
 
         def report_w(desc: str, done: int, total: int) -> None:
-            prog.update(wtask, description=f"writing {desc}", completed=done, total=total)
+            prog.update(
+                wtask,
+                description=f"writing {desc}",
+                completed=done,
+                total=total,
+                count=f"{done}/{total}",
+            )
 
         files = save_demo(result, out, report_w)
     wall = time.perf_counter() - t0

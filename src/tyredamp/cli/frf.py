@@ -10,10 +10,40 @@ import numpy as np
 from ..exceptions import InputError
 from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
-from ..signal.estimators import ESTIMATORS, estimate_frf
+from ..io._safety import check_output_file
+from ..signal.checks import dependent_forces
+from ..signal.estimators import ESTIMATORS
+from ..studies.radial import frf_from_time
+from ..timedata import TimeData
 from ._common import out_file_option
 
-__all__ = ["frf_command", "frf_summary"]
+__all__ = ["frf_command", "frf_summary", "samples"]
+
+
+def samples(text: str, sample_rate: float, option: str) -> int:
+    """A length given as samples (``"4096"``) or seconds (``"0.5s"``) in whole samples.
+
+    Seconds must be a whole number of samples at ``sample_rate`` (to 1e-6 of
+    a sample); otherwise, and for text that is neither, :class:`InputError`
+    names the option.
+    """
+    t = str(text).strip().lower()
+    seconds = t.endswith("s")
+    try:
+        value = float(t[:-1]) * sample_rate if seconds else float(int(t))
+    except ValueError:
+        raise InputError(
+            f"{option}: expected samples (4096) or seconds (0.5s), got {text!r}"
+        ) from None
+    n = round(value) if np.isfinite(value) else -1
+    if seconds and (n < 0 or abs(value - n) > 1e-6 * max(1.0, abs(value))):
+        raise InputError(
+            f"{option}: {text!r} is {value:.6g} samples at {sample_rate:g} Hz, not a whole "
+            "non-negative number; give samples"
+        )
+    if n < 0:
+        raise InputError(f"{option}: expected a non-negative length, got {text!r}")
+    return int(n)
 
 
 def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
@@ -27,6 +57,9 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
         f"estimator {m.get('estimator', '?')}, method {m.get('method', '?')}, "
         f"{m.get('n_averages', '?')} averages of {m.get('segment_samples', '?')} samples",
     ]
+    det = m.get("detection")
+    if isinstance(det, dict) and det.get("reason"):
+        rows.append(f"detected {det['reason']}")
     if frf.coherence is not None:
         coh = frf.coherence
         i_out, i_line = np.unravel_index(int(np.argmin(coh)), coh.shape)
@@ -38,9 +71,27 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
     return rows
 
 
+def _refuse_dependent_forces(td: TimeData) -> None:
+    """Every force channel would be an input: refuse when one follows from the others."""
+    dep = dependent_forces(td)
+    if not dep:
+        return
+    k, r2, uses = dep[0]
+    lab = td.channels
+    forces = ", ".join(f"{lab[i].label}" for i in td.force_indices)
+    raise InputError(
+        f"--reference: every force channel would be an input ({forces}), but "
+        f"{lab[k].label} is {100 * r2:.4g} % a linear combination of "
+        f"{' and '.join(lab[i].label for i in uses)}: the forces are not independent "
+        "excitations (one is a reaction, such as the ground force under a driven body, "
+        "F_ground = F_body - m a); choose the excitation with --reference, for example "
+        f"--reference '{lab[td.force_indices[0]].label}'"
+    )
+
+
 @click.command("frf")
 @click.argument("time_file", type=click.Path(dir_okay=False, path_type=Path))
-@out_file_option("FRF file to write (.uff, .unv, .csv or .npz).")
+@out_file_option("FRF file to write (.uff, .unv, .csv, .npz or .nc).")
 @click.option(
     "--estimator",
     type=click.Choice(ESTIMATORS),
@@ -58,13 +109,26 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
 )
 @click.option(
     "--method",
-    type=click.Choice(["auto", "cyclic", "welch", "transient"]),
+    type=click.Choice(["auto", "cyclic", "welch", "transient", "lrm", "lpm"]),
     default="auto",
     show_default=True,
-    help="auto: cyclic when the file states period_samples, transient when it states "
-    "record_samples, else Welch.",
+    help="auto: cyclic when the file states a period, transient when it states a record "
+    "length, else decided from the data (periodic: cyclic; impact: transient; random: Welch). "
+    "lrm/lpm: local rational/polynomial method on the whole record (random excitation).",
 )
 @click.option("--segment", type=click.IntRange(min=2), help="Welch/transient segment in samples.")
+@click.option(
+    "--period",
+    metavar="SAMPLES|SECONDS",
+    help="Period of a periodic excitation: samples (4096) or seconds (0.5s); it must be a "
+    "whole number of samples. Default: from the file, else detected from the force.",
+)
+@click.option(
+    "--settle",
+    metavar="SAMPLES|SECONDS",
+    help="Samples (or seconds, 2s) to drop at the start (transient). Default: from the "
+    "file, else detected for periodic data.",
+)
 @click.option(
     "--band", nargs=2, type=float, metavar="F_LO F_HI", help="Keep lines in this band (Hz)."
 )
@@ -81,31 +145,41 @@ def frf_command(
     references: tuple[str, ...],
     method: str,
     segment: int | None,
+    period: str | None,
+    settle: str | None,
     band: tuple[float, float] | None,
     fmt: str | None,
 ) -> None:
     """Estimate FRFs (with coherence) from TIME_FILE and write them to --out.
 
-    TIME_FILE holds force and response channels (UFF 58 function type 1, or
-    tyredamp CSV/NPZ). The FRF kind follows the response channels
-    (acceleration gives accelerance). A short summary with coherence
-    figures is printed. Nothing is written when an error occurs.
+    TIME_FILE holds force and response channels (UFF 58 function type 1,
+    tyredamp CSV/NPZ, NI TDMS or ASAM MDF4). The FRF kind follows the
+    response channels (acceleration gives accelerance). Without a stated
+    period or record length the excitation is detected from the force
+    (periodic: cyclic averaging over whole periods after any start
+    transient; impact/burst: records from each hit; random: Welch) and the
+    verdict with its reason is printed with the coherence figures. Nothing
+    is written when an error occurs.
 
     \b
     Example:
       tyredamp frf tyre_test.uff --out tyre_frf.uff --estimator H1
       tyredamp frf rig.npz --out frf.csv --reference 1+Z --method welch --segment 4096
+      tyredamp frf daq.unv --out frf.nc --period 0.5s --settle 2s
     """
-    if out.resolve() == time_file.resolve():
-        raise InputError(f"--out: {out} is the input file; choose another name")
+    check_output_file(out, [time_file])
     out_format = format_of(out, fmt)
     td = read_timedata(time_file)
-    frf = estimate_frf(
+    if not references and len(td.force_indices) > 1:
+        _refuse_dependent_forces(td)
+    frf = frf_from_time(
         td,
         estimator,  # type: ignore[arg-type]
         reference=list(references) or None,
         method=None if method == "auto" else method,  # type: ignore[arg-type]
         segment_samples=segment,
+        period_samples=None if period is None else samples(period, td.sample_rate, "--period"),
+        settle_samples=None if settle is None else samples(settle, td.sample_rate, "--settle"),
         band=band or None,
     )
     write_frf(frf, out, out_format)

@@ -4,34 +4,12 @@
 (default the paper's four: classic, Maxwell, visco-plastic, proposed
 hysteretic) to the lateral accelerance in ``FRF_FILE`` (UFF, CSV or NPZ, read
 with :func:`tyredamp.io.read_frf`), prints the ranking table and writes the
-JSON below. ``tyredamp lateral simulate --out FILE`` writes a noisy FRF of the
-virtual rolling-tyre rig (:mod:`tyredamp.lateral.rig`) with
+lateral-fit JSON. ``tyredamp lateral simulate --out FILE`` writes a noisy FRF of the
+virtual rolling-tyre rig (:mod:`tyredamp.virtual.lateral_rig`) with
 :func:`tyredamp.io.write_frf`; its ``meta`` carries the speed, force and
 wheel mass, which ``fit`` uses when the options are not given.
 
-LATERAL_JSON layout (version 1; SI units; non-finite numbers as ``null``)::
-
-    {
-      "tyredamp": "lateral-fit", "version": 1,
-      "input": {"file": str, "kind": str, "n_lines": int, "band_hz": [lo, hi]},
-      "conditions": {"speed_m_s": float|null, "speed_kmh": float|null,
-                     "force": "ground"|"axle", "wheel_mass_kg": float},
-      "criterion": "bic"|"aic",
-      "order": [model names, best first],
-      "table": [{"rank", "model", "n_params", "rss", "aic", "bic", "delta",
-                 "weight", "amplitude_error_pct", "amplitude_bias_pct"}, ...],
-      "reasons": [one sentence per model],
-      "fits": [{"model", "label", "params": {name: value}, "stderr": {name: value},
-                "units": {name: unit}, "conditions": {...}, "derived": {...},
-                "n_params", "n_lines", "rss", "residual_rms", "aic", "bic",
-                "amplitude_error", "amplitude_bias", "weights", "force",
-                "wheel_mass_kg", "speed_m_s", "message"}, ...]
-    }
-
-``amplitude_error`` is the paper's Table 1 figure as defined in
-:mod:`tyredamp.lateral.fit`: the mean over the fitted lines of
-``| |A_model| - |A_meas| | / |A_meas|`` (a fraction; the table shows %), and
-``amplitude_bias`` its signed version (positive: over-estimation).
+LATERAL_JSON: :mod:`tyredamp.documents.lateral` (layout in its docstring).
 """
 
 from __future__ import annotations
@@ -41,13 +19,14 @@ from pathlib import Path
 
 import click
 
+from ..documents.lateral import write_lateral_fit
 from ..exceptions import InputError
-from ..io import FORMATS, read_frf, write_frf
-from ..io._atomic import atomic_path
-from ..io.jsonfile import json_text
-from ..lateral.fit import DEFAULT_MODELS, LateralData, rank_models
+from ..io import FORMATS, format_of, read_frf, write_frf
+from ..io._safety import check_output_file
+from ..lateral.fit import DEFAULT_MODELS
 from ..lateral.models import MODELS, get_model_class
-from ..lateral.rig import KMH, VirtualLateralRig
+from ..studies.lateral import fit_models, lateral_data
+from ..virtual.lateral_rig import KMH, VirtualLateralRig
 from ._common import out_file_option, seed_option
 
 __all__ = ["lateral_group"]
@@ -60,6 +39,11 @@ def _model_list(values: tuple[str, ...]) -> list[str]:
     if not names:
         return list(DEFAULT_MODELS)
     return [get_model_class(n).name for n in names]
+
+
+def _with_unit(name: str, value: float, unit: str) -> str:
+    """``"sigma = 0.5933 m"``; dimensionless values (unit ``-``) without a unit."""
+    return f"{name} = {value:.4g}" + ("" if unit in ("", "-") else f" {unit}")
 
 
 @click.group("lateral")
@@ -124,11 +108,11 @@ def lateral_group() -> None:
 @click.option(
     "--channel",
     nargs=2,
-    type=int,
-    default=(0, 0),
-    show_default=True,
+    type=click.IntRange(min=1),
+    default=None,
     metavar="OUT IN",
-    help="Output and input positions of the FRF to fit.",
+    help="Output and input of the FRF to fit, counted from 1 like every other option "
+    "(needed when the file holds more than one FRF).",
 )
 def fit_command(
     frf_file: Path,
@@ -140,7 +124,7 @@ def fit_command(
     band: tuple[float, float] | None,
     weights: str,
     criterion: str,
-    channel: tuple[int, int],
+    channel: tuple[int, int] | None,
 ) -> None:
     """Fit lateral tyre models to a measured FRF and rank them.
 
@@ -152,44 +136,56 @@ def fit_command(
       tyredamp lateral fit rig.npz --out lateral.json --models proposed,maxwell \\
           --speed 5 --force axle --wheel-mass 100
     """
+    check_output_file(out, [frf_file])
     frf = read_frf(frf_file)
     names = _model_list(models)
     if speed is not None and not (math.isfinite(speed) and speed > 0):
         raise InputError(f"--speed: expected a speed > 0 km/h, got {speed}")
-    data = LateralData.from_frf(
+    if channel is not None and (channel[0] > frf.n_out or channel[1] > frf.n_in):
+        raise InputError(
+            f"--channel: expected an output 1..{frf.n_out} and an input 1..{frf.n_in} of "
+            f"{frf_file}, got {channel[0]} {channel[1]}"
+        )
+    if channel is None and frf.n_out * frf.n_in != 1:
+        raise InputError(
+            f"--channel: {frf_file} holds {frf.n_out}x{frf.n_in} FRFs and a lateral fit takes "
+            "one; choose it with --channel OUT IN (counted from 1)"
+        )
+    data = lateral_data(
         frf,
-        speed=None if speed is None else speed * KMH,
+        speed_kmh=speed,
         force=force,  # type: ignore[arg-type]
         wheel_mass=wheel_mass,
     )
-    ranking = rank_models(
+    if data.speed is None:
+        need = [n for n in names if "speed" in get_model_class(n).condition_names]
+        if need:
+            raise InputError(
+                f"--speed: the {', '.join(need)} model{'s' if len(need) > 1 else ''} "
+                f"need{'' if len(need) > 1 else 's'} the travel speed and {frf_file} does not "
+                "store it; give --speed KMH"
+            )
+    ranking = fit_models(
         data,
         names,
         criterion=criterion,  # type: ignore[arg-type]
         band=band,
         weights=weights,
-        channel=channel,
+        channel=None if channel is None else (channel[0] - 1, channel[1] - 1),
     )
+    ranking.check()  # no model fits: exit 3 with the reasons, nothing written
     best = ranking.best
-    doc = {
-        "tyredamp": "lateral-fit",
-        "version": 1,
-        "input": {
-            "file": str(frf_file),
-            "kind": frf.kind,
-            "n_lines": best.n_lines,
-            "band_hz": [float(best.frequency[0]), float(best.frequency[-1])],
-        },
-        "conditions": {
-            "speed_m_s": data.speed,
-            "speed_kmh": None if data.speed is None else data.speed / KMH,
-            "force": data.force,
-            "wheel_mass_kg": data.wheel_mass,
-        },
-        **ranking.to_dict(),
-    }
-    with atomic_path(out) as tmp:
-        tmp.write_text(json_text(doc, indent=2), encoding="utf-8")
+    write_lateral_fit(out, ranking, data, source=str(frf_file), frf_kind=frf.kind)
+    assumed = []
+    if force is None and "force" not in frf.meta:
+        assumed.append(
+            "the file does not say which force the FRF refers to: ground assumed "
+            "(give --force axle for an axle-force FRF)"
+        )
+    if wheel_mass is None and "wheel_mass_kg" not in frf.meta and data.force == "axle":
+        assumed.append("the file gives no wheel mass: 0 kg assumed (give --wheel-mass KG)")
+    for a in assumed:
+        click.echo(f"note: {a}", err=True)
     sp = "?" if data.speed is None else f"{data.speed / KMH:g} km/h"
     click.echo(
         f"{frf_file}: {best.n_lines} lines {best.frequency[0]:.3g}-{best.frequency[-1]:.3g} Hz, "
@@ -208,6 +204,8 @@ def fit_command(
             )
         )
     )
+    for p in best.problems():
+        click.echo(f"note: {p}")
     click.echo(f"wrote {out}")
 
 
@@ -254,20 +252,23 @@ def simulate_command(
     """Write the lateral accelerance FRF of the virtual rolling-tyre rig.
 
     The truth is a viscoelastic stretched-string tyre with contact length and
-    a 100 kg wheel (see tyredamp.lateral.rig); the FRF covers 0.25-9 Hz.
+    a 100 kg wheel (see tyredamp.virtual.lateral_rig); the FRF covers 0.25-9 Hz.
 
     \b
     Example:
       tyredamp lateral simulate --out rig_axle.npz --speed 10 --pressure 2.4 \\
           --force axle --seed 3
     """
+    check_output_file(out)
+    fmt = format_of(out, fmt)
     rig = VirtualLateralRig() if noise is None else VirtualLateralRig(relative_noise=noise)
     data = rig.measure(speed, pressure, force, seed)  # type: ignore[arg-type]
     path = write_frf(data.frf, out, fmt)
     truth = data.frf.meta["truth"]["params"]
+    units = data.frf.meta["truth"].get("units", {})
     click.echo(
         f"virtual rig: {data.label}, {force} force, wheel mass {rig.wheel_mass:g} kg, "
         f"{data.frf.n_freq} lines {data.frf.frequency[0]:g}-{data.frf.frequency[-1]:g} Hz; "
-        "truth " + ", ".join(f"{k} = {v:.4g}" for k, v in truth.items())
+        "truth " + ", ".join(_with_unit(k, v, units.get(k, "")) for k, v in truth.items())
     )
     click.echo(f"wrote {path}")

@@ -7,11 +7,15 @@ from pathlib import Path
 import click
 import numpy as np
 
+from ..documents.modes import write_modes_json
 from ..exceptions import InputError
+from ..frf import FRF, Channel
 from ..io import read_frf
-from ..modal.identify import ModalIdentification, identify_modes
-from ..modal.io import write_modes_json
+from ..io._safety import check_output_file
+from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
+from ..studies.radial import label_wave_numbers, modes_from_frf
+from ..studies.verdicts import modal_verdicts
 from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
@@ -32,21 +36,26 @@ def modes_table(name: str, model: ModalModel) -> list[str]:
     q = model.quality
     stat = q.statistic if q is not None else np.full(model.n_modes, np.nan)
     thr = f" (threshold {q.threshold:.3g}, false-alarm rate {q.false_alarm:g})" if q else ""
+    labels = model.meta.get("wave_number_label")
+    if not isinstance(labels, list) or len(labels) != model.n_modes:
+        labels = None
     rows = [
         f"{name} modes ({model.n_modes}):",
-        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7} {'T':>9}{thr}",
+        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7} {'T':>9}"
+        + ("  wave number" if labels else "")
+        + thr,
     ]
     for n in range(model.n_modes):
         rows.append(
             f"  {n + 1:>3} {model.frequency_hz[n]:>10.3f} {sf[n]:>8.3g} "
             f"{100 * model.damping_ratio[n]:>9.4f} {100 * sz[n]:>8.3g} {mpc[n]:>7.4f} "
-            f"{stat[n]:>9.3g}"
+            f"{stat[n]:>9.3g}" + (f"  {labels[n]}" if labels else "")
         )
     rmsd = model.meta.get("rmsd", float("nan"))
     rel = model.meta.get("relative_error", float("nan"))
     rows.append(f"  RMSD (eq. 19) {rmsd:.4g}, relative error {100 * rel:.3g} %")
     if q is not None:
-        rows.append(f"  fit: {q.verdict}")
+        rows.append(f"  goodness of fit (ML): {q.verdict}")
         if q.rejected:
             rows.append(
                 f"  {len(q.rejected)} candidate(s) rejected; first: "
@@ -69,6 +78,27 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     if not vals:
         raise InputError("--frequencies: expected at least one frequency")
     return vals
+
+
+def _with_geometry(frf: FRF, path: Path) -> FRF:
+    """The FRF with channel angles from the geometry when its points lie on a circle."""
+    from dataclasses import replace
+
+    from ..io.uff_geometry import read_uff_geometry
+
+    geo = read_uff_geometry(path)
+    missing = sorted({c.node for c in (*frf.outputs, *frf.inputs)} - set(geo.nodes))
+    if missing:
+        raise InputError(
+            f"--geometry: {path} has no node {missing[0]} ({len(missing)} channel node(s) missing)"
+        )
+    outs = geo.with_angles(frf.outputs)
+    angle = {(c.node, abs(c.direction)): c.angle_deg for c in outs}
+    ins = tuple(
+        Channel(c.node, c.direction, angle.get((c.node, abs(c.direction)), c.angle_deg), c.name)
+        for c in frf.inputs
+    )
+    return replace(frf, outputs=outs, inputs=ins)
 
 
 @click.command("modal")
@@ -112,6 +142,13 @@ def _parse_frequencies(text: str | None) -> list[float] | None:
     "noise mode (also the level of the goodness-of-fit test).",
 )
 @click.option("--no-search", is_flag=True, help="Skip the residual-driven search for missed modes.")
+@click.option(
+    "--geometry",
+    "geometry_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="UFF geometry (nodes 15/2411, trace lines 82, systems 18/2420): every channel's node "
+    "must be in it; points on a circle get their angles from it (ring views).",
+)
 def modal_command(
     frf_file: Path,
     out: Path,
@@ -122,6 +159,7 @@ def modal_command(
     max_order: int | None,
     order_step: int,
     no_residuals: bool,
+    geometry_file: Path | None,
     false_alarm: float,
     no_search: bool,
 ) -> None:
@@ -141,19 +179,34 @@ def modal_command(
       tyredamp modal tyre_frf.uff --out modes.json --band 0 200
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
+    check_output_file(out, [frf_file])
     frf = read_frf(frf_file)
-    res: ModalIdentification = identify_modes(
-        frf,
-        band=None if band is None else (float(band[0]), float(band[1])),
-        model=model,  # type: ignore[arg-type]
-        n_modes=n_modes,
-        frequencies=_parse_frequencies(frequencies),
-        max_order=max_order,
-        order_step=order_step,
-        residuals=not no_residuals,
-        false_alarm=false_alarm,
-        search=not no_search,
-    )
+    if geometry_file is not None:
+        frf = _with_geometry(frf, geometry_file)
+    try:
+        res: ModalIdentification = modes_from_frf(
+            frf,
+            band=None if band is None else (float(band[0]), float(band[1])),
+            model=model,  # type: ignore[arg-type]
+            n_modes=n_modes,
+            frequencies=_parse_frequencies(frequencies),
+            max_order=max_order,
+            order_step=order_step,
+            residuals=not no_residuals,
+            false_alarm=false_alarm,
+            search=not no_search,
+        )
+    except InputError as e:  # the limits of the data, named by the option that set them
+        msg = str(e)
+        for arg, opt in (("n_modes:", "--modes:"), ("frequencies:", "--frequencies:")):
+            if msg.startswith(arg):
+                raise InputError(opt + msg[len(arg) :]) from None
+        raise
+    for mdl in res.models.values():
+        label_wave_numbers(mdl)
+    verdicts = modal_verdicts(frf, res)
+    for name, v in verdicts.items():  # stored with the model: meta.verdict of the modes JSON
+        res.models[name].meta["verdict"] = v.to_dict()
     write_modes_json(
         out, res.models, source=frf_file.name, band_hz=res.band_hz, frf_kind=res.frf_kind
     )
@@ -173,4 +226,8 @@ def modal_command(
         click.echo(f"RMSD real / complex = {ratio:.3g}")
     for w in res.warnings:
         click.echo(f"warning: {w}")
+    for v in verdicts.values():
+        click.echo(f"verdict: {v.summary()}")
+        for c in v.cautions:
+            click.echo(f"  caution: {c}")
     click.echo(f"wrote {out}")

@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from ..exceptions import InputError
-from ..io._atomic import atomic_path
+from ..io._safety import atomic_path, check_output_file, private_matplotlib_config
 from ._common import out_file_option
 
 __all__ = ["report_command"]
@@ -34,14 +34,13 @@ def report_command(result_files: tuple[Path, ...], out: Path, title: str | None)
       tyredamp report modes.json damping.json tyre_frf.uff --out report.html
       tyredamp report lateral.json rig.npz truth.json -o all.html --title "Tyre A"
     """
-    from ..report.files import build_files_report
-
     if not result_files:
         raise InputError("RESULT_FILES: expected at least one result file")
-    for p in result_files:
-        if p.exists() and out.exists() and p.resolve() == out.resolve():
-            raise InputError(f"--out: {out} is one of the input files; choose another name")
-    html = build_files_report(list(result_files), title)
+    check_output_file(out, result_files)
+    with private_matplotlib_config():
+        from ..report.files import build_files_report
+
+        html = build_files_report(list(result_files), title)
     with atomic_path(out) as tmp:
         tmp.write_text(html, encoding="utf-8")
     click.echo(f"report of {len(result_files)} file(s): {', '.join(p.name for p in result_files)}")

@@ -1,46 +1,31 @@
 """``tyredamp simulate``: test data from the virtual rigs, for the other commands.
 
 ``simulate radial`` runs the virtual modal test of the truck tyre
-(:func:`tyredamp.tyre.run_modal_test`) and writes its time data (UFF 58
+(:func:`tyredamp.virtual.run_modal_test`) and writes its time data (UFF 58
 function type 1) or, with ``--frf``, the H1 FRFs estimated from it (function
 type 4); ``--truth`` also writes the exact modes as a modes JSON file.
 ``simulate lateral`` is the rolling-tyre rig; it is the same command as
-``tyredamp lateral simulate`` (same options, same output).
+``tyredamp lateral simulate`` (same options, same output). ``simulate
+campaign`` (:mod:`.simulate_campaign`) writes a whole virtual test campaign
+and its campaign file for ``tyredamp campaign``.
 """
 
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
 from typing import Any
 
 import click
 
+from ..documents.jsonfile import json_text
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
-from ..io._atomic import atomic_path
-from ..io.jsonfile import json_text
-from ._common import out_file_option, seed_option
+from ..io._safety import atomic_paths, check_distinct, check_output_file
+from ._common import OutPath, out_file_option, parse_drive_points, seed_option
 from .lateral import lateral_group
+from .simulate_campaign import simulate_campaign_command
 
 __all__ = ["simulate_group"]
-
-BAR = 1.0e5
-
-
-def _points(values: tuple[str, ...]) -> tuple[int, ...]:
-    out: list[int] = []
-    for v in values:
-        for s in v.replace(";", ",").split(","):
-            if not s.strip():
-                continue
-            try:
-                out.append(int(s))
-            except ValueError:
-                raise InputError(
-                    f"--drive-points: expected point numbers like 1,5, got {v!r}"
-                ) from None
-    return tuple(out) or (1,)
 
 
 @click.group("simulate")
@@ -55,6 +40,7 @@ def simulate_group() -> None:
       tyredamp simulate radial --out tyre_test.uff --pressure 7.5 --seed 1
       tyredamp simulate radial --out tyre_frf.uff --frf --truth truth.json
       tyredamp simulate lateral --out rig.npz --speed 5 --pressure 1.7
+      tyredamp simulate campaign --out virtual
     """
 
 
@@ -109,7 +95,7 @@ def simulate_group() -> None:
 @click.option(
     "--truth",
     "truth_out",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=OutPath(dir_okay=False, path_type=Path),
     help="Also write the exact modes of the tyre as a modes JSON (for tyredamp report).",
 )
 @click.option(
@@ -141,64 +127,64 @@ def radial_command(
       tyredamp simulate radial --out tyre_frf.uff --frf --pressure 9 --snr 30 --seed 2
       tyredamp simulate radial --out mimo.uff --drive-points 1,5 --periods 4
     """
-    from ..demo import single_threaded_blas
-    from ..modal.io import modes_document
-    from ..signal import estimate_frf
-    from ..tyre import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
+    from ..studies.demo import single_threaded_blas
+    from ..studies.radial import frf_from_time, virtual_tyre
+    from ..virtual import run_modal_test
 
-    if truth_out is not None and truth_out.resolve() == out.resolve():
-        raise InputError("--truth: expected another file than --out")
+    check_output_file(out)
+    if truth_out is not None:
+        check_output_file(truth_out, option="--truth")
+        check_distinct([("--out", out), ("--truth", truth_out)])
     out_format = format_of(out, fmt)
-    points = _points(drive_points)
-    tyre = RingTyre(
-        RingTyreParameters(pressure=pressure * BAR), MeasurementLayout(drive_points=points)
-    )
+    points = parse_drive_points(drive_points)
+    tyre = virtual_tyre(pressure, points)
     with single_threaded_blas():
         test = run_modal_test(tyre, n_periods=periods, force_rms=force_rms, snr_db=snr, seed=seed)
-    truth_text = None
-    if truth_out is not None:
-        doc = modes_document(
-            {"complex": test.truth.modal_model("visible")},
-            source=f"truth: virtual ring tyre at {pressure:g} bar",
-            band_hz=test.truth.band,
-            frf_kind="receptance",
-        )
-        truth_text = json_text(doc)
-    existed = out.exists()
-    if as_frf:
-        frf = estimate_frf(test.data, "H1")
-        write_frf(frf, out, out_format)
-        what = f"FRFs {frf.n_out} x {frf.n_in}, {frf.n_freq} lines (function type 4)"
-    else:
-        write_timedata(test.data, out, out_format)
-        td = test.data
-        what = f"time data, {td.n_channels} channels x {td.n_samples} samples (function type 1)"
-    if truth_text is not None and truth_out is not None:
-        try:
-            with atomic_path(truth_out) as tmp:
-                tmp.write_text(truth_text, encoding="utf-8")
-        except BaseException:
-            if not existed:
-                with contextlib.suppress(OSError):
-                    out.unlink()
-            raise
-    vis = test.truth.select("visible")
+    truth_text = None if truth_out is None else _truth_text(test, pressure)
+    # both files or neither: a replaced --out is put back when --truth fails
+    with atomic_paths([out] if truth_out is None else [out, truth_out]) as tmps:
+        if as_frf:
+            frf = frf_from_time(test.data, "H1")
+            write_frf(frf, tmps[0], out_format)
+            what = f"FRFs {frf.n_out} x {frf.n_in}, {frf.n_freq} lines (function type 4)"
+        else:
+            write_timedata(test.data, tmps[0], out_format)
+            td = test.data
+            what = f"time data, {td.n_channels} channels x {td.n_samples} samples (function type 1)"
+        if truth_text is not None:
+            tmps[1].write_text(truth_text, encoding="utf-8")
     click.echo(
         f"virtual truck tyre at {pressure:g} bar: {tyre.layout.n_points} points, drive point(s) "
         f"{', '.join(str(p) for p in points)}, {periods} periods of "
         f"{test.period_samples / test.data.sample_rate:g} s at {test.data.sample_rate:g} Hz, "
         f"SNR {snr:g} dB, seed {seed}"
     )
-    click.echo(
-        "true modes (Hz): "
-        + ", ".join(
-            f"{test.truth.frequency_hz[i]:.2f} (zeta {100 * test.truth.damping_ratio[i]:.2f} %)"
-            for i in vis
-        )
-    )
+    click.echo(_true_modes_line(test))
     click.echo(f"wrote {out} ({out_format}, {what})")
     if truth_out is not None:
         click.echo(f"wrote {truth_out} (exact modes, modes JSON)")
+
+
+def _truth_text(test: Any, pressure: float) -> str:
+    """The exact visible modes of a virtual test as a modes JSON text."""
+    from ..documents.modes import modes_document
+
+    doc = modes_document(
+        {"complex": test.truth.modal_model("visible")},
+        source=f"truth: virtual ring tyre at {pressure:g} bar",
+        band_hz=test.truth.band,
+        frf_kind="receptance",
+    )
+    return json_text(doc)
+
+
+def _true_modes_line(test: Any) -> str:
+    """``true modes (Hz): f (zeta %), ...`` of the visible modes."""
+    tr = test.truth
+    return "true modes (Hz): " + ", ".join(
+        f"{tr.frequency_hz[i]:.2f} (zeta {100 * tr.damping_ratio[i]:.2f} %)"
+        for i in tr.select("visible")
+    )
 
 
 _LATERAL = lateral_group.commands["simulate"]
@@ -232,3 +218,4 @@ simulate_group.add_command(
         short_help="Write the lateral FRF of the virtual rolling-tyre rig.",
     )
 )
+simulate_group.add_command(simulate_campaign_command)

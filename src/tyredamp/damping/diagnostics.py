@@ -234,6 +234,19 @@ def findings(
             "construction: non-proportional damping cannot be identified from real modes. "
             "Use the complex-mode fit to identify damping coupling between modes."
         )
+    out += _symmetry_findings(d, real)
+    out += _definiteness_findings(d)
+    out += _proportionality_findings(d, real, proportional)
+    out += _truncation_findings(d, real)
+    out += _theory_findings(d, real, method)
+    if std_modal is not None and c_modal is not None and d.n_modes > 1:
+        out += _uncertainty_findings(d, std_modal, c_modal)
+    return out
+
+
+def _symmetry_findings(d: DampingDiagnostics, real: bool) -> list[str]:
+    """Symmetry of ``C'`` (reciprocity)."""
+    out: list[str] = []
     # --- symmetry
     if d.n_modes > 1 and not real:
         pct = _pct(d.symmetry_modal)
@@ -262,6 +275,12 @@ def findings(
                 "the modal fit before using this matrix; if the modes are right, use the "
                 "symmetric part (modal_symmetric), which is never further from the truth."
             )
+    return out
+
+
+def _definiteness_findings(d: DampingDiagnostics) -> list[str]:
+    """Definiteness of ``C'`` (passivity)."""
+    out: list[str] = []
     # --- definiteness
     lo, hi = float(d.eigenvalues_modal[0]), float(d.eigenvalues_modal[-1])
     if d.definiteness_modal == "positive definite":
@@ -283,6 +302,12 @@ def findings(
             "combination of modes would gain energy, which no passive tyre does. This "
             "points to errors in the modal data (noise, mismatched or spurious modes)."
         )
+    return out
+
+
+def _proportionality_findings(d: DampingDiagnostics, real: bool, proportional: Any) -> list[str]:
+    """Proportional damping and the best Rayleigh model."""
+    out: list[str] = []
     # --- proportionality
     if not real and d.n_modes > 1:
         pct = _pct(d.non_proportionality)
@@ -307,6 +332,12 @@ def findings(
                 "The full damping matrix describes the data clearly better than any "
                 "proportional model: keep the off-diagonal terms in simulations."
             )
+    return out
+
+
+def _truncation_findings(d: DampingDiagnostics, real: bool) -> list[str]:
+    """Truncation to the identified modes, leakage, residuals, conditioning."""
+    out: list[str] = []
     # --- truncation and leakage
     if d.n_modes < d.n_points:
         out.append(
@@ -350,6 +381,12 @@ def findings(
             f"{d.shape_condition:.3g}); the pseudo-inverse amplifies noise: more points or "
             "fewer modes would help."
         )
+    return out
+
+
+def _theory_findings(d: DampingDiagnostics, real: bool, method: str) -> list[str]:
+    """The small-damping theory, the normalisation and the refined basis."""
+    out: list[str] = []
     # --- theory
     if d.theory_change is not None and not real:
         pct = _pct(d.theory_change)
@@ -375,26 +412,33 @@ def findings(
             f"Complete modal set: Lancaster's exact formula gives a C within "
             f"{_pct(d.lancaster_difference)} % (Frobenius) of this estimate."
         )
+    return out
+
+
+def _uncertainty_findings(
+    d: DampingDiagnostics, std_modal: NDArray[np.float64], c_modal: NDArray[np.float64]
+) -> list[str]:
+    """Monte Carlo standard errors against the asymmetry."""
+    out: list[str] = []
     # --- uncertainty
-    if std_modal is not None and c_modal is not None and d.n_modes > 1:
-        off = ~np.eye(d.n_modes, dtype=bool)
-        sig = np.abs(c_modal[off]) > 2 * std_modal[off]
-        dm = np.abs(np.diag(c_modal))
-        rel_d = np.median(np.diag(std_modal) / np.where(dm > 0, dm, np.inf))
+    off = ~np.eye(d.n_modes, dtype=bool)
+    sig = np.abs(c_modal[off]) > 2 * std_modal[off]
+    dm = np.abs(np.diag(c_modal))
+    rel_d = np.median(np.diag(std_modal) / np.where(dm > 0, dm, np.inf))
+    out.append(
+        f"Monte Carlo standard errors: diagonal of C' to {_pct(rel_d)} % (median); "
+        f"{int(np.count_nonzero(sig))} of {int(np.count_nonzero(off))} off-diagonal terms "
+        "exceed twice their standard error."
+    )
+    # the antisymmetric part is pure error: compare it with the noise it could come from
+    anti = 0.5 * (c_modal - c_modal.T)[off]
+    noise = 0.5 * np.sqrt(std_modal[off] ** 2 + std_modal.T[off] ** 2)
+    ratio = float(np.linalg.norm(anti) / max(float(np.linalg.norm(noise)), 1e-300))
+    if ratio > 3:
         out.append(
-            f"Monte Carlo standard errors: diagonal of C' to {_pct(rel_d)} % (median); "
-            f"{int(np.count_nonzero(sig))} of {int(np.count_nonzero(off))} off-diagonal terms "
-            "exceed twice their standard error."
+            f"The asymmetry of C' is {ratio:.2g} times what the standard errors allow: it "
+            "is a systematic error (leakage from modes outside the set, or model error), "
+            "which the standard errors do not include. The symmetric part removes the "
+            "antisymmetric share of it."
         )
-        # the antisymmetric part is pure error: compare it with the noise it could come from
-        anti = 0.5 * (c_modal - c_modal.T)[off]
-        noise = 0.5 * np.sqrt(std_modal[off] ** 2 + std_modal.T[off] ** 2)
-        ratio = float(np.linalg.norm(anti) / max(float(np.linalg.norm(noise)), 1e-300))
-        if ratio > 3:
-            out.append(
-                f"The asymmetry of C' is {ratio:.2g} times what the standard errors allow: it "
-                "is a systematic error (leakage from modes outside the set, or model error), "
-                "which the standard errors do not include. The symmetric part removes the "
-                "antisymmetric share of it."
-            )
     return out

@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError, InputError, ShapeError
 from ..mechanics.modal_sum import modal_sum_receptance
@@ -21,7 +22,7 @@ from .identify import METHODS, Method, modal_damping_from_modes, physical_matric
 from .lancaster import lancaster_matrices
 from .model import DampingModel
 from .proportional import compare_proportional, comparison_grid
-from .uncertainty import monte_carlo_std
+from .uncertainty import MonteCarloResult, monte_carlo_std
 
 __all__ = ["identify_damping"]
 
@@ -42,6 +43,44 @@ def _residual_fraction(model: ModalModel) -> float | None:
     total = model.receptance(f)
     modes = modal_sum_receptance(f, model.poles, model.psi_out, model.psi_in)
     return float(np.linalg.norm(total - modes) / max(float(np.linalg.norm(total)), 1e-300))
+
+
+def _theory_change(
+    model: ModalModel, shapes: NDArray[np.complex128], est: Any, max_iter: int
+) -> float | None:
+    """``||C'_est - C'_refined|| / ||C'_refined||``: what the small-damping formula neglects."""
+    try:
+        ref = modal_damping_from_modes(model.poles, shapes, "refined", max_iter=max_iter)
+    except ConvergenceError:
+        return None
+    return float(np.linalg.norm(est.c_modal - ref.c_modal) / np.linalg.norm(ref.c_modal))
+
+
+def _lancaster(
+    model: ModalModel, c_phys: NDArray[np.float64]
+) -> tuple[NDArray[np.float64] | None, float | None]:
+    """Lancaster's exact C for a complete modal set and its difference to ``c_phys``."""
+    if model.n_modes != model.psi_out.shape[0]:
+        return None, None
+    lm = lancaster_matrices(model.poles, model.psi_out)
+    diff = float(np.linalg.norm(c_phys - lm.C) / max(float(np.linalg.norm(lm.C)), 1e-300))
+    return lm.C, diff
+
+
+def _uncertainty_notes(mc: MonteCarloResult | None, n_samples: int) -> list[str]:
+    """Why standard errors are missing, or how many Monte Carlo samples failed."""
+    if mc is None:
+        return [
+            "No standard errors: the modal model carries no uncertainty (std) to propagate."
+            if n_samples > 0
+            else "Standard errors not computed (n_samples = 0)."
+        ]
+    if mc.n_failed:
+        return [
+            f"{mc.n_failed} of {mc.n_samples} Monte Carlo samples failed to identify and were "
+            "left out of the standard errors."
+        ]
+    return []
 
 
 def identify_damping(
@@ -103,22 +142,8 @@ def identify_damping(
     est = modal_damping_from_modes(model.poles, shapes, method, normalise, max_iter)
     mass, c_phys, stiff = physical_matrices(est.basis, est.c_modal, est.omega)
 
-    theory_change: float | None = None
-    if method != "refined":
-        try:
-            ref = modal_damping_from_modes(model.poles, shapes, "refined", max_iter=max_iter)
-            theory_change = float(
-                np.linalg.norm(est.c_modal - ref.c_modal) / np.linalg.norm(ref.c_modal)
-            )
-        except ConvergenceError:
-            theory_change = None
-
-    lanc = None
-    lanc_diff: float | None = None
-    if model.n_modes == model.psi_out.shape[0]:
-        lm = lancaster_matrices(model.poles, model.psi_out)
-        lanc = lm.C
-        lanc_diff = float(np.linalg.norm(c_phys - lm.C) / max(float(np.linalg.norm(lm.C)), 1e-300))
+    theory_change = None if method == "refined" else _theory_change(model, shapes, est, max_iter)
+    lanc, lanc_diff = _lancaster(model, c_phys)
 
     prop = compare_proportional(model.poles, model.psi_out, est.basis, est.c_modal, est.omega)
     diag = compute_diagnostics(
@@ -139,10 +164,9 @@ def identify_damping(
         mc = monte_carlo_std(
             model.poles, model.psi_out, shapes, model.std, method, normalise, n_samples, seed
         )
-    std: dict[str, np.ndarray] = {}
+    std: dict[str, np.ndarray] = {} if mc is None else {"modal": mc.modal, "physical": mc.physical}
     unc: dict[str, Any] = {}
     if mc is not None:
-        std = {"modal": mc.modal, "physical": mc.physical}
         unc = {
             "method": "monte_carlo",
             "n_samples": mc.n_samples,
@@ -150,17 +174,7 @@ def identify_damping(
             "seed": mc.seed,
         }
     notes = findings(diag, method, prop, std.get("modal"), est.c_modal)
-    if mc is None:
-        notes.append(
-            "No standard errors: the modal model carries no uncertainty (std) to propagate."
-            if n_samples > 0
-            else "Standard errors not computed (n_samples = 0)."
-        )
-    elif mc.n_failed:
-        notes.append(
-            f"{mc.n_failed} of {mc.n_samples} Monte Carlo samples failed to identify and were "
-            "left out of the standard errors."
-        )
+    notes += _uncertainty_notes(mc, n_samples)
     return DampingModel(
         modal=est.c_modal,
         physical=c_phys,

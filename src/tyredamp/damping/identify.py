@@ -100,6 +100,9 @@ METHODS: tuple[Method, ...] = ("first", "improved", "refined")
 _REFINE_TOL = 1e-10
 #: Relative condition number of Re Psi^ above which the shapes count as dependent.
 _RANK_RTOL = 1e-10
+#: Largest |p| (rad/s) and shape norm (and smallest inverse) whose squares and
+#: products stay inside double precision (1e150^2 = 1e300 < 1.8e308).
+_MAX_SCALE = 1e150
 
 
 @dataclass(frozen=True)
@@ -159,7 +162,24 @@ def _check_inputs(
             f"shapes: need at least as many points as modes to invert Re Psi^, got "
             f"{s.shape[0]} points for {p.size} modes"
         )
-    sv = np.linalg.svd(s.real, compute_uv=False)
+    # C, M and K at the points involve omega^2 and 1/|shape|^2: both must stay finite
+    big = float(np.max(np.abs(p)))
+    if big > _MAX_SCALE:
+        raise InputError(
+            f"poles: |p| up to {big:.3g} rad/s; its square overflows double precision "
+            "(check the units of the modes file)"
+        )
+    amax = np.max(np.abs(s.real), axis=0)  # no squares: no overflow or underflow
+    if np.any(amax == 0):
+        k = int(np.argmin(amax))
+        raise PhysicsError(f"shapes: mode {k + 1} has a zero real part at every point")
+    if np.any(amax < 1 / _MAX_SCALE) or np.any(amax > _MAX_SCALE):
+        raise InputError(
+            f"shapes: largest entries from {amax.min():.3g} to {amax.max():.3g} 1/sqrt(kg) "
+            "mean modal masses that overflow double precision (check the shape scaling)"
+        )
+    # the rank test does not depend on how each column is scaled
+    sv = np.linalg.svd(s.real / amax, compute_uv=False)
     if sv[-1] <= _RANK_RTOL * sv[0]:
         raise PhysicsError(
             f"shapes: the real parts of the {p.size} mode shapes are linearly dependent at the "
@@ -391,7 +411,8 @@ def _refine(
             raise ConvergenceError(
                 "refined damping estimate: the bias-correction equations have no solution "
                 "near the first-order estimate (modes too strongly coupled or inconsistent); "
-                "use method='improved' and read the diagnostics"
+                "use the improved method (--method improved; method='improved' in Python) "
+                "and read the diagnostics"
             ) from None
         x = sol.x * scale
         it += int(sol.nfev)

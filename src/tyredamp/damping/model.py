@@ -1,12 +1,11 @@
 """The :class:`DampingModel` result object and its JSON form.
 
-JSON layout of :meth:`DampingModel.to_dict` (``"kind": "damping"``; all
-matrices as nested lists of floats, row-major; units SI for mass-normalised
-shapes in 1/sqrt(kg))::
+Layout of :meth:`DampingModel.to_dict` (all matrices as nested lists of
+floats, row-major; units SI for mass-normalised shapes in 1/sqrt(kg)); the
+damping JSON file (:mod:`tyredamp.documents.damping`) puts ``"kind":
+"damping"`` and ``"version"`` around it::
 
-    {"kind": "damping",
-     "version": 1,
-     "method": "first" | "improved" | "refined",
+    {"method": "first" | "improved" | "refined",
      "normalised": bool,
      "modes": {"frequency_hz": [m], "damping_ratio": [m],
                "poles": [[re, im] x m]},            # rad/s
@@ -43,8 +42,6 @@ from .diagnostics import DampingDiagnostics
 from .proportional import ProportionalComparison
 
 __all__ = ["DampingModel"]
-
-SCHEMA_VERSION = 1
 
 
 @dataclass(frozen=True, eq=False)
@@ -176,8 +173,6 @@ class DampingModel:
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary; the layout is in the module docstring."""
         return {
-            "kind": "damping",
-            "version": SCHEMA_VERSION,
             "method": self.method,
             "normalised": self.normalised,
             "modes": {
@@ -211,7 +206,7 @@ class DampingModel:
     def from_dict(cls, d: dict[str, Any]) -> DampingModel:
         """Inverse of :meth:`to_dict`; raises :class:`InputError` naming a missing key."""
         try:
-            if d.get("kind") != "damping":
+            if d.get("kind", "damping") != "damping":  # the damping document's envelope
                 raise InputError(f"damping model: expected kind 'damping', got {d.get('kind')!r}")
             poles = np.asarray(d["modes"]["poles"], dtype=float).reshape(-1, 2)
             lp = d.get("lancaster_physical")

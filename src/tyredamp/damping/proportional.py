@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import nnls
 
-from ..mechanics.modal_sum import modal_sum_receptance
+from ..mechanics.modal_sum import modal_sum_receptance, pole_quantities
 
 __all__ = [
     "ProportionalComparison",
@@ -146,8 +146,7 @@ def comparison_grid(
     ndarray, shape (n_lines,)
         Strictly increasing, positive.
     """
-    f = np.abs(poles) / (2 * np.pi)
-    z = -poles.real / np.abs(poles)
+    f, z = pole_quantities(poles)
     t = np.linspace(-8.0, 8.0, points_per_mode)
     local = (f[:, None] * (1 + np.maximum(z, 1e-6)[:, None] * t[None, :])).ravel()
     uniform = np.linspace(0.3 * f.min(), 1.3 * f.max(), n_uniform)

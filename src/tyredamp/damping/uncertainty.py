@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import TyredampError
+from ..mechanics.modal_sum import pole_quantities
 from .identify import Method, align_signs, modal_damping_from_modes, physical_matrices
 
 __all__ = ["MonteCarloResult", "monte_carlo_std"]
@@ -103,8 +104,7 @@ def monte_carlo_std(
     sp = np.asarray(std.get("psi_out", np.zeros(psi.shape)), dtype=float)
     if sp.shape != psi.shape:
         sp = np.zeros(psi.shape)
-    f0 = np.abs(poles) / (2 * np.pi)
-    z0 = -poles.real / np.abs(poles)
+    f0, z0 = pole_quantities(poles)
     rng = np.random.default_rng(seed)
     modal, phys = [], []
     failed = 0

@@ -1,5 +1,8 @@
-"""File formats: UFF 58/58b (pyuff), CSV and NPZ for FRFs and time data.
+"""Measurement file formats: UFF 58/58b (pyuff), CSV and NPZ for FRFs and time data.
 
+One module per format, one line per format in :data:`FILE_FORMATS`: its name,
+the extensions it owns and its reader and writer (the module is imported when
+a file of that format is read or written, so pyuff loads only for UFF files).
 Reading dispatches on the file extension:
 
 ========================  ============================================
@@ -8,6 +11,9 @@ extension                 format
 ``.uff``, ``.unv``, ``.uf``  UFF data set 58, ASCII or binary 58b (read both)
 ``.csv``                  tyredamp CSV layout (:mod:`.csv_format`)
 ``.npz``                  tyredamp NPZ layout (:mod:`.npz`)
+``.nc``                   FRF as netCDF with named dimensions (:mod:`.netcdf`, xarray)
+``.tdms``                 NI TDMS time data, read only (:mod:`.tdms`, npTDMS)
+``.mf4``, ``.mdf``        ASAM MDF time data, read only (:mod:`.mdf`, asammdf)
 ========================  ============================================
 
 Writing takes ``format`` (``"uff58b"`` binary UFF, ``"uff58"`` ASCII UFF,
@@ -15,24 +21,27 @@ Writing takes ``format`` (``"uff58b"`` binary UFF, ``"uff58"`` ASCII UFF,
 58b, which is lossless). Every write is atomic (the file appears whole or not
 at all) and input files are only ever opened for reading. Corrupt, truncated
 or empty files raise :class:`~tyredamp.exceptions.FileFormatError` naming the
-file and the problem. See ``docs/file-formats.md``.
+file and the problem. See ``docs/file-formats.md``. Result documents (modes,
+damping, ... JSON) are :mod:`tyredamp.documents`.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, FRFKind
 from ..timedata import TimeData
-from .csv_format import read_csv, write_csv
-from .npz import read_npz, write_npz
-from .uff import read_uff, write_uff
 
 __all__ = [
+    "FILE_FORMATS",
     "FORMATS",
+    "FileFormat",
     "format_of",
     "read",
     "read_frf",
@@ -42,55 +51,143 @@ __all__ = [
     "write_timedata",
 ]
 
-Format = Literal["uff58b", "uff58", "csv", "npz"]
-#: Formats accepted by the writers.
-FORMATS: tuple[str, ...] = ("uff58b", "uff58", "csv", "npz")
-_EXT: dict[str, Format] = {
-    ".uff": "uff58b",
-    ".unv": "uff58b",
-    ".uf": "uff58b",
-    ".csv": "csv",
-    ".npz": "npz",
+Format = Literal["uff58b", "uff58", "csv", "npz", "netcdf", "tdms", "mdf"]
+
+
+@dataclass(frozen=True)
+class FileFormat:
+    """One measurement file format.
+
+    Attributes
+    ----------
+    name : str
+        Format name (``format=`` of the writers).
+    extensions : tuple of str
+        Lower-case extensions read as (and written by default in) this format.
+    module : str
+        Module holding the reader and writer: ``".uff"`` (relative to this
+        package) or an absolute module name.
+    reader : str
+        Its name: ``reader(path)`` returns an FRF or TimeData (with
+        ``selects=True``: ``reader(path, what, kind)``, ``what`` in
+        ``{"frf", "timedata", None}``).
+    writer : str or None
+        Its name, ``writer(obj, path, **write_options)``; None for a read-only
+        format (acquisition files such as TDMS and MDF).
+    selects : bool
+        The reader can pick FRF or time data out of a file holding both.
+    write_options : mapping
+        Fixed keyword arguments of the writer.
+    holds : {"any", "frf", "timedata"}
+        What the format can hold: FRFs and time data, or only one of them
+        (reading the other kind from it, or writing it, is an error before
+        any I/O).
+    """
+
+    name: str
+    extensions: tuple[str, ...]
+    module: str
+    reader: str
+    writer: str | None
+    selects: bool = False
+    write_options: Mapping[str, Any] = field(default_factory=dict)
+    holds: Literal["any", "frf", "timedata"] = "any"
+
+    def _function(self, name: str) -> Callable[..., Any]:
+        fn: Callable[..., Any] = getattr(importlib.import_module(self.module, __name__), name)
+        return fn
+
+    def read(
+        self, path: str | os.PathLike[str], what: str | None = None, kind: FRFKind | None = None
+    ) -> FRF | TimeData:
+        """Read ``path`` in this format (``what``/``kind`` only where the reader selects)."""
+        if what is not None and self.holds not in ("any", what):
+            held = "an FRF" if self.holds == "frf" else "time data"
+            asked = "an FRF" if what == "frf" else "time data"
+            raise FileFormatError(f"{path}: {self.name} files hold {held}, not {asked}")
+        if self.selects:
+            obj: FRF | TimeData = self._function(self.reader)(path, what, kind)
+        else:
+            obj = self._function(self.reader)(path)
+        return obj
+
+    def write(self, obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
+        """Write ``obj`` to ``path`` in this format."""
+        if self.writer is None:
+            raise InputError(f"format: {self.name} is read only; write as one of {FORMATS}")
+        if self.holds != "any" and isinstance(obj, FRF) != (self.holds == "frf"):
+            held = "FRFs" if self.holds == "frf" else "time data"
+            raise InputError(
+                f"format: {self.name} ({', '.join(self.extensions)}) holds {held}, "
+                f"not {type(obj).__name__}"
+            )
+        self._function(self.writer)(obj, path, **self.write_options)
+
+
+#: Every measurement format; a new format is one module and one line here.
+FILE_FORMATS: dict[str, FileFormat] = {
+    f.name: f
+    for f in (
+        FileFormat(
+            "uff58b",
+            (".uff", ".unv", ".uf"),
+            ".uff",
+            "read_uff",
+            "write_uff",
+            True,
+            {"binary": True},
+        ),
+        FileFormat("uff58", (), ".uff", "read_uff", "write_uff", True, {"binary": False}),
+        FileFormat("csv", (".csv",), ".csv_format", "read_csv", "write_csv"),
+        FileFormat("npz", (".npz",), ".npz", "read_npz", "write_npz"),
+        FileFormat("netcdf", (".nc",), ".netcdf", "read_netcdf", "write_netcdf", holds="frf"),
+        FileFormat("tdms", (".tdms",), ".tdms", "read_tdms", None, holds="timedata"),
+        FileFormat("mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None, holds="timedata"),
+    )
 }
+#: The built-in formats that can be written (choices of the command line).
+FORMATS: tuple[str, ...] = tuple(n for n, f in FILE_FORMATS.items() if f.writer is not None)
+
+
+def _extensions() -> dict[str, str]:
+    """Extension -> format name, from :data:`FILE_FORMATS`."""
+    return {ext: f.name for f in FILE_FORMATS.values() for ext in f.extensions}
 
 
 def format_of(path: str | os.PathLike[str], format: str | None = None) -> Format:
     """The file format for ``path``: ``format`` when given, else from the extension."""
     if format is not None:
-        if format not in FORMATS:
-            raise InputError(f"format: expected one of {FORMATS}, got {format!r}")
+        if format not in FILE_FORMATS:
+            raise InputError(f"format: expected one of {tuple(FILE_FORMATS)}, got {format!r}")
         return format  # type: ignore[return-value]
     ext = Path(path).suffix.lower()
-    if ext not in _EXT:
+    exts = _extensions()
+    if ext not in exts:
         raise InputError(
             f"{path}: unknown file extension {ext or '(none)'!r}; expected one of "
-            f"{', '.join(sorted(_EXT))} or an explicit format"
+            f"{', '.join(sorted(exts))} or an explicit format"
         )
-    return _EXT[ext]
+    return exts[ext]  # type: ignore[return-value]
 
 
-def _read_format(path: str | os.PathLike[str]) -> Format:
+def _read_format(path: str | os.PathLike[str]) -> FileFormat:
     ext = Path(path).suffix.lower()
-    if ext not in _EXT:
+    exts = _extensions()
+    if ext not in exts:
         raise FileFormatError(
             f"{path}: unknown file extension {ext or '(none)'!r}; expected one of "
-            f"{', '.join(sorted(_EXT))}"
+            f"{', '.join(sorted(exts))}"
         )
-    return _EXT[ext]
+    return FILE_FORMATS[exts[ext]]
 
 
 def read(path: str | os.PathLike[str]) -> FRF | TimeData:
     """Read whatever the file holds: an FRF or time data."""
-    fmt = _read_format(path)
-    if fmt == "csv":
-        return read_csv(path)
-    if fmt == "npz":
-        return read_npz(path)
-    return read_uff(path)
+    return _read_format(path).read(path)
 
 
 def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
-    """Read an FRF matrix from a UFF, CSV or NPZ file.
+    """Read an FRF matrix from a UFF, CSV, NPZ or netCDF file.
 
     Parameters
     ----------
@@ -103,23 +200,21 @@ def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
     FileFormatError
         The file is empty, truncated, corrupt, or holds time data.
     """
-    fmt = _read_format(path)
-    obj = read_uff(path, "frf", kind) if fmt.startswith("uff") else read(path)
+    obj = _read_format(path).read(path, "frf", kind)
     if not isinstance(obj, FRF):
         raise FileFormatError(f"{path}: holds time data, not an FRF")
     return obj
 
 
 def read_timedata(path: str | os.PathLike[str]) -> TimeData:
-    """Read time data from a UFF, CSV or NPZ file.
+    """Read time data from a UFF, CSV, NPZ, TDMS or MDF file.
 
     Raises
     ------
     FileFormatError
         The file is empty, truncated, corrupt, or holds an FRF.
     """
-    fmt = _read_format(path)
-    obj = read_uff(path, "timedata") if fmt.startswith("uff") else read(path)
+    obj = _read_format(path).read(path, "timedata")
     if not isinstance(obj, TimeData):
         raise FileFormatError(f"{path}: holds an FRF, not time data")
     return obj
@@ -132,18 +227,13 @@ def write(obj: FRF | TimeData, path: str | os.PathLike[str], format: str | None 
     ----------
     obj : FRF or TimeData
     path : path-like
-    format : {"uff58b", "uff58", "csv", "npz"}, optional
+    format : {"uff58b", "uff58", "csv", "npz", "netcdf"}, optional
         Default from the extension (``.uff``/``.unv``: ``"uff58b"``).
     """
     fmt = format_of(path, format)
     if not isinstance(obj, FRF | TimeData):
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
-    if fmt == "csv":
-        write_csv(obj, path)
-    elif fmt == "npz":
-        write_npz(obj, path)
-    else:
-        write_uff(obj, path, binary=fmt == "uff58b")
+    FILE_FORMATS[fmt].write(obj, path)
     return Path(path)
 
 

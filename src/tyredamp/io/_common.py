@@ -103,6 +103,10 @@ def meta_from_json(text: str, where: str) -> dict[str, Any]:
         out = json.loads(text)
     except json.JSONDecodeError as exc:
         raise FileFormatError(f"{where}: invalid JSON ({exc})") from None
+    except RecursionError:
+        raise FileFormatError(f"{where}: JSON nested too deeply") from None
+    except ValueError as exc:  # for example an integer of more than 4300 digits
+        raise FileFormatError(f"{where}: invalid JSON ({exc})") from None
     if not isinstance(out, dict):
         raise FileFormatError(f"{where}: expected a JSON object, got {type(out).__name__}")
     return out
@@ -113,7 +117,8 @@ def wrap_errors(path: Path) -> Iterator[None]:
     """Turn data errors raised while building an object from a file into FileFormatError.
 
     :class:`TyredampError` other than FileFormatError (for example a NaN
-    sample, a decreasing frequency axis) get the file name prepended.
+    sample, a decreasing frequency axis) get the file name prepended; type
+    errors from content of the wrong type become FileFormatError too.
     """
     try:
         yield
@@ -121,3 +126,6 @@ def wrap_errors(path: Path) -> Iterator[None]:
         raise
     except TyredampError as exc:
         raise FileFormatError(f"{path}: {exc}") from exc
+    except (TypeError, ValueError, KeyError, IndexError, AttributeError, OverflowError) as exc:
+        # content of the wrong type somewhere in the file: still the file's fault
+        raise FileFormatError(f"{path}: invalid content ({type(exc).__name__}: {exc})") from exc

@@ -23,6 +23,8 @@ FRF layout::
   every output (outer loop) and input (inner loop), in the SI unit of the
   kind (``unit`` line: m/N, m/(s N) or m/(s^2 N)).
 * ``coherence[out]``: optional multiple coherence of each output (0..1).
+* ``variance[out/in]``: optional variance of each ``H`` estimate (unit of
+  ``H`` squared), last, for every output (outer) and input (inner).
 
 Time-data layout::
 
@@ -31,13 +33,18 @@ Time-data layout::
     # sample_rate: 2048.0
     # channel: {"node": 1, "direction": 3, "angle_deg": null, "name": "", "quantity": "force"}
     # channel: ...                   (one line per column after time_s)
-    # meta: {"period_samples": 4096}
+    # acquisition: {"period_samples": 4096, "settle_samples": 8192} (optional)
+    # meta: {"operator": "..."}      (free notes, optional)
     time_s,1+Z [N],2+Z [m/s^2],...
     0,0.5,0.001,...
 
 * ``time_s``: sample time in s (informative; ``sample_rate`` in Hz is what is
   used; without a ``sample_rate`` line it is taken from the time column).
 * one column per channel in SI units (N, m, m/s, m/s^2 by ``quantity``).
+* ``acquisition``: the fields of :class:`~tyredamp.timedata.Acquisition`
+  (``period_samples``, ``run_starts``, ``settle_samples``,
+  ``record_samples``, ``band_hz``, ``n_averages``, ``excitation``); files
+  written before it existed kept them in ``meta`` and still read the same.
 
 Channel records: ``node`` (int), ``direction`` (UFF code, 3 = +Z/radial),
 ``angle_deg`` (float or null), ``name`` (str); time-data channels add
@@ -55,7 +62,7 @@ import numpy as np
 
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, UNITS
-from ..timedata import TimeData
+from ..timedata import Acquisition, TimeData
 from ._atomic import atomic_path
 from ._common import (
     channel_from_dict,
@@ -95,6 +102,9 @@ def write_csv(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         if obj.coherence is not None:
             cols += [f"coherence[{c.label}]" for c in obj.outputs]
             blocks.append(obj.coherence.T)
+        if obj.variance is not None:
+            cols += [f"variance[{co.label}/{ci.label}]" for co in obj.outputs for ci in obj.inputs]
+            blocks.append(obj.variance.reshape(-1, obj.n_freq).T)
         table = np.hstack(blocks)
     elif isinstance(obj, TimeData):
         head += ["# type: timedata", f"# sample_rate: {obj.sample_rate!r}"]
@@ -106,6 +116,9 @@ def write_csv(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
             f"{c.label} [{u}]" for c, u in zip(obj.channels, obj.units, strict=True)
         ]
         table = np.hstack([obj.time[:, None], obj.data.T])
+        acq = obj.acquisition.to_dict()
+        if acq:
+            head.append(f"# acquisition: {meta_to_json(acq)}")
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
     if obj.meta:
@@ -192,14 +205,24 @@ def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
             if not outs or not ins:
                 raise FileFormatError(f"{p}: expected '# output:' and '# input:' header lines")
             n_h = 2 * len(outs) * len(ins)
-            if len(cols) == 1 + n_h:
+            n_var = sum(c.startswith("variance[") for c in cols)
+            if n_var not in (0, len(outs) * len(ins)) or any(
+                c.startswith("variance[") for c in cols[: len(cols) - n_var]
+            ):
+                raise FileFormatError(
+                    f"{p}: expected {len(outs) * len(ins)} variance columns at the end, got {n_var}"
+                )
+            n_rest = len(cols) - n_var
+            var = table[:, n_rest:].T.reshape(len(outs), len(ins), -1) if n_var else None
+            if n_rest == 1 + n_h:
                 coh = None
-            elif len(cols) == 1 + n_h + len(outs):
-                coh = table[:, 1 + n_h :].T
+            elif n_rest == 1 + n_h + len(outs):
+                coh = table[:, 1 + n_h : n_rest].T
             else:
                 raise FileFormatError(
                     f"{p}: expected {1 + n_h} columns ({len(outs)} outputs x {len(ins)} inputs, "
-                    f"re and im) or {1 + n_h + len(outs)} with coherence, got {len(cols)}"
+                    f"re and im) or {1 + n_h + len(outs)} with coherence (and the variance "
+                    f"columns), got {len(cols)}"
                 )
             h = table[:, 1 : 1 + n_h : 2] + 1j * table[:, 2 : 2 + n_h : 2]
             h = h.T.reshape(len(outs), len(ins), -1)
@@ -211,6 +234,7 @@ def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
                 inputs=ins,
                 coherence=coh,
                 meta=meta,
+                variance=var,
             )
         if typ == "timedata":
             recs = [meta_from_json(v, f"{p}: channel") for v in fields.get("channel", [])]
@@ -233,11 +257,17 @@ def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
                 if np.any(dt <= 0) or np.ptp(dt) > 1e-6 * np.mean(dt):
                     raise FileFormatError(f"{p}: time column is not evenly increasing")
                 fs = 1.0 / float(np.mean(dt))
+            acq = None
+            if "acquisition" in fields:
+                acq = Acquisition.from_dict(
+                    meta_from_json(fields["acquisition"][0], f"{p}: acquisition")
+                )
             return TimeData(
                 table[:, 1:].T,
                 fs,
                 [channel_from_dict(r, f"{p}: channel") for r in recs],
                 [str(r.get("quantity", "")) for r in recs],
                 meta=meta,
+                acquisition=acq,
             )
     raise FileFormatError(f"{p}: type {typ!r} is not 'frf' or 'timedata'")

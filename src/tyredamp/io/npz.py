@@ -7,10 +7,12 @@ Layout (a NumPy ``.npz`` archive, no pickled objects):
     ``version`` (1), ``type`` ("frf" or "timedata") and, for an FRF,
     ``kind``, ``outputs``, ``inputs`` (lists of channel records ``{"node",
     "direction", "angle_deg", "name"}``) and ``meta``; for time data
-    ``sample_rate`` (Hz), ``channels`` (channel records with ``quantity``)
-    and ``meta``.
+    ``sample_rate`` (Hz), ``channels`` (channel records with ``quantity``),
+    ``acquisition`` (the stated fields of
+    :class:`~tyredamp.timedata.Acquisition`; older files kept them in
+    ``meta`` and read the same) and ``meta``.
 ``frequency`` (n_freq,), ``H`` (n_out, n_in, n_freq) complex, optional
-``coherence`` (n_out, n_freq)
+``coherence`` (n_out, n_freq), optional ``variance`` (n_out, n_in, n_freq)
     FRF arrays, Hz and SI units of the kind.
 ``data`` (n_channels, n_samples)
     Time data in SI units.
@@ -28,7 +30,7 @@ import numpy as np
 
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF
-from ..timedata import TimeData
+from ..timedata import Acquisition, TimeData
 from ._atomic import atomic_path
 from ._common import (
     channel_from_dict,
@@ -64,6 +66,8 @@ def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         arrays.update(frequency=obj.frequency, H=obj.H)
         if obj.coherence is not None:
             arrays["coherence"] = obj.coherence
+        if obj.variance is not None:
+            arrays["variance"] = obj.variance
     elif isinstance(obj, TimeData):
         head = {
             "type": "timedata",
@@ -74,11 +78,79 @@ def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
             ],
         }
         arrays["data"] = obj.data
+        head["acquisition"] = obj.acquisition.to_dict()
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
     text = meta_to_json({"format": "tyredamp", "version": _VERSION, **head, "meta": obj.meta})
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez(fh, header=np.array(text), **arrays)
+
+
+def _check_members(p: os.PathLike[str]) -> None:
+    """Refuse members whose .npy header claims more data than the archive holds.
+
+    A hostile or corrupt header (``shape`` of 1e12 elements) would otherwise
+    make NumPy allocate that much memory before noticing the data is missing;
+    a compressed archive that unpacks to more than the memory available (a
+    "zip bomb") is refused before it is unpacked.
+    """
+    total = 0
+    with zipfile.ZipFile(p) as zf:
+        for info in zf.infolist():
+            if not info.filename.endswith(".npy"):
+                continue
+            with zf.open(info) as fh:
+                version = np.lib.format.read_magic(fh)
+                if version == (1, 0):
+                    shape, _, dtype = np.lib.format.read_array_header_1_0(fh)
+                else:
+                    shape, _, dtype = np.lib.format.read_array_header_2_0(fh)
+            if dtype.hasobject:
+                raise FileFormatError(f"{p}: {info.filename}: object arrays are not accepted")
+            need = int(np.prod(shape, dtype=object)) * dtype.itemsize
+            if need > info.file_size:
+                raise FileFormatError(
+                    f"{p}: {info.filename}: header claims shape {shape} ({need} bytes) but the "
+                    f"archive holds {info.file_size} bytes; the file is corrupt"
+                )
+            total += need
+    avail = _available_memory()
+    if avail is not None and total > avail:
+        raise InputError(
+            f"{p}: its arrays take {total / 1e9:.3g} GB unpacked, more than the "
+            f"{avail / 1e9:.3g} GB of memory available"
+        )
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available to a new allocation (Linux ``MemAvailable``), or None."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def _check_header(p: os.PathLike[str], head: dict[str, Any]) -> None:
+    """Type checks of the header fields (each mistake named)."""
+    expected: dict[str, tuple[type, ...]] = {
+        "meta": (dict,),
+        "outputs": (list,),
+        "inputs": (list,),
+        "channels": (list,),
+        "kind": (str,),
+        "type": (str,),
+        "sample_rate": (int, float),
+    }
+    for key, types in expected.items():
+        if key in head and (not isinstance(head[key], types) or isinstance(head[key], bool)):
+            names = " or ".join(t.__name__ for t in types)
+            raise FileFormatError(
+                f"{p}: header {key!r}: expected {names}, got {type(head[key]).__name__}"
+            )
 
 
 def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
@@ -91,15 +163,23 @@ def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
     """
     p = check_input_file(path)
     try:
+        _check_members(p)
         with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
             if "header" not in z.files:
                 raise FileFormatError(f"{p}: not a tyredamp NPZ file (no 'header' entry)")
-            head = meta_from_json(str(z["header"][()]), f"{p}: header")
+            h = z["header"]
+            if h.ndim != 0 or h.dtype.kind != "U":
+                raise FileFormatError(
+                    f"{p}: header: expected a text (unicode) scalar, got dtype {h.dtype} "
+                    f"shape {h.shape}"
+                )
+            head = meta_from_json(str(h[()]), f"{p}: header")
             arrays = {k: z[k] for k in z.files if k != "header"}
-    except FileFormatError:
+    except (FileFormatError, InputError):
         raise
     except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError) as exc:
         raise FileFormatError(f"{p}: not a readable NPZ file ({exc})") from None
+    _check_header(p, head)
     if head.get("format") != "tyredamp":
         raise FileFormatError(f"{p}: header 'format' is {head.get('format')!r}, not 'tyredamp'")
     if head.get("version") != _VERSION:
@@ -119,16 +199,21 @@ def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
                 inputs=[channel_from_dict(c, f"{p}: inputs") for c in head.get("inputs", [])],
                 coherence=arrays.get("coherence"),
                 meta=meta,
+                variance=arrays.get("variance"),
             )
         if kind == "timedata":
             if "data" not in arrays:
                 raise FileFormatError(f"{p}: missing array 'data'")
             chans = head.get("channels", [])
+            acq = head.get("acquisition")
+            if acq is not None and not isinstance(acq, dict):
+                raise FileFormatError(f"{p}: header 'acquisition' is not a JSON object")
             return TimeData(
                 arrays["data"],
                 head.get("sample_rate", 0.0),
                 [channel_from_dict(c, f"{p}: channels") for c in chans],
-                [str(c.get("quantity", "")) for c in chans],
+                [str(c.get("quantity", "")) if isinstance(c, dict) else "" for c in chans],
                 meta=meta,
+                acquisition=None if acq is None else Acquisition.from_dict(acq),
             )
     raise FileFormatError(f"{p}: header 'type' is {kind!r}, expected 'frf' or 'timedata'")

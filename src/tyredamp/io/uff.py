@@ -19,12 +19,22 @@ What is written
 * ID line 1: a description (``meta["description"]`` or ``"tyredamp FRF ..."``);
   ID line 2: ``tyredamp1 ...`` with the exact frequency axis or sample rate
   as Python floats (the fixed E13.5 fields of record 7 keep only 6 digits);
-  ID line 3: as much of ``meta`` as fits in 80 characters as JSON, the keys
-  the estimators use first (``period_samples``, ``settle_samples``,
-  ``record_samples``, ``run_starts``, ``band_hz`` ...);
+  ID line 3: as much of ``meta`` as fits in 80 characters as JSON, for time
+  data the acquisition fields first (``period_samples``, ``settle_samples``,
+  ``record_samples``, ``run_starts`` (evenly spaced runs as ``run_every``:
+  [step, count]), ``band_hz`` ..., read back into ``TimeData.acquisition``;
+  an acquisition that does not fit is an error, never silently dropped),
+  then the operating conditions of a lateral rig FRF (``speed_m_s``,
+  ``force``, ``wheel_mass_kg``, ``pressure_bar``); the whole ``meta`` is in
+  the metadata record below when it does not fit;
   ID lines 4 and 5: channel name and angle of the response and reference as
   JSON (``NONE`` when there are none); time data have no reference, and ID
   line 5 continues the metadata.
+* ``FRF.variance`` (when present): one extra data set per output/input pair
+  of function type 0 ("general") with ID line 1 ``tyredamp FRF variance``,
+  the pair's response and reference nodes, and the variance of ``H`` in
+  (unit of H)^2 as ordinate; other programs see a general function, tyredamp
+  reads it back into ``FRF.variance``.
 
 Precision
 ---------
@@ -33,22 +43,30 @@ stores every value as a float64 and the frequencies as uneven abscissa
 values: FRF and time data round-trip bit for bit. ASCII 58 (format
 ``"uff58"``) stores values in E20.12 fields, 12 significant digits, relative
 error up to 5e-12; the frequency axis must then be evenly spaced (it is
-rebuilt exactly from ID line 2). Free metadata beyond 80 characters of JSON
-is not kept by either (use NPZ for that).
+rebuilt exactly from ID line 2).
+
+Metadata record
+---------------
+When ``meta`` does not fit the ID lines whole, the file also holds the whole
+``meta`` as JSON in a chain of data sets 151 (header) placed before the data
+sets 58, so nothing is truncated (layout in :mod:`tyredamp.io._uff_meta`).
 
 Reading other programs' files
 -----------------------------
 The response quantity comes from the ordinate data type (8, 11, 12; 9 or 13
-for forces) or else from the ordinate units label; ``m``, ``mm``, ``um``,
-``in``, ``m/s``, ``mm/s``, ``in/s``, ``m/s^2``, ``mm/s^2``, ``g``,
-``in/s^2``, ``N``, ``kN``, ``lbf`` are converted to SI; a blank label or
-``NONE`` is taken as SI; another label is an error. An FRF label such as
-``g/N`` or ``(m/s^2)/N`` with a blank denominator is split at the last ``/``.
+for forces) or else from the ordinate units label, read by
+:mod:`tyredamp.io.units` (``m/s²``, ``m/s2``, ``ms^-2``, ``g``, ``mm/s``,
+``in``, ``µm``, ``lbf``, ``kN`` ..., converted to SI); a blank label or
+``NONE`` is taken as SI; a label that cannot be read is an error naming it.
+An FRF label may hold the whole ratio (``g/N``, ``(m/s^2)/N``,
+``(1/N)*(m/s²)``) or only the response with the force in the denominator
+label; a label and a data type that disagree are an error.
 """
 
 from __future__ import annotations
 
 import gc
+import itertools
 import json
 import os
 import warnings
@@ -63,10 +81,14 @@ from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
 from ._atomic import atomic_path
 from ._common import check_input_file, meta_to_json, wrap_errors
+from ._uff_meta import meta_record, read_meta_record
+from .units import frf_units, quantity_units
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
 
 _MARK = "tyredamp1"
+#: ID line 1 of the extra data sets (function type 0) holding FRF.variance.
+_VARIANCE_ID = "tyredamp FRF variance"
 _SDT = {"displacement": 8, "velocity": 11, "acceleration": 12, "force": 13}
 _SDT_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 13: "force", 9: "force"}
 _KIND_QUANTITY = {
@@ -84,48 +106,6 @@ _AXIS_LABEL = {
 }
 # (length exponent, force exponent) of each quantity in SI
 _EXP = {"displacement": (1, 0), "velocity": (1, 0), "acceleration": (1, 0), "force": (0, 1)}
-_LBF = 4.4482216152605
-_UNITS: dict[str, tuple[str, float]] = {
-    "m": ("displacement", 1.0),
-    "mm": ("displacement", 1e-3),
-    "um": ("displacement", 1e-6),
-    "micron": ("displacement", 1e-6),
-    "in": ("displacement", 0.0254),
-    "m/s": ("velocity", 1.0),
-    "mm/s": ("velocity", 1e-3),
-    "in/s": ("velocity", 0.0254),
-    "m/s^2": ("acceleration", 1.0),
-    "mm/s^2": ("acceleration", 1e-3),
-    "in/s^2": ("acceleration", 0.0254),
-    "g": ("acceleration", 9.80665),
-    "n": ("force", 1.0),
-    "kn": ("force", 1e3),
-    "lbf": ("force", _LBF),
-}
-
-
-def _norm_unit(label: Any) -> str:
-    s = str(label or "").strip().lower().replace(" ", "")
-    s = s.replace("²", "^2").replace("**", "^").replace("µ", "u").replace("μ", "u")
-    s = s.replace("sec", "s")
-    if s.startswith("(") and s.endswith(")"):
-        s = s[1:-1]
-    if s.endswith("/s2"):
-        s = s[:-2] + "s^2"
-    return s
-
-
-def _unit(label: Any, where: str) -> tuple[str, float] | None:
-    """(quantity, factor to SI) of a units label, None when blank."""
-    s = _norm_unit(label)
-    if s in ("", "none"):
-        return None
-    if s not in _UNITS:
-        raise FileFormatError(
-            f"{where}: unknown units label {label!r}; known: m, mm, um, in, m/s, mm/s, in/s, "
-            "m/s^2, mm/s^2, in/s^2, g, N, kN, lbf (blank or NONE = SI)"
-        )
-    return _UNITS[s]
 
 
 # ------------------------------------------------------------------ writing
@@ -153,10 +133,17 @@ _PRIORITY = (
     "record_samples",
     "run_starts",
     "band_hz",
+    "n_averages",
+    "excitation",
     "estimator",
     "method",
     "n_averages",
     "exponential_tau_s",
+    # operating conditions of a lateral rig FRF, readable in the ID lines by other programs
+    "speed_m_s",
+    "force",
+    "wheel_mass_kg",
+    "pressure_bar",
     "description",
 )
 
@@ -182,6 +169,14 @@ def _meta_lines(meta: dict[str, Any], n_lines: int) -> list[str]:
         lines.append(meta_to_json(kept) if kept else "NONE")
         left = rest
     return lines
+
+
+def _meta_fits(meta: dict[str, Any], lines: list[str]) -> bool:
+    """True when the ID ``lines`` written by :func:`_meta_lines` hold every key of ``meta``."""
+    kept: dict[str, Any] = {}
+    for line in lines:
+        kept.update(_extras(line))
+    return all(k in kept for k in meta)
 
 
 def _even_axis(f: np.ndarray) -> str | None:
@@ -251,93 +246,16 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
         ASCII with an uneven frequency axis; channel names too long for an ID
         line; metadata that is not JSON-compatible.
     """
-    sets: list[dict[str, Any]] = []
     if isinstance(obj, FRF):
-        q = _KIND_QUANTITY[obj.kind]
-        axis = _even_axis(obj.frequency)
-        if not binary and axis is None:
-            raise InputError(
-                "frf: ASCII UFF keeps an uneven frequency axis to 6 digits only; write binary "
-                "UFF (uff58b), CSV or NPZ"
-            )
-        id1 = str(obj.meta.get("description", f"tyredamp FRF {obj.kind}"))
-        # binary: uneven abscissa, every frequency stored as a float64 (pyuff needs
-        # two abscissa values, so a single line goes the even way with ID-line 2)
-        uneven = binary and obj.n_freq > 1
-        id2 = f"{_MARK} frf {obj.kind}" + ("" if uneven else f" {axis}")
-        (id3,) = _meta_lines(obj.meta, 1)
-        x = obj.frequency
-        fid = 0
-        for o, co in enumerate(obj.outputs):
-            for i, ci in enumerate(obj.inputs):
-                fid += 1
-                d = _base_set(binary, q, id1, id2, id3)
-                d.update(
-                    func_type=4,
-                    func_id=fid,
-                    rsp_node=co.node,
-                    rsp_dir=co.direction,
-                    ref_node=ci.node,
-                    ref_dir=ci.direction,
-                    id4=_extras_line(co),
-                    id5=_extras_line(ci),
-                    orddenom_spec_data_type=13,
-                    orddenom_len_unit_exp=0,
-                    orddenom_force_unit_exp=1,
-                    orddenom_temp_unit_exp=0,
-                    orddenom_axis_lab="Force",
-                    orddenom_axis_units_lab="N",
-                    data=np.array(obj.H[o, i], dtype=complex),
-                )
-                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
-        if obj.coherence is not None:
-            ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
-            for o, co in enumerate(obj.outputs):
-                fid += 1
-                d = _base_set(
-                    binary,
-                    q,
-                    "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence",
-                    id2,
-                    id3,
-                )
-                d.update(
-                    func_type=6,
-                    func_id=fid,
-                    rsp_node=co.node,
-                    rsp_dir=co.direction,
-                    ref_node=ref.node,
-                    ref_dir=ref.direction,
-                    id4=_extras_line(co),
-                    id5=_extras_line(ref),
-                    ordinate_spec_data_type=0,
-                    ordinate_len_unit_exp=0,
-                    ordinate_force_unit_exp=0,
-                    ordinate_axis_lab="Coherence",
-                    ordinate_axis_units_lab="NONE",
-                    data=np.array(obj.coherence[o], dtype=float),
-                )
-                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+        sets = _frf_sets(obj, binary)
+        id_lines = [sets[0]["id3"]]
     elif isinstance(obj, TimeData):
-        id1 = str(obj.meta.get("description", "tyredamp time data"))
-        id3, id5 = _meta_lines(obj.meta, 2)  # time data: ID line 5 continues the metadata
-        t = obj.time
-        for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
-            d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
-            d.update(
-                func_type=1,
-                func_id=k + 1,
-                rsp_node=c.node,
-                rsp_dir=c.direction,
-                ref_node=0,
-                ref_dir=0,
-                id4=_extras_line(c),
-                id5=id5,
-                data=np.array(obj.data[k], dtype=float),
-            )
-            sets.append(_abscissa(d, t, False, 17, "Time", "s"))
+        sets = _timedata_sets(obj, binary)
+        id_lines = [sets[0]["id3"], sets[0]["id5"]]  # time data: ID line 5 continues them
     else:
         raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
+    if not _meta_fits(obj.meta, id_lines):
+        sets = [*meta_record(obj.meta), *sets]
     with atomic_path(path) as tmp, warnings.catch_warnings():
         # pyuff's 58b writer reopens the file and leaves that handle to the garbage
         # collector: silence the ResourceWarning and collect inside this block
@@ -350,6 +268,132 @@ def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = 
             raise FileFormatError(f"{path}: pyuff could not write the data sets ({exc})") from exc
         finally:
             gc.collect()
+
+
+def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
+    """The UFF 58 data sets of an FRF: H per pair, coherence per output, variance per pair."""
+    sets: list[dict[str, Any]] = []
+    q = _KIND_QUANTITY[obj.kind]
+    axis = _even_axis(obj.frequency)
+    if not binary and axis is None:
+        raise InputError(
+            "frf: ASCII UFF keeps an uneven frequency axis to 6 digits only; write binary "
+            "UFF (uff58b), CSV or NPZ"
+        )
+    id1 = str(obj.meta.get("description", f"tyredamp FRF {obj.kind}"))
+    # binary: uneven abscissa, every frequency stored as a float64 (pyuff needs
+    # two abscissa values, so a single line goes the even way with ID-line 2)
+    uneven = binary and obj.n_freq > 1
+    id2 = f"{_MARK} frf {obj.kind}" + ("" if uneven else f" {axis}")
+    (id3,) = _meta_lines(obj.meta, 1)
+    x = obj.frequency
+    fid = 0
+    for o, co in enumerate(obj.outputs):
+        for i, ci in enumerate(obj.inputs):
+            fid += 1
+            d = _base_set(binary, q, id1, id2, id3)
+            d.update(
+                func_type=4,
+                func_id=fid,
+                rsp_node=co.node,
+                rsp_dir=co.direction,
+                ref_node=ci.node,
+                ref_dir=ci.direction,
+                id4=_extras_line(co),
+                id5=_extras_line(ci),
+                orddenom_spec_data_type=13,
+                orddenom_len_unit_exp=0,
+                orddenom_force_unit_exp=1,
+                orddenom_temp_unit_exp=0,
+                orddenom_axis_lab="Force",
+                orddenom_axis_units_lab="N",
+                data=np.array(obj.H[o, i], dtype=complex),
+            )
+            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+    if obj.coherence is not None:
+        ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
+        for o, co in enumerate(obj.outputs):
+            fid += 1
+            d = _base_set(
+                binary,
+                q,
+                "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence",
+                id2,
+                id3,
+            )
+            d.update(
+                func_type=6,
+                func_id=fid,
+                rsp_node=co.node,
+                rsp_dir=co.direction,
+                ref_node=ref.node,
+                ref_dir=ref.direction,
+                id4=_extras_line(co),
+                id5=_extras_line(ref),
+                ordinate_spec_data_type=0,
+                ordinate_len_unit_exp=0,
+                ordinate_force_unit_exp=0,
+                ordinate_axis_lab="Coherence",
+                ordinate_axis_units_lab="NONE",
+                data=np.array(obj.coherence[o], dtype=float),
+            )
+            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+    if obj.variance is not None:
+        for o, co in enumerate(obj.outputs):
+            for i, ci in enumerate(obj.inputs):
+                fid += 1
+                d = _base_set(binary, q, _VARIANCE_ID, id2, id3)
+                d.update(
+                    func_type=0,
+                    func_id=fid,
+                    rsp_node=co.node,
+                    rsp_dir=co.direction,
+                    ref_node=ci.node,
+                    ref_dir=ci.direction,
+                    id4=_extras_line(co),
+                    id5=_extras_line(ci),
+                    ordinate_spec_data_type=0,
+                    ordinate_len_unit_exp=0,
+                    ordinate_force_unit_exp=0,
+                    ordinate_axis_lab="Variance of H",
+                    ordinate_axis_units_lab=f"({obj.unit})^2"[:20],
+                    data=np.array(obj.variance[o, i], dtype=float),
+                )
+                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+    return sets
+
+
+def _timedata_sets(obj: TimeData, binary: bool) -> list[dict[str, Any]]:
+    """The UFF 58 data sets of time data: one per channel, the acquisition record on ID lines."""
+    sets: list[dict[str, Any]] = []
+    id1 = str(obj.meta.get("description", "tyredamp time data"))
+    # time data: ID line 5 continues the metadata; the acquisition fields go first
+    acq = _compact_acquisition(obj.acquisition.to_dict())
+    id3, id5 = _meta_lines({**acq, **obj.meta}, 2)
+    stored = {**_extras(id3), **_extras(id5)}
+    lost = [k for k in acq if k not in stored]
+    if lost:
+        raise InputError(
+            f"timedata.acquisition: {', '.join(lost)} do not fit the 80-character UFF ID "
+            "lines with the other fields; write NPZ or CSV (a dropped field would change "
+            "how the FRF is estimated)"
+        )
+    t = obj.time
+    for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
+        d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
+        d.update(
+            func_type=1,
+            func_id=k + 1,
+            rsp_node=c.node,
+            rsp_dir=c.direction,
+            ref_node=0,
+            ref_dir=0,
+            id4=_extras_line(c),
+            id5=id5,
+            data=np.array(obj.data[k], dtype=float),
+        )
+        sets.append(_abscissa(d, t, False, 17, "Time", "s"))
+    return sets
 
 
 def _abscissa(
@@ -405,6 +449,7 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
                 f"{p}: no data set 58 (function at nodal DOF); found types {sorted(set(types))}"
             )
         sets = uff.read_sets(idx)
+        record = read_meta_record(p, uff, types)
     except FileFormatError:
         raise
     except Exception as exc:  # pyuff raises bare Exception, and others on garbage
@@ -420,6 +465,9 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
                 f"{s.get('num_pts')} values, found {got}"
             )
         s["_index"] = k + 1
+    if record is not None:
+        for s in sets:
+            s["_meta"] = record
     return sets
 
 
@@ -441,7 +489,7 @@ def _extras(line: Any) -> dict[str, Any]:
         return {}
     try:
         d = json.loads(text)
-    except json.JSONDecodeError:
+    except (json.JSONDecodeError, RecursionError):
         return {}
     return d if isinstance(d, dict) else {}
 
@@ -460,29 +508,27 @@ def _channel(node: Any, direction: Any, extras: dict[str, Any], where: str) -> C
 
 
 def _quantity(s: dict[str, Any], where: str) -> tuple[str | None, float]:
+    """(quantity, factor to SI) of a data set from its ordinate data type and units labels."""
     sdt = int(s.get("ordinate_spec_data_type", 0) or 0)
     label = s.get("ordinate_axis_units_lab", "")
-    num = str(label or "")
-    den_label = s.get("orddenom_axis_units_lab", "")
-    if int(s.get("func_type", 0)) == 4 and _norm_unit(den_label) in ("", "none") and "/" in num:
-        head, tail = num.rsplit("/", 1)
-        if _norm_unit(tail) in ("n", "kn", "lbf"):
-            num, den_label = head, tail
-    u = _unit(num, where)
-    q = _SDT_QUANTITY.get(sdt)
-    if q is None and u is not None:
-        q = u[0]
-    if u is not None and q is not None and u[0] != q:
+    q_sdt = _SDT_QUANTITY.get(sdt)
+    q: str | None
+    try:
+        if int(s.get("func_type", 0)) == 4:
+            r = frf_units(label, s.get("orddenom_axis_units_lab", ""))
+            kind, scale = (None, 1.0) if r is None else r
+            q = None if kind is None else _KIND_QUANTITY[kind]
+        else:
+            u = quantity_units(label)
+            q, scale = (None, 1.0) if u is None else u
+    except InputError as exc:
+        raise FileFormatError(f"{where}: {exc}") from None
+    if q is None:
+        q = q_sdt
+    elif q_sdt is not None and q != q_sdt:
         raise FileFormatError(
-            f"{where}: ordinate data type {sdt} ({q}) disagrees with units label {label!r}"
+            f"{where}: ordinate data type {sdt} ({q_sdt}) disagrees with units label {label!r}"
         )
-    scale = 1.0 if u is None else u[1]
-    if int(s.get("func_type", 0)) == 4:
-        d = _unit(den_label, where)
-        if d is not None:
-            if d[0] != "force":
-                raise FileFormatError(f"{where}: FRF denominator {den_label!r} is not a force")
-            scale /= d[1]
     return q, scale
 
 
@@ -538,13 +584,32 @@ def read_uff(
     raise InputError(f"what: expected 'frf' or 'timedata', got {what!r}")
 
 
+def _compact_acquisition(acq: dict[str, Any]) -> dict[str, Any]:
+    """Evenly spaced ``run_starts`` as ``run_every`` (fits an ID line for many runs)."""
+    runs = acq.get("run_starts")
+    if runs is not None and len(runs) > 2:
+        step = runs[1] - runs[0]
+        if all(b - a == step for a, b in itertools.pairwise(runs)):
+            acq = {k: v for k, v in acq.items() if k != "run_starts"}
+            acq["run_every"] = [int(step), len(runs)]
+    return acq
+
+
 def _meta(s: dict[str, Any], tok: dict[str, str] | None) -> dict[str, Any]:
     meta = _extras(s.get("id3")) if tok is not None else {}
     if tok is not None and tok.get("_what") == "time":
         meta.update(_extras(s.get("id5")))
+        every = meta.pop("run_every", None)
+        if isinstance(every, list) and len(every) == 2:
+            try:
+                meta["run_starts"] = [int(every[0]) * k for k in range(int(every[1]))]
+            except (TypeError, ValueError):
+                raise FileFormatError(f"ID line: run_every {every!r} is not two integers") from None
     desc = str(s.get("id1", "")).strip()
     if desc and desc != "NONE" and not desc.startswith("tyredamp "):
         meta.setdefault("description", desc)
+    if "_meta" in s:  # the whole meta from the metadata record (the acquisition stays above)
+        meta.update(s["_meta"])
     return meta
 
 
@@ -586,7 +651,8 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
             if q is None:
                 raise FileFormatError(
                     f"{where}: cannot tell the response quantity (ordinate data type "
-                    f"{s.get('ordinate_spec_data_type')}, no units label); pass kind="
+                    f"{s.get('ordinate_spec_data_type')}, no units label); give the ordinate "
+                    "data type or units label in the file, or kind= to read_frf (Python)"
                 )
             if q == "force":
                 raise FileFormatError(f"{where}: the ordinate is a force, not a response")
@@ -614,6 +680,7 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
                 )
             h[a, b] = cells[(ko, ki)]
     coh = _read_coherence(sets, list(outs), list(ins), n)
+    var = _read_variance(sets, list(outs), list(ins), n, h.shape)
     return FRF(
         x,
         h,
@@ -622,6 +689,7 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
         inputs=list(ins.values()),
         coherence=coh,
         meta=_meta(first, tok),
+        variance=var,
     )
 
 
@@ -639,6 +707,28 @@ def _read_coherence(
     if not all(o in found for o in outs):
         return None
     return np.array([found[o] for o in outs])
+
+
+def _read_variance(
+    sets: list[dict[str, Any]],
+    outs: list[tuple[int, int]],
+    ins: list[tuple[int, int]],
+    n: int,
+    shape: tuple[int, ...],
+) -> np.ndarray | None:
+    """FRF.variance from tyredamp's extra type-0 data sets, when every pair has one."""
+    found: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray] = {}
+    for s in sets:
+        if int(s["func_type"]) != 0 or str(s.get("id1", "")).strip() != _VARIANCE_ID:
+            continue
+        if len(s["data"]) != n:
+            continue
+        ko = (int(s["rsp_node"]), int(s["rsp_dir"]))
+        ki = (int(s["ref_node"]), int(s["ref_dir"]))
+        found[(ko, ki)] = np.real(np.asarray(s["data"], dtype=float))
+    if not all((o, i) in found for o in outs for i in ins):
+        return None
+    return np.array([[found[(o, i)] for i in ins] for o in outs]).reshape(shape)
 
 
 def _read_time(p: Path, sets: list[dict[str, Any]]) -> TimeData:

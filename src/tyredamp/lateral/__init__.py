@@ -2,17 +2,20 @@
 
 * :mod:`.models` -- the linear models (classic, Maxwell, visco-plastic,
   proposed hysteretic, relaxation length, stretched string) with receptance,
-  mobility and accelerance at the ground or axle force.
+  mobility and accelerance at the ground or axle force; :mod:`.response` --
+  the algebra they share (wheel mass, axle/ground force, string impedance).
 * :mod:`.fiala` -- steady-state Fiala/brush force and its non-linear damper form.
 * :mod:`.characteristics` -- corner frequency and the dB differences of
   eq. 38-40, Figure 7 data.
 * :mod:`.fit` -- weighted complex least-squares fits, standard errors, Table 1
-  figure, AIC/BIC ranking, joint fits across speeds.
+  figure; :mod:`.ranking` -- AIC/BIC ranking; :mod:`.joint` -- joint fits
+  across speeds.
 * :mod:`.vehicle` -- the single-degree-of-freedom vehicle (eq. 41-44).
 * :mod:`.timedomain` -- exact harmonic/periodic steady states, impulse
   response and non-causal precursor, causal generalised-Maxwell approximation
   and exact state-space transients.
-* :mod:`.rig` -- the virtual rolling-tyre rig.
+
+The virtual rolling-tyre rig is :mod:`tyredamp.virtual.lateral_rig`.
 """
 
 from __future__ import annotations
@@ -27,17 +30,8 @@ from .characteristics import (
     figure7_curves,
 )
 from .fiala import FialaTyre
-from .fit import (
-    DEFAULT_MODELS,
-    JointFit,
-    LateralData,
-    LateralFit,
-    Ranking,
-    fit_by_pressure,
-    fit_joint,
-    fit_model,
-    rank_models,
-)
+from .fit import DEFAULT_MODELS, LateralData, LateralFit, fit_model
+from .joint import JointFit, fit_by_pressure, fit_joint
 from .models import (
     MODELS,
     ClassicModel,
@@ -47,12 +41,10 @@ from .models import (
     RelaxationLengthModel,
     StretchedStringModel,
     ViscoPlasticModel,
-    attach_mass,
-    axle_from_ground_accelerance,
     get_model_class,
-    ground_from_axle_accelerance,
 )
-from .rig import AgriculturalTyre, VirtualLateralRig, ViscoelasticStringTyre
+from .ranking import Ranking, rank_models
+from .response import attach_mass, axle_from_ground_accelerance, ground_from_axle_accelerance
 from .timedomain import (
     CausalError,
     GeneralizedMaxwellTyre,
@@ -70,7 +62,6 @@ from .vehicle import LateralVehicle, Resonance
 __all__ = [
     "DEFAULT_MODELS",
     "MODELS",
-    "AgriculturalTyre",
     "CausalError",
     "ClassicModel",
     "CornerDifferences",
@@ -88,9 +79,7 @@ __all__ = [
     "RelaxationLengthModel",
     "Resonance",
     "StretchedStringModel",
-    "VirtualLateralRig",
     "ViscoPlasticModel",
-    "ViscoelasticStringTyre",
     "attach_mass",
     "axle_from_ground_accelerance",
     "causal_error",

@@ -25,7 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._validate import as_finite, check_positive
 from ..exceptions import InputError
-from .models import HystereticModel, as_freq
+from .models import HystereticModel
+from .response import as_freq
 
 __all__ = [
     "CornerDifferences",

@@ -1,4 +1,4 @@
-"""Fitting the lateral models to a measured complex lateral FRF, and ranking them.
+"""Fitting the lateral models to a measured complex lateral FRF.
 
 One function fits any model of :mod:`tyredamp.lateral.models` to the
 accelerance ``y''/Fy`` measured at the ground force or at the axle force
@@ -40,46 +40,28 @@ Method
   the same data and weights are dropped). Lower is better; differences
   are meaningful only between fits to the same lines with the same weights.
 
-Several speeds (and one pressure) can be fitted together with shared
-physical parameters (:func:`fit_joint`): the tyre-road damper of each model
-(``c`` Maxwell, ``c2`` visco-plastic, ``C_r`` proposed) becomes
-``C_alpha / V`` with one cornering stiffness ``C_alpha``, and every other
-parameter (carcass ``K``, ``h`` ...) is shared.
+Ranking several models fitted to the same data is :mod:`.ranking`; fitting
+several speeds together with shared physical parameters is :mod:`.joint`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
 
-from .._validate import as_finite, check_positive
+from .._validate import as_band, as_finite, check_positive
 from ..exceptions import ConvergenceError, InputError, ShapeError
 from ..frf import FRF
-from .models import (
-    ForceKind,
-    LateralModel,
-    _check_force,
-    get_model_class,
-    ground_from_axle_accelerance,
-)
+from .models import LateralModel, get_model_class
+from .response import ForceKind, _check_force, ground_from_axle_accelerance
 
-__all__ = [
-    "DEFAULT_MODELS",
-    "JointFit",
-    "LateralData",
-    "LateralFit",
-    "Ranking",
-    "fit_by_pressure",
-    "fit_joint",
-    "fit_model",
-    "rank_models",
-]
+__all__ = ["DEFAULT_MODELS", "Criterion", "LateralData", "LateralFit", "Weights", "fit_model"]
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -144,20 +126,34 @@ class LateralData:
         """Build from an FRF, taking missing conditions from ``frf.meta``.
 
         Meta keys read: ``"speed_m_s"``, ``"force"``, ``"wheel_mass_kg"``,
-        ``"label"`` (as written by :mod:`tyredamp.lateral.rig`).
+        ``"label"`` (as written by :mod:`tyredamp.virtual.lateral_rig`).
         """
         meta = frf.meta
-        sp = speed if speed is not None else meta.get("speed_m_s")
+        sp = speed if speed is not None else _meta_number(meta, "speed_m_s", "m/s", None)
         fo = force if force is not None else meta.get("force", "ground")
-        wm = wheel_mass if wheel_mass is not None else meta.get("wheel_mass_kg", 0.0)
+        if not isinstance(fo, str):
+            raise InputError(f"FRF meta 'force': expected 'ground' or 'axle', got {fo!r}")
+        wm = (
+            wheel_mass if wheel_mass is not None else _meta_number(meta, "wheel_mass_kg", "kg", 0.0)
+        )
         lb = label if label is not None else str(meta.get("label", ""))
         return cls(
             frf=frf,
             speed=None if sp is None else float(sp),
-            force=fo,
-            wheel_mass=float(wm),
+            force=fo,  # type: ignore[arg-type]
+            wheel_mass=float(0.0 if wm is None else wm),
             label=lb,
         )
+
+
+def _meta_number(meta: dict[str, Any], key: str, unit: str, default: float | None) -> float | None:
+    """A number from FRF meta (absent: ``default``); anything else is an InputError naming it."""
+    if key not in meta:
+        return default
+    v = meta[key]
+    if isinstance(v, bool) or not isinstance(v, int | float) or not np.isfinite(v):
+        raise InputError(f"FRF meta {key!r}: expected a finite number in {unit}, got {v!r}")
+    return float(v)
 
 
 @dataclass(frozen=True)
@@ -175,10 +171,18 @@ def _prepare(
     data: LateralData | FRF,
     band: tuple[float, float] | None,
     weights: Weights | ArrayLike,
-    channel: tuple[int, int] = (0, 0),
+    channel: tuple[int, int] | None = None,
 ) -> _Prepared:
     d = data if isinstance(data, LateralData) else LateralData.from_frf(data)
     frf = d.frf
+    if channel is None:
+        if frf.n_out * frf.n_in != 1:
+            raise ShapeError(
+                f"channel: the FRF holds {frf.n_out}x{frf.n_in} FRFs, a lateral fit takes one; "
+                "choose it with channel=(out, in), counted from 0 (command line: --channel OUT IN, "
+                "counted from 1)"
+            )
+        channel = (0, 0)
     i, j = channel
     if not (0 <= i < frf.n_out and 0 <= j < frf.n_in):
         raise ShapeError(
@@ -195,9 +199,7 @@ def _prepare(
             raise InputError("weights: expected values >= 0")
     keep = np.ones(frf.n_freq, dtype=bool)
     if band is not None:
-        lo, hi = float(band[0]), float(band[1])
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
-            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band}")
+        lo, hi = as_band(band)
         keep &= (frf.frequency >= lo) & (frf.frequency <= hi)
     keep &= frf.frequency > 0
     idx = np.flatnonzero(keep)
@@ -300,6 +302,38 @@ class LateralFit:
     nfev: int
     message: str
     label: str = ""
+    at_bound: tuple[str, ...] = ()
+
+    def problems(self) -> list[str]:
+        """Why this fit cannot be trusted, one sentence each (empty: none found).
+
+        * a parameter ended on the bound of the search (the data drive it to
+          0 or infinity: the model's feature is not in the data);
+        * a parameter's standard error exceeds its value (not determined);
+        * the corner frequency ``f0`` lies more than a decade outside the fitted
+          lines (an extrapolation the data cannot support).
+        """
+        out: list[str] = []
+        if self.at_bound:
+            out.append(f"{self.name}: {', '.join(self.at_bound)} at the bound of the search")
+        loose = [
+            n
+            for n, v in self.params.items()
+            if not (np.isfinite(self.stderr.get(n, np.nan)) and self.stderr[n] <= abs(v))
+        ]
+        if loose:
+            out.append(
+                f"{self.name}: {', '.join(loose)} not determined by the data "
+                "(standard error above the value)"
+            )
+        f0 = self.model.derived().get("f0")
+        lo, hi = float(self.frequency[0]), float(self.frequency[-1])
+        if f0 is not None and not (lo / 10.0 <= f0 <= 10.0 * hi):
+            out.append(
+                f"{self.name}: f0 = {f0:.3g} Hz more than a decade outside the fitted band "
+                f"{lo:g}-{hi:g} Hz"
+            )
+        return out
 
     @property
     def name(self) -> str:
@@ -473,8 +507,9 @@ def _conditions(cls: type[LateralModel], data: LateralData) -> dict[str, float]:
         if n == "speed":
             if data.speed is None:
                 raise InputError(
-                    f"speed: the {cls.name!r} model needs the travel speed (m/s); "
-                    f"give speed= or set frf.meta['speed_m_s']"
+                    f"speed: the {cls.name!r} model needs the travel speed: give speed= in "
+                    "m/s (Python), --speed KMH (command line), or store it with the FRF "
+                    "(meta key speed_m_s, as tyredamp's rig files do)"
                 )
             cond["speed"] = float(data.speed)
         else:  # pragma: no cover - no other condition exists yet
@@ -492,7 +527,7 @@ def fit_model(
     band: tuple[float, float] | None = None,
     weights: Weights | ArrayLike = "auto",
     start: ArrayLike | dict[str, float] | None = None,
-    channel: tuple[int, int] = (0, 0),
+    channel: tuple[int, int] | None = None,
     max_nfev: int = 2000,
 ) -> LateralFit:
     """Fit one lateral model to a measured complex FRF (module docstring for the method).
@@ -632,425 +667,10 @@ def _make_fit(
         nfev=int(res.nfev),
         message=str(res.message),
         label=d.label,
+        at_bound=tuple(
+            n for n, a in zip(cls.param_names, np.asarray(res.active_mask), strict=True) if a != 0
+        ),
     )
 
 
 # ---------------------------------------------------------------------------------- ranking
-def _evidence(delta: float) -> str:
-    # Kass & Raftery (1995) scale for BIC differences (also used for AIC here).
-    if delta < 2:
-        return "not distinguishable from the best"
-    if delta < 6:
-        return "positive evidence against it"
-    if delta < 10:
-        return "strong evidence against it"
-    return "very strong evidence against it"
-
-
-@dataclass(frozen=True, eq=False)
-class Ranking:
-    """Models fitted to the same data and weights, best first.
-
-    Attributes
-    ----------
-    fits : tuple of LateralFit
-        Sorted by the criterion (lowest first).
-    criterion : {"bic", "aic"}
-    delta : tuple of float
-        Criterion minus the best one's.
-    weight : tuple of float
-        ``exp(-delta/2)`` normalised (Akaike or Schwarz weights).
-    reasons : tuple of str
-        One sentence per model explaining its place.
-    """
-
-    fits: tuple[LateralFit, ...]
-    criterion: Criterion
-    delta: tuple[float, ...]
-    weight: tuple[float, ...]
-    reasons: tuple[str, ...] = field(default_factory=tuple)
-
-    @property
-    def best(self) -> LateralFit:
-        """The best fit."""
-        return self.fits[0]
-
-    @property
-    def order(self) -> tuple[str, ...]:
-        """Model names, best first."""
-        return tuple(f.name for f in self.fits)
-
-    def rows(self) -> list[dict[str, Any]]:
-        """One dict per model: rank, name, P, RSS, AIC, BIC, delta, weight, errors (%)."""
-        return [
-            {
-                "rank": i + 1,
-                "model": f.name,
-                "n_params": f.n_params,
-                "rss": f.rss,
-                "aic": f.aic,
-                "bic": f.bic,
-                "delta": self.delta[i],
-                "weight": self.weight[i],
-                "amplitude_error_pct": 100.0 * f.amplitude_error,
-                "amplitude_bias_pct": 100.0 * f.amplitude_bias,
-            }
-            for i, f in enumerate(self.fits)
-        ]
-
-    def format_table(self) -> str:
-        """Plain aligned text table of :meth:`rows` followed by the reasons."""
-        crit = self.criterion.upper()
-        head = (
-            f"{'rank':>4}  {'model':<13} {'P':>2} {'AIC':>10} {'BIC':>10} "
-            f"{'d' + crit:>8} {'weight':>7} {'amp.err %':>9} {'bias %':>7}"
-        )
-        lines = [head, "-" * len(head)]
-        for r in self.rows():
-            lines.append(
-                f"{r['rank']:>4}  {r['model']:<13} {r['n_params']:>2} {r['aic']:>10.1f} "
-                f"{r['bic']:>10.1f} {r['delta']:>8.1f} {r['weight']:>7.3f} "
-                f"{r['amplitude_error_pct']:>9.2f} {r['amplitude_bias_pct']:>+7.2f}"
-            )
-        return "\n".join([*lines, "", *list(self.reasons)])
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: criterion, order, rows, reasons and every fit's summary."""
-        return {
-            "criterion": self.criterion,
-            "order": list(self.order),
-            "table": self.rows(),
-            "reasons": list(self.reasons),
-            "fits": [f.to_dict() for f in self.fits],
-        }
-
-
-def _rank(fits: Sequence[LateralFit], criterion: Criterion) -> Ranking:
-    if criterion not in ("aic", "bic"):
-        raise InputError(f"criterion: expected 'aic' or 'bic', got {criterion!r}")
-    ordered = sorted(fits, key=lambda f: f.criterion(criterion))
-    vals = np.array([f.criterion(criterion) for f in ordered])
-    delta = vals - vals[0]
-    wt = np.exp(-0.5 * delta)
-    wt = wt / wt.sum()
-    crit = criterion.upper()
-    reasons = []
-    for i, f in enumerate(ordered):
-        over = "over" if f.amplitude_bias > 0 else "under"
-        tail = (
-            f"{f.n_params} parameters; amplitude error {100 * f.amplitude_error:.1f} % "
-            f"({over}-estimates by {100 * abs(f.amplitude_bias):.1f} % on average); "
-            f"rms weighted residual {f.residual_rms:.3g}"
-        )
-        if i == 0:
-            nxt = (
-                f"; next {ordered[1].name} at d{crit} = {delta[1]:.1f}" if len(ordered) > 1 else ""
-            )
-            reasons.append(f"1. {f.name}: lowest {crit}{nxt}; {tail}.")
-        else:
-            reasons.append(
-                f"{i + 1}. {f.name}: d{crit} = {delta[i]:.1f}, {_evidence(delta[i])}; {tail}."
-            )
-    return Ranking(
-        tuple(ordered),
-        criterion,
-        tuple(float(x) for x in delta),
-        tuple(float(x) for x in wt),
-        tuple(reasons),
-    )
-
-
-def rank_models(
-    data: LateralData | FRF,
-    models: Sequence[str | type[LateralModel]] = DEFAULT_MODELS,
-    *,
-    criterion: Criterion = "bic",
-    **fit_kwargs: Any,
-) -> Ranking:
-    """Fit several models to the same data and weights and rank them.
-
-    Parameters
-    ----------
-    data : LateralData or FRF
-        The measurement.
-    models : sequence of str or LateralModel subclass
-        Models to compare; default the paper's four (:data:`DEFAULT_MODELS`).
-    criterion : {"bic", "aic"}
-        Ranking criterion (lower is better); BIC penalises extra parameters
-        more for the usual hundreds of lines.
-    **fit_kwargs
-        Passed to :func:`fit_model` (``speed``, ``force``, ``wheel_mass``,
-        ``band``, ``weights`` ...). ``start`` is not allowed.
-
-    Returns
-    -------
-    Ranking
-    """
-    if "start" in fit_kwargs:
-        raise InputError("start: not allowed in rank_models (each model finds its own)")
-    if not models:
-        raise InputError("models: expected at least one model")
-    names = [get_model_class(m).name for m in models]
-    if len(set(names)) != len(names):
-        raise InputError(f"models: duplicated entries in {names}")
-    fits = [fit_model(data, m, **fit_kwargs) for m in models]
-    return _rank(fits, criterion)
-
-
-# -------------------------------------------------------------------------------- joint fit
-@dataclass(frozen=True, eq=False)
-class JointFit:
-    """One model fitted to several conditions with shared parameters.
-
-    Attributes
-    ----------
-    model_name : str
-        Registry name.
-    share : {"physical", "none"}
-        How parameters are shared (:func:`fit_joint`).
-    names, units : tuple of str
-        Global parameter names and units.
-    params, stderr : dict of str to float
-        Global parameters and standard errors (SI).
-    fits : tuple of LateralFit
-        Per-condition results with the shared parameters (their ``stderr``
-        follow from the joint covariance; their ``aic``/``bic`` are those of
-        the condition alone with the global parameter count).
-    rss : float
-        Total weighted residual sum of squares.
-    aic, bic : float
-        Of the joint fit (``n`` = all real residuals, ``P`` = global count).
-    """
-
-    model_name: str
-    share: str
-    names: tuple[str, ...]
-    units: tuple[str, ...]
-    params: dict[str, float]
-    stderr: dict[str, float]
-    fits: tuple[LateralFit, ...]
-    rss: float
-    aic: float
-    bic: float
-
-    @property
-    def n_params(self) -> int:
-        """Number of global parameters."""
-        return len(self.names)
-
-    @property
-    def amplitude_error(self) -> float:
-        """Mean of the per-condition amplitude errors (fraction)."""
-        return float(np.mean([f.amplitude_error for f in self.fits]))
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready summary."""
-        return {
-            "model": self.model_name,
-            "share": self.share,
-            "params": self.params,
-            "stderr": self.stderr,
-            "units": dict(zip(self.names, self.units, strict=True)),
-            "rss": self.rss,
-            "aic": self.aic,
-            "bic": self.bic,
-            "amplitude_error": self.amplitude_error,
-            "conditions": [f.to_dict() for f in self.fits],
-        }
-
-
-def fit_joint(
-    data: Sequence[LateralData],
-    model: str | type[LateralModel],
-    *,
-    share: Literal["physical", "none"] = "physical",
-    band: tuple[float, float] | None = None,
-    weights: Weights | ArrayLike = "auto",
-    max_nfev: int = 4000,
-) -> JointFit:
-    """Fit one model to several speeds (at one pressure) with shared physical parameters.
-
-    With ``share="physical"`` the model's tyre-road damper (``road_damper``:
-    ``c`` Maxwell, ``c2`` visco-plastic, ``C_r`` proposed) is replaced by
-    ``C_alpha / V_i`` with one global cornering stiffness ``C_alpha`` (N/rad;
-    spec: ``C_r = C_alpha / V``, eq. 19, 33) and all other parameters (carcass
-    ``K``, ``h`` ...) are shared. Models with the speed as an operating
-    condition (relaxation, string) share all their parameters. The classic
-    model has no speed term, so all its parameters are shared. With
-    ``share="none"`` every condition keeps its own parameters (the sum of
-    separate fits, for comparison by AIC/BIC).
-
-    Parameters
-    ----------
-    data : sequence of LateralData
-        Two or more measurements, each with its ``speed``.
-    model : str or LateralModel subclass
-    share : {"physical", "none"}
-    band, weights :
-        As in :func:`fit_model` (the same for every condition).
-    max_nfev : int
-        Evaluation budget of the joint refinement.
-
-    Returns
-    -------
-    JointFit
-    """
-    cls = get_model_class(model)
-    ds = list(data)
-    if len(ds) < 2:
-        raise InputError(f"data: expected at least 2 conditions, got {len(ds)}")
-    if share not in ("physical", "none"):
-        raise InputError(f"share: expected 'physical' or 'none', got {share!r}")
-    for i, d in enumerate(ds):
-        if not isinstance(d, LateralData):
-            raise InputError(f"data[{i}]: expected LateralData, got {type(d).__name__}")
-        if d.speed is None and (cls.road_damper is not None or cls.condition_names):
-            raise InputError(f"data[{i}]: the joint fit needs each condition's speed (m/s)")
-    singles = [fit_model(d, cls, band=band, weights=weights) for d in ds]
-    preps = [_prepare(d, band, weights) for d in ds]
-    conds = [_conditions(cls, d) for d in ds]
-    p = len(cls.param_names)
-    names: list[str]
-    units: list[str]
-    # Maps from global log-parameters to each condition's log-parameters:
-    # logp_i = T_i @ x + b_i.
-    maps: list[tuple[FloatArray, FloatArray]] = []
-    if share == "physical":
-        names = list(cls.param_names)
-        units = list(cls.param_units)
-        k_road = cls.param_names.index(cls.road_damper) if cls.road_damper else -1
-        if k_road >= 0:
-            names[k_road] = "C_alpha"
-            units[k_road] = "N/rad"
-        for d in ds:
-            b = np.zeros(p)
-            if k_road >= 0:
-                b[k_road] = -math.log(float(d.speed))  # type: ignore[arg-type]
-            maps.append((np.eye(p), b))
-        x0 = np.mean(
-            [np.log(f.model.vector()) - b for f, (_, b) in zip(singles, maps, strict=True)], axis=0
-        )
-    else:
-        names, units = [], []
-        for i, d in enumerate(ds):
-            tag = d.label or f"#{i}"
-            names += [f"{n}@{tag}" for n in cls.param_names]
-            units += list(cls.param_units)
-            t = np.zeros((p, p * len(ds)))
-            t[:, i * p : (i + 1) * p] = np.eye(p)
-            maps.append((t, np.zeros(p)))
-        x0 = np.concatenate([np.log(f.model.vector()) for f in singles])
-    sizes = [2 * pr.frequency.size for pr in preps]
-    n_res = int(sum(sizes))
-
-    def residual(x: FloatArray) -> FloatArray:
-        parts = []
-        for pr, cd, (t, b) in zip(preps, conds, maps, strict=True):
-            m = cls.from_vector(np.exp(t @ x + b), **cd)
-            r = pr.weights * (_model_accelerance(m, pr) - pr.measured)
-            parts += [r.real, r.imag]
-        return np.concatenate(parts)
-
-    fun = _safe(residual, n_res)
-    res = least_squares(
-        fun,
-        x0,
-        jac="3-point",
-        bounds=(x0 - _LOG_SPAN, x0 + _LOG_SPAN),
-        method="trf",
-        xtol=1e-14,
-        ftol=1e-14,
-        gtol=1e-14,
-        max_nfev=max_nfev,
-    )
-    x = np.asarray(res.x, dtype=float)
-    r = fun(x)
-    rss = float(r @ r)
-    jac = _jacobian(fun, x)
-    n_real = n_res
-    dof = max(n_real - x.size, 1)
-    sd_g, _ = _covariance(jac, rss)
-    # Full covariance for per-condition standard errors.
-    cov = np.linalg.pinv(jac.T @ jac) * (rss / dof)
-    aic, bic = _information(rss, n_real, x.size)
-    gp = np.exp(x)
-    fits = []
-    for pr, cd, (t, b) in zip(preps, conds, maps, strict=True):
-        logp = t @ x + b
-        m = cls.from_vector(np.exp(logp), **cd)
-        fitted = _model_accelerance(m, pr)
-        ri = pr.weights * (fitted - pr.measured)
-        rss_i = float(np.sum(ri.real**2 + ri.imag**2))
-        cov_i = t @ cov @ t.T
-        sd_i = np.sqrt(np.clip(np.diag(cov_i), 0.0, None))
-        corr_i = cov_i / np.outer(np.where(sd_i > 0, sd_i, 1.0), np.where(sd_i > 0, sd_i, 1.0))
-        aic_i, bic_i = _information(rss_i, 2 * pr.frequency.size, x.size)
-        err, bias = _amplitude_errors(fitted, pr.measured)
-        pv = np.exp(logp)
-        fits.append(
-            LateralFit(
-                model=m,
-                params=m.params,
-                stderr={n: float(pv[k] * sd_i[k]) for k, n in enumerate(cls.param_names)},
-                correlation=corr_i,
-                frequency=pr.frequency,
-                measured=pr.measured,
-                fitted=fitted,
-                weights=pr.weights,
-                weights_name=pr.weights_name,
-                force=pr.data.force,
-                wheel_mass=pr.data.wheel_mass,
-                speed=pr.data.speed,
-                rss=rss_i,
-                aic=aic_i,
-                bic=bic_i,
-                amplitude_error=err,
-                amplitude_bias=bias,
-                nfev=int(res.nfev),
-                message=str(res.message),
-                label=pr.data.label,
-            )
-        )
-    return JointFit(
-        model_name=cls.name,
-        share=share,
-        names=tuple(names),
-        units=tuple(units),
-        params={n: float(gp[i]) for i, n in enumerate(names)},
-        stderr={n: float(gp[i] * sd_g[i]) for i, n in enumerate(names)},
-        fits=tuple(fits),
-        rss=rss,
-        aic=aic,
-        bic=bic,
-    )
-
-
-def fit_by_pressure(
-    data: Sequence[LateralData],
-    model: str | type[LateralModel],
-    **joint_kwargs: Any,
-) -> dict[float, JointFit]:
-    """Joint fits (:func:`fit_joint`) of the conditions grouped by inflation pressure.
-
-    Parameters
-    ----------
-    data : sequence of LateralData
-        Measurements whose ``frf.meta["pressure_bar"]`` gives the pressure (as
-        written by :mod:`tyredamp.lateral.rig`); at least two speeds per
-        pressure.
-    model : str or LateralModel subclass
-    **joint_kwargs
-        Passed to :func:`fit_joint` (``share``, ``band``, ``weights`` ...).
-
-    Returns
-    -------
-    dict of float to JointFit
-        By pressure in bar, increasing.
-    """
-    groups: dict[float, list[LateralData]] = {}
-    for i, d in enumerate(data):
-        p = d.frf.meta.get("pressure_bar") if isinstance(d, LateralData) else None
-        if p is None:
-            raise InputError(f"data[{i}]: expected frf.meta['pressure_bar'] (bar)")
-        groups.setdefault(float(p), []).append(d)
-    return {p: fit_joint(g, model, **joint_kwargs) for p, g in sorted(groups.items())}

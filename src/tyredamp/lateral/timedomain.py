@@ -39,7 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import nnls
 from scipy.signal import StateSpace, lsim
 
-from .._validate import as_finite, check_positive
+from .._validate import as_band, as_finite, check_positive
 from ..exceptions import InputError, PhysicsError
 from .models import (
     ClassicModel,
@@ -48,8 +48,8 @@ from .models import (
     MaxwellModel,
     RelaxationLengthModel,
     ViscoPlasticModel,
-    as_freq,
 )
+from .response import as_freq
 from .vehicle import LateralVehicle
 
 __all__ = [
@@ -437,9 +437,7 @@ def fit_generalized_maxwell(
     """
     if not isinstance(model, HystereticModel):
         raise InputError(f"model: expected a HystereticModel, got {type(model).__name__}")
-    lo, hi = float(band[0]), float(band[1])
-    if not (0 < lo < hi and math.isfinite(hi)):
-        raise InputError(f"band: expected 0 < lo < hi in Hz, got {band}")
+    lo, hi = as_band(band, positive=True)  # log-spaced arms
     if int(per_decade) < 1 or int(n_points) < 10:
         raise InputError(
             f"per_decade >= 1 and n_points >= 10 expected, got {per_decade}, {n_points}"

@@ -21,7 +21,6 @@ The system is third order (eq. 41): the damper in series adds a state.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -29,10 +28,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import minimize_scalar
 
-from .._validate import check_positive
+from .._validate import as_band, check_positive
 from ..exceptions import InputError, PhysicsError
 from ..frf import FRF, Channel, FRFKind
-from .models import LateralModel, _receptance_from_mobility, as_freq, attach_mass
+from .models import LateralModel
+from .response import _receptance_from_mobility, as_freq, attach_mass
 
 __all__ = [
     "LateralVehicle",
@@ -201,9 +201,7 @@ class LateralVehicle:
         PhysicsError
             No interior peak: the system is over-damped in the band.
         """
-        lo, hi = float(f_range[0]), float(f_range[1])
-        if not (0 < lo < hi and math.isfinite(hi)):
-            raise InputError(f"f_range: expected 0 < lo < hi in Hz, got {f_range}")
+        lo, hi = as_band(f_range, "f_range", positive=True)  # log-spaced scan
         if quantity not in ("receptance", "accelerance"):
             raise InputError(f"quantity: expected 'receptance' or 'accelerance', got {quantity!r}")
         if int(n_grid) < 100:

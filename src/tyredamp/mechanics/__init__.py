@@ -6,7 +6,12 @@ damped system ``M x'' + C x' + K x = f``.
 
 from __future__ import annotations
 
-from .modal_sum import kind_factor, modal_sum_receptance, pole_from_frequency_damping
+from .modal_sum import (
+    kind_factor,
+    modal_sum_receptance,
+    pole_from_frequency_damping,
+    pole_quantities,
+)
 from .perturbation import (
     SmallDampingError,
     SmallDampingModes,
@@ -37,6 +42,7 @@ __all__ = [
     "modal_sum_receptance",
     "normalisation_constants",
     "pole_from_frequency_damping",
+    "pole_quantities",
     "proportional_part",
     "rayleigh_coefficients",
     "rayleigh_damping",

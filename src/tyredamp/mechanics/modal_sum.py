@@ -11,18 +11,35 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._validate import as_finite, as_frequency
 from ..exceptions import InputError, ShapeError
-from ..frf import KINDS, FRFKind
+from ..frf import KIND_POWER, KINDS, FRFKind
 
-__all__ = ["kind_factor", "modal_sum_receptance", "pole_from_frequency_damping"]
-
-_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
+__all__ = ["kind_factor", "modal_sum_receptance", "pole_from_frequency_damping", "pole_quantities"]
 
 
 def kind_factor(omega: NDArray[np.float64], kind: FRFKind) -> NDArray[np.complex128]:
     """``(i omega)^k`` that turns a receptance into ``kind`` (k = 0, 1, 2)."""
     if kind not in KINDS:
         raise InputError(f"kind: expected one of {KINDS}, got {kind!r}")
-    return (1j * np.asarray(omega, dtype=float)) ** _POWER[kind]
+    return (1j * np.asarray(omega, dtype=float)) ** KIND_POWER[kind]
+
+
+def pole_quantities(poles: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Natural frequency and damping ratio of poles; inverse of :func:`pole_from_frequency_damping`.
+
+    ``f_n = |p_n| / 2 pi`` (Hz) and ``zeta_n = -Re p_n / |p_n|`` (spec eq. [3]/[5]).
+
+    Parameters
+    ----------
+    poles : array_like, complex, any shape
+        Poles in rad/s (one per conjugate pair), ``p != 0``.
+
+    Returns
+    -------
+    frequency_hz, damping_ratio : ndarray, the shape of ``poles``
+    """
+    p = np.asarray(poles, dtype=complex)
+    mag = np.abs(p)
+    return mag / (2 * np.pi), -p.real / mag
 
 
 def pole_from_frequency_damping(f_n: ArrayLike, zeta: ArrayLike) -> NDArray[np.complex128]:

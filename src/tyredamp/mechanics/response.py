@@ -18,7 +18,6 @@ from typing import Literal
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import lfilter
 
 from .._validate import as_finite, check_positive
 from ..exceptions import ShapeError
@@ -122,6 +121,8 @@ def time_response(
     v0a = np.zeros(n) if v0 is None else as_finite(v0, "v0", ndim=1)
     if x0a.size != n or v0a.size != n:
         raise ShapeError(f"x0, v0: expected {n} entries each, got {x0a.size} and {v0a.size}")
+
+    from scipy.signal import lfilter  # imported here: scipy.signal is slow to import
 
     cm = system.complex_modes()
     p, psi = cm.poles, cm.psi

@@ -22,7 +22,7 @@ from .._validate import (
 )
 from ..exceptions import InputError, PhysicsError
 from ..frf import FRF, Channel, FRFKind
-from .modal_sum import kind_factor, modal_sum_receptance
+from .modal_sum import kind_factor, modal_sum_receptance, pole_quantities
 
 __all__ = ["ComplexModes", "MCKSystem", "UndampedModes"]
 
@@ -87,12 +87,12 @@ class ComplexModes:
     @property
     def frequency_hz(self) -> NDArray[np.float64]:
         """Natural frequency ``|p_n| / 2 pi`` in Hz."""
-        return np.abs(self.poles) / (2 * np.pi)
+        return pole_quantities(self.poles)[0]
 
     @property
     def damping_ratio(self) -> NDArray[np.float64]:
         """``zeta_n = -Re p_n / |p_n|``."""
-        return -self.poles.real / np.abs(self.poles)
+        return pole_quantities(self.poles)[1]
 
     def frf(
         self,

@@ -6,8 +6,8 @@ stages are public too: :func:`build_problem` (band cut, normalisation, noise
 model), a :class:`PoleEstimator` (default :func:`plscf`, poles over model
 orders), :func:`stability_flags` and :func:`cluster_poles` (automatic
 selection), :mod:`.search` (mode test, residual search), :class:`ModalFitter`
-(LSFD and variable-projection refinement), :mod:`.stats`, :mod:`.indicators`
-and the modes JSON (:func:`read_modes_json`, :func:`write_modes_json`).
+(LSFD and variable-projection refinement), :mod:`.stats` and
+:mod:`.indicators`. The modes JSON file is :mod:`tyredamp.documents.modes`.
 """
 
 from __future__ import annotations
@@ -25,7 +25,6 @@ from .indicators import (
     relative_error,
     rmsd,
 )
-from .io import modes_document, read_modes_json, write_modes_json
 from .lscf import PoleSet, plscf
 from .model import ModalModel, ModeKind
 from .problem import FitProblem, build_problem
@@ -54,11 +53,8 @@ __all__ = [
     "mac",
     "mean_phase_deviation",
     "modal_phase_collinearity",
-    "modes_document",
     "plscf",
-    "read_modes_json",
     "relative_error",
     "rmsd",
     "stability_flags",
-    "write_modes_json",
 ]

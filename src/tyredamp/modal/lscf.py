@@ -40,8 +40,9 @@ import numpy as np
 import scipy.linalg as sla
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_finite, as_frequency
+from .._validate import as_band, as_finite, as_frequency
 from ..exceptions import InputError, ShapeError
+from ..mechanics.modal_sum import pole_quantities
 from .problem import check_uniform
 
 __all__ = ["PoleSet", "plscf"]
@@ -84,12 +85,12 @@ class PoleSet:
     @property
     def frequency_hz(self) -> NDArray[np.float64]:
         """Undamped natural frequency ``|p| / 2 pi`` in Hz, shape (n,)."""
-        return np.abs(self.poles) / (2 * np.pi)
+        return pole_quantities(self.poles)[0]
 
     @property
     def damping_ratio(self) -> NDArray[np.float64]:
         """``zeta = -Re p / |p|``, shape (n,)."""
-        return -self.poles.real / np.abs(self.poles)
+        return pole_quantities(self.poles)[1]
 
     def at_order(self, order: int) -> NDArray[np.intp]:
         """Indices of the poles of one model order."""
@@ -163,9 +164,7 @@ def plscf(
     step = int(order_step)
     if step < 1:
         raise InputError(f"order_step: expected a positive integer, got {order_step!r}")
-    lo, hi = (float(f[0]), float(f[-1])) if band is None else (float(band[0]), float(band[1]))
-    if not hi > lo:
-        raise InputError(f"band: expected f_lo < f_hi, got [{lo}, {hi}] Hz")
+    lo, hi = (float(f[0]), float(f[-1])) if band is None else as_band(band)
     sel = (f >= lo) & (f <= hi)
     if not sel.all():  # (no copy when the band holds every line)
         f, h = f[sel], h[:, :, sel]

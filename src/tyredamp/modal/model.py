@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._validate import as_finite, as_frequency
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
-from ..mechanics.modal_sum import kind_factor, modal_sum_receptance
+from ..mechanics.modal_sum import kind_factor, modal_sum_receptance, pole_quantities
 from .quality import FitQuality
 
 __all__ = ["ModalModel", "ModeKind"]
@@ -209,7 +209,7 @@ class ModalModel:
     @property
     def frequency_hz(self) -> NDArray[np.float64]:
         """Natural frequency ``|p_n| / 2 pi`` in Hz."""
-        return np.abs(self.poles) / (2 * np.pi)
+        return pole_quantities(self.poles)[0]
 
     @property
     def damped_frequency_hz(self) -> NDArray[np.float64]:
@@ -219,7 +219,7 @@ class ModalModel:
     @property
     def damping_ratio(self) -> NDArray[np.float64]:
         """``zeta_n = -Re p_n / |p_n|``."""
-        return -self.poles.real / np.abs(self.poles)
+        return pole_quantities(self.poles)[1]
 
     @property
     def residues(self) -> NDArray[np.complex128]:

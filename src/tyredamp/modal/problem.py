@@ -35,13 +35,13 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._validate import as_band
 from ..exceptions import InputError, ShapeError
-from ..frf import FRF
+from ..frf import FRF, KIND_POWER
 
 __all__ = ["FitProblem", "NoiseSource", "build_problem", "max_modes"]
 
 NoiseSource = Literal["variance", "coherence", "residual"]
-_POWER = {"receptance": 0, "mobility": 1, "accelerance": 2}
 #: relative spread of the line spacing accepted as uniform (float32 axes of
 #: acquisition files carry about 1e-7; a resampled or merged axis much more)
 _UNIFORM_TOL = 1e-4
@@ -136,7 +136,7 @@ def _line_variance(
 ) -> tuple[NoiseSource, NDArray[np.float64] | None]:
     """Variance of each line of the band (data units) and where it comes from."""
     full = frf.H.shape
-    v_given = variance if variance is not None else getattr(frf, "variance", None)
+    v_given = variance if variance is not None else frf.variance
     if v_given is not None:
         v = np.asarray(v_given, dtype=float)
         if v.shape != full:
@@ -205,9 +205,12 @@ def build_problem(
     if not isinstance(frf, FRF):
         raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
     fa = frf.frequency
-    lo, hi = (float(fa[0]), float(fa[-1])) if band is None else (float(band[0]), float(band[1]))
-    if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo or lo < 0:
-        raise InputError(f"band: expected 0 <= f_lo < f_hi in Hz, got [{lo}, {hi}]")
+    if band is None and np.count_nonzero(fa > 0) < 2:
+        raise InputError(
+            f"frequency: the FRF has {fa.size} line(s) ({', '.join(f'{x:g}' for x in fa[:3])} Hz); "
+            "modes are identified from many lines of a uniform axis"
+        )
+    lo, hi = (float(fa[0]), float(fa[-1])) if band is None else as_band(band)
     # the band first: searchsorted on the sorted axis, no full-length mask
     i0 = int(np.searchsorted(fa, max(lo, 0.0), side="left"))
     i1 = int(np.searchsorted(fa, hi, side="right"))
@@ -246,7 +249,7 @@ def build_problem(
         H=Hn,
         scale=scale,
         kind=frf.kind,
-        power=_POWER[frf.kind],
+        power=KIND_POWER[frf.kind],
         band=(lo, hi),
         drive=frf.drive_points(),
         frf=frf,

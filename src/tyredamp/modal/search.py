@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError
+from ..mechanics.modal_sum import pole_quantities
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode
 
@@ -226,7 +227,7 @@ def search_helpers(
         uncertainty=False,
         max_nfev=FIRST_NFEV,
     )
-    zeta0 = float(np.clip(np.median(-cur.poles.real / np.abs(cur.poles)), 0.005, 0.1))
+    zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
     n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
     sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= MIN_LOW_LINES else [])
     for side in sides:
@@ -410,7 +411,7 @@ def residual_search(
     lo, hi = band
     tried: list[RejectedMode] = []
     cur = modes
-    zeta0 = float(np.clip(np.median(-cur.poles.real / np.abs(cur.poles)), 0.002, 0.1))
+    zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
     pending = list(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
     for _ in range(MAX_ROUNDS):

@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from ..exceptions import InputError
+from ..mechanics.modal_sum import pole_quantities
 from .lscf import PoleSet
 
 _SLACK = 1e-6  # relative widening of the candidate search (rounding of log|p|, arg p)
@@ -317,8 +318,7 @@ def cluster_poles(
     # per-cluster medians, spread, persistence and representative, all at once
     n_orders = ps.orders.size
     n_cl = n_lab
-    fn_all = np.abs(p) / (2 * np.pi)
-    zz_all = -p.real / np.abs(p)
+    fn_all, zz_all = pole_quantities(p)
     count = np.bincount(labels, minlength=n_cl)
     start = np.concatenate([[0], np.cumsum(count)[:-1]])
     lo_i, hi_i = start + (count - 1) // 2, start + count // 2

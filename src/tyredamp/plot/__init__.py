@@ -13,12 +13,14 @@ function                               figure
 :func:`plot_discrepancy`               discrepancy against frequency (Fig. 4)
 :func:`plot_matrix`                    damping matrices as heat maps (Fig. 5)
 :func:`plot_mode_shapes_ring`          mode shapes around the circumference
+:func:`plot_mode_shapes_geometry`      mode shapes on the test geometry (wireframe)
 :func:`plot_stabilisation`             stabilisation diagram of the pole search
 :func:`plot_figure7`                   lateral amplitude ratio, asymptotes, f0 (Fig. 7)
 :func:`plot_lateral_fit`               one lateral fit (Figs. 11-14)
 :func:`plot_ranking`                   every ranked lateral fit (Figs. 11, 12)
 :func:`plot_lateral_models`            measured vs predictions and truth (Figs. 11-14)
 :func:`plot_time_comparison`           lateral time response (Fig. 15)
+:func:`plot_ring_frequencies`          measured vs updated-ring frequencies per n and pressure
 =====================================  =========================================
 """
 
@@ -27,9 +29,11 @@ from __future__ import annotations
 from .comparison import plot_lateral_models
 from .damping import plot_matrix
 from .frf import plot_frf, plot_frf_comparison
+from .geometry import plot_mode_shapes_geometry
 from .lateral import plot_figure7, plot_lateral_fit, plot_ranking, plot_time_comparison
 from .modal import plot_discrepancy, plot_mode_shapes_ring
 from .stabilisation import plot_stabilisation
+from .tyremodel import plot_ring_frequencies
 
 __all__ = [
     "plot_discrepancy",
@@ -39,8 +43,10 @@ __all__ = [
     "plot_lateral_fit",
     "plot_lateral_models",
     "plot_matrix",
+    "plot_mode_shapes_geometry",
     "plot_mode_shapes_ring",
     "plot_ranking",
+    "plot_ring_frequencies",
     "plot_stabilisation",
     "plot_time_comparison",
 ]

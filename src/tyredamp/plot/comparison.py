@@ -15,8 +15,10 @@ from typing import Literal
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
+
+from ..exceptions import InputError
+from ._axes import axes_grid
 
 __all__ = ["MODEL_COLORS", "model_color", "plot_lateral_models"]
 
@@ -76,18 +78,12 @@ def plot_lateral_models(
         The two panels.
     """
     if style not in ("reim", "bode"):
-        raise ValueError(f"style: expected 'reim' or 'bode', got {style!r}")
+        raise InputError(f"style: expected 'reim' or 'bode', got {style!r}")
     f = np.asarray(frequency, dtype=float)
     meas = np.asarray(measured, dtype=complex)
     if meas.shape != f.shape:
-        raise ValueError(f"measured: expected shape {f.shape}, got {meas.shape}")
-    if axes is not None:
-        ax_list = list(axes)
-        if len(ax_list) != 2:
-            raise ValueError(f"axes: expected 2 axes, got {len(ax_list)}")
-    else:
-        fig = Figure(figsize=(9.0, 3.4), layout="constrained")
-        ax_list = list(fig.subplots(1, 2))
+        raise InputError(f"measured: expected shape {f.shape}, got {meas.shape}")
+    ax_list = axes_grid(axes, 2, (9.0, 3.4), columns=True)
 
     def parts(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if style == "reim":

@@ -6,8 +6,10 @@ from collections.abc import Sequence
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
+
+from ..exceptions import InputError
+from ._axes import single_axes
 
 __all__ = ["plot_matrix"]
 
@@ -19,20 +21,34 @@ def plot_matrix(
     unit: str = "",
     ax: Axes | None = None,
     symmetric_colors: bool = True,
+    linthresh: float | None = None,
 ) -> Axes:
     """Heat map of a real matrix with a diverging colour map centred on 0.
 
     Negative entries (e.g. physical-coordinate damping from modal truncation)
     show in blue, positive in red.
+
+    Parameters
+    ----------
+    linthresh : float, optional
+        Symmetric logarithmic colour scale, linear within ``+-linthresh``
+        (:class:`matplotlib.colors.SymLogNorm`): small off-diagonal terms of a
+        diagonally dominant matrix (modal damping) stay visible beside the
+        large diagonal. Default: linear scale.
     """
+    from matplotlib.colors import SymLogNorm
+
     a = np.asarray(matrix, dtype=float)
     if a.ndim != 2:
-        raise ValueError(f"matrix: expected a 2-D array, got shape {a.shape}")
-    if ax is None:
-        ax = Figure(figsize=(4.6, 3.9), layout="constrained").subplots()
+        raise InputError(f"matrix: expected a 2-D array, got shape {a.shape}")
+    ax = single_axes(ax, (4.6, 3.9))
     lim = float(np.max(np.abs(a))) or 1.0
-    vmin, vmax = (-lim, lim) if symmetric_colors else (None, None)
-    im = ax.imshow(a, cmap="RdBu_r", vmin=vmin, vmax=vmax)
+    if linthresh is not None and linthresh > 0:
+        norm = SymLogNorm(linthresh=float(linthresh), vmin=-lim, vmax=lim, base=10)
+        im = ax.imshow(a, cmap="RdBu_r", norm=norm)
+    else:
+        vmin, vmax = (-lim, lim) if symmetric_colors else (None, None)
+        im = ax.imshow(a, cmap="RdBu_r", vmin=vmin, vmax=vmax)
     fig = ax.figure
     fig.colorbar(im, ax=ax, label=unit)
     if labels is not None:

@@ -9,7 +9,9 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from ..exceptions import InputError
 from ..frf import FRF
+from ._axes import axes_grid
 
 __all__ = ["plot_frf", "plot_frf_comparison"]
 
@@ -17,13 +19,7 @@ Style = Literal["bode", "reim", "all"]
 
 
 def _new_axes(n: int, axes: Sequence[Axes] | None) -> list[Axes]:
-    if axes is not None:
-        ax_list = list(axes)
-        if len(ax_list) != n:
-            raise ValueError(f"axes: expected {n} axes, got {len(ax_list)}")
-        return ax_list
-    fig = Figure(figsize=(7.0, 2.2 * n), layout="constrained")
-    return list(fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0])
+    return axes_grid(axes, n, (7.0, 2.2 * n))
 
 
 def plot_frf(
@@ -61,7 +57,7 @@ def plot_frf(
     f = frf.frequency
     panels = {"bode": ["amp", "phase"], "reim": ["re", "im"], "all": ["re", "im", "amp", "phase"]}
     if style not in panels:
-        raise ValueError(f"style: expected one of {tuple(panels)}, got {style!r}")
+        raise InputError(f"style: expected one of {tuple(panels)}, got {style!r}")
     names = panels[style]
     ax_list = _new_axes(len(names), axes)
     lab = label or f"{frf.outputs[out].label}/{frf.inputs[inp].label}"

@@ -7,12 +7,15 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
+
+from ..exceptions import InputError
+from ._axes import axes_grid, single_axes
 
 if TYPE_CHECKING:
     from ..lateral.characteristics import Figure7Curves
-    from ..lateral.fit import LateralFit, Ranking
+    from ..lateral.fit import LateralFit
+    from ..lateral.ranking import Ranking
 
 __all__ = ["plot_figure7", "plot_lateral_fit", "plot_ranking", "plot_time_comparison"]
 
@@ -20,13 +23,7 @@ Style = Literal["reim", "bode"]
 
 
 def _axes(n: int, axes: Sequence[Axes] | None) -> list[Axes]:
-    if axes is not None:
-        out = list(axes)
-        if len(out) != n:
-            raise ValueError(f"axes: expected {n} axes, got {len(out)}")
-        return out
-    fig = Figure(figsize=(7.0, 2.4 * n), layout="constrained")
-    return list(fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0])
+    return axes_grid(axes, n, (7.0, 2.4 * n))
 
 
 def plot_figure7(curves: Figure7Curves | None = None, ax: Axes | None = None) -> dict[str, Any]:
@@ -50,8 +47,7 @@ def plot_figure7(curves: Figure7Curves | None = None, ax: Axes | None = None) ->
         from ..lateral.characteristics import figure7_curves
 
         curves = figure7_curves()
-    if ax is None:
-        ax = Figure(figsize=(6.0, 4.0), layout="constrained").subplots()
+    ax = single_axes(ax, (6.0, 4.0))
     f = curves.frequency
     (model,) = ax.semilogx(f, curves.model_db, "k-", lw=2, label="proposed model")
     (low,) = ax.semilogx(f, curves.low_asymptote_db, "b--", label=r"$1/(i\omega C_r)$")
@@ -71,7 +67,7 @@ def _panels(style: Style) -> tuple[str, str]:
         return "re", "im"
     if style == "bode":
         return "amp", "phase"
-    raise ValueError(f"style: expected 'reim' or 'bode', got {style!r}")
+    raise InputError(f"style: expected 'reim' or 'bode', got {style!r}")
 
 
 def _draw(ax: Axes, kind: str, f: np.ndarray, h: np.ndarray, **kw: Any) -> Any:
@@ -190,8 +186,7 @@ def plot_time_comparison(
     -------
     Axes
     """
-    if ax is None:
-        ax = Figure(figsize=(7.0, 3.0), layout="constrained").subplots()
+    ax = single_axes(ax, (7.0, 3.0))
     t = np.asarray(time, dtype=float)
     ax.plot(t, np.asarray(measured, dtype=float), "k-", lw=1.5, label="measured")
     for name, y in predictions.items():

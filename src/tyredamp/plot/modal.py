@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 
 from ..frf import FRF
 from ..modal.model import ModalModel
+from ._axes import single_axes
 
 __all__ = ["plot_discrepancy", "plot_mode_shapes_ring"]
 
@@ -32,8 +33,7 @@ def plot_discrepancy(
     rmsd : mapping of label to float, optional
         RMSD values (spec eq. [19]) shown in the legend.
     """
-    if ax is None:
-        ax = Figure(figsize=(7.0, 3.0), layout="constrained").subplots()
+    ax = single_axes(ax, (7.0, 3.0))
     for i, (name, fr) in enumerate(fitted.items()):
         d = np.sqrt(np.sum(np.abs(fr.to(measured.kind).H - measured.H) ** 2, axis=(0, 1)))
         lab = name if rmsd is None or name not in rmsd else f"{name} (RMSD {rmsd[name]:.3g})"
@@ -57,7 +57,10 @@ def plot_mode_shapes_ring(
     The real part of the second-order shape ``Re Psi^`` (spec step 7) at the
     measured angles (``Channel.angle_deg``) is drawn as a deformation of the
     unit circle, normalised to the largest entry; the imaginary part dashed.
-    Outputs without an angle are placed equally spaced.
+    Outputs without an angle are placed equally spaced. The wave-number label
+    of each mode (``model.meta["wave_number_label"]``, written by ``tyredamp
+    modal``; :func:`tyredamp.tyremodel.wave_number_analysis`) is added to its
+    title when present.
     """
     idx = list(range(model.n_modes)) if modes is None else list(modes)
     ang = np.array(
@@ -79,6 +82,9 @@ def plot_mode_shapes_ring(
     else:
         ax_list = list(axes)
     shapes = model.second_order_shapes()
+    labels = model.meta.get("wave_number_label")
+    if not isinstance(labels, list) or len(labels) != model.n_modes:
+        labels = None
     for ax, n in zip(ax_list, idx, strict=False):
         s = shapes[order, n]
         s = s / np.max(np.abs(s))
@@ -89,8 +95,10 @@ def plot_mode_shapes_ring(
         ax.plot(th, 1 + scale * im, ls="--", lw=0.8, **line_kw)
         ax.set_ylim(0, 1 + 1.5 * scale)
         ax.set_yticks([])
+        lab = labels[n] if labels is not None else ""
         ax.set_title(
-            f"{model.frequency_hz[n]:.1f} Hz, zeta {100 * model.damping_ratio[n]:.2f} %",
+            f"{model.frequency_hz[n]:.1f} Hz, zeta {100 * model.damping_ratio[n]:.2f} %"
+            + (f"\n{lab}" if lab else ""),
             fontsize="small",
         )
     return ax_list

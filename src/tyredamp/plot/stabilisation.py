@@ -7,10 +7,11 @@ from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
+from ..exceptions import InputError
 from ..frf import FRF
+from ._axes import single_axes
 
 __all__ = ["plot_stabilisation"]
 
@@ -66,11 +67,10 @@ def plot_stabilisation(
     z_ok = np.asarray(flags.damping, dtype=bool)
     v_ok = np.asarray(flags.vector, dtype=bool)
     if not (order.shape == fn.shape == adm.shape == f_ok.shape):
-        raise ValueError(
+        raise InputError(
             f"poles/flags: expected arrays of one length, got {order.shape} and {adm.shape}"
         )
-    if ax is None:
-        ax = Figure(figsize=(7.5, 4.0), layout="constrained").subplots()
+    ax = single_axes(ax, (7.5, 4.0))
     cls = np.zeros(order.shape, dtype=int)
     cls[f_ok] = 1
     cls[f_ok & z_ok] = 2

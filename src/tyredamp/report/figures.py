@@ -1,4 +1,4 @@
-"""The figures of the demo report, built from a :class:`~tyredamp.demo.DemoResult`.
+"""The figures of the demo report, built from a :class:`~tyredamp.studies.demo.DemoResult`.
 
 :func:`demo_figures` returns ``{name: (Figure, caption)}`` in report order;
 names are the PNG file stems (``fig02_real_fit`` ... ``fig15_time_response``;
@@ -25,10 +25,11 @@ from ..plot import (
     plot_time_comparison,
 )
 from ..plot.comparison import model_color
+from ..studies.document import time_test_truth
 
 if TYPE_CHECKING:
-    from ..demo import DemoResult, LateralCondition
-    from ..lateral.models import ForceKind
+    from ..lateral.response import ForceKind
+    from ..studies.results import DemoResult, LateralCondition
 
 __all__ = ["PAPER_MODELS", "demo_figures"]
 
@@ -81,21 +82,74 @@ def _radial(result: DemoResult) -> FigureSet:
         {"real-mode fit": real, "complex-mode fit": cplx, "exact FRF (noise level)": exact},
         {"real-mode fit": mr.meta["rmsd"], "complex-mode fit": mc.meta["rmsd"]},
     )
+    plotted = {
+        name: float(np.sqrt(np.mean(np.sum(np.abs(fr.H - meas.H) ** 2, axis=(0, 1)))))
+        for name, fr in (("real", real), ("complex", cplx))
+    }
     figs["fig04_discrepancy"] = (
         _figure(ax1),
         "Paper Fig. 4: discrepancy sqrt(sum_jk |H_fit - H_meas|^2) over the 16 FRFs against "
-        "frequency, with the RMSD of eq. [19]; the exact FRF of the virtual tyre shows the "
-        "noise level no fit can beat.",
+        "frequency, with the RMSD of eq. [19] in the legend; the exact FRF of the virtual tyre "
+        "shows the noise level no fit can beat. The curves' RMS over the "
+        f"{meas.n_freq} lines is {plotted['real']:.3g} (real) and {plotted['complex']:.3g} "
+        f"(complex) {meas.unit}; eq. [19] divides the root of the same sum by the number of "
+        f"values ({meas.H.size}) instead of its root, hence RMSD "
+        f"{mr.meta['rmsd']:.3g} and {mc.meta['rmsd']:.3g}: the same ratio, another scale.",
     )
+    figs["residual_zoom"] = _residual_zoom(main, meas, real, cplx, out_i, in_i, lab)
 
+    figs["fig05_damping"] = _damping_figure(result)
+
+    ident = main.identification
+    ax2 = plot_stabilisation(ident.poles, ident.flags, meas, mc.frequency_hz)
+    figs["stabilisation"] = (
+        _figure(ax2),
+        f"Stabilisation diagram (pLSCF poles of every model order) at {p}; dashed lines: "
+        "the modes selected automatically; grey curve: summed FRF amplitude.",
+    )
+    axs3 = plot_mode_shapes_ring(mc)
+    vis = main.truth.select("visible")
+    wave = {m: int(main.truth.wave_number[vis[t]]) for t, m in main.matches["complex"].matched}
+    for j, a in enumerate(axs3):
+        if j in wave:
+            a.set_title(f"n = {wave[j]}: " + a.get_title(), fontsize="small")
+    figs["mode_shapes"] = (
+        _figure(axs3[0]),
+        "Complex mode shapes around the circumference (16 points): real part of the "
+        "second-order shape (solid) and imaginary part (dashed), normalised; n = "
+        "circumferential wave number of the matched true mode.",
+    )
+    figs["mac"] = _mac_figure(result)
+
+    figs["checks"] = _checks_figure(result)
+    figs["pressures"] = _pressures_figure(result)
+    return figs
+
+
+def _damping_figure(result: DemoResult) -> tuple[Figure, str]:
+    r = result.radial
+    p = f"{r.main.pressure_bar:g} bar"
     dm = r.damping
     dc = r.damping_truth
     fig = Figure(figsize=(10.0, 8.4), layout="constrained")
     axs = fig.subplots(2, 2)
     mlab = [f"{f:.0f} Hz" for f in dm.frequency_hz]
     tlab = [f"{dm.frequency_hz[i]:.0f} Hz" for i in dc.model_index]
-    plot_matrix(dm.modal, mlab, "identified C' (modal coordinates)", "1/s", ax=axs[0, 0])
-    plot_matrix(dc.modal_true, tlab, "true C' of the virtual tyre (eq. [14])", "1/s", axs[0, 1])
+    # symmetric log colours, linear below the largest true off-diagonal term / 10, so that
+    # the coupling terms show beside the diagonal (100x larger)
+    off = dc.modal_true - np.diag(np.diag(dc.modal_true))
+    lt = float(np.max(np.abs(off))) / 10 if off.size and np.any(off) else None
+    plot_matrix(
+        dm.modal, mlab, "identified C' (modal coordinates)", "1/s", ax=axs[0, 0], linthresh=lt
+    )
+    plot_matrix(
+        dc.modal_true,
+        tlab,
+        "true C' of the virtual tyre (eq. [14])",
+        "1/s",
+        axs[0, 1],
+        linthresh=lt,
+    )
     plab = [c.label for c in dm.points]
     plot_matrix(
         dm.physical_symmetric,
@@ -114,27 +168,19 @@ def _radial(result: DemoResult) -> FigureSet:
         )
     else:
         axs[1, 1].set_visible(False)
-    figs["fig05_damping"] = (
+    return (
         fig,
         f"Paper Fig. 5: damping matrices at {p} ({dm.method} method, eq. [18]) as heat maps, "
-        "identified beside the truth. Negative (blue) entries of the physical matrix come "
-        "from projecting on few modes ('power leakage'), as in the paper.",
+        "identified beside the truth. The modal matrices use a symmetric logarithmic colour "
+        + ("scale (linear within +-" + f"{lt:.2g} 1/s) " if lt else "scale ")
+        + "so that the off-diagonal coupling terms show beside the diagonal. Negative (blue) "
+        "entries of the physical matrix come from projecting on few modes ('power leakage'), "
+        "as in the paper.",
     )
 
-    ident = main.identification
-    ax2 = plot_stabilisation(ident.poles, ident.flags, meas, mc.frequency_hz)
-    figs["stabilisation"] = (
-        _figure(ax2),
-        f"Stabilisation diagram (pLSCF poles of every model order) at {p}; dashed lines: "
-        "the modes selected automatically; grey curve: summed FRF amplitude.",
-    )
-    axs3 = plot_mode_shapes_ring(mc)
-    figs["mode_shapes"] = (
-        _figure(axs3[0]),
-        "Complex mode shapes around the circumference (16 points): real part of the "
-        "second-order shape (solid) and imaginary part (dashed), normalised.",
-    )
 
+def _checks_figure(result: DemoResult) -> tuple[Figure, str]:
+    r = result.radial
     fig = Figure(figsize=(9.0, 3.2), layout="constrained")
     axs = fig.subplots(1, 2)
     for ax_, res, name in ((axs[0], r.linearity, "linearity"), (axs[1], r.reciprocity, "")):
@@ -149,7 +195,7 @@ def _radial(result: DemoResult) -> FigureSet:
         )
         ax_.grid(True, which="both", alpha=0.3)
         ax_.legend(fontsize="x-small")
-    figs["checks"] = (
+    return (
         fig,
         f"Linearity (FRFs at {result.settings.force_levels_n[0]:g} N and "
         f"{result.settings.force_levels_n[1]:g} N RMS) and reciprocity (H between drive points "
@@ -157,6 +203,9 @@ def _radial(result: DemoResult) -> FigureSet:
         "relative difference per line and overall.",
     )
 
+
+def _pressures_figure(result: DemoResult) -> tuple[Figure, str]:
+    r = result.radial
     fig = Figure(figsize=(9.0, 3.4), layout="constrained")
     axs = fig.subplots(1, 2)
     for i, run in enumerate(r.runs):
@@ -185,12 +234,11 @@ def _radial(result: DemoResult) -> FigureSet:
     axs[0].legend(fontsize="x-small")
     for a in axs:
         a.grid(True, alpha=0.3)
-    figs["pressures"] = (
+    return (
         fig,
         "Inflation pressure: natural frequencies against wave number and damping ratios, "
         "identified (circles, complex-mode fit) against the exact modes (lines).",
     )
-    return figs
 
 
 def _ground_axle(
@@ -259,23 +307,31 @@ def _lateral(result: DemoResult) -> FigureSet:
 
     veh = lat.vehicle
     f = np.linspace(0.25, 9.0, 500)
-    fig = Figure(figsize=(7.5, 3.4), layout="constrained")
-    ax = fig.subplots()
-    ax.semilogy(f, np.abs(veh.truth.accelerance(f)), color="k", lw=1.5, label="rig truth")
+    fig = Figure(figsize=(7.5, 5.4), layout="constrained")
+    ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=[3, 2])
+    a_true = np.abs(veh.truth.accelerance(f))
+    ax.semilogy(f, a_true, color="k", lw=1.5, label="rig truth")
     for i, (name, vh) in enumerate(veh.vehicles.items()):
         res = veh.resonances[name]
         lab = name + ("" if res is None else f" ({res.frequency:.2f} Hz)")
-        ax.semilogy(f, np.abs(vh.accelerance(f)), color=model_color(name, i), lw=1, label=lab)
-    ax.axvline(lat.time_test.frequency_hz, color="0.5", ls="--", lw=0.8)
-    ax.set_xlabel("frequency (Hz)")
+        a = np.abs(vh.accelerance(f))
+        ax.semilogy(f, a, color=model_color(name, i), lw=1, label=lab)
+        ax2.plot(f, 100 * (a / a_true - 1), color=model_color(name, i), lw=1)
+    for a_ in (ax, ax2):
+        a_.axvline(lat.time_test.frequency_hz, color="0.5", ls="--", lw=0.8)
+    ax2.axhline(0.0, color="k", lw=1.0)
+    ax2.set_xlabel("frequency (Hz)")
     ax.set_ylabel("|body acceleration / force| (m/(s^2 N))")
+    ax2.set_ylabel("model / truth - 1 (%)")
     ax.grid(True, which="both", alpha=0.3)
+    ax2.grid(True, alpha=0.3)
     ax.legend(fontsize="x-small")
     figs["vehicle"] = (
         fig,
         f"Single-degree-of-freedom vehicle (eq. 41-42): a {veh.body_mass:g} kg body on each "
         f"fitted tyre at {ref.label} and on the rig's exact tyre; body resonance in brackets; "
-        f"dashed: the {lat.time_test.frequency_hz:g} Hz time test.",
+        f"dashed: the {lat.time_test.frequency_hz:g} Hz time test. Below, on a linear scale: "
+        "each model's amplitude against the rig's exact one (the gap the log scale hides).",
     )
 
     tt = lat.time_test
@@ -286,6 +342,7 @@ def _lateral(result: DemoResult) -> FigureSet:
     axs[0].plot(t[win], tt.data.data[0][win], color="0.25", lw=1)
     axs[0].set_ylabel("lateral force (N)")
     axs[0].grid(True, alpha=0.3)
+    truth_acc, gaps = time_test_truth(result)
     plot_time_comparison(
         t,
         tt.data.data[1],
@@ -293,14 +350,127 @@ def _lateral(result: DemoResult) -> FigureSet:
         ax=axs[1],
         window=tt.window_s,
     )
+    axs[1].plot(t, truth_acc, color="k", ls="--", lw=1.5, label="rig truth (exact)")
+    axs[1].legend(loc="upper right", fontsize="small")
     axs[1].grid(True, alpha=0.3)
+    best = min((k for k in names if k in gaps), key=lambda k: gaps[k], default=None)
     figs["fig15_time_response"] = (
         fig,
         f"Paper Fig. 15: lateral force and body acceleration at {tt.frequency_hz:g} Hz "
-        f"({ref.label}), measured against the steady state of each fitted model "
-        f"({tt.window_s[0]:g}-{tt.window_s[1]:g} s).",
+        f"({ref.label}), measured against the steady state of each fitted model and of the "
+        f"rig's exact tyre (dashed; {tt.window_s[0]:g}-{tt.window_s[1]:g} s). The exact "
+        f"response misses the measurement by {100 * gaps['truth_vs_measured']:.3g} % (noise)"
+        + (
+            ""
+            if best is None
+            else f"; the closest model ({best}) misses the exact response by "
+            f"{100 * gaps[best]:.3g} %"
+        )
+        + ".",
     )
     return figs
+
+
+def _mac_figure(result: DemoResult) -> tuple[Figure, str]:
+    """Auto-MAC of the identified shapes at the main pressure and MAC across pressures."""
+    from ..modal.indicators import auto_mac, mac
+
+    runs = result.radial.runs
+    main = runs[0]
+    psi0 = main.models["complex"].psi_out
+    f0 = main.models["complex"].frequency_hz
+    n = len(runs)
+    fig = Figure(figsize=(3.8 * n, 3.6), layout="constrained")
+    axs = np.atleast_1d(fig.subplots(1, n))
+    panels = [(auto_mac(psi0), f0, f"auto-MAC at {main.pressure_bar:g} bar")]
+    for run in runs[1:]:
+        m = run.models["complex"]
+        panels.append(
+            (
+                mac(psi0, m.psi_out),
+                m.frequency_hz,
+                f"{main.pressure_bar:g} against {run.pressure_bar:g} bar",
+            )
+        )
+    im = None
+    for ax, (mm, fc, title) in zip(axs, panels, strict=True):
+        im = ax.imshow(mm, cmap="viridis", vmin=0.0, vmax=1.0)
+        ax.set_yticks(range(f0.size), [f"{f:.0f}" for f in f0], fontsize="x-small")
+        ax.set_xticks(range(fc.size), [f"{f:.0f}" for f in fc], fontsize="x-small", rotation=90)
+        for (i, j), v in np.ndenumerate(mm):
+            ax.text(
+                j,
+                i,
+                f"{v:.2f}",
+                ha="center",
+                va="center",
+                fontsize=6,
+                color="k" if v > 0.5 else "w",
+            )
+        ax.set_title(title, fontsize="small")
+        ax.set_xlabel("mode (Hz)", fontsize="small")
+    axs[0].set_ylabel(f"mode at {main.pressure_bar:g} bar (Hz)", fontsize="small")
+    if im is not None:
+        fig.colorbar(im, ax=list(axs), label="MAC")
+    return (
+        fig,
+        "Modal assurance criterion of the identified complex shapes: with themselves at the "
+        "main pressure (small off-diagonal values: distinct shapes, 16 points resolve them) and "
+        "against the shapes identified at the other pressures (a value near 1 pairs the same "
+        "mode; a missing partner marks a mode not found at that pressure).",
+    )
+
+
+def _residual_zoom(
+    main: Any, meas: Any, real: Any, cplx: Any, out_i: int, in_i: int, lab: str
+) -> tuple[Figure, str]:
+    """Where the real-mode fit misses: per-line residual against the noise, and a zoom."""
+    from ..studies.verdicts import frf_noise_variance
+
+    f = meas.frequency
+    fig = Figure(figsize=(8.0, 5.6), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1)
+    for name, fr, c in (("real-mode fit", real, "C0"), ("complex-mode fit", cplx, "C1")):
+        r = np.sqrt(np.mean(np.abs(fr.H - meas.H) ** 2, axis=(0, 1)))
+        ax1.semilogy(f, r, color=c, lw=0.9, label=name)
+    noise = frf_noise_variance(meas)
+    if noise is not None:
+        ax1.semilogy(
+            f,
+            np.sqrt(np.mean(noise[0], axis=(0, 1))),
+            color="k",
+            lw=0.9,
+            ls="--",
+            label="noise (from the coherence)",
+        )
+    ax1.set_ylabel(f"RMS residual ({meas.unit})")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.legend(fontsize="x-small")
+    lo = max(float(f[0]), 0.7 * float(f[-1]))
+    keep = f >= lo
+    ax2.semilogy(f[keep], np.abs(meas.H[out_i, in_i, keep]), "k.", ms=3, label="measured")
+    ax2.semilogy(
+        f[keep], np.abs(real.H[out_i, in_i, keep]), color="C0", lw=1, label="real-mode fit"
+    )
+    ax2.semilogy(
+        f[keep],
+        np.abs(cplx.H[out_i, in_i, keep]),
+        color="C1",
+        lw=1,
+        ls="--",
+        label="complex-mode fit",
+    )
+    ax2.set_xlabel("frequency (Hz)")
+    ax2.set_ylabel(f"|H| {lab} ({meas.unit})")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize="x-small")
+    return (
+        fig,
+        f"Where the real-mode fit misses at {main.pressure_bar:g} bar: RMS residual over the 16 "
+        "FRFs per line against the noise the coherence implies (above) and the driving-point "
+        f"amplitude zoomed on {lo:.0f}-{f[-1]:.0f} Hz (below), the upper part of the band where "
+        "the paper saw the real-mode fit depart.",
+    )
 
 
 def demo_figures(result: DemoResult) -> FigureSet:

@@ -9,7 +9,9 @@ modes JSON (``"kind": "modes"``)        ``tyredamp modal`` (and ``simulate radia
 damping JSON (``"kind": "damping"``)    ``tyredamp damping``
 lateral JSON (``"tyredamp": "lateral-fit"``)  ``tyredamp lateral fit``
 demo results (``"kind": "tyredamp-demo-results"``)  ``tyredamp demo``
-FRF or time data (.uff .unv .uf .csv .npz)  ``tyredamp frf``, ``simulate``, a DAQ
+FRF or time data (extensions of :data:`tyredamp.io.FILE_FORMATS`)  ``tyredamp frf``, a DAQ
+UFF modes (data sets 55)   another modal program
+UFF test geometry (data sets 15, 82)  another modal program (mode shapes drawn on it)
 ===========================  ==============================================
 
 Modes files are drawn against an FRF file of the same channels (the one
@@ -22,9 +24,9 @@ A lateral file is drawn against its FRF file in the same way.
 
 from __future__ import annotations
 
-import json
+import contextlib
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,17 +35,23 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .. import __version__
+from ..documents import read_document
+from ..documents.modes import read_modes
 from ..exceptions import FileFormatError, InputError, TyredampError
 from ..frf import FRF
+from ..io import FILE_FORMATS, read
 from ..io._common import check_input_file
 from ..modal.model import ModalModel
 from ..timedata import TimeData
-from .build import fmt_pm
+from .build import _verdict, fmt_pm
 from .html import HtmlReport
 
 __all__ = ["ResultFile", "build_files_report", "load_result_file"]
 
-_DATA_EXT = (".uff", ".unv", ".uf", ".csv", ".npz")
+
+def _data_extensions() -> tuple[str, ...]:
+    """Extensions of the measurement formats (FRF, time data), from the io registry."""
+    return tuple(ext for f in FILE_FORMATS.values() for ext in f.extensions)
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,6 +83,22 @@ class ResultFile:
         return self.kind == "modes" and str((self.doc or {}).get("source", "")).startswith("truth")
 
 
+def _uff_modes_or_geometry(p: Path) -> ResultFile | None:
+    """A UFF file of modes (data sets 55) or test geometry (15, 82), else None."""
+    if p.suffix.lower() not in FILE_FORMATS["uff58b"].extensions:
+        return None
+    from ..io.uff55 import uff_has_modes
+    from ..io.uff_geometry import read_uff_geometry, uff_has_geometry
+
+    if uff_has_modes(p):
+        models = read_modes(p)
+        doc = {"kind": "modes", "source": str(p), "band_hz": None, "frf_kind": None}
+        return ResultFile(p, "modes", models, doc)
+    if uff_has_geometry(p):
+        return ResultFile(p, "geometry", read_uff_geometry(p))
+    return None
+
+
 def load_result_file(path: str | Path) -> ResultFile:
     """Read and classify one result file.
 
@@ -84,53 +108,29 @@ def load_result_file(path: str | Path) -> ResultFile:
         Unreadable, not JSON where JSON is expected, or not a tyredamp result.
     """
     p = check_input_file(path)
-    if p.suffix.lower() in _DATA_EXT:
-        from ..io import read
-
+    data_ext = _data_extensions()
+    special = _uff_modes_or_geometry(p)
+    if special is not None:
+        return special
+    if p.suffix.lower() in data_ext:
         obj = read(p)
         return ResultFile(p, "frf" if isinstance(obj, FRF) else "timedata", obj)
     if p.suffix.lower() != ".json":
         raise FileFormatError(
             f"{p}: unknown file extension {p.suffix or '(none)'!r}; expected .json (modes, "
-            f"damping, lateral fit, demo results) or {', '.join(_DATA_EXT)} (FRF, time data)"
+            f"damping, lateral fit, demo results) or {', '.join(data_ext)} (FRF, time data)"
         )
     try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise FileFormatError(f"{p}: not a text (JSON) file") from None
-    if not text.strip():
-        raise FileFormatError(f"{p}: the file is empty")
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise FileFormatError(f"{p}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    if not isinstance(doc, dict):
-        raise FileFormatError(f"{p}: expected a JSON object, got {type(doc).__name__}")
-    kind = doc.get("kind")
-    try:
-        if kind == "modes":
-            from ..modal.io import read_modes_json
-
-            return ResultFile(p, "modes", read_modes_json(p), doc)
-        if kind == "damping":
-            from ..damping import DampingModel
-
-            return ResultFile(p, "damping", DampingModel.from_dict(doc), doc)
-        if kind == "tyredamp-demo-results":
-            return ResultFile(p, "demo", doc, doc)
-        if doc.get("tyredamp") == "lateral-fit":
-            _ = doc["table"], doc["fits"], doc["conditions"]
-            return ResultFile(p, "lateral", doc, doc)
-    except KeyError as exc:
-        raise FileFormatError(f"{p}: missing key {exc.args[0]!r}") from None
-    except TyredampError as exc:
-        if isinstance(exc, FileFormatError):
+        kind, obj, doc = read_document(p)
+    except FileFormatError as exc:
+        if "not a tyredamp result document" not in str(exc):
             raise
-        raise FileFormatError(f"{p}: {exc}") from None
-    raise FileFormatError(
-        f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
-        f"results JSON, or an FRF/time-data file {', '.join(_DATA_EXT)})"
-    )
+        raise FileFormatError(
+            f"{p}: not a tyredamp result file (expected a modes, damping, lateral-fit or demo "
+            f"results JSON, or an FRF/time-data file {', '.join(data_ext)})"
+        ) from None
+    short = {"lateral-fit": "lateral", "tyredamp-demo-results": "demo"}.get(kind, kind)
+    return ResultFile(p, short, obj, doc)
 
 
 # ----------------------------------------------------------------------------- sections
@@ -215,13 +215,17 @@ def _time_section(rep: HtmlReport, item: ResultFile) -> None:
 
 
 def _match(freq: np.ndarray, ref: np.ndarray) -> dict[int, int]:
-    from ..demo import match_modes
+    from ..studies.radial import match_modes
 
     return {m: t for t, m in match_modes(freq, ref).matched}
 
 
 def _modes_section(
-    rep: HtmlReport, item: ResultFile, frfs: list[ResultFile], truth: ResultFile | None
+    rep: HtmlReport,
+    item: ResultFile,
+    frfs: list[ResultFile],
+    truth: ResultFile | None,
+    geometry: Any = None,
 ) -> None:
     models: dict[str, ModalModel] = item.obj
     doc = item.doc or {}
@@ -266,6 +270,11 @@ def _modes_section(
             caption=f"{name}-mode model ({m.n_modes} modes): value ± standard error"
             + ("; truth of the virtual tyre beside" if tmodel is not None else ""),
         )
+        v = m.meta.get("verdict")
+        if isinstance(v, dict) and "summary" in v and "passed" in v:
+            _verdict(rep, v)  # written by tyredamp modal
+        for w in m.meta.get("warnings", []):
+            rep.paragraph(f"warning ({name}-mode fit): {w}", css_class="bad")
     if len(models) > 1:
         rep.table(
             ["model", "RMSD (eq. [19])", "relative error"],
@@ -284,6 +293,19 @@ def _modes_section(
     if frf is not None:
         _fit_figures(rep, frf, models)
     shapes = models.get("complex") or any_model
+    if geometry is not None and shapes.n_modes:
+        from ..plot import plot_mode_shapes_geometry
+
+        gaxs = plot_mode_shapes_geometry(shapes, geometry)
+        rep.figure(
+            gaxs[0].figure,
+            f"{item.path.name}: mode shapes on the test geometry (real part; grey undeformed)",
+        )
+        angles = geometry.ring_angles(shapes.outputs)
+        if angles is not None:  # the ring view at the measured angles of the geometry
+            from dataclasses import replace as _replace
+
+            shapes = _replace(shapes, outputs=geometry.with_angles(shapes.outputs))
     if shapes.n_modes and shapes.psi_out.shape[0] >= 3:
         from ..plot import plot_mode_shapes_ring
 
@@ -479,7 +501,7 @@ def _num(v: Any) -> float:
 def _rig_truth(meta: dict[str, Any]) -> Any:
     """The exact tyre model a virtual lateral rig stored in an FRF's meta, or None."""
     from ..lateral.models import LateralModel
-    from ..lateral.rig import ViscoelasticStringTyre
+    from ..virtual.lateral_rig import ViscoelasticStringTyre
 
     d = meta.get("truth")
     if not isinstance(d, dict) or "params" not in d:
@@ -508,6 +530,16 @@ def _demo_section(rep: HtmlReport, item: ResultFile) -> None:
         f"{100 * rad['damping']['modal_error']:.3g} % of the truth."
     )
     _modes_table(rep, rad["modes"], "Modes identified beside the truth.")
+    for pr in rad.get("pressures", []):
+        for v in (pr.get("verdict") or {}).values():
+            _verdict(rep, v)
+    for c in lat.get("conditions", []):
+        if c.get("verdict"):
+            _verdict(rep, c["verdict"])
+    ws = doc.get("warnings", [])
+    if ws:
+        rep.paragraph(f"Warnings of every stage of the run ({len(ws)}):")
+        rep.bullets([f"{w['stage']}: {w['message']}" for w in ws])
     rep.table(
         ["rank", "model", "mean rank", "best at", "amplitude error (%)"],
         [
@@ -558,6 +590,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
         "demo": "demo results",
         "frf": "FRF",
         "timedata": "time data",
+        "geometry": "test geometry (nodes, trace lines)",
     }
     rep.table(
         ["file", "content"],
@@ -569,6 +602,7 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
     rep.paragraph(f"tyredamp {__version__}.")
     frfs = [i for i in items if i.kind == "frf"]
     truth = next((i for i in items if i.is_truth), None)
+    geometry = next((i.obj for i in items if i.kind == "geometry"), None)
     sections = [
         ("Measured data", [i for i in items if i.kind in ("frf", "timedata")]),
         ("Modal analysis", [i for i in items if i.kind == "modes"]),
@@ -581,16 +615,32 @@ def build_files_report(paths: Sequence[str | Path], title: str | None = None) ->
             continue
         rep.heading(heading)
         for item in group:
-            if item.kind == "frf":
-                _frf_section(rep, item)
-            elif item.kind == "timedata":
-                _time_section(rep, item)
-            elif item.kind == "modes":
-                _modes_section(rep, item, frfs, truth)
-            elif item.kind == "damping":
-                _damping_section(rep, item)
-            elif item.kind == "lateral":
-                _lateral_section(rep, item, frfs)
-            else:
-                _demo_section(rep, item)
+            with _content_errors(item.path):
+                if item.kind == "frf":
+                    _frf_section(rep, item)
+                elif item.kind == "timedata":
+                    _time_section(rep, item)
+                elif item.kind == "modes":
+                    _modes_section(rep, item, frfs, truth, geometry)
+                elif item.kind == "damping":
+                    _damping_section(rep, item)
+                elif item.kind == "lateral":
+                    _lateral_section(rep, item, frfs)
+                else:
+                    _demo_section(rep, item)
     return rep.render()
+
+
+@contextlib.contextmanager
+def _content_errors(path: Path) -> Iterator[None]:
+    """A result JSON whose fields have the wrong type (strings for numbers, a number for a
+    list ...) is the file's fault: one FileFormatError naming it, not a traceback."""
+    try:
+        yield
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError) as exc:
+        if isinstance(exc, TyredampError):
+            raise FileFormatError(f"{path}: {exc}") from exc
+        name = type(exc).__name__
+        raise FileFormatError(
+            f"{path}: a field has the wrong type or value ({name}: {exc})"
+        ) from exc

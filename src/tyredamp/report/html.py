@@ -25,6 +25,14 @@ figure{margin:1em 0}figcaption{font-size:.9em;color:#555}
 img{max-width:100%}.note{background:#f6f6ee;border-left:4px solid #cc9;padding:.5em 1em}
 .ok{color:#185}.bad{color:#a22}code{background:#f3f3f3;padding:0 .2em}
 nav.toc{background:#f4f6f9;padding:.3em 1em;border:1px solid #dde}nav.toc ul{margin:.3em 0}
+.verdict{padding:.4em 1em;margin:.6em 0;border-left:4px solid #185;background:#eef7f1}
+.verdict.bad{border-left-color:#c22;background:#fdeeee;color:#a11;font-weight:600}
+.warn{border-left:4px solid #d80;background:#fff6e8;padding:.3em 1em;margin:.6em 0}
+.warn.bad{border-left-color:#c22;background:#fdeeee;color:#a11}
+.warn ul{margin:.2em 0}
+@media print{body{max-width:none;margin:0;font-size:10pt}nav.toc{display:none}
+h2{break-before:page}h2,h3{break-after:avoid}figure,table,.verdict,.warn{break-inside:avoid}
+img{max-height:90vh}}
 """
 
 

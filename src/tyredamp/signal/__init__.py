@@ -1,8 +1,11 @@
 """Measurement processing: excitation signals, FRF estimators, coherence, checks.
 
 Implements steps 1-2 of spec ``radial-damping.md``: FRFs from time data,
-ensemble averaged, with coherence (:func:`estimate_frf`), and linearity,
-reciprocity and data-quality checks with numbers (:mod:`.checks`).
+ensemble averaged, with coherence and per-line variance
+(:func:`estimate_frf`; the local rational method :func:`local_frf`), the
+excitation detected from the data when a file does not state it
+(:func:`detect_excitation`), and linearity, reciprocity and data-quality
+checks with numbers (:mod:`.checks`).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from .estimators import (
     cross_spectra,
     estimate_frf,
     frf_from_spectra,
+    frf_variance,
     multiple_coherence,
     ordinary_coherence,
     resolve_channels,
@@ -37,6 +41,8 @@ from .excitation import (
     schroeder_multisine,
     swept_chirp,
 )
+from .lrm import local_frf
+from .periodicity import ExcitationDetection, detect_excitation, transient_periods
 from .windows import exponential_window, force_window, segment_window
 
 __all__ = [
@@ -46,16 +52,20 @@ __all__ = [
     "CheckResult",
     "CrossSpectra",
     "Excitation",
+    "ExcitationDetection",
     "amplitude_spectrum",
     "band_lines",
     "burst_random",
     "clipping",
     "cross_spectra",
+    "detect_excitation",
     "estimate_frf",
     "exponential_window",
     "force_window",
     "frf_from_spectra",
+    "frf_variance",
     "linearity_check",
+    "local_frf",
     "merge_inputs",
     "multiple_coherence",
     "ordinary_coherence",
@@ -67,4 +77,5 @@ __all__ = [
     "schroeder_multisine",
     "segment_window",
     "swept_chirp",
+    "transient_periods",
 ]

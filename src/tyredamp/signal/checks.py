@@ -39,10 +39,12 @@ from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel
 from ..timedata import TimeData
 from .estimators import estimate_frf
+from .periodicity import detect_excitation
 
 __all__ = [
     "CheckResult",
     "clipping",
+    "dependent_forces",
     "linearity_check",
     "merge_inputs",
     "quality_check",
@@ -229,7 +231,8 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     """Join FRFs of separate tests (one or more inputs each) into one matrix.
 
     All must have the same kind (others are converted), lines and outputs;
-    the inputs are concatenated. The coherence is kept only for one FRF.
+    the inputs are concatenated. The coherence is kept only for one FRF; the
+    variance when every FRF has one (each column keeps its own).
     """
     if len(frfs) == 0:
         raise InputError("frfs: expected at least one FRF")
@@ -237,6 +240,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
     if len(frfs) == 1:
         return base
     hs = [base.H]
+    vs = [base.variance]
     ins = list(base.inputs)
     for i, f in enumerate(frfs[1:], start=1):
         g = f.to(base.kind) if f.kind != base.kind else f
@@ -246,6 +250,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         ):
             raise ShapeError(f"frfs[{i}]: expected the same outputs as frfs[0]")
         hs.append(g.H)
+        vs.append(g.variance)
         ins += list(g.inputs)
     return FRF(
         base.frequency,
@@ -254,6 +259,7 @@ def merge_inputs(frfs: Sequence[FRF]) -> FRF:
         outputs=base.outputs,
         inputs=ins,
         meta={"merged_from": len(frfs)},
+        variance=None if any(v is None for v in vs) else np.concatenate(vs, axis=1),  # type: ignore[arg-type]
     )
 
 
@@ -382,10 +388,80 @@ def _low_bands(f: NDArray[np.float64], low: NDArray[np.bool_], limit: int = 5) -
     at = np.concatenate(([0], low.astype(np.int8), [0]))
     e = np.diff(at)
     starts, stops = np.flatnonzero(e == 1), np.flatnonzero(e == -1) - 1
-    out = [f"{f[a]:.4g}-{f[b]:.4g} Hz" for a, b in zip(starts, stops, strict=True)]
+    out = [
+        f"{f[a]:.4g} Hz" if a == b else f"{f[a]:.4g}-{f[b]:.4g} Hz"
+        for a, b in zip(starts, stops, strict=True)
+    ]
     if len(out) > limit:
         out = [*out[:limit], f"... ({len(out) - limit} more)"]
     return out
+
+
+def _passivity(
+    frf: FRF, floor: float, ksig: float, figures: dict[str, float], notes: list[str]
+) -> float | None:
+    """Fraction of drive-point lines with ``Re Y / |Y|`` below ``-(floor + ksig eps)``.
+
+    ``eps`` is the normalised random error of the estimate from the
+    coherence and the number of averages. Adds the figures and notes; ``None``
+    without a drive point.
+    """
+    dps = frf.drive_points()
+    figures["drive_points"] = len(dps)
+    if not dps:
+        notes.append("no drive point (no output at an input's point): passivity not checked")
+        return None
+    mob = frf.to("mobility")
+    n_avg = int(frf.meta.get("n_averages", 0) or 0)
+    viol, total, worst = 0, 0, np.inf
+    for i, j in dps:
+        y = _sign(mob.outputs[i]) * _sign(mob.inputs[j]) * mob.H[i, j]
+        mag = np.abs(y)
+        r = _ratio(y.real, mag)
+        r = np.where(mag > 0, r, 0.0)
+        eps = np.zeros_like(r)
+        if mob.coherence is not None and n_avg > 0:
+            g2 = np.clip(mob.coherence[i], 1e-12, 1.0)
+            eps = np.sqrt((1 - g2) / (2 * n_avg * g2))
+        v = r < -(floor + ksig * eps)
+        viol += int(v.sum())
+        total += r.size
+        worst = min(worst, float(r.min()))
+        if v.any():
+            notes.append(
+                f"drive point {mob.outputs[i].label}: Re(mobility) < 0 beyond noise at "
+                f"{int(v.sum())} lines ({', '.join(_low_bands(mob.frequency, v, 3))})"
+            )
+    pfrac = viol / total if total else 0.0
+    figures["passivity_violations"] = viol
+    figures["passivity_fraction"] = pfrac
+    figures["min_drive_point_real_ratio"] = worst
+    return pfrac
+
+
+def _clipping_and_dead(
+    data: TimeData, clip_run: int, figures: dict[str, float], problems: list[str], notes: list[str]
+) -> None:
+    """Clipped and dead channels of ``quality_check`` into its figures, problems and notes."""
+    period = data.acquisition.period_samples
+    live = [i for i in data.force_indices if np.any(data.data[i])]
+    if period is None and live:
+        # a periodic test without metadata repeats its extreme once per period
+        det = detect_excitation(data.data[live])
+        period = det.period_samples if det.kind == "periodic" else None
+    reps = max(1, data.n_samples // int(period)) if period else 1
+    clipped = {c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)}
+    bad = {k: v for k, v in clipped.items() if v > 0}
+    dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
+    figures["clipped_channels"] = len(bad)
+    figures["clipped_samples"] = int(sum(bad.values()))
+    figures["dead_channels"] = len(dead)
+    if bad:
+        problems.append(f"{len(bad)} clipped channel(s)")
+        notes += [f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()]
+    if dead:
+        problems.append(f"{len(dead)} channel(s) of zeros")
+        notes.append(f"channels of zeros: {', '.join(dead)}")
 
 
 def quality_check(
@@ -415,8 +491,10 @@ def quality_check(
         (the verdict figure and threshold).
     clip_run : int
         Shortest run of equal samples at a channel extreme counted as
-        clipping (see :func:`clipping`; with ``meta["period_samples"]`` one
-        repeat of the extreme per period is accepted).
+        clipping (see :func:`clipping`; with ``acquisition.period_samples``, or the
+        period detected from the force by
+        :func:`~tyredamp.signal.periodicity.detect_excitation`, one repeat
+        of the extreme per period is accepted).
     passivity_floor : float
         Allowed negative ``Re Y / |Y|`` at a drive point besides the random
         error (0.02 is about 1 degree of phase error).
@@ -443,24 +521,7 @@ def quality_check(
     problems: list[str] = []
     frf: FRF | None
     if isinstance(data, TimeData):
-        period = data.meta.get("period_samples")
-        reps = max(1, data.n_samples // int(period)) if period else 1
-        clipped = {
-            c.label: clipping(data.data[i], clip_run, reps) for i, c in enumerate(data.channels)
-        }
-        bad = {k: v for k, v in clipped.items() if v > 0}
-        dead = [c.label for i, c in enumerate(data.channels) if not np.any(data.data[i])]
-        figures["clipped_channels"] = len(bad)
-        figures["clipped_samples"] = int(sum(bad.values()))
-        figures["dead_channels"] = len(dead)
-        if bad:
-            problems.append(f"{len(bad)} clipped channel(s)")
-            notes += [
-                f"channel {k}: {v} flat-topped samples at its extreme" for k, v in bad.items()
-            ]
-        if dead:
-            problems.append(f"{len(dead)} channel(s) of zeros")
-            notes.append(f"channels of zeros: {', '.join(dead)}")
+        _clipping_and_dead(data, clip_run, figures, problems, notes)
         dead_force = [i for i in data.force_indices if not np.any(data.data[i])]
         if dead_force or not data.force_indices or not data.response_indices:
             frf = None
@@ -495,38 +556,9 @@ def quality_check(
         notes.append("no coherence available: coherence check skipped")
 
     if frf is not None:
-        dps = frf.drive_points()
-        figures["drive_points"] = len(dps)
-        if not dps:
-            notes.append("no drive point (no output at an input's point): passivity not checked")
-        else:
-            mob = frf.to("mobility")
-            n_avg = int(frf.meta.get("n_averages", 0) or 0)
-            viol, total, worst = 0, 0, np.inf
-            for i, j in dps:
-                y = _sign(mob.outputs[i]) * _sign(mob.inputs[j]) * mob.H[i, j]
-                mag = np.abs(y)
-                r = _ratio(y.real, mag)
-                r = np.where(mag > 0, r, 0.0)
-                eps = np.zeros_like(r)
-                if mob.coherence is not None and n_avg > 0:
-                    g2 = np.clip(mob.coherence[i], 1e-12, 1.0)
-                    eps = np.sqrt((1 - g2) / (2 * n_avg * g2))
-                v = r < -(floor + ksig * eps)
-                viol += int(v.sum())
-                total += r.size
-                worst = min(worst, float(r.min()))
-                if v.any():
-                    notes.append(
-                        f"drive point {mob.outputs[i].label}: Re(mobility) < 0 beyond noise at "
-                        f"{int(v.sum())} lines ({', '.join(_low_bands(mob.frequency, v, 3))})"
-                    )
-            pfrac = viol / total if total else 0.0
-            figures["passivity_violations"] = viol
-            figures["passivity_fraction"] = pfrac
-            figures["min_drive_point_real_ratio"] = worst
-            if pfrac > pthr:
-                problems.append(f"drive point not passive at {100 * pfrac:.3g} % of lines")
+        pfrac = _passivity(frf, floor, ksig, figures, notes)
+        if pfrac is not None and pfrac > pthr:
+            problems.append(f"drive point not passive at {100 * pfrac:.3g} % of lines")
     passed = not problems
     what = "; ".join(problems) if problems else "no clipping, coherence and passivity within limits"
     summary = (
@@ -536,3 +568,56 @@ def quality_check(
     return CheckResult(
         "quality", passed, low_frac, thr, figures, summary, freq, per_line, tuple(notes)
     )
+
+
+def dependent_forces(
+    data: TimeData, channels: Sequence[int] | None = None, min_r2: float = 0.95
+) -> list[tuple[int, float, list[int]]]:
+    """Force channels that are an instantaneous linear combination of other channels.
+
+    An excitation force is independent of the other channels sample by
+    sample; a reaction force measured beside it (the ground force of a
+    vehicle body driven by a shaker: ``F_ground = F_body - m a``) is a linear
+    combination of the excitation and a response. Each force channel is
+    regressed by least squares on every other channel (and a constant); a
+    coefficient of determination ``R^2`` above ``min_r2`` (default 0.95:
+    what is left is at most 5 % of its variance, the noise of a measured
+    channel) marks it as dependent. Dynamic relations (a response to several
+    shakers) are not instantaneous and give low ``R^2`` (about 0.5 on the
+    virtual tyre driven at two points).
+
+    Parameters
+    ----------
+    data : TimeData
+    channels : sequence of int, optional
+        Force channels to test (indices); default every force channel.
+    min_r2 : float
+        Threshold of ``R^2``, 0 < min_r2 < 1.
+
+    Returns
+    -------
+    list of (int, float, list of int)
+        ``(channel, R^2, channels of the combination)`` for each dependent
+        force; the combination lists the channels whose coefficients carry
+        at least 1 % of the fitted variance.
+    """
+    if not 0 < min_r2 < 1:
+        raise InputError(f"min_r2: expected 0 < min_r2 < 1, got {min_r2}")
+    idx = list(data.force_indices) if channels is None else [int(c) for c in channels]
+    out = []
+    x_all = data.data
+    for k in idx:
+        y = x_all[k] - x_all[k].mean()
+        vy = float(np.mean(y**2))
+        if vy == 0:
+            continue
+        others = [i for i in range(data.n_channels) if i != k]
+        x = np.column_stack([x_all[i] - x_all[i].mean() for i in others])
+        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+        fit = x @ coef
+        r2 = 1.0 - float(np.mean((y - fit) ** 2)) / vy
+        if r2 > min_r2:
+            part = (coef * np.sqrt(np.mean(x**2, axis=0))) ** 2
+            uses = [others[j] for j in np.flatnonzero(part >= 0.01 * part.sum())]
+            out.append((k, r2, uses))
+    return out

@@ -35,6 +35,9 @@ Segmenting methods:
 * ``"transient"``: consecutive non-overlapping records (burst random, impact
   hits), rectangular by default, with the optional force window on the inputs
   and the exponential window on all channels.
+* ``"lrm"``, ``"lpm"``: the local rational / polynomial method on the whole
+  record (:mod:`.lrm`), for random excitation: leakage and transients are
+  fitted away line by line, with the noise variance of every line.
 """
 
 from __future__ import annotations
@@ -47,11 +50,22 @@ import numpy as np
 import scipy.fft
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_finite, check_positive
+from .._validate import as_band, as_count, as_finite, check_positive
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..timedata import TimeData
-from .windows import exponential_window, force_window, segment_window
+from .lrm import local_method_frf
+from .segmenting import (
+    METHODS,
+    Method,
+    MethodChoice,
+    SegmentPlan,
+    checked_starts,
+    choose_method,
+    plan_starts,
+    segment_plan,
+    segment_windows,
+)
 
 __all__ = [
     "ESTIMATORS",
@@ -61,15 +75,14 @@ __all__ = [
     "cross_spectra",
     "estimate_frf",
     "frf_from_spectra",
+    "frf_variance",
     "multiple_coherence",
     "ordinary_coherence",
     "resolve_channels",
 ]
 
 Estimator = Literal["H1", "H2", "Hv"]
-Method = Literal["cyclic", "welch", "transient"]
 ESTIMATORS: tuple[str, ...] = ("H1", "H2", "Hv")
-METHODS: tuple[str, ...] = ("cyclic", "welch", "transient")
 #: FRF kind that follows from the measured response quantity.
 RESPONSE_KIND: dict[str, FRFKind] = {
     "displacement": "receptance",
@@ -177,6 +190,39 @@ def cross_spectra(
         One-sided densities scaled as :func:`scipy.signal.csd` with
         ``scaling="density"`` (the scale cancels in every FRF estimator).
     """
+    x, y = _signals(inputs, outputs)
+    fs = check_positive(sample_rate, "sample_rate")
+    seg = as_count(segment_samples, "segment_samples", minimum=2)
+    step = seg if step_samples is None else as_count(step_samples, "step_samples", minimum=1)
+    st0 = as_count(start, "start", minimum=0)
+    seg_starts = checked_starts(x.shape[1], seg, step, st0, starts)
+    w, w_in = segment_windows(window, input_window, seg)
+    gxx, gyx, gyy, gyy_full = _accumulate(x, y, seg_starts, w, w_in, detrend, full_output)
+    n_f = seg // 2 + 1
+    # one-sided density scaling (as scipy.signal.csd): 2 / (fs sum w^2 n_avg)
+    scale = np.full(n_f, 2.0 / (fs * float(np.sum(w * w)) * seg_starts.size))
+    scale[0] /= 2
+    if seg % 2 == 0:
+        scale[-1] /= 2
+    gxx *= scale[:, None, None]
+    gyx *= scale[:, None, None]
+    gyy *= scale[:, None]
+    if gyy_full is not None:
+        gyy_full *= scale[:, None, None]
+    return CrossSpectra(
+        frequency=np.arange(n_f, dtype=float) * (fs / seg),
+        Gxx=gxx,
+        Gyx=gyx,
+        Gyy=gyy,
+        Gyy_full=gyy_full,
+        n_averages=int(seg_starts.size),
+        segment_samples=seg,
+        sample_rate=fs,
+    )
+
+
+def _signals(inputs: ArrayLike, outputs: ArrayLike) -> tuple[NDArray[Any], NDArray[Any]]:
+    """Inputs and outputs as finite 2-D arrays (n_channels, n_samples) of equal length."""
     x = as_finite(inputs, "inputs")
     y = as_finite(outputs, "outputs")
     x = x[None, :] if x.ndim == 1 else x
@@ -188,36 +234,20 @@ def cross_spectra(
             f"inputs, outputs: expected the same number of samples, got {x.shape[1]} and "
             f"{y.shape[1]}"
         )
-    fs = check_positive(sample_rate, "sample_rate")
-    seg = _as_count(segment_samples, "segment_samples", minimum=2)
-    step = seg if step_samples is None else _as_count(step_samples, "step_samples", minimum=1)
-    st0 = _as_count(start, "start", minimum=0)
-    n = x.shape[1]
-    if starts is None:
-        seg_starts = np.arange(st0, n - seg + 1, step)
-    else:
-        seg_starts = np.asarray(starts)
-        if seg_starts.ndim != 1 or not np.issubdtype(seg_starts.dtype, np.integer):
-            raise InputError("starts: expected a 1-D array of integer sample indices")
-        if seg_starts.size and (seg_starts.min() < 0 or seg_starts.max() > n - seg):
-            raise InputError(f"starts: every segment of {seg} samples must lie in 0..{n}")
-    if seg_starts.size == 0:
-        raise InputError(
-            f"segment_samples: a segment of {seg} samples from sample {st0} does not fit in "
-            f"{n} samples"
-        )
-    if isinstance(window, str | tuple):
-        w = segment_window(window, seg)
-    else:
-        w = as_finite(window, "window", ndim=1)
-        if w.size != seg:
-            raise ShapeError(f"window: expected {seg} samples, got {w.size}")
-    w_in = w
-    if input_window is not None:
-        wi = as_finite(input_window, "input_window", ndim=1)
-        if wi.size != seg:
-            raise ShapeError(f"input_window: expected {seg} samples, got {wi.size}")
-        w_in = w * wi
+    return x, y
+
+
+def _accumulate(
+    x: NDArray[Any],
+    y: NDArray[Any],
+    seg_starts: NDArray[np.intp],
+    w: NDArray[np.float64],
+    w_in: NDArray[np.float64],
+    detrend: bool,
+    full_output: bool,
+) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any], NDArray[Any] | None]:
+    """Unscaled sums of ``X X^H``, ``Y X^H``, ``|Y|^2`` (and ``Y Y^H``) over the segments."""
+    seg = w.size
     n_in, n_out = x.shape[0], y.shape[0]
     n_f = seg // 2 + 1
     gxx = np.zeros((n_f, n_in, n_in), dtype=complex)
@@ -240,26 +270,7 @@ def cross_spectra(
         gyy += np.sum(yf.real**2 + yf.imag**2, axis=2)
         if gyy_full is not None:
             gyy_full += yf @ yf.conj().transpose(0, 2, 1)
-    # one-sided density scaling (as scipy.signal.csd): 2 / (fs sum w^2 n_avg)
-    scale = np.full(n_f, 2.0 / (fs * float(np.sum(w * w)) * seg_starts.size))
-    scale[0] /= 2
-    if seg % 2 == 0:
-        scale[-1] /= 2
-    gxx *= scale[:, None, None]
-    gyx *= scale[:, None, None]
-    gyy *= scale[:, None]
-    if gyy_full is not None:
-        gyy_full *= scale[:, None, None]
-    return CrossSpectra(
-        frequency=np.arange(n_f, dtype=float) * (fs / seg),
-        Gxx=gxx,
-        Gyx=gyx,
-        Gyy=gyy,
-        Gyy_full=gyy_full,
-        n_averages=int(seg_starts.size),
-        segment_samples=seg,
-        sample_rate=fs,
-    )
+    return gxx, gyx, gyy, gyy_full
 
 
 def frf_from_spectra(spectra: CrossSpectra, estimator: Estimator = "H1") -> NDArray[np.complex128]:
@@ -318,6 +329,77 @@ def frf_from_spectra(spectra: CrossSpectra, estimator: Estimator = "H1") -> NDAr
                 v = vec[:, :, 0]
                 h[:, j, :] = -(v[:, :n_in] / v[:, n_in : n_in + 1]).conj()
     out: NDArray[np.complex128] = np.moveaxis(np.asarray(h, dtype=complex), 0, -1)
+    return out
+
+
+def frf_variance(
+    spectra: CrossSpectra, coherence: NDArray[np.float64], n_independent: float
+) -> NDArray[np.float64] | None:
+    """Variance of each FRF estimate from the residual (non-coherent) output power.
+
+    Least squares over ``n`` independent segments ``Y_k = H X_k + E_k`` gives
+    ``cov(H_j) = G_ee,j Gxx^-1 / n`` (output ``j``), with the noise density
+    estimated from the part of the output not explained by the inputs,
+    ``G_ee,j = Gyy_jj (1 - gamma_j^2) n / (n - n_in)``, so::
+
+        var(H_ji) = Gyy_jj (1 - gamma_j^2) [Gxx^-1]_ii / (n - n_in).
+
+    For one input this is ``|H|^2 (1 - gamma^2) / (gamma^2 (n - 1))``, twice
+    the squared normalised random error of ``|H|`` of Bendat and Piersol
+    (``(1 - gamma^2) / (2 n gamma^2)``) since the complex variance counts the
+    magnitude and the phase direction. For cyclic averaging the residual is
+    the period-to-period spread of ``Y - H X``. It is the variance of H1 (and
+    a first-order one of H2 and Hv with noise on the outputs).
+
+    Parameters
+    ----------
+    spectra : CrossSpectra
+        Averaged spectra on the kept lines.
+    coherence : ndarray, shape (n_out, n_freq)
+        Multiple coherence of each output.
+    n_independent : float
+        Number of statistically independent segments (the averages, reduced
+        for overlapping windows by :func:`_overlap_factor`).
+
+    Returns
+    -------
+    ndarray, shape (n_out, n_in, n_freq), or None
+        Variance in (unit of H)^2; None when ``n_independent <= n_in`` (no
+        degree of freedom left for the noise).
+    """
+    n_in = spectra.Gxx.shape[1]
+    dof = float(n_independent) - n_in
+    if dof <= 0:
+        return None
+    try:
+        inv_diag = np.real(np.diagonal(np.linalg.inv(spectra.Gxx), axis1=1, axis2=2))  # (f, in)
+    except np.linalg.LinAlgError:
+        return None
+    resid = spectra.Gyy * (1.0 - coherence.T)  # (f, out)
+    var = resid[:, :, None] * np.maximum(inv_diag, 0.0)[:, None, :] / dof  # (f, out, in)
+    var = np.moveaxis(var, 0, -1)
+    if not np.all(np.isfinite(var)):
+        return None
+    return np.maximum(var, 0.0)
+
+
+def _overlap_factor(window: ArrayLike, step: int, n_segments: int) -> float:
+    """Variance inflation of an average of ``n_segments`` overlapping windowed segments.
+
+    ``1 + 2 sum_j (1 - j/K) rho(j)^2`` with ``rho(j)`` the overlap correlation
+    ``sum w[t] w[t + j step] / sum w^2`` (Welch 1967, eq. for the variance
+    of the averaged periodogram of white noise); 1 without overlap.
+    """
+    w = np.asarray(window, dtype=float)
+    seg = w.size
+    k = int(n_segments)
+    total = float(np.sum(w * w))
+    out = 1.0
+    j = 1
+    while j < k and j * step < seg:
+        rho = float(np.sum(w[: seg - j * step] * w[j * step :])) / total
+        out += 2.0 * (1.0 - j / k) * rho * rho
+        j += 1
     return out
 
 
@@ -401,12 +483,6 @@ def resolve_channels(
     return out
 
 
-def _as_count(v: Any, name: str, minimum: int) -> int:
-    if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < minimum:
-        raise InputError(f"{name}: expected an integer >= {minimum}, got {v!r}")
-    return int(v)
-
-
 # --------------------------------------------------------------- entry point
 def estimate_frf(
     timedata: TimeData,
@@ -424,6 +500,7 @@ def estimate_frf(
     exponential_end: float | None = None,
     band: tuple[float, float] | None = None,
     min_relative_power: float = 1e-10,
+    detect: bool = True,
 ) -> FRF:
     """Estimate the FRF matrix of a test from its time data.
 
@@ -437,20 +514,21 @@ def estimate_frf(
         The input (force) channels; default every force channel. Keys as in
         :func:`resolve_channels` (label ``"1+Z"``, name, node number or
         :class:`Channel`).
-    method : {"cyclic", "welch", "transient"}, optional
-        Default: ``"cyclic"`` when ``timedata.meta["period_samples"]`` (or
-        ``period_samples``) is given, ``"transient"`` when
-        ``meta["record_samples"]`` is given, else ``"welch"``.
+    method : {"cyclic", "welch", "transient", "lrm", "lpm"}, optional
+        Default: ``"cyclic"`` when ``timedata.acquisition.period_samples``
+        (or ``period_samples``) is given, ``"transient"`` when
+        ``acquisition.record_samples`` is given, else detected from the data
+        (``detect``), else ``"welch"``.
     outputs : sequence of channel keys, optional
         Response channels; default every non-force channel. They must all be
         the same quantity, which sets the FRF kind (acceleration ->
         accelerance, velocity -> mobility, displacement -> receptance).
     period_samples : int, optional
         Period of a periodic excitation in samples (cyclic method); default
-        ``meta["period_samples"]``.
+        ``timedata.acquisition.period_samples``.
     segment_samples : int, optional
         Segment length: Welch default ``n_samples // 8``; transient default
-        ``meta["record_samples"]``. Not used by the cyclic method.
+        ``timedata.acquisition.record_samples``. Not used by the cyclic method.
     overlap : float, optional
         Welch overlap fraction in [0, 1) (default 0.5); 0 for the other methods.
     window : str or tuple, optional
@@ -458,9 +536,9 @@ def estimate_frf(
         (the cyclic method accepts only ``"boxcar"``).
     settle_samples : int, optional
         Samples dropped at the start of the record, or of each run when
-        ``meta["run_starts"]`` lists the first samples of separately driven
-        runs (segments never straddle runs); default
-        ``meta["settle_samples"]`` or 0.
+        ``timedata.acquisition.run_starts`` lists the first samples of
+        separately driven runs (segments never straddle runs); default
+        ``acquisition.settle_samples``.
     force_window_samples : int, optional
         Transient method: flat length of the force window on the inputs (with
         a taper of a tenth of it).
@@ -470,19 +548,31 @@ def estimate_frf(
         ``1/tau`` to every modal decay rate).
     band : (float, float), optional
         Keep only lines with ``band[0] <= f <= band[1]`` (Hz); default
-        ``meta["band_hz"]`` when given, else all excited lines.
+        ``timedata.acquisition.band_hz`` when given, else all excited lines.
     min_relative_power : float
         Lines where an input's auto spectrum is below this fraction of its
         maximum are not excited and are left out (for a multisine, every line
         outside its band).
+    detect : bool
+        When neither ``method`` nor a period or record length is stated
+        (argument or ``timedata.acquisition``), decide from the signals with
+        :func:`~tyredamp.signal.periodicity.detect_excitation`: periodic data
+        get cyclic averaging with the detected period and start transient,
+        impact data the transient method on records starting at the hits,
+        the rest Welch. ``method="cyclic"`` without a period also detects it.
+        A period given as an argument to data that state none gets its start
+        transient detected (:func:`~tyredamp.signal.periodicity.transient_periods`)
+        unless ``settle_samples`` is given. The verdict and its reason go to
+        ``meta["detection"]``.
 
     Returns
     -------
     FRF
         ``H`` of shape (n_out, n_in, n_lines), the multiple coherence as
-        ``coherence``, and ``meta`` with ``estimator``, ``method``,
-        ``n_averages``, ``segment_samples``, ``sample_rate``, ``window``,
-        ``overlap``.
+        ``coherence``, the variance of each estimate as ``variance`` (see
+        :func:`frf_variance`; None with too few averages), and ``meta``
+        with ``estimator``, ``method``, ``n_averages``, ``segment_samples``,
+        ``sample_rate``, ``window``, ``overlap``.
 
     Raises
     ------
@@ -490,6 +580,38 @@ def estimate_frf(
         Unknown options, no force channel, a force channel of zeros, mixed
         response quantities, fully correlated inputs (MIMO), too few samples.
     """
+    ref_idx, out_idx, kind = _resolve_io(timedata, estimator, reference, outputs)
+    choice = choose_method(
+        timedata, ref_idx, out_idx, method, period_samples, settle_samples, segment_samples, detect
+    )
+    if choice.method in ("lrm", "lpm"):
+        return local_method_frf(
+            timedata,
+            ref_idx,
+            out_idx,
+            kind,
+            choice.method,
+            estimator,
+            choice.settle_samples,
+            band,
+            min_relative_power,
+            window,
+            overlap,
+            segment_samples,
+            choice.detection,
+        )
+    plan = segment_plan(timedata, choice, window, overlap, force_window_samples, exponential_end)
+    io = (ref_idx, out_idx, kind)
+    return _segmented_frf(timedata, io, estimator, choice, plan, band, min_relative_power)
+
+
+def _resolve_io(
+    timedata: TimeData,
+    estimator: str,
+    reference: Sequence[Channel | int | str] | Channel | int | str | None,
+    outputs: Sequence[Channel | int | str] | None,
+) -> tuple[list[int], list[int], FRFKind]:
+    """Positions of the force and response channels and the FRF kind of ``estimate_frf``."""
     if not isinstance(timedata, TimeData):
         raise InputError(f"timedata: expected a TimeData, got {type(timedata).__name__}")
     if estimator not in ESTIMATORS:
@@ -518,125 +640,62 @@ def estimate_frf(
             f"outputs: expected one response quantity, got {sorted(quantities)}; select "
             "outputs of one quantity"
         )
-    kind = RESPONSE_KIND[quantities.pop()]
-    data = timedata.data
     for i in ref_idx:
-        if not np.any(data[i]):
+        if not np.any(timedata.data[i]):
             raise InputError(
                 f"reference: force channel {chans[i].label} is all zeros; no excitation recorded"
             )
+    return ref_idx, out_idx, RESPONSE_KIND[quantities.pop()]
 
-    meta = timedata.meta
-    if method is None:
-        if period_samples is not None or "period_samples" in meta:
-            method = "cyclic"
-        elif segment_samples is None and "record_samples" in meta:
-            method = "transient"
-        else:
-            method = "welch"
-    if method not in METHODS:
-        raise InputError(f"method: expected one of {METHODS}, got {method!r}")
-    settle = settle_samples if settle_samples is not None else meta.get("settle_samples", 0)
-    settle = _as_count(settle, "settle_samples", minimum=0)
-    fs = timedata.sample_rate
-    n = timedata.n_samples
-    x, y = data[ref_idx], data[out_idx]
-    input_window = None
-    window_arg: Any = None
-    info: dict[str, Any] = {}
-    if method == "cyclic":
-        p = period_samples if period_samples is not None else meta.get("period_samples")
-        if p is None:
-            raise InputError("method: 'cyclic' needs period_samples (argument or meta)")
-        seg = _as_count(p, "period_samples", minimum=2)
-        if window not in (None, "boxcar", "rect", "rectangular"):
-            raise InputError(
-                f"window: the cyclic method uses whole periods unwindowed, got {window!r}"
-            )
-        if overlap not in (None, 0, 0.0):
-            raise InputError(f"overlap: the cyclic method uses whole periods, got {overlap!r}")
-        win: str | tuple[str, float] = "boxcar"
-        step, detrend, ov = seg, False, 0.0
-    elif method == "welch":
-        seg = _as_count(
-            segment_samples if segment_samples is not None else max(n // 8, 2),
-            "segment_samples",
-            minimum=2,
-        )
-        ov = 0.5 if overlap is None else float(overlap)
-        if not 0.0 <= ov < 1.0:
-            raise InputError(f"overlap: expected a fraction in [0, 1), got {overlap!r}")
-        step = max(1, round(seg * (1 - ov)))
-        win = window if window is not None else "hann"
-        detrend = True
-    else:
-        rec = segment_samples if segment_samples is not None else meta.get("record_samples")
-        if rec is None:
-            raise InputError("method: 'transient' needs segment_samples or meta['record_samples']")
-        seg = _as_count(rec, "segment_samples", minimum=2)
-        if overlap not in (None, 0, 0.0):
-            raise InputError(f"overlap: the transient method uses whole records, got {overlap!r}")
-        step, detrend, ov = seg, False, 0.0
-        win = window if window is not None else "boxcar"
-        if force_window_samples is not None:
-            fw = _as_count(force_window_samples, "force_window_samples", minimum=1)
-            input_window = force_window(seg, min(fw, seg), min(max(fw // 10, 0), seg))
-            info["force_window_samples"] = fw
-        if exponential_end is not None:
-            ew, tau = exponential_window(seg, fs, exponential_end)
-            window_arg = segment_window(win, seg) * ew
-            info["exponential_tau_s"] = tau
-    seg_starts = _segment_starts(meta, n, seg, step, settle)
-    if seg_starts.size == 0:
-        raise InputError(
-            f"timedata: no whole segment of {seg} samples ({method} method) in {n} samples "
-            f"after dropping {settle} settle samples"
-        )
-    if window_arg is None:
-        window_arg = win
-    mimo_h2 = estimator == "H2" and len(ref_idx) > 1
+
+def _segmented_frf(
+    timedata: TimeData,
+    io: tuple[list[int], list[int], FRFKind],
+    estimator: Estimator,
+    choice: MethodChoice,
+    plan: SegmentPlan,
+    band: tuple[float, float] | None,
+    min_relative_power: float,
+) -> FRF:
+    """``estimate_frf`` by the cyclic, Welch or transient method (segment averages)."""
+    ref_idx, out_idx, kind = io
+    chans = timedata.channels
+    seg = plan.segment_samples
     spectra = cross_spectra(
-        x,
-        y,
-        fs,
+        timedata.data[ref_idx],
+        timedata.data[out_idx],
+        timedata.sample_rate,
         seg,
-        starts=seg_starts,
-        window=window_arg,
-        input_window=input_window,
-        detrend=detrend,
-        full_output=mimo_h2,
+        starts=plan_starts(timedata, choice, plan),
+        window=plan.window_values,
+        input_window=plan.input_window,
+        detrend=plan.detrend,
+        full_output=estimator == "H2" and len(ref_idx) > 1,
     )
-    if band is None and "band_hz" in meta:
-        band = (float(meta["band_hz"][0]), float(meta["band_hz"][1]))
-    lines = _excited_lines(spectra, min_relative_power)
-    if band is not None:
-        lo, hi = float(band[0]), float(band[1])
-        if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
-            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band!r}")
-        f = spectra.frequency
-        lines = lines[(f[lines] >= lo) & (f[lines] <= hi)]
-    if lines.size == 0:
-        raise InputError(
-            "timedata: no excited frequency line"
-            + (f" in band {band!r} Hz" if band is not None else "")
-            + f" (input power above {min_relative_power:g} of its maximum)"
-        )
-    spectra = spectra.select_lines(lines)
+    if band is None:
+        band = timedata.acquisition.band_hz
+    spectra = _band_lines(spectra, band, min_relative_power)
     if len(ref_idx) > 1:
         _check_input_rank(spectra, [chans[i].label for i in ref_idx])
     h = frf_from_spectra(spectra, estimator)
     coh = multiple_coherence(spectra)
+    n_eff = spectra.n_averages / _overlap_factor(
+        plan.window_values, plan.step_samples, spectra.n_averages
+    )
+    win = plan.window
     meta_out: dict[str, Any] = {
         "estimator": estimator,
-        "method": method,
+        "method": choice.method,
         "n_averages": spectra.n_averages,
         "segment_samples": seg,
-        "sample_rate": fs,
+        "sample_rate": timedata.sample_rate,
         "window": win if isinstance(win, str) else list(win),
-        "overlap": ov,
-        "settle_samples": settle,
-        **info,
+        "overlap": plan.overlap,
+        "settle_samples": choice.settle_samples,
+        **plan.info,
     }
+    if choice.detection is not None:
+        meta_out["detection"] = choice.detection.to_dict()
     return FRF(
         spectra.frequency,
         h,
@@ -645,28 +704,26 @@ def estimate_frf(
         inputs=[chans[i] for i in ref_idx],
         coherence=coh,
         meta=meta_out,
+        variance=frf_variance(spectra, coh, n_eff),
     )
 
 
-def _segment_starts(
-    meta: dict[str, Any], n: int, seg: int, step: int, settle: int
-) -> NDArray[np.intp]:
-    """First samples of the segments: within each run (``meta["run_starts"]``), after settling."""
-    runs = meta.get("run_starts", [0])
-    try:
-        r = np.asarray(runs, dtype=np.int64).ravel()
-    except (TypeError, ValueError):
+def _band_lines(
+    spectra: CrossSpectra, band: tuple[float, float] | None, min_relative_power: float
+) -> CrossSpectra:
+    """The spectra on the excited lines inside ``band``."""
+    lines = _excited_lines(spectra, min_relative_power)
+    if band is not None:
+        lo, hi = as_band(band)
+        f = spectra.frequency
+        lines = lines[(f[lines] >= lo) & (f[lines] <= hi)]
+    if lines.size == 0:
         raise InputError(
-            f"timedata.meta['run_starts']: expected sample indices, got {runs!r}"
-        ) from None
-    if r.size == 0 or r[0] != 0 or np.any(np.diff(r) <= 0) or r[-1] >= n:
-        raise InputError(
-            "timedata.meta['run_starts']: expected increasing sample indices from 0 below "
-            f"{n}, got {runs!r}"
+            "timedata: no excited frequency line"
+            + (f" in band {band!r} Hz" if band is not None else "")
+            + f" (input power above {min_relative_power:g} of its maximum)"
         )
-    stops = np.append(r[1:], n)
-    out = [np.arange(a + settle, b - seg + 1, step) for a, b in zip(r, stops, strict=True)]
-    return np.concatenate(out).astype(np.intp)
+    return spectra.select_lines(lines)
 
 
 def _excited_lines(spectra: CrossSpectra, min_relative_power: float) -> NDArray[np.intp]:

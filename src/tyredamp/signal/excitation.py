@@ -3,9 +3,10 @@
 Every generator is a function of the sample rate, the length (period or
 record), the frequency band, the RMS force and (for random signals) a random
 generator, and returns an :class:`Excitation`: the force history in N and the
-metadata the FRF estimators use (``period_samples`` for periodic signals,
-``record_samples`` for burst random, ``band_hz``), so that
-``TimeData(..., meta=excitation.meta())`` selects the right estimation method.
+acquisition record the FRF estimators use (``period_samples`` for periodic
+signals, ``record_samples`` for burst random, ``band_hz``), so that
+``TimeData(..., acquisition=excitation.acquisition())`` selects the right
+estimation method.
 
 Signals
 -------
@@ -30,8 +31,9 @@ import numpy as np
 import scipy.signal
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_finite, check_positive
+from .._validate import as_band, as_finite, check_positive
 from ..exceptions import InputError
+from ..timedata import Acquisition
 
 __all__ = [
     "Excitation",
@@ -83,13 +85,22 @@ class Excitation:
         return float(np.sqrt(np.mean(self.signal**2)))
 
     def meta(self) -> dict[str, Any]:
-        """Metadata for :class:`~tyredamp.timedata.TimeData` (estimator hints)."""
+        """The acquisition fields as a dict (legacy form of :meth:`acquisition`)."""
         out: dict[str, Any] = {"excitation": self.name, "band_hz": list(self.band)}
         if self.period_samples is not None:
             out["period_samples"] = self.period_samples
         if self.record_samples is not None:
             out["record_samples"] = self.record_samples
         return out
+
+    def acquisition(self) -> Acquisition:
+        """The acquisition record for a test driven by this signal (estimator hints)."""
+        return Acquisition(
+            period_samples=self.period_samples,
+            record_samples=self.record_samples,
+            band_hz=self.band,
+            excitation=self.name,
+        )
 
     def amplitude_spectrum(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Amplitude spectrum of one period/record; see :func:`amplitude_spectrum`."""
@@ -436,12 +447,7 @@ def _length(v: Any, name: str, minimum: int = 2) -> int:
 
 
 def _band(band: tuple[float, float], fs: float) -> tuple[float, float]:
-    try:
-        lo, hi = float(band[0]), float(band[1])
-    except (TypeError, ValueError, IndexError):
-        raise InputError(f"band: expected (f_lo, f_hi) in Hz, got {band!r}") from None
-    if not (np.isfinite(lo) and np.isfinite(hi)) or lo < 0 or hi <= lo:
-        raise InputError(f"band: expected 0 <= f_lo < f_hi in Hz, got {band!r}")
+    lo, hi = as_band(band)
     if hi > fs / 2:
         raise InputError(f"band: upper edge {hi:g} Hz is above the Nyquist frequency {fs / 2:g} Hz")
     return lo, hi

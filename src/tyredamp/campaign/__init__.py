@@ -1,0 +1,15 @@
+"""Test campaigns: many tyre tests across conditions, processed in parallel, modes tracked.
+
+* :mod:`.spec`: the campaign file (TOML) -> :class:`Campaign`.
+* :mod:`.steps`: the one adapter that knows how a test is processed.
+* :mod:`.cache`, :mod:`.runner`: content-addressed step results; serial or Dask execution.
+* :mod:`.tracking`: mode families across conditions and their trends.
+* :mod:`.outputs`: tables, per-test documents and the HTML report.
+* :mod:`.virtual`: a virtual campaign with its truth.
+"""
+
+from __future__ import annotations
+
+from .spec import Campaign, CampaignFileError, TestSpec, load_campaign
+
+__all__ = ["Campaign", "CampaignFileError", "TestSpec", "load_campaign"]

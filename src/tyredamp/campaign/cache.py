@@ -1,0 +1,98 @@
+"""Content-addressed cache of step results: a rerun recomputes only what changed.
+
+Each step result of each test is stored as one JSON file
+``DIR/cache/<key>.json``, written atomically
+(:func:`tyredamp.io._safety.atomic_path`), where ``key`` is the SHA-256 of
+
+* the SHA-256 of the test file's bytes,
+* the step (study and name), the settings it depends on and the test
+  conditions it reads,
+* the key of the step before it (so a changed modal result renews the damping),
+* the tyredamp version.
+
+A finished step is on disk as soon as the campaign receives it, so a crash,
+a kill or Ctrl-C loses nothing that finished, and a changed setting renews
+only the steps that depend on it. Entries that cannot be read (for example a
+disk that filled up) count as missing and are computed again.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+from .. import __version__
+from ..documents.jsonfile import json_text
+from ..io._safety import atomic_path
+
+__all__ = ["CACHE_FORMAT", "ResultCache", "file_digest", "step_key"]
+
+#: Version of the cache entry layout (part of every key).
+CACHE_FORMAT = 1
+
+
+def file_digest(path: str | os.PathLike[str]) -> str:
+    """SHA-256 (hex) of a file's bytes (the file is only read)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def step_key(
+    study: str,
+    step: str,
+    input_digest: str,
+    settings: Any,
+    conditions: Any,
+    upstream_key: str | None,
+    version: str = __version__,
+) -> str:
+    """The cache key (SHA-256 hex) of one step of one test (see the module docstring)."""
+    ident = {
+        "format": CACHE_FORMAT,
+        "tyredamp": version,
+        "study": study,
+        "step": step,
+        "input_sha256": input_digest,
+        "settings": settings,
+        "conditions": conditions,
+        "upstream": upstream_key,
+    }
+    text = json.dumps(ident, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+class ResultCache:
+    """Step documents on disk under ``root`` (``DIR/cache``), one JSON file per key."""
+
+    def __init__(self, root: str | os.PathLike[str]) -> None:
+        self.root = Path(root)
+
+    def path(self, key: str) -> Path:
+        """The file of ``key``."""
+        return self.root / f"{key}.json"
+
+    def get(self, key: str) -> dict[str, Any] | None:
+        """The stored document of ``key``, or None when absent or unreadable."""
+        p = self.path(key)
+        try:
+            entry = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError):
+            return None
+        if not isinstance(entry, dict) or entry.get("key") != key:
+            return None
+        doc = entry.get("document")
+        return doc if isinstance(doc, dict) else None
+
+    def put(self, key: str, document: dict[str, Any], about: dict[str, Any]) -> Path:
+        """Store ``document`` under ``key`` atomically, with ``about`` (test, step) beside it."""
+        entry = {"kind": "tyredamp-campaign-cache", "key": key, **about, "document": document}
+        text = json_text(entry, indent=0)
+        with atomic_path(self.path(key)) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+        return self.path(key)

@@ -1,0 +1,511 @@
+"""Mode families across the conditions of a campaign.
+
+Tracking
+--------
+The identified modes of every test are matched into *families* (the same
+physical mode seen at different pressures, loads, speeds, tyres):
+
+1. Within each test, modes whose half-power bands overlap,
+   ``|f_i - f_j| < zeta_i f_i + zeta_j f_j`` (modal overlap above one), form a
+   *pair*: the doubled cos/sin modes of one wave number of a nearly
+   axisymmetric tyre, whose individual shapes rotate freely inside their
+   2-D subspace from test to test. A pair is matched as a whole by the
+   subspace MAC, the mean squared cosine of the principal angles between the
+   two mode-shape subspaces (for single modes this is the usual MAC,
+   ``|u^H v|^2 / (|u|^2 |v|^2)``; Allemang 2003 for the MAC, Björck & Golub
+   1973 for principal angles).
+2. Tests are visited in order of tyre, then conditions. A test is matched
+   against every family already found, each represented by its member in the
+   already visited test nearest in conditions (distance: the sum over the
+   numeric conditions of the difference over that condition's range in the
+   campaign; another tyre counts as far away), so a mode is always compared
+   with its closest observed state and a sweep cannot swap two modes.
+3. The match is an assignment problem (:func:`scipy.optimize.linear_sum_assignment`,
+   one-to-one) with cost ``(1 - MAC) + (Delta f / gap)^2``, where ``gap`` is
+   the distance from the family's representative to the nearest other mode
+   of its test with a *similar shape* (MAC >= 0.5 with it; modes of other
+   shapes may cross freely). A match is admissible only when ``MAC >= 0.5``
+   (the shapes share more than they do not) and ``Delta f < gap`` (the new
+   mode is closer to this family than its look-alike neighbour was, which
+   also keeps spatially aliased wave numbers apart); modes left over start
+   new families. Shapes are compared at the points common to both tests.
+
+Trends
+------
+For each family, quantity (frequency, damping ratio, modal damping ``C'_nn``)
+and numeric condition, each *series* (observations with the same tyre and
+the same other conditions, at least three distinct values of the condition)
+gets a weighted least-squares polynomial (weights ``1 / sigma^2`` from the
+identification's standard errors) whose degree, 0 to 3, minimises the
+corrected Akaike criterion AICc (Hurvich & Tsai 1989) with the scale of the
+errors estimated from the residuals. Frequency against pressure is fitted as
+``f^2`` (a ring on an elastic foundation under inflation has every stiffness
+term linear in pressure, so ``f^2`` is close to linear in ``p``; spec
+``virtual-tyre.md``). The uncertainty band is the standard error of the
+fitted curve, ``sqrt(a^T Cov a)`` with ``Cov = s^2 (A^T W A)^-1`` and ``s^2``
+the reduced chi-square, never below 1 (the band is never narrower than the
+stated standard errors allow).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+
+from ..exceptions import InputError
+
+__all__ = [
+    "MAC_MIN",
+    "ModeSet",
+    "Tracking",
+    "TrendFit",
+    "fit_trend",
+    "group_pairs",
+    "subspace_mac",
+    "track_modes",
+]
+
+#: Smallest (subspace) MAC of an admissible match: the shapes share more than they do not.
+MAC_MIN = 0.5
+_FAR = 1.0e6
+
+
+@dataclass(frozen=True)
+class ModeSet:
+    """The identified modes of one test, for tracking.
+
+    Attributes
+    ----------
+    test_id : str
+        Test name.
+    conditions : dict
+        ``tyre`` and the numeric conditions (None when not given).
+    frequency_hz, damping_ratio : ndarray, shape (m,)
+        Natural frequencies (Hz) and damping ratios.
+    shapes : ndarray, complex, shape (n_points, m)
+        Mode shapes at the points (any scaling).
+    points : tuple of str
+        Point labels (rows of ``shapes``).
+    """
+
+    test_id: str
+    conditions: Mapping[str, Any]
+    frequency_hz: NDArray[np.float64]
+    damping_ratio: NDArray[np.float64]
+    shapes: NDArray[np.complex128]
+    points: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        f = np.asarray(self.frequency_hz, dtype=float).reshape(-1)
+        z = np.asarray(self.damping_ratio, dtype=float).reshape(-1)
+        s = np.asarray(self.shapes, dtype=complex)
+        if s.ndim != 2 or s.shape[1] != f.size or z.size != f.size:
+            raise InputError(
+                f"ModeSet {self.test_id}: expected shapes (n_points, {f.size}) and "
+                f"{f.size} damping ratios, got {s.shape} and {z.size}"
+            )
+        if s.shape[0] != len(self.points):
+            raise InputError(
+                f"ModeSet {self.test_id}: {s.shape[0]} shape rows but {len(self.points)} points"
+            )
+        object.__setattr__(self, "frequency_hz", f)
+        object.__setattr__(self, "damping_ratio", z)
+        object.__setattr__(self, "shapes", s)
+        object.__setattr__(self, "points", tuple(self.points))
+
+
+def group_pairs(frequency_hz: ArrayLike1, damping_ratio: ArrayLike1) -> list[tuple[int, ...]]:
+    """Group modes into units: pairs with overlapping half-power bands, else singles.
+
+    Two modes ``i``, ``j`` form a pair when ``|f_i - f_j| < zeta_i f_i + zeta_j f_j``;
+    the closest qualifying neighbours are paired first and a mode belongs to at
+    most one pair. Returns index tuples in increasing frequency.
+    """
+    f = np.asarray(frequency_hz, dtype=float)
+    z = np.abs(np.asarray(damping_ratio, dtype=float))
+    order = np.argsort(f, kind="stable")
+    cand = []
+    for a, b in itertools.pairwise(order):
+        d = abs(f[b] - f[a])
+        if d < z[a] * f[a] + z[b] * f[b]:
+            cand.append((d, int(a), int(b)))
+    used: set[int] = set()
+    pairs: dict[int, tuple[int, ...]] = {}
+    for _, a, b in sorted(cand):
+        if a not in used and b not in used:
+            used |= {a, b}
+            pairs[a] = (a, b)
+    units = []
+    for i in order:
+        i = int(i)
+        if i in pairs:
+            units.append(pairs[i])
+        elif i not in used:
+            units.append((i,))
+    return units
+
+
+ArrayLike1 = Sequence[float] | NDArray[np.float64]
+
+
+def _basis(v: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    q, r = np.linalg.qr(v)
+    keep = np.abs(np.diag(r)) > 1e-12 * max(float(np.abs(r).max()), 1e-300)
+    return q[:, keep]
+
+
+def subspace_mac(u: NDArray[np.complex128], v: NDArray[np.complex128]) -> float:
+    """Subspace MAC of the column spaces of ``u`` (n, k1) and ``v`` (n, k2), in [0, 1].
+
+    The mean of ``cos^2`` of the ``min(k1, k2)`` principal angles; for two
+    vectors it is the MAC ``|u^H v|^2 / (|u|^2 |v|^2)``.
+    """
+    u = np.asarray(u, dtype=complex)
+    v = np.asarray(v, dtype=complex)
+    if u.ndim == 1:
+        u = u[:, None]
+    if v.ndim == 1:
+        v = v[:, None]
+    qu, qv = _basis(u), _basis(v)
+    k = min(qu.shape[1], qv.shape[1])
+    if k == 0:
+        return 0.0
+    s = np.linalg.svd(qu.conj().T @ qv, compute_uv=False)
+    return float(min(1.0, np.sum(s[:k] ** 2) / k))
+
+
+@dataclass
+class _Unit:
+    test: int
+    modes: tuple[int, ...]
+    frequency: float
+
+
+@dataclass
+class Tracking:
+    """Result of :func:`track_modes`.
+
+    Attributes
+    ----------
+    family : dict of (test_id, mode index) to str
+        Family name (``F1``, ``F2``, ... by increasing median frequency) of
+        every mode (0-based index within its test).
+    slot : dict of (test_id, mode index) to str
+        ``""`` for single modes, ``"a"``/``"b"`` for the lower/upper mode of a
+        pair.
+    mac : dict of (test_id, mode index) to float
+        The (subspace) MAC of the match that put the mode in its family (NaN
+        for the mode that started the family).
+    pairs : set of str
+        Families holding a pair in at least one test.
+    """
+
+    family: dict[tuple[str, int], str] = field(default_factory=dict)
+    slot: dict[tuple[str, int], str] = field(default_factory=dict)
+    mac: dict[tuple[str, int], float] = field(default_factory=dict)
+    pairs: set[str] = field(default_factory=set)
+
+
+def _numeric_conditions(sets: Sequence[ModeSet]) -> list[str]:
+    names: list[str] = []
+    for s in sets:
+        for k, v in s.conditions.items():
+            if k != "tyre" and isinstance(v, int | float) and k not in names:
+                names.append(k)
+    return names
+
+
+def _distance_fn(sets: Sequence[ModeSet]) -> Any:
+    names = _numeric_conditions(sets)
+    span = {}
+    for c in names:
+        vals = [float(s.conditions[c]) for s in sets if s.conditions.get(c) is not None]
+        span[c] = (max(vals) - min(vals)) if vals and max(vals) > min(vals) else 1.0
+
+    def dist(a: ModeSet, b: ModeSet) -> float:
+        d = 0.0 if a.conditions.get("tyre") == b.conditions.get("tyre") else _FAR
+        for c in names:
+            x, y = a.conditions.get(c), b.conditions.get(c)
+            if x is None and y is None:
+                continue
+            d += 1.0 if (x is None or y is None) else abs(float(x) - float(y)) / span[c]
+        return d
+
+    return dist
+
+
+def _sort_key(s: ModeSet, names: Sequence[str]) -> tuple[Any, ...]:
+    vals = tuple(
+        (0, float(s.conditions[c])) if s.conditions.get(c) is not None else (1, 0.0) for c in names
+    )
+    return (str(s.conditions.get("tyre") or ""), *vals, s.test_id)
+
+
+def _shapes_at(s: ModeSet, modes: tuple[int, ...], points: Sequence[str]) -> NDArray:
+    idx = [s.points.index(p) for p in points]
+    return s.shapes[np.ix_(idx, list(modes))]
+
+
+def track_modes(sets: Sequence[ModeSet]) -> Tracking:
+    """Match the modes of all tests into families (see the module docstring).
+
+    Parameters
+    ----------
+    sets : sequence of ModeSet
+        The identified modes of every test (tests without modes may be given).
+
+    Returns
+    -------
+    Tracking
+    """
+    names = _numeric_conditions(sets)
+    dist = _distance_fn(sets)
+    order = sorted(range(len(sets)), key=lambda i: _sort_key(sets[i], names))
+    units: list[list[_Unit]] = [[] for _ in sets]
+    for i, s in enumerate(sets):
+        for u in group_pairs(s.frequency_hz, s.damping_ratio):
+            units[i].append(_Unit(i, u, float(np.mean(s.frequency_hz[list(u)]))))
+    members: list[dict[int, _Unit]] = []  # family -> {test index: unit}
+    match_mac: dict[tuple[int, tuple[int, ...]], float] = {}
+    visited: list[int] = []
+    for i in order:
+        s = sets[i]
+        cur = units[i]
+        if not cur:
+            visited.append(i)
+            continue
+        reps: list[_Unit] = []
+        for fam in members:
+            j = min(fam, key=lambda t: (dist(s, sets[t]), t))
+            reps.append(fam[j])
+        cost = np.full((len(reps), len(cur)), _FAR)
+        macs = np.zeros((len(reps), len(cur)))
+        for a, rep in enumerate(reps):
+            rs = sets[rep.test]
+            own = rs.shapes[:, list(rep.modes)]
+            alike = [
+                u.frequency
+                for u in units[rep.test]
+                if u is not rep and subspace_mac(own, rs.shapes[:, list(u.modes)]) >= MAC_MIN
+            ]
+            gap = min((abs(rep.frequency - f) for f in alike), default=math.inf)
+            common = [p for p in rs.points if p in s.points]
+            if len(common) < 2:
+                continue
+            ur = _shapes_at(rs, rep.modes, common)
+            for b, unit in enumerate(cur):
+                m = subspace_mac(ur, _shapes_at(s, unit.modes, common))
+                df = abs(unit.frequency - rep.frequency)
+                macs[a, b] = m
+                if m >= MAC_MIN and df < gap:
+                    rel = 0.0 if math.isinf(gap) else df / gap
+                    cost[a, b] = (1.0 - m) + rel**2
+        taken: set[int] = set()
+        if reps:
+            rows, cols = linear_sum_assignment(cost)
+            for a, b in zip(rows, cols, strict=True):
+                if cost[a, b] < _FAR:
+                    members[a][i] = cur[b]
+                    match_mac[(i, cur[b].modes)] = float(macs[a, b])
+                    taken.add(int(b))
+        for b, unit in enumerate(cur):
+            if b not in taken:
+                members.append({i: unit})
+                match_mac[(i, unit.modes)] = float("nan")
+        visited.append(i)
+    # name families by increasing median frequency
+    med = [float(np.median([u.frequency for u in fam.values()])) for fam in members]
+    result = Tracking()
+    for rank, k in enumerate(np.argsort(med, kind="stable")):
+        name = f"F{rank + 1}"
+        fam = members[int(k)]
+        is_pair = any(len(u.modes) == 2 for u in fam.values())
+        if is_pair:
+            result.pairs.add(name)
+        pair_means = _pair_slot_means(sets, fam)
+        for t, unit in fam.items():
+            tid = sets[t].test_id
+            f = sets[t].frequency_hz
+            ordered = sorted(unit.modes, key=lambda q: f[q])
+            for pos, q in enumerate(ordered):
+                if len(ordered) == 2:
+                    slot = "ab"[pos]
+                elif is_pair:
+                    slot = _nearest_slot(float(f[q]), pair_means)
+                else:
+                    slot = ""
+                result.family[(tid, q)] = name
+                result.slot[(tid, q)] = slot
+                result.mac[(tid, q)] = match_mac[(t, unit.modes)]
+    return result
+
+
+def _pair_slot_means(sets: Sequence[ModeSet], fam: Mapping[int, _Unit]) -> tuple[float, float]:
+    lo, hi = [], []
+    for t, u in fam.items():
+        if len(u.modes) == 2:
+            fs = sorted(float(sets[t].frequency_hz[q]) for q in u.modes)
+            lo.append(fs[0])
+            hi.append(fs[1])
+    if not lo:
+        return (math.nan, math.nan)
+    return (float(np.mean(lo)), float(np.mean(hi)))
+
+
+def _nearest_slot(f: float, means: tuple[float, float]) -> str:
+    return "a" if abs(f - means[0]) <= abs(f - means[1]) else "b"
+
+
+# ---------------------------------------------------------------------- trends
+@dataclass(frozen=True)
+class TrendFit:
+    """A weighted polynomial trend ``y(x)`` with its uncertainty.
+
+    Attributes
+    ----------
+    degree : int
+        Polynomial degree chosen by AICc.
+    coef : ndarray, shape (degree + 1,)
+        Coefficients in the scaled variable ``u = (x - x0) / xs``, lowest first.
+    cov : ndarray, shape (degree + 1, degree + 1)
+        Their covariance (scaled by the reduced chi-square, at least 1).
+    x0, xs : float
+        Centre and scale of ``x``.
+    transform : {"none", "square"}
+        ``"square"``: the polynomial is fitted to ``y^2`` (frequency against
+        pressure) and :meth:`predict` returns ``sqrt``.
+    n : int
+        Number of observations.
+    aicc : dict of int to float
+        AICc of every degree tried.
+    """
+
+    degree: int
+    coef: NDArray[np.float64]
+    cov: NDArray[np.float64]
+    x0: float
+    xs: float
+    transform: str
+    n: int
+    aicc: dict[int, float]
+
+    def predict(self, x: ArrayLike1) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Trend value and its standard error at ``x`` (same units as the data)."""
+        u = (np.asarray(x, dtype=float) - self.x0) / self.xs
+        a = np.vander(np.atleast_1d(u), self.degree + 1, increasing=True)
+        g = a @ self.coef
+        sg = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", a, self.cov, a), 0.0))
+        if self.transform == "square":
+            y = np.sqrt(np.maximum(g, 0.0))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                sy = np.where(y > 0, sg / (2 * y), np.inf)
+            return y, sy
+        return g, sg
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready description."""
+        return {
+            "degree": self.degree,
+            "coef": self.coef.tolist(),
+            "cov": self.cov.tolist(),
+            "x0": self.x0,
+            "xs": self.xs,
+            "transform": self.transform,
+            "n": self.n,
+            "aicc": {str(k): v for k, v in self.aicc.items()},
+        }
+
+
+def fit_trend(
+    x: ArrayLike1,
+    y: ArrayLike1,
+    sigma: ArrayLike1 | None = None,
+    *,
+    transform: str = "none",
+    max_degree: int = 3,
+) -> TrendFit:
+    """Fit a weighted polynomial trend with the degree chosen by AICc.
+
+    Parameters
+    ----------
+    x, y : array_like, shape (n,)
+        Condition values and observations (finite).
+    sigma : array_like, shape (n,), optional
+        Standard errors of ``y`` (> 0); missing, zero or non-finite values
+        take the median of the others (all missing: equal weights).
+    transform : {"none", "square"}
+        Fit ``y^2`` instead of ``y`` (standard errors ``2 y sigma``).
+    max_degree : int
+        Highest degree tried; degree ``d`` needs ``n >= d + 2`` observations
+        at ``d + 1`` distinct ``x`` (at least one residual degree of freedom);
+        where the AICc correction is undefined (``n = d + 2``) plain AIC is used.
+
+    Raises
+    ------
+    InputError
+        Fewer than 3 finite observations or 2 distinct ``x``, or a bad transform.
+    """
+    xv = np.asarray(x, dtype=float).reshape(-1)
+    yv = np.asarray(y, dtype=float).reshape(-1)
+    if xv.size != yv.size:
+        raise InputError(f"fit_trend: x and y differ in length ({xv.size} and {yv.size})")
+    sv = (
+        np.full(yv.size, np.nan)
+        if sigma is None
+        else np.asarray(
+            [np.nan if s is None else s for s in np.asarray(sigma, dtype=object)], dtype=float
+        )
+    )
+    ok = np.isfinite(xv) & np.isfinite(yv)
+    xv, yv, sv = xv[ok], yv[ok], sv[ok]
+    if transform not in ("none", "square"):
+        raise InputError(f"fit_trend: transform must be 'none' or 'square', got {transform!r}")
+    n_distinct = np.unique(xv).size
+    if yv.size < 3 or n_distinct < 2:
+        raise InputError(
+            f"fit_trend: expected at least 3 observations at 2 distinct values, got {yv.size} "
+            f"at {n_distinct}"
+        )
+    good = np.isfinite(sv) & (sv > 0)
+    sv = np.where(good, sv, np.median(sv[good]) if good.any() else 1.0)
+    absolute = bool(good.any())
+    if transform == "square":
+        sv = 2 * np.abs(yv) * sv
+        yv = yv**2
+    w = 1.0 / sv**2
+    x0 = float(np.mean(xv))
+    xs = float(np.ptp(xv)) / 2 or 1.0
+    u = (xv - x0) / xs
+    n = yv.size
+    best: tuple[float, int, Any] | None = None
+    aicc: dict[int, float] = {}
+    for d in range(0, max_degree + 1):
+        k = d + 1
+        if n < k + 1 or n_distinct < k:
+            break
+        a = np.vander(u, k, increasing=True)
+        sw = np.sqrt(w)
+        coef, *_ = np.linalg.lstsq(a * sw[:, None], yv * sw, rcond=None)
+        chi2 = float(np.sum(w * (yv - a @ coef) ** 2))
+        # Gaussian likelihood with the error scale estimated from the residuals; the
+        # small-sample correction where it is defined (n > k + 1), plain AIC otherwise
+        corr = 2 * k * (k + 1) / (n - k - 1) if n > k + 1 else 0.0
+        score = n * math.log(max(chi2 / n, 1e-300)) + 2 * k + corr
+        aicc[d] = score
+        if best is None or score < best[0] - 1e-12:
+            best = (score, d, (a, coef, chi2))
+    assert best is not None
+    _, d, (a, coef, chi2) = best
+    k = d + 1
+    s2 = chi2 / (n - k) if n > k else 1.0
+    if absolute:
+        s2 = max(s2, 1.0)
+    cov = s2 * np.linalg.inv((a * w[:, None]).T @ a)
+    return TrendFit(d, np.asarray(coef), cov, x0, xs, transform, n, aicc)

@@ -1,0 +1,343 @@
+"""``tyredamp tyre-model``: flexible-ring and rigid-ring tyre models from modes files.
+
+``tyredamp tyre-model MODES_JSON... --out DIR --radius R`` reads one modes
+JSON per test pressure (``tyredamp modal``), labels every mode with its
+circumferential wave number, updates the flexible ring jointly across the
+pressures and writes into the new directory ``DIR``:
+
+* ``ring.json`` -- wave numbers, ring parameters with standard errors,
+  correlations and identifiability verdicts, predictions;
+* ``rigid_ring.json`` -- in-plane rigid-ring (MF-Swift) parameters per
+  pressure, the fields the test cannot give, lateral carcass quantities;
+* ``tyre_inplane_<p>bar.tir`` -- the in-plane ``.tir`` subset per pressure;
+* ``ring_frequencies.png`` -- identified against updated-ring frequencies.
+
+All files are written into a temporary directory beside ``DIR`` first and
+moved into place only when every one is complete: all outputs or none.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..documents.jsonfile import json_text
+from ..documents.modes import read_modes_json
+from ..exceptions import FileFormatError, InputError
+from ..io._safety import atomic_dir, check_output_dir, private_matplotlib_config
+from ..modal.model import ModalModel
+from ._common import OutPath
+
+__all__ = ["tyre_model_command", "write_all_or_none"]
+
+_BAR = 1e5
+_FIGURE = "ring_frequencies.png"
+
+
+def _float_list(text: str | None, name: str) -> list[float] | None:
+    if text is None:
+        return None
+    try:
+        vals = [float(x) for x in text.replace(";", ",").split(",") if x.strip()]
+    except ValueError:
+        raise InputError(f"{name}: expected numbers separated by commas, got {text!r}") from None
+    if not vals or not all(math.isfinite(v) and v >= 0 for v in vals):
+        raise InputError(f"{name}: expected finite values >= 0, got {text!r}")
+    return vals
+
+
+def _meta_pressure_bar(path: Path, model: ModalModel) -> float | None:
+    """Pressure (bar) from the modes document or the model's meta, if recorded."""
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        doc = {}
+    for src in (doc if isinstance(doc, dict) else {}, model.meta):
+        if src.get("pressure_bar") is not None:
+            return float(src["pressure_bar"])
+        if src.get("pressure_pa") is not None:
+            return float(src["pressure_pa"]) / _BAR
+    return None
+
+
+def check_out_dir(out_dir: Path) -> Path:
+    """Refuse an ``--out`` directory that cannot work or is not new or empty; before work.
+
+    See :func:`tyredamp.io._safety.check_output_dir` (a file, the current
+    directory, a missing or read-only parent are refused); a tyre-model output
+    keeps no file list, so any non-empty directory is refused as well. Returns
+    the real directory (links followed).
+    """
+
+    def not_empty(root: Path) -> None:
+        raise InputError(
+            f"--out: directory {out_dir} exists and is not empty; choose a new directory"
+        )
+
+    return check_output_dir(out_dir, not_empty)
+
+
+def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]]) -> list[Path]:
+    """Write every file of ``writers`` into ``out_dir``, or none of them.
+
+    The directory is checked first (:func:`check_out_dir`: it must be new or
+    empty), then every writer writes its file into a temporary directory
+    beside ``out_dir`` that is flushed to disk and renamed into place only
+    when all succeeded (:func:`tyredamp.io._safety.atomic_dir`); on any error
+    or interruption the temporary directory is removed and ``out_dir`` is as
+    it was. Nothing that this function did not write is ever removed.
+
+    Returns
+    -------
+    list of Path
+        The written files.
+    """
+    target = Path(out_dir)
+    check_out_dir(target)
+    written: list[str] = []
+    with atomic_dir(target) as tmp_dir:
+        for name, write in writers.items():
+            write(tmp_dir / name)
+            written.append(name)
+    return [target / n for n in written]
+
+
+@click.command("tyre-model")
+@click.argument(
+    "modes_files", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path)
+)
+@click.option(
+    "--out",
+    "-o",
+    "out",
+    required=True,
+    type=OutPath(file_okay=False, path_type=Path),
+    help="New directory for the outputs (written all at once or not at all).",
+)
+@click.option(
+    "--radius",
+    type=click.FloatRange(min=0, min_open=True),
+    required=True,
+    metavar="M",
+    help="Belt (tread-band centre line) radius in m.",
+)
+@click.option(
+    "--pressure",
+    "pressures",
+    metavar="P1,P2,...",
+    help="Test pressure of each modes file in bar (default from the files' metadata).",
+)
+@click.option(
+    "--model",
+    "model_kind",
+    type=click.Choice(["auto", "complex", "real"]),
+    default="auto",
+    show_default=True,
+    help="Which modes of the files to use (auto: complex when present).",
+)
+@click.option(
+    "--attachment-mass",
+    type=click.FloatRange(min=0),
+    default=0.0,
+    show_default=True,
+    metavar="KG",
+    help="Known point mass at each drive point (transducer, drive-rod tip), kg.",
+)
+@click.option(
+    "--attachment-damping",
+    type=click.FloatRange(min=0),
+    metavar="NS_PER_M",
+    help="Known local radial damper at each drive point, N s/m (default: fitted).",
+)
+@click.option(
+    "--mass-per-length",
+    type=click.FloatRange(min=0, min_open=True),
+    metavar="KG_PER_M",
+    help="Known belt mass per length (default: from the mass-normalised shapes).",
+)
+@click.option(
+    "--foundation-law",
+    type=click.Choice(["linear", "constant"]),
+    default="linear",
+    show_default=True,
+    help="Pressure dependence of the sidewall stiffnesses k_r, k_t across pressures.",
+)
+@click.option(
+    "--predict",
+    "predict",
+    metavar="P1,P2,...",
+    help="Extra pressures (bar) at which to predict the ring's modes.",
+)
+@click.option(
+    "--lateral",
+    "lateral_files",
+    multiple=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Lateral-fit JSON (tyredamp lateral fit) for the lateral carcass quantities; repeatable.",
+)
+@click.option(
+    "--lateral-pressure",
+    type=click.FloatRange(min=0),
+    metavar="BAR",
+    help="Pressure of the lateral tests when their files do not record it.",
+)
+def tyre_model_command(
+    modes_files: tuple[Path, ...],
+    out: Path,
+    radius: float,
+    pressures: str | None,
+    model_kind: str,
+    attachment_mass: float,
+    attachment_damping: float | None,
+    mass_per_length: float | None,
+    foundation_law: str,
+    predict: str | None,
+    lateral_files: tuple[Path, ...],
+    lateral_pressure: float | None,
+) -> None:
+    """Flexible-ring and rigid-ring tyre models from modes files at one or more pressures.
+
+    Every mode gets its circumferential wave number from its shape (the
+    outputs' angles); the ring on an elastic foundation (EI, T0 = p R b +
+    T_c, k_r, k_t, mass per length, damping) is fitted to all pressures at
+    once with the modal standard errors as weights; the in-plane rigid-ring
+    parameters (BELT_MASS, FREQ_LONG, DAMP_LONG) come from the n = 1 modes.
+    Fields a radial test cannot give (wind-up, lateral, yaw) are listed, not
+    invented.
+
+    \b
+    Example:
+      tyredamp tyre-model m5.json m7.json m9.json --pressure 5,7,9 \\
+          --radius 0.5 --attachment-mass 0.1 --out tyre_model
+    """
+    check_out_dir(out)
+    with private_matplotlib_config():
+        _tyre_model(
+            modes_files,
+            out,
+            radius,
+            pressures,
+            model_kind,
+            attachment_mass,
+            attachment_damping,
+            mass_per_length,
+            foundation_law,
+            predict,
+            lateral_files,
+            lateral_pressure,
+        )
+
+
+def _tyre_model(
+    modes_files: tuple[Path, ...],
+    out: Path,
+    radius: float,
+    pressures: str | None,
+    model_kind: str,
+    attachment_mass: float,
+    attachment_damping: float | None,
+    mass_per_length: float | None,
+    foundation_law: str,
+    predict: str | None,
+    lateral_files: tuple[Path, ...],
+    lateral_pressure: float | None,
+) -> None:
+    from matplotlib.figure import Figure
+
+    from ..plot.tyremodel import plot_ring_frequencies
+    from ..tyremodel.lateral import read_lateral_carcass
+    from ..tyremodel.pipeline import build_tyre_model
+
+    p_list = _float_list(pressures, "--pressure")
+    if p_list is not None and len(p_list) != len(modes_files):
+        raise InputError(
+            f"--pressure: expected one pressure per modes file ({len(modes_files)}), "
+            f"got {len(p_list)}"
+        )
+    inputs: list[tuple[float, ModalModel, str]] = []
+    for i, path in enumerate(modes_files):
+        models = read_modes_json(path)
+        if model_kind == "auto":
+            mdl = models.get("complex") or models["real"]
+        elif model_kind not in models:
+            raise FileFormatError(f"{path}: no {model_kind!r} modes in the file")
+        else:
+            mdl = models[model_kind]
+        pb = p_list[i] if p_list is not None else _meta_pressure_bar(path, mdl)
+        if pb is None:
+            raise InputError(
+                f"{path}: the test pressure is not recorded in the file; give --pressure"
+            )
+        inputs.append((pb * _BAR, mdl, path.name))
+    preds = [p * _BAR for p in (_float_list(predict, "--predict") or [])]
+    lateral = []
+    for lf in lateral_files:
+        lateral += read_lateral_carcass(lf, pressure_bar=lateral_pressure)
+    res = build_tyre_model(
+        inputs,
+        radius=radius,
+        attachment_mass=attachment_mass,
+        attachment_damping=attachment_damping,
+        mass_per_length=mass_per_length,
+        foundation_law=foundation_law,  # type: ignore[arg-type]
+        predict_pressures=preds,
+        lateral=lateral,
+    )
+    ring_text = json_text(res.ring_document(), indent=1)
+    rigid_text = json_text(res.rigid_document(), indent=1)
+    tirs = res.tir_files()
+    fig = Figure(figsize=(6.5, 4.0), layout="constrained")
+    plot_ring_frequencies(res.ring, ax=fig.subplots())
+
+    def text_writer(text: str) -> Callable[[Path], None]:
+        def write(tmp: Path) -> None:
+            tmp.write_text(text, encoding="utf-8")
+
+        return write
+
+    def write_fig(tmp: Path) -> None:
+        fig.savefig(tmp, format="png", dpi=120)
+
+    writers: dict[str, Callable[[Path], None]] = {
+        "ring.json": text_writer(ring_text),
+        "rigid_ring.json": text_writer(rigid_text),
+    }
+    for name, text in tirs.items():
+        writers[name] = text_writer(text)
+    writers[_FIGURE] = write_fig
+    files = write_all_or_none(out, writers)
+    _echo_summary(res)
+    click.echo(f"wrote {out}/: " + ", ".join(f.name for f in files))
+
+
+def _echo_summary(res: Any) -> None:
+    for src, p, wa in zip(res.sources, res.pressures, res.analyses, strict=True):
+        click.echo(f"{src} ({p / _BAR:g} bar): wave numbers")
+        for row in wa.format_table().splitlines():
+            click.echo("  " + row)
+        for w in wa.warnings:
+            click.echo(f"  warning: {w}")
+    ring = res.ring
+    click.echo(
+        f"flexible ring ({len(ring.observations)} modes, {ring.pressures.size} pressure(s), "
+        f"weights: {ring.weights}, chi2/dof {ring.chi2 / max(ring.dof, 1):.3g}"
+        f"{', covariance scaled' if ring.scaled_covariance else ''}, "
+        f"{1e3 * ring.fit_time_s:.0f} ms):"
+    )
+    for row in ring.format_table().splitlines():
+        click.echo("  " + row)
+    for r in res.rigid:
+        pb = "?" if r.pressure is None else f"{r.pressure / _BAR:g} bar"
+        click.echo(
+            f"rigid ring ({pb}): BELT_MASS {r.belt_mass:.4g} +- {r.belt_mass_std:.2g} kg, "
+            f"FREQ_LONG {r.freq_long:.4g} +- {r.freq_long_std:.2g} Hz, DAMP_LONG "
+            f"{r.damp_long:.4g} +- {r.damp_long_std:.2g}; FREQ_WINDUP, DAMP_WINDUP, BELT_IYY "
+            "not given (wind-up needs tangential measurement)"
+        )
+    for c in res.lateral:
+        click.echo(c.comment())

@@ -1,0 +1,86 @@
+"""NI TDMS time data (LabVIEW) through npTDMS.
+
+All channels of one group (the first group holding data, or ``group``) are
+read. The sample rate comes from the channels' ``wf_increment`` property
+(seconds per sample, the LabVIEW waveform attribute; all equal), the units
+from ``unit_string`` (read by :mod:`.units` and converted to SI), the channel
+names from the TDMS channel names. The force is the channel with a force
+unit (or the one named ``"force"`` in ``quantities``); see :mod:`._channels`.
+Channels are numbered as nodes 1..n in file order (direction +Z), named as
+in the file.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+
+import numpy as np
+
+from ..exceptions import FileFormatError
+from ..timedata import TimeData
+from ._channels import snap_rate, timedata_from_channels
+from ._common import check_input_file
+
+__all__ = ["read_tdms"]
+
+
+def read_tdms(
+    path: str | os.PathLike[str],
+    quantities: Mapping[str, str] | None = None,
+    group: str | None = None,
+) -> TimeData:
+    """Read time data from a TDMS file.
+
+    Parameters
+    ----------
+    path : path-like
+    quantities : mapping of channel name to quantity, optional
+        ``"force"``, ``"displacement"``, ``"velocity"`` or ``"acceleration"``
+        for channels whose ``unit_string`` is blank (or to override it).
+    group : str, optional
+        Group to read; default the first group with channels.
+
+    Raises
+    ------
+    FileFormatError
+        Not a TDMS file, no channels, no or unequal ``wf_increment``,
+        unequal lengths, unknown quantities, no force channel.
+    """
+    try:
+        from nptdms import TdmsFile
+    except ImportError:  # pragma: no cover - optional dependency
+        raise FileFormatError(
+            f"{path}: reading TDMS needs npTDMS (pip install 'tyredamp[tdms]')"
+        ) from None
+    p = check_input_file(path)
+    try:
+        f = TdmsFile.read(str(p))
+        groups = [g for g in f.groups() if g.channels()]
+    except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on garbage
+        raise FileFormatError(f"{p}: not a readable TDMS file ({exc})") from None
+    if group is not None:
+        groups = [g for g in groups if g.name == group]
+        if not groups:
+            raise FileFormatError(f"{p}: no group {group!r} with channels")
+    if not groups:
+        raise FileFormatError(f"{p}: no channels in the TDMS file")
+    chans = groups[0].channels()
+    names, units, arrays, steps = [], [], [], []
+    for c in chans:
+        props = c.properties
+        if "wf_increment" not in props:
+            raise FileFormatError(
+                f"{p}: channel {c.name!r} has no wf_increment (sample interval) property"
+            )
+        try:
+            steps.append(float(props["wf_increment"]))
+            arrays.append(np.asarray(c[:], dtype=float))
+        except (TypeError, ValueError) as exc:
+            raise FileFormatError(f"{p}: channel {c.name!r}: {exc}") from None
+        names.append(str(c.name))
+        units.append(str(props.get("unit_string", "") or ""))
+    dt = steps[0]
+    if not np.isfinite(dt) or dt <= 0 or any(abs(s - dt) > 1e-12 * dt for s in steps):
+        raise FileFormatError(f"{p}: channels have different or invalid sample intervals {steps}")
+    return timedata_from_channels(p, names, units, arrays, snap_rate(1.0 / dt), quantities)

@@ -1,0 +1,337 @@
+"""Units labels as vendors write them: parsed to SI factor and physical dimension.
+
+A label such as ``(1/N)*(m/s²)``, ``g/N``, ``m/s2/N``, ``mm/s/N``, ``ms^-2``
+or ``lbf`` is read by a small grammar::
+
+    label  := product
+    product:= power (op power)*          op: "/", "*", ".", "·", "×" or a space
+    power  := atom exponent?             exponent: "^n", "**n", "n", "⁻²", "-n"
+    atom   := unit symbol | number | "(" product ")"
+
+evaluated left to right (``m/s/N`` is ``(m/s)/N``). The result is a factor
+to SI and the exponents of length (m), time (s) and force (N); a label
+whose dimension is a displacement, velocity, acceleration or force (or one of
+those per force, an FRF) is accepted, anything else is refused with an
+:class:`~tyredamp.exceptions.InputError` that names the label.
+
+Unit symbols (case as written; upper-case variants such as ``MM/S^2`` are
+accepted where they are unambiguous): ``m``, ``mm``, ``cm``, ``um``/``µm``/
+``μm``/``micron``, ``nm``, ``km``, ``in``/``inch``, ``ft``, ``mil``; ``s``/
+``sec``; ``N``, ``kN``, ``mN``, ``lbf``, ``kgf``, ``kg``; ``g`` and ``gn``
+(standard gravity 9.80665 m/s^2, as in vibration practice, not the gram);
+``ips`` (inch per second). Assumptions stated: ``lb`` is taken as the
+pound-force ``lbf`` (vibration labels such as ``g/lb`` mean force), and
+``ms`` directly followed by an exponent or at the start of a label is metre
+times second (``ms^-2``, ``ms-1``), never the millisecond.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Literal
+
+from ..exceptions import InputError
+
+__all__ = ["QUANTITY_DIMENSIONS", "Unit", "frf_units", "parse_unit", "quantity_units"]
+
+_G = 9.80665
+_LBF = 4.4482216152605
+_IN = 0.0254
+
+# symbol -> (factor to SI, (length, time, force) exponents)
+_ATOMS: dict[str, tuple[float, tuple[int, int, int]]] = {
+    "m": (1.0, (1, 0, 0)),
+    "mm": (1e-3, (1, 0, 0)),
+    "cm": (1e-2, (1, 0, 0)),
+    "um": (1e-6, (1, 0, 0)),
+    "µm": (1e-6, (1, 0, 0)),
+    "μm": (1e-6, (1, 0, 0)),
+    "micron": (1e-6, (1, 0, 0)),
+    "microns": (1e-6, (1, 0, 0)),
+    "nm": (1e-9, (1, 0, 0)),
+    "km": (1e3, (1, 0, 0)),
+    "in": (_IN, (1, 0, 0)),
+    "inch": (_IN, (1, 0, 0)),
+    "inches": (_IN, (1, 0, 0)),
+    "ft": (0.3048, (1, 0, 0)),
+    "mil": (_IN * 1e-3, (1, 0, 0)),
+    "meter": (1.0, (1, 0, 0)),
+    "metre": (1.0, (1, 0, 0)),
+    "s": (1.0, (0, 1, 0)),
+    "sec": (1.0, (0, 1, 0)),
+    "N": (1.0, (0, 0, 1)),
+    "kN": (1e3, (0, 0, 1)),
+    "mN": (1e-3, (0, 0, 1)),
+    "newton": (1.0, (0, 0, 1)),
+    "lbf": (_LBF, (0, 0, 1)),
+    "lb": (_LBF, (0, 0, 1)),
+    "kgf": (_G, (0, 0, 1)),
+    "kg": (1.0, (-1, 2, 1)),  # N s^2 / m
+    "g": (_G, (1, -2, 0)),
+    "gn": (_G, (1, -2, 0)),
+    "ips": (_IN, (1, -1, 0)),
+}
+# case-insensitive look-up where unambiguous (MN, mN clash: neither taken from upper case)
+_LOWER: dict[str, str] = {}
+for _k in _ATOMS:
+    _LOWER.setdefault(_k.lower(), _k)
+_LOWER["n"] = "N"
+_LOWER["kn"] = "kN"
+_LOWER.pop("mn", None)
+
+_SUPERSCRIPT = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺", "0123456789-+")
+_TOKEN = re.compile(
+    r"\s*(?:(?P<num>\d+(?:\.\d*)?(?:[eE][-+]?\d+)?)|(?P<sup>[⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺]+)"
+    r"|(?P<word>[A-Za-zµμ]+)|(?P<op>\*\*|[/*·×^().\-+]))"
+)
+
+Quantity = Literal["displacement", "velocity", "acceleration", "force"]
+#: (length, time, force) exponents of each measured quantity.
+QUANTITY_DIMENSIONS: dict[str, tuple[int, int, int]] = {
+    "displacement": (1, 0, 0),
+    "velocity": (1, -1, 0),
+    "acceleration": (1, -2, 0),
+    "force": (0, 0, 1),
+}
+_KIND = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A parsed units label.
+
+    Attributes
+    ----------
+    label : str
+        The label as written.
+    factor : float
+        Multiply values in this unit by ``factor`` to get SI (m, s, N).
+    dimensions : (int, int, int)
+        Exponents of length, time and force.
+    """
+
+    label: str
+    factor: float
+    dimensions: tuple[int, int, int]
+
+    @property
+    def quantity(self) -> str | None:
+        """``"displacement"``, ``"velocity"``, ``"acceleration"``, ``"force"`` or None."""
+        for q, d in QUANTITY_DIMENSIONS.items():
+            if d == self.dimensions:
+                return q
+        return None
+
+    @property
+    def frf_kind(self) -> str | None:
+        """``"receptance"``, ``"mobility"`` or ``"accelerance"`` for a response per force."""
+        le, t, f = self.dimensions
+        for q, d in QUANTITY_DIMENSIONS.items():
+            if q != "force" and d == (le, t, f + 1):
+                return _KIND[q]
+        return None
+
+
+class _Parser:
+    def __init__(self, label: str) -> None:
+        self.label = label
+        self.toks: list[tuple[str, str]] = []
+        text = label.strip()
+        pos = 0
+        while pos < len(text):
+            m = _TOKEN.match(text, pos)
+            if m is None or m.end() == pos:
+                if text[pos:].strip() == "":
+                    break
+                raise self.error(f"unexpected character {text[pos]!r}")
+            kind = m.lastgroup or ""
+            self.toks.append((kind, m.group(kind)))
+            pos = m.end()
+        self.i = 0
+
+    def error(self, why: str) -> InputError:
+        return InputError(f"units label {self.label!r}: {why}")
+
+    def peek(self) -> tuple[str, str] | None:
+        return self.toks[self.i] if self.i < len(self.toks) else None
+
+    def take(self) -> tuple[str, str]:
+        tok = self.toks[self.i]
+        self.i += 1
+        return tok
+
+    def parse(self) -> tuple[float, tuple[int, int, int]]:
+        if not self.toks:
+            raise self.error("empty")
+        out = self.product()
+        if self.peek() is not None:
+            raise self.error(f"unexpected {self.peek()[1]!r}")  # type: ignore[index]
+        return out
+
+    def product(self) -> tuple[float, tuple[int, int, int]]:
+        fac, dim = self.power()
+        while True:
+            tok = self.peek()
+            if tok is None or tok[1] == ")":
+                return fac, dim
+            if tok[0] == "op" and tok[1] in ("/", "*", ".", "·", "×"):
+                self.take()
+                sign = -1 if tok[1] == "/" else 1
+            elif tok[0] in ("word", "num") or tok[1] == "(":
+                sign = 1  # implicit product: "N m", "m s^-2"
+            else:
+                raise self.error(f"unexpected {tok[1]!r}")
+            f2, d2 = self.power()
+            fac = fac * f2 if sign > 0 else fac / f2
+            dim = tuple(a + sign * b for a, b in zip(dim, d2, strict=True))  # type: ignore[assignment]
+
+    def power(self) -> tuple[float, tuple[int, int, int]]:
+        fac, dim, is_number = self.atom()
+        n = None if is_number else self.exponent()
+        if n is None:
+            return fac, dim
+        return fac**n, tuple(d * n for d in dim)  # type: ignore[return-value]
+
+    def exponent(self) -> int | None:
+        tok = self.peek()
+        if tok is None:
+            return None
+        kind, text = tok
+        if kind == "sup":
+            self.take()
+            return self._int(text.translate(_SUPERSCRIPT))
+        if kind == "op" and text in ("^", "**"):
+            self.take()
+            sign = ""
+            nxt = self.peek()
+            if nxt is not None and nxt[1] in ("-", "+"):
+                sign = self.take()[1]
+            if nxt is not None and nxt[1] == "(":
+                raise self.error("parenthesised exponents are not supported")
+            num = self.peek()
+            if num is None or num[0] != "num":
+                raise self.error(f"expected an integer exponent after {text!r}")
+            return self._int(sign + self.take()[1])
+        if kind == "op" and text == "-":  # "s-2", "ms-1"
+            self.take()
+            num = self.peek()
+            if num is None or num[0] != "num":
+                raise self.error("expected an integer exponent after '-'")
+            return self._int("-" + self.take()[1])
+        if kind == "num":  # "s2"
+            self.take()
+            return self._int(text)
+        return None
+
+    def _int(self, text: str) -> int:
+        try:
+            return int(text)
+        except ValueError:
+            raise self.error(f"exponent {text!r} is not an integer") from None
+
+    def atom(self) -> tuple[float, tuple[int, int, int], bool]:
+        if self.peek() is None:
+            raise self.error("ends where a unit was expected")
+        kind, text = self.take()
+        if kind == "num":
+            return float(text), (0, 0, 0), True
+        if text == "(":
+            fac, dim = self.product()
+            tok = self.peek()
+            if tok is None or tok[1] != ")":
+                raise self.error("unbalanced parenthesis")
+            self.take()
+            return fac, dim, False
+        if kind == "word":
+            return (*self.word(text), False)
+        raise self.error(f"unexpected {text!r}")
+
+    def word(self, text: str) -> tuple[float, tuple[int, int, int]]:
+        key = text if text in _ATOMS else _LOWER.get(text.lower())
+        if key is None and text.lower() == "ms":
+            # metre times second ("ms^-2", "ms-1"), never the millisecond: the
+            # exponent that follows belongs to the second
+            self.toks.insert(self.i, ("word", "s"))
+            return _ATOMS["m"]
+        if key is None:
+            raise self.error(
+                f"unknown unit {text!r}; known: m, mm, cm, um, nm, in, ft, mil, s, N, kN, lbf, "
+                "kgf, kg, g (gravity), ips"
+            )
+        return _ATOMS[key]
+
+
+def parse_unit(label: str) -> Unit:
+    """Parse a units label (module docstring); raise :class:`InputError` naming it."""
+    if not isinstance(label, str):
+        raise InputError(f"units label: expected text, got {type(label).__name__}")
+    fac, dim = _Parser(label).parse()
+    return Unit(label=label, factor=float(fac), dimensions=dim)
+
+
+def _blank(label: object) -> bool:
+    return label is None or str(label).strip().upper() in ("", "NONE", "-")
+
+
+def quantity_units(label: object) -> tuple[str, float] | None:
+    """``(quantity, factor to SI)`` of a measured signal's label; None when blank/``NONE``.
+
+    Raises
+    ------
+    InputError
+        The label cannot be read, or its dimension is not a displacement,
+        velocity, acceleration or force.
+    """
+    if _blank(label):
+        return None
+    u = parse_unit(str(label))
+    q = u.quantity
+    if q is None:
+        raise InputError(
+            f"units label {label!r}: dimension m^{u.dimensions[0]} s^{u.dimensions[1]} "
+            f"N^{u.dimensions[2]} is not a displacement, velocity, acceleration or force"
+        )
+    return q, u.factor
+
+
+def frf_units(label: object, denominator: object = None) -> tuple[str | None, float] | None:
+    """``(FRF kind, factor to SI)`` of an FRF's units label(s); None when both are blank.
+
+    ``label`` may hold the whole ratio (``(m/s^2)/N``, ``g/lbf``,
+    ``(1/N)*(m/s²)``) or only the response (``m/s^2``), with the force in
+    ``denominator`` (a UFF denominator label); a response without any force
+    is taken per newton. With a blank ``label`` and a force denominator the
+    kind is None (unknown response) and the factor converts the force.
+
+    Raises
+    ------
+    InputError
+        A label that cannot be read, a denominator that is not a force, or a
+        ratio that is not a displacement, velocity or acceleration per force.
+    """
+    if _blank(label) and _blank(denominator):
+        return None
+    d_factor, d_force = 1.0, 0
+    if not _blank(denominator):
+        d = parse_unit(str(denominator))
+        if d.quantity != "force":
+            raise InputError(f"units label {denominator!r}: an FRF denominator must be a force")
+        d_factor, d_force = d.factor, 1
+    if _blank(label):
+        return None, 1.0 / d_factor
+    u = parse_unit(str(label))
+    dims = (u.dimensions[0], u.dimensions[1], u.dimensions[2] - d_force)
+    ratio = Unit(u.label, u.factor / d_factor, dims)
+    kind = ratio.frf_kind
+    if kind is not None:
+        return kind, ratio.factor
+    q = ratio.quantity
+    if q is not None and q != "force" and d_force == 0:
+        return _KIND[q], ratio.factor  # response only: per newton
+    raise InputError(
+        f"units label {label!r}"
+        + (f" over {denominator!r}" if d_force else "")
+        + f": dimension m^{dims[0]} s^{dims[1]} N^{dims[2]} is not a displacement, velocity "
+        "or acceleration per force"
+    )

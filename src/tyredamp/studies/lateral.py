@@ -1,0 +1,216 @@
+"""The lateral tyre-dynamics study of paper 001 as named steps.
+
+Each step takes typed inputs and returns a typed result; ``tyredamp lateral
+fit``, the demo and batch processing call these::
+
+    FRF --lateral_data--> LateralData --fit_models--> Ranking (every model, best first)
+
+On the virtual rolling-tyre rig (known truth): :func:`measure_condition`
+(ground- and axle-force FRFs, every model fitted and ranked),
+:func:`vehicle_study` (eq. 41-44), :func:`time_test` (the sine test and the
+causal approximation) and :func:`run_lateral`, the whole study of the demo.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..exceptions import InputError, PhysicsError
+from ..frf import FRF
+from ..lateral import (
+    DEFAULT_MODELS,
+    LateralData,
+    LateralVehicle,
+    Ranking,
+    Resonance,
+    causal_error,
+    figure7_curves,
+    harmonic_response,
+    rank_models,
+)
+from ..lateral.fit import Criterion, Weights
+from ..lateral.response import ForceKind
+from ..virtual.lateral_rig import KMH, VirtualLateralRig
+from .results import LateralCondition, LateralStudy, TimeTest, VehicleStudy
+from .settings import DemoSettings
+
+__all__ = [
+    "fit_models",
+    "lateral_data",
+    "measure_condition",
+    "run_lateral",
+    "time_test",
+    "vehicle_study",
+]
+
+#: ``stage(description)``: called before each stage of :func:`run_lateral`.
+StageCallback = Callable[[str], None]
+
+
+# ---------------------------------------------------------------------------- steps
+def lateral_data(
+    frf: FRF,
+    *,
+    speed_kmh: float | None = None,
+    force: ForceKind | None = None,
+    wheel_mass: float | None = None,
+) -> LateralData:
+    """A lateral measurement from an FRF; conditions not given come from its ``meta``.
+
+    Parameters
+    ----------
+    frf : FRF
+        Lateral acceleration (or displacement, velocity) per lateral force.
+    speed_kmh : float, optional
+        Rolling speed, km/h (> 0).
+    force : {"ground", "axle"}, optional
+        Where the force acts.
+    wheel_mass : float, optional
+        Wheel mass, kg.
+    """
+    if speed_kmh is not None and not (math.isfinite(speed_kmh) and speed_kmh > 0):
+        raise InputError(f"speed: expected a speed > 0 km/h, got {speed_kmh}")
+    return LateralData.from_frf(
+        frf,
+        speed=None if speed_kmh is None else speed_kmh * KMH,
+        force=force,
+        wheel_mass=wheel_mass,
+    )
+
+
+def fit_models(
+    data: LateralData,
+    models: Sequence[str] = DEFAULT_MODELS,
+    *,
+    criterion: Criterion = "bic",
+    band: tuple[float, float] | None = None,
+    weights: Weights | ArrayLike = "auto",
+    channel: tuple[int, int] | None = None,
+) -> Ranking:
+    """Fit every model to the same data and weights and rank them (AIC/BIC).
+
+    See :func:`tyredamp.lateral.fit_model` for ``band``, ``weights`` and ``channel``.
+    """
+    return rank_models(
+        data, models, criterion=criterion, band=band, weights=weights, channel=channel
+    )
+
+
+# --------------------------------------------------------------- on the virtual rig
+def measure_condition(
+    rig: VirtualLateralRig,
+    pressure_bar: float,
+    speed_kmh: float,
+    models: Sequence[str],
+    seed: int,
+) -> LateralCondition:
+    """Ground- and axle-force FRFs of the rig at one condition, every model fitted to the ground."""
+    ground = rig.measure(speed_kmh, pressure_bar, "ground", seed)
+    axle = rig.measure(speed_kmh, pressure_bar, "axle", seed)
+    ranking = fit_models(ground, models)
+    return LateralCondition(
+        pressure_bar, speed_kmh, ground, axle, ranking, rig.truth(speed_kmh, pressure_bar)
+    )
+
+
+def _resonance(vehicle: LateralVehicle) -> Resonance | None:
+    try:
+        return vehicle.resonance((0.3, 20.0))
+    except PhysicsError:
+        return None
+
+
+def vehicle_study(rig: VirtualLateralRig, ref: LateralCondition) -> VehicleStudy:
+    """The single-DOF vehicle (eq. 41-44) on each fitted tyre of ``ref`` and on the truth."""
+    vehicles = {f.name: LateralVehicle(f.model, rig.body_mass) for f in ref.ranking.fits}
+    truth_vehicle = rig.vehicle(ref.speed_kmh, ref.pressure_bar)
+    return VehicleStudy(
+        body_mass=rig.body_mass,
+        vehicles=vehicles,
+        truth=truth_vehicle,
+        resonances={k: _resonance(veh) for k, veh in vehicles.items()},
+        truth_resonance=_resonance(truth_vehicle),
+    )
+
+
+def time_test(
+    rig: VirtualLateralRig,
+    ref: LateralCondition,
+    vehicles: dict[str, LateralVehicle],
+    frequency_hz: float,
+    *,
+    force_amplitude: float = 500.0,
+    window_s: tuple[float, float] = (4.0, 6.0),
+    seed: int = 0,
+) -> TimeTest:
+    """The sinusoidal time test (paper Fig. 15) and each fitted vehicle's prediction.
+
+    Parameters
+    ----------
+    rig : VirtualLateralRig
+    ref : LateralCondition
+        The condition of the test.
+    vehicles : dict of str to LateralVehicle
+        One per fitted model; must hold ``"hysteretic"`` (causal approximation).
+    frequency_hz : float
+        Sine frequency, Hz.
+    force_amplitude : float
+        Body force amplitude, N.
+    window_s : (float, float)
+        Comparison window, s.
+    seed : int
+        Noise seed.
+    """
+    td = rig.time_test(
+        ref.speed_kmh, ref.pressure_bar, frequency_hz, force_amplitude=force_amplitude, seed=seed
+    )
+    t = td.time
+    measured_acc = td.data[1]
+    win = (t >= window_s[0]) & (t <= window_s[1])
+    preds: dict[str, NDArray[np.float64]] = {}
+    errs: dict[str, float] = {}
+    rms_meas = float(np.sqrt(np.mean(measured_acc[win] ** 2)))
+    for name, veh in vehicles.items():
+        a = harmonic_response(veh, frequency_hz, force_amplitude, t, "acceleration")
+        preds[name] = a
+        errs[name] = float(np.sqrt(np.mean((a[win] - measured_acc[win]) ** 2))) / rms_meas
+    causal = causal_error(vehicles["hysteretic"], (0.05, 50.0), sine_frequency=frequency_hz)
+    return TimeTest(td, frequency_hz, force_amplitude, preds, window_s, errs, causal)
+
+
+def run_lateral(s: DemoSettings, stage: StageCallback | None = None) -> LateralStudy:
+    """The lateral study of the demo: every condition, the vehicle and the time test.
+
+    Parameters
+    ----------
+    s : DemoSettings
+        Conditions, models, reference condition, time-test frequency, seed.
+    stage : callable, optional
+        ``stage(description)`` before each stage.
+    """
+
+    def start(name: str) -> None:
+        if stage is not None:
+            stage(name)
+
+    rig = VirtualLateralRig()
+    lat: list[LateralCondition] = []
+    for p, v in conditions(s):
+        start(f"lateral: {len(s.lateral_models)} model fits at {p:g} bar, {v:g} km/h")
+        lat.append(measure_condition(rig, p, v, s.lateral_models, s.seed))
+    ref_p, ref_v = s.reference_condition
+    ref = next(c for c in lat if c.pressure_bar == ref_p and c.speed_kmh == ref_v)
+
+    start(f"lateral: vehicle model and {s.time_test_frequency_hz:g} Hz time response")
+    vstudy = vehicle_study(rig, ref)
+    tt = time_test(rig, ref, vstudy.vehicles, s.time_test_frequency_hz, seed=1000 * s.seed + 201)
+    return LateralStudy(rig, lat, ref, vstudy, tt, figure7_curves())
+
+
+def conditions(s: DemoSettings) -> list[tuple[float, float]]:
+    """``(pressure_bar, speed_kmh)`` of every rig condition of the demo."""
+    return [(p, v) for p in s.lateral_pressures_bar for v in s.lateral_speeds_kmh]

@@ -1,0 +1,496 @@
+"""Fit verdicts: does an identified model fit its FRF to within the noise, and if not, why.
+
+The verdict judges a fit from the data alone:
+
+* **against the noise.** The variance of an FRF estimate follows from its
+  coherence: for an H1 estimate from ``n_d`` averages of a periodic force
+  with noise on the response, ``var(H) = |H|^2 (1 - g^2) / (n_d g^2)``
+  (the random error of frequency-response estimates, Bendat & Piersol,
+  *Random Data*, ch. 9, for the complex value). The estimated coherence is
+  biased upwards, ``E[1 - g_est^2] ~ (1 - g^2)(n_d - 1)/n_d``, so the
+  variance is taken as ``|H|^2 (1 - g_est^2) / ((n_d - 1) g_est^2)``
+  (``n_d`` from ``frf.meta["n_averages"]``). With a new random force in
+  every average the variance of H1 is larger, ``|H|^2 (1 - g^2) /
+  ((n_d - 1) g^2)`` (the mean inverse force spectrum), and the same formula
+  holds again: for a periodic and a random force alike the mean of the
+  statistic ``q`` below is 1 (``tests/test_studies_verdicts.py``,
+  ``benchmarks/verdict_calibration.py``).
+
+  With ``m > 1`` inputs (``g^2`` the multiple coherence of an output) the
+  inputs are taken as uncorrelated and of equal power, so ``|H|^2`` becomes
+  ``sum_j |H_oj|^2``, and the factor ``1/(n_d - 1)`` becomes
+  ``n_d / (n_d - m)^2`` (mean inverse spectrum ``1/(n_d - m)`` of random
+  forces, coherence bias ``(n_d - m)/n_d``). The line-to-line scatter of the
+  forces' spectra makes this approximate, on the side of more noise (mean
+  ``q`` 0.9-1.0 for two inputs and 8-32 averages): a MIMO verdict is
+  conservative. An FRF without a number of averages (the virtual
+  rolling-tyre rig) carries the coherence of the estimate itself:
+  ``var(H) = |H|^2 (1 - g^2) / g^2``.
+
+  The statistic is ``q = sum |H_model - H|^2 / sum var(H)`` over the fitted
+  lines and FRFs: about 1 when the model leaves only noise. Under that
+  hypothesis ``sum |e|^2`` is a weighted sum of chi-square variables with
+  ``nu = 2 (sum var)^2 / sum var^2`` effective degrees of freedom
+  (Satterthwaite), and the variance estimated from ``n_d`` averages has
+  ``(n_d - m) nu``; ``q`` is then F-distributed, and the fit is *within the
+  noise* when ``q`` is below the ``1 - alpha`` quantile (``alpha = 1e-3``).
+  Without averages the chi-square quantile ``chi2(nu) / nu`` is used.
+  Fitted parameters only lower ``q``, so the test is conservative.
+* **where it misses.** The lines holding the central 80 % of the excess
+  residual ``(|e|^2 - var)+`` give the misfit region; when it reaches a band
+  edge the likely cause is a mode at or beyond that edge.
+* **the modes** (modal fits): a mode whose half-power band ``f (1 +- 2 zeta)``
+  crosses a band edge; a strongly complex shape (modal phase collinearity
+  below 0.5, the conventional mark of a spurious or distorted mode unless
+  the damping is strongly non-proportional); expected modes (when the
+  caller knows them, for example the truth of a virtual tyre) that are not
+  identified.
+
+A verdict is ``"ok"`` (within the noise), ``"failed"`` (with the reasons
+and likely causes) or ``"not judged"`` (no coherence to judge against).
+Core-free of plotting and I/O: the report, the CLI summary and results.json
+render :class:`FitVerdict`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats
+
+from ..exceptions import InputError, ShapeError
+from ..frf import FRF
+from ..modal.identify import ModalIdentification
+
+__all__ = [
+    "ALPHA",
+    "FitVerdict",
+    "NoiseTest",
+    "frf_noise_variance",
+    "lateral_fit_verdict",
+    "modal_fit_verdict",
+    "modal_verdicts",
+    "noise_test",
+]
+
+#: Significance level of the test against the noise.
+ALPHA = 1e-3
+#: Share of the excess residual that defines the misfit region (central part).
+_REGION = 0.8
+#: Modal phase collinearity below which a shape is called strongly complex.
+_MPC_LOW = 0.5
+
+Status = Literal["ok", "failed", "not judged"]
+
+
+@dataclass(frozen=True)
+class NoiseTest:
+    """Residual of a fit against the noise of its FRF (module docstring).
+
+    Attributes
+    ----------
+    ratio : float
+        ``q = sum |e|^2 / sum var(H)`` (1: only noise left).
+    threshold : float
+        Upper ``1 - alpha`` quantile of ``q`` when only noise is left.
+    p_value : float
+        Probability of a ``q`` at least this large from noise alone.
+    relative_error : float
+        ``sqrt(sum |e|^2 / sum |H|^2)``.
+    noise_relative_error : float
+        ``sqrt(sum var(H) / sum |H|^2)``: the relative error noise alone gives.
+    dof : float
+        Effective degrees of freedom of the residual.
+    misfit_hz : (float, float) or None
+        Lines holding the central 80 % of the excess residual, Hz; None when
+        there is no excess.
+    """
+
+    ratio: float
+    threshold: float
+    p_value: float
+    relative_error: float
+    noise_relative_error: float
+    dof: float
+    misfit_hz: tuple[float, float] | None
+
+    @property
+    def passed(self) -> bool:
+        """True when the residual is within the noise."""
+        return bool(self.ratio <= self.threshold)
+
+
+@dataclass(frozen=True)
+class FitVerdict:
+    """Verdict on one fit.
+
+    Attributes
+    ----------
+    subject : str
+        What was fitted (``"radial 9 bar, complex-mode fit"``).
+    status : {"ok", "failed", "not judged"}
+    reasons : tuple of str
+        Why it failed, each with its likely cause and remedy.
+    cautions : tuple of str
+        Findings that do not fail the fit but qualify it.
+    test : NoiseTest or None
+        The test against the noise (None without coherence).
+    """
+
+    subject: str
+    status: Status
+    reasons: tuple[str, ...] = ()
+    cautions: tuple[str, ...] = ()
+    test: NoiseTest | None = None
+
+    @property
+    def passed(self) -> bool:
+        """True for ``"ok"``."""
+        return self.status == "ok"
+
+    def summary(self) -> str:
+        """One line: status, the residual against the noise, the first reason."""
+        t = self.test
+        head = {"ok": "OK", "failed": "FAILED", "not judged": "NOT JUDGED"}[self.status]
+        if self.reasons:
+            return f"{self.subject}: {head}: " + "; ".join(self.reasons)
+        if t is not None:
+            return (
+                f"{self.subject}: {head}: within the noise (residual {math.sqrt(t.ratio):.3g}x "
+                f"the noise level; relative error {100 * t.relative_error:.3g} % against "
+                f"{100 * t.noise_relative_error:.3g} % from noise alone)"
+            )
+        return f"{self.subject}: {head}" + (f": {self.cautions[0]}" if self.cautions else "")
+
+    def brief(self) -> str:
+        """A short form for a summary table: ``"FAILED (residual 11x the noise): <cause>"``."""
+        t = self.test
+        if self.status == "ok":
+            return "within noise"
+        if self.status == "not judged":
+            return "not judged (no coherence)"
+        size = "" if t is None else f" (residual {math.sqrt(t.ratio):.3g}x the noise)"
+        causes = [r for r in self.reasons if not r.startswith("the residual is")]
+        return f"FAILED{size}: " + ("; ".join(causes) or "see the report")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form (results.json ``verdict`` objects)."""
+        t = self.test
+        return {
+            "subject": self.subject,
+            "status": self.status,
+            "passed": self.passed,
+            "summary": self.summary(),
+            "brief": self.brief(),
+            "reasons": list(self.reasons),
+            "cautions": list(self.cautions),
+            "residual_to_noise": None if t is None else t.ratio,
+            "threshold": None if t is None else t.threshold,
+            "p_value": None if t is None else t.p_value,
+            "relative_error": None if t is None else t.relative_error,
+            "noise_relative_error": None if t is None else t.noise_relative_error,
+            "misfit_hz": None if t is None or t.misfit_hz is None else list(t.misfit_hz),
+        }
+
+
+# ------------------------------------------------------------------------------- the test
+def frf_noise_variance(frf: FRF) -> tuple[NDArray[np.float64], float] | None:
+    """Variance of each FRF value from the coherence, and the noise estimate's dof factor.
+
+    Module docstring; uses ``frf.meta["n_averages"]`` and ``frf.meta["method"]``.
+
+    Returns
+    -------
+    (ndarray, float) or None
+        ``var`` of shape ``frf.H.shape`` (in the FRF's unit squared) and
+        ``n_d - m`` for ``m`` inputs (``inf`` when the coherence is that of the estimate
+        itself); None when the FRF has no coherence or no more averages than
+        inputs.
+    """
+    if frf.coherence is None:
+        return None
+    nd = frf.meta.get("n_averages")
+    g2 = np.clip(np.asarray(frf.coherence, dtype=float), 1e-12, 1.0)
+    snr = (1.0 - g2) / g2  # (n_out, n_freq)
+    n_in = frf.n_in
+    if nd is None:
+        scale, factor = 1.0, math.inf
+    else:
+        nd = int(nd)
+        if nd <= n_in:  # coherence 1 by construction: no noise information
+            return None
+        factor = float(nd - n_in)
+        # m inputs: mean inverse spectrum of random forces and coherence bias (docstring)
+        scale = 1.0 / (nd - 1) if n_in == 1 else nd / (nd - n_in) ** 2
+    # MIMO (multiple coherence per output): with uncorrelated inputs of equal power, the
+    # noise of output o spreads evenly over its FRFs, var(H_oj) = (1 - g_o^2)/g_o^2 *
+    # sum_j |H_oj|^2 / n_d, for every j; for one input this is the SISO formula
+    power = np.sum(np.abs(frf.H) ** 2, axis=1, keepdims=True)
+    var = np.broadcast_to(power * snr[:, None, :] * scale, frf.H.shape).copy()
+    return var, factor
+
+
+def noise_test(
+    frequency: NDArray[np.float64],
+    measured: NDArray[np.complex128],
+    fitted: NDArray[np.complex128],
+    variance: NDArray[np.float64],
+    noise_dof_factor: float = math.inf,
+    alpha: float = ALPHA,
+) -> NoiseTest:
+    """Test a fit's residual against the noise variance (module docstring).
+
+    Parameters
+    ----------
+    frequency : ndarray, shape (n_freq,)
+        Hz.
+    measured, fitted : ndarray, complex, shape (..., n_freq)
+    variance : ndarray, shape (..., n_freq)
+        Variance of each measured value.
+    noise_dof_factor : float
+        Degrees of freedom of the variance estimate per residual degree of
+        freedom (``n_d - 1``; ``inf`` for a known variance).
+    alpha : float
+        Significance level.
+    """
+    f = np.asarray(frequency, dtype=float)
+    h = np.asarray(measured, dtype=complex)
+    m = np.asarray(fitted, dtype=complex)
+    v = np.asarray(variance, dtype=float)
+    if h.shape != m.shape or h.shape != v.shape or h.shape[-1] != f.size:
+        raise ShapeError(
+            f"measured, fitted, variance: expected equal shapes ending in {f.size} lines, got "
+            f"{h.shape}, {m.shape}, {v.shape}"
+        )
+    if not 0 < alpha < 1:
+        raise InputError(f"alpha: expected 0 < alpha < 1, got {alpha}")
+    e2 = np.abs(m - h) ** 2
+    s_res, s_var = float(e2.sum()), float(v.sum())
+    s_data = float((np.abs(h) ** 2).sum())
+    if not (s_var > 0 and math.isfinite(s_var)):
+        raise InputError("variance: expected a positive, finite noise variance")
+    q = s_res / s_var
+    nu = 2.0 * s_var**2 / float((v**2).sum())
+    if math.isinf(noise_dof_factor):
+        thr = float(stats.chi2.ppf(1 - alpha, nu) / nu)
+        p = float(stats.chi2.sf(q * nu, nu))
+    else:
+        thr = float(stats.f.ppf(1 - alpha, nu, noise_dof_factor * nu))
+        p = float(stats.f.sf(q, nu, noise_dof_factor * nu))
+    excess = np.clip(e2 - v, 0.0, None).reshape(-1, f.size).sum(axis=0)
+    region = None
+    if excess.sum() > 0:
+        c = np.cumsum(excess) / excess.sum()
+        lo = int(np.searchsorted(c, (1 - _REGION) / 2))
+        hi = min(int(np.searchsorted(c, 1 - (1 - _REGION) / 2)), f.size - 1)
+        region = (float(f[lo]), float(f[hi]))
+    return NoiseTest(
+        ratio=q,
+        threshold=thr,
+        p_value=p,
+        relative_error=math.sqrt(s_res / s_data) if s_data > 0 else math.nan,
+        noise_relative_error=math.sqrt(s_var / s_data) if s_data > 0 else math.nan,
+        dof=nu,
+        misfit_hz=region,
+    )
+
+
+def _p(p: float) -> str:
+    return "p < 1e-300" if p <= 0 else f"p = {p:.2g}"
+
+
+def _edge_reason(t: NoiseTest, band: tuple[float, float]) -> str | None:
+    """The likely cause when the misfit region reaches a band edge."""
+    if t.misfit_hz is None:
+        return None
+    lo, hi = band
+    near = 0.05 * (hi - lo)
+    a, b = t.misfit_hz
+    where = f"{a:.4g}-{b:.4g} Hz"
+    if b >= hi - near:
+        return (
+            f"the misfit lies at the upper band edge ({where}): a mode at or just above "
+            f"{hi:g} Hz is missing or cut by the edge; widen or narrow the band"
+        )
+    if a <= lo + near:
+        return (
+            f"the misfit lies at the lower band edge ({where}): a mode at or just below "
+            f"{lo:g} Hz is missing or cut by the edge; widen or narrow the band"
+        )
+    return None
+
+
+# ----------------------------------------------------------------------------- the verdicts
+def modal_fit_verdict(
+    model: Any,
+    measured: FRF,
+    *,
+    subject: str = "modal fit",
+    expected_hz: Sequence[float] | None = None,
+    better: FitVerdict | None = None,
+    alpha: float = ALPHA,
+) -> FitVerdict:
+    """Verdict on a modal model fitted to ``measured`` (module docstring).
+
+    Parameters
+    ----------
+    model : ModalModel
+        The fit (its ``meta["band_hz"]``, ``meta["mpc"]`` are used when present).
+    measured : FRF
+        The measured FRF on the fitted lines (with coherence to judge against
+        the noise).
+    subject : str
+        Name of the fit in the messages.
+    expected_hz : sequence of float, optional
+        Natural frequencies that should be found (the truth of a virtual
+        test); those in the band without an identified mode within 5 % are
+        reported.
+    better : FitVerdict, optional
+        Verdict of another model of the same data (the complex-mode fit for a
+        real-mode one): when it is within the noise and this one is not, the
+        likely cause is the model form (non-proportional damping).
+    alpha : float
+        Significance level of the test against the noise.
+    """
+    f = measured.frequency
+    band_meta = model.meta.get("band_hz")
+    band = (
+        (float(band_meta[0]), float(band_meta[1]))
+        if band_meta is not None
+        else (float(f[0]), float(f[-1]))
+    )
+    synth = model.frf(f, measured.kind).H
+    reasons: list[str] = []
+    cautions: list[str] = []
+    noise = frf_noise_variance(measured)
+    test = None
+    if noise is not None:
+        test = noise_test(f, measured.H, synth, noise[0], noise[1], alpha)
+        if not test.passed:
+            reasons.append(
+                f"the residual is {math.sqrt(test.ratio):.3g}x the noise level (relative error "
+                f"{100 * test.relative_error:.3g} % against {100 * test.noise_relative_error:.3g}"
+                f" % from the coherence; {_p(test.p_value)})"
+            )
+            edge = _edge_reason(test, band)
+            if edge:
+                reasons.append(edge)
+            elif test.misfit_hz is not None:
+                reasons.append(
+                    f"the misfit lies at {test.misfit_hz[0]:.4g}-{test.misfit_hz[1]:.4g} Hz"
+                )
+            if any(
+                str(w).startswith("real-mode refinement not acceptable")
+                for w in model.meta.get("warnings", [])
+            ):
+                reasons.append(
+                    "its refinement fell back to the complex-mode poles (only the residues "
+                    "are fitted)"
+                )
+            if better is not None and better.passed:
+                reasons.append(
+                    f"the {better.subject} is within the noise: the model form misses (real "
+                    "modes cannot hold damping that couples the modes)"
+                )
+    fn = np.asarray(model.frequency_hz, dtype=float)
+    zeta = np.asarray(model.damping_ratio, dtype=float)
+    for k in range(fn.size):
+        half = 2.0 * zeta[k] * fn[k]
+        if (band[0] > 0 and fn[k] - half < band[0]) or fn[k] + half > band[1]:
+            cautions.append(
+                f"mode at {fn[k]:.4g} Hz: its half-power band ({fn[k] - half:.4g}-"
+                f"{fn[k] + half:.4g} Hz) crosses the band edge; its damping is poorly "
+                "determined: widen the band"
+            )
+    mpc = model.meta.get("mpc")
+    if mpc is not None and model.mode_kind == "complex":
+        for k, v in enumerate(np.asarray(mpc, dtype=float)):
+            if v < _MPC_LOW:
+                cautions.append(
+                    f"mode at {fn[k]:.4g} Hz: MPC {v:.2f}, a strongly complex shape: a "
+                    "spurious or distorted mode unless the damping is strongly non-proportional"
+                )
+    if expected_hz is not None:
+        for fe in expected_hz:
+            if not band[0] <= fe <= band[1]:
+                continue
+            if fn.size == 0 or np.min(np.abs(fn - fe)) > 0.05 * fe:
+                gap = min(fe - band[0], band[1] - fe)
+                at_edge = gap < 0.05 * (band[1] - band[0])
+                reasons.append(
+                    f"expected mode at {fe:.4g} Hz not identified"
+                    + (f" ({gap:.3g} Hz from the band edge)" if at_edge else "")
+                )
+    if test is None:
+        status: Status = "failed" if reasons else "not judged"
+        if not reasons:
+            cautions.insert(0, "no coherence (or a single average): not judged against the noise")
+    else:
+        status = "ok" if not reasons else "failed"
+    return FitVerdict(subject, status, tuple(reasons), tuple(cautions), test)
+
+
+def lateral_fit_verdict(
+    fit: Any, frf: FRF, *, subject: str = "", alpha: float = ALPHA
+) -> FitVerdict:
+    """Verdict on a lateral model fitted to the FRF ``frf`` (module docstring).
+
+    Parameters
+    ----------
+    fit : LateralFit
+        Its ``frequency``, ``measured`` and ``fitted`` (accelerance at the
+        data's force) are tested.
+    frf : FRF
+        The measured FRF the fit was made on (1x1, with coherence).
+    """
+    name = subject or f"{fit.name} fit"
+    noise = frf_noise_variance(frf)
+    if noise is None:
+        return FitVerdict(
+            name, "not judged", cautions=("no coherence: not judged against the noise",)
+        )
+    keep = np.flatnonzero(np.isin(frf.frequency, fit.frequency))
+    if keep.size != fit.frequency.size:
+        raise InputError("frf: does not hold every line of the fit")
+    acc = frf.to("accelerance").H[0, 0, keep]
+    rel_var = noise[0][0, 0, keep] / np.abs(frf.H[0, 0, keep]) ** 2
+    var = rel_var * np.abs(acc) ** 2
+    test = noise_test(fit.frequency, fit.measured, fit.fitted, var, noise[1], alpha)
+    reasons: list[str] = []
+    if not test.passed:
+        reasons.append(
+            f"the residual is {math.sqrt(test.ratio):.3g}x the noise level ({_p(test.p_value)})"
+        )
+        where = (
+            ""
+            if test.misfit_hz is None
+            else f" at {test.misfit_hz[0]:.3g}-{test.misfit_hz[1]:.3g} Hz"
+        )
+        reasons.append(
+            f"the model form misses the measured tyre{where} (noise does not explain it)"
+        )
+    return FitVerdict(name, "ok" if not reasons else "failed", tuple(reasons), (), test)
+
+
+def modal_verdicts(frf: FRF, res: ModalIdentification) -> dict[str, FitVerdict]:
+    """Verdict of each fitted model of ``res`` against the noise of the fitted lines of ``frf``.
+
+    The complex-mode fit is judged first; the real-mode fit is judged with it
+    as the better model (:func:`modal_fit_verdict`). ``tyredamp modal`` and
+    the campaign store these as ``meta["verdict"]`` of each model.
+    """
+    keep = np.flatnonzero(np.isin(frf.frequency, res.frequency))
+    meas = frf.select_lines(keep).to(res.frf_kind)  # type: ignore[arg-type]
+    out: dict[str, FitVerdict] = {}
+    if "complex" in res.models:
+        out["complex"] = modal_fit_verdict(res.models["complex"], meas, subject="complex-mode fit")
+    if "real" in res.models:
+        out["real"] = modal_fit_verdict(
+            res.models["real"], meas, subject="real-mode fit", better=out.get("complex")
+        )
+    return out

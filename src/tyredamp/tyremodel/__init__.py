@@ -1,0 +1,60 @@
+"""From the modal test to the tyre models that vehicle simulation uses (issue 18).
+
+* :mod:`.wavenumber` -- circumferential wave number of every identified mode
+  from its shape (spatial Fourier fit over the measured angles), cos/sin
+  members, pair splitting and orientation, spatial aliasing; on
+  :mod:`.harmonics` (what the measured angles resolve, aliases, the
+  single-harmonic fit).
+* :mod:`.ring` -- flexible-ring model updating (EI, tension law, foundation,
+  mass per length, damping) across pressures, with standard errors and
+  identifiability verdicts; predictions of modes and FRFs.
+* :mod:`.rigid` -- in-plane rigid-ring (MF-Swift) parameters from the n = 1
+  modes, with what a radial test cannot give stated.
+* :mod:`.tir` -- the in-plane ``.tir`` subset: writer and reader.
+* :mod:`.lateral` -- lateral carcass stiffness and relaxation length from the
+  lateral fits of paper 001.
+* :mod:`.pipeline` -- all of it in one call (:func:`build_tyre_model`), as
+  ``tyredamp tyre-model`` runs it.
+"""
+
+from __future__ import annotations
+
+from .harmonics import alias_candidates, harmonic_fit, resolved_wave_numbers
+from .lateral import LateralCarcass, lateral_carcass, read_lateral_carcass
+from .pipeline import TyreModelResult, build_tyre_model
+from .rigid import NOT_FROM_RADIAL_TEST, RigidRingParameters, rigid_ring_from_modes
+from .ring import (
+    RingFit,
+    RingObservation,
+    fit_ring,
+    ring_amplitude,
+    ring_frequency,
+    ring_observations,
+)
+from .tir import parse_tir, tir_text
+from .wavenumber import ModeWaveNumber, WaveNumberAnalysis, wave_number_analysis
+
+__all__ = [
+    "NOT_FROM_RADIAL_TEST",
+    "LateralCarcass",
+    "ModeWaveNumber",
+    "RigidRingParameters",
+    "RingFit",
+    "RingObservation",
+    "TyreModelResult",
+    "WaveNumberAnalysis",
+    "alias_candidates",
+    "build_tyre_model",
+    "fit_ring",
+    "harmonic_fit",
+    "lateral_carcass",
+    "parse_tir",
+    "read_lateral_carcass",
+    "resolved_wave_numbers",
+    "rigid_ring_from_modes",
+    "ring_amplitude",
+    "ring_frequency",
+    "ring_observations",
+    "tir_text",
+    "wave_number_analysis",
+]

@@ -1,0 +1,68 @@
+"""Virtual tyres and rigs with a known truth: the radial ring tyre and its modal
+test rig (paper 000), the rolling-tyre lateral rig (paper 001).
+
+* :class:`RingTyreParameters`, :class:`MeasurementLayout`, :class:`Imperfection`:
+  the 295/80R22.5 truck tyre at 7.5 bar (defaults), the 16 measured points and
+  the shaker attachments of paper 000, local changes that split double modes.
+* :func:`analytic_ring_frequencies` (inextensible ring, spec
+  ``virtual-tyre.md``), :func:`ring_dispersion` (extensible ring, continuous or
+  discretised), :func:`ring_convergence` (discrete against analytic).
+* :class:`RingTyre`: the staggered finite-difference ring with ``M``, ``C``,
+  ``K`` (:class:`~tyredamp.mechanics.MCKSystem`), index maps and the
+  ``nonproportionality`` knob; :meth:`RingTyre.truth` gives the exact modal
+  truth at the points (:class:`TyreTruth`).
+* :func:`run_modal_test`: the virtual test rig (periodic chirp, noise,
+  multi-reference), returning :class:`VirtualModalTest` (``TimeData`` + truth).
+* :class:`VirtualLateralRig` (:mod:`.lateral_rig`): the rolling-tyre rig of
+  paper 001 with its exact tyre (:class:`ViscoelasticStringTyre`,
+  :class:`AgriculturalTyre`), FRFs and time tests.
+
+Example
+-------
+>>> from tyredamp.virtual import RingTyre, run_modal_test
+>>> test = run_modal_test(RingTyre(), seed=1)          # doctest: +SKIP
+>>> test.truth.table("visible")[0]["frequency_hz"]      # doctest: +SKIP
+47.90...
+"""
+
+from __future__ import annotations
+
+from .excitation import hadamard_drive_matrix, schroeder_multisine
+from .lateral_rig import KMH, AgriculturalTyre, VirtualLateralRig, ViscoelasticStringTyre
+from .modal_rig import VirtualModalTest, periodic_initial_state, run_modal_test
+from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
+from .ring import (
+    RingConvergence,
+    RingTyre,
+    analytic_ring_frequencies,
+    difference_symbol,
+    ring_convergence,
+    ring_dispersion,
+    staggered_weights,
+)
+from .truth import TyreTruth, modal_phase_collinearity, wave_numbers
+
+__all__ = [
+    "KMH",
+    "AgriculturalTyre",
+    "Imperfection",
+    "MeasurementLayout",
+    "RingConvergence",
+    "RingTyre",
+    "RingTyreParameters",
+    "TyreTruth",
+    "VirtualLateralRig",
+    "VirtualModalTest",
+    "ViscoelasticStringTyre",
+    "analytic_ring_frequencies",
+    "difference_symbol",
+    "hadamard_drive_matrix",
+    "modal_phase_collinearity",
+    "periodic_initial_state",
+    "ring_convergence",
+    "ring_dispersion",
+    "run_modal_test",
+    "schroeder_multisine",
+    "staggered_weights",
+    "wave_numbers",
+]

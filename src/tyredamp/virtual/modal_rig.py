@@ -1,0 +1,534 @@
+"""The virtual modal test rig of paper 000: shaker, periodic chirp, 16 accelerometers.
+
+The tyre (its full ring discretisation) is driven radially at the drive
+point(s) by a periodic chirp and the radial accelerations at the measured
+points are recorded together with the forces, with independent Gaussian
+noise on every channel. The response is computed with
+:func:`tyredamp.mechanics.time_response` (exact modal integration with a
+first-order hold of the sampled force).
+
+Excitation
+----------
+``excitation="chirp"`` (default): the periodic linear sweep of
+:func:`tyredamp.signal.periodic_chirp` (the chirp of paper 000; its band
+edges are moved to DFT lines so that it is continuous from period to period).
+``"multisine"``: the band-limited Schroeder multisine of
+:func:`~tyredamp.virtual.excitation.schroeder_multisine` (flat spectrum on the
+band lines, nothing elsewhere). ``data.meta["lines"]`` lists the DFT lines of one
+period inside ``band``.
+
+Steady state
+------------
+By default the simulation starts in the exact periodic steady state: for each
+complex mode, ``q' = p q + psi^T f`` (spec eq. [10]) is propagated over one
+period from rest with the same one-step coefficients as ``time_response``
+(:func:`~tyredamp.mechanics.step_coefficients`), giving ``q_P``; the periodic
+initial value is ``q*(0) = q_P / (1 - e^{p T})``, and
+``x0 = 2 Re sum psi q*``, ``v0 = 2 Re sum p psi q*``. One period is then
+simulated with ``time_response`` from ``(x0, v0)``; the noise-free
+steady-state response is exactly periodic, so the record is that period
+repeated, plus independent noise. ``initial_state="rest"`` instead simulates
+every period from rest (the transient decays with the slowest mode, about
+``1 / sigma_min`` s) and drops ``settle_periods`` leading periods, or keeps
+them and says so in ``data.acquisition.settle_samples``.
+
+Sampling
+--------
+The force is generated ``oversample`` times faster than ``sample_rate``
+(``fs_sim``) and the response simulated at that rate. The acquisition then
+applies an ideal anti-alias filter (all DFT lines of the simulated period at
+or above ``sample_rate / 2`` removed, on every channel alike, like a DAQ with
+matched filters) and keeps every ``oversample``-th sample. For the periodic
+steady state the filter is exact; in ``initial_state="rest"`` it is applied
+per period and smears the (discarded) transient slightly.
+
+The first-order hold interprets the force as piecewise linear between the
+``fs_sim`` samples, so for the band-limited multisine the cyclic FRF of the
+noise-free data is exactly ``sum_m A(f + m fs_sim) sinc^2(f / fs_sim + m)``
+(``A`` the true accelerance; checked in the tests), which differs from
+``A(f)`` by about ``(pi f / fs_sim)^2 / 3 * |A(f) - M^-1|`` plus folded
+extensional resonances: 5e-4 at 200 Hz for the defaults, below 1 % of
+``|A|`` at every line of the default test.
+
+Several drive points
+--------------------
+All shakers stay attached (their masses and dampers are part of the tyre)
+and the record is a sequence of *runs*, each ``n_periods`` periods of steady
+state: ``drive_mode="sequential"`` drives one input per run (classical
+roving-shaker multi-reference test); ``"simultaneous"`` drives all inputs in
+every run with the same signal times the signs of a Hadamard matrix
+(orthogonal multisines, :func:`~tyredamp.virtual.excitation.hadamard_drive_matrix`),
+so the input cross-spectral matrix summed over the runs is diagonal. Either
+way every period of the record is a steady-state period and an H1 estimator
+over all periods (all runs) recovers every FRF column;
+``data.acquisition.run_starts`` gives the first sample of each run.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass, replace
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.signal import lfilter
+
+from .._validate import as_band, check_positive
+from ..exceptions import InputError
+from ..frf import FRF, FRFKind
+from ..mechanics import ComplexModes, MCKSystem, step_coefficients, time_response
+from ..signal.excitation import band_lines, periodic_chirp
+from ..timedata import Acquisition, TimeData
+from .excitation import hadamard_drive_matrix, schroeder_multisine
+from .ring import RingTyre
+from .truth import TyreTruth
+
+__all__ = ["VirtualModalTest", "periodic_initial_state", "run_modal_test"]
+
+DriveMode = Literal["sequential", "simultaneous"]
+InitialState = Literal["periodic", "rest"]
+ExcitationKind = Literal["chirp", "multisine"]
+
+
+@dataclass(frozen=True, eq=False)
+class VirtualModalTest:
+    """Result of :func:`run_modal_test`: the measured time data and the truth.
+
+    Attributes
+    ----------
+    data : TimeData
+        Force channels (one per drive point, quantity ``"force"``, N) then
+        acceleration channels (one per measured point, ``"acceleration"``,
+        m/s^2). ``data.acquisition`` states ``period_samples``,
+        ``settle_samples``, ``n_averages`` (periods per run), ``run_starts``,
+        ``band_hz`` and ``excitation`` (signal name); ``data.meta`` notes
+        ``drive_matrix``, ``lines``, ``snr_db``, ``noise_std``, ``seed`` and
+        more.
+    truth : TyreTruth
+        Exact modes, damping and FRFs of the tested tyre in the test band.
+    tyre : RingTyre
+        The tested tyre.
+    drive_matrix : ndarray, shape (n_runs, n_inputs)
+        Amplitude factor of each input in each run (0 or +-1).
+    """
+
+    data: TimeData
+    truth: TyreTruth
+    tyre: RingTyre
+    drive_matrix: NDArray[np.float64]
+
+    @property
+    def acquisition(self) -> Acquisition:
+        """The acquisition record of :attr:`data` (period, runs, settle samples, band)."""
+        return self.data.acquisition
+
+    @property
+    def meta(self) -> dict[str, Any]:
+        """A copy of the notes of :attr:`data` with the acquisition fields as keys.
+
+        ``period_samples``, ``settle_samples``, ``run_starts``, ``band_hz``,
+        ``n_averages`` (periods per run), ``excitation`` come from
+        :attr:`acquisition`; the rest (``lines``, ``drive_matrix``,
+        ``snr_db``, ...) from ``data.meta``.
+        """
+        acq = self.data.acquisition
+        return {
+            **self.data.meta,
+            **acq.to_dict(),
+            "settle_samples": acq.settle_samples,
+            "run_starts": list(acq.run_starts),
+        }
+
+    @property
+    def n_runs(self) -> int:
+        """Number of runs (one per drive point when sequential)."""
+        return int(self.drive_matrix.shape[0])
+
+    @property
+    def period_samples(self) -> int:
+        """Samples per excitation period."""
+        p = self.data.acquisition.period_samples
+        if p is None:  # pragma: no cover - the rig always states it
+            raise InputError("data.acquisition: no period_samples")
+        return p
+
+    @property
+    def frequency_lines(self) -> NDArray[np.float64]:
+        """Excited frequencies in Hz (DFT lines of one period), shape (K,)."""
+        lines = np.asarray(self.data.meta["lines"], dtype=float)
+        return lines * self.data.sample_rate / self.period_samples
+
+    def run_data(self, run: int) -> TimeData:
+        """The samples of one run (including its settle samples, if kept) as a TimeData."""
+        if not isinstance(run, int | np.integer) or not 0 <= run < self.n_runs:
+            raise InputError(f"run: expected an integer in 0..{self.n_runs - 1}, got {run!r}")
+        acq = self.data.acquisition
+        starts = [*acq.run_starts, self.data.n_samples]
+        seg = self.data.data[:, starts[run] : starts[run + 1]]
+        meta = dict(self.data.meta)
+        meta["drive_matrix"] = [self.drive_matrix[run].tolist()]
+        return TimeData(
+            seg,
+            self.data.sample_rate,
+            self.data.channels,
+            self.data.quantities,
+            meta,
+            acquisition=replace(acq, run_starts=(0,)),
+        )
+
+    def true_frf(self, frequency: ArrayLike, kind: FRFKind = "accelerance") -> FRF:
+        """Exact FRF of the tested tyre at the points, shape (n_points, n_drive, n_freq)."""
+        return self.truth.frf(frequency, kind)
+
+
+def _modal_propagate(
+    cm: ComplexModes,
+    psi_in: NDArray[np.complex128],
+    force: NDArray[np.float64],
+    h: float,
+    q0: NDArray[np.complex128],
+) -> NDArray[np.complex128]:
+    """Modal state after ``force.shape[1] - 1`` steps from ``q0`` (first-order hold).
+
+    The recursion ``q_{k+1} = Phi q_k + (E0 - E1) g_k + E1 g_{k+1}`` with
+    ``g = psi_in^T f`` is that of :func:`tyredamp.mechanics.time_response`.
+    """
+    p = cm.poles
+    phi, e0, e1 = step_coefficients(p, h)
+    g = psi_in.T @ force  # (m, L + 1)
+    out = np.empty(p.size, dtype=complex)
+    for j in range(p.size):
+        b = np.array([e1[j], e0[j] - e1[j]])
+        zi = np.array([q0[j] - e1[j] * g[j, 0]])
+        q, _ = lfilter(b, np.array([1.0, -phi[j]]), g[j], zi=zi)
+        out[j] = q[-1]
+    return out
+
+
+def _acquire(x: NDArray[np.float64], r: int) -> NDArray[np.float64]:
+    """Ideal anti-alias filter and decimation by ``r`` of one period (rows of ``x``).
+
+    Keeps the DFT lines ``0 <= k < P/2`` of the ``P r``-sample period (``P``
+    samples at the acquisition rate) and returns the ``P`` samples of that
+    band-limited signal at the acquisition instants.
+    """
+    n = x.shape[1]
+    p = n // r
+    spec = np.fft.rfft(x, axis=1)[:, : p // 2 + 1]
+    if p % 2 == 0:
+        spec[:, p // 2] = 0.0
+    return np.fft.irfft(spec, n=p, axis=1) / r
+
+
+def _modal_to_physical(
+    cm: ComplexModes, q: NDArray[np.complex128]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    x = 2 * np.real(cm.psi @ q)
+    v = 2 * np.real(cm.psi @ (cm.poles * q))
+    return x, v
+
+
+def periodic_initial_state(
+    system: MCKSystem,
+    force_period: ArrayLike,
+    sample_rate: float,
+    inputs: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Initial displacement and velocity of the periodic steady state.
+
+    For a force that repeats with period ``T = P / sample_rate`` (first-order
+    hold between samples, as in :func:`~tyredamp.mechanics.time_response`),
+    each complex mode (spec eq. [10]) ``q' = p q + psi^T f`` has the periodic
+    solution with ``q(0) = q_P / (1 - e^{p T})``, ``q_P`` the value after one
+    period from rest. Starting ``time_response`` from the returned state gives
+    the steady state with no transient.
+
+    Parameters
+    ----------
+    system : MCKSystem
+        Underdamped system.
+    force_period : array_like, shape (n_in, P)
+        One period of the force in N (the sample after the last is the first).
+    sample_rate : float
+        Samples per second (Hz).
+    inputs : array_like of int, shape (n_in,)
+        DOF indices where the forces act.
+
+    Returns
+    -------
+    x0, v0 : ndarray, shape (n_dof,)
+        Displacement (m) and velocity (m/s) at ``t = 0``.
+    """
+    f = np.atleast_2d(np.asarray(force_period, dtype=float))
+    idx = np.atleast_1d(np.asarray(inputs, dtype=np.intp))
+    if f.shape[0] != idx.size:
+        raise InputError(
+            f"force_period: expected {idx.size} rows (one per input), got shape {f.shape}"
+        )
+    if idx.size and (idx.min() < 0 or idx.max() >= system.n_dof):
+        raise InputError(
+            f"inputs: DOF indices must lie in 0..{system.n_dof - 1}, got {idx.tolist()}"
+        )
+    h = 1.0 / check_positive(sample_rate, "sample_rate")
+    cm = system.complex_modes()
+    ext = np.concatenate([f, f[:, :1]], axis=1)
+    q_p = _modal_propagate(cm, cm.psi[idx], ext, h, np.zeros(cm.poles.size, dtype=complex))
+    period = f.shape[1] * h
+    q0 = q_p / (-np.expm1(cm.poles * period))
+    return _modal_to_physical(cm, q0)
+
+
+def run_modal_test(
+    tyre: RingTyre | None = None,
+    *,
+    band: tuple[float, float] = (0.0, 200.0),
+    sample_rate: float = 1024.0,
+    period: float = 4.0,
+    n_periods: int = 8,
+    force_rms: float = 10.0,
+    snr_db: float | None = 40.0,
+    seed: int | np.random.Generator | None = None,
+    excitation: ExcitationKind = "chirp",
+    drive_mode: DriveMode = "sequential",
+    oversample: int = 16,
+    initial_state: InitialState = "periodic",
+    settle_periods: int = 0,
+    keep_settle: bool = False,
+) -> VirtualModalTest:
+    """Run the virtual modal test of paper 000 on a ring tyre.
+
+    Parameters
+    ----------
+    tyre : RingTyre, optional
+        The tyre with its layout (default: ``RingTyre()``, 295/80R22.5 at
+        7.5 bar, 16 points, drive at point 1).
+    band : (float, float)
+        Chirp band in Hz (default 0-200 Hz; DC is not excited). Also the band
+        of the returned truth.
+    sample_rate : float
+        Acquisition rate in Hz (default 1024).
+    period : float
+        Chirp period in s (default 4: 0.25 Hz line spacing);
+        ``period * sample_rate`` must be an integer.
+    n_periods : int
+        Recorded periods (averages) per run, >= 1 (default 8).
+    force_rms : float
+        RMS of each shaker force in N (default 10).
+    snr_db : float or None
+        Signal-to-noise ratio of every channel in dB: Gaussian noise of
+        standard deviation ``rms(channel) * 10^(-snr_db/20)`` (RMS over the
+        whole noise-free record of that channel). ``None`` for no noise.
+        Default 40.
+    seed : int, numpy.random.Generator or None
+        Noise seed; the same seed gives the same data.
+    excitation : {"chirp", "multisine"}
+        Periodic linear sweep (:func:`tyredamp.signal.periodic_chirp`,
+        default) or band-limited Schroeder multisine (module docstring).
+    drive_mode : {"sequential", "simultaneous"}
+        With several drive points: one input per run, or all inputs in every
+        run with Hadamard signs (module docstring).
+    oversample : int
+        Simulation rate / ``sample_rate`` (default 16).
+    initial_state : {"periodic", "rest"}
+        Start in the exact periodic steady state (default) or at rest.
+    settle_periods : int
+        Periods simulated before the recorded ones in each run (default 0).
+    keep_settle : bool
+        Keep the settle periods in the record
+        (``data.acquisition.settle_samples`` says how many samples of each
+        run to drop) instead of dropping them.
+
+    Returns
+    -------
+    VirtualModalTest
+
+    Raises
+    ------
+    InputError
+        Inconsistent sampling, band, counts or options (message names the
+        argument).
+    """
+    t_start = _time.perf_counter()
+    tyre, fs, p_samples, f_rms = _checked_options(
+        tyre, sample_rate, period, n_periods, settle_periods, oversample, force_rms, snr_db
+    )
+    _check_choices(drive_mode, excitation, initial_state)
+    bnd = as_band(band)
+    lines = band_lines(fs, p_samples, bnd)
+    truth = tyre.truth(band=bnd)
+    rng = np.random.default_rng(seed)
+
+    n_in = len(tyre.layout.drive_points)
+    drive = np.eye(n_in) if drive_mode == "sequential" else hadamard_drive_matrix(n_in)
+    r = int(oversample)
+    make = periodic_chirp if excitation == "chirp" else schroeder_multisine
+    exc = make(fs * r, p_samples * r, bnd, rms=f_rms)
+    n_keep = int(n_periods) + (int(settle_periods) if keep_settle else 0)
+    periods = (int(settle_periods), int(n_periods), keep_settle)
+    run_len = n_keep * p_samples
+    n_runs = drive.shape[0]
+    clean = np.concatenate(
+        [
+            _simulate_run(
+                tyre, drive[run][:, None] * exc.signal[None, :], fs * r, r, initial_state, periods
+            )
+            for run in range(n_runs)
+        ],
+        axis=1,
+    )
+    measured, noise_std = _add_noise(clean, snr_db, rng)
+    meta = _notes(tyre, drive, drive_mode, exc, lines, (f_rms, snr_db, noise_std), seed, r)
+    meta["initial_state"] = initial_state
+    meta["elapsed_s"] = _time.perf_counter() - t_start
+    acquisition = Acquisition(
+        period_samples=p_samples,
+        run_starts=tuple(run * run_len for run in range(n_runs)),
+        settle_samples=int(settle_periods) * p_samples if keep_settle else 0,
+        band_hz=(float(bnd[0]), float(bnd[1])),
+        n_averages=int(n_periods),
+        excitation=exc.name,
+    )
+    data = TimeData(
+        measured,
+        fs,
+        tyre.input_channels + tyre.output_channels,
+        ["force"] * n_in + ["acceleration"] * len(tyre.point_dofs),
+        meta,
+        acquisition=acquisition,
+    )
+    return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)
+
+
+def _check_choices(drive_mode: str, excitation: str, initial_state: str) -> None:
+    if drive_mode not in ("sequential", "simultaneous"):
+        raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
+    if excitation not in ("chirp", "multisine"):
+        raise InputError(f"excitation: expected 'chirp' or 'multisine', got {excitation!r}")
+    if initial_state not in ("periodic", "rest"):
+        raise InputError(f"initial_state: expected 'periodic' or 'rest', got {initial_state!r}")
+
+
+def _notes(
+    tyre: RingTyre,
+    drive: NDArray[np.float64],
+    drive_mode: str,
+    exc: Any,
+    lines: NDArray[Any],
+    levels: tuple[float, float | None, NDArray[np.float64]],
+    seed: int | np.random.Generator | None,
+    r: int,
+) -> dict[str, Any]:
+    """``data.meta`` of a virtual test; ``levels`` = (force RMS, SNR in dB, noise std)."""
+    f_rms, snr_db, noise_std = levels
+    return {
+        "source": "tyredamp.virtual.run_modal_test (virtual ring tyre)",
+        "n_runs": drive.shape[0],
+        "drive_mode": drive_mode,
+        "drive_matrix": drive.tolist(),
+        "drive_points": list(tyre.layout.drive_points),
+        "excitation_band_hz": [float(exc.band[0]), float(exc.band[1])],
+        "lines": lines.tolist(),
+        "force_rms": f_rms,
+        "snr_db": None if snr_db is None else float(snr_db),
+        "noise_std": noise_std.tolist(),
+        "seed": int(seed) if isinstance(seed, int | np.integer) else None,
+        "oversample": r,
+        "hold": "foh",
+        "anti_alias": "ideal low-pass at sample_rate/2 (per simulated period)",
+        "pressure_pa": tyre.params.pressure,
+        "nonproportionality": tyre.nonproportionality,
+        "n_ring": tyre.n_ring,
+    }
+
+
+def _checked_options(
+    tyre: RingTyre | None,
+    sample_rate: float,
+    period: float,
+    n_periods: int,
+    settle_periods: int,
+    oversample: int,
+    force_rms: float,
+    snr_db: float | None,
+) -> tuple[RingTyre, float, int, float]:
+    """The tyre, sample rate (Hz), samples per period and force RMS (N) of ``run_modal_test``."""
+    if tyre is None:
+        tyre = RingTyre()
+    if not isinstance(tyre, RingTyre):
+        raise InputError(f"tyre: expected a RingTyre, got {type(tyre).__name__}")
+    fs = check_positive(sample_rate, "sample_rate")
+    t_per = check_positive(period, "period")
+    p_samples = round(t_per * fs)
+    if abs(p_samples - t_per * fs) > 1e-6 * max(1.0, t_per * fs) or p_samples < 4:
+        raise InputError(
+            f"period: expected period * sample_rate to be an integer >= 4, got "
+            f"{t_per:g} s * {fs:g} Hz = {t_per * fs:g}"
+        )
+    for name, val, lo in (
+        ("n_periods", n_periods, 1),
+        ("settle_periods", settle_periods, 0),
+        ("oversample", oversample, 1),
+    ):
+        if not isinstance(val, int | np.integer) or isinstance(val, bool) or val < lo:
+            raise InputError(f"{name}: expected an integer >= {lo}, got {val!r}")
+    f_rms = check_positive(force_rms, "force_rms")
+    if snr_db is not None:
+        try:
+            snr = float(snr_db)
+        except (TypeError, ValueError):
+            raise InputError(f"snr_db: expected a number in dB or None, got {snr_db!r}") from None
+        if not (snr > -300.0):  # NaN, -inf (infinite noise) or noise 1e15 x the signal
+            raise InputError(f"snr_db: expected a ratio in dB > -300 (inf: no noise), got {snr:g}")
+    return tyre, fs, p_samples, f_rms
+
+
+def _simulate_run(
+    tyre: RingTyre,
+    force_sim: NDArray[np.float64],
+    fs_sim: float,
+    r: int,
+    initial_state: str,
+    periods: tuple[int, int, bool],
+) -> NDArray[np.float64]:
+    """Forces then accelerations of one run, sampled at ``fs_sim / r``.
+
+    ``force_sim`` (n_in, P r) is one period of the drive forces at the
+    simulation rate; ``periods`` = (settle periods, recorded periods, keep
+    the settle periods).
+    """
+    settle_periods, n_periods, keep_settle = periods
+    n_keep = n_periods + (settle_periods if keep_settle else 0)
+    system = tyre.system
+    inputs = tyre.drive_dofs.tolist()
+    outputs = tyre.point_dofs.tolist()
+    if initial_state == "periodic":
+        x0, v0 = periodic_initial_state(system, force_sim, fs_sim, inputs)
+        resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
+        acc = np.tile(_acquire(resp.acceleration, r), (1, n_keep))
+    else:
+        cm = system.complex_modes()
+        blocks = []
+        q = np.zeros(cm.poles.size, dtype=complex)
+        ext = np.concatenate([force_sim, force_sim[:, :1]], axis=1)
+        psi_in = cm.psi[inputs]
+        for k in range(settle_periods + n_periods):
+            x0, v0 = _modal_to_physical(cm, q)
+            resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
+            if k >= settle_periods or keep_settle:
+                blocks.append(_acquire(resp.acceleration, r))
+            q = _modal_propagate(cm, psi_in, ext, 1.0 / fs_sim, q)
+        acc = np.concatenate(blocks, axis=1)
+    force = np.tile(_acquire(force_sim, r), (1, n_keep))
+    return np.concatenate([force, acc], axis=0)
+
+
+def _add_noise(
+    clean: NDArray[np.float64], snr_db: float | None, rng: np.random.Generator
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The record with Gaussian noise at ``snr_db`` on every channel, and the noise std."""
+    if snr_db is None or np.isinf(float(snr_db)):
+        return clean, np.zeros(clean.shape[0])
+    rms = np.sqrt(np.mean(clean**2, axis=1))
+    noise_std = rms * 10.0 ** (-float(snr_db) / 20.0)
+    return clean + noise_std[:, None] * rng.standard_normal(clean.shape), noise_std

@@ -1,0 +1,296 @@
+"""The demo's own files read back whole, and ``lateral fit`` on them reproduces the demo's fits.
+
+Uses the one quick demo of the test session (:func:`tests.test_studies_demo.quick_demo`).
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from tyredamp.cli import main
+from tyredamp.io import read_frf, read_timedata
+from tyredamp.lateral import DEFAULT_MODELS, LateralData, rank_models
+from tyredamp.studies.results import DemoResult
+
+from .test_studies_demo import quick_demo
+
+
+@pytest.fixture(scope="module")
+def demo() -> tuple[DemoResult, Path]:
+    return quick_demo()
+
+
+def test_every_data_file_reads_back_whole(demo: tuple[DemoResult, Path]) -> None:
+    from tyredamp.report.demo import _data_files
+
+    result, out = demo
+    files = _data_files(result)
+    assert files  # every file the demo writes as data
+    for rel, obj in files.items():
+        back = read_timedata(out / rel) if rel.endswith("time.uff") or "_time_" in rel else None
+        if back is None:
+            frf = read_frf(out / rel)
+            assert_array_equal(frf.H, obj.H)  # type: ignore[union-attr]
+            assert_array_equal(frf.frequency, obj.frequency)  # type: ignore[union-attr]
+            assert frf.meta == json.loads(json.dumps(obj.meta)), rel
+        else:
+            assert_array_equal(back.data, obj.data)  # type: ignore[union-attr]
+            assert back.meta == json.loads(json.dumps(obj.meta)), rel
+
+
+def test_json_documents_read_back(demo: tuple[DemoResult, Path]) -> None:
+    from tyredamp.damping import DampingModel
+    from tyredamp.documents.modes import read_modes_json
+
+    result, out = demo
+    p0 = f"{result.radial.main.pressure_bar:g}bar"
+    from tyredamp.documents.jsonfile import json_text
+
+    def same(a: object, b: object) -> None:
+        # everything the documents hold, compared in their JSON form
+        assert json.loads(json_text(a)) == json.loads(json_text(b))
+
+    models = read_modes_json(out / f"modes_{p0}.json")
+    assert set(models) == set(result.radial.main.models)
+    for name, mdl in result.radial.main.models.items():
+        assert_allclose(models[name].poles, mdl.poles, rtol=1e-15)
+        same(models[name].to_dict(), mdl.to_dict())
+    dm = DampingModel.from_dict(json.loads((out / f"damping_{p0}.json").read_text()))
+    assert_allclose(dm.modal, result.radial.damping.modal, rtol=1e-15)
+    same(dm.to_dict(), result.radial.damping.to_dict())
+
+
+@pytest.mark.parametrize("force", ["ground", "axle"])
+def test_lateral_fit_on_demo_files_reproduces_the_demo(
+    demo: tuple[DemoResult, Path], force: str, tmp_path: Path
+) -> None:
+    """``tyredamp lateral fit FILE`` (no options) gives the demo's parameters to 1e-9."""
+    result, out = demo
+    for c in result.lateral.conditions:
+        tag = f"{c.pressure_bar:g}bar_{c.speed_kmh:g}kmh"
+        path = out / "data" / f"lateral_{tag}_{force}_frf.uff"
+        js = tmp_path / f"{tag}_{force}.json"
+        try:
+            main(["lateral", "fit", str(path), "--out", str(js)])
+        except SystemExit as exc:
+            raise AssertionError(f"lateral fit exited with {exc.code}") from None
+        doc = json.loads(js.read_text())
+        cond = doc["conditions"]
+        assert cond["force"] == force
+        assert_allclose(cond["speed_kmh"], c.speed_kmh, rtol=1e-15)
+        data: LateralData = c.ground if force == "ground" else c.axle
+        assert cond["wheel_mass_kg"] == data.wheel_mass
+        if force == "ground":  # the demo's own ranking of the ground-force FRF
+            fits = {f.name: f for f in c.ranking.fits}
+        else:  # the demo predicts the axle FRF; the same fit of its in-memory data
+            fits = {f.name: f for f in rank_models(data, DEFAULT_MODELS).fits}
+        assert {f["model"] for f in doc["fits"]} == set(DEFAULT_MODELS)
+        for f in doc["fits"]:
+            want = fits[f["model"]].params
+            assert set(f["params"]) == set(want)
+            for k, v in want.items():
+                assert_allclose(f["params"][k], v, rtol=1e-9, err_msg=f"{tag} {f['model']} {k}")
+
+
+def _sections(html_text: str) -> dict[str, str]:
+    """The report's radial and lateral sections (text between their level-2 headings)."""
+    import re
+
+    def at(title: str) -> int:
+        m = re.search(rf'<h2 id="s\d+">{re.escape(title)}', html_text)
+        assert m is not None, title
+        return m.start()
+
+    r0, l0 = at("Radial study: modal test"), at("Lateral study: rolling-tyre rig")
+    f0 = at("Files")
+    return {"radial": html_text[r0:l0], "lateral": html_text[l0:f0]}
+
+
+def test_every_stage_warning_reaches_the_report_beside_its_result(
+    demo: tuple[DemoResult, Path],
+) -> None:
+    import html
+
+    from tyredamp.studies.findings import demo_findings
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    page = (out / "report.html").read_text(encoding="utf-8")
+    sec = _sections(page)
+    # collected again from the stages' own results: nothing is lost on the way
+    raw = []
+    for run in result.radial.runs:
+        raw += list(run.identification.warnings)
+        for mdl in run.models.values():
+            raw += list(mdl.meta.get("warnings", []))
+    for chk in (result.radial.linearity, result.radial.reciprocity, result.radial.quality):
+        if not chk.passed:
+            raw.append(chk.summary)
+    messages = [w["message"] for w in doc["warnings"]]
+    for w in raw:
+        core = w.split("(", 1)[-1].split(")", 1)[0] if w.startswith("real-mode refinement") else w
+        assert any(core in m for m in messages), w
+    fnd = demo_findings(result)
+    assert [f.to_dict() for f in fnd.findings] == doc["warnings"]
+    assert doc["warnings"]  # the quick demo has failures to report (9 bar, real modes)
+    for w in doc["warnings"]:
+        text = html.escape(w["message"])
+        where = "radial" if w["about"].startswith("radial") else "lateral"
+        assert text in sec[where], w  # beside the result it concerns
+        assert page.count(text) >= 2, w  # and in the summary's list
+
+
+def test_every_pressure_and_condition_fits_or_says_why(demo: tuple[DemoResult, Path]) -> None:
+    import html
+
+    from tyredamp.cli.demo import demo_summary_rows
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    page = (out / "report.html").read_text(encoding="utf-8")
+    rows = dict(demo_summary_rows(result, doc))
+    verdicts = []
+    for pr in doc["radial"]["pressures"]:
+        for name in ("complex", "real"):
+            verdicts.append((f"{name}-mode fit {pr['pressure_bar']:g} bar", pr["verdict"][name]))
+    for c in doc["lateral"]["conditions"]:
+        verdicts.append((f"{c['best']} fit {c['label']}", c["verdict"]))
+    assert len(verdicts) == 2 * len(result.radial.runs) + len(result.lateral.conditions)
+    # every warning reaches the summary too (failures through the verdict rows)
+    shown = " ".join(rows.values())
+    for w in doc["warnings"]:
+        if w["severity"] == "warning":
+            assert w["message"] in shown, w
+    for key, v in verdicts:
+        if v["status"] == "ok":
+            assert v["residual_to_noise"] <= v["threshold"]
+            assert rows[key] == "within noise"
+            continue
+        assert v["status"] == "failed"
+        assert v["reasons"], key
+        assert rows[key].startswith("FAILED")
+        assert rows[key] == v["brief"]
+        assert v["reasons"][-1] in rows[key]  # the likely cause
+        assert f'<div class="verdict bad">{html.escape(v["summary"])}</div>' in page
+    # the 9 bar fit misses its band-edge mode: failed, and the report says why
+    nine = next(p for p in doc["radial"]["pressures"] if p["pressure_bar"] == 9.0)
+    reasons = " ".join(nine["verdict"]["complex"]["reasons"])
+    if nine["verdict"]["complex"]["status"] == "failed":
+        assert "band edge" in reasons
+    # the main pressure's complex-mode fit is within its noise
+    main = doc["radial"]["pressures"][0]["verdict"]["complex"]
+    assert main["status"] == "ok"
+
+
+def test_maxwell_and_relaxation_are_one_model_ranked_once(demo: tuple[DemoResult, Path]) -> None:
+    import numpy as np
+
+    from tyredamp.lateral.models import MaxwellModel, RelaxationLengthModel
+
+    # closed form: Y/F = sigma/C_alpha + V/(i w C_alpha) = 1/k + 1/(i w c)
+    rl = RelaxationLengthModel(C_alpha=8e4, sigma=0.6, speed=5 / 3.6)
+    mx = MaxwellModel(k=8e4 / 0.6, c=8e4 / (5 / 3.6))
+    f = np.linspace(0.1, 10, 50)
+    assert_allclose(rl.response(f, "receptance"), mx.response(f, "receptance"), rtol=1e-12)
+    _, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    lat = doc["lateral"]
+    assert ["maxwell", "relaxation"] in lat["equivalent_models"]
+    names = [r["model"] for r in lat["ranking"]]
+    assert "maxwell = relaxation" in names
+    assert "maxwell" not in names
+    assert "relaxation" not in names
+
+
+def test_time_response_truth_and_gap(demo: tuple[DemoResult, Path]) -> None:
+    import numpy as np
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    tr = doc["lateral"]["time_response"]
+    # the rig's exact response misses the measurement by its noise alone: white noise of
+    # relative_noise x the peak amplitude on a sine, RMS ratio relative_noise * sqrt(2)
+    noise = result.lateral.rig.relative_noise * np.sqrt(2)
+    assert_allclose(tr["truth_error"], noise, rtol=0.25)
+    for name, err in tr["relative_error"].items():
+        gap = tr["error_to_truth"][name]
+        # misfit to the measurement = gap to the truth and noise, roughly in quadrature
+        assert gap < err + 1e-12
+        assert gap > 0.5 * err
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "error against the rig&#x27;s exact response" in page
+    assert "The exact response misses the measurement by" in page
+    for c in doc["lateral"]["conditions"]:
+        rd = c["road_damping"]
+        assert_allclose(rd["ratio"], rd["fitted"] / rd["true"], rtol=1e-12)
+
+
+def test_modal_cli_prints_and_stores_the_verdict(
+    demo: tuple[DemoResult, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The demo's 9 bar FRF: a mode at 199 Hz sits on the 200 Hz band edge."""
+    result, out = demo
+    if 9.0 not in result.settings.radial_pressures_bar:
+        pytest.skip("no 9 bar run")
+    frf = out / "data" / "radial_9bar_frf.uff"
+    js = tmp_path / "m.json"
+    verdicts = {}
+    for band in (None, ("0", "195")):
+        capsys.readouterr()
+        main(["modal", str(frf), "--out", str(js), *(["--band", *band] if band else [])])
+        text = capsys.readouterr().out
+        assert "verdict: complex-mode fit: " in text
+        doc = json.loads(js.read_text())
+        verdicts[band] = doc["models"]["complex"]["meta"]["verdict"]
+    demo_v = json.loads((out / "results.json").read_text())
+    nine = next(p for p in demo_v["radial"]["pressures"] if p["pressure_bar"] == 9.0)
+    # the command reaches the demo's own verdict on the same file and band
+    assert verdicts[None]["status"] == nine["verdict"]["complex"]["status"]
+    if verdicts[None]["status"] == "failed":
+        assert "band edge" in " ".join(verdicts[None]["reasons"])
+        # and the remedy it names works: a band that stops short of the edge mode
+        assert verdicts[("0", "195")]["status"] == "ok"
+
+
+def test_quality_check_judged_over_the_checks_band_and_summarised(
+    demo: tuple[DemoResult, Path],
+) -> None:
+    from tyredamp.cli.demo import demo_summary_rows
+
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    q = result.radial.quality
+    lo, hi = result.settings.check_band_hz
+    assert q.frequency is not None
+    assert q.frequency[0] >= lo
+    assert q.frequency[-1] <= hi
+    # the clean virtual test passes once the nearly silent band below the first mode is
+    # judged as the other checks judge it; the summary reports the verdict either way
+    assert doc["radial"]["checks"]["quality"]["passed"]
+    rows = dict(demo_summary_rows(result, doc))
+    assert "quality PASS" in rows["checks"]
+    for note in q.notes:
+        assert not re.search(r"(\d+(?:\.\d+)?)-\1 Hz", note), note  # no "25.5-25.5 Hz"
+
+
+def test_files_report_shows_the_demo_verdicts_and_warnings(
+    demo: tuple[DemoResult, Path], tmp_path: Path
+) -> None:
+    import html
+
+    from tyredamp.report.files import build_files_report
+
+    _, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    page = build_files_report([out / "results.json"])
+    for pr in doc["radial"]["pressures"]:
+        for v in pr["verdict"].values():
+            cls = "verdict" if v["passed"] else "verdict bad"
+            assert f'<div class="{cls}">{html.escape(v["summary"])}</div>' in page
+    for w in doc["warnings"]:
+        assert html.escape(w["message"]) in page

@@ -1,0 +1,265 @@
+"""``tyredamp demo --quick`` end to end: files, report sections, results.json, truth.
+
+The demo runs once per test session (:func:`quick_demo`, shared with
+``test_results_schema.py``): through the command line, with a spy on
+:func:`tyredamp.studies.demo.run_demo` that keeps the in-memory result for the API
+tests. About 15 s on two busy cores.
+"""
+
+from __future__ import annotations
+
+import atexit
+import functools
+import json
+import re
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+
+import tyredamp.studies.demo as demo_mod
+from tyredamp.cli import main
+from tyredamp.documents.demo import validate_results
+from tyredamp.io import read_frf, read_timedata
+from tyredamp.report.build import SECTIONS
+from tyredamp.report.demo import save_demo
+from tyredamp.studies.demo import DemoResult, DemoSettings
+from tyredamp.studies.radial import match_modes
+
+
+@functools.lru_cache(maxsize=1)
+def quick_demo() -> tuple[DemoResult, Path]:
+    """Run ``tyredamp demo --quick`` once; the in-memory result and the output directory."""
+    root = Path(tempfile.mkdtemp(prefix="tyredamp-test-demo-"))
+    atexit.register(shutil.rmtree, root, ignore_errors=True)
+    out = root / "demo"
+    real = demo_mod.run_demo
+    kept: list[DemoResult] = []
+
+    def spy(*args: Any, **kwargs: Any) -> DemoResult:
+        r = real(*args, **kwargs)
+        kept.append(r)
+        return r
+
+    demo_mod.run_demo = spy  # the CLI imports run_demo at call time
+    try:
+        main(["demo", "--quick", "--out", str(out), "--seed", "0"])
+    except SystemExit as exc:  # main exits only on errors
+        raise AssertionError(f"tyredamp demo exited with {exc.code}") from None
+    finally:
+        demo_mod.run_demo = real
+    assert len(kept) == 1
+    return kept[0], out
+
+
+@pytest.fixture(scope="module")
+def demo() -> tuple[DemoResult, Path]:
+    return quick_demo()
+
+
+def test_files_exist(demo: tuple[DemoResult, Path]) -> None:
+    result, out = demo
+    assert (out / "report.html").stat().st_size > 100_000
+    doc = json.loads((out / "results.json").read_text())
+    listed = set(doc["files"])
+    on_disk = {p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_file()}
+    assert listed == on_disk
+    pngs = sorted(p.name for p in (out / "figures").glob("*.png"))
+    for name in (
+        "fig02_real_fit.png",
+        "fig03_complex_fit.png",
+        "fig04_discrepancy.png",
+        "fig05_damping.png",
+        "stabilisation.png",
+        "mode_shapes.png",
+        "fig07_corner_frequency.png",
+        "fig11_ground_5kmh.png",
+        "fig12_ground_10kmh.png",
+        "fig13_axle_5kmh.png",
+        "fig14_axle_10kmh.png",
+        "fig15_time_response.png",
+        "residual_zoom.png",
+        "mac.png",
+    ):
+        assert name in pngs
+        assert (out / "figures" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # nothing left beside the output directory (temporary trees are renamed or removed)
+    assert sorted(p.name for p in out.parent.iterdir()) == ["demo"]
+    assert result.settings.quick
+
+
+def test_generated_data_are_uff58(demo: tuple[DemoResult, Path]) -> None:
+    import pyuff
+
+    result, out = demo
+    frf = read_frf(out / "data" / "radial_7.5bar_frf.uff")
+    main_run = result.radial.main
+    # binary UFF 58b is lossless (io docstring): the file holds the FRF bit for bit
+    assert_allclose(frf.H, main_run.frf.H, rtol=0, atol=0)
+    td = read_timedata(out / "data" / "radial_7.5bar_time.uff")
+    assert td.n_channels == 17
+    assert_allclose(td.data, main_run.test.data.data, rtol=0, atol=0)
+    sets = pyuff.UFF(str(out / "data" / "radial_7.5bar_time.uff")).read_sets()
+    # data sets 58 hold the channels; data sets 151 the whole meta (io.uff "Metadata record")
+    assert {s["func_type"] for s in sets if s["type"] == 58} == {1}
+    assert {s["type"] for s in sets} == {58, 151}
+    sets = pyuff.UFF(str(out / "data" / "lateral_1.7bar_5kmh_axle_frf.uff")).read_sets()
+    assert {s["func_type"] for s in sets if s["type"] == 58} >= {4}
+
+
+def test_report_sections_and_self_contained(demo: tuple[DemoResult, Path]) -> None:
+    _, out = demo
+    html = (out / "report.html").read_text(encoding="utf-8")
+    for heading in SECTIONS:
+        assert re.search(rf'<h2 id="s\d+">{re.escape(heading)}</h2>', html), heading
+    for sub in (
+        "Linearity, reciprocity and data quality",
+        "Stabilisation diagram",
+        "Modes: identified with standard errors, beside the truth",
+        "Real versus complex modes",
+        "Damping matrices",
+        "Model ranking",
+        "Vehicle model and time response",
+    ):
+        assert f"<h3>{sub}</h3>" in html
+    n_png = len(list((out / "figures").glob("*.png")))
+    assert html.count('src="data:image/png;base64,') == n_png
+    # readable offline: no external resource of any kind
+    assert not re.search(r'(src|href)="(?!data:|#)', html)
+    assert "<script" not in html
+    assert "<link" not in html
+    # truth beside the identified values
+    assert "f true (Hz)" in html
+    assert "C_alpha/V true" in html
+
+
+def test_results_validate_and_agree_with_truth(demo: tuple[DemoResult, Path]) -> None:
+    result, out = demo
+    doc = json.loads((out / "results.json").read_text())
+    validate_results(doc)
+    rad = doc["radial"]
+    # complex modes fit the non-proportionally damped tyre better (paper: about 2x)
+    assert rad["rmsd_complex"] < rad["rmsd_real"] / 2
+    matched = [m for m in rad["modes"] if m["true"] and m["complex"]]
+    assert len(matched) >= 5
+    for m in matched:
+        # 40 dB SNR, 4 averages: natural frequencies within 0.05 %, damping ratios within 2 %
+        assert_allclose(m["complex"]["frequency_hz"], m["true"]["frequency_hz"], rtol=5e-4)
+        assert_allclose(m["complex"]["damping_ratio"], m["true"]["damping_ratio"], rtol=0.02)
+    # the symmetric part of C' is within 4 % of the truth (leakage makes the raw C' ~9 %,
+    # tests/test_damping_tyre.py); the checks pass on a linear, reciprocal tyre
+    assert rad["damping"]["modal_error_symmetric"] < 0.04
+    assert rad["checks"]["linearity"]["passed"]
+    assert rad["checks"]["reciprocity"]["passed"]
+    lat = doc["lateral"]
+    # equivalent models (maxwell = relaxation) share one entry of the overall ranking
+    assert {m for r in lat["ranking"] for m in r["equivalent"]} == set(
+        result.settings.lateral_models
+    )
+    assert len(lat["corner_frequency_hz"]) == len(lat["conditions"]) == 2
+    for c in lat["conditions"]:
+        hy = c["params"]["hysteretic"]
+        f0 = hy["K"]["value"] / (2 * np.pi * hy["C_r"]["value"])
+        assert_allclose(c["corner_frequency_hz"], f0, rtol=1e-12)  # eq. 38, same numbers
+
+
+def test_summary_rows(demo: tuple[DemoResult, Path]) -> None:
+    from tyredamp.cli.demo import demo_summary_rows
+    from tyredamp.studies.document import build_results
+
+    result, _ = demo
+    rows = dict(demo_summary_rows(result, build_results(result)))
+    assert "lateral ranking" in rows
+    assert "RMSD" in " ".join(rows)
+
+
+def test_replace_and_no_partial_output(
+    demo: tuple[DemoResult, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from matplotlib.figure import Figure
+
+    import tyredamp.report.demo as build_mod  # save_demo's names for the report and figures
+
+    fig_mod = build_mod
+
+    result, _ = demo
+
+    def one_figure(r: DemoResult) -> dict[str, Any]:
+        # the directory handling is under test here, not the figures (test_files_exist)
+        return {"blank": (Figure(figsize=(1, 1)), "a blank figure")}
+
+    monkeypatch.setattr(fig_mod, "demo_figures", one_figure)
+    out = tmp_path / "out"
+    save_demo(result, out)
+    first = (out / "results.json").read_text()
+    (out / "results.json").touch()
+    save_demo(result, out)  # an earlier demo output is replaced
+    assert (out / "results.json").read_text() == first
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+    def broken(*args: Any, **kwargs: Any) -> str:
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(build_mod, "build_demo_report", broken)
+    with pytest.raises(RuntimeError, match="disk full"):
+        save_demo(result, tmp_path / "new")
+    with pytest.raises(RuntimeError, match="disk full"):
+        save_demo(result, out)
+    # nothing new, nothing half-written, the earlier output untouched
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert (out / "results.json").read_text() == first
+
+
+def test_refuses_foreign_directory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep me")
+    with pytest.raises(SystemExit) as exc:
+        main(["demo", "--quick", "--out", str(tmp_path / "mine")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "not an earlier tyredamp demo output" in err
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep me"
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(SystemExit) as exc:
+        main(["demo", "--out", str(tmp_path / "file")])
+    assert exc.value.code == 2
+    assert "is not a directory" in capsys.readouterr().err
+
+
+def test_settings_validation() -> None:
+    from tyredamp.exceptions import InputError
+
+    with pytest.raises(InputError, match="reference_condition"):
+        DemoSettings(lateral_pressures_bar=(2.4,))
+    with pytest.raises(InputError, match="radial_periods"):
+        DemoSettings(radial_periods=0)
+    with pytest.raises(InputError, match="settings"):
+        demo_mod.run_demo("quick")  # type: ignore[arg-type]
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    st.lists(st.floats(10, 1000), min_size=1, max_size=8, unique=True),
+    st.permutations(range(8)),
+)
+def test_match_modes_recovers_a_permutation(freqs: list[float], perm: list[int]) -> None:
+    """Identified frequencies = a permutation of the true ones, each off by < 0.1 %."""
+    f = np.sort(np.array(freqs))
+    # keep the true modes at least 1 % apart so that the pairing is unambiguous
+    f = f[np.concatenate([[True], np.diff(f) / f[1:] > 0.01])]
+    order = [p for p in perm if p < f.size]
+    ident = f[order] * (1 + 1e-3 * np.sin(np.arange(f.size)))
+    m = match_modes(ident, f)
+    assert len(m.matched) == f.size
+    for t, j in m.matched:
+        assert order[j] == t
+    # a far-away extra mode stays unmatched on its own row
+    m2 = match_modes(np.append(ident, 5000.0), f)
+    assert (None, f.size) in m2.pairs
