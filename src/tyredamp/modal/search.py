@@ -403,12 +403,18 @@ def residual_search(
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
     A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
-    of the diagram) is not a mode: it is rejected whatever its statistic.
+    of the diagram) is not a mode: it is rejected whatever its statistic. Nor
+    is one whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
+    narrower than the line spacing: no line lies inside its resonance, so the
+    lines cannot resolve its frequency and damping, and such a pole fits the
+    noise of single lines (where per-line variances estimated from a few
+    averages are too small) rather than a resonance.
 
     ``candidates`` are starting poles and participation vectors from the
     diagram; each round adds the peaks of the current residual.
     """
     lo, hi = band
+    df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
     tried: list[RejectedMode] = []
     cur = modes
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
@@ -447,6 +453,17 @@ def residual_search(
             if got is None:
                 continue
             p_t, l_t, t = got
+            if -p_t.real / np.pi < df:
+                tried.append(
+                    rejected(
+                        p_t,
+                        f"half-power bandwidth {-p_t.real / np.pi:.3g} Hz below the line "
+                        f"spacing {df:.3g} Hz (not resolved)",
+                        t,
+                        threshold,
+                    )
+                )
+                continue
             if -p_t.real > max_damping * abs(p_t):
                 tried.append(
                     rejected(p_t, f"damping above the admissible {max_damping:.0%}", t, threshold)
