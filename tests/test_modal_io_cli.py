@@ -106,7 +106,7 @@ def test_cli_modal_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert "real modes (6)" in text
     assert "RMSD real / complex" in text
     assert "threshold" in text  # the mode test's column and threshold
-    assert "fit: the model explains the data to the noise" in text
+    assert "goodness of fit (ML): the model explains the data to the noise" in text
     assert "noise model: residual" in text
     models = read_modes_json(out)
     assert_allclose(models["complex"].frequency_hz, sys_.complex_modes().frequency_hz, rtol=1e-4)
