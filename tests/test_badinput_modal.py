@@ -1,9 +1,8 @@
 """Bad-input cases of issue 15 inside the modal identification (the ``modal`` branch's part).
 
-Same promises as ``tests/test_badinput.py``. The cases marked xfail need the
-modal branch (scale-free identification, ``--modes`` bounded by the data, a
-non-uniform axis refused, a one-line FRF named as such); the lead removes the
-marks after merging it.
+Same promises as ``tests/test_badinput.py``: scale-free identification,
+``--modes`` bounded by the data, a non-uniform axis refused, a one-line FRF
+named as such.
 """
 
 from __future__ import annotations
@@ -20,7 +19,6 @@ from tyredamp.io import write_frf
 from .badinput import check_one_error_line, run_main, snapshot
 from .helpers import chain_system
 
-NEEDS_MODAL = pytest.mark.xfail(strict=True, reason="needs the modal branch")
 TRUE_HZ = np.array([7.0833362, 19.84809268, 28.67502205])  # chain_system(3) complex modes
 
 
@@ -38,7 +36,6 @@ def here(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return tmp_path
 
 
-@NEEDS_MODAL
 @pytest.mark.parametrize("scale", [1e300, 1e-300], ids=["1e300", "1e-300"])
 def test_scale_free_identification(
     here: Path, capsys: pytest.CaptureFixture[str], scale: float
@@ -67,7 +64,6 @@ def test_overflowing_csv_value(here: Path, capsys: pytest.CaptureFixture[str]) -
     assert snapshot(here) == before
 
 
-@NEEDS_MODAL
 def test_modes_bounded_by_the_data(here: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """--modes 1000 on 3 outputs x 300 lines: refused before fitting, naming --modes."""
     write_frf(_frf(np.linspace(0.5, 40.0, 300)), here / "x.npz")
@@ -77,7 +73,6 @@ def test_modes_bounded_by_the_data(here: Path, capsys: pytest.CaptureFixture[str
     assert snapshot(here) == before
 
 
-@NEEDS_MODAL
 def test_non_uniform_axis_refused(here: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """pLSCF assumes equally spaced lines; a non-uniform axis is refused, not mis-fitted."""
     f = np.sort(np.concatenate([np.linspace(0.5, 20.0, 200), np.linspace(20.1, 40.0, 60)]))
@@ -88,7 +83,6 @@ def test_non_uniform_axis_refused(here: Path, capsys: pytest.CaptureFixture[str]
     assert snapshot(here) == before
 
 
-@NEEDS_MODAL
 def test_one_line_is_not_a_band_error(here: Path, capsys: pytest.CaptureFixture[str]) -> None:
     write_frf(_frf(np.array([10.0])), here / "x.npz")
     before = snapshot(here)

@@ -362,12 +362,18 @@ def test_doubled_modes_are_tracked_as_pairs_without_swaps(tmp_path: Path) -> Non
     assert check["unmatched"] == []
     assert check["swaps"] == []
     assert check["slot_swaps"] == []
-    pairs = {f: check["families"][f]["T1"] for f in check["pairs"]}
-    assert sorted(next(iter(v)) for v in pairs.values()) == [1, 3, 5]
-    # the members of each pair are tracked through all three pressures
+    waves = {f: next(iter(check["families"][f]["T1"])) for f in check["pairs"]}
+    # both members of the odd wave numbers are visible from points 1 and 5; an even
+    # wave number is a pair only where its weakly driven member (a measurable true
+    # mode below the visibility threshold) passed the mode test too
+    assert sorted(w for w in waves.values() if w % 2) == [1, 3, 5]
+    weak_waves = {w[3] for w in check["weak"]}
+    assert all(w % 2 or w in weak_waves for w in waves.values())
+    odd = {f for f, w in waves.items() if w % 2}
+    # the members of each odd pair are tracked through all three pressures
     n_tests = {f["family"]: f["n_tests"] for f in results.summary["families"]}
-    assert all(n_tests[f] == 3 for f in pairs)
-    held = [h for h in check["held_out"] if h["slot"]]
+    assert all(n_tests[f] == 3 for f in odd)
+    held = [h for h in check["held_out"] if h["slot"] and h["family"] in odd]
     assert len(held) == 3 * 2 * 2  # 3 pairs x 2 members x 2 held-out pressures
     assert check["max_held_out_error"] < 0.005
 

@@ -82,7 +82,7 @@ def test_fit_added_reuses_the_latest_fit_basis_with_the_same_result(
     monkeypatch.setattr(fit_mod, "_orth", counted)
     a = fit.fit_added(*args, omega_bounds=(lo, hi))
     n_plain = len(calls)
-    b = fit.fit_added(*args, omega_bounds=(lo, hi), theta=res.theta)  # cached basis
+    b = fit.fit_added(*args, omega_bounds=(lo, hi), fixed=res)  # the fit's basis, reused
     assert len(calls) - n_plain == n_plain - 1  # the fixed modes' basis is not redone
     assert_allclose(b[0], a[0], rtol=1e-12)
     assert_allclose(b[2], a[2], rtol=1e-9)
@@ -97,6 +97,7 @@ def test_fit_added_gram_blocks_match_the_explicit_projection(
     # columns) unless a subtraction would lose accuracy; forcing the explicit
     # projections everywhere must give the same refinement, and its residual is
     # that of a linear fit with all modes at the refined pole
+    import tyredamp.modal._linalg as lin_mod
     import tyredamp.modal.fit as fit_mod
 
     sys_ = chain_system()
@@ -117,6 +118,7 @@ def test_fit_added_gram_blocks_match_the_explicit_projection(
     assert_allclose(a[2], res.sigma_out, rtol=1e-9)
     monkeypatch.setattr(fit_mod, "_CANCEL_TOL", np.inf)
     monkeypatch.setattr(fit_mod, "_PROJ_TOL", np.inf)
+    monkeypatch.setattr(lin_mod, "_CANCEL_TOL", np.inf)
     b = fit.fit_added(*args, omega_bounds=(lo, hi))
     assert_allclose(b[0], a[0], rtol=1e-10)
     assert_allclose(b[1], a[1], rtol=1e-8)

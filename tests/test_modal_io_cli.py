@@ -105,9 +105,26 @@ def test_cli_modal_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert "complex modes (6)" in text
     assert "real modes (6)" in text
     assert "RMSD real / complex" in text
+    assert "threshold" in text  # the mode test's column and threshold
+    assert "goodness of fit (ML): the model explains the data to the noise" in text
+    assert "noise model: residual" in text
     models = read_modes_json(out)
     assert_allclose(models["complex"].frequency_hz, sys_.complex_modes().frequency_hz, rtol=1e-4)
+    q = models["complex"].quality
+    assert q is not None
+    assert np.all(q.statistic > q.threshold)
+    doc = json.loads(out.read_text())
+    mode0 = doc["models"]["complex"]["modes"][0]
+    assert mode0["test"]["statistic"] > mode0["test"]["threshold"]
     assert Path(src).read_bytes() == before  # input untouched
+    # a non-uniform axis is refused with one line
+    g = np.concatenate([np.linspace(0.5, 20.0, 100), np.linspace(20.2, 40.0, 300)])
+    src2 = write_frf(sys_.frf(g, kind="accelerance", inputs=[0]), tmp_path / "g.npz")
+    assert _run(["modal", str(src2), "--out", str(tmp_path / "g.json")]) == 2
+    assert "uniformly spaced" in capsys.readouterr().err
+    # more modes than the data can hold: refused before any fit
+    assert _run(["modal", str(src), "--out", str(tmp_path / "h.json"), "--modes", "1000"]) == 2
+    assert "at most" in capsys.readouterr().err
 
 
 def test_cli_modal_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

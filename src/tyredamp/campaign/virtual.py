@@ -180,9 +180,39 @@ def tyre_truth(
     One dict per mode: ``wave_number``, ``frequency_hz``, ``damping_ratio``
     and ``shape`` (complex mode at the 16 points as ``[re, im]`` pairs).
     """
+    return _truth_modes(params, pressure_bar, load_n, drive_points, "visible")
+
+
+def weak_truth(
+    params: RingTyreParameters,
+    pressure_bar: float,
+    load_n: float,
+    drive_points: tuple[int, ...] = (1,),
+) -> list[dict]:
+    """The measurable modes below the visibility threshold, as :func:`tyre_truth`.
+
+    Weakly driven (drive-point amplitude under ``VISIBLE_THRESHOLD`` of the
+    largest point amplitude) but present in the data: an identification that
+    tests modes against the noise may find them, and they are true modes.
+    """
+    return _truth_modes(params, pressure_bar, load_n, drive_points, "weak")
+
+
+def _truth_modes(
+    params: RingTyreParameters,
+    pressure_bar: float,
+    load_n: float,
+    drive_points: tuple[int, ...],
+    which: str,
+) -> list[dict]:
     truth = _tyre(params, pressure_bar, load_n, drive_points).truth()
     out = []
-    for i in truth.select("visible"):
+    idx = (
+        truth.select("visible")
+        if which == "visible"
+        else np.flatnonzero(truth.measurable & ~truth.visible)
+    )
+    for i in idx:
         psi = truth.psi_points[:, i]
         out.append(
             {
@@ -310,6 +340,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
                             "pressure_bar": p,
                             "load_n": load,
                             "modes": tyre_truth(params, p, load, s.drive_points),
+                            "weak_modes": weak_truth(params, p, load, s.drive_points),
                         }
                     )
                     done += 1
@@ -445,7 +476,9 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
     dict
         ``families``: family -> {tyre: set of true wave numbers} (one number
         each when there is no swap); ``unmatched``: identified modes with no
-        true mode; ``swaps``: families holding two wave numbers for one tyre;
+        true mode; ``weak``: identified modes that are measurable true modes
+        below the visibility threshold (``weak_modes`` of the truth: test,
+        mode, frequency, wave number); ``swaps``: families holding two wave numbers for one tyre;
         ``pairs``: families tracked as pairs; ``slot_swaps``: a pair's slot
         (``a``/``b``) holding both true members of the pair for one tyre;
         ``held_out``: one row per (family, tyre, load, held-out pressure) with
@@ -455,6 +488,7 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
 
     by_file = {t["file"]: t for t in truth["tests"] if t["study"] == "radial"}
     wave: dict[tuple[str, int], tuple[int, int] | None] = {}
+    weak: dict[tuple[str, int], int] = {}  # (test, mode) -> wave number of a weak true mode
     for r in runs:
         t = by_file.get(r.spec.rel)
         recs = steps.mode_records(r.spec.study, r.documents)
@@ -462,16 +496,30 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
             continue
         freqs = np.array([m["frequency_hz"] for m in recs], dtype=float)
         shapes = np.column_stack([m["shape"] for m in recs])
-        for k, found in enumerate(_true_match(freqs, shapes, t["modes"])):
-            wave[(r.spec.test_id, k + 1)] = found
+        found = _true_match(freqs, shapes, t["modes"])
+        rest = [k for k, m in enumerate(found) if m is None]
+        if rest and t.get("weak_modes"):
+            # identified modes that are no visible mode: a weakly driven true mode?
+            for k, m in zip(
+                rest, _true_match(freqs[rest], shapes[:, rest], t["weak_modes"]), strict=True
+            ):
+                if m is not None:
+                    weak[(r.spec.test_id, k + 1)] = m[0]
+        for k, m in enumerate(found):
+            wave[(r.spec.test_id, k + 1)] = m
     families: dict[str, dict[str, set[int | None]]] = {}
     slots: dict[tuple[str, str, str], set[int]] = {}
     unmatched = []
+    weak_found = []
     for row in results.modes:
-        match = wave.get((row["test_id"], row["mode"]))
-        if match is None:
-            unmatched.append((row["test_id"], row["mode"], row["frequency_hz"]))
+        key = (row["test_id"], row["mode"])
+        match = wave.get(key)
         wn = None if match is None else match[0]
+        if match is None and key in weak:
+            wn = weak[key]
+            weak_found.append((row["test_id"], row["mode"], row["frequency_hz"], wn))
+        elif match is None:
+            unmatched.append((row["test_id"], row["mode"], row["frequency_hz"]))
         families.setdefault(row["family"], {}).setdefault(row["tyre"], set()).add(wn)
         if match is not None and row["slot"]:
             slots.setdefault((row["family"], row["slot"], row["tyre"]), set()).add(match[1])
@@ -520,6 +568,7 @@ def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[s
     return {
         "families": families,
         "unmatched": unmatched,
+        "weak": weak_found,
         "swaps": swaps,
         "pairs": sorted({k[0] for k in slots}, key=lambda f: int(f[1:])),
         "slot_swaps": slot_swaps,

@@ -20,29 +20,47 @@ from ._common import out_file_option
 
 __all__ = ["modal_command", "modes_table"]
 
+_NOISE = {
+    "variance": "per-line variance carried by the FRF",
+    "coherence": "per-line variance from the coherence and the number of averages",
+    "residual": "noise level per output estimated from the residual of the fit",
+}
+
 
 def modes_table(name: str, model: ModalModel) -> list[str]:
-    """Text table of one model: frequency, damping (with standard errors), MPC, RMSD."""
+    """Text table of one model: frequency, damping (with standard errors), MPC, the
+    mode test's statistic, RMSD and the goodness-of-fit verdict."""
     sf = model.std.get("frequency_hz", np.full(model.n_modes, np.nan))
     sz = model.std.get("damping_ratio", np.full(model.n_modes, np.nan))
     mpc = np.asarray(model.meta.get("mpc", np.full(model.n_modes, np.nan)), float)
+    q = model.quality
+    stat = q.statistic if q is not None else np.full(model.n_modes, np.nan)
+    thr = f" (threshold {q.threshold:.3g}, false-alarm rate {q.false_alarm:g})" if q else ""
     labels = model.meta.get("wave_number_label")
     if not isinstance(labels, list) or len(labels) != model.n_modes:
         labels = None
     rows = [
         f"{name} modes ({model.n_modes}):",
-        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7}"
-        + ("  wave number" if labels else ""),
+        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7} {'T':>9}"
+        + ("  wave number" if labels else "")
+        + thr,
     ]
     for n in range(model.n_modes):
         rows.append(
             f"  {n + 1:>3} {model.frequency_hz[n]:>10.3f} {sf[n]:>8.3g} "
-            f"{100 * model.damping_ratio[n]:>9.4f} {100 * sz[n]:>8.3g} {mpc[n]:>7.4f}"
-            + (f"  {labels[n]}" if labels else "")
+            f"{100 * model.damping_ratio[n]:>9.4f} {100 * sz[n]:>8.3g} {mpc[n]:>7.4f} "
+            f"{stat[n]:>9.3g}" + (f"  {labels[n]}" if labels else "")
         )
     rmsd = model.meta.get("rmsd", float("nan"))
     rel = model.meta.get("relative_error", float("nan"))
     rows.append(f"  RMSD (eq. 19) {rmsd:.4g}, relative error {100 * rel:.3g} %")
+    if q is not None:
+        rows.append(f"  goodness of fit (ML): {q.verdict}")
+        if q.rejected:
+            rows.append(
+                f"  {len(q.rejected)} candidate(s) rejected; first: "
+                + "; ".join(f"{r.frequency_hz:.2f} Hz ({r.reason})" for r in q.rejected[:3])
+            )
     for w in model.meta.get("warnings", []):
         rows.append(f"  warning: {w}")
     return rows
@@ -116,6 +134,15 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
 )
 @click.option("--no-residuals", is_flag=True, help="Fit without lower/upper residual terms.")
 @click.option(
+    "--false-alarm",
+    type=click.FloatRange(min=0.0, max=1.0, min_open=True, max_open=True),
+    default=0.01,
+    show_default=True,
+    help="False-alarm rate of the mode test: probability that a fit of pure noise keeps a "
+    "noise mode (also the level of the goodness-of-fit test).",
+)
+@click.option("--no-search", is_flag=True, help="Skip the residual-driven search for missed modes.")
+@click.option(
     "--geometry",
     "geometry_file",
     type=click.Path(dir_okay=False, path_type=Path),
@@ -133,6 +160,8 @@ def modal_command(
     order_step: int,
     no_residuals: bool,
     geometry_file: Path | None,
+    false_alarm: float,
+    no_search: bool,
 ) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
 
@@ -140,7 +169,10 @@ def modal_command(
     selection (no frequencies needed); residues, poles and participation are
     then refined together over all FRFs, shapes are mass-normalised from the
     drive point(s), and every frequency, damping ratio and shape entry gets a
-    standard error. Prints a table per model with the RMSD of eq. 19.
+    standard error. The mode count is decided by a likelihood-ratio test
+    against the noise (statistic T per mode, threshold from --false-alarm),
+    and a search of the residual adds missed modes that pass it. Prints a
+    table per model with the RMSD of eq. 19 and a goodness-of-fit verdict.
 
     \b
     Example:
@@ -151,16 +183,25 @@ def modal_command(
     frf = read_frf(frf_file)
     if geometry_file is not None:
         frf = _with_geometry(frf, geometry_file)
-    res: ModalIdentification = modes_from_frf(
-        frf,
-        band=None if band is None else (float(band[0]), float(band[1])),
-        model=model,  # type: ignore[arg-type]
-        n_modes=n_modes,
-        frequencies=_parse_frequencies(frequencies),
-        max_order=max_order,
-        order_step=order_step,
-        residuals=not no_residuals,
-    )
+    try:
+        res: ModalIdentification = modes_from_frf(
+            frf,
+            band=None if band is None else (float(band[0]), float(band[1])),
+            model=model,  # type: ignore[arg-type]
+            n_modes=n_modes,
+            frequencies=_parse_frequencies(frequencies),
+            max_order=max_order,
+            order_step=order_step,
+            residuals=not no_residuals,
+            false_alarm=false_alarm,
+            search=not no_search,
+        )
+    except InputError as e:  # the limits of the data, named by the option that set them
+        msg = str(e)
+        for arg, opt in (("n_modes:", "--modes:"), ("frequencies:", "--frequencies:")):
+            if msg.startswith(arg):
+                raise InputError(opt + msg[len(arg) :]) from None
+        raise
     for mdl in res.models.values():
         label_wave_numbers(mdl)
     verdicts = modal_verdicts(frf, res)
@@ -173,6 +214,7 @@ def modal_command(
         f"FRF {frf_file.name}: {frf.n_out} output(s) x {frf.n_in} input(s), {res.frf_kind}, "
         f"band {res.band_hz[0]:g}-{res.band_hz[1]:g} Hz, {res.frequency.size} lines"
     )
+    click.echo(f"noise model: {res.noise_source} ({_NOISE[res.noise_source]})")
     for name in ("complex", "real"):
         if name in res.models:
             for row in modes_table(name, res.models[name]):

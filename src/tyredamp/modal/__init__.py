@@ -1,15 +1,18 @@
 """Modal identification: poles, residues, real and complex mode fits, indicators.
 
 The usual entry point is :func:`identify_modes` (FRFs in, real and complex
-:class:`ModalModel` out, with standard errors); the stages are public too:
-:func:`plscf` (poles over model orders), :func:`stability_flags` and
-:func:`cluster_poles` (automatic selection), :class:`ModalFitter` (LSFD and
-variable-projection refinement), and :mod:`.indicators`. The modes JSON
-file is :mod:`tyredamp.documents.modes`.
+:class:`ModalModel` out, with standard errors and a :class:`FitQuality`); the
+stages are public too: :func:`build_problem` (band cut, normalisation, noise
+model), a :class:`PoleEstimator` (default :func:`plscf`, poles over model
+orders), :func:`stability_flags` and :func:`cluster_poles` (automatic
+selection), :mod:`.search` (mode test, residual search), :class:`ModalFitter`
+(LSFD and variable-projection refinement), :mod:`.stats` and
+:mod:`.indicators`. The modes JSON file is :mod:`tyredamp.documents.modes`.
 """
 
 from __future__ import annotations
 
+from .estimators import PoleEstimator
 from .fit import FitResult, ModalFitter
 from .identify import ModalIdentification, identify_modes
 from .indicators import (
@@ -24,18 +27,25 @@ from .indicators import (
 )
 from .lscf import PoleSet, plscf
 from .model import ModalModel, ModeKind
+from .problem import FitProblem, build_problem
+from .quality import FitQuality, RejectedMode
 from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
 
 __all__ = [
     "Cluster",
+    "FitProblem",
+    "FitQuality",
     "FitResult",
     "ModalFitter",
     "ModalIdentification",
     "ModalModel",
     "ModeKind",
+    "PoleEstimator",
     "PoleSet",
+    "RejectedMode",
     "StabilityFlags",
     "auto_mac",
+    "build_problem",
     "cluster_poles",
     "discrepancy",
     "equivalent_real_modes",

@@ -61,23 +61,34 @@ frequencies, damping ratios and mode-shape entries by the delta method.
 from __future__ import annotations
 
 import copy
-import math
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-import scipy.linalg as sla
 from numpy.typing import NDArray
 from scipy.linalg import lapack
 
 from ..exceptions import InputError
+from . import _basis, _scaling
+from ._linalg import (
+    _CANCEL_TOL,
+    _PROJ_TOL,
+    _extra_ss,
+    _levenberg_marquardt,
+    _orth,
+    _vp_solve,
+)
+from .compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
 
 ModelKind = Literal["complex", "real"]
 
-#: derivative-column layouts (ModalFitter._layout) per (kind, m, n_in, q, w_ref)
-_LAYOUTS: dict[tuple[str, int, int, int, float], _Layout] = {}
+#: noise floor of the mode statistics, relative to the RMS of each output: the
+#: noise can never be below the rounding of the data and of the fit (synthesised
+#: double-precision FRFs and the fit's arithmetic carry 1e-13..1e-11); without
+#: it, noise-free data would make structure at the level of rounding "significant"
+NOISE_FLOOR = 1e-10
 
 
 @dataclass
@@ -103,10 +114,17 @@ class FitResult:
     status: str
     warnings: list[str] = field(default_factory=list)
     contribution: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    #: extra-sum-of-squares statistic of each mode (:func:`_extra_ss` / s^2)
     significance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    #: number of (weighted) real observations and of fitted parameters
+    n_obs: int = 0
+    n_par: int = 0
     theta: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     participation: NDArray[np.complex128] = field(default_factory=lambda: np.zeros((0, 0), complex))
     drive_phi2: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(0, complex))
+    #: theta, ref, Phi, R and Q (None when not formed) of the fit's projection, which
+    #: :meth:`ModalFitter.fit_added` reuses (``fixed=``); the fitter keeps no state
+    projection: tuple[Any, ...] | None = None
 
 
 class ModalFitter:
@@ -129,6 +147,13 @@ class ModalFitter:
     unit_weights : bool
         Weight every output row by 1 in every pass (for rows that are already
         normalised combinations of outputs, see :func:`compress_outputs`).
+    line_weights : ndarray, shape (n_freq,), optional
+        Weight of each line (``1 / sigma_f`` of a per-line noise model
+        ``Var H_jk(f) = sigma_j^2 sigma_f^2``): data and basis rows of line
+        ``f`` are multiplied by it, so that the least-squares cost is the
+        Gaussian negative log-likelihood of that noise model (maximum
+        likelihood). Default 1 for every line. ``FitResult.model`` is
+        returned unweighted.
     """
 
     def __init__(
@@ -142,6 +167,7 @@ class ModalFitter:
         upper: bool = True,
         lower: bool = True,
         unit_weights: bool = False,
+        line_weights: NDArray[np.float64] | None = None,
     ) -> None:
         if mode_kind not in ("complex", "real"):
             raise InputError(f"mode_kind: expected 'complex' or 'real', got {mode_kind!r}")
@@ -159,11 +185,22 @@ class ModalFitter:
         self.s = 1j * w
         self.kappa = (1j * w) ** power
         self.kappa_low = (1j * w) ** (power - 2)
+        self.line_weights: NDArray[np.float64] | None = None
+        if line_weights is not None:
+            lw = np.asarray(line_weights, float)
+            if lw.shape != frequency.shape or not np.all(np.isfinite(lw) & (lw > 0)):
+                raise InputError(
+                    f"line_weights: expected {frequency.size} finite positive values, got "
+                    f"shape {lw.shape}"
+                )
+            self.line_weights = lw
+            # every basis column is kappa or kappa_low times a function of s: weighting
+            # the two factors weights every basis and derivative row of the line
+            self.kappa = self.kappa * lw
+            self.kappa_low = self.kappa_low * lw
+            H = H * lw[None, None, :]
         self._kap2 = 2.0 * self.kappa[None, :]
         self.w_ref = float(w[-1])
-        # theta, ref, Phi, R and Q (None when not formed) of the latest fit's
-        # projection, reused by fit_added(theta=...)
-        self._last_q: tuple[Any, ...] | None = None
         # data: rows (k, f) complex, real and imaginary part interleaved (row 2i:
         # Re, row 2i + 1: Im of line i); the basis columns use the same layout
         hc = H.transpose(1, 2, 0).reshape(self.n_in * self.n_f, self.n_out)
@@ -171,6 +208,8 @@ class ModalFitter:
         self.n_rows = self.Y.shape[0]
         self.data_ss = float(np.sum(self.Y**2))
         self._rms = np.sqrt(np.mean(self.Y**2, axis=0))  # RMS per output row
+        #: noise floor per output (units of the data; NOISE_FLOOR)
+        self.noise_floor = NOISE_FLOOR * self._rms
         # weights of a first pass (fit without sigma, fit_added): 1 / RMS per output
         self._w1 = (
             np.ones_like(self._rms)
@@ -242,213 +281,12 @@ class ModalFitter:
         D = B[:, q:][:, lay.ecol] * self._coef(lay, poles)[None, :]
         return phi, D, lay.dpar.copy(), lay.dcol.copy()
 
-    def _layout(self, m: int) -> _Layout:
-        """Derivative columns of ``m`` modes: ``D = E[:, ecol] * coef`` (cached, read-only).
+    # the basis and its derivative columns (functions of the fitter, in _basis)
+    _layout = _basis.layout
+    _coef = staticmethod(_basis.coef)
+    _basis_ek = _basis.basis_ek
+    _basis_real = _basis.basis_real
 
-        Complex modes: per mode ``n`` the columns of ``E`` are ``[S]``, ``[i T]``
-        (see :meth:`_basis_ek`), then ``[g]``, ``[i g']`` of each free
-        participation entry (inputs ``k != ref[n]`` in increasing ``k``); the
-        derivative columns, in the order of :meth:`basis`, are ``(-sigma [S], x1,
-        col 2n)``, ``(-sigma [i T], x1, 2n+1)``, ``(w_ref [i T], x2, 2n)``, ``(-w_ref
-        [S], x2, 2n+1)`` and per free entry ``([g], Re l, 2n)``, ``([i g'], Re l,
-        2n+1)``, ``([i g'], Im l, 2n)``, ``(-[g], Im l, 2n+1)`` -- (column of ``E``
-        and factor, parameter, basis column). Real modes: ``E = D`` (no repeated
-        columns).
-        """
-        q = self.n_cols(m)
-        key = (self.kind, m, self.n_in, q, self.w_ref)
-        lay = _LAYOUTS.get(key)
-        if lay is not None:
-            return lay
-        nin = self.n_in
-        ar = np.arange(m)
-        if self.kind == "complex":
-            n_par = 2 * m + 2 * (nin - 1) * m
-            npp, ne_m = 4 * nin, 2 * nin
-            e_m = [0, 1, 1, 0]
-            for j in range(nin - 1):
-                e_m += [2 + 2 * j, 3 + 2 * j, 3 + 2 * j, 2 + 2 * j]
-            sign_m = [-1.0, -1.0, self.w_ref, -self.w_ref] + [1.0, 1.0, 1.0, -1.0] * (nin - 1)
-            pp = 2 * m + 2 * (nin - 1) * ar[:, None] + 2 * np.arange(nin - 1)[None, :]
-            part = (pp[:, :, None] + np.array([0, 0, 1, 1])[None, None, :]).reshape(m, -1)
-            pole = 2 * ar[:, None] + np.array([0, 0, 1, 1])[None, :]
-            dpar = np.concatenate([pole, part], axis=1).ravel()
-            dcol = 2 * np.repeat(ar, npp) + np.tile([0, 1, 0, 1], m * nin)
-            nsig = 2
-        else:
-            n_par = 2 * m + (nin - 1) * m
-            npp = ne_m = 2 + (nin - 1)
-            e_m = list(range(npp))
-            sign_m = [1.0] * npp
-            part = 2 * m + (nin - 1) * ar[:, None] + np.arange(nin - 1)[None, :]
-            dpar = np.concatenate([2 * ar[:, None] + np.array([0, 1])[None, :], part], 1).ravel()
-            dcol = np.repeat(ar, npp)
-            nsig = 0
-        ecol = (ne_m * ar[:, None] + np.array(e_m, np.intp)[None, :]).ravel()
-        nd, ne = ecol.size, ne_m * m
-        A = np.zeros((nd, n_par))
-        A[np.arange(nd), dpar] = 1.0
-        lay = _Layout(
-            ecol=ecol.astype(np.intp),
-            sign=np.tile(np.array(sign_m), m),
-            nsig=nsig,
-            dpar=dpar.astype(np.intp),
-            dcol=dcol.astype(np.intp),
-            A=A,
-            ee=(ecol[:, None] * ne + ecol[None, :]).astype(np.intp),
-            dd=(dcol[:, None] * q + dcol[None, :]).astype(np.intp),
-            eq=(ecol * q + dcol).astype(np.intp),
-        )
-        for arr in (lay.ecol, lay.sign, lay.dpar, lay.dcol, lay.A, lay.ee, lay.dd, lay.eq):
-            arr.flags.writeable = False
-        if len(_LAYOUTS) >= 64:
-            _LAYOUTS.clear()
-        _LAYOUTS[key] = lay
-        return lay
-
-    @staticmethod
-    def _coef(lay: _Layout, poles: NDArray[np.complex128]) -> NDArray[np.float64]:
-        """Factors ``coef`` (n_d,) of ``D = E[:, ecol] * coef`` at the poles."""
-        coef = lay.sign.copy()
-        if lay.nsig:
-            cm = coef.reshape(poles.size, -1)
-            cm[:, : lay.nsig] *= (-poles.real)[:, None]  # d p / d x1 = -sigma
-        return coef
-
-    def _basis_ek(
-        self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], derivatives: bool = True
-    ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
-        """``B = [Phi | E]`` (n_rows, q + n_e), Fortran-ordered, and the poles.
-
-        Complex modes, all at once: columns ``2n, 2n+1`` of mode ``n`` are ``A + B``
-        and ``i (A - B)`` with ``A_k = l_kn kappa / (s - p_n)`` and ``B_k =
-        conj(l_kn) kappa / (s - conj p_n)`` (real and imaginary part of the output
-        coefficient ``u_jn``). The distinct derivative columns ``E`` (``n_e = 2
-        n_in m``) of mode ``n`` are ``[S]`` and ``[i T]`` with ``S = A' + B'``, ``T =
-        A' - B'`` (``A' = A / (s - p_n)``, ``B' = B / (s - conj p_n)``: ``d A / d p =
-        A'``), then ``[g]`` and ``[i g']`` at input ``k`` only (``g = kappa / (s -
-        p_n) + kappa / (s - conj p_n)``, ``g'`` the difference) for each free
-        participation entry; ``[.]`` is a complex column as real rows (real and
-        imaginary part of each line interleaved, as the data ``Y``). With one
-        input (``l = 1``), ``t = s + sigma_n`` and ``d = (s - p_n)(s - conj p_n) =
-        t^2 + Omega_n^2``: ``A + B = 2 t kappa / d``,
-        ``i (A - B) = -2 Omega_n kappa / d``, ``S = 2 (t^2 - Omega_n^2) kappa / d^2``
-        and ``i T = -4 Omega_n t kappa / d^2`` (one complex division per line and
-        mode). Each column is written in place (transposed, contiguous). Real
-        modes: ``E`` holds the derivative columns of :meth:`_basis_real`.
-        ``derivatives=False``: ``B = Phi``.
-        """
-        poles, part = self.unpack(th, m, ref)
-        q = self.n_cols(m)
-        if self.kind == "real":
-            phi, D = self._basis_real(poles, part, ref, derivatives)
-            B = np.empty((self.n_rows, q + D.shape[1]), order="F")
-            B[:, :q] = phi
-            B[:, q:] = D
-            return B, poles
-        nin, nf = self.n_in, self.n_f
-        ne = 2 * nin * m if derivatives else 0
-        # rows: columns of B, complex (real and imaginary part interleaved as in Y)
-        bt = np.empty((q + ne, nin, nf), complex)
-        s, kap = self.s[None, :], self.kappa[None, :]
-        if nin == 1:
-            sig = (-poles.real)[:, None] + 0j  # complex factors: no casts in the loops
-            mom = -poles.imag[:, None] + 0j
-            den = s - poles[:, None]
-            den *= s - np.conj(poles)[:, None]  # d = (s - p)(s - conj p)
-            r = np.reciprocal(den)
-            h = self._kap2 * r  # 2 kappa / d
-            t = s + sig
-            np.multiply(t, h, out=bt[0 : 2 * m : 2, 0])
-            np.multiply(h, mom, out=bt[1 : 2 * m : 2, 0])
-            if derivatives:
-                h *= r  # 2 kappa / d^2
-                den -= 2.0 * mom * mom  # t^2 - Omega^2
-                np.multiply(den, h, out=bt[q::2, 0])
-                o = bt[q + 1 :: 2, 0]
-                np.multiply(t, h, out=o)
-                o *= 2.0 * mom
-        else:
-            e = 1.0 / (s - poles[:, None])  # (m, nf)
-            eb = 1.0 / (s - np.conj(poles)[:, None])
-            g = kap * e
-            gb = kap * eb
-            lc = part[:, :, None]  # (m, nin, 1)
-            A = lc * g[:, None, :]  # (m, nin, nf)
-            B_ = np.conj(lc) * gb[:, None, :]
-            _put_pair(bt, 0, 2, A, B_)
-            if derivatives:
-                A *= e[:, None, :]
-                B_ *= eb[:, None, :]
-                _put_pair(bt, q, 2 * nin, A, B_)
-                # participation columns: zero but at input k
-                oth = np.array([[k for k in range(nin) if k != ref[n]] for n in range(m)])
-                rows = q + 2 * nin * np.arange(m)
-                pairs = bt[q:].reshape(m, nin, 2, nin, nf)[:, 1:]  # (m, nin - 1, 2, nin, nf)
-                pairs[...] = 0.0
-                gp = g + gb
-                gm = 1j * (g - gb)
-                for j in range(nin - 1):
-                    kk_ = oth[:, j]
-                    bt[rows + 2 + 2 * j, kk_] = gp
-                    bt[rows + 3 + 2 * j, kk_] = gm
-        c0 = 2 * m
-        for use, kk in ((self.use_upper, self.kappa), (self.use_lower, self.kappa_low)):
-            if use:
-                bt[c0 : c0 + nin] = 0.0
-                for k in range(nin):
-                    bt[c0 + k, k] = kk
-                c0 += nin
-        return bt.reshape(q + ne, nin * nf).view(np.float64).T, poles
-
-    def _basis_real(
-        self,
-        poles: NDArray[np.complex128],
-        part: NDArray[np.complex128],
-        ref: NDArray[np.intp],
-        derivatives: bool,
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """``Phi`` and ``D`` of the real-mode model (columns of :meth:`_layout`)."""
-        nin, nf = self.n_in, self.n_f
-        s, kap = self.s, self.kappa
-        m = poles.size
-        q = self.n_cols(m)
-        cols = np.zeros((q, nin, nf), complex)
-        dl: list[NDArray[np.complex128]] = []
-        for n in range(m):
-            p = poles[n]
-            sig, om = -p.real, p.imag
-            L = part[n]
-            den = s**2 + 2 * sig * s + sig**2 + om**2
-            base = kap / den
-            cols[n] = L.real[:, None] * base[None, :]
-            if not derivatives:
-                continue
-            d_sig = -kap * (2 * s + 2 * sig) / den**2
-            d_om = -kap * (2 * om) / den**2
-            dl += [L.real[:, None] * (d_sig * sig)[None, :]]
-            dl += [L.real[:, None] * (d_om * self.w_ref)[None, :]]
-            for k in range(nin):
-                if k == ref[n]:
-                    continue
-                a_ = np.zeros((nin, nf), complex)
-                a_[k] = base
-                dl.append(a_)
-        c0 = m
-        if self.use_upper:
-            for k in range(nin):
-                cols[c0, k] = kap
-                c0 += 1
-        if self.use_lower:
-            for k in range(nin):
-                cols[c0, k] = self.kappa_low
-                c0 += 1
-        phi = cols.reshape(q, nin * nf).view(np.float64).T
-        if not derivatives or not dl:
-            return phi, np.zeros((self.n_rows, 0))
-        return phi, np.stack(dl).reshape(len(dl), nin * nf).view(np.float64).T
-
-    # ---------------------------------------------------- variable projection
     def _solve(
         self,
         th: NDArray[np.float64],
@@ -564,9 +402,10 @@ class ModalFitter:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
-        # the projection at the result, for fit_added(theta=...) on these modes
-        self._last_q = (th.copy(), ref.copy(), sol["phi"], sol["R"], sol["Q"])
-        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        # the projection at the result, for fit_added(fixed=res) on these modes
+        res.projection = (th.copy(), ref.copy(), sol["phi"], sol["R"], sol["Q"])
+        return res
 
     def fit_added(
         self,
@@ -578,7 +417,7 @@ class ModalFitter:
         omega_bounds: tuple[float, float] | None = None,
         max_nfev: int = 200,
         tol: float = 1e-6,
-        theta: NDArray[np.float64] | None = None,
+        fixed: FitResult | None = None,
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
@@ -593,9 +432,9 @@ class ModalFitter:
         accuracy (columns or data mostly in the span of ``Qf``).
         ``omega_bounds`` (rad/s, lower < upper) limits the damped natural
         frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
-        ``theta``: the parameter vector of the fixed modes when they come from
-        this fitter's latest :meth:`fit` (``FitResult.theta``), whose
-        orthonormal basis is then reused.
+        ``fixed``: the :meth:`fit` of this fitter that gave the fixed modes
+        (``poles``, ``part`` its poles and participation), whose orthonormal
+        basis is then reused (no state is kept between the calls).
 
         Returns
         -------
@@ -621,36 +460,7 @@ class ModalFitter:
         w = self._w1
         Yw = self.Y * w[None, :]
         yy = np.einsum("ij,ij->j", Yw, Yw)
-        last = self._last_q
-        if (
-            theta is not None
-            and last is not None
-            and np.array_equal(theta, last[0])
-            and np.array_equal(ref, last[1])
-        ):
-            phi_f, r_f, q_f = last[2], last[3], last[4]
-        else:
-            phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
-            q_f, r_f = _orth(phi_f)
-        # products with the fixed modes' orthonormal basis Qf (Qf = Phi_f R_f^-1 when
-        # the latest fit did not form it)
-        if q_f is None:
-
-            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(lapack.dtrtrs(r_f, phi_f.T @ X, trans=1)[0])
-
-            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(phi_f @ lapack.dtrtrs(r_f, QX)[0])
-
-        else:
-            qf = q_f
-
-            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(qf.T @ X)
-
-            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(qf @ QX)
-
+        qt, back = self._fixed_projector(poles, part, ref, fixed)
         # the data projected on the complement of the fixed basis, Yp = Yw - Qf Qf^T Yw,
         # enters through Qf^T Yw only (formed when ||Yp||^2 would lose accuracy)
         qty = qt(Yw)
@@ -715,6 +525,46 @@ class ModalFitter:
         res_ss = np.maximum(sol["cost_out"], 0.0) / w**2
         return complex(p_out[0]), l_out[0], np.sqrt(res_ss / max(dof, 1))
 
+    def _fixed_projector(
+        self,
+        poles: NDArray[np.complex128],
+        part: NDArray[np.complex128],
+        ref: NDArray[np.intp],
+        fixed: FitResult | None,
+    ) -> tuple[Any, Any]:
+        """``X -> Qf^T X`` and ``QX -> Qf QX`` for the orthonormal basis ``Qf`` of the
+        fixed modes (``Qf = Phi_f R_f^-1`` when the fit ``fixed`` did not form it)."""
+        m = poles.size
+        last = None if fixed is None else fixed.projection
+        if (
+            fixed is not None
+            and last is not None
+            and np.array_equal(fixed.poles, poles)
+            and np.array_equal(ref, last[1])
+        ):
+            phi_f, r_f, q_f = last[2], last[3], last[4]
+        else:
+            phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
+            q_f, r_f = _orth(phi_f)
+        if q_f is None:
+
+            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(lapack.dtrtrs(r_f, phi_f.T @ X, trans=1)[0])
+
+            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
+                return np.asarray(phi_f @ lapack.dtrtrs(r_f, QX)[0])
+
+            return qt, back
+        qf = q_f
+
+        def qt2(X: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.asarray(qf.T @ X)
+
+        def back2(QX: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.asarray(qf @ QX)
+
+        return qt2, back2
+
     def _refine(
         self,
         th0: NDArray[np.float64],
@@ -762,121 +612,54 @@ class ModalFitter:
         return x, nfev, "converged" if ok else "maxfev", sol
 
     # --------------------------------------------------------- results
-    def _scale(
+    # scaling and shape uncertainty (functions of the fitter, in _scaling)
+    _scale = _scaling.scale
+    _scale_jacobian = _scaling.scale_jacobian
+    _shape_std = _scaling.shape_std
+
+    def _pole_std(
         self,
         th: NDArray[np.float64],
         m: int,
         ref: NDArray[np.intp],
-        cd_w: NDArray[np.float64],
-        wd: NDArray[np.float64],
-    ) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.float64]]:
-        """Scale factors ``b`` (m,) with ``psi_out = u b``; ``psi_in`` (n_in, m); ``a^2`` check.
-
-        ``cd_w`` (n_drive, q) are the weighted coefficients of the drive outputs.
-        """
-        poles, part = self.unpack(th, m, ref)
-        if self.kind == "complex":
-            ud = np.asarray(
-                (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None], complex
-            )
-        else:
-            ud = np.asarray(cd_w[:, :m] / wd[:, None], complex)
-        if ud.shape[0] == 0:
-            a = np.ones(m, complex)
-            a2r = np.ones(m)
-        else:
-            ks = np.array([k for _, k in self.drive])
-            lk = part[:, ks].T  # (n_drive, m)
-            den = np.sum(np.abs(ud) ** 2, axis=0)
-            a2 = np.sum(np.conj(ud) * lk, axis=0) / np.where(den > 0, den, 1.0)
-            a2r = a2.real.copy()
-            a = np.sqrt(np.abs(a2.real)) + 0j if self.kind == "real" else np.sqrt(a2)
-            a = np.where(a == 0, 1.0, a)
-        psi_in = (part / a[:, None]).T
-        b = a.copy()
-        if self.kind == "real":
-            root = np.sqrt(2j * poles.imag)
-            b = a / root
-            psi_in = psi_in / root[None, :]
-        return b, psi_in, a2r
-
-    def _scale_jacobian(
-        self,
-        th: NDArray[np.float64],
-        m: int,
-        ref: NDArray[np.intp],
-        cd_w: NDArray[np.float64],
-        wd: NDArray[np.float64],
-    ) -> NDArray[np.complex128]:
-        """``d b / d G`` (n_par + n_drive q, m) of :meth:`_scale`, analytically.
-
-        ``G = [theta, cd_w.ravel()]``. With ``a^2 = N / den``, ``N = sum_d conj(u_d)
-        l_{k_d}``, ``den = sum_d |u_d|^2`` (``u_d = cd_w[d] / wd[d]``):
-        ``d a^2 / d Re u_d = (l - 2 a^2 Re u_d) / den``, ``d a^2 / d Im u_d =
-        (-i l - 2 a^2 Im u_d) / den``, ``d a^2 / d l_k = sum_{d: k_d = k} conj(u_d)
-        / den``; complex modes ``b = a = sqrt(a^2)``, real modes ``a = |Re
-        a^2|^(1/2)`` and ``b = a / sqrt(2 i Omega)``.
-        """
+        w: NDArray[np.float64],
+        sol: dict[str, Any],
+        s2: float,
+        shapes: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.intp]],
+        uncertainty: bool,
+    ) -> tuple[
+        NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64]
+    ]:
+        """Standard errors of f, zeta, the pole and the shapes (NaN without ``uncertainty``):
+        Gauss-Newton covariance ``s^2 (J^T J)^-1`` at the optimum and the delta method."""
+        b, u, didx = shapes
         n_par = th.size
-        nd, q = cd_w.shape
-        beta = np.zeros((n_par + nd * q, m), complex)
-        if nd == 0:
-            return beta
-        poles, part = self.unpack(th, m, ref)
-        ks = np.array([k for _, k in self.drive], dtype=np.intp)
-        cplx = self.kind == "complex"
-        if cplx:
-            u_raw = (cd_w[:, 0 : 2 * m : 2] + 1j * cd_w[:, 1 : 2 * m : 2]) / wd[:, None]
-        else:
-            u_raw = cd_w[:, :m] / wd[:, None]
-        ud = np.asarray(u_raw, dtype=complex)
-        lk = part[:, ks].T  # (nd, m)
-        den = np.sum(np.abs(ud) ** 2, axis=0)
-        den = np.where(den > 0, den, 1.0)
-        a2 = np.sum(np.conj(ud) * lk, axis=0) / den
-        d_re = (lk - 2 * a2[None, :] * ud.real) / den[None, :]
-        d_im = (-1j * lk - 2 * a2[None, :] * ud.imag) / den[None, :]
-        d_l = np.zeros((m, self.n_in), complex)  # d a^2 / d l_k (a real l_k step)
-        for d, k in enumerate(ks):
-            d_l[:, k] += np.conj(ud[d]) / den
-        if cplx:
-            a = np.sqrt(a2)
-            fac = np.where(a == 0, 0.0, 0.5 / np.where(a == 0, 1.0, a))  # d a / d a^2
-
-            def conv(x: NDArray[np.complex128]) -> NDArray[np.complex128]:
-                return np.asarray(fac * x)
-
-        else:
-            a = np.sqrt(np.abs(a2.real))
-            root = np.sqrt(2j * poles.imag)
-            sgn = np.sign(a2.real)
-            fac_r = np.where(a == 0, 0.0, 0.5 * sgn / np.where(a == 0, 1.0, a))
-
-            def conv(x: NDArray[np.complex128]) -> NDArray[np.complex128]:
-                return np.asarray(fac_r * x.real / root)
-
-            b = np.where(a == 0, 1.0, a) / root
+        poles = self.unpack(th, m, ref)[0]
+        nan = np.full(m, np.nan)
+        std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
+        std_psi = np.full((self.n_out, m), np.nan)
+        if uncertainty:
+            jtj = sol["jtj"] if "jtj" in sol else self._normal(sol, n_par)[0]
+            cth = s2 * np.linalg.pinv(jtj, hermitian=True)
+            x1 = th[0 : 2 * m : 2]
+            sig = self.w_ref * np.exp(x1)
+            om = poles.imag
+            mag = np.abs(poles)
+            jf = np.zeros((m, n_par))
+            jz = np.zeros((m, n_par))
             ar = np.arange(m)
-            beta[2 * ar + 1, ar] = -b * self.w_ref / (2 * poles.imag)
-        ar = np.arange(m)
-        for d in range(nd):
-            base = n_par + d * q
-            if cplx:
-                beta[base + 2 * ar, ar] = conv(d_re[d]) / wd[d]
-                beta[base + 2 * ar + 1, ar] = conv(d_im[d]) / wd[d]
-            else:
-                beta[base + ar, ar] = conv(d_re[d]) / wd[d]
-        i = 2 * m
-        for n in range(m):
-            for k in range(self.n_in):
-                if k == ref[n]:
-                    continue
-                beta[i, n] = conv(d_l[:, k])[n]
-                i += 1
-                if cplx:  # imaginary part of l_k
-                    beta[i, n] = conv(1j * d_l[:, k])[n]
-                    i += 1
-        return beta
+            jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
+            jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
+            jz[ar, 2 * ar] = (om**2 / mag**3) * sig
+            jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
+            std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
+            std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
+            std_pole = (
+                np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
+                + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
+            )
+            std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
+        return std_f, std_z, std_pole, std_psi
 
     def _result(
         self,
@@ -935,36 +718,17 @@ class ModalFitter:
         n_obs = self.n_rows * self.n_out
         dof = max(n_obs - q * self.n_out - n_par, 1)
         s2 = sol["cost"] / dof
-        nan = np.full(m, np.nan)
-        std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
-        std_psi = np.full((self.n_out, m), np.nan)
-        if uncertainty:
-            jtj = sol["jtj"] if "jtj" in sol else self._normal(sol, n_par)[0]
-            cth = s2 * np.linalg.pinv(jtj, hermitian=True)
-            x1 = th[0 : 2 * m : 2]
-            sig = self.w_ref * np.exp(x1)
-            om = poles.imag
-            mag = np.abs(poles)
-            jf = np.zeros((m, n_par))
-            jz = np.zeros((m, n_par))
-            ar = np.arange(m)
-            jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
-            jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
-            jz[ar, 2 * ar] = (om**2 / mag**3) * sig
-            jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
-            std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
-            std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
-            std_pole = (
-                np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
-                + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
-            )
-            std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
+        std_f, std_z, std_pole, std_psi = self._pole_std(
+            th, m, ref, w, sol, s2, (b, u, didx), uncertainty
+        )
         # ---- model (final fits only), contributions
         phi = sol["phi"]
         model = np.zeros((0, self.n_in, self.n_f), complex)
         if uncertainty:
             hw = np.ascontiguousarray((C / w[None, :]).T @ phi.T)  # (n_out, n_rows)
             model = hw.view(np.complex128).reshape(self.n_out, self.n_in, self.n_f)
+            if self.line_weights is not None:
+                model = model / self.line_weights[None, None, :]
         per = 2 if self.kind == "complex" else 1
         data_ss = self.data_ss
         # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's
@@ -974,7 +738,8 @@ class ModalFitter:
         cb = C[: per * m].reshape(m, per, self.n_out)
         ss = np.sum(cb * np.matmul(gram, cb), axis=1)  # (m, n_out)
         contrib = np.sqrt(np.sum(ss / w[None, :] ** 2, axis=1) / max(data_ss, 1e-300))
-        signif = np.sum(ss, axis=1) / (s2 * (per * self.n_out + 2))
+        s2_floor = float(np.mean((w * self.noise_floor) ** 2))
+        signif = _extra_ss(sol["R"], C, per, m) / max(s2, s2_floor, 1e-300)
         return FitResult(
             poles=poles,
             psi_out=psi_out,
@@ -993,512 +758,9 @@ class ModalFitter:
             warnings=warn,
             contribution=contrib,
             significance=signif,
+            n_obs=n_obs,
+            n_par=q * self.n_out + n_par,
             theta=th,
             participation=self.unpack(th, m, ref)[1],
             drive_phi2=phi2,
         )
-
-    def _shape_std(
-        self,
-        th: NDArray[np.float64],
-        m: int,
-        ref: NDArray[np.intp],
-        w: NDArray[np.float64],
-        sol: dict[str, Any],
-        cth: NDArray[np.float64],
-        s2: float,
-        b: NDArray[np.complex128],
-        u: NDArray[np.complex128],
-        didx: NDArray[np.intp],
-    ) -> NDArray[np.float64]:
-        """``sqrt(E|d psi_out|^2)`` per entry (n_out, m) by the delta method."""
-        C, Rq = sol["C"], sol["R"]
-        lay = sol["lay"]
-        q, n_out = C.shape
-        n_par = th.size
-        nd = didx.size
-        rinv = lapack.dtrtri(Rq)[0]
-        F = rinv @ rinv.T  # (Phi^T Phi)^-1
-        E = rinv @ (sol["QtE"][:, lay.ecol] * sol["coef"][None, :])  # Phi^+ D, (q, n_d)
-        A = lay.A
-        # M_j = -Phi^+ dPhi/dtheta C_j: M[j, a, k] = -sum_d E[a, d] C[dcol_d, j] A[d, k]
-        ec = E[None, :, :] * C[lay.dcol].T[:, None, :]  # (n_out, q, n_d)
-        M = -(ec.reshape(n_out * q, -1) @ A).reshape(n_out, q, n_par)
-        MC = (M.reshape(n_out * q, n_par) @ cth).reshape(M.shape)  # Cov(C_j, theta)
-        # Var of the coefficient of mode n for output j
-        cov_cc_diag = s2 * np.diag(F)[None, :] + np.einsum("jak,jak->ja", MC, M)
-        if self.kind == "complex":
-            var_u = cov_cc_diag[:, 0 : 2 * m : 2] + cov_cc_diag[:, 1 : 2 * m : 2]
-        else:
-            var_u = cov_cc_diag[:, :m]
-        term1 = np.abs(b[None, :]) ** 2 * var_u / w[:, None] ** 2
-        if nd == 0:
-            # unscaled shapes: only the coefficient noise and the participation
-            return np.asarray(np.sqrt(np.maximum(term1, 0.0)))
-        # global quantities G = [theta, C_D (n_d * q)] and d b / d G
-        beta = self._scale_jacobian(th, m, ref, C[:, didx].T, w[didx])
-        ng = beta.shape[0]
-        MD = M[didx]  # (nd, q, n_par)
-        # Sigma_GG
-        sgg = np.zeros((ng, ng))
-        sgg[:n_par, :n_par] = cth
-        cdt = MC[didx]  # Cov(C_D, theta): (nd, q, n_par)
-        sgg[n_par:, :n_par] = cdt.reshape(nd * q, n_par)
-        sgg[:n_par, n_par:] = sgg[n_par:, :n_par].T
-        dd = cdt.reshape(nd * q, n_par) @ MD.reshape(nd * q, n_par).T  # MD cth MD^T
-        dd += s2 * np.kron(np.eye(nd), F)
-        sgg[n_par:, n_par:] = dd
-        v3 = np.real(np.sum(beta.conj() * (sgg @ beta), axis=0))
-        term3 = np.abs(u) ** 2 * v3[None, :]
-        # cross_jn = sum_g Sigma_cG_j[a_n, g] beta[g, n] with Sigma_cG_j = [MC_j,
-        # MC_j MD^T + s2 F (j = drive)] (a_n the coefficient rows of mode n), summed
-        # without forming the (n_out, q, ng) matrix: T = beta_theta + MD^T beta_D
-        beta_d = beta[n_par:]  # (nd q, m)
-        T = beta[:n_par] + MD.reshape(nd * q, n_par).T @ beta_d  # (n_par, m)
-        bd = beta_d.reshape(nd, q, m)
-        fb = s2 * np.matmul(F, bd)  # (nd, q, m)
-        rsel = (
-            [np.arange(0, 2 * m, 2), np.arange(1, 2 * m, 2)]
-            if self.kind == "complex"
-            else [np.arange(m)]
-        )
-        cross = np.zeros((self.n_out, m), complex)
-        for sign, rr in zip((1.0, -1j), rsel, strict=False):
-            part_ = np.einsum("jnk,kn->jn", MC[:, rr, :], T)
-            for i, j in enumerate(didx):
-                part_[j] += fb[i, rr, np.arange(m)]
-            cross += sign * part_
-        term2 = 2 * np.real(np.conj(b)[None, :] / w[:, None] * u * cross)
-        return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))
-
-
-@dataclass(frozen=True)
-class _Layout:
-    """Derivative columns ``D = E[:, ecol] * coef`` of one basis layout.
-
-    ``coef = sign`` with the first ``nsig`` entries of every mode's block times
-    ``sigma_n`` (:meth:`ModalFitter._coef`); ``dpar``, ``dcol``: parameter and
-    basis column of each derivative column; ``A`` (n_d, n_par): 0/1 map of
-    derivative columns to parameters; ``ee``, ``dd``, ``eq``: flat indices of
-    ``(ecol_d, ecol_d')`` in ``E^T P E``, ``(dcol_d, dcol_d')`` in ``C C^T`` and
-    ``(ecol_d, dcol_d)`` in ``E^T r C^T``.
-    """
-
-    ecol: NDArray[np.intp]
-    sign: NDArray[np.float64]
-    nsig: int
-    dpar: NDArray[np.intp]
-    dcol: NDArray[np.intp]
-    A: NDArray[np.float64]
-    ee: NDArray[np.intp]
-    dd: NDArray[np.intp]
-    eq: NDArray[np.intp]
-
-
-def _put_pair(
-    out: NDArray[np.complex128],
-    c: int,
-    stride: int,
-    a: NDArray[np.complex128],
-    b: NDArray[np.complex128],
-) -> None:
-    """Write the columns ``a + b`` and ``i (a - b)`` of every mode.
-
-    ``a``, ``b``: (m, nin, nf) complex; ``out`` of shape (rows, nin, nf); mode
-    ``n`` goes to rows ``c + stride n, c + stride n + 1``.
-    """
-    m = a.shape[0]
-    o1, o2 = out[c : c + stride * m : stride], out[c + 1 : c + stride * m : stride]
-    np.add(a, b, out=o1)
-    np.subtract(a, b, out=o2)
-    o2 *= 1j
-
-
-#: largest condition estimate of the unit-column Gram matrix of the basis for which
-#: the projection is taken from the Gram blocks (relative error ~ eps * this)
-_MAX_GRAM_COND = 1e6
-#: a squared norm ``||x||^2 - ||Q^T x||^2`` smaller than this fraction of the
-#: subtracted term (relative error ~ eps / this) is formed from the explicit residual
-_CANCEL_TOL = 1e-6
-#: fit_added: an added column whose squared norm drops below this fraction when the
-#: fixed basis is projected out is projected explicitly
-_PROJ_TOL = 1e-4
-
-
-def _gram_chol(
-    g: NDArray[np.float64],
-) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-    """Cholesky factor of a Gram matrix with unit diagonal scaling, or None.
-
-    ``g = Phi^T Phi``: returns ``rs`` (upper) and ``d`` with ``g = diag(d) rs^T rs
-    diag(d)`` (so ``Phi = Q R`` with ``R = rs diag(d)``), or None when a column
-    vanishes, the factorisation fails or the condition estimate of ``rs^T rs``
-    exceeds ``_MAX_GRAM_COND``.
-    """
-    dg = g.diagonal()
-    if g.shape[0] == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):  # NaN: False
-        return None
-    d = np.sqrt(dg)
-    gs = g / np.multiply.outer(d, d)
-    rs, info = lapack.dpotrf(gs, lower=0, clean=1)
-    if info != 0:
-        return None
-    rcond, info = lapack.dpocon(rs, float(abs(gs).sum(axis=0).max()))
-    if info != 0 or not rcond * _MAX_GRAM_COND >= 1.0:
-        return None
-    return rs, d
-
-
-def _vp_solve(
-    G: NDArray[np.float64],
-    P: NDArray[np.float64],
-    q: int,
-    yy: NDArray[np.float64],
-    explicit: Any,
-    *,
-    residual: bool,
-    gradient: bool,
-    cancel: NDArray[np.float64] | None = None,
-) -> dict[str, Any]:
-    """Variable projection from the Gram blocks of ``B = [Phi | E]``.
-
-    Parameters
-    ----------
-    G : ndarray, shape (q + n_e, q + n_e)
-        ``B^T B``.
-    P : ndarray, shape (q + n_e, n_out)
-        ``B^T Y``.
-    q : int
-        Number of basis columns (the first ``q`` of ``B``).
-    yy : ndarray, shape (n_out,)
-        ``||Y_j||^2`` per column.
-    explicit : callable
-        Returns ``(B, Y)`` (n_rows rows), called only to orthogonalise an
-        ill-conditioned basis or to form the residual.
-    residual : bool
-        Form the residual ``r = Y - Phi C`` (else only when ``cost`` loses
-        accuracy by cancellation: ``cost_j < _CANCEL_TOL cancel_j``).
-    gradient : bool
-        Return ``E^T r``.
-    cancel : ndarray, shape (n_out,), optional
-        Reference of the cancellation test (default ``||Q^T Y_j||^2``).
-
-    Returns
-    -------
-    dict
-        ``R`` (``Phi = Q R``), ``C`` (q, n_out) coefficients, ``Ct = Q^T Y``,
-        ``QtE = Q^T E``, ``GE = E^T P E`` (``P`` the projector on the complement
-        of ``Phi``), ``Etr = E^T r`` (or None), ``cost``, ``cost_out``, ``resid``
-        (or None) and ``Q`` (None unless the basis was orthogonalised).
-
-    Notes
-    -----
-    With ``R`` from the Cholesky factor of ``Phi^T Phi`` (:func:`_gram_chol`):
-    ``Q^T X = R^-T Phi^T X`` for ``X = E, Y``, ``C = R^-1 Q^T Y``, ``cost_j =
-    ||Y_j||^2 - ||Q^T Y_j||^2``, ``E^T P E = E^T E - (Q^T E)^T Q^T E`` and ``E^T r =
-    E^T Y - (Q^T E)^T Q^T Y``. When the Gram matrix is too ill-conditioned
-    ``Q`` comes from :func:`_orth` of the explicit basis.
-    """
-    ne = G.shape[0] - q
-    fac = _gram_chol(G[:q, :q])
-    Q = None
-    Bx = Yx = None
-    if fac is not None:
-        rs, d = fac
-        rhs = np.concatenate([G[:q, q:], P[:q]], axis=1) / d[:, None]
-        x = lapack.dtrtrs(rs, rhs, trans=1)[0]
-        QtE, Ct = x[:, :ne], x[:, ne:]
-        R = rs * d[None, :]
-        C = lapack.dtrtrs(rs, Ct)[0] / d[:, None]
-    else:
-        Bx, Yx = explicit()
-        phi = Bx[:, :q]
-        Q, R = _orth(phi)
-        QtE = Q.T @ Bx[:, q:]
-        Ct = Q.T @ Yx
-        diag = np.abs(np.diag(R))
-        if diag.min() <= 1e-13 * diag.max():
-            C = np.linalg.lstsq(phi, Yx, rcond=None)[0]
-        else:
-            C = sla.solve_triangular(R, Ct)
-    ct2 = (Ct * Ct).sum(axis=0)
-    cost_out = yy - ct2
-    GE = G[q:, q:] - QtE.T @ QtE
-    resid = Etr = None
-    if residual or (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
-        if Bx is None:
-            Bx, Yx = explicit()
-        resid = Yx - (Bx[:, :q] @ C if Q is None else Q @ Ct)
-        cost_out = np.einsum("ij,ij->j", resid, resid)
-        if gradient:
-            Etr = Bx[:, q:].T @ resid
-    elif gradient:
-        Etr = P[q:] - QtE.T @ Ct
-    return {
-        "R": R,
-        "C": C,
-        "Ct": Ct,
-        "Q": Q,
-        "QtE": QtE,
-        "GE": GE,
-        "Etr": Etr,
-        "resid": resid,
-        "cost": float(cost_out.sum()),
-        "cost_out": cost_out,
-    }
-
-
-def _orth(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Thin QR ``phi = Q R`` by CholeskyQR2 (Yamamoto et al. 2015), Householder fallback.
-
-    Two Cholesky passes on the Gram matrix of the column-scaled basis give
-    ``Q`` orthonormal to round-off whenever ``cond(phi) < ~1e7`` and cost two
-    ``n x q`` Gram products and triangular solves -- several times faster than
-    LAPACK's Householder QR with an explicit ``Q`` for the tall bases here.
-    Householder QR for small bases and when a Cholesky factor is singular or
-    too ill-conditioned.
-    """
-    n, q = phi.shape
-    if n * q * q < 4e6:  # small: LAPACK's call overhead is lower than two Cholesky passes
-        return _householder(phi)
-    nrm = np.sqrt(np.einsum("ij,ij->j", phi, phi))
-    if np.all(nrm > 0) and np.all(np.isfinite(nrm)):
-        g1 = (phi.T @ phi) / np.outer(nrm, nrm)
-        try:
-            r1 = np.linalg.cholesky(g1).T
-            d1 = np.abs(np.diag(r1))
-            if d1.min() > 1e-7 * d1.max():
-                eye = np.eye(r1.shape[0])
-                q1 = phi @ (sla.solve_triangular(r1, eye) / nrm[:, None])
-                r2 = np.linalg.cholesky(q1.T @ q1).T
-                q = q1 @ sla.solve_triangular(r2, eye)
-                return q, (r2 @ r1) * nrm[None, :]
-        except np.linalg.LinAlgError:
-            pass
-    return _householder(phi)
-
-
-def _householder(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Thin Householder QR by LAPACK ``dgeqrf`` + ``dorgqr`` (less call overhead
-    than :func:`numpy.linalg.qr` for the small bases); NumPy's on failure."""
-    n, q = phi.shape
-    if n >= q > 0:
-        qr, tau, _, info = lapack.dgeqrf(phi)
-        if info == 0:
-            r = np.triu(qr[:q])
-            qm, _, info = lapack.dorgqr(qr, tau, overwrite_a=1)
-            if info == 0:
-                return qm, r
-    qn, rn = np.linalg.qr(phi)
-    return qn, rn
-
-
-def _lu_solve(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.float64], int]:
-    """``a x = b`` by LAPACK ``dgesv`` (LU, partial pivoting) and its ``info`` (> 0: singular)."""
-    x, info = lapack.dgesv(a, b)[2:]
-    return x, int(info)
-
-
-def _levenberg_marquardt(
-    evaluate: Any,
-    x0: NDArray[np.float64],
-    lb: NDArray[np.float64],
-    ub: NDArray[np.float64],
-    max_nfev: int,
-    dof: int,
-    tol: float = 1e-6,
-) -> tuple[NDArray[np.float64], int, bool, Any]:
-    """Bounded Levenberg-Marquardt on the normal equations of a least-squares cost.
-
-    ``evaluate(x)`` returns the cost ``||r||^2``, ``J^T J``, ``J^T r`` (the
-    variable-projection quantities of :meth:`ModalFitter._normal`; the
-    residual itself is never formed) and any by-product, returned for the
-    final point. Steps solve ``(J^T J + lam diag(J^T J))
-    d = -J^T r`` over the free parameters; a parameter at a bound whose
-    gradient points outwards is held there (projected step). The damping
-    ``lam`` follows Nielsen's rule (gain ratio ``rho``: ``lam *= max(1/3,
-    1 - (2 rho - 1)^3)`` on success, doubled growth on failure).
-
-    Convergence is statistical: the iteration stops when the Gauss-Newton
-    decrement ``(J^T r)^T (J^T J)^-1 J^T r`` (the predicted cost reduction of
-    a full Gauss-Newton step) is below ``tol s^2`` with ``s^2 = cost / dof`` the residual
-    variance -- with the default ``tol = 1e-6`` the remaining step is about
-    1e-3 standard deviations of the parameters, far below their uncertainty --
-    or below ``1e-24`` times the starting cost (noise-free data), or when no
-    step reduces the cost any more (round-off).
-
-    Returns the parameters, the number of evaluations, whether it converged
-    and the by-product of ``evaluate`` at the returned parameters.
-    """
-    x = np.clip(np.asarray(x0, float), lb, ub)
-    cost, A, g, aux = evaluate(x)
-    cost0 = max(cost, 1e-300)
-    nfev = 1
-    lam = 1e-3
-    nu = 2.0
-    n = x.size
-    new_point = True  # the quantities of the current point are computed once
-    while nfev < max_nfev:
-        if new_point:
-            if not math.isfinite(cost):
-                return x, nfev, False, aux
-            diag = A.diagonal()
-            d_a = np.sqrt(np.maximum(diag, 1e-300))
-            # held: at a bound with the descent direction -g pointing outwards, or
-            # without information (e.g. the damping of a residual mode far outside
-            # the band: its column of J vanishes)
-            held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
-            held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
-            free: NDArray[np.intp] | None = None
-            d_f = d_a
-            if held.any():
-                idx = np.flatnonzero(~held)
-                if idx.size == 0:
-                    return x, nfev, True, aux
-                free, d_f = idx, d_a[idx]
-                An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
-                gn = g[idx] / d_f
-            else:
-                An = A / np.outer(d_a, d_a)
-                gn = g / d_a
-            eye = np.eye(gn.size)
-            # Gauss-Newton decrement at this point (convergence test)
-            gn_step, info = _lu_solve(An + 1e-12 * eye, -gn)
-            if info != 0:
-                gn_step = -gn
-            decrement = float(-gn @ gn_step)
-            if decrement <= max(tol * cost / dof, 1e-24 * cost0):
-                return x, nfev, True, aux
-            new_point = False
-        step_n, info = _lu_solve(An + lam * eye, -gn)
-        if info != 0:  # singular
-            lam *= nu
-            nu *= 2
-            continue
-        if free is None:
-            d = step_n / d_f
-        else:
-            d = np.zeros(n)
-            d[free] = step_n / d_f
-        x_new = np.minimum(np.maximum(x + d, lb), ub)
-        d = x_new - x
-        if np.all(np.abs(d) <= 1e-15 * (1.0 + np.abs(x))):
-            return x, nfev, True, aux
-        pred = -(2.0 * float(g @ d) + float(d @ A @ d))  # predicted cost reduction
-        c_new, A_new, g_new, aux_new = evaluate(x_new)
-        nfev += 1
-        rho = (cost - c_new) / pred if pred > 0 else -1.0
-        if math.isfinite(c_new) and c_new < cost and rho > 1e-4:
-            x, cost, A, g, aux = x_new, c_new, A_new, g_new, aux_new
-            lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
-            nu = 2.0
-            new_point = True
-        else:
-            lam *= nu
-            nu *= 2.0
-            if lam > 1e12:  # no descent left at round-off level
-                return x, nfev, True, aux
-    return x, nfev, False, aux
-
-
-def compress_outputs(
-    H: NDArray[np.complex128],
-    rank: int,
-    seed: int = 0,
-    weights: NDArray[np.float64] | None = None,
-) -> NDArray[np.complex128]:
-    """Principal output combinations of weighted FRFs (for fast pole searches).
-
-    See :func:`_compress` (same arguments) for the method; returns the
-    combinations, complex, shape (rank, n_in, n_freq).
-    """
-    return _compress(H, rank, seed, weights)[0]
-
-
-def combine_outputs(
-    H: NDArray[np.complex128], patterns: NDArray[np.float64], weights: NDArray[np.float64]
-) -> NDArray[np.complex128]:
-    """Orthonormal combinations of the weighted outputs spanning ``weights * patterns``.
-
-    With the patterns of :func:`_compress` (found with other weights) this
-    re-weights a compression without a new range search: the rows
-    ``diag(weights) H`` are combined by ``Q``, the orthonormal basis of
-    ``diag(weights) patterns`` (one product with the data).
-
-    Parameters
-    ----------
-    H : ndarray, complex, shape (n_out, n_in, n_freq)
-    patterns : ndarray, shape (n_out, rank)
-    weights : ndarray, shape (n_out,)
-
-    Returns
-    -------
-    ndarray, complex, shape (rank, n_in, n_freq)
-    """
-    n_out, n_in, n_f = H.shape
-    q, _ = np.linalg.qr(weights[:, None] * patterns)
-    x = H.reshape(n_out, -1)
-    c = (q * weights[:, None]).T
-    return np.asarray(((c @ x.real) + 1j * (c @ x.imag)).reshape(q.shape[1], n_in, n_f))
-
-
-def _compress(
-    H: NDArray[np.complex128],
-    rank: int,
-    seed: int = 0,
-    weights: NDArray[np.float64] | None = None,
-) -> tuple[NDArray[np.complex128], NDArray[np.float64]]:
-    """Principal output combinations of normalised FRFs (for fast pole searches).
-
-    Each output row is multiplied by its weight (default ``1 / RMS`` of the
-    row), then the rows are combined by the ``rank`` leading left singular
-    vectors of the real matrix ``[Re H, Im H]`` (``n_out x 2 n_in n_freq``),
-    found by a randomised range finder with one power iteration (Halko et al.
-    2011). A real orthogonal combination of outputs keeps the modal model
-    (eq. [10]: the combined rows have combined coefficients), and the leading
-    components hold the modes while the dropped ones hold mostly noise, so
-    poles fitted to the combinations are close to those fitted to all
-    outputs at a fraction of the cost.
-
-    Parameters
-    ----------
-    H : ndarray, complex, shape (n_out, n_in, n_freq)
-    rank : int
-        Number of combinations kept (``< n_out``).
-    seed : int
-        Seed of the random test matrix.
-    weights : ndarray, shape (n_out,), optional
-        Row weights (e.g. ``1 / sigma`` of a noise estimate); default
-        ``1 / RMS``.
-
-    Returns
-    -------
-    combinations : ndarray, complex, shape (rank, n_in, n_freq)
-    patterns : ndarray, shape (n_out, rank)
-        The combinations in unweighted outputs (``weights^-1 v``): they span the
-        same signal subspace for any other row weighting
-        (:func:`combine_outputs`).
-    """
-    n_out, n_in, n_f = H.shape
-    if weights is None:
-        rms = np.sqrt(np.mean(np.abs(H) ** 2, axis=(1, 2)))
-        wt = 1.0 / np.where(rms > 0, rms, 1.0)
-    else:
-        wt = np.asarray(weights, float)
-    x = H.reshape(n_out, -1)
-    xr = np.empty((n_out, 2 * x.shape[1]))
-    xr[:, : x.shape[1]] = x.real
-    xr[:, x.shape[1] :] = x.imag
-    xr *= wt[:, None]
-    rng = np.random.default_rng(seed)
-    k = min(n_out, rank + 10)
-    q0, _ = np.linalg.qr(xr @ rng.normal(size=(xr.shape[1], k)))
-    q1, _ = np.linalg.qr(xr @ (xr.T @ q0))
-    b = q1.T @ xr  # (k, 2 n_in n_freq): the rows in the found basis
-    # left singular vectors of b from its (k x k) Gram matrix, largest first
-    _, u = np.linalg.eigh(b @ b.T)
-    u = u[:, ::-1][:, :rank]
-    c = u.T @ b  # = v^T xr with v = q1 u
-    half = x.shape[1]
-    comb = np.asarray((c[:, :half] + 1j * c[:, half:]).reshape(rank, n_in, n_f))
-    return comb, (q1 @ u) / wt[:, None]

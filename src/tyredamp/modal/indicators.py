@@ -153,7 +153,7 @@ def modal_phase_collinearity(psi: ArrayLike) -> NDArray[np.float64]:
     ndarray, shape (m,)
         1 for a real (monophase) mode, down to 0 for a travelling-wave-like mode.
     """
-    a = _shapes(psi, "psi")
+    a = _unit_columns(_shapes(psi, "psi"))
     re, im = a.real, a.imag
     sxx = np.sum(re * re, axis=0)
     syy = np.sum(im * im, axis=0)
@@ -180,7 +180,7 @@ def mean_phase_deviation(psi: ArrayLike) -> NDArray[np.float64]:
     -------
     ndarray, shape (m,)
     """
-    a = _shapes(psi, "psi")
+    a = _unit_columns(_shapes(psi, "psi"))
     re, im = a.real, a.imag
     sxx = np.sum(re * re, axis=0)
     syy = np.sum(im * im, axis=0)
@@ -213,7 +213,7 @@ def equivalent_real_modes(psi: ArrayLike) -> NDArray[np.float64]:
         Same units as ``psi`` (magnitude preserved along the principal line).
     """
     a = _shapes(psi, "psi")
-    re, im = a.real, a.imag
+    re, im = _unit_columns(a).real, _unit_columns(a).imag
     sxx = np.sum(re * re, axis=0)
     syy = np.sum(im * im, axis=0)
     sxy = np.sum(re * im, axis=0)
@@ -223,3 +223,11 @@ def equivalent_real_modes(psi: ArrayLike) -> NDArray[np.float64]:
     sign = np.sign(r[idx, np.arange(r.shape[1])])
     sign[sign == 0] = 1.0
     return np.asarray(r * sign)
+
+
+def _unit_columns(a: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    """Each column divided by its largest magnitude (MPC, MPD and the principal
+    direction do not depend on the scale of a shape; this keeps their squares
+    finite for any magnitude)."""
+    mx = np.max(np.abs(a), axis=0) if a.shape[0] else np.zeros(a.shape[1])
+    return np.asarray(a / np.where(mx > 0, mx, 1.0)[None, :])

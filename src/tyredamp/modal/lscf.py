@@ -43,6 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._validate import as_band, as_finite, as_frequency
 from ..exceptions import InputError, ShapeError
 from ..mechanics.modal_sum import pole_quantities
+from .problem import check_uniform
 
 __all__ = ["PoleSet", "plscf"]
 
@@ -111,7 +112,8 @@ def plscf(
     Parameters
     ----------
     frequency : array_like, shape (n_freq,)
-        Frequency lines in Hz (strictly increasing).
+        Frequency lines in Hz (strictly increasing and uniformly spaced in the
+        band: the z-domain basis assumes it; a non-uniform axis is refused).
     H : array_like, complex, shape (n_out, n_in, n_freq)
         FRFs of any kind; the rational model absorbs the kind.
     max_order : int
@@ -166,6 +168,7 @@ def plscf(
     sel = (f >= lo) & (f <= hi)
     if not sel.all():  # (no copy when the band holds every line)
         f, h = f[sel], h[:, :, sel]
+    check_uniform(f)
     n_out, n_in, n_f = h.shape
     if n_f * 2 <= (p_max + 1) * (n_in + 1):
         raise InputError(
@@ -180,29 +183,45 @@ def plscf(
         w = as_finite(output_weights, "output_weights", ndim=1)
         if w.size != n_out:
             raise ShapeError(f"output_weights: expected {n_out} values, got {w.size}")
-    # weighted real and imaginary parts, each contiguous for the matrix products
-    h_re = h.real * w[:, None, None]
-    h_im = h.imag * w[:, None, None]
     dt = np.pi / (2 * np.pi * (hi - lo))
-    theta = 2 * np.pi * (f - lo) * dt  # in [0, pi]
     P = p_max
-    zc, zs = _unit_powers(theta, P)  # Re and Im of z^d, d = 0..P, shape (P+1, n_f)
     lag = np.arange(P + 1)[None, :] - np.arange(P + 1)[:, None]  # r' - r
+    z0, c, t = _lag_sums(f, h, w, lo, dt, P)
     # R[r, r'] = Re sum_f z^(r'-r)    (common to all outputs)
-    R = zc.sum(axis=1)[np.abs(lag)]
-    # c_ok(d) = Re sum_f z^d H_ok(f), d = -P..P (index d + P): two real products
-    c = _real_lag_sums(h_re.reshape(n_out * n_in, n_f), h_im.reshape(n_out * n_in, n_f), zc, zs)
+    R = z0[np.abs(lag)]
     c = c.reshape(n_out, n_in * (2 * P + 1))
-    # sum_o T_o[(r,k),(r',k')] = Re sum_f z^(r'-r) q_kk'(f),  q_kk' = sum_o conj(H_ok) H_ok'
-    q_re = np.einsum("okf,olf->klf", h_re, h_re) + np.einsum("okf,olf->klf", h_im, h_im)
-    q_im = np.einsum("okf,olf->klf", h_re, h_im) - np.einsum("okf,olf->klf", h_im, h_re)
-    t = _real_lag_sums(q_re.reshape(n_in * n_in, n_f), q_im.reshape(n_in * n_in, n_f), zc, zs)
     t = t.reshape(n_in, n_in, 2 * P + 1)
     T = t[:, :, lag + P].transpose(2, 0, 3, 1).reshape((P + 1) * n_in, (P + 1) * n_in)
+    U = _whitened(c, R, P, n_in)
+
+    orders = np.arange(P, p_min - 1, -step)[::-1]
+    w_lo = 2 * np.pi * lo
+    z_up, l_up = _roots_of_orders(U, T, orders, n_in)
+    # the poles of all orders at once
+    zv = np.concatenate(z_up)
+    if zv.size == 0:
+        raise InputError("plscf: no pole found in the band at any order")
+    pole = np.asarray(1j * w_lo + np.log(zv) / dt, dtype=complex)
+    order = np.repeat(orders.astype(np.int64), [z.size for z in z_up])
+    lvec = np.ones((zv.size, 1), complex) if n_in == 1 else np.concatenate(l_up)
+    pos = pole.imag > 0
+    return PoleSet(
+        order=order[pos],
+        poles=pole[pos],
+        participation=lvec[pos],
+        orders=orders.astype(np.int64),
+        band_hz=(lo, hi),
+    )
+
+
+def _whitened(
+    c: NDArray[np.float64], R: NDArray[np.float64], P: int, n_in: int
+) -> NDArray[np.float64]:
+    """``U_o = L^-1 S_o`` of every output (``R = L L^T``), shape (P+1, n_v, (P+1) n_in)."""
     # sum_o S_o^T R^-1 S_o is a quadratic form in the rows c_o: with more outputs
     # than entries of c_o, any rows with the same Gram matrix sum_o c_o c_o^T give
     # the same sum; its scaled eigenvectors are the fewest such rows (exact)
-    if n_out > c.shape[1]:
+    if c.shape[0] > c.shape[1]:
         lam, vec = np.linalg.eigh(c.T @ c)
         keep = lam > lam[-1] * 1e-15
         c = (vec[:, keep] * np.sqrt(lam[keep])).T
@@ -218,11 +237,18 @@ def plscf(
     # solved in place, no copy of S, and U comes out C-ordered
     U = sla.blas.dtrsm(1.0, L, S.T, side=1, lower=1, trans_a=1, overwrite_b=1).T
     U = U.reshape(P + 1, n_v, (P + 1) * n_in)
+    return U
 
-    orders = np.arange(P, p_min - 1, -step)[::-1]
+
+def _roots_of_orders(
+    U: NDArray[np.float64], T: NDArray[np.float64], orders: NDArray[np.int64], n_in: int
+) -> tuple[list[NDArray[np.complex128]], list[NDArray[np.complex128]]]:
+    """Upper-half-plane roots ``z`` of the denominator of every order, and their
+    participation vectors (``n_in > 1``), from the reduced normal equations
+    (``U`` the whitened numerator blocks, ``T`` the denominator block)."""
+    P = int(orders[-1])
     z_up: list[NDArray[np.complex128]] = []  # upper-half-plane roots of each order
     l_up: list[NDArray[np.complex128]] = []  # their participation vectors (n_in > 1)
-    w_lo = 2 * np.pi * lo
     # the reduced matrix of order p uses the leading p + 1 rows of every U_o:
     # sum_o U_o^T U_o accumulates row block by row block up the orders (lower
     # triangle only, F-ordered, updated in place by BLAS dsyrk)
@@ -263,21 +289,51 @@ def plscf(
         z_up.append(zval)
         if n_in > 1:
             l_up.append(_participation(alpha, zval, n_in))
-    # the poles of all orders at once
-    zv = np.concatenate(z_up)
-    if zv.size == 0:
-        raise InputError("plscf: no pole found in the band at any order")
-    pole = np.asarray(1j * w_lo + np.log(zv) / dt, dtype=complex)
-    order = np.repeat(orders.astype(np.int64), [z.size for z in z_up])
-    lvec = np.ones((zv.size, 1), complex) if n_in == 1 else np.concatenate(l_up)
-    pos = pole.imag > 0
-    return PoleSet(
-        order=order[pos],
-        poles=pole[pos],
-        participation=lvec[pos],
-        orders=orders.astype(np.int64),
-        band_hz=(lo, hi),
-    )
+    return z_up, l_up
+
+
+#: lines per block of the lag sums (:func:`_lag_sums`): the power tables of a
+#: block hold ``3 (P + 1) _BLOCK`` floats (24 MB at P = 60), whatever the length
+#: of the axis
+_BLOCK = 16384
+
+
+def _lag_sums(
+    f: NDArray[np.float64],
+    h: NDArray[np.complex128],
+    w: NDArray[np.float64],
+    lo: float,
+    dt: float,
+    P: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The sums over lines of the normal equations, accumulated block by block.
+
+    Returns ``Re sum_f z^d`` (d = 0..P), ``c_ok(d) = Re sum_f z^d w_o H_ok(f)``
+    (rows ``(o, k)``, columns ``d = -P..P``) and ``Re sum_f z^d q_kk'(f)`` with
+    ``q_kk' = sum_o w_o^2 conj(H_ok) H_ok'`` (rows ``(k, k')``). Blocks of
+    ``_BLOCK`` lines keep the memory of the power tables independent of the
+    number of lines (the sums are the same to rounding).
+    """
+    n_out, n_in, n_f = h.shape
+    z0 = np.zeros(P + 1)
+    c = np.zeros((n_out * n_in, 2 * P + 1))
+    t = np.zeros((n_in * n_in, 2 * P + 1))
+    for a in range(0, n_f, _BLOCK):
+        b = min(a + _BLOCK, n_f)
+        # weighted real and imaginary parts, each contiguous for the matrix products
+        h_re = h[:, :, a:b].real * w[:, None, None]
+        h_im = h[:, :, a:b].imag * w[:, None, None]
+        theta = 2 * np.pi * (f[a:b] - lo) * dt  # in [0, pi]
+        zc, zs = _unit_powers(theta, P)  # Re and Im of z^d, d = 0..P, shape (P+1, n)
+        z0 += zc.sum(axis=1)
+        n = b - a
+        # c_ok(d) = Re sum_f z^d H_ok(f), d = -P..P (index d + P): two real products
+        c += _real_lag_sums(h_re.reshape(n_out * n_in, n), h_im.reshape(n_out * n_in, n), zc, zs)
+        # sum_o T_o[(r,k),(r',k')] = Re sum_f z^(r'-r) q_kk'(f)
+        q_re = np.einsum("okf,olf->klf", h_re, h_re) + np.einsum("okf,olf->klf", h_im, h_im)
+        q_im = np.einsum("okf,olf->klf", h_re, h_im) - np.einsum("okf,olf->klf", h_im, h_re)
+        t += _real_lag_sums(q_re.reshape(n_in * n_in, n), q_im.reshape(n_in * n_in, n), zc, zs)
+    return z0, c, t
 
 
 def _unit_powers(

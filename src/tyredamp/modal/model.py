@@ -21,6 +21,7 @@ from .._validate import as_finite, as_frequency
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..mechanics.modal_sum import kind_factor, modal_sum_receptance, pole_quantities
+from .quality import FitQuality
 
 __all__ = ["ModalModel", "ModeKind"]
 
@@ -61,6 +62,12 @@ class ModalModel:
         modes of this model (``n_modes``, ``poles`` and the shapes exclude
         them) but :meth:`receptance` adds their contribution, so the model
         reproduces the fitted FRFs. Same outputs and inputs.
+    quality : FitQuality, optional
+        Fit quality of an identified model: goodness of fit against the
+        noise, each mode's test statistic and why it was kept, the rejected
+        candidates (per-mode entries follow the sorted poles).
+
+    The arrays of a model are read-only, as those of :class:`~tyredamp.frf.FRF`.
     """
 
     poles: NDArray[np.complex128]
@@ -74,6 +81,7 @@ class ModalModel:
     std: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
     residual_modes: ModalModel | None = None
+    quality: FitQuality | None = None
 
     def __init__(
         self,
@@ -88,6 +96,7 @@ class ModalModel:
         std: dict[str, ArrayLike] | None = None,
         meta: dict[str, Any] | None = None,
         residual_modes: ModalModel | None = None,
+        quality: FitQuality | None = None,
     ) -> None:
         p = as_finite(poles, "poles", ndim=1, dtype=complex, allow_empty=True)
         po = as_finite(psi_out, "psi_out", ndim=2, dtype=complex, allow_empty=True)
@@ -123,10 +132,10 @@ class ModalModel:
                 raise ShapeError(
                     f"{name}: expected shape {(po.shape[0], pi.shape[0])}, got {ra.shape}"
                 )
-            res.append(ra)
+            res.append(ra.copy())
         stds: dict[str, NDArray[np.float64]] = {}
         for key, val in (std or {}).items():
-            arr = np.asarray(val, dtype=float)
+            arr = np.array(val, dtype=float)
             if key in ("frequency_hz", "damping_ratio") and arr.shape != (p.size,):
                 raise ShapeError(f"std[{key!r}]: expected shape ({p.size},), got {arr.shape}")
             stds[key] = arr[..., order] if arr.ndim and arr.shape[-1] == p.size else arr
@@ -153,6 +162,17 @@ class ModalModel:
                     f"{residual_modes.psi_out.shape[0]} and {residual_modes.psi_in.shape[0]}"
                 )
         object.__setattr__(self, "residual_modes", residual_modes)
+        if quality is not None:
+            if not isinstance(quality, FitQuality):
+                raise InputError(f"quality: expected a FitQuality, got {type(quality).__name__}")
+            if quality.statistic.size != p.size:
+                raise ShapeError(
+                    f"quality: expected {p.size} per-mode entries, got {quality.statistic.size}"
+                )
+            quality = quality.reordered(order)
+        object.__setattr__(self, "quality", quality)
+        for arr in (p, po, pi, *(r for r in res if r is not None), *stds.values()):
+            arr.setflags(write=False)
 
     @classmethod
     def from_real_modes(
@@ -298,6 +318,13 @@ class ModalModel:
                     "std": std,
                 }
             )
+            if self.quality is not None:
+                t = float(self.quality.statistic[n])
+                modes[-1]["test"] = {
+                    "statistic": t if np.isfinite(t) else None,
+                    "threshold": self.quality.threshold,
+                    "kept": self.quality.kept[n],
+                }
         return {
             "mode_kind": self.mode_kind,
             "outputs": [_channel_dict(c) for c in self.outputs],
@@ -309,6 +336,7 @@ class ModalModel:
             "residual_modes": None
             if self.residual_modes is None
             else self.residual_modes.to_dict(),
+            "quality": None if self.quality is None else self.quality.to_dict(),
         }
 
     @classmethod
@@ -342,6 +370,7 @@ class ModalModel:
             lr = d.get("lower_residual")
             ur = d.get("upper_residual")
             rm = d.get("residual_modes")
+            qd = d.get("quality")
             return cls(
                 poles,
                 po,
@@ -354,6 +383,7 @@ class ModalModel:
                 std=std,
                 meta=d.get("meta", {}),
                 residual_modes=None if rm is None else cls.from_dict(rm),
+                quality=None if qd is None else FitQuality.from_dict(qd),
             )
         except KeyError as exc:
             raise InputError(f"modal model: missing key {exc.args[0]!r}") from None

@@ -26,8 +26,10 @@ from scipy.optimize import linear_sum_assignment
 from ..damping import DampingModel, Method, identify_damping
 from ..exceptions import InputError
 from ..frf import FRF, Channel
+from ..modal.estimators import PoleEstimator
 from ..modal.identify import ModalIdentification, ModelChoice, identify_modes
 from ..modal.model import ModalModel
+from ..modal.stats import FALSE_ALARM
 from ..signal import CheckResult, linearity_check, quality_check, reciprocity_check
 from ..signal.checks import merge_inputs
 from ..signal.estimators import Estimator, estimate_frf
@@ -152,11 +154,18 @@ def modes_from_frf(
     max_order: int | None = None,
     order_step: int = 2,
     residuals: bool = True,
+    false_alarm: float = FALSE_ALARM,
+    search: bool = True,
+    variance: ArrayLike | None = None,
+    estimator: PoleEstimator | None = None,
 ) -> ModalIdentification:
     """Real-mode (eq. [2]/[3]) and complex-mode (eq. [10]) fits with RMSD (eq. [19]).
 
     Poles from the stabilisation diagram with automatic selection, then
-    residues and poles refined together; see
+    residues and poles refined together, the mode count decided by the mode
+    test at ``false_alarm`` and a residual search (``search``) for missed
+    modes; ``variance`` is the per-line noise variance (default
+    ``FRF.variance``, else from the coherence); see
     :func:`tyredamp.modal.identify_modes` for every parameter.
     """
     return identify_modes(
@@ -168,6 +177,10 @@ def modes_from_frf(
         max_order=max_order,
         order_step=order_step,
         residuals=residuals,
+        false_alarm=false_alarm,
+        search=search,
+        variance=variance,
+        estimator=estimator,
     )
 
 

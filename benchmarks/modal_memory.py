@@ -1,0 +1,104 @@
+"""Memory per frequency line and narrow-band time of ``identify_modes`` (issue 15).
+
+Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/modal_memory.py [--lines 1e5 3e5 1e6 4e6]``.
+
+Each size runs in a fresh process: a 1 x 1 accelerance of a 6-mode system
+(20-190 Hz, 1-3 % damping) on ``n`` uniform lines over 0-200 Hz with 40 dB
+noise is built, then ``identify_modes(frf, model="complex")`` runs on the
+whole axis. Printed: the peak resident memory of the identification above
+the memory held before it (data included), per line, and per line above the
+data's own 24 bytes (8 frequency + 16 complex H). Then the time of a narrow
+band (40-60 Hz) of a long FRF against its whole length: with the band cut
+first, the time follows the lines in the band.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+from typing import Any
+
+CHILD = r"""
+import json, resource, sys, time
+import numpy as np
+from tyredamp.frf import FRF
+from tyredamp.modal import ModalModel, identify_modes
+
+n = int(float(sys.argv[1])); band = json.loads(sys.argv[2])
+fn = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0])
+z = np.array([0.03, 0.02, 0.02, 0.015, 0.012, 0.01])
+w = 2 * np.pi * fn
+p = -z * w + 1j * w * np.sqrt(1 - z**2)
+m = ModalModel(p, np.ones((1, 6)) + 0.1j, np.ones((1, 6)))
+f = np.linspace(0.0, 200.0, n)
+h = m.frf(f[1:], "accelerance").H
+rng = np.random.default_rng(0)
+e = (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
+h = h + 1e-2 * np.sqrt(np.mean(np.abs(h) ** 2)) * e
+del e
+frf = FRF(f[1:], h, kind="accelerance")
+del h
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+t = time.perf_counter()
+res = identify_modes(frf, band=None if band is None else tuple(band), model="complex")
+dt = time.perf_counter() - t
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(json.dumps({"n": frf.frequency.size, "base": base, "peak": peak, "time": dt,
+                  "modes": res.models["complex"].n_modes, "band_lines": int(res.frequency.size)}))
+"""
+
+
+def run(n: float, band: tuple[float, float] | None) -> dict[str, Any]:
+    out = subprocess.run(
+        [sys.executable, "-c", CHILD, str(n), json.dumps(band)],
+        check=False,
+        capture_output=True,
+        text=True,
+    )
+    if out.returncode != 0:
+        last = (out.stderr.strip().splitlines() or ["?"])[-1]
+        return {"error": last}
+    return dict(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--lines", nargs="+", type=float, default=[1e5, 3e5, 1e6, 4e6])
+    ap.add_argument("--long", type=float, default=2e6, help="lines of the narrow-band run")
+    args = ap.parse_args()
+    print("peak memory of identify_modes (1 x 1 FRF, whole axis, complex modes)")
+    print(
+        f"{'lines':>10} {'modes':>5} {'time [s]':>9} {'peak-base [MB]':>15} {'B/line':>8} "
+        f"{'B/line above data':>18}"
+    )
+    for n in args.lines:
+        r = run(n, None)
+        if "error" in r:
+            print(f"{int(n):>10} failed: {r['error']}")
+            continue
+        extra = r["peak"] - r["base"]
+        print(
+            f"{int(r['n']):>10} {int(r['modes']):>5} {r['time']:>9.2f} {extra / 1e6:>15.1f} "
+            f"{extra / r['n']:>8.0f} {extra / r['n'] - 24:>18.0f}"
+        )
+    print(f"\nnarrow band of a long FRF ({args.long:.0e} lines)")
+    whole = run(args.long, None)
+    narrow = run(args.long, (40.0, 60.0))
+    if "error" in whole or "error" in narrow:
+        print(f"failed: {whole.get('error', '')} {narrow.get('error', '')}")
+        return
+    for name, r in (("whole axis", whole), ("band 40-60 Hz", narrow)):
+        print(
+            f"{name:>14}: {int(r['band_lines']):>9} lines in the band, {r['time']:7.2f} s, "
+            f"peak above data {(r['peak'] - r['base']) / 1e6:8.1f} MB"
+        )
+    ratio = narrow["time"] / whole["time"]
+    print(
+        f"time ratio {ratio:.3f} for a line ratio {narrow['band_lines'] / whole['band_lines']:.3f}"
+    )
+
+
+if __name__ == "__main__":
+    main()

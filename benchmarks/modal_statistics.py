@@ -1,0 +1,268 @@
+"""Random-MDOF corpus: does the identification find every significant mode, keep
+no noise mode, and report honest uncertainties? (issue 16)
+
+Run::
+
+    OPENBLAS_NUM_THREADS=1 python benchmarks/modal_statistics.py [--systems 200]
+        [--old-src /path/to/checkout-of-c34c232/src]
+
+Corpus (generated from the seed, truth known): ``--systems`` random systems of
+4-40 modes in 20-180 Hz with 1-4 inputs and 2-8 outputs; complex
+(non-proportionally damped) shapes; damping ratios 0.5-4 %; mode amplitudes
+log-uniform so that contributions span about 1e-4 to 1; a third of the modes
+placed in close pairs, half a half-power bandwidth (``0.5 * 2 zeta f``) to
+two bandwidths from a neighbour; SNR 20, 40, 60 or 80 dB (complex Gaussian
+noise per output, relative to the output's RMS); receptance, mobility or
+accelerance; 0.1-0.2 half-power bandwidths per line. The identification
+gets the FRF and nothing else (noise from the residual).
+
+Per SNR the table prints:
+
+* ``found``: share of the *significant* true modes that were identified
+  (a true mode is significant when the likelihood-ratio statistic of the true
+  model with and without it, at the true poles with linear residues, exceeds
+  the mode test's threshold at a 1 % false-alarm rate; matched when an
+  identified mode lies within half a half-power half-width, ``0.5 zeta f``);
+* ``false/fit``: identified in-band modes matched to no true mode, per fit;
+* ``err/CRLB f, zeta``: RMS over the matched significant modes of the error
+  divided by its Cramer-Rao bound (the Gauss-Newton standard error of the
+  true model at the true parameters; 1 for an efficient estimator);
+* ``cover f, zeta``: share of those errors within the reported 95 % interval
+  (``1.96`` standard errors; 0.95 for honest intervals).
+
+With ``--old-src`` the same corpus is identified by the code at that path
+(run in a subprocess) and its table is printed beside.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from typing import Any
+
+import numpy as np
+
+KINDS = ("receptance", "mobility", "accelerance")
+SNRS = (20.0, 40.0, 60.0, 80.0)
+
+
+def system(seed: int) -> dict[str, Any]:
+    """One random system of the corpus (module docstring): poles, shapes, data settings."""
+    rng = np.random.default_rng(seed)
+    m = int(rng.integers(4, 41))
+    n_in = int(rng.integers(1, 5))
+    n_out = int(rng.integers(2, 9))
+    zeta = np.exp(rng.uniform(np.log(0.005), np.log(0.04), m))
+    f = np.sort(rng.uniform(20.0, 180.0, m))
+    # a third of the modes in close pairs: 0.5-2 half-power bandwidths from the previous
+    for i in range(1, m):
+        if rng.random() < 1 / 3:
+            f[i] = f[i - 1] * (1 + rng.uniform(0.5, 2.0) * 2 * zeta[i - 1])
+    order = np.argsort(f)
+    f, zeta = f[order], zeta[order]
+    keep = f < 185.0
+    f, zeta = f[keep], zeta[keep]
+    m = f.size
+    w = 2 * np.pi * f
+    poles = -zeta * w + 1j * w * np.sqrt(1 - zeta**2)
+    amp = np.exp(rng.uniform(np.log(1e-2), 0.0, m))
+    psi_out = (rng.normal(size=(n_out, m)) + 1j * rng.normal(size=(n_out, m))) * amp
+    psi_in = rng.normal(size=(n_in, m)) + 0.3j * rng.normal(size=(n_in, m))
+    df = float(np.min(zeta * f) * rng.uniform(0.2, 0.4))  # 0.1-0.2 bandwidths per line
+    df = max(df, 160.0 / 6000)  # at most 6000 lines
+    return {
+        "poles": poles,
+        "psi_out": psi_out,
+        "psi_in": psi_in,
+        "kind": KINDS[seed % 3],
+        "snr": SNRS[(seed // 3) % 4],
+        "freq": np.arange(10.0, 195.0, df),
+        "band": (15.0, 190.0),
+    }
+
+
+def frf_of(sys_: dict[str, Any], seed: int) -> tuple[Any, np.ndarray]:
+    from tyredamp.modal import ModalModel
+
+    mdl = ModalModel(sys_["poles"], sys_["psi_out"], sys_["psi_in"])
+    frf = mdl.frf(sys_["freq"], sys_["kind"])
+    h = frf.H
+    rms = np.sqrt(np.mean(np.abs(h) ** 2, axis=(1, 2), keepdims=True))
+    sd = 10 ** (-sys_["snr"] / 20) * rms
+    rng = np.random.default_rng(10_000 + seed)
+    e = (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
+    return frf.with_H(h + sd * e), np.broadcast_to(sd, h.shape) ** 2
+
+
+def identify(seed: int) -> dict[str, Any]:
+    """Identified in-band modes of system ``seed`` (frequency, damping, their std)."""
+    import warnings
+
+    from tyredamp.modal import identify_modes
+
+    s = system(seed)
+    frf, _ = frf_of(s, seed)
+    t = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            res = identify_modes(frf, band=s["band"], model="complex")
+        except Exception as exc:  # a failed fit counts as nothing found
+            return {"seed": seed, "error": f"{type(exc).__name__}: {exc}", "time": 0.0}
+    c = res.models["complex"]
+    return {
+        "seed": seed,
+        "f": c.frequency_hz.tolist(),
+        "z": c.damping_ratio.tolist(),
+        "sf": np.asarray(c.std["frequency_hz"]).tolist(),
+        "sz": np.asarray(c.std["damping_ratio"]).tolist(),
+        "time": time.perf_counter() - t,
+    }
+
+
+def truth_stats(seed: int) -> dict[str, Any]:
+    """Significance and Cramer-Rao bounds of the true modes (true poles, linear residues)."""
+    from tyredamp.modal.fit import ModalFitter
+    from tyredamp.modal.problem import build_problem
+    from tyredamp.modal.stats import mode_parameters, mode_threshold
+
+    s = system(seed)
+    frf, _ = frf_of(s, seed)
+    pr = build_problem(frf, s["band"])
+    n_out, n_in, n_f = pr.shape
+    fit = ModalFitter(pr.frequency, pr.H, pr.power, "complex", [], upper=True, lower=True)
+    part = s["psi_in"].T.copy()
+    inb = (np.abs(s["poles"]) / (2 * np.pi) >= pr.band[0]) & (
+        np.abs(s["poles"]) / (2 * np.pi) <= pr.band[1]
+    )
+    p_all = s["poles"]
+    rms = np.sqrt(np.mean(np.abs(pr.H) ** 2, axis=(1, 2)))
+    sigma = rms * 10 ** (-s["snr"] / 20)
+    res = fit.fit(p_all, part, refine=False, sigma=sigma)
+    thr = mode_threshold(mode_parameters(n_out, n_in, "complex"), n_f, 0.01)
+    return {
+        "f": (np.abs(p_all) / (2 * np.pi)).tolist(),
+        "z": (-p_all.real / np.abs(p_all)).tolist(),
+        "sig": (res.significance > thr).tolist(),
+        "inb": inb.tolist(),
+        "crlb_f": res.std_frequency_hz.tolist(),
+        "crlb_z": res.std_damping_ratio.tolist(),
+    }
+
+
+def score(tr: dict[str, Any], idr: dict[str, Any]) -> dict[str, Any]:
+    """Match identified to true modes (greedy, nearest first, within 0.5 zeta f)."""
+    ft, zt = np.array(tr["f"]), np.array(tr["z"])
+    fi = np.array(idr.get("f", []))
+    zi = np.array(idr.get("z", []))
+    used: set[int] = set()
+    match = -np.ones(ft.size, int)
+    if fi.size:
+        pairs = sorted(
+            (abs(fi[j] - ft[i]) / (zt[i] * ft[i]), i, j)
+            for i in range(ft.size)
+            for j in range(fi.size)
+        )
+        for d, i, j in pairs:
+            if d > 0.5:
+                break
+            if match[i] < 0 and j not in used:
+                match[i] = j
+                used.add(j)
+    sig = np.array(tr["sig"]) & np.array(tr["inb"])
+    out: dict[str, Any] = {
+        "n_sig": int(sig.sum()),
+        "n_found": int(np.sum(sig & (match >= 0))),
+        "false": int(fi.size - len(used)),
+        "ef": [],
+        "ez": [],
+        "cf": [],
+        "cz": [],
+    }
+    for i in np.flatnonzero(sig & (match >= 0)):
+        j = match[i]
+        ef, ez = fi[j] - ft[i], zi[j] - zt[i]
+        out["ef"].append(ef / tr["crlb_f"][i])
+        out["ez"].append(ez / tr["crlb_z"][i])
+        sf, sz = idr["sf"][j], idr["sz"][j]
+        out["cf"].append(bool(abs(ef) <= 1.96 * sf))
+        out["cz"].append(bool(abs(ez) <= 1.96 * sz))
+    return out
+
+
+def table(title: str, rows: list[tuple[float, dict[str, Any]]]) -> list[str]:
+    lines = [
+        title,
+        f"{'SNR':>5} {'fits':>5} {'found':>8} {'false/fit':>9} {'err/CRLB f':>10} "
+        f"{'zeta':>6} {'cover f':>8} {'zeta':>6} {'time/fit':>9}",
+    ]
+    for snr in SNRS:
+        sel = [r for s, r in rows if s == snr]
+        if not sel:
+            continue
+        n_sig = sum(r["n_sig"] for r in sel)
+        found = sum(r["n_found"] for r in sel) / max(n_sig, 1)
+        false = sum(r["false"] for r in sel) / len(sel)
+        ef = np.concatenate([r["ef"] for r in sel] + [np.zeros(0)])
+        ez = np.concatenate([r["ez"] for r in sel] + [np.zeros(0)])
+        cf = np.concatenate([r["cf"] for r in sel] + [np.zeros(0, bool)])
+        cz = np.concatenate([r["cz"] for r in sel] + [np.zeros(0, bool)])
+        rms_f = float(np.sqrt(np.mean(ef**2))) if ef.size else float("nan")
+        rms_z = float(np.sqrt(np.mean(ez**2))) if ez.size else float("nan")
+        tpf = float(np.mean([r["time"] for r in sel]))
+        lines.append(
+            f"{snr:>5.0f} {len(sel):>5} {found:>8.2%} {false:>9.3f} {rms_f:>10.2f} "
+            f"{rms_z:>6.2f} {np.mean(cf) if cf.size else np.nan:>8.2%} "
+            f"{np.mean(cz) if cz.size else np.nan:>6.2%} {tpf:>8.2f}s"
+        )
+    return lines
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--systems", type=int, default=200)
+    ap.add_argument("--old-src", help="src directory of the code to compare with (c34c232)")
+    ap.add_argument("--identify-only", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    seeds = list(range(args.systems))
+    if args.identify_only:  # subprocess of --old-src: identification results as JSON
+        print(json.dumps([identify(s) for s in seeds]))
+        return
+    old = None
+    if args.old_src:
+        env = {**os.environ, "PYTHONPATH": os.path.abspath(args.old_src)}
+        proc = subprocess.Popen(
+            [sys.executable, __file__, "--systems", str(args.systems), "--identify-only"],
+            env=env,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+    new = [identify(s) for s in seeds]
+    truths = [truth_stats(s) for s in seeds]
+    if args.old_src:
+        out, _ = proc.communicate()
+        old = json.loads(out)
+    rows_new = [
+        (system(s)["snr"], {**score(t, r), "time": r["time"]})
+        for s, t, r in zip(seeds, truths, new, strict=True)
+    ]
+    errors = [r["error"] for r in new if "error" in r]
+    for line in table(f"this code ({args.systems} systems; {len(errors)} failed fits)", rows_new):
+        print(line)
+    if old is not None:
+        rows_old = [
+            (system(s)["snr"], {**score(t, r), "time": r["time"]})
+            for s, t, r in zip(seeds, truths, old, strict=True)
+        ]
+        err_old = [r["error"] for r in old if "error" in r]
+        print()
+        for line in table(f"old rules ({args.old_src}; {len(err_old)} failed fits)", rows_old):
+            print(line)
+
+
+if __name__ == "__main__":
+    main()

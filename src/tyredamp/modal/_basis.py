@@ -1,0 +1,271 @@
+"""The real basis of the modal fits and its derivative columns.
+
+Functions of a :class:`~tyredamp.modal.fit.ModalFitter` (its methods
+``_basis_ek``, ``_basis_real``, ``_layout``, ``_coef``); the layout of the
+columns is stated in the docstring of :mod:`tyredamp.modal.fit`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+#: derivative-column layouts (layout) per (kind, m, n_in, q, w_ref)
+LAYOUTS: dict[tuple[str, int, int, int, float], Layout] = {}
+
+
+def layout(fitter: Any, m: int) -> Layout:
+    """Derivative columns of ``m`` modes: ``D = E[:, ecol] * coef`` (cached, read-only).
+
+    Complex modes: per mode ``n`` the columns of ``E`` are ``[S]``, ``[i T]``
+    (see :meth:`_basis_ek`), then ``[g]``, ``[i g']`` of each free
+    participation entry (inputs ``k != ref[n]`` in increasing ``k``); the
+    derivative columns, in the order of :meth:`basis`, are ``(-sigma [S], x1,
+    col 2n)``, ``(-sigma [i T], x1, 2n+1)``, ``(w_ref [i T], x2, 2n)``, ``(-w_ref
+    [S], x2, 2n+1)`` and per free entry ``([g], Re l, 2n)``, ``([i g'], Re l,
+    2n+1)``, ``([i g'], Im l, 2n)``, ``(-[g], Im l, 2n+1)`` -- (column of ``E``
+    and factor, parameter, basis column). Real modes: ``E = D`` (no repeated
+    columns).
+    """
+    q = fitter.n_cols(m)
+    key = (fitter.kind, m, fitter.n_in, q, fitter.w_ref)
+    lay = LAYOUTS.get(key)
+    if lay is not None:
+        return lay
+    nin = fitter.n_in
+    ar = np.arange(m)
+    if fitter.kind == "complex":
+        n_par = 2 * m + 2 * (nin - 1) * m
+        npp, ne_m = 4 * nin, 2 * nin
+        e_m = [0, 1, 1, 0]
+        for j in range(nin - 1):
+            e_m += [2 + 2 * j, 3 + 2 * j, 3 + 2 * j, 2 + 2 * j]
+        sign_m = [-1.0, -1.0, fitter.w_ref, -fitter.w_ref] + [1.0, 1.0, 1.0, -1.0] * (nin - 1)
+        pp = 2 * m + 2 * (nin - 1) * ar[:, None] + 2 * np.arange(nin - 1)[None, :]
+        part = (pp[:, :, None] + np.array([0, 0, 1, 1])[None, None, :]).reshape(m, -1)
+        pole = 2 * ar[:, None] + np.array([0, 0, 1, 1])[None, :]
+        dpar = np.concatenate([pole, part], axis=1).ravel()
+        dcol = 2 * np.repeat(ar, npp) + np.tile([0, 1, 0, 1], m * nin)
+        nsig = 2
+    else:
+        n_par = 2 * m + (nin - 1) * m
+        npp = ne_m = 2 + (nin - 1)
+        e_m = list(range(npp))
+        sign_m = [1.0] * npp
+        part = 2 * m + (nin - 1) * ar[:, None] + np.arange(nin - 1)[None, :]
+        dpar = np.concatenate([2 * ar[:, None] + np.array([0, 1])[None, :], part], 1).ravel()
+        dcol = np.repeat(ar, npp)
+        nsig = 0
+    ecol = (ne_m * ar[:, None] + np.array(e_m, np.intp)[None, :]).ravel()
+    nd, ne = ecol.size, ne_m * m
+    A = np.zeros((nd, n_par))
+    A[np.arange(nd), dpar] = 1.0
+    lay = Layout(
+        ecol=ecol.astype(np.intp),
+        sign=np.tile(np.array(sign_m), m),
+        nsig=nsig,
+        dpar=dpar.astype(np.intp),
+        dcol=dcol.astype(np.intp),
+        A=A,
+        ee=(ecol[:, None] * ne + ecol[None, :]).astype(np.intp),
+        dd=(dcol[:, None] * q + dcol[None, :]).astype(np.intp),
+        eq=(ecol * q + dcol).astype(np.intp),
+    )
+    for arr in (lay.ecol, lay.sign, lay.dpar, lay.dcol, lay.A, lay.ee, lay.dd, lay.eq):
+        arr.flags.writeable = False
+    if len(LAYOUTS) >= 64:
+        LAYOUTS.clear()
+    LAYOUTS[key] = lay
+    return lay
+
+
+def coef(lay: Layout, poles: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """Factors ``coef`` (n_d,) of ``D = E[:, ecol] * coef`` at the poles."""
+    coef = lay.sign.copy()
+    if lay.nsig:
+        cm = coef.reshape(poles.size, -1)
+        cm[:, : lay.nsig] *= (-poles.real)[:, None]  # d p / d x1 = -sigma
+    return coef
+
+
+def basis_ek(
+    fitter: Any, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], derivatives: bool = True
+) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
+    """``B = [Phi | E]`` (n_rows, q + n_e), Fortran-ordered, and the poles.
+
+    Complex modes, all at once: columns ``2n, 2n+1`` of mode ``n`` are ``A + B``
+    and ``i (A - B)`` with ``A_k = l_kn kappa / (s - p_n)`` and ``B_k =
+    conj(l_kn) kappa / (s - conj p_n)`` (real and imaginary part of the output
+    coefficient ``u_jn``). The distinct derivative columns ``E`` (``n_e = 2
+    n_in m``) of mode ``n`` are ``[S]`` and ``[i T]`` with ``S = A' + B'``, ``T =
+    A' - B'`` (``A' = A / (s - p_n)``, ``B' = B / (s - conj p_n)``: ``d A / d p =
+    A'``), then ``[g]`` and ``[i g']`` at input ``k`` only (``g = kappa / (s -
+    p_n) + kappa / (s - conj p_n)``, ``g'`` the difference) for each free
+    participation entry; ``[.]`` is a complex column as real rows (real and
+    imaginary part of each line interleaved, as the data ``Y``). With one
+    input (``l = 1``), ``t = s + sigma_n`` and ``d = (s - p_n)(s - conj p_n) =
+    t^2 + Omega_n^2``: ``A + B = 2 t kappa / d``,
+    ``i (A - B) = -2 Omega_n kappa / d``, ``S = 2 (t^2 - Omega_n^2) kappa / d^2``
+    and ``i T = -4 Omega_n t kappa / d^2`` (one complex division per line and
+    mode). Each column is written in place (transposed, contiguous). Real
+    modes: ``E`` holds the derivative columns of :meth:`_basis_real`.
+    ``derivatives=False``: ``B = Phi``.
+    """
+    poles, part = fitter.unpack(th, m, ref)
+    q = fitter.n_cols(m)
+    if fitter.kind == "real":
+        phi, D = basis_real(fitter, poles, part, ref, derivatives)
+        B = np.empty((fitter.n_rows, q + D.shape[1]), order="F")
+        B[:, :q] = phi
+        B[:, q:] = D
+        return B, poles
+    nin, nf = fitter.n_in, fitter.n_f
+    ne = 2 * nin * m if derivatives else 0
+    # rows: columns of B, complex (real and imaginary part interleaved as in Y)
+    bt = np.empty((q + ne, nin, nf), complex)
+    s, kap = fitter.s[None, :], fitter.kappa[None, :]
+    if nin == 1:
+        sig = (-poles.real)[:, None] + 0j  # complex factors: no casts in the loops
+        mom = -poles.imag[:, None] + 0j
+        den = s - poles[:, None]
+        den *= s - np.conj(poles)[:, None]  # d = (s - p)(s - conj p)
+        r = np.reciprocal(den)
+        h = fitter._kap2 * r  # 2 kappa / d
+        t = s + sig
+        np.multiply(t, h, out=bt[0 : 2 * m : 2, 0])
+        np.multiply(h, mom, out=bt[1 : 2 * m : 2, 0])
+        if derivatives:
+            h *= r  # 2 kappa / d^2
+            den -= 2.0 * mom * mom  # t^2 - Omega^2
+            np.multiply(den, h, out=bt[q::2, 0])
+            o = bt[q + 1 :: 2, 0]
+            np.multiply(t, h, out=o)
+            o *= 2.0 * mom
+    else:
+        e = 1.0 / (s - poles[:, None])  # (m, nf)
+        eb = 1.0 / (s - np.conj(poles)[:, None])
+        g = kap * e
+        gb = kap * eb
+        lc = part[:, :, None]  # (m, nin, 1)
+        A = lc * g[:, None, :]  # (m, nin, nf)
+        B_ = np.conj(lc) * gb[:, None, :]
+        put_pair(bt, 0, 2, A, B_)
+        if derivatives:
+            A *= e[:, None, :]
+            B_ *= eb[:, None, :]
+            put_pair(bt, q, 2 * nin, A, B_)
+            # participation columns: zero but at input k
+            oth = np.array([[k for k in range(nin) if k != ref[n]] for n in range(m)])
+            rows = q + 2 * nin * np.arange(m)
+            pairs = bt[q:].reshape(m, nin, 2, nin, nf)[:, 1:]  # (m, nin - 1, 2, nin, nf)
+            pairs[...] = 0.0
+            gp = g + gb
+            gm = 1j * (g - gb)
+            for j in range(nin - 1):
+                kk_ = oth[:, j]
+                bt[rows + 2 + 2 * j, kk_] = gp
+                bt[rows + 3 + 2 * j, kk_] = gm
+    c0 = 2 * m
+    for use, kk in ((fitter.use_upper, fitter.kappa), (fitter.use_lower, fitter.kappa_low)):
+        if use:
+            bt[c0 : c0 + nin] = 0.0
+            for k in range(nin):
+                bt[c0 + k, k] = kk
+            c0 += nin
+    return bt.reshape(q + ne, nin * nf).view(np.float64).T, poles
+
+
+def basis_real(
+    fitter: Any,
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    ref: NDArray[np.intp],
+    derivatives: bool,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``Phi`` and ``D`` of the real-mode model (columns of :meth:`_layout`)."""
+    nin, nf = fitter.n_in, fitter.n_f
+    s, kap = fitter.s, fitter.kappa
+    m = poles.size
+    q = fitter.n_cols(m)
+    cols = np.zeros((q, nin, nf), complex)
+    dl: list[NDArray[np.complex128]] = []
+    for n in range(m):
+        p = poles[n]
+        sig, om = -p.real, p.imag
+        L = part[n]
+        den = s**2 + 2 * sig * s + sig**2 + om**2
+        base = kap / den
+        cols[n] = L.real[:, None] * base[None, :]
+        if not derivatives:
+            continue
+        d_sig = -kap * (2 * s + 2 * sig) / den**2
+        d_om = -kap * (2 * om) / den**2
+        dl += [L.real[:, None] * (d_sig * sig)[None, :]]
+        dl += [L.real[:, None] * (d_om * fitter.w_ref)[None, :]]
+        for k in range(nin):
+            if k == ref[n]:
+                continue
+            a_ = np.zeros((nin, nf), complex)
+            a_[k] = base
+            dl.append(a_)
+    c0 = m
+    if fitter.use_upper:
+        for k in range(nin):
+            cols[c0, k] = kap
+            c0 += 1
+    if fitter.use_lower:
+        for k in range(nin):
+            cols[c0, k] = fitter.kappa_low
+            c0 += 1
+    phi = cols.reshape(q, nin * nf).view(np.float64).T
+    if not derivatives or not dl:
+        return phi, np.zeros((fitter.n_rows, 0))
+    return phi, np.stack(dl).reshape(len(dl), nin * nf).view(np.float64).T
+
+
+# ---------------------------------------------------- variable projection
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Derivative columns ``D = E[:, ecol] * coef`` of one basis layout.
+
+    ``coef = sign`` with the first ``nsig`` entries of every mode's block times
+    ``sigma_n`` (:meth:`ModalFitter._coef`); ``dpar``, ``dcol``: parameter and
+    basis column of each derivative column; ``A`` (n_d, n_par): 0/1 map of
+    derivative columns to parameters; ``ee``, ``dd``, ``eq``: flat indices of
+    ``(ecol_d, ecol_d')`` in ``E^T P E``, ``(dcol_d, dcol_d')`` in ``C C^T`` and
+    ``(ecol_d, dcol_d)`` in ``E^T r C^T``.
+    """
+
+    ecol: NDArray[np.intp]
+    sign: NDArray[np.float64]
+    nsig: int
+    dpar: NDArray[np.intp]
+    dcol: NDArray[np.intp]
+    A: NDArray[np.float64]
+    ee: NDArray[np.intp]
+    dd: NDArray[np.intp]
+    eq: NDArray[np.intp]
+
+
+def put_pair(
+    out: NDArray[np.complex128],
+    c: int,
+    stride: int,
+    a: NDArray[np.complex128],
+    b: NDArray[np.complex128],
+) -> None:
+    """Write the columns ``a + b`` and ``i (a - b)`` of every mode.
+
+    ``a``, ``b``: (m, nin, nf) complex; ``out`` of shape (rows, nin, nf); mode
+    ``n`` goes to rows ``c + stride n, c + stride n + 1``.
+    """
+    m = a.shape[0]
+    o1, o2 = out[c : c + stride * m : stride], out[c + 1 : c + stride * m : stride]
+    np.add(a, b, out=o1)
+    np.subtract(a, b, out=o2)
+    o2 *= 1j

@@ -1,0 +1,341 @@
+"""Final stage of an identification: the maximum-likelihood fit of each model,
+its goodness of fit and the :class:`~tyredamp.modal.model.ModalModel` with its
+:class:`~tyredamp.modal.quality.FitQuality`.
+
+The final fits weight every line by the noise model of the
+:class:`~tyredamp.modal.problem.FitProblem`: with a known per-line variance
+(given, or from the coherence) the weighted cost is the Gaussian negative
+log-likelihood (times two) of the data, and the fit is the maximum-likelihood
+estimate of poles, participation and residues; otherwise the noise level of
+each output is estimated from the residual of the search's model (a
+generous model) and the fit iterates it (iteratively reweighted least
+squares, the maximum-likelihood estimate for a noise level per output).
+Standard errors come from the Gauss-Newton (Fisher) information ``J^T J`` at
+the optimum, scaled by the residual variance.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .fit import FitResult, ModalFitter
+from .indicators import mean_phase_deviation, modal_phase_collinearity
+from .model import ModalModel
+from .problem import FitProblem
+from .quality import FitQuality, RejectedMode
+from .search import ModeSet, fit_checked
+from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
+
+__all__ = ["fit_real", "goodness", "to_model", "unscale"]
+
+#: the final fits stop when a full Gauss-Newton step would lower the cost by less
+#: than 1e-4 s^2: the remaining step is about 0.01 standard deviations of the
+#: parameters, far below their uncertainty (ModalFitter.fit's default is 1e-6)
+FINAL_TOL = 1e-4
+
+
+def _abs2(z: NDArray[np.complex128]) -> NDArray[np.float64]:
+    return np.asarray(z.real**2 + z.imag**2)
+
+
+def _problem(res: FitResult, m: int, n_free: int, band: tuple[float, float]) -> tuple[str, int]:
+    """Why a fit is not acceptable ("" when it is: a mode crossed a band edge, or
+    two merged) and the index of the mode concerned (-1 when none)."""
+    p = res.poles
+    fd = p.imag / (2 * np.pi)
+    inb = (fd >= band[0]) & (fd <= band[1])
+    free = np.zeros(len(p) - m, bool)
+    free[:n_free] = True
+    wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
+    if wrong.size:
+        return f"a pole crossed the band edge ({fd[wrong[0]]:.2f} Hz)", int(wrong[0])
+    d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
+    np.fill_diagonal(d, np.inf)
+    if d.size and d.min() < 5e-4:
+        i, j = np.unravel_index(np.argmin(d), d.shape)
+        return "two poles merged", int(max(i, j))
+    return "", -1
+
+
+def fit_real(
+    problem: FitProblem,
+    residuals: bool,
+    refine: bool,
+    search: ModalFitter | None,
+    start: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet],
+) -> tuple[FitResult, int, list[str]]:
+    """Real-mode fit (pole-pair optimisation) started from the complex-mode poles.
+
+    The real model keeps the modes of the complex model. When its refinement
+    is not acceptable (a pole crosses a band edge or two merge: real modes
+    that cannot describe strongly complex data), the poles are kept at the
+    complex-mode values, only the real residues are fitted, and a warning
+    says so. ``search``: the compressed search fitter (a pre-fit on the
+    output combinations) or None. ``start``: poles and participation of all
+    modes (in-band first) and the mode set they belong to.
+    """
+    p0, l0, modes = start
+    m, nf = modes.m, modes.n_free
+    fitter = ModalFitter(
+        problem.frequency,
+        problem.H,
+        problem.power,
+        "real",
+        problem.drive,
+        upper=residuals,
+        lower=residuals,
+        line_weights=problem.line_weights,
+    )
+    sigma = problem.sigma_out
+    passes = 1 if sigma is not None else 2
+    if not refine:
+        return fitter.fit(p0, l0, refine=False, sigma=sigma), m, []
+    start_p, start_l = p0, l0
+    why, bad = "", -1
+    if search is not None:
+        # real modes start far from the complex optimum: pre-fit on the combinations
+        pre = ModalFitter(
+            search.f,
+            search.H,
+            problem.power,
+            "real",
+            [],
+            upper=residuals,
+            lower=residuals,
+            unit_weights=True,
+            line_weights=problem.line_weights,
+        ).fit(p0, l0, passes=1)
+        why, bad = _problem(pre, m, nf, problem.band)
+        start_p, start_l = pre.poles, pre.participation
+    # an out-of-band residual mode that real modes cannot hold is dropped (it only
+    # shapes the band's edges); an in-band mode that crosses ends the refinement
+    for _ in range(start_p.size - m + 1):
+        if why:
+            break
+        # the evaluation limit bounds the time spent on data that real modes cannot fit
+        res = fitter.fit(start_p, start_l, max_nfev=100, tol=FINAL_TOL, sigma=sigma, passes=passes)
+        why, bad = _problem(res, m, nf, problem.band)
+        if not why:
+            return res, m, []
+        if bad >= m + nf:
+            keep = np.arange(start_p.size) != bad
+            start_p, start_l, p0, l0 = start_p[keep], start_l[keep], p0[keep], l0[keep]
+            why = ""
+    res = fitter.fit(p0, l0, refine=False, sigma=sigma)
+    return (
+        res,
+        m,
+        [
+            f"real-mode refinement not acceptable ({why}): poles kept at the complex-mode "
+            "values, real residues fitted"
+        ],
+    )
+
+
+def unscale(res: FitResult, c: float, drive: bool) -> FitResult:
+    """The fit of data ``H / c`` turned into that of ``H``: residues times ``c``.
+
+    With drive points the shapes are mass-normalised (``R = psi_out psi_in``):
+    both scale by ``sqrt(c)``; without, ``psi_in`` is the participation and
+    ``psi_out`` scales by ``c``.
+    """
+    so = np.sqrt(c) if drive else c
+    si = np.sqrt(c) if drive else 1.0
+    return dataclasses.replace(
+        res,
+        psi_out=res.psi_out * so,
+        psi_in=res.psi_in * si,
+        std_psi_out=res.std_psi_out * so,
+        upper=None if res.upper is None else res.upper * c,
+        lower=None if res.lower is None else res.lower * c,
+        sigma_out=res.sigma_out * c,
+        drive_phi2=res.drive_phi2 * c,
+    )
+
+
+def goodness(
+    problem: FitProblem, sq: NDArray[np.float64], n_par: int, n_rejected: int, false_alarm: float
+) -> GoodnessOfFit:
+    """Goodness of fit of ``sq = |H_model - H|^2`` (normalised units, (n_out, n_in, n_f))."""
+    n_obs = 2 * sq.size
+    if problem.variance is not None:
+        v = problem.variance
+        pos = v > 0
+        # E|e|^2 = V: real and imaginary part each of variance V / 2, 2 dof per entry
+        chi2 = 2.0 * float(np.sum(sq[pos] / v[pos]))
+        label = "per-line variance " + (
+            "given" if problem.noise_source == "variance" else "from coherence and averages"
+        )
+        return goodness_of_fit(
+            chi2, n_obs - n_par, label, n_rejected=n_rejected, false_alarm=false_alarm
+        )
+    var = difference_noise(problem.H)
+    if not np.all(np.isfinite(var)) or np.any(var <= 0):
+        return goodness_of_fit(
+            float("nan"), n_obs - n_par, "unknown", n_rejected=n_rejected, false_alarm=false_alarm
+        )
+    # |e|^2 / (s^2 / 2) per real and imaginary part: chi-square with 2 dof per entry
+    chi2 = 2.0 * float(np.sum(sq / var[:, None, None]))
+    return goodness_of_fit(
+        chi2,
+        n_obs - n_par,
+        "from second differences of adjacent lines",
+        n_rejected=n_rejected,
+        false_alarm=false_alarm,
+    )
+
+
+@dataclasses.dataclass(frozen=True)
+class ModelContext:
+    """What :func:`to_model` needs besides the fit."""
+
+    problem: FitProblem
+    kind: Literal["complex", "real"]
+    max_order: int
+    order_step: int
+    threshold: float
+    false_alarm: float
+    kept: tuple[str, ...] | None
+    rejected: tuple[RejectedMode, ...]
+    method: str
+
+
+def to_model(
+    res: FitResult, n_band: int, ctx: ModelContext
+) -> tuple[ModalModel, NDArray[np.float64]]:
+    """ModalModel of one fit (normalised data) in the data's units, and its
+    discrepancy per line (RMS over FRFs, FRF unit).
+
+    Fit indicators: RMSD eq. [19] (as :func:`~tyredamp.modal.indicators.rmsd`), its
+    value per FRF and the relative error (as ``relative_error``), computed in
+    the normalised units and scaled back (no overflow for any data magnitude).
+    """
+    pr = ctx.problem
+    c = pr.scale
+    sq = _abs2(res.model - pr.H)
+    gof = goodness(pr, sq, res.n_par, len(ctx.rejected), ctx.false_alarm)
+    u = unscale(res, c, bool(pr.drive))
+    data = pr.frf
+    resid_modes = None
+    if len(res.poles) > n_band:
+        resid_modes = ModalModel(
+            u.poles[n_band:],
+            u.psi_out[:, n_band:],
+            u.psi_in[:, n_band:],
+            mode_kind=ctx.kind,
+            outputs=data.outputs,
+            inputs=data.inputs,
+            meta={"role": "out-of-band modes used as residual terms"},
+        )
+    # in-band modes, sorted by Im p as ModalModel sorts them (keeps meta arrays aligned)
+    o = np.argsort(u.poles[:n_band].imag)
+    poles, psi_out, psi_in = u.poles[o], u.psi_out[:, o], u.psi_in[:, o]
+    std: dict[str, ArrayLike] = {
+        "frequency_hz": u.std_frequency_hz[o],
+        "damping_ratio": u.std_damping_ratio[o],
+        "psi_out": u.std_psi_out[:, o],
+    }
+    n_f = pr.H.shape[-1]
+    rmsd = float(c * np.sqrt(sq.sum()) / sq.size)
+    rel = float(np.sqrt(sq.sum() / max(float(np.sum(_abs2(pr.H))), 1e-300)))
+    per_frf = c * np.sqrt(sq.sum(axis=-1)) / n_f
+    stat = res.significance[:n_band][o]
+    kept = ctx.kept
+    if kept is None:
+        kept = tuple(
+            f"T = {t:.3g} > {ctx.threshold:.3g} (false-alarm rate {ctx.false_alarm:g})"
+            if t > ctx.threshold
+            else f"asked for; T = {t:.3g} <= {ctx.threshold:.3g}: not significant"
+            for t in stat
+        )
+    else:
+        kept = tuple(kept[int(i)] for i in o)
+    quality = FitQuality(
+        rmsd=rmsd,
+        relative_error=rel,
+        rmsd_per_frf=per_frf,
+        n_lines=n_f,
+        noise_source=pr.noise_source,
+        noise_rms_per_output=u.sigma_out,
+        chi2=gof.chi2,
+        dof=gof.dof,
+        p_value=gof.p_value,
+        passed=gof.passed,
+        verdict=gof.verdict,
+        statistic=stat,
+        threshold=ctx.threshold,
+        false_alarm=ctx.false_alarm,
+        kept=kept,
+        rejected=ctx.rejected,
+        status=res.status,
+        n_evaluations=res.n_iter,
+    )
+    meta = {
+        "band_hz": [pr.band[0], pr.band[1]],
+        "frf_kind": data.kind,
+        "rmsd": rmsd,
+        "relative_error": rel,
+        "rmsd_per_frf": per_frf,
+        "n_lines": int(n_f),
+        "method": ctx.method,
+        "max_order": ctx.max_order,
+        "order_step": int(ctx.order_step),
+        "refinement": res.status,
+        "n_evaluations": res.n_iter,
+        "noise_rms_per_output": u.sigma_out,
+        "mpc": modal_phase_collinearity(psi_out),
+        "mpd_deg": mean_phase_deviation(psi_out),
+        "contribution": res.contribution[o],
+        "significance": stat,
+        "drive_point_phi2": u.drive_phi2[o],
+        "std_pole": res.std_pole[o],
+        "n_residual_modes": len(res.poles) - n_band,
+        "warnings": list(res.warnings),
+    }
+    mdl = ModalModel(
+        poles,
+        psi_out,
+        psi_in,
+        mode_kind=ctx.kind,
+        outputs=data.outputs,
+        inputs=data.inputs,
+        upper_residual=u.upper,
+        lower_residual=u.lower,
+        std=std,
+        meta=meta,
+        residual_modes=resid_modes,
+        quality=quality,
+    )
+    return mdl, c * np.sqrt(np.mean(sq, axis=(0, 1)))
+
+
+def final_complex(
+    problem: FitProblem,
+    cfit: ModalFitter,
+    modes: ModeSet,
+    sigma0: NDArray[np.float64] | None,
+    refine: bool,
+    combined: ModalFitter | None,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
+    combinations (many outputs), whose poles then give the residues of every output."""
+    if combined is not None and sigma0 is not None:
+        r0, cur, dropped = fit_checked(
+            combined, modes, True, problem.band, passes=1, tol=FINAL_TOL, uncertainty=False
+        )
+        res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
+        res.status, res.n_iter = r0.status, r0.n_iter
+        return res, cur, dropped
+    return fit_checked(
+        cfit,
+        modes,
+        refine,
+        problem.band,
+        passes=1 if sigma0 is not None else 2,
+        sigma=sigma0,
+        tol=FINAL_TOL,
+    )

@@ -1,0 +1,261 @@
+"""The fit problem of an identification, built once from the band-limited FRF.
+
+:func:`build_problem` checks the FRF and the band, cuts the lines to the band
+*before* anything else touches the data (the per-line cost of an
+identification is then that of the band, not of the file), normalises the
+data to unit RMS (so that the result does not depend on the unit or the
+magnitude of the data: ``H x 1e-300`` and ``H x 1e300`` give the same modes),
+and states the noise model of the fit:
+
+* ``"variance"``: the variance of each line, given (``variance=``) or carried
+  by the FRF (``FRF.variance``);
+* ``"coherence"``: derived from the coherence ``gamma^2`` and the number of
+  averages ``n_d`` (``meta["n_averages"]``) with the H1 estimator's random
+  error ``Var H = |H|^2 (1 - gamma^2) / (gamma^2 (n_d - 1))``: the noise
+  spectrum ``(1 - gamma^2) G_yy`` over ``sum |X|^2``, whose expectation for
+  random inputs holds ``n_d - 1`` (Bendat & Piersol, *Random Data*, 4th ed.
+  2010, sec. 9.2.3, the magnitude and phase errors of eq. 9.73 summed; the
+  estimated coherence of ``n_d`` averages is biased towards 1 by about ``(1 -
+  gamma^2) / n_d``, which ``n_d - 1`` offsets to first order);
+* ``"residual"``: none is known, the noise level per output is estimated
+  from the residual of a generous model during the fit.
+
+A known variance ``V_jkf`` enters the fit as a separable model ``sigma_j^2
+g_f`` (``sigma_j^2`` the mean variance of output ``j``, ``g_f`` the mean of
+``V_jkf / sigma_j^2`` over outputs and inputs at line ``f``): the fitter
+shares one basis over the outputs, so the line factor weights the basis rows
+and the output factor the data columns (:class:`~tyredamp.modal.fit.ModalFitter`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .._validate import as_band
+from ..exceptions import InputError, ShapeError
+from ..frf import FRF, KIND_POWER
+
+__all__ = ["FitProblem", "NoiseSource", "build_problem", "max_modes"]
+
+NoiseSource = Literal["variance", "coherence", "residual"]
+#: relative spread of the line spacing accepted as uniform (float32 axes of
+#: acquisition files carry about 1e-7; a resampled or merged axis much more)
+_UNIFORM_TOL = 1e-4
+
+
+@dataclass(frozen=True)
+class FitProblem:
+    """Band-limited, normalised data of one identification (read-only arrays).
+
+    Attributes
+    ----------
+    frequency : ndarray, shape (n_freq,)
+        Lines in the band (Hz, > 0, uniformly spaced).
+    H : ndarray, complex, shape (n_out, n_in, n_freq)
+        FRFs of the band divided by ``scale``.
+    scale : float
+        Factor of the data: ``FRF.H = scale * H`` (the RMS of the band's data).
+    kind : str
+        FRF kind; ``power`` the power of ``i w`` that turns receptance into it.
+    power : int
+    band : (float, float)
+        Analysis band (Hz) as asked.
+    drive : list of (int, int)
+        Drive points ``(output, input)``.
+    frf : FRF
+        The FRF the problem was built from (channels, kind).
+    noise_source : {"variance", "coherence", "residual"}
+        Where the noise model comes from (module docstring).
+    sigma_out : ndarray, shape (n_out,) or None
+        Noise RMS per output in the normalised units (known noise only).
+    line_weights : ndarray, shape (n_freq,) or None
+        ``1 / sqrt(g_f)`` of the separable per-line noise model (mean square 1).
+    variance : ndarray, shape (n_out, n_in, n_freq) or None
+        Per-line variance in the normalised units (known noise only).
+    lines : slice
+        The band's lines in ``frf.frequency``.
+    """
+
+    frequency: NDArray[np.float64]
+    H: NDArray[np.complex128]
+    scale: float
+    kind: str
+    power: int
+    band: tuple[float, float]
+    drive: list[tuple[int, int]]
+    frf: FRF
+    noise_source: NoiseSource
+    sigma_out: NDArray[np.float64] | None
+    line_weights: NDArray[np.float64] | None
+    variance: NDArray[np.float64] | None
+    lines: slice
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        n_out, n_in, n_f = self.H.shape
+        return int(n_out), int(n_in), int(n_f)
+
+
+def max_modes(n_out: int, n_in: int, n_f: int) -> int:
+    """Most modes the data of a band can support.
+
+    Two bounds, the smaller counts: the pLSCF diagram of the highest order the
+    lines allow (``2 n_f / (n_in + 1) - 2``, :func:`identify_modes`) has
+    ``order n_in / 2`` root pairs; and the fit needs more real data
+    (``2 n_out n_in n_f``) than parameters (per complex mode ``2 n_out``
+    residue and ``2 n_in`` pole and participation parameters, plus the
+    ``2 n_out n_in`` residual terms), with at least as many left for the noise.
+    """
+    order = (2 * n_f) // (n_in + 1) - 2
+    by_order = max(order * n_in // 2, 0)
+    per_mode = 2 * n_out + 2 * n_in
+    by_data = (n_out * n_in * n_f - 2 * n_out * n_in) // per_mode
+    return int(max(min(by_order, by_data), 0))
+
+
+def check_uniform(f: NDArray[np.float64]) -> None:
+    """Raise :class:`InputError` unless the lines ``f`` (Hz) are uniformly spaced."""
+    if f.size < 3:
+        return
+    df = np.diff(f)
+    mean = (f[-1] - f[0]) / (f.size - 1)
+    dev = float(np.max(np.abs(df - mean)))
+    if dev > _UNIFORM_TOL * mean:
+        raise InputError(
+            f"frequency: pLSCF needs uniformly spaced lines; the spacing of the band varies "
+            f"from {df.min():.6g} to {df.max():.6g} Hz (resample the FRF onto a uniform axis)"
+        )
+
+
+def _line_variance(
+    frf: FRF, lines: NDArray[np.intp], H: NDArray[np.complex128], variance: ArrayLike | None
+) -> tuple[NoiseSource, NDArray[np.float64] | None]:
+    """Variance of each line of the band (data units) and where it comes from."""
+    full = frf.H.shape
+    v_given = variance if variance is not None else frf.variance
+    if v_given is not None:
+        v = np.asarray(v_given, dtype=float)
+        if v.shape != full:
+            raise ShapeError(f"variance: expected shape {full} (that of H), got {v.shape}")
+        v = v[:, :, lines]
+        if not np.all(np.isfinite(v)) or np.any(v < 0):
+            raise InputError("variance: expected finite values >= 0")
+        return "variance", v
+    coh = frf.coherence
+    n_avg = frf.meta.get("n_averages") if isinstance(frf.meta, dict) else None
+    if coh is not None and isinstance(n_avg, int | float) and n_avg >= 2:
+        g2 = np.clip(np.asarray(coh)[:, lines], 1e-6, 1.0)
+        v = np.abs(H) ** 2 * ((1.0 - g2) / (g2 * (float(n_avg) - 1.0)))[:, None, :]
+        return "coherence", v
+    return "residual", None
+
+
+def _separable(
+    v: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """Output RMS and line weights of the separable model of ``v`` (module docstring)."""
+    so2 = np.mean(v, axis=(1, 2))
+    pos = so2 > 0
+    if not np.any(pos):
+        return None  # noise-free data: no noise model to use
+    so2 = np.where(pos, so2, np.min(so2[pos]))
+    g = np.mean(v / so2[:, None, None], axis=(0, 1))
+    gpos = g > 0
+    if not np.any(gpos):
+        return None
+    # lines without variance (exact data) get the weight of the least noisy line
+    g = np.where(gpos, g, np.min(g[gpos]))
+    g = g / np.mean(g)
+    return np.sqrt(so2), 1.0 / np.sqrt(g)
+
+
+def build_problem(
+    frf: FRF,
+    band: tuple[float, float] | None = None,
+    *,
+    variance: ArrayLike | None = None,
+) -> FitProblem:
+    """Cut ``frf`` to the band, normalise it and state its noise model.
+
+    Parameters
+    ----------
+    frf : FRF
+        Measured FRFs, shape (n_out, n_in, n_freq).
+    band : (float, float), optional
+        Band in Hz; default the whole axis. Lines at 0 Hz are skipped.
+    variance : array_like, shape (n_out, n_in, n_freq), optional
+        Variance of each line of ``H`` (units of ``H`` squared); default
+        ``FRF.variance`` when the FRF carries it, else from the coherence and
+        ``meta["n_averages"]``, else none (estimated from the residual).
+
+    Returns
+    -------
+    FitProblem
+
+    Raises
+    ------
+    InputError
+        Not an FRF, a bad band, a band without lines, a non-uniform axis, an
+        all-zero band or a bad variance.
+    """
+    if not isinstance(frf, FRF):
+        raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
+    fa = frf.frequency
+    if band is None and np.count_nonzero(fa > 0) < 2:
+        raise InputError(
+            f"frequency: the FRF has {fa.size} line(s) ({', '.join(f'{x:g}' for x in fa[:3])} Hz); "
+            "modes are identified from many lines of a uniform axis"
+        )
+    lo, hi = (float(fa[0]), float(fa[-1])) if band is None else as_band(band)
+    # the band first: searchsorted on the sorted axis, no full-length mask
+    i0 = int(np.searchsorted(fa, max(lo, 0.0), side="left"))
+    i1 = int(np.searchsorted(fa, hi, side="right"))
+    if i0 < i1 and fa[i0] <= 0:
+        i0 += 1  # 0 Hz lines are skipped
+    if i1 <= i0:
+        raise InputError(
+            f"band: no line above 0 Hz in [{lo:g}, {hi:g}] Hz; data cover "
+            f"[{fa[0]:g}, {fa[-1]:g}] Hz"
+        )
+    lines = np.arange(i0, i1)
+    f = np.ascontiguousarray(fa[i0:i1])
+    check_uniform(f)
+    Hb = np.asarray(frf.H[:, :, i0:i1])
+    # scale by the largest magnitude first (no overflow of the squares), then the RMS
+    peak = float(np.max(np.abs(Hb)))
+    if not peak > 0:
+        raise InputError(f"H: every FRF is zero in [{lo:g}, {hi:g}] Hz; nothing to identify")
+    Hn = Hb / peak
+    rms = float(np.sqrt(np.mean(Hn.real**2 + Hn.imag**2)))
+    Hn = Hn / rms
+    scale = peak * rms
+    source, v = _line_variance(frf, lines, Hb, variance)
+    sig = lw = vn = None
+    if v is not None:
+        vn = v / peak**2 / rms**2
+        sep = _separable(vn)
+        if sep is None:
+            source, vn = "residual", None
+        else:
+            sig, lw = sep
+    for a in (f, Hn, *(x for x in (sig, lw, vn) if x is not None)):
+        a.setflags(write=False)
+    return FitProblem(
+        frequency=f,
+        H=Hn,
+        scale=scale,
+        kind=frf.kind,
+        power=KIND_POWER[frf.kind],
+        band=(lo, hi),
+        drive=frf.drive_points(),
+        frf=frf,
+        noise_source=source,
+        sigma_out=sig,
+        line_weights=lw,
+        variance=vn,
+        lines=slice(i0, i1),
+    )

@@ -1,0 +1,205 @@
+"""Typed fit-quality record of an identified :class:`~tyredamp.modal.model.ModalModel`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..exceptions import InputError
+
+__all__ = ["FitQuality", "RejectedMode"]
+
+
+def _ro(x: ArrayLike, dtype: type = float) -> NDArray[Any]:
+    a: NDArray[Any] = np.array(x, dtype=dtype)
+    a.setflags(write=False)
+    return a
+
+
+@dataclass(frozen=True)
+class RejectedMode:
+    """A candidate mode that the identification tried and did not keep.
+
+    Attributes
+    ----------
+    frequency_hz, damping_ratio : float
+        Natural frequency (Hz) and damping ratio of the candidate.
+    reason : str
+        Why, in statistical terms where a test decided it.
+    statistic : float
+        Its mode statistic ``T`` (NaN when no test was made).
+    threshold : float
+        The threshold ``T`` had to exceed (NaN when no test was made).
+    """
+
+    frequency_hz: float
+    damping_ratio: float
+    reason: str
+    statistic: float = float("nan")
+    threshold: float = float("nan")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "frequency_hz": self.frequency_hz,
+            "damping_ratio": self.damping_ratio,
+            "reason": self.reason,
+            "statistic": _num(self.statistic),
+            "threshold": _num(self.threshold),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> RejectedMode:
+        return cls(
+            float(d["frequency_hz"]),
+            float(d["damping_ratio"]),
+            str(d["reason"]),
+            _flt(d.get("statistic")),
+            _flt(d.get("threshold")),
+        )
+
+
+def _num(x: float) -> float | None:
+    return float(x) if np.isfinite(x) else None
+
+
+def _flt(x: Any) -> float:
+    return float("nan") if x is None else float(x)
+
+
+@dataclass(frozen=True, eq=False)
+class FitQuality:
+    """How well a modal model explains its data, and why each mode is in it.
+
+    Attributes
+    ----------
+    rmsd : float
+        RMSD of eq. [19] (FRF unit).
+    relative_error : float
+        ``||H_model - H|| / ||H||`` over the band.
+    rmsd_per_frf : ndarray, shape (n_out, n_in)
+        RMSD of each FRF (read-only).
+    n_lines : int
+        Lines of the band.
+    noise_source : str
+        ``"variance"``, ``"coherence"`` or ``"residual"`` (see
+        :mod:`tyredamp.modal.problem`).
+    noise_rms_per_output : ndarray, shape (n_out,)
+        Noise RMS per output (FRF unit; read-only): known, or the residual RMS.
+    chi2, dof, p_value : float, int, float
+        Goodness-of-fit test (:func:`tyredamp.modal.stats.goodness_of_fit`).
+    passed : bool
+        The cost is within its chi-square range.
+    verdict : str
+        "the model explains the data to the noise ..." or "structure is left: ...".
+    statistic : ndarray, shape (m,)
+        Mode statistic ``T`` of each mode (cost rise in units of the noise
+        variance when the mode is removed; read-only).
+    threshold : float
+        Threshold of ``T`` (:func:`tyredamp.modal.stats.mode_threshold`).
+    false_alarm : float
+        Level of the mode test and of the goodness-of-fit test.
+    kept : tuple of str
+        Why each mode is in the model.
+    rejected : tuple of RejectedMode
+        Candidates tried and not kept.
+    status : str
+        Refinement status (``"converged"``, ``"maxfev"``, ``"lsfd"``).
+    n_evaluations : int
+        Cost evaluations of the refinement.
+    """
+
+    rmsd: float
+    relative_error: float
+    rmsd_per_frf: NDArray[np.float64]
+    n_lines: int
+    noise_source: str
+    noise_rms_per_output: NDArray[np.float64]
+    chi2: float
+    dof: int
+    p_value: float
+    passed: bool
+    verdict: str
+    statistic: NDArray[np.float64]
+    threshold: float
+    false_alarm: float
+    kept: tuple[str, ...]
+    rejected: tuple[RejectedMode, ...] = ()
+    status: str = ""
+    n_evaluations: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("rmsd_per_frf", "noise_rms_per_output", "statistic"):
+            object.__setattr__(self, name, _ro(getattr(self, name)))
+        if len(self.kept) != self.statistic.size:
+            raise InputError(
+                f"kept: expected one reason per mode ({self.statistic.size}), got {len(self.kept)}"
+            )
+        object.__setattr__(self, "kept", tuple(self.kept))
+        object.__setattr__(self, "rejected", tuple(self.rejected))
+
+    def reordered(self, order: NDArray[np.intp]) -> FitQuality:
+        """The same record with the per-mode entries in ``order``."""
+        return FitQuality(
+            **{
+                **self.__dict__,
+                "statistic": self.statistic[order],
+                "kept": tuple(self.kept[int(i)] for i in order),
+            }
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dictionary (non-finite numbers as null); see :meth:`from_dict`."""
+        return {
+            "rmsd": _num(self.rmsd),
+            "relative_error": _num(self.relative_error),
+            "rmsd_per_frf": self.rmsd_per_frf.tolist(),
+            "n_lines": self.n_lines,
+            "noise_source": self.noise_source,
+            "noise_rms_per_output": self.noise_rms_per_output.tolist(),
+            "chi2": _num(self.chi2),
+            "dof": self.dof,
+            "p_value": _num(self.p_value),
+            "passed": self.passed,
+            "verdict": self.verdict,
+            "statistic": [_num(float(x)) for x in self.statistic],
+            "threshold": _num(self.threshold),
+            "false_alarm": self.false_alarm,
+            "kept": list(self.kept),
+            "rejected": [r.to_dict() for r in self.rejected],
+            "status": self.status,
+            "n_evaluations": self.n_evaluations,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> FitQuality:
+        """Inverse of :meth:`to_dict`; raises :class:`InputError` naming a bad key."""
+        try:
+            return cls(
+                rmsd=_flt(d["rmsd"]),
+                relative_error=_flt(d["relative_error"]),
+                rmsd_per_frf=np.array(d["rmsd_per_frf"], float),
+                n_lines=int(d["n_lines"]),
+                noise_source=str(d["noise_source"]),
+                noise_rms_per_output=np.array(d["noise_rms_per_output"], float),
+                chi2=_flt(d["chi2"]),
+                dof=int(d["dof"]),
+                p_value=_flt(d["p_value"]),
+                passed=bool(d["passed"]),
+                verdict=str(d["verdict"]),
+                statistic=np.array([_flt(x) for x in d["statistic"]], float),
+                threshold=_flt(d["threshold"]),
+                false_alarm=float(d["false_alarm"]),
+                kept=tuple(str(x) for x in d["kept"]),
+                rejected=tuple(RejectedMode.from_dict(r) for r in d.get("rejected", [])),
+                status=str(d.get("status", "")),
+                n_evaluations=int(d.get("n_evaluations", 0)),
+            )
+        except KeyError as exc:
+            raise InputError(f"fit quality: missing key {exc.args[0]!r}") from None
+        except (TypeError, ValueError, AttributeError) as exc:
+            if isinstance(exc, InputError):
+                raise
+            raise InputError(f"fit quality: malformed entry ({exc})") from None

@@ -1,0 +1,508 @@
+"""Which modes the data hold: out-of-band residual modes, the mode test, and the
+residual-driven search for missed modes.
+
+Three stages of :func:`~tyredamp.modal.identify.identify_modes` (automatic
+mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
+
+1. :func:`search_helpers`: out-of-band residual modes above and below the band
+   (docstring there);
+2. :func:`reject_by_test`: each in-band mode's statistic ``T`` (the rise of
+   the weighted cost, in units of the noise variance, when the mode is
+   removed; :mod:`tyredamp.modal.stats`) against the threshold of the
+   stated false-alarm rate; the weakest failing mode is dropped and the rest
+   refitted, until every mode passes;
+3. :func:`residual_search`: candidates for missed modes, from the diagram
+   (clusters that too few orders resolved, modes rejected earlier) and from
+   the peaks of the residual (the fit's residual power per line, in units of
+   the noise, summed over the FRFs: a mode indicator on the residual), each
+   refined alone with the other modes held fixed
+   (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`, its frequency within 3 %
+   of the start); a candidate whose cost drop passes the mode test is refined
+   with all modes, and kept when it still passes; repeated until no
+   candidate passes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..exceptions import ConvergenceError
+from ..mechanics.modal_sum import pole_quantities
+from .fit import FitResult, ModalFitter
+from .quality import RejectedMode
+
+__all__ = ["ModeSet", "reject_by_test", "residual_search", "search_helpers"]
+
+#: convergence thresholds of the intermediate fits, in units of the residual
+#: variance s^2 (ModalFitter.fit ``tol``): the joint fits of the search and of the
+#: rejection stop when a further step would lower the cost by less than 10 s^2, a
+#: trial mode by less than 1 s^2. They only choose the modes and start the final
+#: fit, which converges to a much smaller tolerance.
+SEARCH_TOL = 10.0
+TRIAL_TOL = 1.0
+#: evaluation limit of the search's first joint fit: before the residual modes are
+#: found, the modes near a band edge absorb the out-of-band ones and converge slowly
+#: (linearly) to that biased optimum; one Gauss-Newton step takes most of the gain
+#: from the estimator's poles, the later joint fits and the final fit do the rest
+FIRST_NFEV = 2
+#: a residual mode below the band (damped frequency in [f_lo / 2, f_lo]) shapes the
+#: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
+#: starts at the first lines) it cannot be told from the lower residual term
+MIN_LOW_LINES = 10
+#: poles closer than this (relative to |p|) are one mode
+MERGE = 5e-4
+#: residual search: a candidate's frequency stays within this factor of its start
+TRIAL_SPAN = 0.03
+#: evaluation limit of the joint refit after an accepted trial (it only decides
+#: whether the mode stays; the final fit converges)
+JOINT_NFEV = 30
+#: evaluation limit of a trial mode (a mode that is there converges in a few steps)
+TRIAL_NFEV = 30
+#: residual search: most candidates tried per round, and rounds
+MAX_TRIALS = 12
+MAX_ROUNDS = 4
+
+
+@dataclass
+class ModeSet:
+    """Current modes of a search: ``m`` in-band, then ``len(hp)`` residual modes.
+
+    The first ``n_free`` residual modes are in-band modes the user did not ask
+    for (not checked against the band), the others lie outside the band.
+    """
+
+    poles: NDArray[np.complex128]
+    part: NDArray[np.complex128]
+    hp: NDArray[np.complex128]
+    hl: NDArray[np.complex128]
+    n_free: int = 0
+
+    @property
+    def m(self) -> int:
+        return int(self.poles.size)
+
+    def all(self) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+        return np.concatenate([self.poles, self.hp]), np.concatenate([self.part, self.hl])
+
+    def take(self, res: FitResult) -> ModeSet:
+        m = self.m
+        return ModeSet(
+            res.poles[:m], res.participation[:m], res.poles[m:], res.participation[m:], self.n_free
+        )
+
+
+def rejected(
+    p: complex, why: str, t: float = float("nan"), thr: float = float("nan")
+) -> RejectedMode:
+    """Record of a candidate that was not kept."""
+    return RejectedMode(
+        float(abs(p) / (2 * np.pi)), float(-p.real / abs(p)), why, float(t), float(thr)
+    )
+
+
+def fit_checked(
+    fitter: ModalFitter,
+    modes: ModeSet,
+    refine: bool,
+    band: tuple[float, float],
+    **fit_kw: object,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """Fit the modes; drop any that left its side of the band or merged, and refit.
+
+    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`. Returns the fit,
+    the modes at the fit's values and the dropped ones.
+    """
+    dropped: list[RejectedMode] = []
+    cur = modes
+    for _ in range(modes.m + modes.hp.size + 1):
+        m = cur.m
+        p0, l0 = cur.all()
+        res = fitter.fit(p0, l0, refine=refine, **fit_kw)  # type: ignore[arg-type]
+        p = res.poles
+        fd = p.imag / (2 * np.pi)
+        inb = (fd >= band[0]) & (fd <= band[1])
+        free = np.zeros(cur.hp.size, bool)
+        free[: cur.n_free] = True
+        wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
+        why = "crossed the band edge during refinement"
+        if not wrong.size:
+            d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
+            np.fill_diagonal(d, np.inf)
+            if d.size and d.min() < MERGE:
+                i, j = np.unravel_index(np.argmin(d), d.shape)
+                wrong = np.array([i if res.contribution[i] < res.contribution[j] else j])
+                why = "merged with another mode during refinement"
+        if not wrong.size:
+            return res, cur.take(res), dropped
+        # every mode that crossed a band edge is dropped at once (one refit)
+        inband = wrong[wrong < m]
+        if inband.size >= m:
+            raise ConvergenceError(f"every mode {why}")
+        dropped += [
+            rejected(complex(cur.poles[i]), f"complex fit: {why} ({fd[i]:.2f} Hz)") for i in inband
+        ]
+        out = wrong[wrong >= m] - m
+        keep_m = np.setdiff1d(np.arange(m), inband)
+        keep_h = np.setdiff1d(np.arange(cur.hp.size), out)
+        cur = ModeSet(
+            cur.poles[keep_m],
+            cur.part[keep_m],
+            cur.hp[keep_h],
+            cur.hl[keep_h],
+            int(np.count_nonzero(keep_h < cur.n_free)),
+        )
+    raise ConvergenceError("refinement kept losing modes")
+
+
+def _trial(
+    fitter: ModalFitter,
+    res: FitResult,
+    modes: ModeSet,
+    pole: complex,
+    part: NDArray[np.complex128],
+    w_lim: tuple[float, float],
+    strict: bool = True,
+) -> tuple[complex, NDArray[np.complex128], float] | None:
+    """Refine one added mode alone; its statistic ``T``. ``strict``: None when it
+    stopped at a limit of ``w_lim`` (an out-of-band residual mode that runs into
+    the band edge is not there); otherwise the limit only localises the trial."""
+    p_all, l_all = modes.all()
+    try:
+        p_t, l_t, sig_t = fitter.fit_added(
+            p_all,
+            l_all,
+            pole,
+            part,
+            omega_bounds=w_lim,
+            tol=TRIAL_TOL,
+            fixed=res,
+            max_nfev=TRIAL_NFEV,
+        )
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    tol = 1e-4 * (w_lim[1] - w_lim[0])
+    if strict and not (w_lim[0] + tol < p_t.imag < w_lim[1] - tol):
+        return None  # a trial pole stopped at a limit did not find a mode there
+    n_all = p_all.size
+    dof0 = max(fitter.n_rows - fitter.n_cols(n_all), 1)
+    dof1 = max(fitter.n_rows - fitter.n_cols(n_all + 1), 1)
+    s2a = np.maximum(sig_t**2, np.maximum(fitter.noise_floor**2, 1e-300))
+    s2b = np.maximum(res.sigma_out**2, s2a)
+    t = float(np.sum((s2b * dof0 - s2a * dof1) / s2a))
+    return p_t, l_t, t
+
+
+def search_helpers(
+    fitter: ModalFitter,
+    modes: ModeSet,
+    band: tuple[float, float],
+    data_band: tuple[float, float],
+    max_helpers: int,
+    threshold: float,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """Refine, then add out-of-band residual modes while they pass the mode test.
+
+    A trial pole is started at ``1.1 f_hi`` (then ``1.3 f_hi``, ...) above the
+    band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0`` and at least
+    ``MIN_LOW_LINES`` lines lie in ``[f_lo, 2 f_lo]``, with the median
+    damping of the in-band modes. Only the trial mode is refined, with every
+    other mode held fixed, its damped frequency kept outside the band but
+    within a factor 2 of its edge. It is kept when it did not stop at one of
+    these limits and its statistic ``T`` (cost drop in units of the noise
+    variance per output) exceeds ``threshold``; all modes are then refined
+    together, and the search stops instead if that moves the trial mode out
+    of its range or an in-band mode out of the band.
+    """
+    lo, hi = band
+    res, cur, dropped = fit_checked(
+        fitter,
+        modes,
+        True,
+        band,
+        passes=1,
+        tol=SEARCH_TOL,
+        uncertainty=False,
+        max_nfev=FIRST_NFEV,
+    )
+    zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
+    n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
+    sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= MIN_LOW_LINES else [])
+    for side in sides:
+        for k in range(max_helpers):
+            fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
+            if fh <= 0:
+                break
+            wh = 2 * np.pi * fh
+            ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
+            edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
+            w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
+            got = _trial(fitter, res, cur, ph, np.ones(fitter.n_in, complex), w_lim)
+            if got is None or got[2] < threshold:
+                break
+            p_t, l_t, _ = got
+            try:
+                trial = fitter.fit(
+                    *_with_helper(cur, p_t, l_t),
+                    passes=1,
+                    tol=SEARCH_TOL,
+                    uncertainty=False,
+                )
+            except (np.linalg.LinAlgError, ValueError):
+                break
+            fd = trial.poles[-1].imag / (2 * np.pi)
+            fin = trial.poles[: cur.m].imag / (2 * np.pi)
+            outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)
+            if not (outside and np.all((fin >= lo) & (fin <= hi))):
+                break
+            cur = ModeSet(
+                trial.poles[: cur.m],
+                trial.participation[: cur.m],
+                trial.poles[cur.m :],
+                trial.participation[cur.m :],
+                cur.n_free,
+            )
+            res = trial
+    return res, cur, dropped
+
+
+def _with_helper(
+    cur: ModeSet, p: complex, lv: NDArray[np.complex128]
+) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+    p_all, l_all = cur.all()
+    return np.append(p_all, p), np.concatenate([l_all, lv[None, :]])
+
+
+def reject_by_test(
+    fitter: ModalFitter,
+    modes: ModeSet,
+    band: tuple[float, float],
+    threshold: float,
+    refine: bool,
+    min_contribution: float = 0.0,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """Drop the weakest mode that fails the mode test, refit; until every mode passes.
+
+    The first fit refines every mode jointly (and drops modes that leave the
+    band); after each removal the residues are refitted at the current poles.
+    ``min_contribution`` (default 0: off) also drops modes whose synthesised
+    FRFs have an RMS below that fraction of the data's.
+    """
+    out: list[RejectedMode] = []
+    cur = modes
+    res: FitResult | None = None
+    for i in range(modes.m + 1):
+        if i == 0 and refine:
+            # a converged joint fit first (modes that leave the band are dropped)
+            res, cur, gone = fit_checked(
+                fitter, cur, True, band, passes=1, tol=SEARCH_TOL, uncertainty=False
+            )
+            out += gone
+        elif res is None:
+            # after a removal the others barely move: the residues are refitted at
+            # the current poles (the final fit refines them all)
+            p0, l0 = cur.all()
+            res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
+        cur = cur.take(res)
+        m = cur.m
+        t, con = res.significance[:m], res.contribution[:m]
+        bad = (t < threshold) | (con < min_contribution)
+        if not np.any(bad) or m <= 1:
+            break
+        worst = int(np.argmin(np.where(bad, t, np.inf)))
+        why = (
+            f"contribution {con[worst]:.2%} < {min_contribution:.2%}"
+            if con[worst] < min_contribution
+            else f"not significant: T = {t[worst]:.3g} <= {threshold:.3g}"
+        )
+        out.append(rejected(complex(cur.poles[worst]), why, float(t[worst]), threshold))
+        cur = ModeSet(
+            np.delete(cur.poles, worst),
+            np.delete(cur.part, worst, axis=0),
+            cur.hp,
+            cur.hl,
+            cur.n_free,
+        )
+        res = None
+    if res is None:
+        p0, l0 = cur.all()
+        res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
+    return res, cur, out
+
+
+def _residual_peaks(
+    fitter: ModalFitter, res: FitResult, n_max: int, threshold: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Frequencies (Hz) of the largest peaks of the residual power per line.
+
+    The residual of the fit (weighted as the fit weights it) is summed over
+    the FRFs in units of each output's noise variance and smoothed over 5
+    lines; its local maxima, largest first. Also returns the residual power
+    per line above its median (the excess a missed mode could explain).
+    """
+    m_all = res.poles.size
+    s = fitter.s
+    u = res.psi_out  # unscaled (no drive points in a search fitter) or scaled: u l = R
+    lv = res.psi_in
+    model = np.zeros((fitter.n_out, fitter.n_in, fitter.n_f), complex)
+    for n in range(m_all):
+        g = fitter.kappa / (s - res.poles[n])
+        gb = fitter.kappa / (s - np.conj(res.poles[n]))
+        r = u[:, n, None] * lv[None, :, n]
+        model += r[:, :, None] * g + np.conj(r)[:, :, None] * gb
+    if res.upper is not None:
+        model += res.upper[:, :, None] * fitter.kappa
+    if res.lower is not None:
+        model += res.lower[:, :, None] * fitter.kappa_low
+    data = fitter.H if fitter.line_weights is None else fitter.H * fitter.line_weights
+    e = data - model
+    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
+    pw = np.sum((e.real**2 + e.imag**2) / s2[:, None, None], axis=(0, 1))
+    k = min(5, pw.size)
+    sm = np.convolve(pw, np.ones(k) / k, mode="same")
+    if sm.size < 3:
+        return np.zeros(0), pw - np.median(pw)
+    peak = np.flatnonzero((sm[1:-1] > sm[:-2]) & (sm[1:-1] >= sm[2:])) + 1
+    # a missed mode explains at least the residual power it leaves above the noise
+    # level: peaks whose excess over the median within the window is below a
+    # quarter of the test's threshold cannot hold a significant mode
+    excess = k * (sm[peak] - np.median(sm))
+    peak = peak[(sm[peak] > 2.0 * np.median(sm)) & (excess > 0.25 * threshold)]
+    # largest first; a peak within 1 % of a larger one is the same structure
+    out: list[float] = []
+    for i in peak[np.argsort(-sm[peak])]:
+        fi = float(fitter.f[i])
+        if all(abs(fi - g) > 0.01 * g for g in out):
+            out.append(fi)
+        if len(out) >= n_max:
+            break
+    return np.asarray(out), pw - np.median(pw)
+
+
+def _room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> float:
+    """Residual power above the noise (units of the noise variance) within the
+    half-power band ``+-2 zeta f`` of a candidate pole ``p`` (at least 5 lines)."""
+    fc = abs(p.imag) / (2 * np.pi)
+    z = -p.real / max(abs(p), 1e-300)
+    half = max(2 * z * fc, 2.5 * (f[-1] - f[0]) / max(f.size - 1, 1))
+    sel = (f >= fc - half) & (f <= fc + half)
+    return float(np.sum(excess[sel]))
+
+
+def residual_search(
+    fitter: ModalFitter,
+    res: FitResult,
+    modes: ModeSet,
+    candidates: list[tuple[complex, NDArray[np.complex128]]],
+    band: tuple[float, float],
+    threshold: float,
+    max_damping: float = 0.2,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """Add missed in-band modes that pass the mode test (module docstring, stage 3).
+
+    A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
+    of the diagram) is not a mode: it is rejected whatever its statistic. Nor
+    is one whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
+    narrower than the line spacing: no line lies inside its resonance, so the
+    lines cannot resolve its frequency and damping, and such a pole fits the
+    noise of single lines (where per-line variances estimated from a few
+    averages are too small) rather than a resonance.
+
+    ``candidates`` are starting poles and participation vectors from the
+    diagram; each round adds the peaks of the current residual.
+    """
+    lo, hi = band
+    df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
+    tried: list[RejectedMode] = []
+    cur = modes
+    zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
+    pending = list(candidates)
+    seen: list[complex] = []  # starts tried (a start is tried once)
+    for _ in range(MAX_ROUNDS):
+        # the residual's peaks first (where the structure is), then the diagram's
+        starts: list[tuple[complex, NDArray[np.complex128]]] = []
+        peaks, excess = _residual_peaks(fitter, res, MAX_TRIALS, threshold)
+        for fpk in peaks:
+            w = 2 * np.pi * fpk
+            starts.append(
+                (complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), np.ones(fitter.n_in, complex))
+            )
+        # a diagram candidate can explain at most the residual power above the noise
+        # within its half-power band (+-2 zeta f): skipped when that cannot pass
+        starts += [c for c in pending if _room(fitter.f, excess, c[0]) > 0.25 * threshold]
+        pending = []
+        added = False
+        n_tried = 0
+        for p0, l0 in starts:
+            p_all = np.concatenate([cur.all()[0], np.asarray(seen, complex)])
+            if p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE:
+                continue
+            if n_tried >= MAX_TRIALS:
+                break
+            n_tried += 1
+            seen.append(complex(p0))
+            w_lim = (
+                max(abs(p0.imag) * (1 - TRIAL_SPAN), 2 * np.pi * lo),
+                min(abs(p0.imag) * (1 + TRIAL_SPAN), 2 * np.pi * hi),
+            )
+            if not w_lim[0] < w_lim[1]:
+                continue
+            got = _trial(fitter, res, cur, p0, np.asarray(l0, complex), w_lim, strict=False)
+            if got is None:
+                continue
+            p_t, l_t, t = got
+            if -p_t.real / np.pi < df:
+                tried.append(
+                    rejected(
+                        p_t,
+                        f"half-power bandwidth {-p_t.real / np.pi:.3g} Hz below the line "
+                        f"spacing {df:.3g} Hz (not resolved)",
+                        t,
+                        threshold,
+                    )
+                )
+                continue
+            if -p_t.real > max_damping * abs(p_t):
+                tried.append(
+                    rejected(p_t, f"damping above the admissible {max_damping:.0%}", t, threshold)
+                )
+                continue
+            if t <= threshold:
+                tried.append(
+                    rejected(p_t, f"not significant: T = {t:.3g} <= {threshold:.3g}", t, threshold)
+                )
+                continue
+            new = ModeSet(
+                np.append(cur.poles, p_t),
+                np.concatenate([cur.part, l_t[None, :]]),
+                cur.hp,
+                cur.hl,
+                cur.n_free,
+            )
+            try:
+                r1, c1, drop = fit_checked(
+                    fitter,
+                    new,
+                    True,
+                    band,
+                    passes=1,
+                    tol=SEARCH_TOL,
+                    uncertainty=False,
+                    max_nfev=JOINT_NFEV,
+                )
+            except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+                continue
+            if drop or c1.m != new.m or np.min(r1.significance[: c1.m]) <= threshold:
+                t1 = float(np.min(r1.significance[: c1.m])) if c1.m else float("nan")
+                tried.append(
+                    rejected(
+                        p_t, f"not significant with all modes refitted: T = {t1:.3g}", t1, threshold
+                    )
+                )
+                continue
+            res, cur, added = r1, c1, True
+        if not added:
+            break
+    return res, cur, tried

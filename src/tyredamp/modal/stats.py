@@ -1,0 +1,160 @@
+"""Statistics that decide the mode count and judge a fit against the noise.
+
+Mode test (:func:`mode_threshold`). Adding a mode to a model adds ``k``
+parameters (complex modes: ``2 n_out`` residue coefficients, 2 for the pole
+and ``2 (n_in - 1)`` for the participation; real modes ``n_out + 2 + (n_in -
+1)``). With Gaussian noise of known variance the drop of the weighted cost
+(negative log-likelihood times two) when the mode is added, ``T = (S_0 -
+S_1) / s^2``, is chi-square with ``k`` degrees of freedom when the mode is
+not there (Wilks 1938; with ``s^2`` estimated from ``n_obs - n_par``
+residual degrees of freedom, ``T / k`` is ``F(k, n_obs - n_par)``, Seber &
+Lee 2003, sec. 4.3). The pole of a mode that is not there is not defined,
+so the largest ``T`` over the positions a search tries exceeds the
+chi-square quantile more often than its level; the test therefore uses a
+Bonferroni bound over the ``n_freq`` lines of the band (each line one
+position where a candidate could sit): a mode is kept when ``T >
+chi2_k^-1(1 - alpha / n_freq)``, so that a fit of pure noise keeps a noise
+mode with probability at most ``alpha`` (the false-alarm rate, default 1 %).
+The threshold depends neither on the noise level nor on the scale of the
+data; ``T`` is measured in units of the noise.
+
+Goodness of fit (:func:`goodness_of_fit`): the weighted cost of the final
+fit against its chi-square expectation ``n_obs - n_par`` when the noise is
+known (given variance or coherence); otherwise against the noise estimated
+from the second differences of adjacent lines (:func:`difference_noise`),
+which a smooth FRF barely contains. The verdict is "the model explains the
+data to the noise" when the upper tail probability of the cost is at least
+the false-alarm rate.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats as sps
+
+__all__ = [
+    "GoodnessOfFit",
+    "difference_noise",
+    "goodness_of_fit",
+    "mode_parameters",
+    "mode_threshold",
+]
+
+#: default false-alarm rate of the mode test and of the goodness-of-fit test
+FALSE_ALARM = 0.01
+
+
+def mode_parameters(n_out: int, n_in: int, mode_kind: str) -> int:
+    """Number of real parameters ``k`` one mode adds (module docstring)."""
+    if mode_kind == "complex":
+        return 2 * n_out + 2 + 2 * (n_in - 1)
+    return n_out + 2 + (n_in - 1)
+
+
+def mode_threshold(k: int, n_lines: int, false_alarm: float = FALSE_ALARM) -> float:
+    """Threshold of the mode statistic ``T``: ``chi2_k^-1(1 - alpha / n_lines)``.
+
+    Parameters
+    ----------
+    k : int
+        Parameters of one mode (:func:`mode_parameters`).
+    n_lines : int
+        Lines of the band (Bonferroni factor).
+    false_alarm : float
+        Probability ``alpha`` that a fit of pure noise keeps a noise mode.
+    """
+    if not 0.0 < false_alarm < 1.0:
+        raise ValueError(f"false_alarm: expected a probability in (0, 1), got {false_alarm}")
+    return float(sps.chi2.isf(false_alarm / max(int(n_lines), 1), int(k)))
+
+
+def difference_noise(H: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """Noise variance per output from second differences of adjacent lines.
+
+    For white complex noise of variance ``s^2`` per line, ``d_f = H_{f+1} - 2
+    H_f + H_{f-1}`` has ``E|d|^2 = 6 s^2`` and ``|d|^2`` is exponential, with
+    median ``6 s^2 ln 2``; the median over lines and inputs ignores the few
+    lines near sharp peaks where the FRF itself curves. Returns shape
+    (n_out,), in the units of ``H`` squared (an upper bound of the noise when
+    the FRF curves at most lines: few lines per half-power bandwidth).
+    """
+    if H.shape[-1] < 3:
+        return np.full(H.shape[0], np.nan)
+    d = H[..., 2:] - 2.0 * H[..., 1:-1] + H[..., :-2]
+    a2 = (d.real**2 + d.imag**2).reshape(H.shape[0], -1)
+    return np.asarray(np.median(a2, axis=1) / (6.0 * math.log(2.0)))
+
+
+@dataclass(frozen=True)
+class GoodnessOfFit:
+    """Cost of a fit against its chi-square expectation.
+
+    Attributes
+    ----------
+    chi2 : float
+        Weighted cost ``sum |H_model - H|^2 / Var H``.
+    dof : int
+        Residual degrees of freedom ``n_obs - n_par``.
+    p_value : float
+        ``P(chi2_dof >= chi2)``.
+    noise : str
+        Which noise the cost is measured against.
+    passed : bool
+        ``p_value >= false_alarm``.
+    verdict : str
+        One sentence for people.
+    """
+
+    chi2: float
+    dof: int
+    p_value: float
+    noise: str
+    passed: bool
+    verdict: str
+
+
+def goodness_of_fit(
+    resid_ss: float,
+    dof: int,
+    noise: str,
+    *,
+    n_rejected: int = 0,
+    false_alarm: float = FALSE_ALARM,
+) -> GoodnessOfFit:
+    """Test a weighted residual sum of squares against ``chi2(dof)``.
+
+    Parameters
+    ----------
+    resid_ss : float
+        Residual sum of squares in units of the noise variance.
+    dof : int
+        Residual degrees of freedom.
+    noise : str
+        Source of the noise level, for the verdict.
+    n_rejected : int
+        Candidate modes tried and rejected, for the verdict.
+    false_alarm : float
+        Level of the test.
+    """
+    dof = max(int(dof), 1)
+    chi2 = float(resid_ss)
+    p = float(sps.chi2.sf(chi2, dof)) if np.isfinite(chi2) else 0.0
+    passed = p >= false_alarm
+    ratio = chi2 / dof
+    if passed:
+        verdict = (
+            f"the model explains the data to the noise (chi2/dof = {ratio:.3g}, p = {p:.2g}; "
+            f"noise {noise})"
+        )
+    else:
+        why = (
+            f"{n_rejected} candidate mode(s) were tried and rejected"
+            if n_rejected
+            else "the model is incomplete"
+        )
+        verdict = f"structure is left: chi2/dof = {ratio:.3g} (p = {p:.2g}; noise {noise}); {why}"
+    return GoodnessOfFit(chi2=chi2, dof=dof, p_value=p, noise=noise, passed=passed, verdict=verdict)
