@@ -109,6 +109,18 @@ _EXP = {"displacement": (1, 0), "velocity": (1, 0), "acceleration": (1, 0), "for
 
 
 # ------------------------------------------------------------------ writing
+def _pair_fields(out: Channel, inp: Channel) -> dict[str, Any]:
+    """The response and reference fields of the data set of one output/input pair."""
+    return {
+        "rsp_node": out.node,
+        "rsp_dir": out.direction,
+        "ref_node": inp.node,
+        "ref_dir": inp.direction,
+        "id4": _extras_line(out),
+        "id5": _extras_line(inp),
+    }
+
+
 def _extras_line(c: Channel) -> str:
     d: dict[str, Any] = {}
     if c.name:
@@ -295,12 +307,7 @@ def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
             d.update(
                 func_type=4,
                 func_id=fid,
-                rsp_node=co.node,
-                rsp_dir=co.direction,
-                ref_node=ci.node,
-                ref_dir=ci.direction,
-                id4=_extras_line(co),
-                id5=_extras_line(ci),
+                **_pair_fields(co, ci),
                 orddenom_spec_data_type=13,
                 orddenom_len_unit_exp=0,
                 orddenom_force_unit_exp=1,
@@ -346,12 +353,7 @@ def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
                 d.update(
                     func_type=0,
                     func_id=fid,
-                    rsp_node=co.node,
-                    rsp_dir=co.direction,
-                    ref_node=ci.node,
-                    ref_dir=ci.direction,
-                    id4=_extras_line(co),
-                    id5=_extras_line(ci),
+                    **_pair_fields(co, ci),
                     ordinate_spec_data_type=0,
                     ordinate_len_unit_exp=0,
                     ordinate_force_unit_exp=0,
