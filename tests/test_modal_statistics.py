@@ -25,6 +25,7 @@ from tyredamp.modal.stats import (
     difference_noise,
     mode_parameters,
     mode_threshold,
+    weight_factor,
 )
 from tyredamp.signal.estimators import (
     CrossSpectra,
@@ -347,3 +348,30 @@ def test_cost_reference_tends_to_chi_square() -> None:
     assert_allclose([mean, c * c * 2 * d], [150.0, 1350.0])
     with pytest.raises(ValueError, match="nu > 4"):
         cost_reference(100, 4.0)
+
+
+def test_mode_statistic_with_estimated_line_weights() -> None:
+    # a pole where no mode is: its T (2 n_out = 4 residue parameters, poles fixed)
+    # is inflated by the estimated line weights by at most (nu_w - 2) / (nu_w - 4),
+    # nu_w = 2 (n_avg - 1) n_out = 12: 1.25, the factor the threshold carries
+    poles = np.r_[TWO_DOF, 2 * np.pi * 95.0 * (-0.01 + 1j)]
+    t = []
+    for s in range(200):
+        pr = build_problem(_averaged_frf(4, s))
+        fitter = ModalFitter(
+            pr.frequency, pr.H, pr.power, "complex", pr.drive, line_weights=pr.line_weights
+        )
+        res = fitter.fit(poles, np.ones((3, 1), complex), refine=False, sigma=pr.sigma_out)
+        t.append(res.significance[2])
+    assert pr.weight_dof == 12.0
+    factor = weight_factor(pr.weight_dof)
+    assert factor == pytest.approx(1.25)
+    tt = np.array(t)
+    sd = np.std(tt) / np.sqrt(tt.size)
+    assert 4.0 < np.mean(tt) < 4.0 * factor + 3 * sd
+    # the corrected 5 % threshold of one position is exceeded at most at its rate
+    thr = mode_threshold(4, 1, 0.05, pr.weight_dof)
+    assert thr == pytest.approx(factor * sps.chi2.isf(0.05, 4))
+    assert np.mean(tt > thr) <= 0.05 + 3 * np.sqrt(0.05 * 0.95 / tt.size)
+    assert weight_factor(None) == 1.0
+    assert weight_factor(5.0) == 2.0

@@ -245,7 +245,9 @@ def identify_modes(
     warnings: list[str] = []
     modes, rej = _start_modes(problem, dg, fr, n_modes, min_fraction, warnings)
     fitters = _Fitters.build(problem, residuals, modes, max_helpers)
-    thr = mode_threshold(mode_parameters(n_out, n_in, "complex"), n_f, false_alarm)
+    thr = mode_threshold(
+        mode_parameters(n_out, n_in, "complex"), n_f, false_alarm, problem.weight_dof
+    )
     last, modes, more = _select(
         fitters, modes, dg, rej, thr, auto, refine, max_helpers, min_contribution, search, (lo, hi)
     )
@@ -521,6 +523,7 @@ def _final_models(
                 mode_parameters(n_out, problem.shape[1], "real"),
                 problem.shape[2],
                 ctx["false_alarm"],
+                problem.weight_dof,
             ),
             false_alarm=ctx["false_alarm"],
             kept=kept,

@@ -115,6 +115,18 @@ class FitProblem:
     n_averages: int | None = None
 
     @property
+    def weight_dof(self) -> float | None:
+        """Degrees of freedom of the estimated line weights: ``noise_dof n_out``.
+
+        The separable line factor averages the residual powers of the outputs
+        (independent); those of the inputs of one output share it. None when the
+        weights are known or absent (:func:`~tyredamp.modal.stats.mode_threshold`).
+        """
+        if self.noise_dof is None or self.line_weights is None:
+            return None
+        return float(self.noise_dof) * int(self.H.shape[0])
+
+    @property
     def shape(self) -> tuple[int, int, int]:
         n_out, n_in, n_f = self.H.shape
         return int(n_out), int(n_in), int(n_f)

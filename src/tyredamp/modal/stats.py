@@ -19,10 +19,19 @@ The threshold depends neither on the noise level nor on the scale of the
 data; ``T`` is measured in units of the noise. ``T`` is divided by the
 residual variance of the weighted fit itself (``s^2 = cost / dof`` over
 every line, :class:`~tyredamp.modal.fit.ModalFitter`), not by the per-line
-variance estimates: when the weights come from a variance estimated from few
-averages, numerator and ``s^2`` carry the same weights, the inflation
-``nu / (nu - 2)`` described below cancels, and the threshold needs no
-correction.
+variance estimates, so the inflation ``nu / (nu - 2)`` of the goodness of fit
+(below) cancels to first order. What is left comes from the line weights
+``w_f = 1 / g^_f`` being estimates (``nu_w`` degrees of freedom: ``nu n_out``,
+the separable line factor averages the independent residual powers of the
+outputs, :mod:`tyredamp.modal.problem`): with ``b_f = g_f / g^_f`` the
+projection onto a mode's weighted columns explains ``sum b_f^2 a_f / sum b_f
+a_f`` noise units (``a_f`` the mode's share of line ``f``), between ``E b =
+nu_w / (nu_w - 2)`` (one line) and ``E b^2 / E b = nu_w / (nu_w - 4)`` (many
+lines), while ``s^2`` holds ``E b``. ``T`` is thus inflated by at most
+``(nu_w - 2) / (nu_w - 4)`` (1.25 for 4 averages and 2 outputs, 1.08 for 8),
+and the threshold is scaled by that bound when the weights are estimated
+(``weight_dof``; 2 at most, its value at ``nu_w = 6``, where the bound
+diverges).
 
 Goodness of fit (:func:`goodness_of_fit`): the weighted cost of the final
 fit against its chi-square expectation ``n_obs - n_par`` when the noise is
@@ -66,6 +75,7 @@ __all__ = [
     "goodness_of_fit",
     "mode_parameters",
     "mode_threshold",
+    "weight_factor",
 ]
 
 #: default false-alarm rate of the mode test and of the goodness-of-fit test
@@ -79,8 +89,13 @@ def mode_parameters(n_out: int, n_in: int, mode_kind: str) -> int:
     return n_out + 2 + (n_in - 1)
 
 
-def mode_threshold(k: int, n_lines: int, false_alarm: float = FALSE_ALARM) -> float:
+def mode_threshold(
+    k: int, n_lines: int, false_alarm: float = FALSE_ALARM, weight_dof: float | None = None
+) -> float:
     """Threshold of the mode statistic ``T``: ``chi2_k^-1(1 - alpha / n_lines)``.
+
+    Times ``(nu_w - 2) / (nu_w - 4)`` (at most 2) when the line weights are
+    estimated with ``nu_w`` degrees of freedom (module docstring).
 
     Parameters
     ----------
@@ -90,10 +105,22 @@ def mode_threshold(k: int, n_lines: int, false_alarm: float = FALSE_ALARM) -> fl
         Lines of the band (Bonferroni factor).
     false_alarm : float
         Probability ``alpha`` that a fit of pure noise keeps a noise mode.
+    weight_dof : float, optional
+        Degrees of freedom ``nu_w`` of estimated line weights; default None
+        (known weights or none: no correction).
     """
     if not 0.0 < false_alarm < 1.0:
         raise ValueError(f"false_alarm: expected a probability in (0, 1), got {false_alarm}")
-    return float(sps.chi2.isf(false_alarm / max(int(n_lines), 1), int(k)))
+    thr = float(sps.chi2.isf(false_alarm / max(int(n_lines), 1), int(k)))
+    return thr * weight_factor(weight_dof)
+
+
+def weight_factor(weight_dof: float | None) -> float:
+    """Bound ``(nu_w - 2) / (nu_w - 4)`` of the inflation of ``T`` (1 for None, at most 2)."""
+    if weight_dof is None or not math.isfinite(weight_dof):
+        return 1.0
+    nu = float(weight_dof)
+    return 2.0 if nu <= 6.0 else (nu - 2.0) / (nu - 4.0)
 
 
 def difference_noise(H: NDArray[np.complex128]) -> NDArray[np.float64]:
