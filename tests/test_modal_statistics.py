@@ -375,3 +375,11 @@ def test_mode_statistic_with_estimated_line_weights() -> None:
     assert np.mean(tt > thr) <= 0.05 + 3 * np.sqrt(0.05 * 0.95 / tt.size)
     assert weight_factor(None) == 1.0
     assert weight_factor(5.0) == 2.0
+
+
+def test_variance_from_three_averages_is_not_tested_against() -> None:
+    # nu = 4: a term 2 F(2, 4) has no variance; the second-difference noise is used
+    g = _fit_quality(_averaged_frf(3, 0), TWO_DOF)
+    assert g.noise_dof is None
+    assert "second differences" in g.noise
+    assert "from 3 averages has nu = 4" in g.noise
