@@ -572,9 +572,8 @@ def estimate_frf(
         ``coherence``, the variance of each estimate as ``variance`` (see
         :func:`frf_variance`; None with too few averages), and ``meta``
         with ``estimator``, ``method``, ``n_averages``, ``segment_samples``,
-        ``sample_rate``, ``window``, ``overlap``, ``variance_dof`` (real
-        degrees of freedom of ``variance``: ``2 (n_eff - n_in)`` with ``n_eff``
-        the averages reduced for overlap; segment methods only).
+        ``sample_rate``, ``window``, ``overlap``, ``variance_dof`` (segment
+        methods: ``2 (n_eff - n_in)``, ``n_eff`` the averages net of overlap).
 
     Raises
     ------
