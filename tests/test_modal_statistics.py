@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -12,10 +14,25 @@ from tyredamp.exceptions import InputError
 from tyredamp.frf import FRF, Channel
 from tyredamp.modal import ModalModel, identify_modes
 from tyredamp.modal.estimators import PoleEstimator
+from tyredamp.modal.final import goodness
 from tyredamp.modal.fit import ModalFitter
 from tyredamp.modal.lscf import PoleSet
+from tyredamp.modal.problem import build_problem
 from tyredamp.modal.quality import FitQuality
-from tyredamp.modal.stats import difference_noise, mode_parameters, mode_threshold
+from tyredamp.modal.stats import (
+    GoodnessOfFit,
+    cost_reference,
+    difference_noise,
+    mode_parameters,
+    mode_threshold,
+    weight_factor,
+)
+from tyredamp.signal.estimators import (
+    CrossSpectra,
+    frf_from_spectra,
+    frf_variance,
+    multiple_coherence,
+)
 
 from .helpers import chain_system
 
@@ -243,3 +260,126 @@ def test_damping_chain_without_a_mode_count() -> None:
     dm = identify_damping(c, "refined", n_samples=0)
     err = np.linalg.norm(dm.physical - s.C) / np.linalg.norm(s.C)
     assert err < 1e-3
+
+
+# --------------------------------------------- goodness of fit with an estimated variance
+F_MC = np.arange(50.0, 150.0, 0.25)
+TWO_DOF = np.array(
+    [-0.02 * 2 * np.pi * 80 + 2j * np.pi * 80, -0.02 * 2 * np.pi * 110 + 2j * np.pi * 110]
+)
+
+
+def _averaged_frf(n_avg: int, seed: int) -> FRF:
+    """H1 of a 2-DOF system (one input, two outputs) from ``n_avg`` simulated averages.
+
+    Per line and average a random complex force ``X_m`` and output noise
+    ``E_m``; the spectra go through the project's own estimator (H1,
+    multiple coherence, :func:`frf_variance` from ``n_avg`` averages).
+    """
+    psi = np.array([[1.0, 0.6], [0.5, -0.9]])
+    truth = ModalModel(TWO_DOF, psi, psi[:1], "real")
+    h = np.moveaxis(truth.frf(F_MC, "receptance").H, -1, 0)  # (f, out, in)
+    rng = np.random.default_rng(seed)
+    n_f = F_MC.size
+
+    def cn(*shape: int) -> np.ndarray:
+        return (rng.normal(size=shape) + 1j * rng.normal(size=shape)) / np.sqrt(2)
+
+    x = cn(n_f, n_avg, 1)  # (f, avg, in)
+    sd = 0.02 * np.sqrt(np.mean(np.abs(h) ** 2, axis=(0, 2)))  # (out,)
+    y = np.einsum("foi,fai->fao", h, x) + sd * cn(n_f, n_avg, 2)  # (f, avg, out)
+    spectra = CrossSpectra(
+        frequency=F_MC,
+        Gxx=np.einsum("fai,faj->fij", x, x.conj()) / n_avg,
+        Gyx=np.einsum("fao,fai->foi", y, x.conj()) / n_avg,
+        Gyy=np.mean(np.abs(y) ** 2, axis=1),
+        Gyy_full=None,
+        n_averages=n_avg,
+        segment_samples=2 * n_f,
+        sample_rate=1.0,
+    )
+    coh = multiple_coherence(spectra)
+    var = frf_variance(spectra, coh, n_avg)
+    meta = {"n_averages": n_avg, "variance_dof": 2.0 * (n_avg - 1)}
+    return FRF(
+        F_MC, frf_from_spectra(spectra), "receptance", coherence=coh, variance=var, meta=meta
+    )
+
+
+def _fit_quality(frf: FRF, poles: np.ndarray, noise_dof: bool = True) -> GoodnessOfFit:
+    """Goodness of fit of the linear fit of ``frf`` with the given poles (residues free)."""
+    pr = build_problem(frf)
+    if not noise_dof:
+        pr = dataclasses.replace(pr, noise_dof=None)  # the chi-square test of before
+    fitter = ModalFitter(
+        pr.frequency, pr.H, pr.power, "complex", pr.drive, line_weights=pr.line_weights
+    )
+    res = fitter.fit(poles, np.ones((poles.size, 1), complex), refine=False, sigma=pr.sigma_out)
+    sq = np.abs(res.model - pr.H) ** 2
+    return goodness(pr, sq, res.n_par, 0, 0.01)
+
+
+@pytest.mark.parametrize("n_avg", [4, 8])
+def test_goodness_of_fit_with_variance_from_few_averages(n_avg: int) -> None:
+    # the true poles: the F-corrected test passes at its 1 % false-alarm rate
+    # (expected 99 of 100; >= 95 is 4 binomial sd below), the chi-square test did not
+    q = [_fit_quality(_averaged_frf(n_avg, s), TWO_DOF) for s in range(100)]
+    assert q[0].noise_dof == 2.0 * (n_avg - 1)
+    assert f"estimated from {n_avg} averages" in q[0].noise
+    assert sum(g.passed for g in q) >= 95
+    # the cost of a correct model averages dof nu / (nu - 2) (1.5 dof for 4 averages)
+    ratio = np.mean([g.chi2 / g.dof for g in q])
+    nu = 2.0 * (n_avg - 1)
+    assert abs(ratio / (nu / (nu - 2)) - 1) < 0.03
+    old = [_fit_quality(_averaged_frf(n_avg, s), TWO_DOF, noise_dof=False) for s in range(20)]
+    assert sum(g.passed for g in old) <= 10
+    # a model missing the 110 Hz mode still fails
+    miss = [_fit_quality(_averaged_frf(n_avg, s), TWO_DOF[:1]) for s in range(10)]
+    assert not any(g.passed for g in miss)
+    assert miss[0].verdict.startswith("structure is left")
+
+
+def test_cost_reference_tends_to_chi_square() -> None:
+    assert cost_reference(100, None) == (100.0, 1.0, 100.0)
+    mean, c, d = cost_reference(100, 1e9)
+    assert_allclose([mean, c, d], [100.0, 1.0, 100.0], rtol=1e-6)
+    # nu = 6: mean 1.5 dof; variance 2 dof 216 / (16 * 2) = 13.5 dof
+    mean, c, d = cost_reference(100, 6.0)
+    assert_allclose([mean, c * c * 2 * d], [150.0, 1350.0])
+    with pytest.raises(ValueError, match="nu > 4"):
+        cost_reference(100, 4.0)
+
+
+def test_mode_statistic_with_estimated_line_weights() -> None:
+    # a pole where no mode is: its T (2 n_out = 4 residue parameters, poles fixed)
+    # is inflated by the estimated line weights by at most (nu_w - 2) / (nu_w - 4),
+    # nu_w = 2 (n_avg - 1) n_out = 12: 1.25, the factor the threshold carries
+    poles = np.r_[TWO_DOF, 2 * np.pi * 95.0 * (-0.01 + 1j)]
+    t = []
+    for s in range(200):
+        pr = build_problem(_averaged_frf(4, s))
+        fitter = ModalFitter(
+            pr.frequency, pr.H, pr.power, "complex", pr.drive, line_weights=pr.line_weights
+        )
+        res = fitter.fit(poles, np.ones((3, 1), complex), refine=False, sigma=pr.sigma_out)
+        t.append(res.significance[2])
+    assert pr.weight_dof == 12.0
+    factor = weight_factor(pr.weight_dof)
+    assert factor == pytest.approx(1.25)
+    tt = np.array(t)
+    sd = np.std(tt) / np.sqrt(tt.size)
+    assert 4.0 < np.mean(tt) < 4.0 * factor + 3 * sd
+    # the corrected 5 % threshold of one position is exceeded at most at its rate
+    thr = mode_threshold(4, 1, 0.05, pr.weight_dof)
+    assert thr == pytest.approx(factor * sps.chi2.isf(0.05, 4))
+    assert np.mean(tt > thr) <= 0.05 + 3 * np.sqrt(0.05 * 0.95 / tt.size)
+    assert weight_factor(None) == 1.0
+    assert weight_factor(5.0) == 2.0
+
+
+def test_variance_from_three_averages_is_not_tested_against() -> None:
+    # nu = 4: a term 2 F(2, 4) has no variance; the second-difference noise is used
+    g = _fit_quality(_averaged_frf(3, 0), TWO_DOF)
+    assert g.noise_dof is None
+    assert "second differences" in g.noise
+    assert "from 3 averages has nu = 4" in g.noise

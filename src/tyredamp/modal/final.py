@@ -160,18 +160,35 @@ def unscale(res: FitResult, c: float, drive: bool) -> FitResult:
 def goodness(
     problem: FitProblem, sq: NDArray[np.float64], n_par: int, n_rejected: int, false_alarm: float
 ) -> GoodnessOfFit:
-    """Goodness of fit of ``sq = |H_model - H|^2`` (normalised units, (n_out, n_in, n_f))."""
+    """Goodness of fit of ``sq = |H_model - H|^2`` (normalised units, (n_out, n_in, n_f)).
+
+    A known variance: chi-square; one estimated with ``nu > 4`` degrees of
+    freedom (``problem.noise_dof``): the ``F``-corrected test of
+    :mod:`tyredamp.modal.stats`; one estimated with ``nu <= 4`` (too few
+    averages for the cost to have a variance): the second-difference noise.
+    """
     n_obs = 2 * sq.size
-    if problem.variance is not None:
+    nu = problem.noise_dof
+    few = nu is not None and not nu > 4.0
+    if problem.variance is not None and not few:
         v = problem.variance
         pos = v > 0
         # E|e|^2 = V: real and imaginary part each of variance V / 2, 2 dof per entry
         chi2 = 2.0 * float(np.sum(sq[pos] / v[pos]))
-        label = "per-line variance " + (
-            "given" if problem.noise_source == "variance" else "from coherence and averages"
-        )
+        if problem.noise_source == "variance" and nu is None:
+            label = "per-line variance given"
+        else:
+            what = "variance" if problem.noise_source == "variance" else "variance from coherence"
+            n_avg = problem.n_averages
+            src = f"{n_avg} averages, " if n_avg is not None else ""
+            label = f"per-line {what} estimated from {src}nu = {nu:.3g} dof"
         return goodness_of_fit(
-            chi2, n_obs - n_par, label, n_rejected=n_rejected, false_alarm=false_alarm
+            chi2,
+            n_obs - n_par,
+            label,
+            n_rejected=n_rejected,
+            false_alarm=false_alarm,
+            noise_dof=nu,
         )
     var = difference_noise(problem.H)
     if not np.all(np.isfinite(var)) or np.any(var <= 0):
@@ -180,12 +197,14 @@ def goodness(
         )
     # |e|^2 / (s^2 / 2) per real and imaginary part: chi-square with 2 dof per entry
     chi2 = 2.0 * float(np.sum(sq / var[:, None, None]))
+    label = "from second differences of adjacent lines"
+    if few:
+        label += (
+            f" (the per-line variance from {problem.n_averages} averages has nu = {nu:.3g} "
+            "<= 4 dof, too few to test against)"
+        )
     return goodness_of_fit(
-        chi2,
-        n_obs - n_par,
-        "from second differences of adjacent lines",
-        n_rejected=n_rejected,
-        false_alarm=false_alarm,
+        chi2, n_obs - n_par, label, n_rejected=n_rejected, false_alarm=false_alarm
     )
 
 

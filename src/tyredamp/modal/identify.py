@@ -233,7 +233,7 @@ def identify_modes(
     if model not in ("both", "complex", "real"):
         raise InputError(f"model: expected 'both', 'complex' or 'real', got {model!r}")
     problem = build_problem(frf, band, variance=variance)
-    n_out, n_in, n_f = problem.shape
+    _, n_in, n_f = problem.shape
     lo, hi = problem.band
     fr = _check_counts(problem, n_modes, frequencies)
     nm_hint = int(n_modes) if n_modes is not None else (None if fr is None else fr.size)
@@ -245,7 +245,7 @@ def identify_modes(
     warnings: list[str] = []
     modes, rej = _start_modes(problem, dg, fr, n_modes, min_fraction, warnings)
     fitters = _Fitters.build(problem, residuals, modes, max_helpers)
-    thr = mode_threshold(mode_parameters(n_out, n_in, "complex"), n_f, false_alarm)
+    thr = _threshold(problem, "complex", false_alarm)
     last, modes, more = _select(
         fitters, modes, dg, rej, thr, auto, refine, max_helpers, min_contribution, search, (lo, hi)
     )
@@ -276,6 +276,13 @@ def identify_modes(
         warnings=warnings,
         noise_source=problem.noise_source,
     )
+
+
+def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:
+    """Threshold of the mode test for ``kind`` modes on ``problem`` (:func:`mode_threshold`)."""
+    n_out, n_in, n_f = problem.shape
+    k = mode_parameters(n_out, n_in, kind)
+    return mode_threshold(k, n_f, false_alarm, problem.weight_dof)
 
 
 def _start_modes(
@@ -488,7 +495,6 @@ def _final_models(
     models: dict[str, ModalModel] = {}
     disc: dict[str, NDArray[np.float64]] = {}
     base: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet] = (*modes.all(), modes)
-    n_out = problem.shape[0]
     for kind in kinds:
         extra_warn: list[str] = []
         if kind == "complex":
@@ -517,11 +523,7 @@ def _final_models(
             order_step=ctx["order_step"],
             threshold=ctx["threshold"]
             if kind == "complex"
-            else mode_threshold(
-                mode_parameters(n_out, problem.shape[1], "real"),
-                problem.shape[2],
-                ctx["false_alarm"],
-            ),
+            else _threshold(problem, "real", ctx["false_alarm"]),
             false_alarm=ctx["false_alarm"],
             kept=kept,
             rejected=tuple(rej),

@@ -20,6 +20,18 @@ and states the noise model of the fit:
 * ``"residual"``: none is known, the noise level per output is estimated
   from the residual of a generous model during the fit.
 
+Degrees of freedom of the variance (``FitProblem.noise_dof``). A variance
+passed as ``variance=`` is taken as known (the goodness of fit is then
+chi-square). One carried by the FRF or derived from its coherence is an
+estimate: its real degrees of freedom ``nu`` are ``meta["variance_dof"]``
+when the estimator states them (:func:`~tyredamp.signal.estimators.estimate_frf`:
+``2 (n_eff - n_in)`` with ``n_eff`` the averages reduced for overlapping
+windows), else ``2 (n_averages - n_in)`` from ``meta["n_averages"]`` (the
+residual of the least-squares H1 over the averages, no overlap correction),
+else unknown: taken as known (the local methods, ``n_averages = 1``, whose
+variance has the local fit's degrees of freedom, not stated in the meta
+yet). The goodness of fit corrects for them (:mod:`tyredamp.modal.stats`).
+
 A known variance ``V_jkf`` enters the fit as a separable model ``sigma_j^2
 g_f`` (``sigma_j^2`` the mean variance of output ``j``, ``g_f`` the mean of
 ``V_jkf / sigma_j^2`` over outputs and inputs at line ``f``): the fitter
@@ -29,6 +41,7 @@ and the output factor the data columns (:class:`~tyredamp.modal.fit.ModalFitter`
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -78,6 +91,11 @@ class FitProblem:
         Per-line variance in the normalised units (known noise only).
     lines : slice
         The band's lines in ``frf.frequency``.
+    noise_dof : float or None
+        Real degrees of freedom of an estimated per-line variance (module
+        docstring); None when the variance is known or there is none.
+    n_averages : int or None
+        Averages the variance was estimated from (``meta["n_averages"]``), for the verdict.
     """
 
     frequency: NDArray[np.float64]
@@ -93,6 +111,20 @@ class FitProblem:
     line_weights: NDArray[np.float64] | None
     variance: NDArray[np.float64] | None
     lines: slice
+    noise_dof: float | None = None
+    n_averages: int | None = None
+
+    @property
+    def weight_dof(self) -> float | None:
+        """Degrees of freedom of the estimated line weights: ``noise_dof n_out``.
+
+        The separable line factor averages the residual powers of the outputs
+        (independent); those of the inputs of one output share it. None when the
+        weights are known or absent (:func:`~tyredamp.modal.stats.mode_threshold`).
+        """
+        if self.noise_dof is None or self.line_weights is None:
+            return None
+        return float(self.noise_dof) * int(self.H.shape[0])
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -152,6 +184,27 @@ def _line_variance(
         v = np.abs(H) ** 2 * ((1.0 - g2) / (g2 * (float(n_avg) - 1.0)))[:, None, :]
         return "coherence", v
     return "residual", None
+
+
+def _meta_number(frf: FRF, key: str) -> float | None:
+    """A finite positive number of ``frf.meta`` (None when absent or not one)."""
+    x = frf.meta.get(key) if isinstance(frf.meta, dict) else None
+    if isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x) or x <= 0:
+        return None
+    return float(x)
+
+
+def variance_dof(frf: FRF, source: NoiseSource, given: bool) -> float | None:
+    """Real degrees of freedom of an estimated per-line variance (module docstring)."""
+    if given or source == "residual":
+        return None
+    stated = _meta_number(frf, "variance_dof")
+    if stated is not None:
+        return stated
+    n_avg = _meta_number(frf, "n_averages")
+    if n_avg is None or n_avg <= frf.n_in:
+        return None
+    return 2.0 * (n_avg - frf.n_in)
 
 
 def _separable(
@@ -234,6 +287,8 @@ def build_problem(
     Hn = Hn / rms
     scale = peak * rms
     source, v = _line_variance(frf, lines, Hb, variance)
+    nu = variance_dof(frf, source, variance is not None)
+    n_avg = _meta_number(frf, "n_averages")
     sig = lw = vn = None
     if v is not None:
         vn = v / peak**2 / rms**2
@@ -258,4 +313,6 @@ def build_problem(
         line_weights=lw,
         variance=vn,
         lines=slice(i0, i1),
+        noise_dof=nu if source != "residual" else None,
+        n_averages=None if n_avg is None else int(n_avg),
     )

@@ -16,7 +16,22 @@ position where a candidate could sit): a mode is kept when ``T >
 chi2_k^-1(1 - alpha / n_freq)``, so that a fit of pure noise keeps a noise
 mode with probability at most ``alpha`` (the false-alarm rate, default 1 %).
 The threshold depends neither on the noise level nor on the scale of the
-data; ``T`` is measured in units of the noise.
+data; ``T`` is measured in units of the noise. ``T`` is divided by the
+residual variance of the weighted fit itself (``s^2 = cost / dof`` over
+every line, :class:`~tyredamp.modal.fit.ModalFitter`), not by the per-line
+variance estimates, so the inflation ``nu / (nu - 2)`` of the goodness of fit
+(below) cancels to first order. What is left comes from the line weights
+``w_f = 1 / g^_f`` being estimates (``nu_w`` degrees of freedom: ``nu n_out``,
+the separable line factor averages the independent residual powers of the
+outputs, :mod:`tyredamp.modal.problem`): with ``b_f = g_f / g^_f`` the
+projection onto a mode's weighted columns explains ``sum b_f^2 a_f / sum b_f
+a_f`` noise units (``a_f`` the mode's share of line ``f``), between ``E b =
+nu_w / (nu_w - 2)`` (one line) and ``E b^2 / E b = nu_w / (nu_w - 4)`` (many
+lines), while ``s^2`` holds ``E b``. ``T`` is thus inflated by at most
+``(nu_w - 2) / (nu_w - 4)`` (1.25 for 4 averages and 2 outputs, 1.08 for 8),
+and the threshold is scaled by that bound when the weights are estimated
+(``weight_dof``; 2 at most, its value at ``nu_w = 6``, where the bound
+diverges).
 
 Goodness of fit (:func:`goodness_of_fit`): the weighted cost of the final
 fit against its chi-square expectation ``n_obs - n_par`` when the noise is
@@ -25,6 +40,23 @@ from the second differences of adjacent lines (:func:`difference_noise`),
 which a smooth FRF barely contains. The verdict is "the model explains the
 data to the noise" when the upper tail probability of the cost is at least
 the false-alarm rate.
+
+Estimated variance. When the per-line variance ``V^_k`` is itself estimated
+with ``nu`` real degrees of freedom (H1 from ``n`` independent averages and
+``n_in`` inputs: the least-squares residual of ``Y_m = H X_m + E_m`` over the
+averages has ``n - n_in`` complex, ``nu = 2 (n - n_in)`` real degrees of
+freedom and is independent of ``H^``, Seber & Lee 2003, thm. 3.5), a term is
+``2 |e_k|^2 / V^_k = (2 |e_k|^2 / V_k) / (V^_k / V_k) = chi2_2 / (chi2_nu / nu)
+= 2 F(2, nu)``, with mean ``2 nu / (nu - 2)`` and variance
+``4 nu^3 / ((nu - 2)^2 (nu - 4))`` (``nu > 4``): the cost of a correct model
+is ``nu / (nu - 2)`` times its chi-square expectation (1.5 for 4 averages of
+one input) and has a heavier tail. The cost, a sum of ``dof / 2`` such
+complex terms, is then tested against the scaled chi-square ``c chi2_d`` of
+the same mean and variance (Satterthwaite 1946; Box 1954):
+``mean = dof nu / (nu - 2)``, ``var = 2 dof nu^3 / ((nu - 2)^2 (nu - 4))``,
+``c = var / (2 mean)``, ``d = 2 mean^2 / var``; it tends to ``chi2_dof`` as
+``nu -> inf``. With ``nu <= 4`` the variance of a term is infinite and the
+test is not defined (the caller falls back to the difference noise).
 """
 
 from __future__ import annotations
@@ -38,10 +70,12 @@ from scipy import stats as sps
 
 __all__ = [
     "GoodnessOfFit",
+    "cost_reference",
     "difference_noise",
     "goodness_of_fit",
     "mode_parameters",
     "mode_threshold",
+    "weight_factor",
 ]
 
 #: default false-alarm rate of the mode test and of the goodness-of-fit test
@@ -55,8 +89,13 @@ def mode_parameters(n_out: int, n_in: int, mode_kind: str) -> int:
     return n_out + 2 + (n_in - 1)
 
 
-def mode_threshold(k: int, n_lines: int, false_alarm: float = FALSE_ALARM) -> float:
+def mode_threshold(
+    k: int, n_lines: int, false_alarm: float = FALSE_ALARM, weight_dof: float | None = None
+) -> float:
     """Threshold of the mode statistic ``T``: ``chi2_k^-1(1 - alpha / n_lines)``.
+
+    Times ``(nu_w - 2) / (nu_w - 4)`` (at most 2) when the line weights are
+    estimated with ``nu_w`` degrees of freedom (module docstring).
 
     Parameters
     ----------
@@ -66,10 +105,22 @@ def mode_threshold(k: int, n_lines: int, false_alarm: float = FALSE_ALARM) -> fl
         Lines of the band (Bonferroni factor).
     false_alarm : float
         Probability ``alpha`` that a fit of pure noise keeps a noise mode.
+    weight_dof : float, optional
+        Degrees of freedom ``nu_w`` of estimated line weights; default None
+        (known weights or none: no correction).
     """
     if not 0.0 < false_alarm < 1.0:
         raise ValueError(f"false_alarm: expected a probability in (0, 1), got {false_alarm}")
-    return float(sps.chi2.isf(false_alarm / max(int(n_lines), 1), int(k)))
+    thr = float(sps.chi2.isf(false_alarm / max(int(n_lines), 1), int(k)))
+    return thr * weight_factor(weight_dof)
+
+
+def weight_factor(weight_dof: float | None) -> float:
+    """Bound ``(nu_w - 2) / (nu_w - 4)`` of the inflation of ``T`` (1 for None, at most 2)."""
+    if weight_dof is None or not math.isfinite(weight_dof):
+        return 1.0
+    nu = float(weight_dof)
+    return 2.0 if nu <= 6.0 else (nu - 2.0) / (nu - 4.0)
 
 
 def difference_noise(H: NDArray[np.complex128]) -> NDArray[np.float64]:
@@ -96,7 +147,7 @@ class GoodnessOfFit:
     Attributes
     ----------
     chi2 : float
-        Weighted cost ``sum |H_model - H|^2 / Var H``.
+        Weighted cost ``2 sum |H_model - H|^2 / Var H``.
     dof : int
         Residual degrees of freedom ``n_obs - n_par``.
     p_value : float
@@ -107,6 +158,11 @@ class GoodnessOfFit:
         ``p_value >= false_alarm``.
     verdict : str
         One sentence for people.
+    noise_dof : float or None
+        Real degrees of freedom ``nu`` of an estimated per-line variance (the
+        cost is then ``F``-corrected, module docstring); None for a known one.
+    expected : float
+        Expectation of ``chi2`` for a correct model (``dof``, or ``dof nu / (nu - 2)``).
     """
 
     chi2: float
@@ -115,6 +171,35 @@ class GoodnessOfFit:
     noise: str
     passed: bool
     verdict: str
+    noise_dof: float | None = None
+    expected: float = float("nan")
+
+
+def cost_reference(dof: int, noise_dof: float | None) -> tuple[float, float, float]:
+    """Mean of the cost of a correct model and its scaled chi-square ``c chi2_d``.
+
+    Parameters
+    ----------
+    dof : int
+        Residual degrees of freedom ``n_obs - n_par``.
+    noise_dof : float or None
+        Real degrees of freedom ``nu > 4`` of the per-line variance estimate;
+        None for a known variance (then ``c = 1``, ``d = dof``).
+
+    Returns
+    -------
+    (float, float, float)
+        ``mean``, ``c``, ``d`` (module docstring).
+    """
+    dof = max(int(dof), 1)
+    if noise_dof is None or not math.isfinite(noise_dof):
+        return float(dof), 1.0, float(dof)
+    nu = float(noise_dof)
+    if not nu > 4.0:
+        raise ValueError(f"noise_dof: the F-corrected test needs nu > 4, got {nu:g}")
+    mean = dof * nu / (nu - 2.0)
+    var = 2.0 * dof * nu**3 / ((nu - 2.0) ** 2 * (nu - 4.0))
+    return mean, var / (2.0 * mean), 2.0 * mean * mean / var
 
 
 def goodness_of_fit(
@@ -124,13 +209,19 @@ def goodness_of_fit(
     *,
     n_rejected: int = 0,
     false_alarm: float = FALSE_ALARM,
+    noise_dof: float | None = None,
 ) -> GoodnessOfFit:
-    """Test a weighted residual sum of squares against ``chi2(dof)``.
+    """Test a weighted residual sum of squares against its reference distribution.
+
+    ``chi2(dof)`` for a known noise variance; the scaled chi-square of the
+    ``F``-corrected cost when the variance is estimated with ``noise_dof``
+    degrees of freedom (module docstring).
 
     Parameters
     ----------
     resid_ss : float
-        Residual sum of squares in units of the noise variance.
+        Residual sum of squares in units of the noise variance (``2 |e|^2 / V``
+        summed: ``dof`` expected for a correct model and known variance).
     dof : int
         Residual degrees of freedom.
     noise : str
@@ -139,22 +230,35 @@ def goodness_of_fit(
         Candidate modes tried and rejected, for the verdict.
     false_alarm : float
         Level of the test.
+    noise_dof : float, optional
+        Real degrees of freedom ``nu > 4`` of an estimated per-line variance;
+        default None (known variance: chi-square).
     """
     dof = max(int(dof), 1)
+    mean, c, d = cost_reference(dof, noise_dof)
     chi2 = float(resid_ss)
-    p = float(sps.chi2.sf(chi2, dof)) if np.isfinite(chi2) else 0.0
+    p = float(sps.chi2.sf(chi2 / c, d)) if np.isfinite(chi2) else 0.0
     passed = p >= false_alarm
-    ratio = chi2 / dof
+    if noise_dof is None:
+        stat = f"chi2/dof = {chi2 / dof:.3g}"
+    else:
+        stat = f"cost/expectation = {chi2 / mean:.3g} (F-corrected, nu = {noise_dof:.3g})"
     if passed:
-        verdict = (
-            f"the model explains the data to the noise (chi2/dof = {ratio:.3g}, p = {p:.2g}; "
-            f"noise {noise})"
-        )
+        verdict = f"the model explains the data to the noise ({stat}, p = {p:.2g}; noise {noise})"
     else:
         why = (
             f"{n_rejected} candidate mode(s) were tried and rejected"
             if n_rejected
             else "the model is incomplete"
         )
-        verdict = f"structure is left: chi2/dof = {ratio:.3g} (p = {p:.2g}; noise {noise}); {why}"
-    return GoodnessOfFit(chi2=chi2, dof=dof, p_value=p, noise=noise, passed=passed, verdict=verdict)
+        verdict = f"structure is left: {stat} (p = {p:.2g}; noise {noise}); {why}"
+    return GoodnessOfFit(
+        chi2=chi2,
+        dof=dof,
+        p_value=p,
+        noise=noise,
+        passed=passed,
+        verdict=verdict,
+        noise_dof=noise_dof,
+        expected=mean,
+    )

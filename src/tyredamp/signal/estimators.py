@@ -572,7 +572,8 @@ def estimate_frf(
         ``coherence``, the variance of each estimate as ``variance`` (see
         :func:`frf_variance`; None with too few averages), and ``meta``
         with ``estimator``, ``method``, ``n_averages``, ``segment_samples``,
-        ``sample_rate``, ``window``, ``overlap``.
+        ``sample_rate``, ``window``, ``overlap``, ``variance_dof`` (segment
+        methods: ``2 (n_eff - n_in)``, ``n_eff`` the averages net of overlap).
 
     Raises
     ------
@@ -692,6 +693,8 @@ def _segmented_frf(
         "window": win if isinstance(win, str) else list(win),
         "overlap": plan.overlap,
         "settle_samples": choice.settle_samples,
+        # real degrees of freedom of ``variance`` (frf_variance): 2 (n_eff - n_in)
+        "variance_dof": 2.0 * (n_eff - len(ref_idx)),
         **plan.info,
     }
     if choice.detection is not None:
