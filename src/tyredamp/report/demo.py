@@ -44,14 +44,16 @@ def check_output_dir(out: Path) -> Path:
 
     An earlier demo output (a ``results.json`` of kind ``tyredamp-demo-results``)
     is replaced only when the directory holds nothing but the files listed in
-    that results.json; links are followed (see
+    that results.json, each unchanged since it was written (the directory's
+    SHA-256 manifest); links are followed (see
     :func:`tyredamp.io._safety.check_output_dir`). Returns the real directory.
 
     Raises
     ------
     InputError
         ``out`` is a file, the current directory, has no parent directory, or is a
-        non-empty directory that is not an earlier demo output or holds other files.
+        non-empty directory that is not an earlier demo output, holds other files,
+        or holds a file changed since the demo wrote it.
     """
     return _check_output_dir(out, _demo_files, what="tyredamp demo output")
 
