@@ -21,8 +21,31 @@ __all__ = [
     "check_input_file",
     "meta_from_json",
     "meta_to_json",
+    "uff_set_types",
     "wrap_errors",
 ]
+
+
+def uff_set_types(path: str | os.PathLike[str]) -> frozenset[int]:
+    """The data-set types of a UFF file (empty when the file is not readable as UFF).
+
+    A probe for choosing a reader: a file that is not UFF gives an empty set and
+    the chosen reader reports it. pyuff is imported here only when called.
+    """
+    import gc
+    import warnings
+
+    import pyuff
+
+    p = check_input_file(path)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ResourceWarning)
+            types = frozenset(int(t) for t in pyuff.UFF(str(p)).get_set_types())
+            gc.collect()
+    except Exception:  # not a UFF file: the caller's reader reports it
+        return frozenset()
+    return types
 
 
 def check_input_file(path: str | os.PathLike[str]) -> Path:

@@ -51,7 +51,7 @@ import pyuff
 from ..exceptions import FileFormatError, InputError
 from ..frf import Channel
 from ._atomic import atomic_path
-from ._common import check_input_file
+from ._common import check_input_file, uff_set_types
 
 __all__ = ["read_uff55", "uff_has_modes", "write_uff55"]
 
@@ -156,14 +156,7 @@ def _load55(p: Path) -> list[dict[str, Any]]:
 
 def uff_has_modes(path: str | os.PathLike[str]) -> bool:
     """True when the UFF file holds data sets 55 and no data set 58."""
-    p = check_input_file(path)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ResourceWarning)
-            types = set(pyuff.UFF(str(p)).get_set_types())
-            gc.collect()
-    except Exception:  # not a UFF file: the caller's reader reports it
-        return False
+    types = uff_set_types(path)
     return 55 in types and 58 not in types
 
 

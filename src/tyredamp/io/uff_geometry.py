@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import FileFormatError
 from ..geometry import Geometry
-from ._common import check_input_file
+from ._common import check_input_file, uff_set_types
 
 __all__ = ["read_uff_geometry", "uff_has_geometry"]
 
@@ -83,14 +83,7 @@ def _load(p: Any) -> list[dict[str, Any]]:
 
 def uff_has_geometry(path: str | os.PathLike[str]) -> bool:
     """True when the UFF file holds nodes (15 or 2411) and no data set 58 or 55."""
-    p = check_input_file(path)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", ResourceWarning)
-            types = set(pyuff.UFF(str(p)).get_set_types())
-            gc.collect()
-    except Exception:  # not a UFF file: the caller's reader reports it
-        return False
+    types = uff_set_types(path)
     return bool(types & {15, 2411}) and not types & {55, 58}
 
 

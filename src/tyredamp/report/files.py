@@ -87,14 +87,17 @@ def _uff_modes_or_geometry(p: Path) -> ResultFile | None:
     """A UFF file of modes (data sets 55) or test geometry (15, 82), else None."""
     if p.suffix.lower() not in FILE_FORMATS["uff58b"].extensions:
         return None
-    from ..io.uff55 import uff_has_modes
-    from ..io.uff_geometry import read_uff_geometry, uff_has_geometry
+    from ..io._common import uff_set_types
+    from ..io.uff_geometry import read_uff_geometry
 
-    if uff_has_modes(p):
+    types = uff_set_types(p)  # one read of the file to choose the reader
+    if 58 in types:
+        return None
+    if 55 in types:
         models = read_modes(p)
         doc = {"kind": "modes", "source": str(p), "band_hz": None, "frf_kind": None}
         return ResultFile(p, "modes", models, doc)
-    if uff_has_geometry(p):
+    if types & {15, 2411}:
         return ResultFile(p, "geometry", read_uff_geometry(p))
     return None
 
