@@ -26,8 +26,15 @@ Method
   ground-force accelerance ``A_axle/(1 - M_w A_axle)`` (no wheel resonance,
   so the starts land in the right basin), then refined on the axle data.
 * Standard errors: ``cov(log p) = s^2 (J^T J)^-1`` with ``J`` the Jacobian of
-  the weighted residuals in log-parameters (central differences) and
-  ``s^2 = RSS/(2N - P)``; ``SE(p) = p SE(log p)`` (delta method).
+  the weighted residuals in log-parameters (analytic, from each model's
+  ``_mobility_gradient``) and ``s^2 = RSS/(2N - P)``; ``SE(p) = p SE(log p)``
+  (delta method).
+* Cost: the residual and its Jacobian are never held whole; they are reduced
+  block by block to the ``(P+1) x (P+1)`` triangular factor of ``[J r]``, which
+  keeps ``J^T J``, ``J^T r`` and ``r^T r`` exactly (:mod:`._lsq`), so time grows
+  in proportion to the lines and memory stays near the data's own size. Every
+  model fitted to the same data (:func:`~tyredamp.lateral.rank_models`) shares
+  one preparation of the lines.
 * Paper Table 1 figure, defined here precisely: the **amplitude error**
   ``mean_k | |A_model| - |A_meas| | / |A_meas|`` over the fitted lines, and the
   signed **amplitude bias** ``mean_k (|A_model| - |A_meas|) / |A_meas|``
@@ -47,17 +54,18 @@ several speeds together with shared physical parameters is :mod:`.joint`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import least_squares
 
 from .._validate import as_band, as_finite, check_positive
 from ..exceptions import ConvergenceError, InputError, ShapeError
-from ..frf import FRF
+from ..frf import FRF, KIND_POWER
+from ._lsq import BLOCK, Lines, Problem, Segment
 from .models import LateralModel, get_model_class
 from .response import ForceKind, _check_force, ground_from_axle_accelerance
 
@@ -156,15 +164,92 @@ def _meta_number(meta: dict[str, Any], key: str, unit: str, default: float | Non
     return float(v)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class _Prepared:
+    """The lines to fit, shared by every model fitted to the same data and options."""
+
     data: LateralData
     frequency: FloatArray
-    omega: FloatArray
     measured: ComplexArray  # accelerance at the data's force
     weights: FloatArray
     weights_name: str
-    ground_receptance: ComplexArray  # for starting values
+
+    @property
+    def omega(self) -> FloatArray:
+        """Angular frequency, rad/s."""
+        return 2.0 * np.pi * self.frequency
+
+    def ground_receptance(self) -> ComplexArray:
+        """Ground-force receptance of the data, m/N (for the starting values)."""
+        d = self.data
+        acc = self.measured
+        a_g = ground_from_axle_accelerance(acc, d.wheel_mass) if d.force == "axle" else acc
+        return np.asarray(a_g / (-(self.omega**2)), dtype=complex)
+
+    def segment(
+        self,
+        cls: type[LateralModel],
+        cond: dict[str, float],
+        tmap: FloatArray | None = None,
+        offset: FloatArray | None = None,
+    ) -> Segment:
+        """The residual of ``cls`` on these lines (:mod:`._lsq`; ``tmap``, ``offset`` there)."""
+        d = self.data
+        return Segment(cls, cond, self.lines, d.force, d.wheel_mass, tmap, offset)
+
+    @cached_property
+    def lines(self) -> Lines:
+        """The lines with their per-line factors (:mod:`._lsq`), built once per preparation."""
+        return Lines(self.frequency, self.measured, self.weights)
+
+
+def _lines(frf: FRF, band: tuple[float, float] | None) -> slice:
+    """The lines above 0 Hz within ``band``: a slice, as the axis increases strictly."""
+    f = frf.frequency
+    lo = int(np.searchsorted(f, 0.0, side="right"))
+    hi = f.size
+    if band is not None:
+        b_lo, b_hi = as_band(band)
+        lo = max(lo, int(np.searchsorted(f, b_lo, side="left")))
+        hi = int(np.searchsorted(f, b_hi, side="right"))
+    return slice(lo, max(lo, hi))
+
+
+def _channel(frf: FRF, channel: tuple[int, int] | None) -> tuple[int, int]:
+    if channel is None:
+        if frf.n_out * frf.n_in != 1:
+            raise ShapeError(
+                f"channel: the FRF holds {frf.n_out}x{frf.n_in} FRFs, a lateral fit takes one; "
+                "choose it with channel=(out, in), counted from 0 (command line: --channel OUT IN, "
+                "counted from 1)"
+            )
+        return (0, 0)
+    i, j = channel
+    if not (0 <= i < frf.n_out and 0 <= j < frf.n_in):
+        raise ShapeError(
+            f"channel: expected (out, in) within {frf.n_out}x{frf.n_in}, got {channel}"
+        )
+    return i, j
+
+
+def _weights(
+    weights: Weights | ArrayLike, mag: FloatArray, coherence: FloatArray | None
+) -> tuple[FloatArray, str]:
+    mode = weights
+    if mode == "auto":
+        mode = "coherence" if coherence is not None else "relative"
+    if mode == "relative":
+        return 1.0 / mag, "relative"
+    if mode == "uniform":
+        return np.full(mag.size, 1.0 / float(np.sqrt(np.mean(mag**2)))), "uniform"
+    if mode == "coherence":
+        if coherence is None:
+            raise InputError("weights: 'coherence' needs an FRF with coherence")
+        g2 = np.clip(coherence, 1e-6, 1.0 - 1e-9)
+        return 1.0 / (mag * np.sqrt((1.0 - g2) / g2)), "coherence"
+    raise InputError(
+        f"weights: expected 'auto', 'relative', 'coherence', 'uniform' or an array, got {weights!r}"
+    )
 
 
 def _prepare(
@@ -173,21 +258,10 @@ def _prepare(
     weights: Weights | ArrayLike,
     channel: tuple[int, int] | None = None,
 ) -> _Prepared:
+    """The fitted lines as views of the FRF (copies only where a conversion needs one)."""
     d = data if isinstance(data, LateralData) else LateralData.from_frf(data)
     frf = d.frf
-    if channel is None:
-        if frf.n_out * frf.n_in != 1:
-            raise ShapeError(
-                f"channel: the FRF holds {frf.n_out}x{frf.n_in} FRFs, a lateral fit takes one; "
-                "choose it with channel=(out, in), counted from 0 (command line: --channel OUT IN, "
-                "counted from 1)"
-            )
-        channel = (0, 0)
-    i, j = channel
-    if not (0 <= i < frf.n_out and 0 <= j < frf.n_in):
-        raise ShapeError(
-            f"channel: expected (out, in) within {frf.n_out}x{frf.n_in}, got {channel}"
-        )
+    i, j = _channel(frf, channel)
     user_w: FloatArray | None = None
     if not isinstance(weights, str):
         user_w = as_finite(weights, "weights", ndim=1)
@@ -197,48 +271,31 @@ def _prepare(
             )
         if np.any(user_w < 0):
             raise InputError("weights: expected values >= 0")
-    keep = np.ones(frf.n_freq, dtype=bool)
-    if band is not None:
-        lo, hi = as_band(band)
-        keep &= (frf.frequency >= lo) & (frf.frequency <= hi)
-    keep &= frf.frequency > 0
-    idx = np.flatnonzero(keep)
-    sub = frf.select(outputs=[i], inputs=[j]).select_lines(idx) if idx.size else None
-    if sub is None or sub.n_freq < 4:
-        raise InputError(f"frf: expected at least 4 lines above 0 Hz in the band, got {idx.size}")
-    acc = sub.to("accelerance").H[0, 0]
-    f = sub.frequency
-    w = 2.0 * np.pi * f
+    sl = _lines(frf, band)
+    n = sl.stop - sl.start
+    if n < 4:
+        raise InputError(f"frf: expected at least 4 lines above 0 Hz in the band, got {n}")
+    f = frf.frequency[sl]
+    acc = frf.H[i, j, sl]
+    k = KIND_POWER["accelerance"] - KIND_POWER[frf.kind]
+    if k:  # as FRF.to: H (i omega)^k
+        acc = acc * (1j * (2.0 * np.pi * f)) ** k
     mag = np.abs(acc)
     if np.any(mag == 0):
         raise InputError("frf: some lines are exactly 0; drop them (relative weights undefined)")
+    coh = None  # multiple coherence refers to all inputs (FRF.select)
+    if frf.coherence is not None and frf.n_in == 1:
+        coh = frf.coherence[i, sl]
     if user_w is not None:
-        wts = user_w[idx]
-        wname = "user"
+        wts, wname = user_w[sl], "user"
     else:
-        mode = weights
-        if mode == "auto":
-            mode = "coherence" if sub.coherence is not None else "relative"
-        if mode == "relative":
-            wts = 1.0 / mag
-        elif mode == "uniform":
-            wts = np.full(f.size, 1.0 / float(np.sqrt(np.mean(mag**2))))
-        elif mode == "coherence":
-            if sub.coherence is None:
-                raise InputError("weights: 'coherence' needs an FRF with coherence")
-            g2 = np.clip(sub.coherence[0], 1e-6, 1.0 - 1e-9)
-            wts = 1.0 / (mag * np.sqrt((1.0 - g2) / g2))
-        else:
-            raise InputError(
-                f"weights: expected 'auto', 'relative', 'coherence', 'uniform' or an array, "
-                f"got {weights!r}"
-            )
-        wname = str(mode)
+        wts, wname = _weights(weights, mag, coh)
+    del mag
     if np.count_nonzero(wts) < 4:
         raise InputError("weights: expected at least 4 lines with non-zero weight")
-    a_g = ground_from_axle_accelerance(acc, d.wheel_mass) if d.force == "axle" else acc
-    rec_g = a_g / (-(w**2))
-    return _Prepared(d, f, w, acc, np.asarray(wts, dtype=float), wname, rec_g)
+    if d.force == "axle" and np.any(1.0 - d.wheel_mass * acc == 0):  # A_g infinite
+        raise InputError("accelerance: 1 - wheel_mass * A_axle is 0 at some line (A_g infinite)")
+    return _Prepared(d, f, acc, np.asarray(wts, dtype=float), wname)
 
 
 # --------------------------------------------------------------------------------- results
@@ -403,30 +460,28 @@ def _information(rss: float, n_real: int, n_params: int) -> tuple[float, float]:
 
 
 def _amplitude_errors(fitted: ComplexArray, measured: ComplexArray) -> tuple[float, float]:
-    rel = (np.abs(fitted) - np.abs(measured)) / np.abs(measured)
-    return float(np.mean(np.abs(rel))), float(np.mean(rel))
+    """Mean absolute and signed relative amplitude error (module docstring), in blocks."""
+    s_abs = s_sig = 0.0
+    for lo in range(0, fitted.size, BLOCK):
+        mag = np.abs(measured[lo : lo + BLOCK])
+        rel = (np.abs(fitted[lo : lo + BLOCK]) - mag) / mag
+        s_sig += float(np.sum(rel))
+        s_abs += float(np.sum(np.abs(rel)))
+    return s_abs / fitted.size, s_sig / fitted.size
 
 
-def _jacobian(
-    fun: Callable[[FloatArray], FloatArray], x: FloatArray, step: float = 1e-5
-) -> FloatArray:
-    cols = []
-    for k in range(x.size):
-        e = np.zeros_like(x)
-        e[k] = step
-        cols.append((fun(x + e) - fun(x - e)) / (2.0 * step))
-    return np.column_stack(cols)
-
-
-def _covariance(jac: FloatArray, rss: float) -> tuple[FloatArray, FloatArray]:
+def _covariance(r_factor: FloatArray, rss: float, n_rows: int) -> tuple[FloatArray, FloatArray]:
     """Standard deviations and correlation of the parameters from ``s^2 (J^T J)^-1``.
 
-    Directions the data do not determine (negligible singular values) give
-    infinite standard deviations for the parameters they involve.
+    ``r_factor`` is the triangular factor ``R`` of ``J = Q R`` (``n_rows x P``,
+    :mod:`._lsq`): ``J`` and ``R`` have the same singular values and right
+    singular vectors. Directions the data do not determine (negligible
+    singular values) give infinite standard deviations for the parameters
+    they involve.
     """
-    n, p = jac.shape
+    n, p = n_rows, r_factor.shape[1]
     s2 = rss / max(n - p, 1)
-    _, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    _, sv, vt = np.linalg.svd(r_factor, full_matrices=False)
     tol = (sv.max() if sv.size else 0.0) * max(n, p) * np.finfo(float).eps
     keep = sv > tol
     cov = (vt[keep].T / sv[keep] ** 2) @ vt[keep] * s2
@@ -442,11 +497,7 @@ def _covariance(jac: FloatArray, rss: float) -> tuple[FloatArray, FloatArray]:
     return sd, corr
 
 
-def _solve(
-    fun: Callable[[FloatArray], FloatArray],
-    starts: Sequence[FloatArray],
-    max_nfev: int,
-) -> Any:
+def _solve(problem: Problem, starts: Sequence[FloatArray], max_nfev: int) -> Any:
     """Pick the cheapest starts on a factor grid, refine them, return the best result."""
     cands: list[tuple[float, FloatArray]] = []
     for s in starts:
@@ -457,25 +508,11 @@ def _solve(
             grid = np.vstack([np.zeros(p), np.eye(p) * np.log(3), -np.eye(p) * np.log(3)])
         for g in grid:
             x = logs + g
-            r = fun(x)
-            cost = float(r @ r) if np.all(np.isfinite(r)) else np.inf
-            cands.append((cost, x))
+            cands.append((problem.rss(x), x))
     cands.sort(key=lambda c: c[0])
     best = None
     for _, x0 in cands[:3]:
-        lb, ub = x0 - _LOG_SPAN, x0 + _LOG_SPAN
-        res = least_squares(
-            fun,
-            x0,
-            jac="3-point",
-            bounds=(lb, ub),
-            method="trf",
-            xtol=1e-14,
-            ftol=1e-14,
-            gtol=1e-14,
-            x_scale=1.0,
-            max_nfev=max_nfev,
-        )
+        res = problem.solve(x0, _LOG_SPAN, max_nfev, x_scale=1.0)
         if best is None or res.cost < best.cost:
             best = res
     if best is None or not np.all(np.isfinite(best.x)):
@@ -483,22 +520,64 @@ def _solve(
     return best
 
 
-def _safe(fun: Callable[[FloatArray], FloatArray], n: int) -> Callable[[FloatArray], FloatArray]:
-    def wrapped(x: FloatArray) -> FloatArray:
-        try:
-            r = fun(x)
-        except (InputError, FloatingPointError, ZeroDivisionError):
-            return np.full(n, 1e100)
-        if not np.all(np.isfinite(r)):
-            return np.full(n, 1e100)
-        return r
-
-    return wrapped
-
-
 def _model_accelerance(m: LateralModel, prep: _Prepared) -> ComplexArray:
+    """The model's accelerance at the data's force on the fitted lines (in blocks)."""
+    d, f = prep.data, prep.frequency
+    out = np.empty(f.size, dtype=complex)
+    for lo in range(0, f.size, BLOCK):
+        out[lo : lo + BLOCK] = m.response(f[lo : lo + BLOCK], "accelerance", d.force, d.wheel_mass)
+    return out
+
+
+def _lateral_fit(
+    m: LateralModel,
+    prep: _Prepared,
+    cov_log: tuple[FloatArray, FloatArray],
+    n_params: int,
+    res: Any,
+    *,
+    rss: float | None = None,
+    at_bound: tuple[str, ...] = (),
+) -> LateralFit:
+    """The :class:`LateralFit` of model ``m`` on ``prep`` (single and joint fits).
+
+    ``cov_log`` holds the standard deviations and correlation of the
+    log-parameters; ``n_params`` is the parameter count of the information
+    criteria; ``rss`` defaults to that of ``m`` on ``prep``.
+    """
+    fitted = _model_accelerance(m, prep)
+    if rss is None:
+        ri = prep.weights * (fitted - prep.measured)
+        rss = float(np.sum(ri.real**2 + ri.imag**2))
+        del ri
+    sd_log, corr = cov_log
+    aic, bic = _information(rss, 2 * prep.frequency.size, n_params)
+    err, bias = _amplitude_errors(fitted, prep.measured)
+    pv = m.vector()
     d = prep.data
-    return m.response(prep.frequency, "accelerance", d.force, d.wheel_mass)
+    return LateralFit(
+        model=m,
+        params=m.params,
+        stderr={n: float(pv[k] * sd_log[k]) for k, n in enumerate(m.param_names)},
+        correlation=corr,
+        frequency=prep.frequency,
+        measured=prep.measured,
+        fitted=fitted,
+        weights=prep.weights,
+        weights_name=prep.weights_name,
+        force=d.force,
+        wheel_mass=d.wheel_mass,
+        speed=d.speed,
+        rss=rss,
+        aic=aic,
+        bic=bic,
+        amplitude_error=err,
+        amplitude_bias=bias,
+        nfev=int(res.nfev),
+        message=str(res.message),
+        label=d.label,
+        at_bound=at_bound,
+    )
 
 
 def _conditions(cls: type[LateralModel], data: LateralData) -> dict[str, float]:
@@ -515,6 +594,103 @@ def _conditions(cls: type[LateralModel], data: LateralData) -> dict[str, float]:
         else:  # pragma: no cover - no other condition exists yet
             raise InputError(f"{cls.name}: unknown condition {n!r}")
     return cond
+
+
+def _starts(
+    cls: type[LateralModel],
+    prep: _Prepared,
+    cond: dict[str, float],
+    start: ArrayLike | dict[str, float] | None,
+) -> list[FloatArray]:
+    if start is None:
+        starts = cls.initial_guesses(prep.omega, prep.ground_receptance(), **cond)
+    else:
+        if isinstance(start, dict):
+            try:
+                sv = np.array([float(start[n]) for n in cls.param_names])
+            except KeyError as exc:
+                raise InputError(f"start: missing parameter {exc} of {cls.param_names}") from None
+        else:
+            sv = as_finite(start, "start", ndim=1)
+        if sv.size != len(cls.param_names) or np.any(sv <= 0):
+            raise InputError(
+                f"start: expected {len(cls.param_names)} values > 0 for {cls.param_names}, got {sv}"
+            )
+        starts = [sv]
+    starts = [
+        np.asarray(s, dtype=float)
+        for s in starts
+        if np.all(np.isfinite(s)) and np.all(np.asarray(s) > 0)
+    ]
+    if not starts:
+        raise ConvergenceError(f"fit: no usable starting values for the {cls.name!r} model")
+    return starts
+
+
+def _fit_prepared(
+    cls: type[LateralModel],
+    prep: _Prepared,
+    start: ArrayLike | dict[str, float] | None = None,
+    max_nfev: int = 2000,
+) -> LateralFit:
+    """Fit ``cls`` to prepared lines (:func:`fit_model`, module docstring)."""
+    d = prep.data
+    cond = _conditions(cls, d)
+    n_p = len(cls.param_names)
+    problem = Problem([prep.segment(cls, cond)], n_p)
+    starts = _starts(cls, prep, cond, start)
+    if d.force == "axle" and d.wheel_mass > 0:
+        # Stage 1 on the ground-force accelerance A_axle/(1 - M_w A_axle): smoother
+        # (no wheel resonance), so the starts land in the right basin.
+        a_g = -(prep.omega**2) * prep.ground_receptance()
+        stage1 = Segment(cls, cond, Lines(prep.frequency, a_g, 1.0 / np.abs(a_g)))
+        res_g = _solve(Problem([stage1], n_p), starts, max_nfev)
+        del a_g, stage1
+        starts = [np.exp(res_g.x), *starts]
+    res = _solve(problem, starts, max_nfev)
+    x = np.asarray(res.x, dtype=float)
+    r_aug, rss = problem.qr(x)
+    cov_log = _covariance(r_aug[:n_p, :n_p], rss, problem.n_residuals)
+    at_bound = tuple(
+        n for n, a in zip(cls.param_names, np.asarray(res.active_mask), strict=True) if a != 0
+    )
+    m = cls.from_vector(np.exp(x), **cond)
+    return _lateral_fit(m, prep, cov_log, n_p, res, rss=rss, at_bound=at_bound)
+
+
+def _with_conditions(
+    data: LateralData | FRF,
+    speed: float | None = None,
+    force: ForceKind | None = None,
+    wheel_mass: float | None = None,
+) -> LateralData:
+    d0 = data if isinstance(data, LateralData) else LateralData.from_frf(data)
+    return LateralData(
+        frf=d0.frf,
+        speed=speed if speed is not None else d0.speed,
+        force=force if force is not None else d0.force,
+        wheel_mass=wheel_mass if wheel_mass is not None else d0.wheel_mass,
+        label=d0.label,
+    )
+
+
+def fit_models_on(
+    data: LateralData | FRF,
+    models: Sequence[str | type[LateralModel]],
+    *,
+    speed: float | None = None,
+    force: ForceKind | None = None,
+    wheel_mass: float | None = None,
+    band: tuple[float, float] | None = None,
+    weights: Weights | ArrayLike = "auto",
+    start: ArrayLike | dict[str, float] | None = None,
+    channel: tuple[int, int] | None = None,
+    max_nfev: int = 2000,
+) -> list[LateralFit]:
+    """:func:`fit_model` for several models on lines prepared once (same options for all)."""
+    classes = [get_model_class(m) for m in models]
+    prep = _prepare(_with_conditions(data, speed, force, wheel_mass), band, weights, channel)
+    return [_fit_prepared(cls, prep, start, max_nfev) for cls in classes]
 
 
 def fit_model(
@@ -569,108 +745,18 @@ def fit_model(
     ConvergenceError
         The optimizer failed from every start.
     """
-    cls = get_model_class(model)
-    d0 = data if isinstance(data, LateralData) else LateralData.from_frf(data)
-    d = LateralData(
-        frf=d0.frf,
-        speed=speed if speed is not None else d0.speed,
-        force=force if force is not None else d0.force,
-        wheel_mass=wheel_mass if wheel_mass is not None else d0.wheel_mass,
-        label=d0.label,
-    )
-    prep = _prepare(d, band, weights, channel)
-    cond = _conditions(cls, d)
-    n_res = 2 * prep.frequency.size
-
-    def residual(logp: FloatArray) -> FloatArray:
-        m = cls.from_vector(np.exp(logp), **cond)
-        r = prep.weights * (_model_accelerance(m, prep) - prep.measured)
-        return np.concatenate([r.real, r.imag])
-
-    fun = _safe(residual, n_res)
-    if start is None:
-        starts = cls.initial_guesses(prep.omega, prep.ground_receptance, **cond)
-    else:
-        if isinstance(start, dict):
-            try:
-                sv = np.array([float(start[n]) for n in cls.param_names])
-            except KeyError as exc:
-                raise InputError(f"start: missing parameter {exc} of {cls.param_names}") from None
-        else:
-            sv = as_finite(start, "start", ndim=1)
-        if sv.size != len(cls.param_names) or np.any(sv <= 0):
-            raise InputError(
-                f"start: expected {len(cls.param_names)} values > 0 for {cls.param_names}, got {sv}"
-            )
-        starts = [sv]
-    starts = [
-        np.asarray(s, dtype=float)
-        for s in starts
-        if np.all(np.isfinite(s)) and np.all(np.asarray(s) > 0)
-    ]
-    if not starts:
-        raise ConvergenceError(f"fit: no usable starting values for the {cls.name!r} model")
-    if d.force == "axle" and d.wheel_mass > 0:
-        # Stage 1 on the ground-force accelerance A_axle/(1 - M_w A_axle): smoother
-        # (no wheel resonance), so the starts land in the right basin.
-        a_g = -(prep.omega**2) * prep.ground_receptance
-        w_g = 1.0 / np.abs(a_g)
-
-        def residual_g(logp: FloatArray) -> FloatArray:
-            m = cls.from_vector(np.exp(logp), **cond)
-            r = w_g * (m.response(prep.frequency, "accelerance") - a_g)
-            return np.concatenate([r.real, r.imag])
-
-        res_g = _solve(_safe(residual_g, n_res), starts, max_nfev)
-        starts = [np.exp(res_g.x), *starts]
-    res = _solve(fun, starts, max_nfev)
-    return _make_fit(cls, cond, prep, fun, res)
-
-
-def _make_fit(
-    cls: type[LateralModel],
-    cond: dict[str, float],
-    prep: _Prepared,
-    fun: Callable[[FloatArray], FloatArray],
-    res: Any,
-) -> LateralFit:
-    x = np.asarray(res.x, dtype=float)
-    m = cls.from_vector(np.exp(x), **cond)
-    fitted = _model_accelerance(m, prep)
-    r = fun(x)
-    rss = float(r @ r)
-    jac = _jacobian(fun, x)
-    sd_log, corr = _covariance(jac, rss)
-    p = np.exp(x)
-    n_real = 2 * prep.frequency.size
-    aic, bic = _information(rss, n_real, x.size)
-    err, bias = _amplitude_errors(fitted, prep.measured)
-    d = prep.data
-    return LateralFit(
-        model=m,
-        params=m.params,
-        stderr={n: float(p[i] * sd_log[i]) for i, n in enumerate(cls.param_names)},
-        correlation=corr,
-        frequency=prep.frequency,
-        measured=prep.measured,
-        fitted=fitted,
-        weights=prep.weights,
-        weights_name=prep.weights_name,
-        force=d.force,
-        wheel_mass=d.wheel_mass,
-        speed=d.speed,
-        rss=rss,
-        aic=aic,
-        bic=bic,
-        amplitude_error=err,
-        amplitude_bias=bias,
-        nfev=int(res.nfev),
-        message=str(res.message),
-        label=d.label,
-        at_bound=tuple(
-            n for n, a in zip(cls.param_names, np.asarray(res.active_mask), strict=True) if a != 0
-        ),
-    )
+    return fit_models_on(
+        data,
+        [model],
+        speed=speed,
+        force=force,
+        wheel_mass=wheel_mass,
+        band=band,
+        weights=weights,
+        start=start,
+        channel=channel,
+        max_nfev=max_nfev,
+    )[0]
 
 
 # ---------------------------------------------------------------------------------- ranking

@@ -16,25 +16,21 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import least_squares
 
 from ..exceptions import InputError
+from ._lsq import Problem
 from .fit import (
     _LOG_SPAN,
     FloatArray,
     LateralData,
     LateralFit,
     Weights,
-    _amplitude_errors,
     _conditions,
     _covariance,
+    _fit_prepared,
     _information,
-    _jacobian,
-    _model_accelerance,
+    _lateral_fit,
     _prepare,
-    _Prepared,
-    _safe,
-    fit_model,
 )
 from .models import LateralModel, get_model_class
 
@@ -142,49 +138,6 @@ def _joint_parameters(
     return names, units, maps, np.concatenate([np.log(f.model.vector()) for f in singles])
 
 
-def _condition_fit(
-    cls: type[LateralModel],
-    pr: _Prepared,
-    cd: dict[str, float],
-    logp: FloatArray,
-    cov_i: FloatArray,
-    n_global: int,
-    res: Any,
-) -> LateralFit:
-    """One condition's :class:`LateralFit` from the joint solution (log-parameters ``logp``)."""
-    m = cls.from_vector(np.exp(logp), **cd)
-    fitted = _model_accelerance(m, pr)
-    ri = pr.weights * (fitted - pr.measured)
-    rss_i = float(np.sum(ri.real**2 + ri.imag**2))
-    sd_i = np.sqrt(np.clip(np.diag(cov_i), 0.0, None))
-    corr_i = cov_i / np.outer(np.where(sd_i > 0, sd_i, 1.0), np.where(sd_i > 0, sd_i, 1.0))
-    aic_i, bic_i = _information(rss_i, 2 * pr.frequency.size, n_global)
-    err, bias = _amplitude_errors(fitted, pr.measured)
-    pv = np.exp(logp)
-    return LateralFit(
-        model=m,
-        params=m.params,
-        stderr={n: float(pv[k] * sd_i[k]) for k, n in enumerate(cls.param_names)},
-        correlation=corr_i,
-        frequency=pr.frequency,
-        measured=pr.measured,
-        fitted=fitted,
-        weights=pr.weights,
-        weights_name=pr.weights_name,
-        force=pr.data.force,
-        wheel_mass=pr.data.wheel_mass,
-        speed=pr.data.speed,
-        rss=rss_i,
-        aic=aic_i,
-        bic=bic_i,
-        amplitude_error=err,
-        amplitude_bias=bias,
-        nfev=int(res.nfev),
-        message=str(res.message),
-        label=pr.data.label,
-    )
-
-
 def fit_joint(
     data: Sequence[LateralData],
     model: str | type[LateralModel],
@@ -232,48 +185,32 @@ def fit_joint(
             raise InputError(f"data[{i}]: expected LateralData, got {type(d).__name__}")
         if d.speed is None and (cls.road_damper is not None or cls.condition_names):
             raise InputError(f"data[{i}]: the joint fit needs each condition's speed (m/s)")
-    singles = [fit_model(d, cls, band=band, weights=weights) for d in ds]
     preps = [_prepare(d, band, weights) for d in ds]
+    singles = [_fit_prepared(cls, pr) for pr in preps]
     conds = [_conditions(cls, d) for d in ds]
     names, units, maps, x0 = _joint_parameters(cls, ds, singles, share)
-    sizes = [2 * pr.frequency.size for pr in preps]
-    n_res = int(sum(sizes))
-
-    def residual(x: FloatArray) -> FloatArray:
-        parts = []
-        for pr, cd, (t, b) in zip(preps, conds, maps, strict=True):
-            m = cls.from_vector(np.exp(t @ x + b), **cd)
-            r = pr.weights * (_model_accelerance(m, pr) - pr.measured)
-            parts += [r.real, r.imag]
-        return np.concatenate(parts)
-
-    fun = _safe(residual, n_res)
-    res = least_squares(
-        fun,
-        x0,
-        jac="3-point",
-        bounds=(x0 - _LOG_SPAN, x0 + _LOG_SPAN),
-        method="trf",
-        xtol=1e-14,
-        ftol=1e-14,
-        gtol=1e-14,
-        max_nfev=max_nfev,
-    )
+    segments = [
+        pr.segment(cls, cd, t, b) for pr, cd, (t, b) in zip(preps, conds, maps, strict=True)
+    ]
+    problem = Problem(segments, int(x0.size))
+    res = problem.solve(x0, _LOG_SPAN, max_nfev)
     x = np.asarray(res.x, dtype=float)
-    r = fun(x)
-    rss = float(r @ r)
-    jac = _jacobian(fun, x)
-    n_real = n_res
+    r_aug, rss = problem.qr(x)
+    r_factor = r_aug[: x.size, : x.size]
+    n_real = problem.n_residuals
     dof = max(n_real - x.size, 1)
-    sd_g, _ = _covariance(jac, rss)
-    # Full covariance for per-condition standard errors.
-    cov = np.linalg.pinv(jac.T @ jac) * (rss / dof)
+    sd_g, _ = _covariance(r_factor, rss, n_real)
+    # Full covariance for per-condition standard errors (J^T J = R^T R).
+    cov = np.linalg.pinv(r_factor.T @ r_factor) * (rss / dof)
     aic, bic = _information(rss, n_real, x.size)
     gp = np.exp(x)
-    fits = [
-        _condition_fit(cls, pr, cd, t @ x + b, t @ cov @ t.T, x.size, res)
-        for pr, cd, (t, b) in zip(preps, conds, maps, strict=True)
-    ]
+    fits = []
+    for pr, cd, (t, b) in zip(preps, conds, maps, strict=True):
+        cov_i = t @ cov @ t.T
+        sd_i = np.sqrt(np.clip(np.diag(cov_i), 0.0, None))
+        scale = np.where(sd_i > 0, sd_i, 1.0)
+        m = cls.from_vector(np.exp(t @ x + b), **cd)
+        fits.append(_lateral_fit(m, pr, (sd_i, cov_i / np.outer(scale, scale)), x.size, res))
     return JointFit(
         model_name=cls.name,
         share=share,

@@ -103,6 +103,14 @@ class LateralModel(ABC):
         """Receptance at 0 Hz in m/N (``inf`` when a damper is in series)."""
         return math.inf
 
+    def _mobility_gradient(self, omega: FloatArray) -> tuple[ComplexArray, ComplexArray] | None:
+        """The mobility and its derivatives ``d V / d ln p_k`` (shape ``(P, n)``) at ``omega``.
+
+        Used by the fits for an analytic Jacobian; None (the default): central
+        differences instead.
+        """
+        return None
+
     # ----------------------------------------------------------------- kinds
     def mobility(self, freq_hz: ArrayLike) -> ComplexArray:
         """Ground-force mobility ``i omega Y/Fy``.
@@ -371,6 +379,14 @@ class ClassicModel(LateralModel):
     def _mobility(self, omega: FloatArray) -> ComplexArray:
         return np.asarray(1j * omega / (self.k + 1j * omega * self.c), dtype=complex)
 
+    def _mobility_gradient(self, omega: FloatArray) -> tuple[ComplexArray, ComplexArray]:
+        # V = i w / Z, Z = k + i w c: dV/dln k = -V k / Z, dV/dln c = -V (i w c) / Z.
+        iwc = 1j * omega * self.c
+        z = self.k + iwc
+        v = 1j * omega / z
+        vz = v / z
+        return v, np.array([-self.k * vz, -iwc * vz])
+
     def _static_compliance(self) -> float:
         return 1.0 / self.k
 
@@ -416,6 +432,13 @@ class MaxwellModel(LateralModel):
 
     def _mobility(self, omega: FloatArray) -> ComplexArray:
         return np.asarray(1j * omega / self.k + 1.0 / self.c, dtype=complex)
+
+    def _mobility_gradient(self, omega: FloatArray) -> tuple[ComplexArray, ComplexArray]:
+        # V = i w / k + 1/c.
+        g = np.empty((2, omega.size), dtype=complex)
+        g[0] = -1j * omega / self.k
+        g[1] = -1.0 / self.c
+        return 1.0 / self.c - g[0], g
 
     def corner_frequency(self) -> float:
         """``k / (2 pi c)`` in Hz (where the two compliances are equal in size)."""
@@ -465,6 +488,19 @@ class ViscoPlasticModel(LateralModel):
         return np.asarray(
             1j * omega / (self.k + 1j * omega * self.c1) + 1.0 / self.c2, dtype=complex
         )
+
+    def _mobility_gradient(self, omega: FloatArray) -> tuple[ComplexArray, ComplexArray]:
+        # V = i w / Z + 1/c2, Z = k + i w c1 (as the classic model, plus the series damper).
+        iwc = 1j * omega * self.c1
+        z = self.k + iwc
+        vt = 1j * omega / z
+        vz = vt / z
+        g = np.empty((3, omega.size), dtype=complex)
+        np.multiply(vz, -self.k, out=g[0])
+        np.multiply(vz, -iwc, out=g[1])
+        g[2] = -1.0 / self.c2
+        vt += 1.0 / self.c2
+        return vt, g
 
     def derived(self) -> dict[str, float]:
         return {"f0": self.k / (2.0 * np.pi * self.c2)}
@@ -527,6 +563,18 @@ class HystereticModel(LateralModel):
     def _mobility(self, omega: FloatArray) -> ComplexArray:
         road = 0.0 if math.isinf(self.C_r) else 1.0 / self.C_r
         return np.asarray(1j * omega / (self.K + 1j * self.h) + road, dtype=complex)
+
+    def _mobility_gradient(self, omega: FloatArray) -> tuple[ComplexArray, ComplexArray]:
+        # V = i w / Z + 1/C_r, Z = K + i h (constant): dV/dln K = -V_t K/Z, dV/dln h = -V_t i h/Z.
+        z = self.K + 1j * self.h
+        road = 0.0 if math.isinf(self.C_r) else 1.0 / self.C_r
+        g = np.empty((3, omega.size), dtype=complex)
+        np.multiply(omega, 1j / z, out=g[0])  # V_t
+        np.multiply(g[0], -1j * self.h / z, out=g[1])
+        v = g[0] + road
+        g[0] *= -self.K / z
+        g[2] = -road
+        return v, g
 
     def _static_compliance(self) -> float:
         return 1.0 / self.K if math.isinf(self.C_r) else math.inf
@@ -601,6 +649,14 @@ class RelaxationLengthModel(LateralModel):
 
     def _mobility(self, omega: FloatArray) -> ComplexArray:
         return np.asarray((1j * omega * self.sigma + self.speed) / self.C_alpha, dtype=complex)
+
+    def _mobility_gradient(self, omega: FloatArray) -> tuple[ComplexArray, ComplexArray]:
+        # V = (i w sigma + V_s) / C_alpha.
+        g = np.empty((2, omega.size), dtype=complex)
+        np.multiply(omega, 1j * self.sigma / self.C_alpha, out=g[1])
+        v = g[1] + self.speed / self.C_alpha
+        np.negative(v, out=g[0])
+        return v, g
 
     def maxwell(self) -> MaxwellModel:
         """Equivalent :class:`MaxwellModel` (``k = C_alpha/sigma``, ``c = C_alpha/V``)."""

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..exceptions import ConvergenceError, InputError
 from ..frf import FRF
-from .fit import DEFAULT_MODELS, Criterion, LateralData, LateralFit, fit_model
+from .fit import DEFAULT_MODELS, Criterion, LateralData, LateralFit, fit_models_on
 from .models import LateralModel, get_model_class
 
 __all__ = ["Ranking", "rank_models"]
@@ -197,7 +197,7 @@ def rank_models(
     names = [get_model_class(m).name for m in models]
     if len(set(names)) != len(names):
         raise InputError(f"models: duplicated entries in {names}")
-    fits = [fit_model(data, m, **fit_kwargs) for m in models]
+    fits = fit_models_on(data, models, **fit_kwargs)  # the lines prepared once
     return _rank(fits, criterion)
 
 
