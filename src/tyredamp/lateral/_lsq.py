@@ -4,26 +4,28 @@ The residual of a lateral fit (:mod:`.fit`, :mod:`.joint`) stacks, for each FRF
 (a *segment*), the real and imaginary parts of ``r_k = w_k (A(f_k; p) - A_k)``
 with the model parameters ``log p = T x + b`` of global log-parameters ``x``.
 A Gauss-Newton trust-region method needs from ``r`` and its Jacobian ``J``
-(``2N x P``) only ``J^T J``, ``J^T r`` and ``r^T r``. All three are kept
-exactly, and stably, by the triangular factor of the QR decomposition of
-``[J r]``:
+(``2N x P``) only ``J^T J``, ``J^T r`` and ``r^T r``, that is the
+``(P+1) x (P+1)`` product ``G = [J r]^T [J r]``, a sum over the lines. It is
+accumulated block by block (:meth:`Problem.gram`), so no ``2N x P`` array is
+ever held: the work arrays are one block, whatever the number of lines.
 
-    [J r] = Q R_aug,   R_aug = [[R, q], [0, rho]]   ((P+1) x (P+1)),
+:func:`scipy.optimize.least_squares` (method ``"trf"``) is run on a factor
+``F`` of ``G`` (``F^T F = G``, Cholesky, or the symmetric square root when
+``G`` is singular): with residual ``F[:, P]`` and Jacobian ``F[:, :P]`` the
+cost, the gradient and the trust-region subproblem (which scipy solves through
+the SVD of the scaled Jacobian) are those of the full problem, so the iterates
+are the full problem's up to rounding. Two differences: forming ``G`` squares
+the condition number of ``J`` (harmless for the well-posed fits; for a
+parameter the data do not determine the iterates may wander differently along
+the flat valley), and scipy's rank threshold ``eps * m * s_max`` sees
+``m = P + 1`` rows instead of ``2N``.
 
-so ``J^T J = R^T R``, ``J^T r = R^T q`` and ``r^T r = |q|^2 + rho^2``; the
-singular values and right singular vectors of ``J`` are those of ``R``
-(Golub & Van Loan, *Matrix Computations*, 4th ed., sec. 5.3.3, the QR approach
-to least squares). ``R_aug`` is accumulated over blocks of lines by
-re-factorising ``[R_aug; J_blk r_blk]`` (the "tall-skinny QR" of Demmel et al.,
-SIAM J. Sci. Comput. 34 (2012) A206), so no ``2N x P`` array is ever held:
-memory is a block, whatever the number of lines.
-
-:func:`scipy.optimize.least_squares` (method ``"trf"``) is run on the reduced
-residual ``R_aug[:, P]`` with Jacobian ``R_aug[:, :P]``: every quantity the
-method uses (cost, gradient, the trust-region subproblem through the SVD of
-the scaled Jacobian) is the same as for the full residual, so the iterates are
-those of the full problem up to rounding (the one difference: scipy's rank
-threshold ``eps * m * s_max`` sees ``m = P + 1`` rows instead of ``2N``).
+The standard errors need the small singular values of ``J`` accurately, so at
+the solution the triangular factor of ``[J r] = Q R_aug`` is computed by
+Householder QR accumulated over the blocks (re-factorising ``[R_aug; J_blk
+r_blk]``, the "tall-skinny QR" of Demmel et al., SIAM J. Sci. Comput. 34 (2012)
+A206): ``J`` and ``R`` have the same singular values and right singular
+vectors (Golub & Van Loan, *Matrix Computations*, 4th ed., sec. 5.3.3).
 
 The Jacobian is analytic (each model's ``_mobility_gradient``) with the
 axle-force chain rule ``d V_axle = d V / (1 + i omega M V)^2``; a model
@@ -218,7 +220,7 @@ class Problem:
         return np.asarray(t.T @ local @ t)
 
     def gram(self, x: FloatArray) -> tuple[FloatArray, float]:
-        """``[J r]^T [J r]`` (``(P+1) x (P+1)``) at ``x`` and ``r^T r``; cached for the last ``x``."""
+        """``G = [J r]^T [J r]`` at ``x`` and ``r^T r``; cached for the last ``x``."""
         if self._cache is not None and np.array_equal(self._cache[0], x):
             return self._cache[1], self._cache[2]
         p = self.n_params
@@ -238,7 +240,7 @@ class Problem:
         return gram, rss
 
     def reduced(self, x: FloatArray) -> FloatArray:
-        """A ``(P+1) x (P+1)`` factor ``F`` with ``F^T F`` = :meth:`gram` (scipy's residual, Jacobian)."""
+        """A factor ``F`` with ``F^T F = G`` (:meth:`gram`): scipy's residual and Jacobian."""
         gram, _ = self.gram(x)
         try:
             return np.asarray(np.linalg.cholesky(gram).T)
@@ -266,7 +268,7 @@ class Problem:
             if not np.all(np.isfinite(blk)):
                 return self._bad()
             total += float(np.vdot(a[p], a[p]).real)
-            r_aug = np.linalg.qr(blk, mode="r")
+            r_aug = np.asarray(np.linalg.qr(blk, mode="r"))
         if r_aug.shape[0] < p + 1:  # fewer residuals than unknowns + 1: pad with zeros
             r_aug = np.vstack([r_aug, np.zeros((p + 1 - r_aug.shape[0], p + 1))])
         return r_aug, total
