@@ -210,3 +210,84 @@ def test_cli_too_few_points_leaves_no_output(
     assert "at least as many points as modes" in capsys.readouterr().err
     assert not out.exists()
     assert list(tmp_path.iterdir()) == [src]  # no temporary file left behind
+
+
+def _with_nan_std(model: ModalModel, where: dict[str, list[tuple[int, ...]]]) -> ModalModel:
+    """``model`` with its standard errors set to NaN at the given (mode) / (point, mode) entries."""
+    std = {k: np.array(v, dtype=float) for k, v in model.std.items()}
+    for key, entries in where.items():
+        for e in entries:
+            std[key][e] = np.nan
+    return ModalModel(
+        model.poles,
+        model.psi_out,
+        model.psi_in,
+        outputs=model.outputs,
+        inputs=model.inputs,
+        std=std,
+    )
+
+
+def test_some_nan_standard_errors_are_named_and_skip_the_monte_carlo(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Some NaN standard errors: C' and C written without standard errors, exit 0, and one
+    warning line naming exactly the modes and quantities (as the all-NaN case, which says
+    "every mode")."""
+    from tyredamp.documents.modes import write_modes_json
+
+    s = mck(4, n=8, zeta_max=0.01, rank=8)
+    base = truncated(s, 5)
+    f = base.frequency_hz
+    lab = [c.label for c in base.outputs]
+    bad = _with_nan_std(base, {"frequency_hz": [(1,)], "psi_out": [(2, 3), (5, 3)]})
+    src = write_modes_json(tmp_path / "modes.json", {"complex": bad})
+    before = src.read_bytes()
+    out = tmp_path / "d.json"
+    main(["damping", str(src), "-o", str(out), "--samples", "30"])
+    cap = capsys.readouterr()
+    expected = (
+        f"mode 2 ({f[1]:.4g} Hz): frequency; mode 4 ({f[3]:.4g} Hz): shape at points "
+        f"{lab[2]}, {lab[5]}"
+    )
+    err = cap.err.strip().splitlines()
+    assert len(err) == 1, err
+    assert err[0].startswith("tyredamp: warning: No standard errors"), err
+    assert expected in err[0]
+    assert expected in cap.out  # the same finding in the printed summary
+    assert "nan %" not in cap.out.lower()
+    doc = json.loads(out.read_text())
+    assert doc["std"] == {}
+    assert doc["uncertainty"] == {}
+    assert any(expected in s for s in doc["findings"])
+    assert src.read_bytes() == before
+    # The damping matrix itself is that of the modes without their standard errors.
+    assert_allclose(doc["modal"], identify_damping(base, n_samples=0).modal, rtol=1e-13)
+
+    # Every standard error NaN: the same rule, named as "every mode".
+    all_nan = _with_nan_std(base, {k: [np.index_exp[...]] for k in base.std})
+    write_modes_json(src, {"complex": all_nan})
+    main(["damping", str(src), "-o", str(out), "--samples", "30"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert "for every mode;" in err[0], err
+    # Without Monte Carlo samples there is nothing to warn about.
+    main(["damping", str(src), "-o", str(out), "--samples", "0"])
+    assert capsys.readouterr().err == ""
+
+
+def test_missing_std_names_each_gap() -> None:
+    from tyredamp.damping import missing_std
+
+    f = np.array([10.0, 20.0, 30.0])
+    ok = {"frequency_hz": np.ones(3), "damping_ratio": np.ones(3), "psi_out": np.ones((2, 3))}
+    assert missing_std(ok, f) == ""
+    some = {**ok, "damping_ratio": np.array([1.0, -1.0, np.inf])}
+    assert missing_std(some, f) == "mode 2 (20 Hz): damping ratio; mode 3 (30 Hz): damping ratio"
+    shp = {**ok, "psi_out": np.array([[1.0, np.nan, np.nan], [1.0, 1.0, np.nan]])}
+    assert missing_std(shp, f, ["1+Z", "2+Z"]) == (
+        "mode 2 (20 Hz): shape at point 1+Z; mode 3 (30 Hz): shape at every point"
+    )
+    nan = {k: np.full_like(v, np.nan) for k, v in ok.items()}
+    assert missing_std(nan, f) == "every mode"
+    assert missing_std({}, f) == ""

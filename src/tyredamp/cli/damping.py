@@ -14,7 +14,7 @@ from typing import Any
 import click
 import numpy as np
 
-from ..damping import METHODS, DampingModel
+from ..damping import METHODS, DampingModel, missing_std, no_std_note
 from ..documents.damping import write_damping_json
 from ..documents.modes import read_modes
 from ..exceptions import InputError
@@ -121,3 +121,7 @@ def damping_command(
     for row in damping_summary(dm):
         click.echo(row)
     click.echo(f"wrote {out}")
+    chosen = models[model_name]
+    missing = missing_std(chosen.std, chosen.frequency_hz, [c.label for c in chosen.outputs])
+    if missing and samples > 0:  # the run goes on; the gap is said where scripts look
+        click.echo(f"tyredamp: warning: {no_std_note(missing)}", err=True)

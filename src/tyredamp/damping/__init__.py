@@ -12,7 +12,7 @@ damping fits (:func:`compare_proportional`) and Monte Carlo standard errors
 from __future__ import annotations
 
 from .diagnostics import DampingDiagnostics, definiteness, findings
-from .estimate import identify_damping
+from .estimate import identify_damping, no_std_note
 from .identify import (
     METHODS,
     Method,
@@ -33,7 +33,7 @@ from .proportional import (
     fit_rayleigh,
     reduced_receptance,
 )
-from .uncertainty import MonteCarloResult, monte_carlo_std
+from .uncertainty import MonteCarloResult, missing_std, monte_carlo_std
 
 __all__ = [
     "METHODS",
@@ -53,9 +53,11 @@ __all__ = [
     "fit_rayleigh",
     "identify_damping",
     "lancaster_matrices",
+    "missing_std",
     "modal_damping_from_modes",
     "modal_system_shapes",
     "monte_carlo_std",
+    "no_std_note",
     "normalise_shapes",
     "physical_matrices",
     "reduced_receptance",

@@ -22,9 +22,18 @@ from .identify import METHODS, Method, modal_damping_from_modes, physical_matric
 from .lancaster import lancaster_matrices
 from .model import DampingModel
 from .proportional import compare_proportional, comparison_grid
-from .uncertainty import MonteCarloResult, monte_carlo_std
+from .uncertainty import MonteCarloResult, missing_std, monte_carlo_std
 
-__all__ = ["identify_damping"]
+__all__ = ["identify_damping", "no_std_note"]
+
+
+def no_std_note(missing: str) -> str:
+    """The finding when some standard errors of the modes are unusable (:func:`missing_std`)."""
+    return (
+        "No standard errors: the modes give no usable standard error (NaN, infinite or "
+        f"negative) for {missing}; the Monte Carlo propagation needs all of them, so C' and C "
+        "are given without standard errors."
+    )
 
 
 def _residual_fraction(model: ModalModel) -> float | None:
@@ -67,8 +76,10 @@ def _lancaster(
     return lm.C, diff
 
 
-def _uncertainty_notes(mc: MonteCarloResult | None, n_samples: int) -> list[str]:
+def _uncertainty_notes(mc: MonteCarloResult | None, n_samples: int, missing: str) -> list[str]:
     """Why standard errors are missing, or how many Monte Carlo samples failed."""
+    if missing and n_samples > 0:
+        return [no_std_note(missing)]
     if mc is None:
         return [
             "No standard errors: the modal model carries no uncertainty (std) to propagate."
@@ -160,7 +171,8 @@ def identify_damping(
     )
 
     mc = None
-    if n_samples > 0:
+    missing = missing_std(model.std, model.frequency_hz, [c.label for c in model.outputs])
+    if n_samples > 0 and not missing:
         mc = monte_carlo_std(
             model.poles, model.psi_out, shapes, model.std, method, normalise, n_samples, seed
         )
@@ -174,7 +186,7 @@ def identify_damping(
             "seed": mc.seed,
         }
     notes = findings(diag, method, prop, std.get("modal"), est.c_modal)
-    notes += _uncertainty_notes(mc, n_samples)
+    notes += _uncertainty_notes(mc, n_samples, missing)
     return DampingModel(
         modal=est.c_modal,
         physical=c_phys,

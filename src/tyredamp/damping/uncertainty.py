@@ -22,6 +22,7 @@ The random generator is seeded (default 0), so results are reproducible.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,7 +32,7 @@ from ..exceptions import TyredampError
 from ..mechanics.modal_sum import pole_quantities
 from .identify import Method, align_signs, modal_damping_from_modes, physical_matrices
 
-__all__ = ["MonteCarloResult", "monte_carlo_std"]
+__all__ = ["MonteCarloResult", "missing_std", "monte_carlo_std"]
 
 
 @dataclass(frozen=True)
@@ -57,6 +58,71 @@ class MonteCarloResult:
     n_samples: int
     n_failed: int
     seed: int
+
+
+def missing_std(
+    std: dict[str, NDArray[np.float64]],
+    frequency_hz: NDArray[np.float64],
+    points: Sequence[str] = (),
+) -> str:
+    """Which standard errors in ``std`` are not finite numbers >= 0 (NaN, inf, negative).
+
+    The Monte Carlo propagation (:func:`monte_carlo_std`) needs every standard
+    error it is given: one unknown one makes the spread of ``C'`` and ``C``
+    unknown, and treating it as 0 would understate it.
+
+    Parameters
+    ----------
+    std : dict
+        ``ModalModel.std`` (``"frequency_hz"``, ``"damping_ratio"``: shape (m,);
+        ``"psi_out"``: shape (N, m)).
+    frequency_hz : ndarray, shape (m,)
+        Natural frequencies of the modes, Hz (to name them).
+    points : sequence of str, optional
+        Labels of the ``N`` points (default their numbers from 1).
+
+    Returns
+    -------
+    str
+        Empty when every given standard error is usable; else ``"every mode"``
+        when no mode has one usable value, or one clause per mode, e.g.
+        ``"mode 2 (19.85 Hz): frequency; mode 3 (28.68 Hz): shape at points 2+Z, 3+Z"``.
+    """
+    m = frequency_hz.size
+    names = {"frequency_hz": "frequency", "damping_ratio": "damping ratio"}
+    per_mode: list[list[str]] = [[] for _ in range(m)]
+    usable = np.zeros(m, dtype=bool)
+    for key, name in names.items():
+        if key in std:
+            ok = _usable(std[key])
+            usable |= ok
+            for i in np.flatnonzero(~ok).tolist():
+                per_mode[i].append(name)
+    if "psi_out" in std and np.ndim(std["psi_out"]) == 2 and np.shape(std["psi_out"])[1] == m:
+        ok2 = _usable(std["psi_out"])
+        usable |= ok2.any(axis=0)
+        for n in range(m):
+            bad = np.flatnonzero(~ok2[:, n])
+            if bad.size:
+                lab = [points[j] if j < len(points) else str(j + 1) for j in bad.tolist()]
+                every = bad.size == ok2.shape[0]
+                where = "every point" if every else f"point{'s' * (bad.size > 1)} {', '.join(lab)}"
+                per_mode[n].append(f"shape at {where}")
+    if not any(per_mode):
+        return ""
+    if not usable.any():
+        return "every mode"
+    return "; ".join(
+        f"mode {n + 1} ({frequency_hz[n]:.4g} Hz): {', '.join(q)}"
+        for n, q in enumerate(per_mode)
+        if q
+    )
+
+
+def _usable(a: NDArray[np.float64]) -> NDArray[np.bool_]:
+    v = np.asarray(a, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(v) & (v >= 0)
 
 
 def monte_carlo_std(
