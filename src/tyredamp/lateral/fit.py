@@ -27,7 +27,8 @@ Method
   so the starts land in the right basin), then refined on the axle data.
 * Standard errors: ``cov(log p) = s^2 (J^T J)^-1`` with ``J`` the Jacobian of
   the weighted residuals in log-parameters (analytic, from each model's
-  ``_mobility_gradient``) and ``s^2 = RSS/(2N - P)``; ``SE(p) = p SE(log p)``
+  ``_mobility_gradient``; central differences for a model without one, the
+  stretched string) and ``s^2 = RSS/(2N - P)``; ``SE(p) = p SE(log p)``
   (delta method).
 * Cost: the residual and its Jacobian are never held whole; they are reduced
   block by block to the ``(P+1) x (P+1)`` triangular factor of ``[J r]``, which
