@@ -95,7 +95,7 @@ def coef(lay: Layout, poles: NDArray[np.complex128]) -> NDArray[np.float64]:
 #: the Gram blocks, the QR route and the fitted FRFs are accumulated over blocks
 #: of lines of this size, so that no array of the fits grows with the lines
 #: beyond the data (:func:`blocks`)
-BLOCK_BYTES = 2_000_000
+BLOCK_BYTES = 1_000_000
 #: fewest lines of a block (fewer make the per-block overhead dominate)
 MIN_BLOCK_LINES = 256
 
@@ -208,10 +208,13 @@ def basis_ek(
     ref: NDArray[np.intp],
     derivatives: bool = True,
     lines: slice | None = None,
+    given: tuple[Any, Any] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
     """``B = [Phi | E]`` (n_rows, q + n_e), Fortran-ordered, and the poles.
 
     ``lines``: the rows of these lines only (:func:`blocks`; default all).
+    ``given``: ``(factors(fitter, lines), unpack(th, m, ref))`` when the caller
+    has them already (either may be None).
 
     Complex modes, all at once: columns ``2n, 2n+1`` of mode ``n`` are ``A + B``
     and ``i (A - B)`` with ``A_k = l_kn kappa / (s - p_n)`` and ``B_k =
@@ -231,9 +234,10 @@ def basis_ek(
     modes: ``E`` holds the derivative columns of :meth:`_basis_real`.
     ``derivatives=False``: ``B = Phi``.
     """
-    poles, part = fitter.unpack(th, m, ref)
+    fac, pp = (None, None) if given is None else given
+    poles, part = fitter.unpack(th, m, ref) if pp is None else pp
     q = fitter.n_cols(m)
-    s1, kap1, kap_low = factors(fitter, lines)
+    s1, kap1, kap_low = factors(fitter, lines) if fac is None else fac
     if fitter.kind == "real":
         phi, D = basis_real(fitter, poles, part, ref, derivatives, lines)
         B = np.empty((phi.shape[0], q + D.shape[1]), order="F")

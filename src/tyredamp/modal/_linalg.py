@@ -233,12 +233,12 @@ def _qr_blocks(
     for Bb, Yb in blocks:
         A = np.concatenate([R, Bb])
         Yst = np.concatenate([Z, Yb])
-        qr, tau, _, info = lapack.dgeqrf(A)
+        qr, tau, _, info = lapack.dgeqrf(A, overwrite_a=1)
         if info != 0:
             raise np.linalg.LinAlgError("QR of the basis failed")
         k = min(A.shape[0], n_col)
         lwork = max(1, Yst.shape[1]) * 64
-        qty, _, info = lapack.dormqr("L", "T", qr, tau, Yst, lwork)
+        qty, _, info = lapack.dormqr("L", "T", qr, tau, Yst, lwork, overwrite_c=1)
         if info != 0:
             raise np.linalg.LinAlgError("QR of the basis failed")
         rest = qty[k:]

@@ -322,14 +322,15 @@ class ModalFitter:
         ``gradient=False``: no ``E^T r`` (a fit without refinement needs no
         gradient); ``derivatives=False``: no ``E`` (nor ``J^T J``)."""
         q = self.n_cols(m)
-        poles = self.unpack(th, m, ref)[0]
+        pp = self.unpack(th, m, ref)
         lay = self._layout(m) if derivatives else None
         n_col = q + (0 if lay is None else int(lay.ecol.max(initial=-1)) + 1)
         parts = _basis.blocks(self, n_col)
 
         def rows() -> Any:
             for sl in parts:
-                yield self._basis_ek(th, m, ref, derivatives, sl)[0], self._ydata(sl) * w
+                b = self._basis_ek(th, m, ref, derivatives, sl, (None, pp))[0]
+                yield b, self._ydata(sl) * w
 
         G = np.zeros((n_col, n_col))
         P = np.zeros((n_col, self.n_out))
@@ -347,7 +348,7 @@ class ModalFitter:
         )
         if lay is not None:
             sol["lay"] = lay
-            sol["coef"] = self._coef(lay, poles)
+            sol["coef"] = self._coef(lay, pp[0])
         return sol
 
     def _normal(
@@ -494,11 +495,12 @@ class ModalFitter:
         # fits one block; otherwise it is formed again block by block when needed
         keep = len(parts) == 1 or qf <= self.n_out
         cache: dict[int, NDArray[np.float64]] = {}
+        pp_f = self.unpack(th_f, m, ref)
 
-        def fixed_cols(i: int) -> NDArray[np.float64]:
+        def fixed_cols(i: int, fac: Any = None) -> NDArray[np.float64]:
             if i in cache:
                 return cache[i]
-            phi_f = self._basis_ek(th_f, m, ref, False, parts[i])[0]
+            phi_f = self._basis_ek(th_f, m, ref, False, parts[i], (fac, pp_f))[0]
             if keep:
                 cache[i] = phi_f
             return phi_f
@@ -516,9 +518,11 @@ class ModalFitter:
             cross = np.zeros((qf, n1))
             g0 = np.zeros((n1, n1))
             p0 = np.zeros((n1, self.n_out))
+            pp1 = one.unpack(th, 1, ref1)
             for i, sl in enumerate(parts):
-                b1 = one._basis_ek(th, 1, ref1, True, sl)[0]
-                cross += fixed_cols(i).T @ b1
+                fac = None if i in cache else _basis.factors(self, sl)
+                b1 = one._basis_ek(th, 1, ref1, True, sl, (fac, pp1))[0]
+                cross += fixed_cols(i, fac).T @ b1
                 g0 += b1.T @ b1
                 p0 += b1.T @ (self._ydata(sl) * w)
             qb = tmap.T @ cross

@@ -142,7 +142,7 @@ class ModalIdentification:
         Candidates dropped, each ``{"frequency_hz", "damping_ratio", "reason",
         "statistic", "threshold"}`` (:class:`~tyredamp.modal.quality.RejectedMode`).
     frequency : ndarray, shape (n_freq,)
-        Lines used (Hz).
+        Lines used (Hz; a read-only view of the FRF's axis, no copy).
     discrepancy : dict of str to ndarray
         ``|H_model - H_data|`` RMS over FRFs per line, for each model.
     warnings : list of str
@@ -279,7 +279,7 @@ def identify_modes(
         flags=dg.flags,
         clusters=dg.kept,
         rejected=[r.to_dict() for r in rej],
-        frequency=np.array(problem.frequency),
+        frequency=problem.frequency,
         discrepancy=disc,
         warnings=warnings,
         noise_source=problem.noise_source,
