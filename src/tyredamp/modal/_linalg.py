@@ -53,9 +53,13 @@ def _fixed_range(
         if not (yyp < _CANCEL_TOL * yy).any():
             tmap = lapack.dtrtri(rs)[0] / d[:, None]  # R^-1 with R = rs diag(d)
             return np.asarray(tmap), np.asarray(qty), np.asarray(yyp)
-    R, Z, yyp = _qr_blocks(blocks(), q, yy.size)
+    R, Z, rho = _qr_blocks(blocks(), q, yy.size)
     u, sv, vt = np.linalg.svd(R)
     r = int(np.count_nonzero(sv > 1e-13 * sv.max())) if sv.size and sv.max() > 0 else 0
+    # the leading directions of Q outside the range (Q U_r+1.., a rank-deficient Phi)
+    # hold part of ||P Y||^2 as well
+    zo = u[:, r:].T @ Z
+    yyp = rho + np.einsum("ij,ij->j", zo, zo)
     return np.asarray(vt[:r].T / sv[:r]), np.asarray(u[:, :r].T @ Z), np.asarray(yyp)
 
 
@@ -196,18 +200,24 @@ def _vp_solve(
     R, QtE, R2 = Rb[:q, :q], Rb[:q, q:], Rb[q:, q:]
     Ct, X = Z[:q], Z[q:]
     diag = np.abs(np.diag(R))
+    cost_out = np.einsum("ij,ij->j", X, X) + rho
+    Etr = R2.T @ X if gradient else None
     if diag.size and diag.min() <= 1e-13 * diag.max():
         C = np.linalg.lstsq(R, Ct, rcond=None)[0]  # minimum-norm, as lstsq(Phi, Y)
+        # a rank-deficient Phi leaves part of Q^T Y unexplained: r = Q (Ct - R C) + ...
+        top = Ct - R @ C
+        cost_out = cost_out + np.einsum("ij,ij->j", top, top)
+        if Etr is not None:
+            Etr = Etr + QtE.T @ top
     else:
         C = sla.solve_triangular(R, Ct)
-    cost_out = np.einsum("ij,ij->j", X, X) + rho
     return {
         "R": R,
         "C": C,
         "Ct": Ct,
         "QtE": QtE,
         "GE": R2.T @ R2,
-        "Etr": R2.T @ X if gradient else None,
+        "Etr": Etr,
         "cost": float(cost_out.sum()),
         "cost_out": cost_out,
         "qr": True,
@@ -238,7 +248,8 @@ def _qr_blocks(
             raise np.linalg.LinAlgError("QR of the basis failed")
         k = min(A.shape[0], n_col)
         lwork = max(1, Yst.shape[1]) * 64
-        qty, _, info = lapack.dormqr("L", "T", qr, tau, Yst, lwork, overwrite_c=1)
+        # the reflectors are the first k columns (fewer rows than columns: k rows)
+        qty, _, info = lapack.dormqr("L", "T", qr[:, :k], tau[:k], Yst, lwork, overwrite_c=1)
         if info != 0:
             raise np.linalg.LinAlgError("QR of the basis failed")
         rest = qty[k:]
