@@ -39,11 +39,19 @@ symmetric rank-k update and one matrix product with the data, ``O(n_in n_freq
 complement of the basis, ``r`` the residual), and from them ``J^T J`` and
 ``J^T r`` -- neither ``Q``, nor the residual, nor the ``(n_out n_in n_freq) x
 n_param`` Jacobian is formed. This is accurate to ``eps cond(Phi)^2`` (the
-columns scaled to unit norm); a basis whose condition estimate is too large
-for that is orthogonalised (Householder or CholeskyQR2) instead, and the
-residual is formed when the cost would lose accuracy by cancellation. The
-refinement is a bounded Levenberg-Marquardt iteration on these normal
-equations.
+columns scaled to unit norm); for a basis whose condition estimate is too
+large for that, or when the cost would lose accuracy by cancellation, the
+same quantities come from a Householder QR of ``[Phi | E]`` with ``Q^T``
+applied to ``Y`` (:func:`~tyredamp.modal._linalg._vp_solve`). The refinement
+is a bounded Levenberg-Marquardt iteration on these normal equations.
+
+Memory (issue 15): the Gram blocks, the QR and the fitted FRFs are summed
+over blocks of lines of a fixed size (:func:`~tyredamp.modal._basis.blocks`,
+about 1 MB); the basis of all lines, the weighted data ``Y`` and the
+residual are never held, so a fit costs the data plus a constant. The data
+rows, ``s = i w`` and ``kappa`` of a block are formed when needed (the
+attributes ``Y``, ``s``, ``kappa``, ``kappa_low`` form them for all lines on
+request).
 
 Scaling (spec step 3 and eq. [10]): with drive points ``(j_k, k)`` (output
 ``j_k`` at the place of input ``k``) reciprocity ``psi_in[k] = psi_out[j_k]``
