@@ -2,7 +2,10 @@
 
 :func:`settle_order` computes the diagram of the starting order with the pole
 estimator and raises the order by the sizing rule and by trials of an
-unsettled diagram, as the docstring of :mod:`tyredamp.modal.identify` states.
+unsettled diagram, as the docstring of :mod:`tyredamp.modal.identify` states,
+up to :func:`order_cap`: twice the roots the sizing rule asks for the
+resonances the data show (:func:`modes_shown`), so that the order follows the
+modes of the band and not its number of lines.
 """
 
 from __future__ import annotations
