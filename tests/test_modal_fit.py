@@ -80,8 +80,8 @@ def test_analytic_gradient_matches_finite_differences(kind: str) -> None:
     part = part.astype(complex) * (1 + 0.05 * rng.normal(size=part.shape))
     ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
     th = fit.pack(cm.poles * (1 + 0.002), part, ref)
-    yw = fit.Y / np.sqrt(np.mean(fit.Y**2, axis=0))
-    sol = fit._solve(th, 6, ref, yw)
+    w = 1 / np.sqrt(np.mean(fit.Y**2, axis=0))
+    sol = fit._solve(th, 6, ref, w)
     _, jtr = fit._normal(sol, th.size)
     # a subset of the parameters keeps the test fast: both pole parameters of three
     # modes and every participation parameter of two modes
@@ -92,9 +92,9 @@ def test_analytic_gradient_matches_finite_differences(kind: str) -> None:
     for i in check:
         e = np.zeros(th.size)
         e[i] = 1e-6 * max(1.0, abs(th[i]))
-        num[i] = (
-            fit._solve(th + e, 6, ref, yw)["cost"] - fit._solve(th - e, 6, ref, yw)["cost"]
-        ) / (2 * e[i])
+        num[i] = (fit._solve(th + e, 6, ref, w)["cost"] - fit._solve(th - e, 6, ref, w)["cost"]) / (
+            2 * e[i]
+        )
     # d||r||^2/dtheta = 2 J^T r; Kaufman's J gives the exact VarPro gradient.
     # Central differences of a cost ~1e3 with steps 1e-6: agreement to ~1e-5 relative.
     assert_allclose(2 * jtr[check], num[check], rtol=2e-4, atol=2e-4 * np.max(np.abs(num)))
@@ -222,8 +222,8 @@ def _random_problem(kind: str, inputs: list[int], power: int = 0) -> tuple:
     part = part * (1 + 0.05 * rng.normal(size=part.shape))
     ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
     th = fit.pack(cm.poles * (1 + 0.003), part, ref)
-    yw = fit.Y / np.sqrt(np.mean(fit.Y**2, axis=0))
-    return fit, th, cm.poles.size, ref, yw
+    w = 1 / np.sqrt(np.mean(fit.Y**2, axis=0))  # weights per output
+    return fit, th, cm.poles.size, ref, w
 
 
 @pytest.mark.parametrize("kind", ["complex", "real"])
@@ -258,7 +258,8 @@ def test_normal_equations_match_the_explicit_kaufman_formulas(
 
     if not gram:  # every basis "ill-conditioned": the QR route
         monkeypatch.setattr(fit_mod, "_MAX_GRAM_COND", 0.0)
-    fit, th, m, ref, yw = _random_problem(kind, inputs, power=2)
+    fit, th, m, ref, w = _random_problem(kind, inputs, power=2)
+    yw = fit.Y * w
     # reference: the full derivative matrix, a Householder QR and the residual
     phi, D, dpar, dcol = fit.basis(th, m, ref)
     Q, _ = np.linalg.qr(phi)
@@ -271,8 +272,8 @@ def test_normal_equations_match_the_explicit_kaufman_formulas(
     jtj_ref = A.T @ (G * (C @ C.T)[dcol[:, None], dcol[None, :]]) @ A
     jtr_ref = -(A.T @ np.einsum("id,id->d", D, (r @ C.T)[:, dcol]))
     for residual in (False, True):
-        sol = fit._solve(th, m, ref, yw, residual=residual)
-        assert (sol["Q"] is None) == gram
+        sol = fit._solve(th, m, ref, w, residual=residual)
+        assert sol["qr"] == (residual or not gram)  # residual=True: the QR route
         jtj, jtr = fit._normal(sol, th.size)
         assert_allclose(sol["cost"], np.sum(r**2), rtol=1e-10)
         assert_allclose(sol["C"], C, rtol=0, atol=1e-9 * np.max(np.abs(C)))
@@ -283,13 +284,14 @@ def test_normal_equations_match_the_explicit_kaufman_formulas(
 def test_ill_conditioned_basis_is_orthogonalised() -> None:
     # two nearly equal poles: cond(Phi)^2 beyond _MAX_GRAM_COND, so the projection
     # takes the QR route and still fits the data as well as a least-squares solver
-    fit, th, m, ref, yw = _random_problem("complex", [0])
+    fit, th, m, ref, w = _random_problem("complex", [0])
+    yw = fit.Y * w
     poles = fit.unpack(th, m, ref)[0]
     poles = np.append(poles, poles[2] * (1 + 1e-6))
     ref2 = np.append(ref, 0).astype(np.intp)
     th2 = fit.pack(poles, np.ones((m + 1, 1), complex), ref2)
-    sol = fit._solve(th2, m + 1, ref2, yw, residual=False)
-    assert sol["Q"] is not None
+    sol = fit._solve(th2, m + 1, ref2, w, residual=False)
+    assert sol["qr"]
     phi = fit.basis(th2, m + 1, ref2, derivatives=False)[0]
     c = np.linalg.lstsq(phi, yw, rcond=None)[0]
     assert_allclose(sol["cost"], np.sum((yw - phi @ c) ** 2), rtol=1e-8)

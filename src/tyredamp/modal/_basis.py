@@ -91,10 +91,130 @@ def coef(lay: Layout, poles: NDArray[np.complex128]) -> NDArray[np.float64]:
     return coef
 
 
+#: bytes of one block of rows of the fits (basis, derivative and data columns):
+#: the Gram blocks, the QR route and the fitted FRFs are accumulated over blocks
+#: of lines of this size, so that no array of the fits grows with the lines
+#: beyond the data (:func:`blocks`)
+BLOCK_BYTES = 1_000_000
+#: fewest lines of a block (fewer make the per-block overhead dominate)
+MIN_BLOCK_LINES = 256
+
+
+def blocks(fitter: Any, n_col: int) -> list[slice]:
+    """Blocks of lines for arrays of ``n_col`` real columns (``2 n_in`` rows per line).
+
+    One block when the lines fit in :data:`BLOCK_BYTES`; otherwise blocks of
+    ``BLOCK_BYTES / (16 n_in (n_col + n_out))`` lines (at least
+    :data:`MIN_BLOCK_LINES`).
+    """
+    n_f = fitter.n_f
+    per_line = 16 * fitter.n_in * (n_col + fitter.n_out)
+    nb = max(MIN_BLOCK_LINES, int(BLOCK_BYTES // max(per_line, 1)))
+    if n_f <= nb:
+        return [slice(0, n_f)]
+    return [slice(a, min(a + nb, n_f)) for a in range(0, n_f, nb)]
+
+
+def factors(
+    fitter: Any, lines: slice | None = None
+) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]]:
+    """``s = i w``, ``kappa = (i w)^power`` and ``kappa_low = (i w)^(power - 2)`` of the
+    lines (times the line weights when the fitter has them), computed when needed."""
+    f = fitter.f if lines is None else fitter.f[lines]
+    w = 2 * np.pi * f
+    s = 1j * w
+    kappa = (1j * w) ** fitter.power
+    kappa_low = (1j * w) ** (fitter.power - 2)
+    lw = fitter.line_weights
+    if lw is not None:
+        lw = lw if lines is None else lw[lines]
+        kappa = kappa * lw
+        kappa_low = kappa_low * lw
+    return s, kappa, kappa_low
+
+
+def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
+    """Data rows of the lines (``(k, f)``, real and imaginary part interleaved), (rows, n_out).
+
+    Weighted by the line weights when the fitter has them; row ``2 i`` is the
+    real, ``2 i + 1`` the imaginary part of entry ``i``, as the basis rows.
+    """
+    h = fitter.H if lines is None else fitter.H[:, :, lines]
+    lw = fitter.line_weights
+    if lw is not None:
+        h = h * (lw if lines is None else lw[lines])[None, None, :]
+    n_out, n_in, nb = h.shape
+    hc = h.transpose(1, 2, 0).reshape(n_in * nb, n_out)
+    Y = np.empty((2 * n_in * nb, n_out))
+    Y[0::2] = hc.real
+    Y[1::2] = hc.imag
+    return Y
+
+
+def synth(
+    fitter: Any, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], coef: NDArray[np.float64]
+) -> NDArray[np.complex128]:
+    """Fitted FRFs ``Phi coef`` (unweighted), complex, (n_out, n_in, n_f), block by block.
+
+    ``coef`` (q, n_out): the linear coefficients of the unweighted outputs.
+    """
+    out = np.empty((fitter.n_out, fitter.n_in, fitter.n_f), complex)
+    lw = fitter.line_weights
+    for sl in blocks(fitter, fitter.n_cols(m)):
+        phi = basis_ek(fitter, th, m, ref, False, sl)[0]
+        hw = np.ascontiguousarray(coef.T @ phi.T)  # (n_out, rows)
+        blk = hw.view(np.complex128).reshape(fitter.n_out, fitter.n_in, -1)
+        if lw is not None:
+            blk = blk / lw[sl][None, None, :]
+        out[:, :, sl] = blk
+    return out
+
+
+def residual_power(
+    fitter: Any,
+    poles: NDArray[np.complex128],
+    residues: NDArray[np.complex128],
+    terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    s2: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Residual power per line ``sum_jk |H_jk - H^_jk|^2 / s2_j`` (weighted as the fit
+    weights the lines), (n_f,), block by block.
+
+    ``residues`` (n_out, n_in, m): ``R_jkn`` of the model ``sum_n R / (s - p_n) +
+    conj(R) / (s - conj p_n)`` in the data's kind; ``terms``: upper and lower
+    residual terms (n_out, n_in) or None; ``s2`` (n_out,) the noise variances.
+    """
+    out = np.empty(fitter.n_f)
+    for sl in blocks(fitter, 2 * poles.size + 2 * fitter.n_in):
+        s, kap, kap_low = factors(fitter, sl)
+        h = fitter.H[:, :, sl]
+        e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
+        for n in range(poles.size):
+            r = residues[:, :, n, None]
+            e -= r * (kap / (s - poles[n])) + np.conj(r) * (kap / (s - np.conj(poles[n])))
+        upper, lower = terms
+        if upper is not None:
+            e -= upper[:, :, None] * kap
+        if lower is not None:
+            e -= lower[:, :, None] * kap_low
+        out[sl] = np.einsum("jkf,j->f", e.real**2 + e.imag**2, 1.0 / s2)
+    return out
+
+
 def basis_ek(
-    fitter: Any, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], derivatives: bool = True
+    fitter: Any,
+    th: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    derivatives: bool = True,
+    lines: slice | None = None,
+    given: tuple[Any, Any] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
     """``B = [Phi | E]`` (n_rows, q + n_e), Fortran-ordered, and the poles.
+
+    ``lines``: the rows of these lines only (:func:`blocks`; default all).
+    ``given``: ``(factors(fitter, lines), unpack(th, m, ref))`` when the caller
+    has them already (either may be None).
 
     Complex modes, all at once: columns ``2n, 2n+1`` of mode ``n`` are ``A + B``
     and ``i (A - B)`` with ``A_k = l_kn kappa / (s - p_n)`` and ``B_k =
@@ -114,26 +234,28 @@ def basis_ek(
     modes: ``E`` holds the derivative columns of :meth:`_basis_real`.
     ``derivatives=False``: ``B = Phi``.
     """
-    poles, part = fitter.unpack(th, m, ref)
+    fac, pp = (None, None) if given is None else given
+    poles, part = fitter.unpack(th, m, ref) if pp is None else pp
     q = fitter.n_cols(m)
+    s1, kap1, kap_low = factors(fitter, lines) if fac is None else fac
     if fitter.kind == "real":
-        phi, D = basis_real(fitter, poles, part, ref, derivatives)
-        B = np.empty((fitter.n_rows, q + D.shape[1]), order="F")
+        phi, D = basis_real(fitter, poles, part, ref, derivatives, lines)
+        B = np.empty((phi.shape[0], q + D.shape[1]), order="F")
         B[:, :q] = phi
         B[:, q:] = D
         return B, poles
-    nin, nf = fitter.n_in, fitter.n_f
+    nin, nf = fitter.n_in, s1.size
     ne = 2 * nin * m if derivatives else 0
     # rows: columns of B, complex (real and imaginary part interleaved as in Y)
     bt = np.empty((q + ne, nin, nf), complex)
-    s, kap = fitter.s[None, :], fitter.kappa[None, :]
+    s, kap = s1[None, :], kap1[None, :]
     if nin == 1:
         sig = (-poles.real)[:, None] + 0j  # complex factors: no casts in the loops
         mom = -poles.imag[:, None] + 0j
         den = s - poles[:, None]
         den *= s - np.conj(poles)[:, None]  # d = (s - p)(s - conj p)
         r = np.reciprocal(den)
-        h = fitter._kap2 * r  # 2 kappa / d
+        h = 2.0 * kap * r  # 2 kappa / d
         t = s + sig
         np.multiply(t, h, out=bt[0 : 2 * m : 2, 0])
         np.multiply(h, mom, out=bt[1 : 2 * m : 2, 0])
@@ -169,7 +291,7 @@ def basis_ek(
                 bt[rows + 2 + 2 * j, kk_] = gp
                 bt[rows + 3 + 2 * j, kk_] = gm
     c0 = 2 * m
-    for use, kk in ((fitter.use_upper, fitter.kappa), (fitter.use_lower, fitter.kappa_low)):
+    for use, kk in ((fitter.use_upper, kap1), (fitter.use_lower, kap_low)):
         if use:
             bt[c0 : c0 + nin] = 0.0
             for k in range(nin):
@@ -184,10 +306,11 @@ def basis_real(
     part: NDArray[np.complex128],
     ref: NDArray[np.intp],
     derivatives: bool,
+    lines: slice | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``Phi`` and ``D`` of the real-mode model (columns of :meth:`_layout`)."""
-    nin, nf = fitter.n_in, fitter.n_f
-    s, kap = fitter.s, fitter.kappa
+    s, kap, kap_low = factors(fitter, lines)
+    nin, nf = fitter.n_in, s.size
     m = poles.size
     q = fitter.n_cols(m)
     cols = np.zeros((q, nin, nf), complex)
@@ -218,11 +341,11 @@ def basis_real(
             c0 += 1
     if fitter.use_lower:
         for k in range(nin):
-            cols[c0, k] = fitter.kappa_low
+            cols[c0, k] = kap_low
             c0 += 1
     phi = cols.reshape(q, nin * nf).view(np.float64).T
     if not derivatives or not dl:
-        return phi, np.zeros((fitter.n_rows, 0))
+        return phi, np.zeros((phi.shape[0], 0))
     return phi, np.stack(dl).reshape(len(dl), nin * nf).view(np.float64).T
 
 

@@ -1,5 +1,5 @@
-"""Linear algebra of the modal fits: variable projection from Gram blocks,
-orthogonalisation, the extra sum of squares of a mode, and the bounded
+"""Linear algebra of the modal fits: variable projection from Gram blocks or a
+blocked QR, the extra sum of squares of a mode, and the bounded
 Levenberg-Marquardt iteration (used by :class:`~tyredamp.modal.fit.ModalFitter`)."""
 
 from __future__ import annotations
@@ -22,6 +22,45 @@ _CANCEL_TOL = 1e-6
 #: fit_added: an added column whose squared norm drops below this fraction when the
 #: fixed basis is projected out is projected explicitly
 _PROJ_TOL = 1e-4
+
+
+def _fixed_range(
+    blocks: Any, q: int, yy: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The range of a fixed basis ``Phi``; ``blocks()`` returns its row blocks ``(Phi_b,
+    Y_b)`` with those of the data (called again when a second pass is needed).
+
+    Returns ``T`` (q, r) with ``Q_r^T X = T^T Phi^T X`` for an orthonormal basis
+    ``Q_r`` of the range of ``Phi``, ``Q_r^T Y`` (r, n_out) and ``||P Y_j||^2``
+    (``P`` the projector on the complement of the range). From the Gram blocks
+    when the column-scaled Gram matrix is well conditioned (:func:`_gram_chol`:
+    ``T = R^-1``, ``Q^T Y = R^-T Phi^T Y``, ``||P Y||^2 = ||Y||^2 - ||Q^T Y||^2``)
+    and that difference keeps its accuracy; otherwise from the blocked QR
+    (:func:`_qr_blocks`) and the SVD ``R = U S V^T`` (``r`` singular values above
+    ``1e-13`` times the largest): ``Q_r = Q U_r = Phi V_r S_r^-1``, so ``T = V_r
+    S_r^-1`` and ``Q_r^T Y = U_r^T Q^T Y`` (a rank-deficient ``Phi`` included).
+    """
+    G = np.zeros((q, q))
+    P = np.zeros((q, yy.size))
+    for Pb, Yb in blocks():
+        G += Pb.T @ Pb
+        P += Pb.T @ Yb
+    fac = _gram_chol(G)
+    if fac is not None:
+        rs, d = fac
+        qty = lapack.dtrtrs(rs, P / d[:, None], trans=1)[0]
+        yyp = yy - np.einsum("ij,ij->j", qty, qty)
+        if not (yyp < _CANCEL_TOL * yy).any():
+            tmap = lapack.dtrtri(rs)[0] / d[:, None]  # R^-1 with R = rs diag(d)
+            return np.asarray(tmap), np.asarray(qty), np.asarray(yyp)
+    R, Z, rho = _qr_blocks(blocks(), q, yy.size)
+    u, sv, vt = np.linalg.svd(R)
+    r = int(np.count_nonzero(sv > 1e-13 * sv.max())) if sv.size and sv.max() > 0 else 0
+    # the leading directions of Q outside the range (Q U_r+1.., a rank-deficient Phi)
+    # hold part of ||P Y||^2 as well
+    zo = u[:, r:].T @ Z
+    yyp = rho + np.einsum("ij,ij->j", zo, zo)
+    return np.asarray(vt[:r].T / sv[:r]), np.asarray(u[:, :r].T @ Z), np.asarray(yyp)
 
 
 def _extra_ss(
@@ -100,11 +139,16 @@ def _vp_solve(
     yy : ndarray, shape (n_out,)
         ``||Y_j||^2`` per column.
     explicit : callable
-        Returns ``(B, Y)`` (n_rows rows), called only to orthogonalise an
-        ill-conditioned basis or to form the residual.
+        Returns an iterable of row blocks ``(B_b, Y_b)`` of ``B`` and ``Y``
+        (together every row once), called only when the basis is too
+        ill-conditioned for its Gram matrix or the cost would lose accuracy:
+        the projection then comes from a QR factorisation of ``[Phi | E]``
+        accumulated block by block (:func:`_qr_blocks`), no ``n_rows`` array
+        is formed.
     residual : bool
-        Form the residual ``r = Y - Phi C`` (else only when ``cost`` loses
-        accuracy by cancellation: ``cost_j < _CANCEL_TOL cancel_j``).
+        Take the projection from the QR route whatever the conditioning (else
+        only when ``cost`` loses accuracy by cancellation: ``cost_j < _CANCEL_TOL
+        cancel_j``).
     gradient : bool
         Return ``E^T r``.
     cancel : ndarray, shape (n_out,), optional
@@ -115,109 +159,106 @@ def _vp_solve(
     dict
         ``R`` (``Phi = Q R``), ``C`` (q, n_out) coefficients, ``Ct = Q^T Y``,
         ``QtE = Q^T E``, ``GE = E^T P E`` (``P`` the projector on the complement
-        of ``Phi``), ``Etr = E^T r`` (or None), ``cost``, ``cost_out``, ``resid``
-        (or None) and ``Q`` (None unless the basis was orthogonalised).
+        of ``Phi``), ``Etr = E^T r`` (or None), ``cost``, ``cost_out`` and
+        ``qr`` (True when the QR route was taken).
 
     Notes
     -----
     With ``R`` from the Cholesky factor of ``Phi^T Phi`` (:func:`_gram_chol`):
     ``Q^T X = R^-T Phi^T X`` for ``X = E, Y``, ``C = R^-1 Q^T Y``, ``cost_j =
     ||Y_j||^2 - ||Q^T Y_j||^2``, ``E^T P E = E^T E - (Q^T E)^T Q^T E`` and ``E^T r =
-    E^T Y - (Q^T E)^T Q^T Y``. When the Gram matrix is too ill-conditioned
-    ``Q`` comes from :func:`_orth` of the explicit basis.
+    E^T Y - (Q^T E)^T Q^T Y``. The QR route factors ``[Phi | E] = Q_B R_B`` with
+    ``R_B = [[R, Q^T E], [0, R_2]]`` and ``Q_B^T Y = [Q^T Y; X]`` plus the rows
+    beyond, whose squared norm ``rho_j`` is the part of ``Y`` outside the span
+    of ``[Phi | E]``: ``E^T P E = R_2^T R_2``, ``E^T r = R_2^T X`` and ``cost_j =
+    ||X_j||^2 + rho_j``, free of cancellation (Golub & Van Loan, *Matrix
+    Computations*, 4th ed. 2013, sec. 5.3 and 5.6: least squares by QR of the
+    augmented matrix).
     """
     ne = G.shape[0] - q
     fac = _gram_chol(G[:q, :q])
-    Q = None
-    Bx = Yx = None
-    if fac is not None:
+    if fac is not None and not residual:
         rs, d = fac
         rhs = np.concatenate([G[:q, q:], P[:q]], axis=1) / d[:, None]
         x = lapack.dtrtrs(rs, rhs, trans=1)[0]
         QtE, Ct = x[:, :ne], x[:, ne:]
-        R = rs * d[None, :]
-        C = lapack.dtrtrs(rs, Ct)[0] / d[:, None]
+        ct2 = (Ct * Ct).sum(axis=0)
+        cost_out = yy - ct2
+        if not (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
+            return {
+                "R": rs * d[None, :],
+                "C": lapack.dtrtrs(rs, Ct)[0] / d[:, None],
+                "Ct": Ct,
+                "QtE": QtE,
+                "GE": G[q:, q:] - QtE.T @ QtE,
+                "Etr": P[q:] - QtE.T @ Ct if gradient else None,
+                "cost": float(cost_out.sum()),
+                "cost_out": cost_out,
+                "qr": False,
+            }
+    Rb, Z, rho = _qr_blocks(explicit(), G.shape[0], P.shape[1])
+    R, QtE, R2 = Rb[:q, :q], Rb[:q, q:], Rb[q:, q:]
+    Ct, X = Z[:q], Z[q:]
+    diag = np.abs(np.diag(R))
+    cost_out = np.einsum("ij,ij->j", X, X) + rho
+    Etr = R2.T @ X if gradient else None
+    if diag.size and diag.min() <= 1e-13 * diag.max():
+        C = np.linalg.lstsq(R, Ct, rcond=None)[0]  # minimum-norm, as lstsq(Phi, Y)
+        # a rank-deficient Phi leaves part of Q^T Y unexplained: r = Q (Ct - R C) + ...
+        top = Ct - R @ C
+        cost_out = cost_out + np.einsum("ij,ij->j", top, top)
+        if Etr is not None:
+            Etr = Etr + QtE.T @ top
     else:
-        Bx, Yx = explicit()
-        phi = Bx[:, :q]
-        Q, R = _orth(phi)
-        QtE = Q.T @ Bx[:, q:]
-        Ct = Q.T @ Yx
-        diag = np.abs(np.diag(R))
-        if diag.min() <= 1e-13 * diag.max():
-            C = np.linalg.lstsq(phi, Yx, rcond=None)[0]
-        else:
-            C = sla.solve_triangular(R, Ct)
-    ct2 = (Ct * Ct).sum(axis=0)
-    cost_out = yy - ct2
-    GE = G[q:, q:] - QtE.T @ QtE
-    resid = Etr = None
-    if residual or (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
-        if Bx is None:
-            Bx, Yx = explicit()
-        resid = Yx - (Bx[:, :q] @ C if Q is None else Q @ Ct)
-        cost_out = np.einsum("ij,ij->j", resid, resid)
-        if gradient:
-            Etr = Bx[:, q:].T @ resid
-    elif gradient:
-        Etr = P[q:] - QtE.T @ Ct
+        C = sla.solve_triangular(R, Ct)
     return {
         "R": R,
         "C": C,
         "Ct": Ct,
-        "Q": Q,
         "QtE": QtE,
-        "GE": GE,
+        "GE": R2.T @ R2,
         "Etr": Etr,
-        "resid": resid,
         "cost": float(cost_out.sum()),
         "cost_out": cost_out,
+        "qr": True,
     }
 
 
-def _orth(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Thin QR ``phi = Q R`` by CholeskyQR2 (Yamamoto et al. 2015), Householder fallback.
+def _qr_blocks(
+    blocks: Any, n_col: int, n_out: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """QR of a tall ``B`` given as row blocks, with ``Q^T`` applied to ``Y``.
 
-    Two Cholesky passes on the Gram matrix of the column-scaled basis give
-    ``Q`` orthonormal to round-off whenever ``cond(phi) < ~1e7`` and cost two
-    ``n x q`` Gram products and triangular solves -- several times faster than
-    LAPACK's Householder QR with an explicit ``Q`` for the tall bases here.
-    Householder QR for small bases and when a Cholesky factor is singular or
-    too ill-conditioned.
+    ``blocks`` yields ``(B_b, Y_b)``. Each block is stacked under the triangle
+    of the blocks before it and factored again (Householder, LAPACK ``dgeqrf``
+    and ``dormqr``; the tall-skinny QR of Demmel et al. 2012), so that only
+    one block and an ``n_col`` triangle are held. Returns ``R`` (n_col, n_col,
+    upper; zero rows when ``B`` has fewer rows), ``Z`` (n_col, n_out) the
+    leading rows of ``Q^T Y`` and ``rho`` (n_out,) the squared norms of its
+    other rows.
     """
-    n, q = phi.shape
-    if n * q * q < 4e6:  # small: LAPACK's call overhead is lower than two Cholesky passes
-        return _householder(phi)
-    nrm = np.sqrt(np.einsum("ij,ij->j", phi, phi))
-    if np.all(nrm > 0) and np.all(np.isfinite(nrm)):
-        g1 = (phi.T @ phi) / np.outer(nrm, nrm)
-        try:
-            r1 = np.linalg.cholesky(g1).T
-            d1 = np.abs(np.diag(r1))
-            if d1.min() > 1e-7 * d1.max():
-                eye = np.eye(r1.shape[0])
-                q1 = phi @ (sla.solve_triangular(r1, eye) / nrm[:, None])
-                r2 = np.linalg.cholesky(q1.T @ q1).T
-                q = q1 @ sla.solve_triangular(r2, eye)
-                return q, (r2 @ r1) * nrm[None, :]
-        except np.linalg.LinAlgError:
-            pass
-    return _householder(phi)
-
-
-def _householder(phi: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Thin Householder QR by LAPACK ``dgeqrf`` + ``dorgqr`` (less call overhead
-    than :func:`numpy.linalg.qr` for the small bases); NumPy's on failure."""
-    n, q = phi.shape
-    if n >= q > 0:
-        qr, tau, _, info = lapack.dgeqrf(phi)
-        if info == 0:
-            r = np.triu(qr[:q])
-            qm, _, info = lapack.dorgqr(qr, tau, overwrite_a=1)
-            if info == 0:
-                return qm, r
-    qn, rn = np.linalg.qr(phi)
-    return qn, rn
+    R = np.zeros((0, n_col))
+    Z = np.zeros((0, n_out))
+    rho = np.zeros(n_out)
+    for Bb, Yb in blocks:
+        A = np.concatenate([R, Bb])
+        Yst = np.concatenate([Z, Yb])
+        qr, tau, _, info = lapack.dgeqrf(A, overwrite_a=1)
+        if info != 0:
+            raise np.linalg.LinAlgError("QR of the basis failed")
+        k = min(A.shape[0], n_col)
+        lwork = max(1, Yst.shape[1]) * 64
+        # the reflectors are the first k columns (fewer rows than columns: k rows)
+        qty, _, info = lapack.dormqr("L", "T", qr[:, :k], tau[:k], Yst, lwork, overwrite_c=1)
+        if info != 0:
+            raise np.linalg.LinAlgError("QR of the basis failed")
+        rest = qty[k:]
+        rho += np.einsum("ij,ij->j", rest, rest)
+        R, Z = np.triu(qr[:k]), np.array(qty[:k])
+    if R.shape[0] < n_col:  # fewer rows than columns
+        R = np.concatenate([R, np.zeros((n_col - R.shape[0], n_col))])
+        Z = np.concatenate([Z, np.zeros((n_col - Z.shape[0], n_out))])
+    return R, Z, rho
 
 
 def _lu_solve(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.float64], int]:

@@ -42,6 +42,19 @@ def _abs2(z: NDArray[np.complex128]) -> NDArray[np.float64]:
     return np.asarray(z.real**2 + z.imag**2)
 
 
+#: lines per block of the per-line residual powers (no temporaries of the data's size)
+_BLOCK = 16384
+
+
+def _abs2_diff(a: NDArray[np.complex128], b: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """``|a - b|^2`` (same shape, lines last), computed over blocks of lines."""
+    out = np.empty(a.shape)
+    for i in range(0, a.shape[-1], _BLOCK):
+        sl = slice(i, i + _BLOCK)
+        out[..., sl] = _abs2(a[..., sl] - b[..., sl])
+    return out
+
+
 def _problem(res: FitResult, m: int, n_free: int, band: tuple[float, float]) -> tuple[str, int]:
     """Why a fit is not acceptable ("" when it is: a mode crossed a band edge, or
     two merged) and the index of the mode concerned (-1 when none)."""
@@ -196,7 +209,7 @@ def goodness(
             float("nan"), n_obs - n_par, "unknown", n_rejected=n_rejected, false_alarm=false_alarm
         )
     # |e|^2 / (s^2 / 2) per real and imaginary part: chi-square with 2 dof per entry
-    chi2 = 2.0 * float(np.sum(sq / var[:, None, None]))
+    chi2 = 2.0 * float(np.einsum("okf,o->", sq, 1.0 / var))
     label = "from second differences of adjacent lines"
     if few:
         label += (
@@ -235,7 +248,7 @@ def to_model(
     """
     pr = ctx.problem
     c = pr.scale
-    sq = _abs2(res.model - pr.H)
+    sq = _abs2_diff(res.model, pr.H)
     gof = goodness(pr, sq, res.n_par, len(ctx.rejected), ctx.false_alarm)
     u = unscale(res, c, bool(pr.drive))
     data = pr.frf
@@ -260,7 +273,7 @@ def to_model(
     }
     n_f = pr.H.shape[-1]
     rmsd = float(c * np.sqrt(sq.sum()) / sq.size)
-    rel = float(np.sqrt(sq.sum() / max(float(np.sum(_abs2(pr.H))), 1e-300)))
+    rel = float(np.sqrt(sq.sum() / max(float(np.vdot(pr.H, pr.H).real), 1e-300)))
     per_frf = c * np.sqrt(sq.sum(axis=-1)) / n_f
     stat = res.significance[:n_band][o]
     kept = ctx.kept

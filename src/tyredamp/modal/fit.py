@@ -39,11 +39,19 @@ symmetric rank-k update and one matrix product with the data, ``O(n_in n_freq
 complement of the basis, ``r`` the residual), and from them ``J^T J`` and
 ``J^T r`` -- neither ``Q``, nor the residual, nor the ``(n_out n_in n_freq) x
 n_param`` Jacobian is formed. This is accurate to ``eps cond(Phi)^2`` (the
-columns scaled to unit norm); a basis whose condition estimate is too large
-for that is orthogonalised (Householder or CholeskyQR2) instead, and the
-residual is formed when the cost would lose accuracy by cancellation. The
-refinement is a bounded Levenberg-Marquardt iteration on these normal
-equations.
+columns scaled to unit norm); for a basis whose condition estimate is too
+large for that, or when the cost would lose accuracy by cancellation, the
+same quantities come from a Householder QR of ``[Phi | E]`` with ``Q^T``
+applied to ``Y`` (:func:`~tyredamp.modal._linalg._vp_solve`). The refinement
+is a bounded Levenberg-Marquardt iteration on these normal equations.
+
+Memory (issue 15): the Gram blocks, the QR and the fitted FRFs are summed
+over blocks of lines of a fixed size (:func:`~tyredamp.modal._basis.blocks`,
+about 1 MB); the basis of all lines, the weighted data ``Y`` and the
+residual are never held, so a fit costs the data plus a constant. The data
+rows, ``s = i w`` and ``kappa`` of a block are formed when needed (the
+attributes ``Y``, ``s``, ``kappa``, ``kappa_low`` form them for all lines on
+request).
 
 Scaling (spec step 3 and eq. [10]): with drive points ``(j_k, k)`` (output
 ``j_k`` at the place of input ``k``) reciprocity ``psi_in[k] = psi_out[j_k]``
@@ -66,16 +74,14 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import lapack
 
 from ..exceptions import InputError
 from . import _basis, _scaling
 from ._linalg import (
-    _CANCEL_TOL,
     _PROJ_TOL,
     _extra_ss,
+    _fixed_range,
     _levenberg_marquardt,
-    _orth,
     _vp_solve,
 )
 from .compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
@@ -122,8 +128,7 @@ class FitResult:
     theta: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     participation: NDArray[np.complex128] = field(default_factory=lambda: np.zeros((0, 0), complex))
     drive_phi2: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(0, complex))
-    #: theta, ref, Phi, R and Q (None when not formed) of the fit's projection, which
-    #: :meth:`ModalFitter.fit_added` reuses (``fixed=``); the fitter keeps no state
+    #: not filled any more (the fits keep no per-line array); kept for compatibility
     projection: tuple[Any, ...] | None = None
 
 
@@ -181,10 +186,7 @@ class ModalFitter:
         self.use_upper = upper
         self.use_lower = lower
         self.unit_weights = unit_weights
-        w = 2 * np.pi * frequency
-        self.s = 1j * w
-        self.kappa = (1j * w) ** power
-        self.kappa_low = (1j * w) ** (power - 2)
+        self.power = int(power)
         self.line_weights: NDArray[np.float64] | None = None
         if line_weights is not None:
             lw = np.asarray(line_weights, float)
@@ -193,21 +195,20 @@ class ModalFitter:
                     f"line_weights: expected {frequency.size} finite positive values, got "
                     f"shape {lw.shape}"
                 )
-            self.line_weights = lw
             # every basis column is kappa or kappa_low times a function of s: weighting
             # the two factors weights every basis and derivative row of the line
-            self.kappa = self.kappa * lw
-            self.kappa_low = self.kappa_low * lw
-            H = H * lw[None, None, :]
-        self._kap2 = 2.0 * self.kappa[None, :]
-        self.w_ref = float(w[-1])
-        # data: rows (k, f) complex, real and imaginary part interleaved (row 2i:
-        # Re, row 2i + 1: Im of line i); the basis columns use the same layout
-        hc = H.transpose(1, 2, 0).reshape(self.n_in * self.n_f, self.n_out)
-        self.Y = np.stack([hc.real, hc.imag], axis=1).reshape(2 * hc.shape[0], self.n_out)
-        self.n_rows = self.Y.shape[0]
-        self.data_ss = float(np.sum(self.Y**2))
-        self._rms = np.sqrt(np.mean(self.Y**2, axis=0))  # RMS per output row
+            self.line_weights = lw
+        self.w_ref = float(2 * np.pi * frequency[-1])
+        # data rows (k, f), real and imaginary part interleaved (_basis.ydata), are
+        # formed block by block when needed; only their sums of squares are kept
+        self.n_rows = 2 * self.n_in * self.n_f
+        yss = np.zeros(self.n_out)
+        for sl in _basis.blocks(self, 0):
+            yb = _basis.ydata(self, sl)
+            yss += np.einsum("ij,ij->j", yb, yb)
+        self._yss = yss  # ||Y_j||^2 per output
+        self.data_ss = float(np.sum(yss))
+        self._rms = np.sqrt(yss / max(self.n_rows, 1))  # RMS per output row
         #: noise floor per output (units of the data; NOISE_FLOOR)
         self.noise_floor = NOISE_FLOOR * self._rms
         # weights of a first pass (fit without sigma, fit_added): 1 / RMS per output
@@ -216,6 +217,26 @@ class ModalFitter:
             if unit_weights
             else 1.0 / np.where(self._rms > 0, self._rms, 1.0)
         )
+
+    @property
+    def Y(self) -> NDArray[np.float64]:
+        """Data rows (2 n_in n_freq, n_out), formed on request (the fits use blocks)."""
+        return _basis.ydata(self)
+
+    @property
+    def s(self) -> NDArray[np.complex128]:
+        """``i w`` of every line (formed on request)."""
+        return _basis.factors(self)[0]
+
+    @property
+    def kappa(self) -> NDArray[np.complex128]:
+        """``(i w)^power`` times the line weights (formed on request)."""
+        return _basis.factors(self)[1]
+
+    @property
+    def kappa_low(self) -> NDArray[np.complex128]:
+        """``(i w)^(power - 2)`` times the line weights (formed on request)."""
+        return _basis.factors(self)[2]
 
     # ------------------------------------------------------------ layout
     def n_cols(self, m: int) -> int:
@@ -286,42 +307,56 @@ class ModalFitter:
     _coef = staticmethod(_basis.coef)
     _basis_ek = _basis.basis_ek
     _basis_real = _basis.basis_real
+    _ydata = _basis.ydata
 
     def _solve(
         self,
         th: NDArray[np.float64],
         m: int,
         ref: NDArray[np.intp],
-        Yw: NDArray[np.float64],
+        w: NDArray[np.float64],
         residual: bool = True,
         gradient: bool = True,
-        yy: NDArray[np.float64] | None = None,
         derivatives: bool = True,
     ) -> dict[str, Any]:
-        """Projection at ``th`` from the Gram blocks ``B^T B`` and ``B^T Yw`` of ``B =
-        [Phi | E]`` (:func:`_vp_solve`). With ``residual=False`` the residual
-        matrix is not formed unless the cost would lose accuracy (an output
-        fitted better than 0.1 %); ``gradient=False``: no ``E^T r`` (a fit
-        without refinement needs no gradient); ``derivatives=False``: no ``E``
-        (nor ``J^T J``). ``yy``: the column sums of ``Yw**2``, when already known."""
-        B, poles = self._basis_ek(th, m, ref, derivatives)
+        """Projection at ``th`` for the data weighted by ``w`` (n_out,) per output.
+
+        The Gram blocks ``B^T B`` and ``B^T Y`` of ``B = [Phi | E]`` are summed over
+        blocks of lines (:func:`~tyredamp.modal._basis.blocks`; neither the basis nor
+        the weighted data of all lines is formed) and solved by :func:`_vp_solve`,
+        which goes through the blocks again for the QR route. With ``residual=True``
+        the QR route is taken (no cancellation in the cost); otherwise only when
+        the Gram matrix is ill-conditioned or the cost would lose accuracy;
+        ``gradient=False``: no ``E^T r`` (a fit without refinement needs no
+        gradient); ``derivatives=False``: no ``E`` (nor ``J^T J``)."""
         q = self.n_cols(m)
-        if yy is None:
-            yy = np.einsum("ij,ij->j", Yw, Yw)
+        pp = self.unpack(th, m, ref)
+        lay = self._layout(m) if derivatives else None
+        n_col = q + (0 if lay is None else int(lay.ecol.max(initial=-1)) + 1)
+        parts = _basis.blocks(self, n_col)
+
+        def rows() -> Any:
+            for sl in parts:
+                b = self._basis_ek(th, m, ref, derivatives, sl, (None, pp))[0]
+                yield b, self._ydata(sl) * w
+
+        G = np.zeros((n_col, n_col))
+        P = np.zeros((n_col, self.n_out))
+        for B, Yb in rows():
+            G += B.T @ B
+            P += B.T @ Yb
         sol = _vp_solve(
-            B.T @ B,
-            B.T @ Yw,
+            G,
+            P,
             q,
-            yy,
-            lambda: (B, Yw),
+            self._yss * w**2,
+            rows,
             residual=residual,
             gradient=gradient and derivatives,
         )
-        sol["phi"] = B[:, :q]
-        if derivatives:
-            lay = self._layout(m)
+        if lay is not None:
             sol["lay"] = lay
-            sol["coef"] = self._coef(lay, poles)
+            sol["coef"] = self._coef(lay, pp[0])
         return sol
 
     def _normal(
@@ -389,23 +424,19 @@ class ModalFitter:
         nit = 0
         warn: list[str] = []
         for ip in range(max(1, passes if refine else 1)):
-            Yw = self.Y * w[None, :]
             if refine:
-                th, nfev, status, sol = self._refine(th, m, ref, Yw, max_nfev, tol=tol)
+                th, nfev, status, sol = self._refine(th, m, ref, w, max_nfev, tol=tol)
                 nit += nfev
             else:
                 sol = self._solve(
-                    th, m, ref, Yw, residual=False, gradient=False, derivatives=uncertainty
+                    th, m, ref, w, residual=False, gradient=False, derivatives=uncertainty
                 )
             sig_out = np.sqrt(sol["cost_out"] / w**2 / max(dof, 1))
             if ip + 1 < passes and refine and not self.unit_weights:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
-        res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
-        # the projection at the result, for fit_added(fixed=res) on these modes
-        res.projection = (th.copy(), ref.copy(), sol["phi"], sol["R"], sol["Q"])
-        return res
+        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
 
     def fit_added(
         self,
@@ -421,20 +452,21 @@ class ModalFitter:
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
-        The basis of the fixed modes and of the residual terms (orthonormal
-        ``Qf``) is projected out of the data; the added pole and participation
+        The basis ``Phi_f`` of the fixed modes and of the residual terms is
+        projected out of the data; the added pole and participation
         (``part_new``, (n_in,)) are then refined by variable projection on the
         projected data (same weighting as the first pass of :meth:`fit`). An
-        evaluation needs the Gram blocks of the added mode's columns ``B1 = [Phi_1
-        | E_1]`` only: ``B1^T B1 - (Qf^T B1)^T Qf^T B1`` and ``B1^T Y - (Qf^T
-        B1)^T Qf^T Y`` (``Qf^T Y`` once per call), neither the projected data nor
-        the projected columns are formed unless the subtraction would lose
-        accuracy (columns or data mostly in the span of ``Qf``).
-        ``omega_bounds`` (rad/s, lower < upper) limits the damped natural
-        frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
-        ``fixed``: the :meth:`fit` of this fitter that gave the fixed modes
-        (``poles``, ``part`` its poles and participation), whose orthonormal
-        basis is then reused (no state is kept between the calls).
+        evaluation solves the joint projection of ``[Phi_f | Phi_1 | E_1]``
+        (:func:`_vp_solve`), whose rows of the added mode are those of the
+        projected problem (Frisch-Waugh-Lovell theorem, e.g. Seber & Lee 2003,
+        sec. 3.7); ``Phi_f^T Phi_f`` and ``Phi_f^T Y`` are summed once per call,
+        an evaluation adds the blocks of the added columns ``B1 = [Phi_1 | E_1]``
+        (``Phi_f^T B1``, ``B1^T B1``, ``B1^T Y``) over blocks of lines; the QR
+        route of :func:`_vp_solve` is taken when the subtraction would lose
+        accuracy. ``omega_bounds`` (rad/s, lower < upper) limits the damped
+        natural frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
+        ``fixed``: accepted for compatibility and not used (the fixed basis is
+        formed block by block; no per-line array is kept between calls).
 
         Returns
         -------
@@ -458,119 +490,80 @@ class ModalFitter:
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
         w = self._w1
-        Yw = self.Y * w[None, :]
-        yy = np.einsum("ij,ij->j", Yw, Yw)
-        qt, back = self._fixed_projector(poles, part, ref, fixed)
-        # the data projected on the complement of the fixed basis, Yp = Yw - Qf Qf^T Yw,
-        # enters through Qf^T Yw only (formed when ||Yp||^2 would lose accuracy)
-        qty = qt(Yw)
-        Yp: NDArray[np.float64] | None = None
-        yyp = yy - np.einsum("ij,ij->j", qty, qty)
-        if np.any(yyp < _CANCEL_TOL * yy):
-            Yp = Yw - back(qty)
-            yyp = np.einsum("ij,ij->j", Yp, Yp)
-        yp_cache: list[NDArray[np.float64]] = [] if Yp is None else [Yp]
-
-        def projected_data() -> NDArray[np.float64]:
-            if not yp_cache:
-                yp_cache.append(Yw - back(qty))
-            return yp_cache[0]
-
-        # the added mode alone: same fitter without residual columns
+        th_f = self.pack(poles, part, ref)
+        qf = self.n_cols(m)
         one = copy.copy(self)
         one.use_upper = one.use_lower = False
         th0 = one.pack(p1, l1, ref1)
         q1 = one.n_cols(1)
         lay1 = one._layout(1)
+        n1 = q1 + int(lay1.ecol.max()) + 1
+        parts = _basis.blocks(self, qf + n1)
+        # the fixed basis is kept when it is no larger than the data (many outputs) or
+        # fits one block; otherwise it is formed again block by block when needed
+        keep = len(parts) == 1 or qf <= self.n_out
+        cache: dict[int, NDArray[np.float64]] = {}
+        pp_f = self.unpack(th_f, m, ref)
+
+        def fixed_cols(i: int, fac: Any = None) -> NDArray[np.float64]:
+            if i in cache:
+                return cache[i]
+            phi_f = self._basis_ek(th_f, m, ref, False, parts[i], (fac, pp_f))[0]
+            if keep:
+                cache[i] = phi_f
+            return phi_f
+
+        # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
+        # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
+        yy = self._yss * w**2
+        tmap, qty, yyp = _fixed_range(
+            lambda: ((fixed_cols(i), self._ydata(sl) * w) for i, sl in enumerate(parts)), qf, yy
+        )
 
         def solve(th: NDArray[np.float64]) -> dict[str, Any]:
-            # Gram blocks of the added mode's [Phi | E] projected on the complement of Qf
-            B1, p_1 = one._basis_ek(th, 1, ref1)
-            QB = qt(B1)
-            G0 = B1.T @ B1
-            G = G0 - QB.T @ QB
-            d0 = np.diag(G0)
-            Bp: NDArray[np.float64] | None = None
-            if np.any(np.diag(G) < _PROJ_TOL * d0):  # mostly in span(Qf): project explicitly
-                Bp = B1 - back(QB)
-                G = Bp.T @ Bp
-                P = Bp.T @ projected_data()
-            elif Yp is None:
-                P = B1.T @ Yw - QB.T @ qty
-            else:
-                P = B1.T @ Yp
+            # Gram blocks of the added mode's [Phi_1 | E_1] projected on the complement
+            # of Phi_f: B1^T B1 - (Q_r^T B1)^T Q_r^T B1 and B1^T Y - (Q_r^T B1)^T Q_r^T Y
+            cross = np.zeros((qf, n1))
+            g0 = np.zeros((n1, n1))
+            p0 = np.zeros((n1, self.n_out))
+            pp1 = one.unpack(th, 1, ref1)
+            for i, sl in enumerate(parts):
+                fac = None if i in cache else _basis.factors(self, sl)
+                b1 = one._basis_ek(th, 1, ref1, True, sl, (fac, pp1))[0]
+                cross += fixed_cols(i, fac).T @ b1
+                g0 += b1.T @ b1
+                p0 += b1.T @ (self._ydata(sl) * w)
+            qb = tmap.T @ cross
+            G = g0 - qb.T @ qb
+            P = p0 - qb.T @ qty
 
-            def explicit() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-                return (B1 - back(QB) if Bp is None else Bp), projected_data()
+            def projected() -> Any:
+                for i, sl in enumerate(parts):
+                    b1 = one._basis_ek(th, 1, ref1, True, sl)[0]
+                    pt = fixed_cols(i) @ tmap
+                    yield b1 - pt @ qb, self._ydata(sl) * w - pt @ qty
 
-            sol = _vp_solve(
-                G,
-                P,
-                q1,
-                yyp,
-                explicit,
-                residual=False,
-                gradient=True,
-                cancel=yy if Yp is None else yyp,
-            )
+            # columns mostly in span(Phi_f): the QR route of the projected rows
+            force = bool(np.any(np.diag(G) < _PROJ_TOL * np.diag(g0)))
+            sol = _vp_solve(G, P, q1, yyp, projected, residual=force, gradient=True, cancel=yy)
             sol["lay"] = lay1
-            sol["coef"] = one._coef(lay1, p_1)
+            sol["coef"] = one._coef(lay1, one.unpack(th, 1, ref1)[0])
             return sol
 
         th, _, _, sol = self._refine(
-            th0, 1, ref1, Yw, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
+            th0, 1, ref1, w, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
         )
         p_out, l_out = one.unpack(th, 1, ref1)
         dof = self.n_rows - self.n_cols(m + 1)
         res_ss = np.maximum(sol["cost_out"], 0.0) / w**2
         return complex(p_out[0]), l_out[0], np.sqrt(res_ss / max(dof, 1))
 
-    def _fixed_projector(
-        self,
-        poles: NDArray[np.complex128],
-        part: NDArray[np.complex128],
-        ref: NDArray[np.intp],
-        fixed: FitResult | None,
-    ) -> tuple[Any, Any]:
-        """``X -> Qf^T X`` and ``QX -> Qf QX`` for the orthonormal basis ``Qf`` of the
-        fixed modes (``Qf = Phi_f R_f^-1`` when the fit ``fixed`` did not form it)."""
-        m = poles.size
-        last = None if fixed is None else fixed.projection
-        if (
-            fixed is not None
-            and last is not None
-            and np.array_equal(fixed.poles, poles)
-            and np.array_equal(ref, last[1])
-        ):
-            phi_f, r_f, q_f = last[2], last[3], last[4]
-        else:
-            phi_f = self.basis(self.pack(poles, part, ref), m, ref, derivatives=False)[0]
-            q_f, r_f = _orth(phi_f)
-        if q_f is None:
-
-            def qt(X: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(lapack.dtrtrs(r_f, phi_f.T @ X, trans=1)[0])
-
-            def back(QX: NDArray[np.float64]) -> NDArray[np.float64]:
-                return np.asarray(phi_f @ lapack.dtrtrs(r_f, QX)[0])
-
-            return qt, back
-        qf = q_f
-
-        def qt2(X: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.asarray(qf.T @ X)
-
-        def back2(QX: NDArray[np.float64]) -> NDArray[np.float64]:
-            return np.asarray(qf @ QX)
-
-        return qt2, back2
-
     def _refine(
         self,
         th0: NDArray[np.float64],
         m: int,
         ref: NDArray[np.intp],
-        Yw: NDArray[np.float64],
+        w: NDArray[np.float64],
         max_nfev: int,
         solve: Any = None,
         omega_bounds: tuple[float, float] | None = None,
@@ -588,13 +581,11 @@ class ModalFitter:
         th0 = np.clip(th0, lb + 1e-9, ub - 1e-9)
 
         n_lin = self.n_cols(m) if solve is None else 2
-        n_obs = Yw.size
-
-        yy = np.einsum("ij,ij->j", Yw, Yw) if solve is None else None
+        n_obs = self.n_rows * self.n_out
 
         def evaluate(x: NDArray[np.float64]) -> tuple[float, Any, Any, dict[str, Any]]:
             # a given ``solve`` (fit_added) replaces the projection
-            sol = self._solve(x, m, ref, Yw, residual=False, yy=yy) if solve is None else solve(x)
+            sol = self._solve(x, m, ref, w, residual=False) if solve is None else solve(x)
             jtj, jtr = self._normal(sol, n_par)
             sol["jtj"] = jtj  # kept for the standard errors at the optimum
             return float(sol["cost"]), jtj, jtr, sol
@@ -606,7 +597,7 @@ class ModalFitter:
                 lb,
                 ub,
                 max_nfev,
-                dof=max(n_obs - n_lin * Yw.shape[1] - n_par, 1),
+                dof=max(n_obs - n_lin * self.n_out - n_par, 1),
                 tol=tol,
             )
         return x, nfev, "converged" if ok else "maxfev", sol
@@ -722,13 +713,9 @@ class ModalFitter:
             th, m, ref, w, sol, s2, (b, u, didx), uncertainty
         )
         # ---- model (final fits only), contributions
-        phi = sol["phi"]
         model = np.zeros((0, self.n_in, self.n_f), complex)
         if uncertainty:
-            hw = np.ascontiguousarray((C / w[None, :]).T @ phi.T)  # (n_out, n_rows)
-            model = hw.view(np.complex128).reshape(self.n_out, self.n_in, self.n_f)
-            if self.line_weights is not None:
-                model = model / self.line_weights[None, None, :]
+            model = _basis.synth(self, th, m, ref, Cu)
         per = 2 if self.kind == "complex" else 1
         data_ss = self.data_ss
         # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's

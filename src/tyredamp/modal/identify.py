@@ -40,7 +40,15 @@ roots; ``limit = 2 n_freq / (n_in + 1) - 2``):
   Otherwise order ``p`` and its diagram are kept as they were and the
   search stops.
 
-No order exceeds ``limit``. Settled diagrams (the virtual tyre, the rings,
+No order exceeds ``limit``, nor the cap set by the modes the data show:
+``max(p_start, ceil(8 (M + 2) / n))`` with ``M`` the resonance peaks of the
+FRFs that stand out of their noise (:func:`~tyredamp.modal.order.modes_shown`:
+prominence of the FRFs in noise units above twice the largest excursion
+``n_freq`` lines of noise make at the false-alarm rate), i.e. twice the roots
+the sizing rule asks for those modes. The cap follows the resonances, not the
+lines: a band sampled more finely shows the same peaks and keeps its order,
+where the surplus roots of a higher order would fit the noise of the many
+lines and form persistent columns of their own. Settled diagrams (the virtual tyre, the rings,
 bands of up to about 20 modes) take no trial and cost what the sizing rule
 alone costs; each raise or trial recomputes pLSCF at the higher order, and a
 rejected trial costs one pLSCF at about twice the final order.
@@ -134,7 +142,7 @@ class ModalIdentification:
         Candidates dropped, each ``{"frequency_hz", "damping_ratio", "reason",
         "statistic", "threshold"}`` (:class:`~tyredamp.modal.quality.RejectedMode`).
     frequency : ndarray, shape (n_freq,)
-        Lines used (Hz).
+        Lines used (Hz; a read-only view of the FRF's axis, no copy).
     discrepancy : dict of str to ndarray
         ``|H_model - H_data|`` RMS over FRFs per line, for each model.
     warnings : list of str
@@ -271,7 +279,7 @@ def identify_modes(
         flags=dg.flags,
         clusters=dg.kept,
         rejected=[r.to_dict() for r in rej],
-        frequency=np.array(problem.frequency),
+        frequency=problem.frequency,
         discrepancy=disc,
         warnings=warnings,
         noise_source=problem.noise_source,

@@ -15,7 +15,8 @@ The numerator coefficients are eliminated per output (reduced normal
 equations). With one weight per output the normal-equation blocks are
 Toeplitz in the polynomial degree, so they are built from the real parts of
 the sums ``sum_f z_f^d H_ok(f)``: two real matrix products over all outputs
-and lines, ``O(n_out n_freq order)``. The blocks of every lower order are leading
+and lines, ``O(n_out n_freq order)``, accumulated over blocks of lines of a fixed
+memory. The blocks of every lower order are leading
 sub-blocks of the highest order, so a whole stabilisation diagram costs about
 as much as one high-order solve.
 
@@ -292,10 +293,13 @@ def _roots_of_orders(
     return z_up, l_up
 
 
-#: lines per block of the lag sums (:func:`_lag_sums`): the power tables of a
-#: block hold ``3 (P + 1) _BLOCK`` floats (24 MB at P = 60), whatever the length
-#: of the axis
-_BLOCK = 16384
+#: bytes of one block of the lag sums (:func:`_lag_sums`): per line the power
+#: tables hold ``3 (P + 1)`` floats and the weighted data ``2 n_out n_in + 2 n_in^2``,
+#: so a block has ``_BLOCK_BYTES / (8 (3 (P + 1) + 2 n_out n_in + 2 n_in^2))`` lines
+#: (at least ``_MIN_BLOCK``; 668 at P = 60 with one output and input), whatever
+#: the length of the axis
+_BLOCK_BYTES = 1_000_000
+_MIN_BLOCK = 256
 
 
 def _lag_sums(
@@ -311,15 +315,16 @@ def _lag_sums(
     Returns ``Re sum_f z^d`` (d = 0..P), ``c_ok(d) = Re sum_f z^d w_o H_ok(f)``
     (rows ``(o, k)``, columns ``d = -P..P``) and ``Re sum_f z^d q_kk'(f)`` with
     ``q_kk' = sum_o w_o^2 conj(H_ok) H_ok'`` (rows ``(k, k')``). Blocks of
-    ``_BLOCK`` lines keep the memory of the power tables independent of the
+    ``_BLOCK_BYTES`` keep the memory of the power tables independent of the
     number of lines (the sums are the same to rounding).
     """
     n_out, n_in, n_f = h.shape
     z0 = np.zeros(P + 1)
     c = np.zeros((n_out * n_in, 2 * P + 1))
     t = np.zeros((n_in * n_in, 2 * P + 1))
-    for a in range(0, n_f, _BLOCK):
-        b = min(a + _BLOCK, n_f)
+    nb = max(_MIN_BLOCK, _BLOCK_BYTES // (8 * (3 * (P + 1) + 2 * n_out * n_in + 2 * n_in * n_in)))
+    for a in range(0, n_f, nb):
+        b = min(a + nb, n_f)
         # weighted real and imaginary parts, each contiguous for the matrix products
         h_re = h[:, :, a:b].real * w[:, None, None]
         h_im = h[:, :, a:b].imag * w[:, None, None]

@@ -2,21 +2,40 @@
 
 :func:`settle_order` computes the diagram of the starting order with the pole
 estimator and raises the order by the sizing rule and by trials of an
-unsettled diagram, as the docstring of :mod:`tyredamp.modal.identify` states.
+unsettled diagram, as the docstring of :mod:`tyredamp.modal.identify` states,
+up to :func:`order_cap`: twice the roots the sizing rule asks for the
+resonances the data show (:func:`modes_shown`), so that the order follows the
+modes of the band and not its number of lines.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.signal import find_peaks
 
 from .estimators import PoleEstimator
 from .lscf import PoleSet
 from .problem import FitProblem
 from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
+from .stats import FALSE_ALARM, difference_noise
 
-__all__ = ["Diagram", "SelectionRules", "default_order", "order_limit", "settle_order"]
+__all__ = [
+    "Diagram",
+    "SelectionRules",
+    "default_order",
+    "modes_shown",
+    "order_cap",
+    "order_limit",
+    "settle_order",
+]
+
+#: lines per block of the mode indicator of :func:`modes_shown`
+_BLOCK = 16384
+#: most points of the indicator whose peaks :func:`modes_shown` examines
+_PEAK_POINTS = 8192
 
 #: automatic order (identify docstring): a stabilisation diagram is settled when at
 #: least this share of its stable poles belongs to persistent clusters. Settled
@@ -66,6 +85,56 @@ def default_order(n_in: int, n_f: int, n_modes: int | None) -> int:
     return max(2, min(p, order_limit(n_in, n_f)))
 
 
+def modes_shown(problem: FitProblem, false_alarm: float = FALSE_ALARM) -> int:
+    """Number of resonance peaks the data show above their noise.
+
+    The indicator is ``r(f) = (sum_jk |H_jk(f)|^2 / s_j^2)^(1/2)``, the FRFs
+    in units of each output's noise ``s_j`` (from second differences of
+    adjacent lines, :func:`~tyredamp.modal.stats.difference_noise`). The noise
+    moves ``r`` by about one unit at any level (``|h + e| - |h|`` has a
+    standard deviation below 1 for ``e`` of unit variance), and the largest of
+    ``n_f`` such excursions stays below ``z = (2 ln(n_f / alpha))^(1/2)`` with
+    probability about ``1 - alpha`` (the Gaussian tail bound with a Bonferroni
+    factor over the lines, ``alpha = false_alarm``). A local maximum counts as a
+    peak when it rises more than ``2 z`` above the higher of the two minima that
+    separate it from higher ground (its topographic prominence,
+    :func:`scipy.signal.find_peaks`): a maximum and a minimum can each be moved
+    by ``z``. Close modes that share one peak count once, so this is a lower
+    bound of the modes in the band; it does not grow with the number of lines
+    when the lines only sample the same resonances more finely.
+    """
+    H = problem.H
+    n_f = H.shape[-1]
+    if n_f < 3:
+        return 0
+    var = difference_noise(H)
+    s2 = np.where(np.isfinite(var) & (var > 0), var, np.inf)
+    if not np.all(np.isfinite(s2)):
+        # noise-free or too few lines: a noise floor at the data's rounding
+        rms2 = np.mean(H.real**2 + H.imag**2, axis=(1, 2))
+        s2 = np.where(np.isfinite(s2), s2, np.maximum(1e-20 * rms2, 1e-300))
+    r = np.empty(n_f)
+    for i in range(0, n_f, _BLOCK):
+        h = H[:, :, i : i + _BLOCK]
+        r[i : i + _BLOCK] = np.einsum("jkf,j->f", h.real**2 + h.imag**2, 1.0 / s2)
+    np.sqrt(r, out=r)
+    z = math.sqrt(2.0 * math.log(n_f / false_alarm))
+    if n_f > 2 * _PEAK_POINTS:
+        # the prominence of every noise maximum of a long axis costs more than the
+        # identification: the largest value of each of _PEAK_POINTS windows keeps
+        # every resonance wider than two windows (closer ones count once)
+        k = n_f // _PEAK_POINTS
+        r = r[: k * _PEAK_POINTS].reshape(_PEAK_POINTS, k).max(axis=1)
+    peaks, _ = find_peaks(r, prominence=2.0 * z)
+    return int(peaks.size)
+
+
+def order_cap(n_in: int, n_f: int, p_start: int, n_shown: int) -> int:
+    """Highest automatic order: ``max(p_start, ceil(8 (n_shown + 2) / n_in))``, at most
+    :func:`order_limit` (twice the roots the sizing rule asks for the modes shown)."""
+    return max(2, min(order_limit(n_in, n_f), max(p_start, math.ceil(8 * (n_shown + 2) / n_in))))
+
+
 def diagram(
     problem: FitProblem, estimator: PoleEstimator, p: int, rules: SelectionRules
 ) -> Diagram:
@@ -93,9 +162,12 @@ def settle_order(
     rules: SelectionRules,
     automatic: bool,
 ) -> Diagram:
-    """Diagram of the automatic order (sizing rule and trial raises), or of ``p_start``."""
+    """Diagram of the automatic order (sizing rule and trial raises, up to
+    :func:`order_cap` of the modes the data show), or of ``p_start``."""
     n_in = problem.shape[1]
     limit = order_limit(n_in, problem.shape[2])
+    if automatic:
+        limit = min(limit, order_cap(n_in, problem.shape[2], p_start, modes_shown(problem)))
     cur = diagram(problem, estimator, p_start, rules)
     trial: Diagram | None = None  # the diagram before a trial raise
     while automatic:

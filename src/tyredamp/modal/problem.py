@@ -283,8 +283,8 @@ def build_problem(
     if not peak > 0:
         raise InputError(f"H: every FRF is zero in [{lo:g}, {hi:g}] Hz; nothing to identify")
     Hn = Hb / peak
-    rms = float(np.sqrt(np.mean(Hn.real**2 + Hn.imag**2)))
-    Hn = Hn / rms
+    rms = float(np.sqrt(np.vdot(Hn, Hn).real / Hn.size))
+    Hn /= rms  # in place: one copy of the band's data
     scale = peak * rms
     source, v = _line_variance(frf, lines, Hb, variance)
     nu = variance_dof(frf, source, variance is not None)

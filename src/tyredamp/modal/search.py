@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
+from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode
 
@@ -342,24 +343,10 @@ def _residual_peaks(
     lines; its local maxima, largest first. Also returns the residual power
     per line above its median (the excess a missed mode could explain).
     """
-    m_all = res.poles.size
-    s = fitter.s
-    u = res.psi_out  # unscaled (no drive points in a search fitter) or scaled: u l = R
-    lv = res.psi_in
-    model = np.zeros((fitter.n_out, fitter.n_in, fitter.n_f), complex)
-    for n in range(m_all):
-        g = fitter.kappa / (s - res.poles[n])
-        gb = fitter.kappa / (s - np.conj(res.poles[n]))
-        r = u[:, n, None] * lv[None, :, n]
-        model += r[:, :, None] * g + np.conj(r)[:, :, None] * gb
-    if res.upper is not None:
-        model += res.upper[:, :, None] * fitter.kappa
-    if res.lower is not None:
-        model += res.lower[:, :, None] * fitter.kappa_low
-    data = fitter.H if fitter.line_weights is None else fitter.H * fitter.line_weights
-    e = data - model
+    # u l = R (u unscaled without drive points, or scaled); summed block by block
+    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
     s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    pw = np.sum((e.real**2 + e.imag**2) / s2[:, None, None], axis=(0, 1))
+    pw = residual_power(fitter, res.poles, residues, (res.upper, res.lower), s2)
     k = min(5, pw.size)
     sm = np.convolve(pw, np.ones(k) / k, mode="same")
     if sm.size < 3:

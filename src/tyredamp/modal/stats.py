@@ -80,6 +80,8 @@ __all__ = [
 
 #: default false-alarm rate of the mode test and of the goodness-of-fit test
 FALSE_ALARM = 0.01
+#: lines per block of :func:`difference_noise`
+_DIFF_BLOCK = 16384
 
 
 def mode_parameters(n_out: int, n_in: int, mode_kind: str) -> int:
@@ -135,9 +137,14 @@ def difference_noise(H: NDArray[np.complex128]) -> NDArray[np.float64]:
     """
     if H.shape[-1] < 3:
         return np.full(H.shape[0], np.nan)
-    d = H[..., 2:] - 2.0 * H[..., 1:-1] + H[..., :-2]
-    a2 = (d.real**2 + d.imag**2).reshape(H.shape[0], -1)
-    return np.asarray(np.median(a2, axis=1) / (6.0 * math.log(2.0)))
+    n = H.shape[-1] - 2
+    a2 = np.empty((*H.shape[:-1], n))
+    for i in range(0, n, _DIFF_BLOCK):  # blocks of lines: no temporaries of H's size
+        j = min(i + _DIFF_BLOCK, n)
+        d = H[..., i + 2 : j + 2] - 2.0 * H[..., i + 1 : j + 1] + H[..., i:j]
+        a2[..., i:j] = d.real**2 + d.imag**2
+    a2 = a2.reshape(H.shape[0], -1)
+    return np.asarray(np.median(a2, axis=1, overwrite_input=True) / (6.0 * math.log(2.0)))
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,102 @@
+"""Cost bounded by the data (issue 15): the automatic order follows the modes the
+data show, and the blocked linear algebra of the fits equals the dense one."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from tyredamp.frf import FRF
+from tyredamp.modal import ModalModel, identify_modes
+from tyredamp.modal._linalg import _fixed_range, _qr_blocks
+from tyredamp.modal.order import modes_shown, order_cap
+from tyredamp.modal.problem import build_problem
+
+FN = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0])
+ZETA = np.array([0.03, 0.02, 0.02, 0.015, 0.012, 0.01])
+
+
+def _six_modes(n: int, snr_db: float = 40.0, seed: int = 0) -> FRF:
+    """1 x 1 accelerance of six modes on ``n`` lines over 0-200 Hz, noise at ``snr_db``."""
+    w = 2 * np.pi * FN
+    p = -ZETA * w + 1j * w * np.sqrt(1 - ZETA**2)
+    m = ModalModel(p, np.ones((1, 6)) + 0.1j, np.ones((1, 6)))
+    f = np.linspace(0.0, 200.0, n)[1:]
+    h = m.frf(f, "accelerance").H
+    rng = np.random.default_rng(seed)
+    e = (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
+    h = h + 10 ** (-snr_db / 20) * np.sqrt(np.mean(np.abs(h) ** 2)) * e
+    return FRF(f, h, kind="accelerance")
+
+
+@pytest.mark.parametrize("n", [2001, 20001, 200001])
+def test_modes_shown_counts_the_resonances_at_any_sampling(n: int) -> None:
+    # six separated modes at 40 dB: six peaks whether 10 or 1000 lines sample each
+    # half-power band (the count must not follow the lines)
+    assert modes_shown(build_problem(_six_modes(n))) == 6
+    assert modes_shown(build_problem(_six_modes(n), band=(40.0, 60.0))) == 1
+
+
+def test_modes_shown_of_pure_noise_is_zero() -> None:
+    # white noise has no resonance: a peak needs a prominence of twice the largest
+    # excursion of the lines' noise at the false-alarm rate (1 %)
+    rng = np.random.default_rng(5)
+    n = 50_000
+    h = (rng.normal(size=(1, 1, n)) + 1j * rng.normal(size=(1, 1, n))) / np.sqrt(2)
+    frf = FRF(np.linspace(1.0, 200.0, n), h, kind="accelerance")
+    assert modes_shown(build_problem(frf)) == 0
+
+
+def test_order_cap_is_twice_the_sizing_of_the_modes_shown() -> None:
+    # ceil(8 (M + 2) / n_in), never below the start, never above the line limit
+    assert order_cap(1, 100_000, 60, 1) == 60
+    assert order_cap(1, 100_000, 60, 30) == 256
+    assert order_cap(2, 100_000, 30, 30) == 128
+    assert order_cap(1, 40, 60, 30) == 2 * 40 // 2 - 2
+
+
+def test_narrow_band_of_an_oversampled_frf_keeps_a_small_order() -> None:
+    # 2000 lines in 40-60 Hz (100 per half-power band of the 48 Hz mode): the order
+    # is set by the one resonance, not by the lines (the line-driven rule reached
+    # order 536 here); the mode is found as on a coarse axis
+    res = identify_modes(_six_modes(20001), band=(40.0, 60.0), model="complex")
+    mdl = res.models["complex"]
+    assert mdl.meta["max_order"] <= 60
+    k = int(np.argmin(np.abs(mdl.frequency_hz - 48.0)))
+    # 48 Hz to its standard error (1 % noise): well within 0.1 %
+    assert abs(mdl.frequency_hz[k] - 48.0) < 1e-3 * 48.0
+
+
+def test_blocked_qr_equals_the_dense_least_squares() -> None:
+    # R^T R = B^T B, Z = leading rows of Q^T Y and rho the residual of the columns'
+    # least squares: against numpy's QR and lstsq on the stacked matrix
+    rng = np.random.default_rng(2)
+    B = rng.normal(size=(103, 7)) @ np.diag([1, 1e-3, 1, 10, 1, 1, 1e2])
+    Y = rng.normal(size=(103, 3))
+    parts = [slice(0, 5), slice(5, 40), slice(40, 41), slice(41, 103)]  # one shorter than n_col
+    R, Z, rho = _qr_blocks(((B[s], Y[s]) for s in parts), 7, 3)
+    assert_allclose(R.T @ R, B.T @ B, rtol=0, atol=1e-10 * np.abs(B.T @ B).max())
+    assert_allclose(np.triu(R), R, rtol=0, atol=0)
+    c = np.linalg.lstsq(B, Y, rcond=None)[0]
+    assert_allclose(rho, np.sum((Y - B @ c) ** 2, axis=0), rtol=1e-10)
+    assert_allclose(np.linalg.solve(R, Z), c, rtol=1e-9)
+
+
+@pytest.mark.parametrize("rank_deficient", [False, True])
+def test_fixed_range_projects_on_the_span(rank_deficient: bool) -> None:
+    # Q_r^T X = T^T Phi^T X with Q_r orthonormal spanning Phi, and ||P Y||^2 the
+    # residual of the least squares on Phi (a repeated column: the QR route + SVD)
+    rng = np.random.default_rng(3)
+    phi = rng.normal(size=(80, 5))
+    if rank_deficient:
+        phi[:, 4] = phi[:, 1]
+    Y = rng.normal(size=(80, 2))
+    parts = [slice(0, 30), slice(30, 80)]
+    tmap, qty, yyp = _fixed_range(lambda: ((phi[s], Y[s]) for s in parts), 5, np.sum(Y**2, axis=0))
+    q_r = phi @ tmap
+    assert q_r.shape[1] == (4 if rank_deficient else 5)
+    assert_allclose(q_r.T @ q_r, np.eye(q_r.shape[1]), atol=1e-12)
+    assert_allclose(qty, q_r.T @ Y, atol=1e-12)
+    c = np.linalg.lstsq(phi, Y, rcond=None)[0]
+    assert_allclose(yyp, np.sum((Y - phi @ c) ** 2, axis=0), rtol=1e-10)
