@@ -28,9 +28,10 @@ when the estimator states them (:func:`~tyredamp.signal.estimators.estimate_frf`
 ``2 (n_eff - n_in)`` with ``n_eff`` the averages reduced for overlapping
 windows), else ``2 (n_averages - n_in)`` from ``meta["n_averages"]`` (the
 residual of the least-squares H1 over the averages, no overlap correction),
-else unknown: taken as known (the local methods, ``n_averages = 1``, whose
-variance has the local fit's degrees of freedom, not stated in the meta
-yet). The goodness of fit corrects for them (:mod:`tyredamp.modal.stats`).
+else unknown: taken as known. The local methods (LRM/LPM, ``n_averages =
+1``) state the local fit's ``2 (2 n + 1 - n_par)``
+(:func:`~tyredamp.signal.lrm.local_variance_dof`). The goodness of fit
+corrects for them (:mod:`tyredamp.modal.stats`).
 
 A known variance ``V_jkf`` enters the fit as a separable model ``sigma_j^2
 g_f`` (``sigma_j^2`` the mean variance of output ``j``, ``g_f`` the mean of
