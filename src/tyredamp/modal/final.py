@@ -3,15 +3,18 @@ its goodness of fit and the :class:`~tyredamp.modal.model.ModalModel` with its
 :class:`~tyredamp.modal.quality.FitQuality`.
 
 The final fits weight every line by the noise model of the
-:class:`~tyredamp.modal.problem.FitProblem`: with a known per-line variance
-(given, or from the coherence) the weighted cost is the Gaussian negative
-log-likelihood (times two) of the data, and the fit is the maximum-likelihood
-estimate of poles, participation and residues; otherwise the noise level of
-each output is estimated from the residual of the search's model (a
-generous model) and the fit iterates it (iteratively reweighted least
-squares, the maximum-likelihood estimate for a noise level per output).
-Standard errors come from the Gauss-Newton (Fisher) information ``J^T J`` at
-the optimum, scaled by the residual variance.
+:class:`~tyredamp.modal.problem.FitProblem`. With a known per-line variance
+(given, or from the coherence and the averages, with ``nu > 4`` degrees of
+freedom when estimated) the weighted least-squares fit with its separable
+approximation ``sigma_j^2 g_f`` starts the maximum-likelihood refinement of
+poles, participation and residues with the variance of every entry
+(:mod:`~tyredamp.modal.ml`, the default final stage), whose standard errors
+come from its Fisher information. Otherwise the noise level of each output
+is estimated from the residual of the search's model (a generous model) and
+the fit iterates it (iteratively reweighted least squares, the
+maximum-likelihood estimate for a noise level per output); standard errors
+from the Gauss-Newton information ``J^T J`` at the optimum, scaled by the
+residual variance (equal to the Fisher information of that noise model).
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .fit import FitResult, ModalFitter
 from .indicators import mean_phase_deviation, modal_phase_collinearity
+from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
 from .quality import FitQuality, RejectedMode
@@ -120,6 +124,9 @@ def fit_real(
         res = fitter.fit(start_p, start_l, max_nfev=100, tol=FINAL_TOL, sigma=sigma, passes=passes)
         why, bad = _problem(res, m, nf, problem.band)
         if not why:
+            ml = maximum_likelihood(problem, fitter, res)
+            if not _problem(ml, m, nf, problem.band)[0]:
+                res = ml
             return res, m, []
         if bad >= m + nf:
             keep = np.arange(start_p.size) != bad
@@ -348,13 +355,71 @@ def final_complex(
         )
         res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
         res.status, res.n_iter = r0.status, r0.n_iter
-        return res, cur, dropped
-    return fit_checked(
-        cfit,
-        modes,
-        refine,
-        problem.band,
-        passes=1 if sigma0 is not None else 2,
-        sigma=sigma0,
-        tol=FINAL_TOL,
+    else:
+        res, cur, dropped = fit_checked(
+            cfit,
+            modes,
+            refine,
+            problem.band,
+            passes=1 if sigma0 is not None else 2,
+            sigma=sigma0,
+            tol=FINAL_TOL,
+        )
+    if refine:
+        res = maximum_likelihood(problem, cfit, res)
+    return res, cur, dropped
+
+
+def full_weights(problem: FitProblem) -> bool:
+    """Whether weighting every entry by its own variance estimate ``V^`` beats the
+    separable weights ``sigma_j^2 g_f`` of the WLS fit (both against the true
+    weights ``1 / V``).
+
+    A weighted least-squares estimate with weights ``w`` has the covariance of
+    the ideal one times ``E[w^2 V] E[1 / V] / E[w]^2`` (lines of equal
+    leverage; Kantorovich's inequality makes it >= 1). For the entries' own
+    estimates (``V^ / V ~ chi2_nu / nu``) that is ``(nu - 2) / (nu - 4)``
+    (infinite for ``nu <= 4``); for the separable model, with ``rho = V /
+    (sigma_j^2 g_f)``, it is ``mean(rho) mean(1 / rho)``, estimated from ``rho^ =
+    V^ / (sigma_j^2 g_f)`` as ``mean(rho^) mean(1 / rho^) (nu - 2) / nu``
+    (``E[1 / rho^] = nu / (nu - 2) E[1 / rho]``). A known variance (``nu``
+    None) is always used entry by entry (maximum likelihood).
+    """
+    nu = problem.noise_dof
+    v = problem.variance
+    if v is None or problem.sigma_out is None or problem.line_weights is None:
+        return False
+    if nu is None:
+        return True
+    if not nu > 4.0:
+        return False
+    sep = problem.sigma_out[:, None, None] ** 2 / problem.line_weights[None, None, :] ** 2
+    pos = v > 0
+    rho = v[pos] / np.broadcast_to(sep, v.shape)[pos]
+    if rho.size == 0:
+        return False
+    loss_sep = float(np.mean(rho) * np.mean(1.0 / rho)) * (nu - 2.0) / nu
+    return (nu - 2.0) / (nu - 4.0) < loss_sep
+
+
+def maximum_likelihood(problem: FitProblem, fitter: ModalFitter, res: FitResult) -> FitResult:
+    """The maximum-likelihood refinement (:func:`~tyredamp.modal.ml.ml_refine`) of the
+    weighted fit ``res`` of ``fitter`` when the per-line variance is known, or
+    estimated and :func:`full_weights` says its own weights are the better ones."""
+    if problem.variance is None or not full_weights(problem):
+        return res
+    nu = problem.noise_dof
+    plain = ModalFitter(
+        problem.frequency,
+        problem.H,
+        problem.power,
+        fitter.kind,
+        problem.drive,
+        upper=fitter.use_upper,
+        lower=fitter.use_lower,
     )
+    try:
+        return ml_refine(plain, res, problem.variance, nu, tol=FINAL_TOL)
+    except (np.linalg.LinAlgError, ValueError):
+        res.warnings.append("maximum-likelihood refinement failed: weighted fit kept")
+        return res
