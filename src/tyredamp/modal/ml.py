@@ -46,6 +46,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import sparse
 from scipy.linalg import solve_triangular
 
 from ._linalg import _levenberg_marquardt
@@ -90,12 +91,21 @@ def _evaluate(
     m: int,
     ref: NDArray[np.intp],
     om: NDArray[np.float64],
-    A: NDArray[np.float64],
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
-    """Cost, ``J^T J``, ``J^T r`` and the coefficients ``C`` (q, n_out) at ``th``."""
-    phi, D, _, dcol = fitter.basis(th, m, ref)
+    """Cost, ``J^T J``, ``J^T r`` and the coefficients ``C`` (q, n_out) at ``th``.
+
+    With ``M_j = W_j (dPhi / dtheta) C_j`` and ``Q_j^T r_j = 0``: ``J_j^T J_j = M_j^T
+    M_j - (Q_j^T M_j)^T Q_j^T M_j`` and ``J_j^T r_j = -M_j^T r_j``. ``M_j = W_j E
+    S_j`` with ``E`` the distinct derivative columns (:meth:`ModalFitter.basis`)
+    and ``S_j`` sparse (one entry ``coef_d C_j[dcol_d]`` per derivative column).
+    """
+    B, poles = fitter._basis_ek(th, m, ref, True)
+    q = fitter.n_cols(m)
+    lay = fitter._layout(m)
+    coef = fitter._coef(lay, poles)
+    phi, E = B[:, :q], B[:, q:]
     n_par = th.size
-    q = phi.shape[1]
+    n_e = E.shape[1]
     jtj = np.zeros((n_par, n_par))
     jtr = np.zeros(n_par)
     C = np.zeros((q, fitter.n_out))
@@ -108,10 +118,11 @@ def _evaluate(
         C[:, j] = solve_triangular(R, qy)
         r = yw - Q @ qy
         cost += float(r @ r)
-        M = ((D * C[dcol, j][None, :]) * wj[:, None]) @ A  # W_j (dPhi/dtheta) C_j
-        J = Q @ (Q.T @ M) - M
-        jtj += J.T @ J
-        jtr += J.T @ r
+        S = sparse.csr_matrix((coef * C[lay.dcol, j], (lay.dpar, lay.ecol)), shape=(n_par, n_e))
+        M = np.asarray((S @ (E * wj[:, None]).T).T)  # (n_rows, n_par)
+        qm = Q.T @ M
+        jtj += M.T @ M - qm.T @ qm
+        jtr -= M.T @ r
     return cost, 0.5 * (jtj + jtj.T), jtr, {"C": C, "phi": phi, "jtj": jtj}
 
 
@@ -176,8 +187,6 @@ def ml_refine(
     part = np.asarray(res.participation, complex)
     ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
     th0 = fitter.pack(res.poles, part, ref)
-    lay = fitter._layout(m_all)
-    A = np.asarray(lay.A, float)
     n_par = th0.size
     lb = np.full(n_par, -np.inf)
     ub = np.full(n_par, np.inf)
@@ -189,7 +198,7 @@ def ml_refine(
     dof = max(n_obs - q * fitter.n_out - n_par, 1)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         th, nfev, ok, sol = _levenberg_marquardt(
-            lambda x: _evaluate(fitter, x, m_all, ref, om, A),
+            lambda x: _evaluate(fitter, x, m_all, ref, om),
             np.clip(th0, lb + 1e-9, ub - 1e-9),
             lb,
             ub,
