@@ -4,9 +4,10 @@ its goodness of fit and the :class:`~tyredamp.modal.model.ModalModel` with its
 
 The final fits weight every line by the noise model of the
 :class:`~tyredamp.modal.problem.FitProblem`. With a known per-line variance
-(given, or from the coherence and the averages, with ``nu > 4`` degrees of
-freedom when estimated) the weighted least-squares fit with its separable
-approximation ``sigma_j^2 g_f`` starts the maximum-likelihood refinement of
+(given; or estimated from the coherence and the averages when its own
+weights beat the separable ones, :func:`full_weights`) the weighted
+least-squares fit with its separable approximation ``sigma_j^2 g_f`` (or
+with that approximation alone) starts the maximum-likelihood refinement of
 poles, participation and residues with the variance of every entry
 (:mod:`~tyredamp.modal.ml`, the default final stage), whose standard errors
 come from its Fisher information. Otherwise the noise level of each output

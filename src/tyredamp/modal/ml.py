@@ -35,8 +35,10 @@ information computed with ``V^`` is ``nu / (nu - 2)`` times too large
 (sums over many lines, where the law of large numbers holds): the inverse
 information is multiplied by ``nu / (nu - 4)``. With ``nu <= 4`` (no finite
 second moment) it is scaled by the residual variance ``cost / dof`` instead.
-The standard errors of the mode shapes are kept from the WLS fit (the
-delta method of :mod:`~tyredamp.modal._scaling` on the shared basis).
+The standard errors of the mode shapes, the contributions and the mode
+statistics ``T`` are kept from the WLS fit (the delta method of
+:mod:`~tyredamp.modal._scaling` and the extra sum of squares on the shared
+basis).
 """
 
 from __future__ import annotations
