@@ -3,14 +3,14 @@ its goodness of fit and the :class:`~tyredamp.modal.model.ModalModel` with its
 :class:`~tyredamp.modal.quality.FitQuality`.
 
 The final fits weight every line by the noise model of the
-:class:`~tyredamp.modal.problem.FitProblem`. With a known per-line variance
-(given; or estimated from the coherence and the averages when its own
-weights beat the separable ones, :func:`full_weights`) the weighted
-least-squares fit with its separable approximation ``sigma_j^2 g_f`` (or
-with that approximation alone) starts the maximum-likelihood refinement of
-poles, participation and residues with the variance of every entry
-(:mod:`~tyredamp.modal.ml`, the default final stage), whose standard errors
-come from its Fisher information. Otherwise the noise level of each output
+:class:`~tyredamp.modal.problem.FitProblem`. With a per-line variance (given,
+or estimated from the coherence and the averages) the fit is weighted by its
+separable approximation ``sigma_j^2 g_f``; when the variance is given, or
+estimated well enough that weighting every entry by its own estimate beats
+that approximation (:func:`full_weights`), this weighted least-squares fit
+starts the maximum-likelihood refinement of poles, participation and
+residues with the variance of every entry (:mod:`~tyredamp.modal.ml`, the
+default final stage), whose standard errors come from its Fisher information. Otherwise the noise level of each output
 is estimated from the residual of the search's model (a generous model) and
 the fit iterates it (iteratively reweighted least squares, the
 maximum-likelihood estimate for a noise level per output); standard errors
