@@ -10,11 +10,11 @@ estimated well enough that weighting every entry by its own estimate beats
 that approximation (:func:`full_weights`), this weighted least-squares fit
 starts the maximum-likelihood refinement of poles, participation and
 residues with the variance of every entry (:mod:`~tyredamp.modal.ml`, the
-default final stage), whose standard errors come from its Fisher information. Otherwise the noise level of each output
-is estimated from the residual of the search's model (a generous model) and
-the fit iterates it (iteratively reweighted least squares, the
-maximum-likelihood estimate for a noise level per output); standard errors
-from the Gauss-Newton information ``J^T J`` at the optimum, scaled by the
+default final stage), whose standard errors come from its Fisher
+information. Otherwise the noise level of each output is estimated from the
+residual of the search's model (a generous model) and the fit iterates it
+(iteratively reweighted least squares, the maximum-likelihood estimate for a
+noise level per output); standard errors from the Gauss-Newton information ``J^T J`` at the optimum, scaled by the
 residual variance (equal to the Fisher information of that noise model).
 """
 
