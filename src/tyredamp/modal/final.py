@@ -14,8 +14,9 @@ default final stage), whose standard errors come from its Fisher
 information. Otherwise the noise level of each output is estimated from the
 residual of the search's model (a generous model) and the fit iterates it
 (iteratively reweighted least squares, the maximum-likelihood estimate for a
-noise level per output); standard errors from the Gauss-Newton information ``J^T J`` at the optimum, scaled by the
-residual variance (equal to the Fisher information of that noise model).
+noise level per output); standard errors from the Gauss-Newton information
+``J^T J`` at the optimum, scaled by the residual variance (equal to the
+Fisher information of that noise model).
 """
 
 from __future__ import annotations
