@@ -61,7 +61,8 @@ TRIAL_SPAN = 0.03
 JOINT_NFEV = 30
 #: evaluation limit of a trial mode (a mode that is there converges in a few steps)
 TRIAL_NFEV = 30
-#: residual search: most candidates tried per round, and rounds
+#: residual search: most candidates tried per round; rounds go on while one adds a
+#: mode (a band missing many modes adds a few per round), MAX_ROUNDS only bounds them
 MAX_TRIALS = 12
 MAX_ROUNDS = 50
 
