@@ -33,7 +33,7 @@ from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
 from .quality import FitQuality, RejectedMode
-from .search import ModeSet, fit_checked
+from .search import ModeSet, fit_checked, rejected
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
 __all__ = ["fit_real", "goodness", "to_model", "unscale"]
@@ -348,28 +348,62 @@ def final_complex(
     sigma0: NDArray[np.float64] | None,
     refine: bool,
     combined: ModalFitter | None,
+    threshold: float | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
-    combinations (many outputs), whose poles then give the residues of every output."""
+    combinations (many outputs), whose poles then give the residues of every output.
+
+    ``threshold`` (automatic mode count): the final fit holds the mode test too.
+    A mode whose statistic fell to the threshold in the final refinement (its
+    pole moved onto noise, e.g. a damping that collapsed) is dropped, the
+    weakest first, and the fit repeated.
+    """
+    dropped: list[RejectedMode] = []
+    cur = modes
+    for _ in range(modes.m):
+        res, cur, gone = _final_fit(problem, cfit, cur, sigma0, refine, combined)
+        dropped += gone
+        if threshold is None or cur.m <= 1:
+            break
+        m = cur.m
+        t = res.significance[:m]
+        if not np.any(t <= threshold):
+            break
+        worst = int(np.argmin(t))
+        why = f"final fit: not significant: T = {t[worst]:.3g} <= {threshold:.3g}"
+        dropped.append(rejected(complex(res.poles[worst]), why, float(t[worst]), threshold))
+        keep = np.arange(m) != worst
+        cur = ModeSet(cur.poles[keep], cur.part[keep], cur.hp, cur.hl, cur.n_free)
+    if refine:
+        res = maximum_likelihood(problem, cfit, res)
+    return res, cur, dropped
+
+
+def _final_fit(
+    problem: FitProblem,
+    cfit: ModalFitter,
+    modes: ModeSet,
+    sigma0: NDArray[np.float64] | None,
+    refine: bool,
+    combined: ModalFitter | None,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """One weighted least-squares final fit of ``modes`` (:func:`final_complex`)."""
     if combined is not None and sigma0 is not None:
         r0, cur, dropped = fit_checked(
             combined, modes, True, problem.band, passes=1, tol=FINAL_TOL, uncertainty=False
         )
         res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
         res.status, res.n_iter = r0.status, r0.n_iter
-    else:
-        res, cur, dropped = fit_checked(
-            cfit,
-            modes,
-            refine,
-            problem.band,
-            passes=1 if sigma0 is not None else 2,
-            sigma=sigma0,
-            tol=FINAL_TOL,
-        )
-    if refine:
-        res = maximum_likelihood(problem, cfit, res)
-    return res, cur, dropped
+        return res, cur, dropped
+    return fit_checked(
+        cfit,
+        modes,
+        refine,
+        problem.band,
+        passes=1 if sigma0 is not None else 2,
+        sigma=sigma0,
+        tol=FINAL_TOL,
+    )
 
 
 def full_weights(problem: FitProblem) -> bool:
