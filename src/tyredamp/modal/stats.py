@@ -31,7 +31,13 @@ lines), while ``s^2`` holds ``E b``. ``T`` is thus inflated by at most
 ``(nu_w - 2) / (nu_w - 4)`` (1.25 for 4 averages and 2 outputs, 1.08 for 8),
 and the threshold is scaled by that bound when the weights are estimated
 (``weight_dof``; 2 at most, its value at ``nu_w = 6``, where the bound
-diverges).
+diverges). That bounds the mean; the tail of a mode whose few lines share
+one estimated factor is that of ``k F(k, nu_w)``, and the threshold is the
+larger of the two (:func:`mode_threshold`). ``nu_w`` is ``nu n_out`` for
+outputs with independent noise, fewer when the noise is common to the
+outputs (an H1 estimate's input noise): measured from the scatter of the
+line factor between adjacent lines
+(:func:`~tyredamp.modal.problem.line_factor_dof`).
 
 Goodness of fit (:func:`goodness_of_fit`): the weighted cost of the final
 fit against its chi-square expectation ``n_obs - n_par`` when the noise is
