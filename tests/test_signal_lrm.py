@@ -7,8 +7,9 @@ import pytest
 import scipy.signal
 
 from tyredamp import InputError
+from tyredamp.modal.problem import build_problem
 from tyredamp.signal import estimate_frf
-from tyredamp.signal.lrm import local_frf
+from tyredamp.signal.lrm import local_frf, local_variance_dof
 from tyredamp.timedata import Acquisition, TimeData
 
 # two lightly damped modes (0.5 % and 0.3 %): the exact FRF is B/A at exp(2 pi i f)
@@ -123,3 +124,38 @@ def test_lrm_two_inputs() -> None:
     assert np.median(rel_error(h[0, 0], exact(f))) < 1e-6
     assert np.median(rel_error(h[0, 1], h2)) < 1e-6
     assert np.max(rel_error(h[0, 0], exact(f))) < 1e-3
+
+
+@pytest.mark.parametrize("rational", [True, False])
+def test_local_variance_dof_matches_the_scatter_of_the_variance(rational: bool) -> None:
+    """The stated dof ``nu`` of the local variance: ``V^ / V ~ chi2_nu / nu`` has
+    relative variance ``2 / nu`` (Seber & Lee 2003, thm. 3.5), measured over
+    200 records of the same force with new noise (the relative variance of a
+    line's variance estimate, median over lines; its standard error ~10 %)."""
+    nu = local_variance_dof(1, rational=rational)
+    # one input, order 2: n_par = 6 (+ 2 rational), window 2 ceil((n_par + 3) / 2) + 1
+    # = 11 (13) lines: 5 complex degrees of freedom either way
+    assert nu == 10.0
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal(512)
+    y0 = scipy.signal.lfilter(B, A, x)
+    vs = np.array(
+        [
+            local_frf(x, y0 + 0.05 * rng.standard_normal(x.size), 1.0, rational=rational)[2][0, 0]
+            for _ in range(200)
+        ]
+    )[:, 10:-10]
+    rel_var = np.median(np.var(vs, axis=0) / np.mean(vs, axis=0) ** 2)
+    assert rel_var == pytest.approx(2.0 / nu, rel=0.2)
+
+
+def test_estimate_frf_local_methods_state_the_variance_dof() -> None:
+    rng = np.random.default_rng(4)
+    x = rng.standard_normal(2048)
+    y = scipy.signal.lfilter(B, A, x) + 0.01 * rng.standard_normal(x.size)
+    td = TimeData(np.vstack([x, y]), 100.0, [1, 2], ["force", "displacement"])
+    for method, rational in (("lrm", True), ("lpm", False)):
+        frf = estimate_frf(td, method=method)
+        assert frf.meta["variance_dof"] == local_variance_dof(1, rational=rational)
+        # the fit problem takes the stated dof for the goodness of fit
+        assert build_problem(frf).noise_dof == frf.meta["variance_dof"]

@@ -3,15 +3,20 @@ its goodness of fit and the :class:`~tyredamp.modal.model.ModalModel` with its
 :class:`~tyredamp.modal.quality.FitQuality`.
 
 The final fits weight every line by the noise model of the
-:class:`~tyredamp.modal.problem.FitProblem`: with a known per-line variance
-(given, or from the coherence) the weighted cost is the Gaussian negative
-log-likelihood (times two) of the data, and the fit is the maximum-likelihood
-estimate of poles, participation and residues; otherwise the noise level of
-each output is estimated from the residual of the search's model (a
-generous model) and the fit iterates it (iteratively reweighted least
-squares, the maximum-likelihood estimate for a noise level per output).
-Standard errors come from the Gauss-Newton (Fisher) information ``J^T J`` at
-the optimum, scaled by the residual variance.
+:class:`~tyredamp.modal.problem.FitProblem`. With a per-line variance (given,
+or estimated from the coherence and the averages) the fit is weighted by its
+separable approximation ``sigma_j^2 g_f``; when the variance is given, or
+estimated well enough that weighting every entry by its own estimate beats
+that approximation (:func:`full_weights`), this weighted least-squares fit
+starts the maximum-likelihood refinement of poles, participation and
+residues with the variance of every entry (:mod:`~tyredamp.modal.ml`, the
+default final stage), whose standard errors come from its Fisher
+information. Otherwise the noise level of each output is estimated from the
+residual of the search's model (a generous model) and the fit iterates it
+(iteratively reweighted least squares, the maximum-likelihood estimate for a
+noise level per output); standard errors from the Gauss-Newton information
+``J^T J`` at the optimum, scaled by the residual variance (equal to the
+Fisher information of that noise model).
 """
 
 from __future__ import annotations
@@ -24,10 +29,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from .fit import FitResult, ModalFitter
 from .indicators import mean_phase_deviation, modal_phase_collinearity
+from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
 from .quality import FitQuality, RejectedMode
-from .search import ModeSet, fit_checked
+from .search import ModeSet, fit_checked, rejected
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
 __all__ = ["fit_real", "goodness", "to_model", "unscale"]
@@ -133,6 +139,9 @@ def fit_real(
         res = fitter.fit(start_p, start_l, max_nfev=100, tol=FINAL_TOL, sigma=sigma, passes=passes)
         why, bad = _problem(res, m, nf, problem.band)
         if not why:
+            ml = maximum_likelihood(problem, fitter, res)
+            if not _problem(ml, m, nf, problem.band)[0]:
+                res = ml
             return res, m, []
         if bad >= m + nf:
             keep = np.arange(start_p.size) != bad
@@ -352,9 +361,46 @@ def final_complex(
     sigma0: NDArray[np.float64] | None,
     refine: bool,
     combined: ModalFitter | None,
+    threshold: float | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
-    combinations (many outputs), whose poles then give the residues of every output."""
+    combinations (many outputs), whose poles then give the residues of every output.
+
+    ``threshold`` (automatic mode count): the final fit holds the mode test too.
+    A mode whose statistic fell to the threshold in the final refinement (its
+    pole moved onto noise, e.g. a damping that collapsed) is dropped, the
+    weakest first, and the fit repeated.
+    """
+    dropped: list[RejectedMode] = []
+    cur = modes
+    for _ in range(modes.m):
+        res, cur, gone = _final_fit(problem, cfit, cur, sigma0, refine, combined)
+        dropped += gone
+        if threshold is None or cur.m <= 1:
+            break
+        m = cur.m
+        t = res.significance[:m]
+        if not np.any(t <= threshold):
+            break
+        worst = int(np.argmin(t))
+        why = f"final fit: not significant: T = {t[worst]:.3g} <= {threshold:.3g}"
+        dropped.append(rejected(complex(res.poles[worst]), why, float(t[worst]), threshold))
+        keep = np.arange(m) != worst
+        cur = ModeSet(cur.poles[keep], cur.part[keep], cur.hp, cur.hl, cur.n_free)
+    if refine:
+        res = maximum_likelihood(problem, cfit, res)
+    return res, cur, dropped
+
+
+def _final_fit(
+    problem: FitProblem,
+    cfit: ModalFitter,
+    modes: ModeSet,
+    sigma0: NDArray[np.float64] | None,
+    refine: bool,
+    combined: ModalFitter | None,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """One weighted least-squares final fit of ``modes`` (:func:`final_complex`)."""
     if combined is not None and sigma0 is not None:
         r0, cur, dropped = fit_checked(
             combined, modes, True, problem.band, passes=1, tol=FINAL_TOL, uncertainty=False
@@ -371,3 +417,58 @@ def final_complex(
         sigma=sigma0,
         tol=FINAL_TOL,
     )
+
+
+def full_weights(problem: FitProblem) -> bool:
+    """Whether weighting every entry by its own variance estimate ``V^`` beats the
+    separable weights ``sigma_j^2 g_f`` of the WLS fit (both against the true
+    weights ``1 / V``).
+
+    A weighted least-squares estimate with weights ``w`` has the covariance of
+    the ideal one times ``E[w^2 V] E[1 / V] / E[w]^2`` (lines of equal
+    leverage; Kantorovich's inequality makes it >= 1). For the entries' own
+    estimates (``V^ / V ~ chi2_nu / nu``) that is ``(nu - 2) / (nu - 4)``
+    (infinite for ``nu <= 4``); for the separable model, with ``rho = V /
+    (sigma_j^2 g_f)``, it is ``mean(rho) mean(1 / rho)``, estimated from ``rho^ =
+    V^ / (sigma_j^2 g_f)`` as ``mean(rho^) mean(1 / rho^) (nu - 2) / nu``
+    (``E[1 / rho^] = nu / (nu - 2) E[1 / rho]``). A known variance (``nu``
+    None) is always used entry by entry (maximum likelihood).
+    """
+    nu = problem.noise_dof
+    v = problem.variance
+    if v is None or problem.sigma_out is None or problem.line_weights is None:
+        return False
+    if nu is None:
+        return True
+    if not nu > 4.0:
+        return False
+    sep = problem.sigma_out[:, None, None] ** 2 / problem.line_weights[None, None, :] ** 2
+    pos = v > 0
+    rho = v[pos] / np.broadcast_to(sep, v.shape)[pos]
+    if rho.size == 0:
+        return False
+    loss_sep = float(np.mean(rho) * np.mean(1.0 / rho)) * (nu - 2.0) / nu
+    return (nu - 2.0) / (nu - 4.0) < loss_sep
+
+
+def maximum_likelihood(problem: FitProblem, fitter: ModalFitter, res: FitResult) -> FitResult:
+    """The maximum-likelihood refinement (:func:`~tyredamp.modal.ml.ml_refine`) of the
+    weighted fit ``res`` of ``fitter`` when the per-line variance is known, or
+    estimated and :func:`full_weights` says its own weights are the better ones."""
+    if problem.variance is None or not full_weights(problem):
+        return res
+    nu = problem.noise_dof
+    plain = ModalFitter(
+        problem.frequency,
+        problem.H,
+        problem.power,
+        fitter.kind,
+        problem.drive,
+        upper=fitter.use_upper,
+        lower=fitter.use_lower,
+    )
+    try:
+        return ml_refine(plain, res, problem.variance, nu, tol=FINAL_TOL)
+    except (np.linalg.LinAlgError, ValueError):
+        res.warnings.append("maximum-likelihood refinement failed: weighted fit kept")
+        return res

@@ -513,6 +513,7 @@ def _final_models(
                 sigma0,
                 refine,
                 _combined(problem, fitters, sigma0, residuals),
+                ctx["threshold"] if ctx["kept"] is None else None,
             )
             rej = rej + dropped
             base = (res.poles, res.participation, cur)

@@ -28,9 +28,10 @@ when the estimator states them (:func:`~tyredamp.signal.estimators.estimate_frf`
 ``2 (n_eff - n_in)`` with ``n_eff`` the averages reduced for overlapping
 windows), else ``2 (n_averages - n_in)`` from ``meta["n_averages"]`` (the
 residual of the least-squares H1 over the averages, no overlap correction),
-else unknown: taken as known (the local methods, ``n_averages = 1``, whose
-variance has the local fit's degrees of freedom, not stated in the meta
-yet). The goodness of fit corrects for them (:mod:`tyredamp.modal.stats`).
+else unknown: taken as known. The local methods (LRM/LPM, ``n_averages =
+1``) state the local fit's ``2 (2 n + 1 - n_par)``
+(:func:`~tyredamp.signal.lrm.local_variance_dof`). The goodness of fit
+corrects for them (:mod:`tyredamp.modal.stats`).
 
 A known variance ``V_jkf`` enters the fit as a separable model ``sigma_j^2
 g_f`` (``sigma_j^2`` the mean variance of output ``j``, ``g_f`` the mean of
@@ -52,7 +53,7 @@ from .._validate import as_band
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, KIND_POWER
 
-__all__ = ["FitProblem", "NoiseSource", "build_problem", "max_modes"]
+__all__ = ["FitProblem", "NoiseSource", "build_problem", "line_factor_dof", "max_modes"]
 
 NoiseSource = Literal["variance", "coherence", "residual"]
 #: relative spread of the line spacing accepted as uniform (float32 axes of
@@ -116,20 +117,45 @@ class FitProblem:
 
     @property
     def weight_dof(self) -> float | None:
-        """Degrees of freedom of the estimated line weights: ``noise_dof n_out``.
+        """Degrees of freedom of the estimated line weights.
 
-        The separable line factor averages the residual powers of the outputs
-        (independent); those of the inputs of one output share it. None when the
-        weights are known or absent (:func:`~tyredamp.modal.stats.mode_threshold`).
+        The separable line factor ``g_f`` averages the residual powers of the
+        outputs: ``noise_dof n_out`` degrees of freedom when their noises are
+        independent (those of the inputs of one output share it). Noise common
+        to the outputs (an H1 estimate's input noise, errors-in-variables) makes
+        them fewer; they are measured from the scatter of the factor between
+        adjacent lines (:func:`line_factor_dof`) and the smaller count is
+        taken. None when the weights are known or absent
+        (:func:`~tyredamp.modal.stats.mode_threshold`).
         """
         if self.noise_dof is None or self.line_weights is None:
             return None
-        return float(self.noise_dof) * int(self.H.shape[0])
+        nominal = float(self.noise_dof) * int(self.H.shape[0])
+        return min(nominal, line_factor_dof(self.line_weights))
 
     @property
     def shape(self) -> tuple[int, int, int]:
         n_out, n_in, n_f = self.H.shape
         return int(n_out), int(n_in), int(n_f)
+
+
+def line_factor_dof(line_weights: NDArray[np.float64]) -> float:
+    """Degrees of freedom of an estimated line factor ``g^_f = 1 / w_f^2``, from its
+    scatter between adjacent lines.
+
+    For ``g^_f = g_f chi2_nu / nu`` with independent estimates and a smooth
+    true factor ``g_f`` (the noise spectrum changes little from one line to
+    the next), the relative difference ``d_f = (g^_(f+1) - g^_f) / mean`` has
+    ``E d^2 = 2 (2 / nu)``, so ``nu = 4 / mean(d^2)``. A true factor that varies
+    between adjacent lines only lowers the count (conservative). Infinite for
+    fewer than three lines or a constant factor.
+    """
+    g = 1.0 / np.asarray(line_weights, float) ** 2
+    if g.size < 3:
+        return math.inf
+    d = np.diff(g) / (0.5 * (g[1:] + g[:-1]))
+    m2 = float(np.mean(d * d))
+    return math.inf if not m2 > 0 else 4.0 / m2
 
 
 def max_modes(n_out: int, n_in: int, n_f: int) -> int:

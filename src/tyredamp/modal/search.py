@@ -62,9 +62,10 @@ TRIAL_SPAN = 0.03
 JOINT_NFEV = 30
 #: evaluation limit of a trial mode (a mode that is there converges in a few steps)
 TRIAL_NFEV = 30
-#: residual search: most candidates tried per round, and rounds
+#: residual search: most candidates tried per round; rounds go on while one adds a
+#: mode (a band missing many modes adds a few per round), MAX_ROUNDS only bounds them
 MAX_TRIALS = 12
-MAX_ROUNDS = 4
+MAX_ROUNDS = 50
 
 
 @dataclass
@@ -356,7 +357,7 @@ def _residual_peaks(
     # level: peaks whose excess over the median within the window is below a
     # quarter of the test's threshold cannot hold a significant mode
     excess = k * (sm[peak] - np.median(sm))
-    peak = peak[(sm[peak] > 2.0 * np.median(sm)) & (excess > 0.25 * threshold)]
+    peak = peak[excess > 0.25 * threshold]
     # largest first; a peak within 1 % of a larger one is the same structure
     out: list[float] = []
     for i in peak[np.argsort(-sm[peak])]:

@@ -31,7 +31,13 @@ lines), while ``s^2`` holds ``E b``. ``T`` is thus inflated by at most
 ``(nu_w - 2) / (nu_w - 4)`` (1.25 for 4 averages and 2 outputs, 1.08 for 8),
 and the threshold is scaled by that bound when the weights are estimated
 (``weight_dof``; 2 at most, its value at ``nu_w = 6``, where the bound
-diverges).
+diverges). That bounds the mean; the tail of a mode whose few lines share
+one estimated factor is that of ``k F(k, nu_w)``, and the threshold is the
+larger of the two (:func:`mode_threshold`). ``nu_w`` is ``nu n_out`` for
+outputs with independent noise, fewer when the noise is common to the
+outputs (an H1 estimate's input noise): measured from the scatter of the
+line factor between adjacent lines
+(:func:`~tyredamp.modal.problem.line_factor_dof`).
 
 Goodness of fit (:func:`goodness_of_fit`): the weighted cost of the final
 fit against its chi-square expectation ``n_obs - n_par`` when the noise is
@@ -96,8 +102,12 @@ def mode_threshold(
 ) -> float:
     """Threshold of the mode statistic ``T``: ``chi2_k^-1(1 - alpha / n_lines)``.
 
-    Times ``(nu_w - 2) / (nu_w - 4)`` (at most 2) when the line weights are
-    estimated with ``nu_w`` degrees of freedom (module docstring).
+    When the line weights are estimated with ``nu_w`` degrees of freedom, the
+    larger of that times ``(nu_w - 2) / (nu_w - 4)`` (at most 2; the bound of
+    the mean, module docstring) and ``k F^-1_(k, nu_w)(1 - alpha / n_lines)``:
+    the tail of ``T`` for a mode whose few lines share one estimated factor,
+    ``T / k = (chi2_k / k) / (chi2_nu_w / nu_w)`` (Seber & Lee 2003, sec. 4.3),
+    the bound of the tail (a mode over many lines averages several factors).
 
     Parameters
     ----------
@@ -113,8 +123,13 @@ def mode_threshold(
     """
     if not 0.0 < false_alarm < 1.0:
         raise ValueError(f"false_alarm: expected a probability in (0, 1), got {false_alarm}")
-    thr = float(sps.chi2.isf(false_alarm / max(int(n_lines), 1), int(k)))
-    return thr * weight_factor(weight_dof)
+    level = false_alarm / max(int(n_lines), 1)
+    thr = float(sps.chi2.isf(level, int(k)))
+    if weight_dof is None or not math.isfinite(weight_dof):
+        return thr
+    # the mean bound and the F tail of a mode whose lines share one estimated factor
+    f_tail = int(k) * float(sps.f.isf(level, int(k), max(float(weight_dof), 1.0)))
+    return max(thr * weight_factor(weight_dof), f_tail)
 
 
 def weight_factor(weight_dof: float | None) -> float:

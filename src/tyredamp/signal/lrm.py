@@ -41,7 +41,7 @@ from ..frf import FRF, FRFKind
 from ..timedata import TimeData
 from .periodicity import ExcitationDetection
 
-__all__ = ["local_frf", "local_method_frf"]
+__all__ = ["local_frf", "local_method_frf", "local_variance_dof"]
 
 
 def _windows(n_lines: int, half: int) -> NDArray[np.intp]:
@@ -49,6 +49,42 @@ def _windows(n_lines: int, half: int) -> NDArray[np.intp]:
     w = 2 * half + 1
     start = np.clip(np.arange(n_lines) - half, 0, n_lines - w)
     return start[:, None] + np.arange(w)[None, :]
+
+
+def _local_size(n_in: int, order: int, half_width: int | None, rational: bool) -> tuple[int, int]:
+    """Half width ``n`` of the window and number ``n_par`` of local parameters (checked)."""
+    if isinstance(order, bool) or not isinstance(order, int | np.integer) or order < 0:
+        raise InputError(f"order: expected an integer >= 0, got {order!r}")
+    r_ord = int(order)
+    n_par = (r_ord + 1) * (n_in + 1) + (r_ord if rational else 0)
+    if half_width is None:
+        return int(np.ceil((n_par + 4 - 1) / 2)), n_par
+    if isinstance(half_width, bool) or not isinstance(half_width, int | np.integer):
+        raise InputError(f"half_width: expected an integer, got {half_width!r}")
+    half = int(half_width)
+    if 2 * half + 1 <= n_par:
+        raise InputError(
+            f"half_width: {2 * half + 1} lines cannot fit {n_par} local parameters and "
+            f"leave a degree of freedom for the noise; use at least {n_par // 2 + 1}"
+        )
+    return half, n_par
+
+
+def local_variance_dof(
+    n_in: int, *, order: int = 2, half_width: int | None = None, rational: bool = True
+) -> float:
+    """Real degrees of freedom of the variance of :func:`local_frf`: ``2 (2 n + 1 - n_par)``.
+
+    The noise variance of a line is the residual of a complex least-squares
+    fit of ``2 n + 1`` lines with ``n_par`` complex parameters (module
+    docstring): ``2 n + 1 - n_par`` complex, twice as many real degrees of
+    freedom (Pintelon et al. 2010, part I, sec. 4; Seber & Lee 2003, thm. 3.5).
+    Stated as ``FRF.meta["variance_dof"]`` by the local methods of
+    :func:`~tyredamp.signal.estimate_frf` (:mod:`tyredamp.modal.problem`).
+    Arguments as in :func:`local_frf`.
+    """
+    half, n_par = _local_size(int(n_in), order, half_width, rational)
+    return 2.0 * (2 * half + 1 - n_par)
 
 
 def local_frf(
@@ -98,22 +134,9 @@ def local_frf(
             f"{y.shape}"
         )
     fs = check_positive(sample_rate, "sample_rate")
-    if isinstance(order, bool) or not isinstance(order, int | np.integer) or order < 0:
-        raise InputError(f"order: expected an integer >= 0, got {order!r}")
-    r_ord = int(order)
     n_in, n_out = x.shape[0], y.shape[0]
-    n_par = (r_ord + 1) * (n_in + 1) + (r_ord if rational else 0)
-    if half_width is None:
-        half = int(np.ceil((n_par + 4 - 1) / 2))
-    else:
-        if isinstance(half_width, bool) or not isinstance(half_width, int | np.integer):
-            raise InputError(f"half_width: expected an integer, got {half_width!r}")
-        half = int(half_width)
-        if 2 * half + 1 <= n_par:
-            raise InputError(
-                f"half_width: {2 * half + 1} lines cannot fit {n_par} local parameters and "
-                f"leave a degree of freedom for the noise; use at least {n_par // 2 + 1}"
-            )
+    half, n_par = _local_size(n_in, order, half_width, rational)
+    r_ord = int(order)
     n = x.shape[1]
     n_f = n // 2 + 1
     w = 2 * half + 1
@@ -215,7 +238,8 @@ def local_method_frf(
     chans = timedata.channels
     data = timedata.data[:, settle:]
     x, y = data[ref_idx], data[out_idx]
-    f, h, var = local_frf(x, y, timedata.sample_rate, rational=method == "lrm")
+    rational = method == "lrm"
+    f, h, var = local_frf(x, y, timedata.sample_rate, rational=rational)
     lines = _local_lines(x, f, band if band is not None else acq.band_hz, min_relative_power)
     meta_out: dict[str, Any] = {
         "estimator": "H1",
@@ -227,6 +251,8 @@ def local_method_frf(
         "overlap": 0.0,
         "settle_samples": settle,
         "local_order": 2,
+        # the local fit's residual degrees of freedom (modal.problem: goodness of fit)
+        "variance_dof": local_variance_dof(len(ref_idx), rational=rational),
     }
     if detection is not None:
         meta_out["detection"] = detection.to_dict()

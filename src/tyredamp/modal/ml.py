@@ -1,0 +1,270 @@
+"""Maximum-likelihood refinement with the full per-line noise model.
+
+The fits of :mod:`~tyredamp.modal.fit` share one basis over the outputs, so
+they can weight a known per-line variance ``V_jkf`` (output ``j``, input
+``k``, line ``f``) only through its separable approximation ``sigma_j^2 g_f``
+(:mod:`~tyredamp.modal.problem`). When the variance is known, the final stage
+(:func:`ml_refine`) starts from that weighted least-squares (WLS) fit and
+minimises the Gaussian negative log-likelihood (times two) of the data with
+the variance of every entry::
+
+    L(theta, C) = sum_jkf |H_jkf - H^model_jkf(theta, C_j)|^2 / (V_jkf / 2)
+
+(real and imaginary part each of variance ``V / 2``; Pintelon & Schoukens,
+*System Identification*, 2nd ed. 2012, sec. 7.2 and 9.2, the frequency-domain
+maximum-likelihood cost with a known noise model). The linear coefficients
+``C_j`` of each output are eliminated with that output's weights (variable
+projection, Golub & Pereyra 1973): for each output the weighted basis ``W_j
+Phi`` is orthonormalised (``Q_j R_j``), the residual is ``r_j = (I - Q_j
+Q_j^T) W_j y_j`` and Kaufman's Jacobian ``J_j = -(I - Q_j Q_j^T) W_j (dPhi /
+dtheta) C_j``; Gauss-Newton/Levenberg-Marquardt steps on ``sum_j J_j^T J_j``
+and ``sum_j J_j^T r_j`` (:func:`~tyredamp.modal._linalg._levenberg_marquardt`).
+The cost per evaluation is ``n_out`` QR factorisations of the ``(2 n_in
+n_freq) x q`` basis: a few evaluations from the WLS start.
+
+Standard errors from the Fisher information. ``J^T J`` above is the Fisher
+information of the non-linear parameters with the linear ones profiled out
+(the Schur complement of the full information; the variance is known, so it
+is not scaled by the residual variance). When the variance is an estimate
+with ``nu`` real degrees of freedom (:attr:`FitProblem.noise_dof`), the
+weights ``1 / V^`` are noisy: with ``V^ / V ~ chi2_nu / nu`` independent of
+the data, ``E[1 / V^] = nu / ((nu - 2) V)`` and ``E[1 / V^2] = nu^2 / ((nu
+- 2)(nu - 4) V^2)``, so the covariance of the weighted estimate is ``(nu -
+2) / (nu - 4)`` times the inverse information of the true weights while the
+information computed with ``V^`` is ``nu / (nu - 2)`` times too large
+(sums over many lines, where the law of large numbers holds): the inverse
+information is multiplied by ``nu / (nu - 4)``. With ``nu <= 4`` (no finite
+second moment) it is scaled by the residual variance ``cost / dof`` instead.
+The standard errors of the mode shapes, the contributions and the mode
+statistics ``T`` are kept from the WLS fit (the delta method of
+:mod:`~tyredamp.modal._scaling` and the extra sum of squares on the shared
+basis).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import sparse
+from scipy.linalg import solve_triangular
+
+from ._linalg import _levenberg_marquardt
+from .fit import FitResult, ModalFitter
+
+__all__ = ["fisher_scale", "line_weights_full", "ml_refine"]
+
+
+def line_weights_full(variance: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """Row weights ``1 / sqrt(V / 2)`` of the fitter's real rows, shape (2 n_in n_f, n_out).
+
+    Rows follow :class:`ModalFitter`'s layout (input, line; real and imaginary
+    part interleaved). Entries without variance (exact lines) get the weight
+    of the output's least noisy line. None when every variance is zero.
+    """
+    n_out, n_in, n_f = variance.shape
+    v = np.array(variance, dtype=float).reshape(n_out, n_in * n_f)
+    pos = v > 0
+    if not np.any(pos):
+        return None
+    vmin = np.min(v[pos])
+    floor = np.array([np.min(r[p]) if np.any(p) else vmin for r, p in zip(v, pos, strict=True)])
+    v = np.where(pos, v, floor[:, None])
+    return np.repeat(1.0 / np.sqrt(v / 2.0), 2, axis=1).T.copy()
+
+
+def fisher_scale(noise_dof: float | None, cost: float, dof: int) -> float:
+    """Factor of the inverse Fisher information (module docstring): 1 for a known
+    variance, ``nu / (nu - 4)`` for one estimated with ``nu > 4`` degrees of
+    freedom, ``cost / dof`` otherwise."""
+    if noise_dof is None or not np.isfinite(noise_dof):
+        return 1.0
+    nu = float(noise_dof)
+    if nu > 4.0:
+        return nu / (nu - 4.0)
+    return max(cost / max(dof, 1), 1e-300)
+
+
+def _evaluate(
+    fitter: ModalFitter,
+    th: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    om: NDArray[np.float64],
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+    """Cost, ``J^T J``, ``J^T r`` and the coefficients ``C`` (q, n_out) at ``th``.
+
+    With ``M_j = W_j (dPhi / dtheta) C_j`` and ``Q_j^T r_j = 0``: ``J_j^T J_j = M_j^T
+    M_j - (Q_j^T M_j)^T Q_j^T M_j`` and ``J_j^T r_j = -M_j^T r_j``. ``M_j = W_j E
+    S_j`` with ``E`` the distinct derivative columns (:meth:`ModalFitter.basis`)
+    and ``S_j`` sparse (one entry ``coef_d C_j[dcol_d]`` per derivative column).
+    """
+    B, poles = fitter._basis_ek(th, m, ref, True)
+    q = fitter.n_cols(m)
+    lay = fitter._layout(m)
+    coef = fitter._coef(lay, poles)
+    phi, E = B[:, :q], B[:, q:]
+    n_par = th.size
+    n_e = E.shape[1]
+    jtj = np.zeros((n_par, n_par))
+    jtr = np.zeros(n_par)
+    C = np.zeros((q, fitter.n_out))
+    cost = 0.0
+    for j in range(fitter.n_out):
+        wj = om[:, j]
+        Q, R = np.linalg.qr(phi * wj[:, None])
+        yw = fitter.Y[:, j] * wj
+        qy = Q.T @ yw
+        C[:, j] = solve_triangular(R, qy)
+        r = yw - Q @ qy
+        cost += float(r @ r)
+        S = sparse.csr_matrix((coef * C[lay.dcol, j], (lay.dpar, lay.ecol)), shape=(n_par, n_e))
+        M = np.asarray((S @ (E * wj[:, None]).T).T)  # (n_rows, n_par)
+        qm = Q.T @ M
+        jtj += M.T @ M - qm.T @ qm
+        jtr -= M.T @ r
+    return cost, 0.5 * (jtj + jtj.T), jtr, {"C": C, "phi": phi, "jtj": jtj}
+
+
+def _pole_se(
+    fitter: ModalFitter, th: NDArray[np.float64], m: int, cth: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128]]:
+    """Standard errors of f (Hz), zeta and the pole by the delta method
+    (``sigma = w_ref exp(x1)``, ``Omega = w_ref x2``; as :class:`ModalFitter`)."""
+    ar = np.arange(m)
+    sig = fitter.w_ref * np.exp(th[0 : 2 * m : 2])
+    om = fitter.w_ref * th[1 : 2 * m : 2]
+    mag = np.hypot(sig, om)
+    v11 = cth[2 * ar, 2 * ar]
+    v22 = cth[2 * ar + 1, 2 * ar + 1]
+    v12 = cth[2 * ar, 2 * ar + 1]
+    # d|p|/dx1 = sig^2 / |p|, d|p|/dx2 = w_ref om / |p|; zeta = sig / |p|
+    a1, a2 = sig * sig / mag / (2 * np.pi), fitter.w_ref * om / mag / (2 * np.pi)
+    z1, z2 = om**2 * sig / mag**3, -sig * om * fitter.w_ref / mag**3
+    var_f = a1 * a1 * v11 + 2 * a1 * a2 * v12 + a2 * a2 * v22
+    var_z = z1 * z1 * v11 + 2 * z1 * z2 * v12 + z2 * z2 * v22
+    std_p = np.sqrt(np.maximum(v11, 0)) * sig + 1j * np.sqrt(np.maximum(v22, 0)) * fitter.w_ref
+    return np.sqrt(np.maximum(var_f, 0.0)), np.sqrt(np.maximum(var_z, 0.0)), std_p
+
+
+def ml_refine(
+    fitter: ModalFitter,
+    res: FitResult,
+    variance: NDArray[np.float64],
+    noise_dof: float | None = None,
+    *,
+    max_nfev: int = 20,
+    tol: float = 1e-4,
+) -> FitResult:
+    """Maximum-likelihood refinement of a WLS fit with the per-line variance.
+
+    Parameters
+    ----------
+    fitter : ModalFitter
+        Fitter of the unweighted data (no ``line_weights``), the model kind and
+        residual terms of ``res``.
+    res : FitResult
+        The weighted least-squares fit to start from (poles, participation).
+    variance : ndarray, shape (n_out, n_in, n_freq)
+        Variance of each line, in the units of ``fitter.H`` squared.
+    noise_dof : float, optional
+        Real degrees of freedom of an estimated variance (None: known).
+    max_nfev, tol : int, float
+        Evaluation limit and convergence threshold (units of the residual
+        variance, :func:`~tyredamp.modal._linalg._levenberg_marquardt`).
+
+    Returns
+    -------
+    FitResult
+        ``res`` with the maximum-likelihood poles, participation, residues,
+        residual terms, model, cost (``L``) and Fisher standard errors of the
+        frequencies, damping ratios and poles (module docstring).
+    """
+    om = line_weights_full(variance)
+    if om is None:
+        return res
+    m_all = int(res.poles.size)
+    part = np.asarray(res.participation, complex)
+    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+    th0 = fitter.pack(res.poles, part, ref)
+    n_par = th0.size
+    lb = np.full(n_par, -np.inf)
+    ub = np.full(n_par, np.inf)
+    # the bounds of ModalFitter's refinement: sigma in [1e-7, 5] w_ref, Omega in (0, 20] w_ref
+    lb[0 : 2 * m_all : 2], ub[0 : 2 * m_all : 2] = np.log(1e-7), np.log(5.0)
+    lb[1 : 2 * m_all : 2], ub[1 : 2 * m_all : 2] = 1e-6, 20.0
+    q = fitter.n_cols(m_all)
+    n_obs = fitter.n_rows * fitter.n_out
+    dof = max(n_obs - q * fitter.n_out - n_par, 1)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        th, nfev, ok, sol = _levenberg_marquardt(
+            lambda x: _evaluate(fitter, x, m_all, ref, om),
+            np.clip(th0, lb + 1e-9, ub - 1e-9),
+            lb,
+            ub,
+            max_nfev,
+            dof=dof,
+            tol=tol,
+        )
+    C = sol["C"]
+    cost = float(np.sum((om * (fitter.Y - sol["phi"] @ C)) ** 2))
+    cth = fisher_scale(noise_dof, cost, dof) * np.linalg.pinv(sol["jtj"], hermitian=True)
+    return _as_result(fitter, res, th, ref, C, sol["phi"], cth, cost, nfev, ok)
+
+
+def _as_result(
+    fitter: ModalFitter,
+    res: FitResult,
+    th: NDArray[np.float64],
+    ref: NDArray[np.intp],
+    C: NDArray[np.float64],
+    phi: NDArray[np.float64],
+    cth: NDArray[np.float64],
+    cost: float,
+    nfev: int,
+    ok: bool,
+) -> FitResult:
+    """The FitResult of the maximum-likelihood parameters (scaled as :class:`ModalFitter`)."""
+    m = int(res.poles.size)
+    poles, part = fitter.unpack(th, m, ref)
+    didx = np.array([j for j, _ in fitter.drive], dtype=np.intp)
+    b, psi_in, _ = fitter._scale(th, m, ref, C[:, didx].T, np.ones(didx.size))
+    per = 2 if fitter.kind == "complex" else 1
+    u = C[0 : 2 * m : 2].T + 1j * C[1 : 2 * m : 2].T if per == 2 else C[:m].T + 0j
+    psi_out = u * b[None, :]
+    off = per * m
+    upper = lower = None
+    if fitter.use_upper:
+        upper = C[off : off + fitter.n_in].T.copy()
+        off += fitter.n_in
+    if fitter.use_lower:
+        lower = C[off : off + fitter.n_in].T.copy()
+    hw = np.ascontiguousarray((phi @ C).T)  # (n_out, n_rows), rows re/im interleaved
+    model = hw.view(np.complex128).reshape(fitter.n_out, fitter.n_in, fitter.n_f)
+    phi2 = res.drive_phi2
+    if didx.size:
+        kin = np.array([k for _, k in fitter.drive], dtype=np.intp)
+        phi2 = np.mean(2j * poles.imag[None, :] * psi_out[didx] * psi_in[kin], axis=0)
+    std_f, std_z, std_p = _pole_se(fitter, th, m, cth)
+    status = "maximum likelihood" + ("" if ok else " (evaluation limit)")
+    return dataclasses.replace(
+        res,
+        poles=poles,
+        psi_out=psi_out,
+        psi_in=psi_in,
+        upper=upper,
+        lower=lower,
+        std_frequency_hz=std_f,
+        std_damping_ratio=std_z,
+        std_pole=std_p,
+        model=model,
+        cost=cost,
+        n_iter=res.n_iter + nfev,
+        status=status,
+        theta=th,
+        participation=part,
+        drive_phi2=phi2,
+        projection=None,
+    )
