@@ -115,11 +115,21 @@ def blocks(fitter: Any, n_col: int) -> list[slice]:
     return [slice(a, min(a + nb, n_f)) for a in range(0, n_f, nb)]
 
 
+def one_block(fitter: Any) -> bool:
+    """Do the data rows of every line fit in one block (:data:`BLOCK_BYTES`)? The
+    fitter then keeps them (no more memory than one block of a blocked fit)."""
+    return bool(16 * fitter.n_in * fitter.n_f * fitter.n_out <= BLOCK_BYTES)
+
+
 def factors(
     fitter: Any, lines: slice | None = None
 ) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]]:
     """``s = i w``, ``kappa = (i w)^power`` and ``kappa_low = (i w)^(power - 2)`` of the
-    lines (times the line weights when the fitter has them), computed when needed."""
+    lines (times the line weights when the fitter has them), computed when needed
+    (slices of the fitter's ``_factors`` of every line when it holds them)."""
+    full = getattr(fitter, "_factors", None)
+    if full is not None:
+        return full if lines is None else (full[0][lines], full[1][lines], full[2][lines])
     f = fitter.f if lines is None else fitter.f[lines]
     w = 2 * np.pi * f
     s = 1j * w
@@ -138,7 +148,12 @@ def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
 
     Weighted by the line weights when the fitter has them; row ``2 i`` is the
     real, ``2 i + 1`` the imaginary part of entry ``i``, as the basis rows.
+    The fitter's ``_y`` (the rows of every line, read-only) when it holds them
+    (data of at most one block, :func:`one_block`) and ``lines`` covers them all.
     """
+    full = getattr(fitter, "_y", None)
+    if full is not None and (lines is None or lines.indices(fitter.n_f) == (0, fitter.n_f, 1)):
+        return full  # type: ignore[no-any-return]
     h = fitter.H if lines is None else fitter.H[:, :, lines]
     lw = fitter.line_weights
     if lw is not None:

@@ -76,14 +76,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import InputError
-from . import _basis, _scaling
-from ._linalg import (
-    _PROJ_TOL,
-    _extra_ss,
-    _fixed_range,
-    _levenberg_marquardt,
-    _vp_solve,
-)
+from . import _added, _basis, _scaling
+from ._linalg import _extra_ss, _levenberg_marquardt, _vp_solve
 from .compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
@@ -200,8 +194,22 @@ class ModalFitter:
             self.line_weights = lw
         self.w_ref = float(2 * np.pi * frequency[-1])
         # data rows (k, f), real and imaginary part interleaved (_basis.ydata), are
-        # formed block by block when needed; only their sums of squares are kept
+        # formed block by block when needed; only their sums of squares are kept --
+        # unless they fit one block (the common case): then they are formed once and
+        # kept, with the line factors (s, kappa, kappa_low: three values per line)
         self.n_rows = 2 * self.n_in * self.n_f
+        self._y: NDArray[np.float64] | None = None
+        self._factors: tuple[NDArray[np.complex128], ...] | None = None
+        fac = _basis.factors(self)
+        for a in fac:
+            a.flags.writeable = False
+        self._factors = fac
+        # a fit_added of the same fixed modes again: its fixed range (_fixed_memo)
+        self._fixed_memo: tuple[Any, ...] | None = None
+        if _basis.one_block(self):
+            y = _basis.ydata(self)
+            y.flags.writeable = False
+            self._y = y
         yss = np.zeros(self.n_out)
         for sl in _basis.blocks(self, 0):
             yb = _basis.ydata(self, sl)
@@ -340,17 +348,26 @@ class ModalFitter:
                 b = self._basis_ek(th, m, ref, derivatives, sl, (None, pp))[0]
                 yield b, self._ydata(sl) * w
 
-        G = np.zeros((n_col, n_col))
-        P = np.zeros((n_col, self.n_out))
-        for B, Yb in rows():
-            G += B.T @ B
-            P += B.T @ Yb
+        explicit = rows
+        if len(parts) == 1:  # one block: formed once, kept for the QR route
+            kept = list(rows())
+            B, Yb = kept[0]
+            G, P = B.T @ B, B.T @ Yb
+
+            def explicit() -> Any:
+                return iter(kept)
+        else:
+            G = np.zeros((n_col, n_col))
+            P = np.zeros((n_col, self.n_out))
+            for B, Yb in rows():
+                G += B.T @ B
+                P += B.T @ Yb
         sol = _vp_solve(
             G,
             P,
             q,
             self._yss * w**2,
-            rows,
+            explicit,
             residual=residual,
             gradient=gradient and derivatives,
         )
@@ -465,8 +482,8 @@ class ModalFitter:
         route of :func:`_vp_solve` is taken when the subtraction would lose
         accuracy. ``omega_bounds`` (rad/s, lower < upper) limits the damped
         natural frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
-        ``fixed``: accepted for compatibility and not used (the fixed basis is
-        formed block by block; no per-line array is kept between calls).
+        ``fixed``: accepted for compatibility and not used (the fitter keeps the
+        fixed part of its latest fixed modes, :mod:`~tyredamp.modal._added`).
 
         Returns
         -------
@@ -491,65 +508,13 @@ class ModalFitter:
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
         w = self._w1
         th_f = self.pack(poles, part, ref)
-        qf = self.n_cols(m)
         one = copy.copy(self)
         one.use_upper = one.use_lower = False
         th0 = one.pack(p1, l1, ref1)
-        q1 = one.n_cols(1)
         lay1 = one._layout(1)
-        n1 = q1 + int(lay1.ecol.max()) + 1
-        parts = _basis.blocks(self, qf + n1)
-        # the fixed basis is kept when it is no larger than the data (many outputs) or
-        # fits one block; otherwise it is formed again block by block when needed
-        keep = len(parts) == 1 or qf <= self.n_out
-        cache: dict[int, NDArray[np.float64]] = {}
-        pp_f = self.unpack(th_f, m, ref)
-
-        def fixed_cols(i: int, fac: Any = None) -> NDArray[np.float64]:
-            if i in cache:
-                return cache[i]
-            phi_f = self._basis_ek(th_f, m, ref, False, parts[i], (fac, pp_f))[0]
-            if keep:
-                cache[i] = phi_f
-            return phi_f
-
-        # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
-        # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
-        yy = self._yss * w**2
-        tmap, qty, yyp = _fixed_range(
-            lambda: ((fixed_cols(i), self._ydata(sl) * w) for i, sl in enumerate(parts)), qf, yy
-        )
-
-        def solve(th: NDArray[np.float64]) -> dict[str, Any]:
-            # Gram blocks of the added mode's [Phi_1 | E_1] projected on the complement
-            # of Phi_f: B1^T B1 - (Q_r^T B1)^T Q_r^T B1 and B1^T Y - (Q_r^T B1)^T Q_r^T Y
-            cross = np.zeros((qf, n1))
-            g0 = np.zeros((n1, n1))
-            p0 = np.zeros((n1, self.n_out))
-            pp1 = one.unpack(th, 1, ref1)
-            for i, sl in enumerate(parts):
-                fac = None if i in cache else _basis.factors(self, sl)
-                b1 = one._basis_ek(th, 1, ref1, True, sl, (fac, pp1))[0]
-                cross += fixed_cols(i, fac).T @ b1
-                g0 += b1.T @ b1
-                p0 += b1.T @ (self._ydata(sl) * w)
-            qb = tmap.T @ cross
-            G = g0 - qb.T @ qb
-            P = p0 - qb.T @ qty
-
-            def projected() -> Any:
-                for i, sl in enumerate(parts):
-                    b1 = one._basis_ek(th, 1, ref1, True, sl)[0]
-                    pt = fixed_cols(i) @ tmap
-                    yield b1 - pt @ qb, self._ydata(sl) * w - pt @ qty
-
-            # columns mostly in span(Phi_f): the QR route of the projected rows
-            force = bool(np.any(np.diag(G) < _PROJ_TOL * np.diag(g0)))
-            sol = _vp_solve(G, P, q1, yyp, projected, residual=force, gradient=True, cancel=yy)
-            sol["lay"] = lay1
-            sol["coef"] = one._coef(lay1, one.unpack(th, 1, ref1)[0])
-            return sol
-
+        n1 = one.n_cols(1) + int(lay1.ecol.max()) + 1
+        fx = _added.fixed_part(self, th_f, m, ref, _basis.blocks(self, self.n_cols(m) + n1))
+        solve = _added.added_solver(self, one, fx, ref1, lay1)
         th, _, _, sol = self._refine(
             th0, 1, ref1, w, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
         )
