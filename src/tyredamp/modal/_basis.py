@@ -153,7 +153,7 @@ def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
     """
     full = getattr(fitter, "_y", None)
     if full is not None and (lines is None or lines.indices(fitter.n_f) == (0, fitter.n_f, 1)):
-        return full  # type: ignore[no-any-return]
+        return full
     h = fitter.H if lines is None else fitter.H[:, :, lines]
     lw = fitter.line_weights
     if lw is not None:
