@@ -267,6 +267,61 @@ def _lu_solve(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[n
     return x, int(info)
 
 
+def _gn_point(
+    x: NDArray[np.float64],
+    A: NDArray[np.float64],
+    g: NDArray[np.float64],
+    lb: NDArray[np.float64],
+    ub: NDArray[np.float64],
+) -> tuple[NDArray[np.intp] | None, NDArray[np.float64], Any, Any, float] | None:
+    """The free parameters of a point of :func:`_levenberg_marquardt` and its
+    Gauss-Newton decrement (None when every parameter is held).
+
+    Returns the free indices (None: all), their scales ``sqrt(diag A)``, the
+    scaled ``A`` and ``g`` of the free parameters and the decrement ``-g^T
+    A^-1 g`` (``A`` regularised by ``1e-12`` of its scaled diagonal).
+    """
+    diag = A.diagonal()
+    d_a = np.sqrt(np.maximum(diag, 1e-300))
+    # held: at a bound with the descent direction -g pointing outwards, or
+    # without information (e.g. the damping of a residual mode far outside
+    # the band: its column of J vanishes)
+    held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
+    held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
+    free: NDArray[np.intp] | None = None
+    d_f = d_a
+    if held.any():
+        idx = np.flatnonzero(~held)
+        if idx.size == 0:
+            return None
+        free, d_f = idx, d_a[idx]
+        An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
+        gn = g[idx] / d_f
+    else:
+        An = A / np.outer(d_a, d_a)
+        gn = g / d_a
+    # Gauss-Newton decrement at this point (convergence test)
+    gn_step, info = _lu_solve(An + 1e-12 * np.eye(gn.size), -gn)
+    if info != 0:
+        gn_step = -gn
+    return free, d_f, An, gn, float(-gn @ gn_step)
+
+
+def at_rest(
+    x: NDArray[np.float64],
+    cost: float,
+    A: NDArray[np.float64],
+    g: NDArray[np.float64],
+    bounds: tuple[NDArray[np.float64], NDArray[np.float64]],
+    tol: float,
+    dof: int,
+) -> bool:
+    """Would :func:`_levenberg_marquardt` started at ``x`` (cost, ``J^T J = A``,
+    ``J^T r = g``) stop there at once, with ``tol`` and ``dof``?"""
+    point = _gn_point(x, A, g, *bounds)
+    return point is None or point[4] <= max(tol * cost / dof, 1e-24 * max(cost, 1e-300))
+
+
 def _levenberg_marquardt(
     evaluate: Any,
     x0: NDArray[np.float64],
@@ -310,31 +365,11 @@ def _levenberg_marquardt(
         if new_point:
             if not math.isfinite(cost):
                 return x, nfev, False, aux
-            diag = A.diagonal()
-            d_a = np.sqrt(np.maximum(diag, 1e-300))
-            # held: at a bound with the descent direction -g pointing outwards, or
-            # without information (e.g. the damping of a residual mode far outside
-            # the band: its column of J vanishes)
-            held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
-            held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
-            free: NDArray[np.intp] | None = None
-            d_f = d_a
-            if held.any():
-                idx = np.flatnonzero(~held)
-                if idx.size == 0:
-                    return x, nfev, True, aux
-                free, d_f = idx, d_a[idx]
-                An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
-                gn = g[idx] / d_f
-            else:
-                An = A / np.outer(d_a, d_a)
-                gn = g / d_a
+            point = _gn_point(x, A, g, lb, ub)
+            if point is None:
+                return x, nfev, True, aux
+            free, d_f, An, gn, decrement = point
             eye = np.eye(gn.size)
-            # Gauss-Newton decrement at this point (convergence test)
-            gn_step, info = _lu_solve(An + 1e-12 * eye, -gn)
-            if info != 0:
-                gn_step = -gn
-            decrement = float(-gn @ gn_step)
             if decrement <= max(tol * cost / dof, 1e-24 * cost0):
                 return x, nfev, True, aux
             new_point = False

@@ -69,7 +69,7 @@ frequencies, damping ratios and mode-shape entries by the delta method.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -77,7 +77,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import InputError
 from . import _added, _basis, _scaling
-from ._linalg import _extra_ss, _levenberg_marquardt, _vp_solve
+from ._linalg import _extra_ss, _levenberg_marquardt, _vp_solve, at_rest
 from .compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
@@ -206,6 +206,8 @@ class ModalFitter:
         self._factors = fac
         # a fit_added of the same fixed modes again: its fixed range (_fixed_memo)
         self._fixed_memo: tuple[Any, ...] | None = None
+        # an intermediate fit at rest: the same fit started at its result (_fit_memo)
+        self._fit_memo: tuple[Any, FitResult] | None = None
         if _basis.one_block(self):
             y = _basis.ydata(self)
             y.flags.writeable = False
@@ -426,6 +428,7 @@ class ModalFitter:
         """
         m = int(poles.size)
         part = np.asarray(part, complex).reshape(m, self.n_in)
+        start = (np.asarray(poles, complex).tobytes(), part.tobytes())
         if self.kind == "real":
             ph = np.exp(-1j * np.angle(part[np.arange(m), np.argmax(np.abs(part), axis=1)]))
             part = (part * ph[:, None]).real.astype(complex)
@@ -435,6 +438,13 @@ class ModalFitter:
         w = self._w1
         if sigma is not None and not self.unit_weights:
             w = 1.0 / np.maximum(np.asarray(sigma, float), np.maximum(floor, 1e-300))
+        # an intermediate one-pass refinement started at the result of the previous
+        # one (same weights and tolerance) that stopped at rest would stop at once:
+        # that result again (one evaluation)
+        once = refine and not uncertainty and passes <= 1 and max_nfev >= 2
+        memo = self._fit_memo
+        if once and memo is not None and memo[0] == (*start, w.tobytes(), tol):
+            return replace(memo[1], n_iter=1, warnings=list(memo[1].warnings))
         q = self.n_cols(m)
         dof = self.n_rows - q
         status = "lsfd"
@@ -453,7 +463,11 @@ class ModalFitter:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
-        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        if once and sol.get("at_rest"):
+            end = (res.poles.tobytes(), res.participation.tobytes(), w.tobytes(), tol)
+            self._fit_memo = (end, res)
+        return res
 
     def fit_added(
         self,
@@ -553,17 +567,19 @@ class ModalFitter:
             sol = self._solve(x, m, ref, w, residual=False) if solve is None else solve(x)
             jtj, jtr = self._normal(sol, n_par)
             sol["jtj"] = jtj  # kept for the standard errors at the optimum
+            sol["jtr"] = jtr
             return float(sol["cost"]), jtj, jtr, sol
 
+        dof = max(n_obs - n_lin * self.n_out - n_par, 1)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             x, nfev, ok, sol = _levenberg_marquardt(
-                evaluate,
-                th0,
-                lb,
-                ub,
-                max_nfev,
-                dof=max(n_obs - n_lin * self.n_out - n_par, 1),
-                tol=tol,
+                evaluate, th0, lb, ub, max_nfev, dof=dof, tol=tol
+            )
+            # a fit started here again would stop at once (strictly inside the bounds)
+            sol["at_rest"] = bool(
+                ok
+                and np.all((x > lb + 1e-9) & (x < ub - 1e-9))
+                and at_rest(x, sol["cost"], sol["jtj"], sol["jtr"], (lb, ub), tol, dof)
             )
         return x, nfev, "converged" if ok else "maxfev", sol
 
