@@ -1,0 +1,129 @@
+"""What a ModalFitter keeps between calls (the fixed part of fit_added, an
+intermediate fit at rest, the data rows of one block) gives the results of
+computing everything again."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from tyredamp.modal import _basis
+from tyredamp.modal._linalg import _levenberg_marquardt, at_rest
+from tyredamp.modal.fit import ModalFitter
+
+from .helpers import chain_system
+
+F = np.linspace(0.5, 40.0, 400)
+
+
+def _noisy(noise: float, seed: int) -> tuple[Any, np.ndarray]:
+    sys_ = chain_system()
+    rng = np.random.default_rng(seed)
+    h = sys_.frf(F, kind="accelerance", inputs=[0, 5]).H
+    h = h + noise * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    return sys_, h
+
+
+def _fitter(h: np.ndarray, kind: str = "complex") -> ModalFitter:
+    return ModalFitter(F, h, 2, kind, [(0, 0), (5, 1)])
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+@pytest.mark.parametrize("many_blocks", [False, True])
+def test_fit_added_again_against_the_same_modes_gives_a_new_fitters_result(
+    kind: str, many_blocks: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    if many_blocks:
+        monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
+        monkeypatch.setattr(_basis, "MIN_BLOCK_LINES", 37)
+    sys_, h = _noisy(1e-3, 5)
+    cm = sys_.complex_modes()
+    part = cm.psi[[0, 5]].T
+    k = int(np.argsort(cm.poles.imag)[3])
+    keep = np.delete(np.arange(cm.poles.size), k)
+    lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
+    fixed = (cm.poles[keep] * 1.001, part[keep])
+    fit = _fitter(h, kind)
+    assert (len(_basis.blocks(fit, 20)) > 1) == many_blocks
+    # a first candidate, then two others against the same fixed modes: the second
+    # and third reuse the fixed part the first formed
+    fit.fit_added(*fixed, cm.poles[k] * 1.03, np.ones(2), omega_bounds=(lo, hi))
+    for start in (cm.poles[k] * 1.01, cm.poles[k] * (0.99 + 0.01j)):
+        kept = fit.fit_added(*fixed, start, np.ones(2), omega_bounds=(lo, hi))
+        new = _fitter(h, kind).fit_added(*fixed, start, np.ones(2), omega_bounds=(lo, hi))
+        # the same arithmetic on the same arrays: identical
+        for a, b in zip(kept, new, strict=True):
+            assert_array_equal(a, b)
+    # other fixed modes: formed again (not the kept ones)
+    other = (cm.poles[keep] * 1.002, part[keep])
+    a = fit.fit_added(*other, cm.poles[k] * 1.01, np.ones(2), omega_bounds=(lo, hi))
+    b = _fitter(h, kind).fit_added(*other, cm.poles[k] * 1.01, np.ones(2), omega_bounds=(lo, hi))
+    for x, y in zip(a, b, strict=True):
+        assert_array_equal(x, y)
+
+
+def test_a_fit_started_at_a_fit_at_rest_returns_it_with_one_evaluation() -> None:
+    sys_, h = _noisy(1e-2, 6)
+    cm = sys_.complex_modes()
+    part = cm.psi[[0, 5]].T
+    fit = _fitter(h)
+    opts = {"passes": 1, "tol": 10.0, "uncertainty": False}
+    first = fit.fit(cm.poles * 1.002, part, **opts)
+    assert first.status == "converged"
+    assert first.n_iter > 1
+    again = fit.fit(first.poles, first.participation, **opts)
+    # a new fitter runs the refinement from there: it stops after one evaluation
+    # at the same point (the start re-packed from the poles, round-off apart)
+    new = _fitter(h).fit(first.poles, first.participation, **opts)
+    assert again.n_iter == new.n_iter == 1
+    assert again.status == new.status == "converged"
+    assert_allclose(again.poles, new.poles, rtol=1e-13)
+    assert_allclose(again.sigma_out, new.sigma_out, rtol=1e-10)
+    assert_allclose(again.significance, new.significance, rtol=1e-8)
+    assert_array_equal(again.poles, first.poles)
+    # another tolerance is not served from it: the refinement goes on
+    other = fit.fit(first.poles, first.participation, passes=1, tol=1e-6, uncertainty=False)
+    assert other.n_iter > 1
+    full = fit.fit(first.poles, first.participation, passes=1, tol=10.0)
+    assert np.all(np.isfinite(full.std_frequency_hz))
+
+
+def test_at_rest_is_the_first_stop_of_levenberg_marquardt() -> None:
+    # cost (x - a)^T M (x - a) + c: J^T J = M, J^T r = M (x - a) (gradient / 2)
+    rng = np.random.default_rng(1)
+    a_mat = rng.normal(size=(4, 4))
+    M = a_mat @ a_mat.T + 4 * np.eye(4)
+    a = rng.normal(size=4)
+    lb, ub = np.full(4, -10.0), np.full(4, 10.0)
+
+    def evaluate(x: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, None]:
+        d = x - a
+        return float(d @ M @ d) + 1.0, M, M @ d, None
+
+    for shift, rest in ((1e-6, True), (1e-1, False)):
+        x = a + shift
+        c, A, g, _ = evaluate(x)
+        assert at_rest(x, c, A, g, (lb, ub), 1.0, 10) == rest
+        nfev = _levenberg_marquardt(evaluate, x, lb, ub, 50, dof=10, tol=1.0)[1]
+        assert (nfev == 1) == rest
+
+
+def test_one_block_data_rows_are_kept_read_only_and_equal_the_blocked_rows(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    _, h = _noisy(1e-3, 7)
+    fit = _fitter(h)
+    assert _basis.one_block(fit)
+    y = fit.Y
+    assert not y.flags.writeable
+    monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
+    blocked = _fitter(h)
+    assert not _basis.one_block(blocked)
+    assert_array_equal(blocked.Y, y)
+    # the rows of some lines from the data, all lines from what the fitter keeps
+    sl = slice(3, 40)
+    assert_array_equal(_basis.ydata(fit, sl), _basis.ydata(blocked, sl))
+    assert _basis.ydata(fit, slice(0, F.size)) is y
