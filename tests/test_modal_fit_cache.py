@@ -127,3 +127,60 @@ def test_one_block_data_rows_are_kept_read_only_and_equal_the_blocked_rows(
     sl = slice(3, 40)
     assert_array_equal(_basis.ydata(fit, sl), _basis.ydata(blocked, sl))
     assert _basis.ydata(fit, slice(0, F.size)) is y
+
+
+@pytest.mark.parametrize("spacing", [3e-5, 3e-6])
+def test_one_block_ill_conditioned_basis_by_cholesky_qr_twice(
+    spacing: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a pole pair this close makes the Gram matrix too ill-conditioned for the Gram
+    # route (cond > _MAX_GRAM_COND) but not for CholeskyQR2 (< _MAX_CQR2_COND): the
+    # one-block projection must match an independent least-squares solution and
+    # the Kaufman normal equations from the explicit derivative matrix
+    from scipy.linalg import lapack
+
+    import tyredamp.modal._linalg as lin
+
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(12)
+    h = sys_.frf(F, inputs=[0]).H * (2j * np.pi * F) ** 2
+    h = h + 1e-2 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    fit = ModalFitter(F, h, 2, "complex", [])
+    poles = np.append(cm.poles, cm.poles[2] * (1 + spacing))  # cond 1.3e6, 1.3e8
+    m = poles.size
+    ref = np.zeros(m, np.intp)
+    th = fit.pack(poles, np.ones((m, 1), complex), ref)
+    phi, D, dpar, dcol = fit.basis(th, m, ref)
+    g = phi.T @ phi
+    d = np.sqrt(g.diagonal())
+    gs = g / np.outer(d, d)
+    r1 = lapack.dpotrf(gs)[0]
+    cond = 1.0 / lapack.dpocon(r1, float(abs(gs).sum(axis=0).max()))[0]
+    assert lin._MAX_GRAM_COND < cond < lin._MAX_CQR2_COND
+
+    def no_householder(*args: Any, **kw: Any) -> Any:
+        raise AssertionError("the Householder route was taken")
+
+    monkeypatch.setattr(lin, "_qr_blocks", no_householder)
+    w = np.ones(fit.n_out)
+    sol = fit._solve(th, m, ref, w, residual=False)
+    assert sol["qr"]
+    # references: least squares by numpy's SVD solver, Q from numpy's Householder QR
+    yw = fit.Y * w
+    C = np.linalg.lstsq(phi, yw, rcond=None)[0]
+    r = yw - phi @ C
+    Q = np.linalg.qr(phi)[0]
+    qtd = Q.T @ D
+    A = np.zeros((D.shape[1], th.size))
+    A[np.arange(D.shape[1]), dpar] = 1.0
+    jtj_ref = A.T @ ((D.T @ D - qtd.T @ qtd) * (C @ C.T)[dcol[:, None], dcol[None, :]]) @ A
+    jtr_ref = -(A.T @ np.einsum("id,id->d", D, (r @ C.T)[:, dcol]))
+    jtj, jtr = fit._normal(sol, th.size)
+    # tolerances: round-off times cond(Phi) ~ sqrt(cond) for the cost and the fit,
+    # the coefficients of the close pair are as ill-determined as cond(Phi) says
+    assert_allclose(sol["cost"], np.sum(r**2), rtol=1e-9)
+    assert_allclose(phi @ sol["C"], phi @ C, rtol=0, atol=1e-9 * np.abs(yw).max())
+    assert_allclose(np.abs(sol["R"].T @ sol["R"]), np.abs(g), rtol=0, atol=1e-12 * np.abs(g).max())
+    assert_allclose(jtj, jtj_ref, rtol=0, atol=1e-8 * np.max(np.abs(jtj_ref)))
+    assert_allclose(jtr, jtr_ref, rtol=0, atol=1e-8 * np.max(np.abs(jtr_ref)))

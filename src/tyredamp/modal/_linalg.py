@@ -11,11 +11,16 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
-from scipy.linalg import lapack
+from scipy.linalg import blas, lapack
 
 #: largest condition estimate of the unit-column Gram matrix of the basis for which
 #: the projection is taken from the Gram blocks (relative error ~ eps * this)
 _MAX_GRAM_COND = 1e6
+#: largest condition estimate of that Gram matrix for which a basis held as one
+#: block is orthogonalised by Cholesky QR twice (:func:`_cholqr2`; beyond, and for
+#: several blocks, Householder): ``eps cond`` must stay far below 1 for the first
+#: Cholesky factor to be accurate enough for the second pass to orthogonalise
+_MAX_CQR2_COND = 1e10
 #: a squared norm ``||x||^2 - ||Q^T x||^2`` smaller than this fraction of the
 #: subtracted term (relative error ~ eps / this) is formed from the explicit residual
 _CANCEL_TOL = 1e-6
@@ -125,6 +130,7 @@ def _vp_solve(
     residual: bool,
     gradient: bool,
     cancel: NDArray[np.float64] | None = None,
+    one: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> dict[str, Any]:
     """Variable projection from the Gram blocks of ``B = [Phi | E]``.
 
@@ -153,6 +159,10 @@ def _vp_solve(
         Return ``E^T r``.
     cancel : ndarray, shape (n_out,), optional
         Reference of the cancellation test (default ``||Q^T Y_j||^2``).
+    one : (ndarray, ndarray), optional
+        ``B`` and ``Y`` themselves when they are one block: an ill-conditioned
+        ``Phi`` is then orthogonalised by :func:`_cholqr2` (when its condition
+        allows), not by the Householder QR.
 
     Returns
     -------
@@ -196,6 +206,10 @@ def _vp_solve(
                 "cost_out": cost_out,
                 "qr": False,
             }
+    if fac is None and not residual and one is not None:
+        got = _cholqr2(G, P, q, yy, one, gradient=gradient, cancel=cancel)
+        if got is not None:
+            return got
     Rb, Z, rho = _qr_blocks(explicit(), G.shape[0], P.shape[1])
     R, QtE, R2 = Rb[:q, :q], Rb[:q, q:], Rb[q:, q:]
     Ct, X = Z[:q], Z[q:]
@@ -218,6 +232,70 @@ def _vp_solve(
         "QtE": QtE,
         "GE": R2.T @ R2,
         "Etr": Etr,
+        "cost": float(cost_out.sum()),
+        "cost_out": cost_out,
+        "qr": True,
+    }
+
+
+def _cholqr2(
+    G: NDArray[np.float64],
+    P: NDArray[np.float64],
+    q: int,
+    yy: NDArray[np.float64],
+    one: tuple[NDArray[np.float64], NDArray[np.float64]],
+    *,
+    gradient: bool,
+    cancel: NDArray[np.float64] | None,
+) -> dict[str, Any] | None:
+    """The projection of :func:`_vp_solve` with ``Phi`` orthogonalised by Cholesky
+    QR twice, or None (condition beyond :data:`_MAX_CQR2_COND`, a failed
+    factorisation, or a cost that would lose accuracy by cancellation).
+
+    ``one = (B, Y)``: the rows of ``B = [Phi | E]`` and of the data. With ``D``
+    the column norms of ``Phi`` and ``R_1`` the Cholesky factor of ``D^-1 Phi^T
+    Phi D^-1``, ``Q_1 = Phi D^-1 R_1^-1`` is formed explicitly; the Cholesky
+    factor ``R_2`` of ``Q_1^T Q_1`` (condition ``1 + O(eps cond(Phi)^2)``) gives
+    ``Phi = Q R`` with ``Q = Q_1 R_2^-1`` orthonormal to working precision and
+    ``R = R_2 R_1 D`` (CholeskyQR2: Fukaya, Nakatsukasa, Yanagisawa & Yamamoto,
+    2014; Yamamoto, Nakatsukasa, Yanagisawa & Fukaya, *ETNA* 44, 2015, stable
+    for ``cond(Phi)`` up to about ``eps^-1/2``). ``Q^T E = R_2^-T Q_1^T E`` and
+    ``Q^T Y = R_2^-T Q_1^T Y`` are products with that explicit basis (no
+    ``cond(Phi)^2`` amplification); the rest follows the Gram route of
+    :func:`_vp_solve` (``E^T P E``, ``E^T r`` and the cost by subtraction, the
+    same cancellation test).
+    """
+    B, Y = one
+    ne = G.shape[0] - q
+    dg = G.diagonal()[:q]
+    if q == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):
+        return None
+    d = np.sqrt(dg)
+    gs = G[:q, :q] / np.multiply.outer(d, d)
+    r1, info = lapack.dpotrf(gs, lower=0, clean=1)
+    if info != 0:
+        return None
+    rcond, info = lapack.dpocon(r1, float(abs(gs).sum(axis=0).max()))
+    if info != 0 or not rcond * _MAX_CQR2_COND >= 1.0:
+        return None
+    q1 = blas.dtrsm(1.0, r1, B[:, :q] / d, side=1, lower=0)  # Phi D^-1 R_1^-1
+    r2, info = lapack.dpotrf(q1.T @ q1, lower=0, clean=1)
+    if info != 0:
+        return None
+    x = lapack.dtrtrs(r2, np.concatenate([q1.T @ B[:, q:], q1.T @ Y], axis=1), trans=1)[0]
+    QtE, Ct = x[:, :ne], x[:, ne:]
+    ct2 = (Ct * Ct).sum(axis=0)
+    cost_out = yy - ct2
+    if (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
+        return None
+    c = lapack.dtrtrs(r1, lapack.dtrtrs(r2, Ct)[0])[0] / d[:, None]  # R C = Q^T Y
+    return {
+        "R": (r2 @ r1) * d[None, :],
+        "C": c,
+        "Ct": Ct,
+        "QtE": QtE,
+        "GE": G[q:, q:] - QtE.T @ QtE,
+        "Etr": P[q:] - QtE.T @ Ct if gradient else None,
         "cost": float(cost_out.sum()),
         "cost_out": cost_out,
         "qr": True,

@@ -351,10 +351,12 @@ class ModalFitter:
                 yield b, self._ydata(sl) * w
 
         explicit = rows
+        one = None
         if len(parts) == 1:  # one block: formed once, kept for the QR route
             kept = list(rows())
             B, Yb = kept[0]
             G, P = B.T @ B, B.T @ Yb
+            one = (B, Yb)
 
             def explicit() -> Any:
                 return iter(kept)
@@ -372,6 +374,7 @@ class ModalFitter:
             explicit,
             residual=residual,
             gradient=gradient and derivatives,
+            one=one,
         )
         if lay is not None:
             sol["lay"] = lay
