@@ -184,3 +184,30 @@ def test_one_block_ill_conditioned_basis_by_cholesky_qr_twice(
     assert_allclose(np.abs(sol["R"].T @ sol["R"]), np.abs(g), rtol=0, atol=1e-12 * np.abs(g).max())
     assert_allclose(jtj, jtj_ref, rtol=0, atol=1e-8 * np.max(np.abs(jtj_ref)))
     assert_allclose(jtr, jtr_ref, rtol=0, atol=1e-8 * np.max(np.abs(jtr_ref)))
+
+
+@pytest.mark.parametrize("n_in", [1, 2])
+def test_residual_power_is_the_weighted_residual_of_the_modal_sum(n_in: int) -> None:
+    # _basis.residual_power forms the modes' terms as one matrix product; reference:
+    # the modal sum R / (s - p) + conj(R) / (s - conj p) mode by mode, plus the
+    # residual terms, weighted per line and per output
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    inputs = [0, 5][:n_in]
+    rng = np.random.default_rng(8)
+    h = sys_.frf(F, kind="accelerance", inputs=inputs).H
+    h = h + 1e-2 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    lw = 1.0 + 0.3 * np.sin(F)
+    fit = ModalFitter(F, h, 2, "complex", [], line_weights=lw)
+    res = fit.fit(cm.poles, cm.psi[inputs].T, refine=False)
+    R = res.psi_out[:, None, :] * res.psi_in[None, :, :]
+    s2 = res.sigma_out**2
+    got = _basis.residual_power(fit, res.poles, R, (res.upper, res.lower), s2)
+    s = 2j * np.pi * F
+    model = np.zeros_like(h)
+    for n, p in enumerate(res.poles):
+        r = R[:, :, n, None]
+        model += r * s**2 / (s - p) + np.conj(r) * s**2 / (s - np.conj(p))
+    model += res.upper[:, :, None] * s**2 + res.lower[:, :, None]
+    ref = np.einsum("jkf,j->f", np.abs(h - model) ** 2 * lw**2, 1.0 / s2)
+    assert_allclose(got, ref, rtol=1e-9)  # two routes to the same sums: round-off

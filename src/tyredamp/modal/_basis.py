@@ -200,13 +200,17 @@ def residual_power(
     residual terms (n_out, n_in) or None; ``s2`` (n_out,) the noise variances.
     """
     out = np.empty(fitter.n_f)
+    n_out, n_in, m = residues.shape
+    # the modes' terms of every FRF as one product: [R | conj R] (n_out n_in, 2 m)
+    # times the columns kappa / (s - p_n), kappa / (s - conj p_n) (2 m, lines)
+    rr = np.concatenate([residues, np.conj(residues)], axis=2).reshape(n_out * n_in, 2 * m)
+    pp = np.concatenate([poles, np.conj(poles)])[:, None]
     for sl in blocks(fitter, 2 * poles.size + 2 * fitter.n_in):
         s, kap, kap_low = factors(fitter, sl)
         h = fitter.H[:, :, sl]
         e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
-        for n in range(poles.size):
-            r = residues[:, :, n, None]
-            e -= r * (kap / (s - poles[n])) + np.conj(r) * (kap / (s - np.conj(poles[n])))
+        if m:
+            e -= (rr @ (kap / (s - pp))).reshape(e.shape)
         upper, lower = terms
         if upper is not None:
             e -= upper[:, :, None] * kap
