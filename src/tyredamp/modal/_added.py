@@ -114,6 +114,7 @@ def fixed_part(
         lambda: ((fx.basis(fitter, i), fx.data(fitter, i, w)) for i in range(len(parts))),
         qf,
         fitter._yss * w**2,
+        (fx.basis(fitter, 0), fx.data(fitter, 0, w)) if one else None,
     )
     # several blocks: only the range map is held between calls
     fitter._fixed_memo = (key, fx if one else dataclasses.replace(fx, cols={}))

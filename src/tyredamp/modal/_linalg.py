@@ -30,7 +30,10 @@ _PROJ_TOL = 1e-4
 
 
 def _fixed_range(
-    blocks: Any, q: int, yy: NDArray[np.float64]
+    blocks: Any,
+    q: int,
+    yy: NDArray[np.float64],
+    one: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The range of a fixed basis ``Phi``; ``blocks()`` returns its row blocks ``(Phi_b,
     Y_b)`` with those of the data (called again when a second pass is needed).
@@ -44,6 +47,10 @@ def _fixed_range(
     (:func:`_qr_blocks`) and the SVD ``R = U S V^T`` (``r`` singular values above
     ``1e-13`` times the largest): ``Q_r = Q U_r = Phi V_r S_r^-1``, so ``T = V_r
     S_r^-1`` and ``Q_r^T Y = U_r^T Q^T Y`` (a rank-deficient ``Phi`` included).
+    ``one = (Phi, Y)`` when they are one block: an ill-conditioned ``Phi`` of full
+    rank (condition estimate up to :data:`_MAX_CQR2_COND`) is orthogonalised by
+    CholeskyQR2 first (:func:`_cholqr2`: ``T = D^-1 R_1^-1 R_2^-1``, ``Q^T Y = R_2^-T
+    Q_1^T Y``), with the same cancellation test.
     """
     G = np.zeros((q, q))
     P = np.zeros((q, yy.size))
@@ -57,6 +64,14 @@ def _fixed_range(
         yyp = yy - np.einsum("ij,ij->j", qty, qty)
         if not (yyp < _CANCEL_TOL * yy).any():
             tmap = lapack.dtrtri(rs)[0] / d[:, None]  # R^-1 with R = rs diag(d)
+            return np.asarray(tmap), np.asarray(qty), np.asarray(yyp)
+    cq = None if one is None or fac is not None else _cqr2_factor(G, one[0])
+    if cq is not None and one is not None:
+        r1, r2, d, q1 = cq
+        qty = lapack.dtrtrs(r2, q1.T @ one[1], trans=1)[0]
+        yyp = yy - np.einsum("ij,ij->j", qty, qty)
+        if not (yyp < _CANCEL_TOL * yy).any():
+            tmap = (lapack.dtrtri(r1)[0] @ lapack.dtrtri(r2)[0]) / d[:, None]
             return np.asarray(tmap), np.asarray(qty), np.asarray(yyp)
     R, Z, rho = _qr_blocks(blocks(), q, yy.size)
     u, sv, vt = np.linalg.svd(R)
@@ -238,6 +253,30 @@ def _vp_solve(
     }
 
 
+def _cqr2_factor(
+    g: NDArray[np.float64], phi: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], Any] | None:
+    """CholeskyQR2 of ``Phi`` (rows ``phi``, Gram matrix ``g``): ``R_1``, ``R_2``, ``D``
+    and ``Q_1 = Phi D^-1 R_1^-1`` (:func:`_cholqr2`), or None when the condition
+    estimate of ``D^-1 g D^-1`` exceeds :data:`_MAX_CQR2_COND` or a factorisation fails."""
+    dg = g.diagonal()
+    if g.shape[0] == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):
+        return None
+    d = np.sqrt(dg)
+    gs = g / np.multiply.outer(d, d)
+    r1, info = lapack.dpotrf(gs, lower=0, clean=1)
+    if info != 0:
+        return None
+    rcond, info = lapack.dpocon(r1, float(abs(gs).sum(axis=0).max()))
+    if info != 0 or not rcond * _MAX_CQR2_COND >= 1.0:
+        return None
+    q1 = blas.dtrsm(1.0, r1, phi / d, side=1, lower=0)  # Phi D^-1 R_1^-1
+    r2, info = lapack.dpotrf(q1.T @ q1, lower=0, clean=1)
+    if info != 0:
+        return None
+    return r1, r2, d, q1
+
+
 def _cholqr2(
     G: NDArray[np.float64],
     P: NDArray[np.float64],
@@ -267,21 +306,10 @@ def _cholqr2(
     """
     B, Y = one
     ne = G.shape[0] - q
-    dg = G.diagonal()[:q]
-    if q == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):
+    fac = _cqr2_factor(G[:q, :q], B[:, :q])
+    if fac is None:
         return None
-    d = np.sqrt(dg)
-    gs = G[:q, :q] / np.multiply.outer(d, d)
-    r1, info = lapack.dpotrf(gs, lower=0, clean=1)
-    if info != 0:
-        return None
-    rcond, info = lapack.dpocon(r1, float(abs(gs).sum(axis=0).max()))
-    if info != 0 or not rcond * _MAX_CQR2_COND >= 1.0:
-        return None
-    q1 = blas.dtrsm(1.0, r1, B[:, :q] / d, side=1, lower=0)  # Phi D^-1 R_1^-1
-    r2, info = lapack.dpotrf(q1.T @ q1, lower=0, clean=1)
-    if info != 0:
-        return None
+    r1, r2, d, q1 = fac
     x = lapack.dtrtrs(r2, np.concatenate([q1.T @ B[:, q:], q1.T @ Y], axis=1), trans=1)[0]
     QtE, Ct = x[:, :ne], x[:, ne:]
     ct2 = (Ct * Ct).sum(axis=0)
