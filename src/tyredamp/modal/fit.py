@@ -200,18 +200,16 @@ class ModalFitter:
         self.n_rows = 2 * self.n_in * self.n_f
         self._y: NDArray[np.float64] | None = None
         self._factors: tuple[NDArray[np.complex128], ...] | None = None
-        fac = _basis.factors(self)
-        for a in fac:
-            a.flags.writeable = False
-        self._factors = fac
         # a fit_added of the same fixed modes again: its fixed range (_fixed_memo)
         self._fixed_memo: tuple[Any, ...] | None = None
         # an intermediate fit at rest: the same fit started at its result (_fit_memo)
         self._fit_memo: tuple[Any, FitResult] | None = None
         if _basis.one_block(self):
+            fac = _basis.factors(self)
             y = _basis.ydata(self)
-            y.flags.writeable = False
-            self._y = y
+            for a in (*fac, y):
+                a.flags.writeable = False
+            self._factors, self._y = fac, y
         yss = np.zeros(self.n_out)
         for sl in _basis.blocks(self, 0):
             yb = _basis.ydata(self, sl)
