@@ -122,6 +122,9 @@ def test_one_block_data_rows_are_kept_read_only_and_equal_the_blocked_rows(
     monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
     blocked = _fitter(h)
     assert not _basis.one_block(blocked)
+    # several blocks: no per-line array is kept (issue 15: the data plus a constant)
+    assert blocked._y is None
+    assert blocked._factors is None
     assert_array_equal(blocked.Y, y)
     # the rows of some lines from the data, all lines from what the fitter keeps
     sl = slice(3, 40)
