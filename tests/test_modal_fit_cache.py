@@ -214,3 +214,27 @@ def test_residual_power_is_the_weighted_residual_of_the_modal_sum(n_in: int) -> 
     model += res.upper[:, :, None] * s**2 + res.lower[:, :, None]
     ref = np.einsum("jkf,j->f", np.abs(h - model) ** 2 * lw**2, 1.0 / s2)
     assert_allclose(got, ref, rtol=1e-9)  # two routes to the same sums: round-off
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_basis_times_data_from_the_complex_data(kind: str) -> None:
+    # _basis.rows_t_data: B^T Y as Re(conj(B_c)^T H_c), without forming the data rows;
+    # reference: the real rows of the data (ydata) and a real product
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(2)
+    h = sys_.frf(F, kind="accelerance", inputs=[0, 5]).H
+    h = h + 1e-2 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    fit = ModalFitter(F, h, 2, kind, [], line_weights=1.0 + 0.4 * np.cos(F))
+    part = cm.psi[[0, 5]].T
+    if kind == "real":
+        part = np.abs(part) + 0j
+    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+    th = fit.pack(cm.poles, part, ref)
+    sl = slice(37, 290)
+    B = fit._basis_ek(th, cm.poles.size, ref, True, sl)[0]
+    want = B.T @ _basis.ydata(fit, sl)
+    assert_allclose(_basis.rows_t_data(fit, sl, B), want, rtol=0, atol=1e-12 * np.abs(want).max())
+    # rows in another layout: the real product itself
+    Bc = np.ascontiguousarray(B)
+    assert_allclose(_basis.rows_t_data(fit, sl, Bc), want, rtol=0, atol=0)

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from . import _basis
 from ._linalg import _PROJ_TOL, _fixed_range, _vp_solve
 
 
@@ -149,7 +150,7 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
                 b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
                 cross += fx.basis(fitter, i).T @ b1
                 g0 += b1.T @ b1
-                p0 += b1.T @ fx.data(fitter, i, w)
+                p0 += _basis.rows_t_data(fitter, sl, b1) * w  # no data rows formed
         qb = fx.tmap.T @ cross
         G = g0 - qb.T @ qb
         P = p0 - qb.T @ fx.qty

@@ -166,6 +166,29 @@ def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
     return Y
 
 
+def rows_t_data(fitter: Any, lines: slice, b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``b^T Y`` (c, n_out) of basis rows ``b`` (rows of ``lines``, c columns) and the
+    data rows of those lines, without forming ``Y``.
+
+    ``b`` holds complex columns as real rows (real and imaginary part of each
+    entry ``(k, f)`` interleaved, as :func:`basis_ek` returns them), and so does
+    ``Y``: the real inner product of two such columns is ``Re(conj(a)^T y)`` of
+    the complex columns, so ``b^T Y = Re(conj(b_c)^T H_c)`` with ``H_c`` the
+    block of ``fitter.H`` (times the line weights, here put on ``b_c``). Falls
+    back to ``b.T @ ydata(...)`` when ``b`` is not laid out that way.
+    """
+    bt = b.T
+    if not (bt.flags.c_contiguous and bt.shape[1] % 2 == 0):
+        return np.asarray(bt @ ydata(fitter, lines))
+    n_out, n_in = fitter.n_out, fitter.n_in
+    bc = bt.view(np.complex128)  # (c, n_in nb), entry (k, f)
+    lw = fitter.line_weights
+    if lw is not None:
+        bc = (bc.reshape(bc.shape[0], n_in, -1) * lw[lines]).reshape(bc.shape[0], -1)
+    h = fitter.H[:, :, lines].reshape(n_out, -1)
+    return np.asarray((np.conj(bc) @ h.T).real)
+
+
 def synth(
     fitter: Any, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], coef: NDArray[np.float64]
 ) -> NDArray[np.complex128]:

@@ -361,9 +361,10 @@ class ModalFitter:
         else:
             G = np.zeros((n_col, n_col))
             P = np.zeros((n_col, self.n_out))
-            for B, Yb in rows():
+            for sl in parts:  # B^T Y from the complex data (no data rows formed)
+                B = self._basis_ek(th, m, ref, derivatives, sl, (None, pp))[0]
                 G += B.T @ B
-                P += B.T @ Yb
+                P += _basis.rows_t_data(self, sl, B) * w
         sol = _vp_solve(
             G,
             P,
