@@ -475,7 +475,7 @@ class ModalFitter:
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
         res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
-        if once and sol.get("at_rest"):
+        if once and status == "converged" and self._at_rest(th, sol):
             end = (res.poles.tobytes(), res.participation.tobytes(), w.tobytes(), tol)
             self._fit_memo = (end, res)
         return res
@@ -586,13 +586,16 @@ class ModalFitter:
             x, nfev, ok, sol = _levenberg_marquardt(
                 evaluate, th0, lb, ub, max_nfev, dof=dof, tol=tol
             )
-            # a fit started here again would stop at once (strictly inside the bounds)
-            sol["at_rest"] = bool(
-                ok
-                and np.all((x > lb + 1e-9) & (x < ub - 1e-9))
-                and at_rest(x, sol["cost"], sol["jtj"], sol["jtr"], (lb, ub), tol, dof)
-            )
+        sol["lm"] = (lb, ub, dof, tol)  # the iteration's settings (_at_rest)
         return x, nfev, "converged" if ok else "maxfev", sol
+
+    @staticmethod
+    def _at_rest(x: NDArray[np.float64], sol: dict[str, Any]) -> bool:
+        """Would a refinement started at its result ``x`` (strictly inside the bounds)
+        stop at once (:func:`~tyredamp.modal._linalg.at_rest`)?"""
+        lb, ub, dof, tol = sol["lm"]
+        inside = bool(np.all((x > lb + 1e-9) & (x < ub - 1e-9)))
+        return inside and at_rest(x, sol["cost"], sol["jtj"], sol["jtr"], (lb, ub), tol, dof)
 
     # --------------------------------------------------------- results
     # scaling and shape uncertainty (functions of the fitter, in _scaling)
