@@ -115,11 +115,21 @@ def blocks(fitter: Any, n_col: int) -> list[slice]:
     return [slice(a, min(a + nb, n_f)) for a in range(0, n_f, nb)]
 
 
+def one_block(fitter: Any) -> bool:
+    """Do the data rows of every line fit in one block (:data:`BLOCK_BYTES`)? The
+    fitter then keeps them (no more memory than one block of a blocked fit)."""
+    return bool(16 * fitter.n_in * fitter.n_f * fitter.n_out <= BLOCK_BYTES)
+
+
 def factors(
     fitter: Any, lines: slice | None = None
 ) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]]:
     """``s = i w``, ``kappa = (i w)^power`` and ``kappa_low = (i w)^(power - 2)`` of the
-    lines (times the line weights when the fitter has them), computed when needed."""
+    lines (times the line weights when the fitter has them), computed when needed
+    (slices of the fitter's ``_factors`` of every line when it holds them)."""
+    full = getattr(fitter, "_factors", None)
+    if full is not None:
+        return full if lines is None else (full[0][lines], full[1][lines], full[2][lines])
     f = fitter.f if lines is None else fitter.f[lines]
     w = 2 * np.pi * f
     s = 1j * w
@@ -138,7 +148,12 @@ def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
 
     Weighted by the line weights when the fitter has them; row ``2 i`` is the
     real, ``2 i + 1`` the imaginary part of entry ``i``, as the basis rows.
+    The fitter's ``_y`` (the rows of every line, read-only) when it holds them
+    (data of at most one block, :func:`one_block`) and ``lines`` covers them all.
     """
+    full = getattr(fitter, "_y", None)
+    if full is not None and (lines is None or lines.indices(fitter.n_f) == (0, fitter.n_f, 1)):
+        return full
     h = fitter.H if lines is None else fitter.H[:, :, lines]
     lw = fitter.line_weights
     if lw is not None:
@@ -149,6 +164,29 @@ def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
     Y[0::2] = hc.real
     Y[1::2] = hc.imag
     return Y
+
+
+def rows_t_data(fitter: Any, lines: slice, b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``b^T Y`` (c, n_out) of basis rows ``b`` (rows of ``lines``, c columns) and the
+    data rows of those lines, without forming ``Y``.
+
+    ``b`` holds complex columns as real rows (real and imaginary part of each
+    entry ``(k, f)`` interleaved, as :func:`basis_ek` returns them), and so does
+    ``Y``: the real inner product of two such columns is ``Re(conj(a)^T y)`` of
+    the complex columns, so ``b^T Y = Re(conj(b_c)^T H_c)`` with ``H_c`` the
+    block of ``fitter.H`` (times the line weights, here put on ``b_c``). Falls
+    back to ``b.T @ ydata(...)`` when ``b`` is not laid out that way.
+    """
+    bt = b.T
+    if not (bt.flags.c_contiguous and bt.shape[1] % 2 == 0):
+        return np.asarray(bt @ ydata(fitter, lines))
+    n_out, n_in = fitter.n_out, fitter.n_in
+    bc = bt.view(np.complex128)  # (c, n_in nb), entry (k, f)
+    lw = fitter.line_weights
+    if lw is not None:
+        bc = (bc.reshape(bc.shape[0], n_in, -1) * lw[lines]).reshape(bc.shape[0], -1)
+    h = fitter.H[:, :, lines].reshape(n_out, -1)
+    return np.asarray((np.conj(bc) @ h.T).real)
 
 
 def synth(
@@ -185,13 +223,17 @@ def residual_power(
     residual terms (n_out, n_in) or None; ``s2`` (n_out,) the noise variances.
     """
     out = np.empty(fitter.n_f)
+    n_out, n_in, m = residues.shape
+    # the modes' terms of every FRF as one product: [R | conj R] (n_out n_in, 2 m)
+    # times the columns kappa / (s - p_n), kappa / (s - conj p_n) (2 m, lines)
+    rr = np.concatenate([residues, np.conj(residues)], axis=2).reshape(n_out * n_in, 2 * m)
+    pp = np.concatenate([poles, np.conj(poles)])[:, None]
     for sl in blocks(fitter, 2 * poles.size + 2 * fitter.n_in):
         s, kap, kap_low = factors(fitter, sl)
         h = fitter.H[:, :, sl]
         e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
-        for n in range(poles.size):
-            r = residues[:, :, n, None]
-            e -= r * (kap / (s - poles[n])) + np.conj(r) * (kap / (s - np.conj(poles[n])))
+        if m:
+            e -= (rr @ (kap / (s - pp))).reshape(e.shape)
         upper, lower = terms
         if upper is not None:
             e -= upper[:, :, None] * kap

@@ -11,11 +11,16 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
-from scipy.linalg import lapack
+from scipy.linalg import blas, lapack
 
 #: largest condition estimate of the unit-column Gram matrix of the basis for which
 #: the projection is taken from the Gram blocks (relative error ~ eps * this)
 _MAX_GRAM_COND = 1e6
+#: largest condition estimate of that Gram matrix for which a basis held as one
+#: block is orthogonalised by Cholesky QR twice (:func:`_cholqr2`; beyond, and for
+#: several blocks, Householder): ``eps cond`` must stay far below 1 for the first
+#: Cholesky factor to be accurate enough for the second pass to orthogonalise
+_MAX_CQR2_COND = 1e10
 #: a squared norm ``||x||^2 - ||Q^T x||^2`` smaller than this fraction of the
 #: subtracted term (relative error ~ eps / this) is formed from the explicit residual
 _CANCEL_TOL = 1e-6
@@ -25,7 +30,10 @@ _PROJ_TOL = 1e-4
 
 
 def _fixed_range(
-    blocks: Any, q: int, yy: NDArray[np.float64]
+    blocks: Any,
+    q: int,
+    yy: NDArray[np.float64],
+    one: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The range of a fixed basis ``Phi``; ``blocks()`` returns its row blocks ``(Phi_b,
     Y_b)`` with those of the data (called again when a second pass is needed).
@@ -39,6 +47,10 @@ def _fixed_range(
     (:func:`_qr_blocks`) and the SVD ``R = U S V^T`` (``r`` singular values above
     ``1e-13`` times the largest): ``Q_r = Q U_r = Phi V_r S_r^-1``, so ``T = V_r
     S_r^-1`` and ``Q_r^T Y = U_r^T Q^T Y`` (a rank-deficient ``Phi`` included).
+    ``one = (Phi, Y)`` when they are one block: an ill-conditioned ``Phi`` of full
+    rank (condition estimate up to :data:`_MAX_CQR2_COND`) is orthogonalised by
+    CholeskyQR2 first (:func:`_cholqr2`: ``T = D^-1 R_1^-1 R_2^-1``, ``Q^T Y = R_2^-T
+    Q_1^T Y``), with the same cancellation test.
     """
     G = np.zeros((q, q))
     P = np.zeros((q, yy.size))
@@ -52,6 +64,14 @@ def _fixed_range(
         yyp = yy - np.einsum("ij,ij->j", qty, qty)
         if not (yyp < _CANCEL_TOL * yy).any():
             tmap = lapack.dtrtri(rs)[0] / d[:, None]  # R^-1 with R = rs diag(d)
+            return np.asarray(tmap), np.asarray(qty), np.asarray(yyp)
+    cq = None if one is None or fac is not None else _cqr2_factor(G, one[0])
+    if cq is not None and one is not None:
+        r1, r2, d, q1 = cq
+        qty = lapack.dtrtrs(r2, q1.T @ one[1], trans=1)[0]
+        yyp = yy - np.einsum("ij,ij->j", qty, qty)
+        if not (yyp < _CANCEL_TOL * yy).any():
+            tmap = (lapack.dtrtri(r1)[0] @ lapack.dtrtri(r2)[0]) / d[:, None]
             return np.asarray(tmap), np.asarray(qty), np.asarray(yyp)
     R, Z, rho = _qr_blocks(blocks(), q, yy.size)
     u, sv, vt = np.linalg.svd(R)
@@ -125,6 +145,7 @@ def _vp_solve(
     residual: bool,
     gradient: bool,
     cancel: NDArray[np.float64] | None = None,
+    one: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> dict[str, Any]:
     """Variable projection from the Gram blocks of ``B = [Phi | E]``.
 
@@ -153,6 +174,10 @@ def _vp_solve(
         Return ``E^T r``.
     cancel : ndarray, shape (n_out,), optional
         Reference of the cancellation test (default ``||Q^T Y_j||^2``).
+    one : (ndarray, ndarray), optional
+        ``B`` and ``Y`` themselves when they are one block: an ill-conditioned
+        ``Phi`` is then orthogonalised by :func:`_cholqr2` (when its condition
+        allows), not by the Householder QR.
 
     Returns
     -------
@@ -196,6 +221,10 @@ def _vp_solve(
                 "cost_out": cost_out,
                 "qr": False,
             }
+    if fac is None and not residual and one is not None:
+        got = _cholqr2(G, P, q, yy, one, gradient=gradient, cancel=cancel)
+        if got is not None:
+            return got
     Rb, Z, rho = _qr_blocks(explicit(), G.shape[0], P.shape[1])
     R, QtE, R2 = Rb[:q, :q], Rb[:q, q:], Rb[q:, q:]
     Ct, X = Z[:q], Z[q:]
@@ -218,6 +247,83 @@ def _vp_solve(
         "QtE": QtE,
         "GE": R2.T @ R2,
         "Etr": Etr,
+        "cost": float(cost_out.sum()),
+        "cost_out": cost_out,
+        "qr": True,
+    }
+
+
+def _cqr2_factor(
+    g: NDArray[np.float64], phi: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], Any] | None:
+    """CholeskyQR2 of ``Phi`` (rows ``phi``, Gram matrix ``g``): ``R_1``, ``R_2``, ``D``
+    and ``Q_1 = Phi D^-1 R_1^-1`` (:func:`_cholqr2`), or None when the condition
+    estimate of ``D^-1 g D^-1`` exceeds :data:`_MAX_CQR2_COND` or a factorisation fails."""
+    dg = g.diagonal()
+    if g.shape[0] == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):
+        return None
+    d = np.sqrt(dg)
+    gs = g / np.multiply.outer(d, d)
+    r1, info = lapack.dpotrf(gs, lower=0, clean=1)
+    if info != 0:
+        return None
+    rcond, info = lapack.dpocon(r1, float(abs(gs).sum(axis=0).max()))
+    if info != 0 or not rcond * _MAX_CQR2_COND >= 1.0:
+        return None
+    q1 = blas.dtrsm(1.0, r1, phi / d, side=1, lower=0)  # Phi D^-1 R_1^-1
+    r2, info = lapack.dpotrf(q1.T @ q1, lower=0, clean=1)
+    if info != 0:
+        return None
+    return r1, r2, d, q1
+
+
+def _cholqr2(
+    G: NDArray[np.float64],
+    P: NDArray[np.float64],
+    q: int,
+    yy: NDArray[np.float64],
+    one: tuple[NDArray[np.float64], NDArray[np.float64]],
+    *,
+    gradient: bool,
+    cancel: NDArray[np.float64] | None,
+) -> dict[str, Any] | None:
+    """The projection of :func:`_vp_solve` with ``Phi`` orthogonalised by Cholesky
+    QR twice, or None (condition beyond :data:`_MAX_CQR2_COND`, a failed
+    factorisation, or a cost that would lose accuracy by cancellation).
+
+    ``one = (B, Y)``: the rows of ``B = [Phi | E]`` and of the data. With ``D``
+    the column norms of ``Phi`` and ``R_1`` the Cholesky factor of ``D^-1 Phi^T
+    Phi D^-1``, ``Q_1 = Phi D^-1 R_1^-1`` is formed explicitly; the Cholesky
+    factor ``R_2`` of ``Q_1^T Q_1`` (condition ``1 + O(eps cond(Phi)^2)``) gives
+    ``Phi = Q R`` with ``Q = Q_1 R_2^-1`` orthonormal to working precision and
+    ``R = R_2 R_1 D`` (CholeskyQR2: Fukaya, Nakatsukasa, Yanagisawa & Yamamoto,
+    2014; Yamamoto, Nakatsukasa, Yanagisawa & Fukaya, *ETNA* 44, 2015, stable
+    for ``cond(Phi)`` up to about ``eps^-1/2``). ``Q^T E = R_2^-T Q_1^T E`` and
+    ``Q^T Y = R_2^-T Q_1^T Y`` are products with that explicit basis (no
+    ``cond(Phi)^2`` amplification); the rest follows the Gram route of
+    :func:`_vp_solve` (``E^T P E``, ``E^T r`` and the cost by subtraction, the
+    same cancellation test).
+    """
+    B, Y = one
+    ne = G.shape[0] - q
+    fac = _cqr2_factor(G[:q, :q], B[:, :q])
+    if fac is None:
+        return None
+    r1, r2, d, q1 = fac
+    x = lapack.dtrtrs(r2, np.concatenate([q1.T @ B[:, q:], q1.T @ Y], axis=1), trans=1)[0]
+    QtE, Ct = x[:, :ne], x[:, ne:]
+    ct2 = (Ct * Ct).sum(axis=0)
+    cost_out = yy - ct2
+    if (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
+        return None
+    c = lapack.dtrtrs(r1, lapack.dtrtrs(r2, Ct)[0])[0] / d[:, None]  # R C = Q^T Y
+    return {
+        "R": (r2 @ r1) * d[None, :],
+        "C": c,
+        "Ct": Ct,
+        "QtE": QtE,
+        "GE": G[q:, q:] - QtE.T @ QtE,
+        "Etr": P[q:] - QtE.T @ Ct if gradient else None,
         "cost": float(cost_out.sum()),
         "cost_out": cost_out,
         "qr": True,
@@ -267,6 +373,61 @@ def _lu_solve(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[n
     return x, int(info)
 
 
+def _gn_point(
+    x: NDArray[np.float64],
+    A: NDArray[np.float64],
+    g: NDArray[np.float64],
+    lb: NDArray[np.float64],
+    ub: NDArray[np.float64],
+) -> tuple[NDArray[np.intp] | None, NDArray[np.float64], Any, Any, float] | None:
+    """The free parameters of a point of :func:`_levenberg_marquardt` and its
+    Gauss-Newton decrement (None when every parameter is held).
+
+    Returns the free indices (None: all), their scales ``sqrt(diag A)``, the
+    scaled ``A`` and ``g`` of the free parameters and the decrement ``-g^T
+    A^-1 g`` (``A`` regularised by ``1e-12`` of its scaled diagonal).
+    """
+    diag = A.diagonal()
+    d_a = np.sqrt(np.maximum(diag, 1e-300))
+    # held: at a bound with the descent direction -g pointing outwards, or
+    # without information (e.g. the damping of a residual mode far outside
+    # the band: its column of J vanishes)
+    held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
+    held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
+    free: NDArray[np.intp] | None = None
+    d_f = d_a
+    if held.any():
+        idx = np.flatnonzero(~held)
+        if idx.size == 0:
+            return None
+        free, d_f = idx, d_a[idx]
+        An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
+        gn = g[idx] / d_f
+    else:
+        An = A / np.outer(d_a, d_a)
+        gn = g / d_a
+    # Gauss-Newton decrement at this point (convergence test)
+    gn_step, info = _lu_solve(An + 1e-12 * np.eye(gn.size), -gn)
+    if info != 0:
+        gn_step = -gn
+    return free, d_f, An, gn, float(-gn @ gn_step)
+
+
+def at_rest(
+    x: NDArray[np.float64],
+    cost: float,
+    A: NDArray[np.float64],
+    g: NDArray[np.float64],
+    bounds: tuple[NDArray[np.float64], NDArray[np.float64]],
+    tol: float,
+    dof: int,
+) -> bool:
+    """Would :func:`_levenberg_marquardt` started at ``x`` (cost, ``J^T J = A``,
+    ``J^T r = g``) stop there at once, with ``tol`` and ``dof``?"""
+    point = _gn_point(x, A, g, *bounds)
+    return point is None or point[4] <= max(tol * cost / dof, 1e-24 * max(cost, 1e-300))
+
+
 def _levenberg_marquardt(
     evaluate: Any,
     x0: NDArray[np.float64],
@@ -310,31 +471,11 @@ def _levenberg_marquardt(
         if new_point:
             if not math.isfinite(cost):
                 return x, nfev, False, aux
-            diag = A.diagonal()
-            d_a = np.sqrt(np.maximum(diag, 1e-300))
-            # held: at a bound with the descent direction -g pointing outwards, or
-            # without information (e.g. the damping of a residual mode far outside
-            # the band: its column of J vanishes)
-            held = ((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0))
-            held |= diag <= 1e-13 * max(float(diag.max()), 1e-300)
-            free: NDArray[np.intp] | None = None
-            d_f = d_a
-            if held.any():
-                idx = np.flatnonzero(~held)
-                if idx.size == 0:
-                    return x, nfev, True, aux
-                free, d_f = idx, d_a[idx]
-                An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
-                gn = g[idx] / d_f
-            else:
-                An = A / np.outer(d_a, d_a)
-                gn = g / d_a
+            point = _gn_point(x, A, g, lb, ub)
+            if point is None:
+                return x, nfev, True, aux
+            free, d_f, An, gn, decrement = point
             eye = np.eye(gn.size)
-            # Gauss-Newton decrement at this point (convergence test)
-            gn_step, info = _lu_solve(An + 1e-12 * eye, -gn)
-            if info != 0:
-                gn_step = -gn
-            decrement = float(-gn @ gn_step)
             if decrement <= max(tol * cost / dof, 1e-24 * cost0):
                 return x, nfev, True, aux
             new_point = False

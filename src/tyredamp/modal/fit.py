@@ -51,7 +51,16 @@ about 1 MB); the basis of all lines, the weighted data ``Y`` and the
 residual are never held, so a fit costs the data plus a constant. The data
 rows, ``s = i w`` and ``kappa`` of a block are formed when needed (the
 attributes ``Y``, ``s``, ``kappa``, ``kappa_low`` form them for all lines on
-request).
+request); with several blocks ``B^T Y`` comes from the complex data
+(:func:`~tyredamp.modal._basis.rows_t_data`), no data rows are formed. When
+the data rows fit one block (the common case: 16 outputs x 800 lines are 0.2
+MB), the fitter forms them and the line factors once and keeps them (no
+more than the one block of a blocked fit), a basis is formed once per
+evaluation for both routes, and an ill-conditioned basis is orthogonalised
+by CholeskyQR2 (:func:`~tyredamp.modal._linalg._cholqr2`) rather than by
+Householder. Between calls a fitter keeps the fixed part of its latest
+``fit_added`` (:mod:`~tyredamp.modal._added`) and its latest intermediate fit
+at rest (``fit``); both are pure caches of its data (same results).
 
 Scaling (spec step 3 and eq. [10]): with drive points ``(j_k, k)`` (output
 ``j_k`` at the place of input ``k``) reciprocity ``psi_in[k] = psi_out[j_k]``
@@ -69,21 +78,15 @@ frequencies, damping ratios and mode-shape entries by the delta method.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import InputError
-from . import _basis, _scaling
-from ._linalg import (
-    _PROJ_TOL,
-    _extra_ss,
-    _fixed_range,
-    _levenberg_marquardt,
-    _vp_solve,
-)
+from . import _added, _basis, _scaling
+from ._linalg import _extra_ss, _levenberg_marquardt, _vp_solve, at_rest
 from .compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
@@ -200,8 +203,22 @@ class ModalFitter:
             self.line_weights = lw
         self.w_ref = float(2 * np.pi * frequency[-1])
         # data rows (k, f), real and imaginary part interleaved (_basis.ydata), are
-        # formed block by block when needed; only their sums of squares are kept
+        # formed block by block when needed; only their sums of squares are kept --
+        # unless they fit one block (the common case): then they are formed once and
+        # kept, with the line factors (s, kappa, kappa_low: three values per line)
         self.n_rows = 2 * self.n_in * self.n_f
+        self._y: NDArray[np.float64] | None = None
+        self._factors: tuple[NDArray[np.complex128], ...] | None = None
+        # a fit_added of the same fixed modes again: its fixed range (_fixed_memo)
+        self._fixed_memo: tuple[Any, ...] | None = None
+        # an intermediate fit at rest: the same fit started at its result (_fit_memo)
+        self._fit_memo: tuple[Any, FitResult] | None = None
+        if _basis.one_block(self):
+            fac = _basis.factors(self)
+            y = _basis.ydata(self)
+            for a in (*fac, y):
+                a.flags.writeable = False
+            self._factors, self._y = fac, y
         yss = np.zeros(self.n_out)
         for sl in _basis.blocks(self, 0):
             yb = _basis.ydata(self, sl)
@@ -340,19 +357,32 @@ class ModalFitter:
                 b = self._basis_ek(th, m, ref, derivatives, sl, (None, pp))[0]
                 yield b, self._ydata(sl) * w
 
-        G = np.zeros((n_col, n_col))
-        P = np.zeros((n_col, self.n_out))
-        for B, Yb in rows():
-            G += B.T @ B
-            P += B.T @ Yb
+        explicit = rows
+        one = None
+        if len(parts) == 1:  # one block: formed once, kept for the QR route
+            kept = list(rows())
+            B, Yb = kept[0]
+            G, P = B.T @ B, B.T @ Yb
+            one = (B, Yb)
+
+            def explicit() -> Any:
+                return iter(kept)
+        else:
+            G = np.zeros((n_col, n_col))
+            P = np.zeros((n_col, self.n_out))
+            for sl in parts:  # B^T Y from the complex data (no data rows formed)
+                B = self._basis_ek(th, m, ref, derivatives, sl, (None, pp))[0]
+                G += B.T @ B
+                P += _basis.rows_t_data(self, sl, B) * w
         sol = _vp_solve(
             G,
             P,
             q,
             self._yss * w**2,
-            rows,
+            explicit,
             residual=residual,
             gradient=gradient and derivatives,
+            one=one,
         )
         if lay is not None:
             sol["lay"] = lay
@@ -409,6 +439,7 @@ class ModalFitter:
         """
         m = int(poles.size)
         part = np.asarray(part, complex).reshape(m, self.n_in)
+        start = (np.asarray(poles, complex).tobytes(), part.tobytes())
         if self.kind == "real":
             ph = np.exp(-1j * np.angle(part[np.arange(m), np.argmax(np.abs(part), axis=1)]))
             part = (part * ph[:, None]).real.astype(complex)
@@ -418,6 +449,13 @@ class ModalFitter:
         w = self._w1
         if sigma is not None and not self.unit_weights:
             w = 1.0 / np.maximum(np.asarray(sigma, float), np.maximum(floor, 1e-300))
+        # an intermediate one-pass refinement started at the result of the previous
+        # one (same weights and tolerance) that stopped at rest would stop at once:
+        # that result again (one evaluation)
+        once = refine and not uncertainty and passes <= 1 and max_nfev >= 2
+        memo = self._fit_memo
+        if once and memo is not None and memo[0] == (*start, w.tobytes(), tol):
+            return replace(memo[1], n_iter=1, warnings=list(memo[1].warnings))
         q = self.n_cols(m)
         dof = self.n_rows - q
         status = "lsfd"
@@ -436,7 +474,11 @@ class ModalFitter:
                 w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
-        return self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
+        if once and status == "converged" and self._at_rest(th, sol):
+            end = (res.poles.tobytes(), res.participation.tobytes(), w.tobytes(), tol)
+            self._fit_memo = (end, res)
+        return res
 
     def fit_added(
         self,
@@ -465,8 +507,8 @@ class ModalFitter:
         route of :func:`_vp_solve` is taken when the subtraction would lose
         accuracy. ``omega_bounds`` (rad/s, lower < upper) limits the damped
         natural frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
-        ``fixed``: accepted for compatibility and not used (the fixed basis is
-        formed block by block; no per-line array is kept between calls).
+        ``fixed``: accepted for compatibility and not used (the fitter keeps the
+        fixed part of its latest fixed modes, :mod:`~tyredamp.modal._added`).
 
         Returns
         -------
@@ -491,65 +533,13 @@ class ModalFitter:
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
         w = self._w1
         th_f = self.pack(poles, part, ref)
-        qf = self.n_cols(m)
         one = copy.copy(self)
         one.use_upper = one.use_lower = False
         th0 = one.pack(p1, l1, ref1)
-        q1 = one.n_cols(1)
         lay1 = one._layout(1)
-        n1 = q1 + int(lay1.ecol.max()) + 1
-        parts = _basis.blocks(self, qf + n1)
-        # the fixed basis is kept when it is no larger than the data (many outputs) or
-        # fits one block; otherwise it is formed again block by block when needed
-        keep = len(parts) == 1 or qf <= self.n_out
-        cache: dict[int, NDArray[np.float64]] = {}
-        pp_f = self.unpack(th_f, m, ref)
-
-        def fixed_cols(i: int, fac: Any = None) -> NDArray[np.float64]:
-            if i in cache:
-                return cache[i]
-            phi_f = self._basis_ek(th_f, m, ref, False, parts[i], (fac, pp_f))[0]
-            if keep:
-                cache[i] = phi_f
-            return phi_f
-
-        # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
-        # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
-        yy = self._yss * w**2
-        tmap, qty, yyp = _fixed_range(
-            lambda: ((fixed_cols(i), self._ydata(sl) * w) for i, sl in enumerate(parts)), qf, yy
-        )
-
-        def solve(th: NDArray[np.float64]) -> dict[str, Any]:
-            # Gram blocks of the added mode's [Phi_1 | E_1] projected on the complement
-            # of Phi_f: B1^T B1 - (Q_r^T B1)^T Q_r^T B1 and B1^T Y - (Q_r^T B1)^T Q_r^T Y
-            cross = np.zeros((qf, n1))
-            g0 = np.zeros((n1, n1))
-            p0 = np.zeros((n1, self.n_out))
-            pp1 = one.unpack(th, 1, ref1)
-            for i, sl in enumerate(parts):
-                fac = None if i in cache else _basis.factors(self, sl)
-                b1 = one._basis_ek(th, 1, ref1, True, sl, (fac, pp1))[0]
-                cross += fixed_cols(i, fac).T @ b1
-                g0 += b1.T @ b1
-                p0 += b1.T @ (self._ydata(sl) * w)
-            qb = tmap.T @ cross
-            G = g0 - qb.T @ qb
-            P = p0 - qb.T @ qty
-
-            def projected() -> Any:
-                for i, sl in enumerate(parts):
-                    b1 = one._basis_ek(th, 1, ref1, True, sl)[0]
-                    pt = fixed_cols(i) @ tmap
-                    yield b1 - pt @ qb, self._ydata(sl) * w - pt @ qty
-
-            # columns mostly in span(Phi_f): the QR route of the projected rows
-            force = bool(np.any(np.diag(G) < _PROJ_TOL * np.diag(g0)))
-            sol = _vp_solve(G, P, q1, yyp, projected, residual=force, gradient=True, cancel=yy)
-            sol["lay"] = lay1
-            sol["coef"] = one._coef(lay1, one.unpack(th, 1, ref1)[0])
-            return sol
-
+        n1 = one.n_cols(1) + int(lay1.ecol.max()) + 1
+        fx = _added.fixed_part(self, th_f, m, ref, _basis.blocks(self, self.n_cols(m) + n1))
+        solve = _added.added_solver(self, one, fx, ref1, lay1)
         th, _, _, sol = self._refine(
             th0, 1, ref1, w, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
         )
@@ -588,19 +578,24 @@ class ModalFitter:
             sol = self._solve(x, m, ref, w, residual=False) if solve is None else solve(x)
             jtj, jtr = self._normal(sol, n_par)
             sol["jtj"] = jtj  # kept for the standard errors at the optimum
+            sol["jtr"] = jtr
             return float(sol["cost"]), jtj, jtr, sol
 
+        dof = max(n_obs - n_lin * self.n_out - n_par, 1)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             x, nfev, ok, sol = _levenberg_marquardt(
-                evaluate,
-                th0,
-                lb,
-                ub,
-                max_nfev,
-                dof=max(n_obs - n_lin * self.n_out - n_par, 1),
-                tol=tol,
+                evaluate, th0, lb, ub, max_nfev, dof=dof, tol=tol
             )
+        sol["lm"] = (lb, ub, dof, tol)  # the iteration's settings (_at_rest)
         return x, nfev, "converged" if ok else "maxfev", sol
+
+    @staticmethod
+    def _at_rest(x: NDArray[np.float64], sol: dict[str, Any]) -> bool:
+        """Would a refinement started at its result ``x`` (strictly inside the bounds)
+        stop at once (:func:`~tyredamp.modal._linalg.at_rest`)?"""
+        lb, ub, dof, tol = sol["lm"]
+        inside = bool(np.all((x > lb + 1e-9) & (x < ub - 1e-9)))
+        return inside and at_rest(x, sol["cost"], sol["jtj"], sol["jtr"], (lb, ub), tol, dof)
 
     # --------------------------------------------------------- results
     # scaling and shape uncertainty (functions of the fitter, in _scaling)

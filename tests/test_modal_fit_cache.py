@@ -1,0 +1,240 @@
+"""What a ModalFitter keeps between calls (the fixed part of fit_added, an
+intermediate fit at rest, the data rows of one block) gives the results of
+computing everything again."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from tyredamp.modal import _basis
+from tyredamp.modal._linalg import _levenberg_marquardt, at_rest
+from tyredamp.modal.fit import ModalFitter
+
+from .helpers import chain_system
+
+F = np.linspace(0.5, 40.0, 400)
+
+
+def _noisy(noise: float, seed: int) -> tuple[Any, np.ndarray]:
+    sys_ = chain_system()
+    rng = np.random.default_rng(seed)
+    h = sys_.frf(F, kind="accelerance", inputs=[0, 5]).H
+    h = h + noise * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    return sys_, h
+
+
+def _fitter(h: np.ndarray, kind: str = "complex") -> ModalFitter:
+    return ModalFitter(F, h, 2, kind, [(0, 0), (5, 1)])
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+@pytest.mark.parametrize("many_blocks", [False, True])
+def test_fit_added_again_against_the_same_modes_gives_a_new_fitters_result(
+    kind: str, many_blocks: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    if many_blocks:
+        monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
+        monkeypatch.setattr(_basis, "MIN_BLOCK_LINES", 37)
+    sys_, h = _noisy(1e-3, 5)
+    cm = sys_.complex_modes()
+    part = cm.psi[[0, 5]].T
+    k = int(np.argsort(cm.poles.imag)[3])
+    keep = np.delete(np.arange(cm.poles.size), k)
+    lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
+    fixed = (cm.poles[keep] * 1.001, part[keep])
+    fit = _fitter(h, kind)
+    assert (len(_basis.blocks(fit, 20)) > 1) == many_blocks
+    # a first candidate, then two others against the same fixed modes: the second
+    # and third reuse the fixed part the first formed
+    fit.fit_added(*fixed, cm.poles[k] * 1.03, np.ones(2), omega_bounds=(lo, hi))
+    for start in (cm.poles[k] * 1.01, cm.poles[k] * (0.99 + 0.01j)):
+        kept = fit.fit_added(*fixed, start, np.ones(2), omega_bounds=(lo, hi))
+        new = _fitter(h, kind).fit_added(*fixed, start, np.ones(2), omega_bounds=(lo, hi))
+        # the same arithmetic on the same arrays: identical
+        for a, b in zip(kept, new, strict=True):
+            assert_array_equal(a, b)
+    # other fixed modes: formed again (not the kept ones)
+    other = (cm.poles[keep] * 1.002, part[keep])
+    a = fit.fit_added(*other, cm.poles[k] * 1.01, np.ones(2), omega_bounds=(lo, hi))
+    b = _fitter(h, kind).fit_added(*other, cm.poles[k] * 1.01, np.ones(2), omega_bounds=(lo, hi))
+    for x, y in zip(a, b, strict=True):
+        assert_array_equal(x, y)
+
+
+def test_a_fit_started_at_a_fit_at_rest_returns_it_with_one_evaluation() -> None:
+    sys_, h = _noisy(1e-2, 6)
+    cm = sys_.complex_modes()
+    part = cm.psi[[0, 5]].T
+    fit = _fitter(h)
+    opts = {"passes": 1, "tol": 10.0, "uncertainty": False}
+    first = fit.fit(cm.poles * 1.002, part, **opts)
+    assert first.status == "converged"
+    assert first.n_iter > 1
+    again = fit.fit(first.poles, first.participation, **opts)
+    # a new fitter runs the refinement from there: it stops after one evaluation
+    # at the same point (the start re-packed from the poles, round-off apart)
+    new = _fitter(h).fit(first.poles, first.participation, **opts)
+    assert again.n_iter == new.n_iter == 1
+    assert again.status == new.status == "converged"
+    assert_allclose(again.poles, new.poles, rtol=1e-13)
+    assert_allclose(again.sigma_out, new.sigma_out, rtol=1e-10)
+    assert_allclose(again.significance, new.significance, rtol=1e-8)
+    assert_array_equal(again.poles, first.poles)
+    # another tolerance is not served from it: the refinement goes on
+    other = fit.fit(first.poles, first.participation, passes=1, tol=1e-6, uncertainty=False)
+    assert other.n_iter > 1
+    full = fit.fit(first.poles, first.participation, passes=1, tol=10.0)
+    assert np.all(np.isfinite(full.std_frequency_hz))
+
+
+def test_at_rest_is_the_first_stop_of_levenberg_marquardt() -> None:
+    # cost (x - a)^T M (x - a) + c: J^T J = M, J^T r = M (x - a) (gradient / 2)
+    rng = np.random.default_rng(1)
+    a_mat = rng.normal(size=(4, 4))
+    M = a_mat @ a_mat.T + 4 * np.eye(4)
+    a = rng.normal(size=4)
+    lb, ub = np.full(4, -10.0), np.full(4, 10.0)
+
+    def evaluate(x: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, None]:
+        d = x - a
+        return float(d @ M @ d) + 1.0, M, M @ d, None
+
+    for shift, rest in ((1e-6, True), (1e-1, False)):
+        x = a + shift
+        c, A, g, _ = evaluate(x)
+        assert at_rest(x, c, A, g, (lb, ub), 1.0, 10) == rest
+        nfev = _levenberg_marquardt(evaluate, x, lb, ub, 50, dof=10, tol=1.0)[1]
+        assert (nfev == 1) == rest
+
+
+def test_one_block_data_rows_are_kept_read_only_and_equal_the_blocked_rows(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    _, h = _noisy(1e-3, 7)
+    fit = _fitter(h)
+    assert _basis.one_block(fit)
+    y = fit.Y
+    assert not y.flags.writeable
+    monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
+    blocked = _fitter(h)
+    assert not _basis.one_block(blocked)
+    # several blocks: no per-line array is kept (issue 15: the data plus a constant)
+    assert blocked._y is None
+    assert blocked._factors is None
+    assert_array_equal(blocked.Y, y)
+    # the rows of some lines from the data, all lines from what the fitter keeps
+    sl = slice(3, 40)
+    assert_array_equal(_basis.ydata(fit, sl), _basis.ydata(blocked, sl))
+    assert _basis.ydata(fit, slice(0, F.size)) is y
+
+
+@pytest.mark.parametrize("spacing", [3e-5, 3e-6])
+def test_one_block_ill_conditioned_basis_by_cholesky_qr_twice(
+    spacing: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a pole pair this close makes the Gram matrix too ill-conditioned for the Gram
+    # route (cond > _MAX_GRAM_COND) but not for CholeskyQR2 (< _MAX_CQR2_COND): the
+    # one-block projection must match an independent least-squares solution and
+    # the Kaufman normal equations from the explicit derivative matrix
+    from scipy.linalg import lapack
+
+    import tyredamp.modal._linalg as lin
+
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(12)
+    h = sys_.frf(F, inputs=[0]).H * (2j * np.pi * F) ** 2
+    h = h + 1e-2 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    fit = ModalFitter(F, h, 2, "complex", [])
+    poles = np.append(cm.poles, cm.poles[2] * (1 + spacing))  # cond 1.3e6, 1.3e8
+    m = poles.size
+    ref = np.zeros(m, np.intp)
+    th = fit.pack(poles, np.ones((m, 1), complex), ref)
+    phi, D, dpar, dcol = fit.basis(th, m, ref)
+    g = phi.T @ phi
+    d = np.sqrt(g.diagonal())
+    gs = g / np.outer(d, d)
+    r1 = lapack.dpotrf(gs)[0]
+    cond = 1.0 / lapack.dpocon(r1, float(abs(gs).sum(axis=0).max()))[0]
+    assert lin._MAX_GRAM_COND < cond < lin._MAX_CQR2_COND
+
+    def no_householder(*args: Any, **kw: Any) -> Any:
+        raise AssertionError("the Householder route was taken")
+
+    monkeypatch.setattr(lin, "_qr_blocks", no_householder)
+    w = np.ones(fit.n_out)
+    sol = fit._solve(th, m, ref, w, residual=False)
+    assert sol["qr"]
+    # references: least squares by numpy's SVD solver, Q from numpy's Householder QR
+    yw = fit.Y * w
+    C = np.linalg.lstsq(phi, yw, rcond=None)[0]
+    r = yw - phi @ C
+    Q = np.linalg.qr(phi)[0]
+    qtd = Q.T @ D
+    A = np.zeros((D.shape[1], th.size))
+    A[np.arange(D.shape[1]), dpar] = 1.0
+    jtj_ref = A.T @ ((D.T @ D - qtd.T @ qtd) * (C @ C.T)[dcol[:, None], dcol[None, :]]) @ A
+    jtr_ref = -(A.T @ np.einsum("id,id->d", D, (r @ C.T)[:, dcol]))
+    jtj, jtr = fit._normal(sol, th.size)
+    # tolerances: round-off times cond(Phi) ~ sqrt(cond) for the cost and the fit,
+    # the coefficients of the close pair are as ill-determined as cond(Phi) says
+    assert_allclose(sol["cost"], np.sum(r**2), rtol=1e-9)
+    assert_allclose(phi @ sol["C"], phi @ C, rtol=0, atol=1e-9 * np.abs(yw).max())
+    assert_allclose(np.abs(sol["R"].T @ sol["R"]), np.abs(g), rtol=0, atol=1e-12 * np.abs(g).max())
+    assert_allclose(jtj, jtj_ref, rtol=0, atol=1e-8 * np.max(np.abs(jtj_ref)))
+    assert_allclose(jtr, jtr_ref, rtol=0, atol=1e-8 * np.max(np.abs(jtr_ref)))
+
+
+@pytest.mark.parametrize("n_in", [1, 2])
+def test_residual_power_is_the_weighted_residual_of_the_modal_sum(n_in: int) -> None:
+    # _basis.residual_power forms the modes' terms as one matrix product; reference:
+    # the modal sum R / (s - p) + conj(R) / (s - conj p) mode by mode, plus the
+    # residual terms, weighted per line and per output
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    inputs = [0, 5][:n_in]
+    rng = np.random.default_rng(8)
+    h = sys_.frf(F, kind="accelerance", inputs=inputs).H
+    h = h + 1e-2 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    lw = 1.0 + 0.3 * np.sin(F)
+    fit = ModalFitter(F, h, 2, "complex", [], line_weights=lw)
+    res = fit.fit(cm.poles, cm.psi[inputs].T, refine=False)
+    R = res.psi_out[:, None, :] * res.psi_in[None, :, :]
+    s2 = res.sigma_out**2
+    got = _basis.residual_power(fit, res.poles, R, (res.upper, res.lower), s2)
+    s = 2j * np.pi * F
+    model = np.zeros_like(h)
+    for n, p in enumerate(res.poles):
+        r = R[:, :, n, None]
+        model += r * s**2 / (s - p) + np.conj(r) * s**2 / (s - np.conj(p))
+    model += res.upper[:, :, None] * s**2 + res.lower[:, :, None]
+    ref = np.einsum("jkf,j->f", np.abs(h - model) ** 2 * lw**2, 1.0 / s2)
+    assert_allclose(got, ref, rtol=1e-9)  # two routes to the same sums: round-off
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_basis_times_data_from_the_complex_data(kind: str) -> None:
+    # _basis.rows_t_data: B^T Y as Re(conj(B_c)^T H_c), without forming the data rows;
+    # reference: the real rows of the data (ydata) and a real product
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(2)
+    h = sys_.frf(F, kind="accelerance", inputs=[0, 5]).H
+    h = h + 1e-2 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    fit = ModalFitter(F, h, 2, kind, [], line_weights=1.0 + 0.4 * np.cos(F))
+    part = cm.psi[[0, 5]].T
+    if kind == "real":
+        part = np.abs(part) + 0j
+    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+    th = fit.pack(cm.poles, part, ref)
+    sl = slice(37, 290)
+    B = fit._basis_ek(th, cm.poles.size, ref, True, sl)[0]
+    want = B.T @ _basis.ydata(fit, sl)
+    assert_allclose(_basis.rows_t_data(fit, sl, B), want, rtol=0, atol=1e-12 * np.abs(want).max())
+    # rows in another layout: the real product itself
+    Bc = np.ascontiguousarray(B)
+    assert_allclose(_basis.rows_t_data(fit, sl, Bc), want, rtol=0, atol=0)
