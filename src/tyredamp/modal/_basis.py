@@ -7,6 +7,7 @@ columns is stated in the docstring of :mod:`tyredamp.modal.fit`.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -223,6 +224,19 @@ def residual_power(
     residual terms (n_out, n_in) or None; ``s2`` (n_out,) the noise variances.
     """
     out = np.empty(fitter.n_f)
+    for sl, e in residual_blocks(fitter, poles, residues, terms):
+        out[sl] = np.einsum("jkf,j->f", e.real**2 + e.imag**2, 1.0 / s2)
+    return out
+
+
+def residual_blocks(
+    fitter: Any,
+    poles: NDArray[np.complex128],
+    residues: NDArray[np.complex128],
+    terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+) -> Iterator[tuple[slice, NDArray[np.complex128]]]:
+    """The weighted residual ``H - H^`` (line weights applied), (n_out, n_in, lines),
+    block by block with its lines (arguments as :func:`residual_power`)."""
     n_out, n_in, m = residues.shape
     # the modes' terms of every FRF as one product: [R | conj R] (n_out n_in, 2 m)
     # times the columns kappa / (s - p_n), kappa / (s - conj p_n) (2 m, lines)
@@ -239,8 +253,7 @@ def residual_power(
             e -= upper[:, :, None] * kap
         if lower is not None:
             e -= lower[:, :, None] * kap_low
-        out[sl] = np.einsum("jkf,j->f", e.real**2 + e.imag**2, 1.0 / s2)
-    return out
+        yield sl, e
 
 
 def basis_ek(

@@ -95,6 +95,7 @@ from .problem import FitProblem, build_problem, max_modes
 from .quality import RejectedMode
 from .search import (
     ModeSet,
+    ModeTest,
     reject_by_test,
     rejected,
     residual_search,
@@ -254,8 +255,19 @@ def identify_modes(
     modes, rej = _start_modes(problem, dg, fr, n_modes, min_fraction, warnings)
     fitters = _Fitters.build(problem, residuals, modes, max_helpers)
     thr = _threshold(problem, "complex", false_alarm)
+    test = ModeTest(mode_parameters(*problem.shape[:2], "complex"), n_f, false_alarm)
     last, modes, more = _select(
-        fitters, modes, dg, rej, thr, auto, refine, max_helpers, min_contribution, search, (lo, hi)
+        fitters,
+        modes,
+        dg,
+        rej,
+        (thr, test),
+        auto,
+        refine,
+        max_helpers,
+        min_contribution,
+        search,
+        (lo, hi),
     )
     rej += more
     sigma0 = _noise_per_output(problem, fitters, modes, last, refine)
@@ -431,7 +443,7 @@ def _select(
     modes: ModeSet,
     dg: Diagram,
     rej: list[RejectedMode],
-    thr: float,
+    thresholds: tuple[float, ModeTest],
     auto: bool,
     refine: bool,
     max_helpers: int,
@@ -439,7 +451,12 @@ def _select(
     search: bool,
     problem_band: tuple[float, float],
 ) -> tuple[FitResult | None, ModeSet, list[RejectedMode]]:
-    """Step 3: refine, add out-of-band residual modes, decide the mode count."""
+    """Step 3: refine, add out-of-band residual modes, decide the mode count.
+
+    ``thresholds``: the mode test's threshold and what each in-band mode's own
+    threshold needs (raised where the noise lies along the response,
+    :func:`~tyredamp.modal.search.local_thresholds`)."""
+    thr, test = thresholds
     sfit = fitters.sfit
     band = (float(sfit.f[0]), float(sfit.f[-1]))
     out: list[RejectedMode] = []
@@ -449,14 +466,16 @@ def _select(
         out += dropped
     if not auto:
         return last, modes, out
-    last, modes, dropped = reject_by_test(sfit, modes, problem_band, thr, refine, min_contribution)
+    last, modes, dropped = reject_by_test(
+        sfit, modes, problem_band, thr, refine, min_contribution, test
+    )
     out += dropped
     if search and refine:
         cands = [(c.pole, c.participation) for c in dg.weak] + [
             (_pole_of(r), np.ones(sfit.n_in, complex)) for r in rej + out
         ]
         last, modes, tried = residual_search(
-            sfit, last, modes, cands, problem_band, thr, dg.max_damping
+            sfit, last, modes, cands, problem_band, thr, dg.max_damping, test
         )
         out += tried
     return last, modes, out

@@ -34,8 +34,10 @@ from ..mechanics.modal_sum import pole_quantities
 from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode
+from .span_noise import SpanNoise, span_noise
+from .stats import FALSE_ALARM, span_threshold
 
-__all__ = ["ModeSet", "reject_by_test", "residual_search", "search_helpers"]
+__all__ = ["ModeSet", "ModeTest", "reject_by_test", "residual_search", "search_helpers"]
 
 #: convergence thresholds of the intermediate fits, in units of the residual
 #: variance s^2 (ModalFitter.fit ``tol``): the joint fits of the search and of the
@@ -94,6 +96,46 @@ class ModeSet:
         return ModeSet(
             res.poles[:m], res.participation[:m], res.poles[m:], res.participation[m:], self.n_free
         )
+
+
+@dataclass(frozen=True)
+class ModeTest:
+    """What a mode's own threshold needs besides the base one: the parameters
+    ``k`` of a mode, the lines of the band and the false-alarm rate
+    (:func:`~tyredamp.modal.stats.span_threshold`)."""
+
+    k: int
+    n_lines: int
+    false_alarm: float = FALSE_ALARM
+
+
+def _span(fitter: ModalFitter, res: FitResult) -> SpanNoise:
+    """Residual noise in and off the span of the data (:mod:`~tyredamp.modal.span_noise`)."""
+    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
+    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
+    return span_noise(fitter, res.poles, residues, (res.upper, res.lower), s2)
+
+
+def local_thresholds(
+    fitter: ModalFitter,
+    span: SpanNoise | None,
+    poles: NDArray[np.complex128],
+    threshold: float,
+    test: ModeTest | None,
+) -> NDArray[np.float64]:
+    """Each pole's threshold: ``threshold`` raised where the residual's noise lies
+    along the response (:func:`~tyredamp.modal.stats.span_threshold`); ``threshold``
+    for every pole without ``test`` or ``span``."""
+    if test is None or span is None:
+        return np.full(poles.size, float(threshold))
+    return np.array(
+        [
+            span_threshold(
+                threshold, test.k, fitter.n_in, test.n_lines, span.at(complex(p)), test.false_alarm
+            )
+            for p in poles
+        ]
+    )
 
 
 def rejected(
@@ -284,17 +326,22 @@ def reject_by_test(
     threshold: float,
     refine: bool,
     min_contribution: float = 0.0,
+    test: ModeTest | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Drop the weakest mode that fails the mode test, refit; until every mode passes.
 
     The first fit refines every mode jointly (and drops modes that leave the
     band); after each removal the residues are refitted at the current poles.
     ``min_contribution`` (default 0: off) also drops modes whose synthesised
-    FRFs have an RMS below that fraction of the data's.
+    FRFs have an RMS below that fraction of the data's. With ``test``, each
+    mode's threshold is raised where the noise of the first fit's residual
+    (every mode in it: no mode's signal counts as noise) lies along the
+    response (:func:`local_thresholds`).
     """
     out: list[RejectedMode] = []
     cur = modes
     res: FitResult | None = None
+    span: SpanNoise | None = None
     for i in range(modes.m + 1):
         if i == 0 and refine:
             # a converged joint fit first (modes that leave the band are dropped)
@@ -309,17 +356,20 @@ def reject_by_test(
             res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
         cur = cur.take(res)
         m = cur.m
+        if span is None and test is not None:
+            span = _span(fitter, res)
+        thr = local_thresholds(fitter, span, cur.poles, threshold, test)
         t, con = res.significance[:m], res.contribution[:m]
-        bad = (t < threshold) | (con < min_contribution)
+        bad = (t < thr) | (con < min_contribution)
         if not np.any(bad) or m <= 1:
             break
-        worst = int(np.argmin(np.where(bad, t, np.inf)))
+        worst = int(np.argmin(np.where(bad, t / thr, np.inf)))
         why = (
             f"contribution {con[worst]:.2%} < {min_contribution:.2%}"
             if con[worst] < min_contribution
-            else f"not significant: T = {t[worst]:.3g} <= {threshold:.3g}"
+            else f"not significant: T = {t[worst]:.3g} <= {_thr_text(thr[worst], threshold)}"
         )
-        out.append(rejected(complex(cur.poles[worst]), why, float(t[worst]), threshold))
+        out.append(rejected(complex(cur.poles[worst]), why, float(t[worst]), float(thr[worst])))
         cur = ModeSet(
             np.delete(cur.poles, worst),
             np.delete(cur.part, worst, axis=0),
@@ -332,6 +382,13 @@ def reject_by_test(
         p0, l0 = cur.all()
         res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
     return res, cur, out
+
+
+def _thr_text(thr: float, base: float) -> str:
+    """A threshold for a reason; says when the noise along the response raised it."""
+    if thr > base:
+        return f"{thr:.3g} (raised from {base:.3g}: noise along the response)"
+    return f"{thr:.3g}"
 
 
 def _residual_peaks(
@@ -387,6 +444,7 @@ def residual_search(
     band: tuple[float, float],
     threshold: float,
     max_damping: float = 0.2,
+    test: ModeTest | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
@@ -399,7 +457,11 @@ def residual_search(
     averages are too small) rather than a resonance.
 
     ``candidates`` are starting poles and participation vectors from the
-    diagram; each round adds the peaks of the current residual.
+    diagram; each round adds the peaks of the current residual. With
+    ``test``, the added mode must also pass its own threshold in the joint
+    refit, raised where the noise of that fit's residual (the mode in it: a
+    true mode's signal does not count as noise) lies along the response
+    (:func:`local_thresholds`).
     """
     lo, hi = band
     df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
@@ -489,6 +551,20 @@ def residual_search(
                         p_t, f"not significant with all modes refitted: T = {t1:.3g}", t1, threshold
                     )
                 )
+                continue
+            t_new = float(r1.significance[c1.m - 1])
+            thr_new = float(
+                local_thresholds(
+                    fitter,
+                    _span(fitter, r1) if test is not None else None,
+                    c1.poles[-1:],
+                    threshold,
+                    test,
+                )[0]
+            )
+            if t_new <= thr_new:
+                why = f"not significant with all modes refitted: T = {t_new:.3g} <= "
+                tried.append(rejected(p_t, why + _thr_text(thr_new, threshold), t_new, thr_new))
                 continue
             res, cur, added = r1, c1, True
         if not added:

@@ -81,6 +81,7 @@ __all__ = [
     "goodness_of_fit",
     "mode_parameters",
     "mode_threshold",
+    "span_threshold",
     "weight_factor",
 ]
 
@@ -130,6 +131,49 @@ def mode_threshold(
     # the mean bound and the F tail of a mode whose lines share one estimated factor
     f_tail = int(k) * float(sps.f.isf(level, int(k), max(float(weight_dof), 1.0)))
     return max(thr * weight_factor(weight_dof), f_tail)
+
+
+def span_threshold(
+    threshold: float,
+    k: int,
+    n_in: int,
+    n_lines: int,
+    span: tuple[float, float, int],
+    false_alarm: float = FALSE_ALARM,
+) -> float:
+    """The mode threshold where the noise concentrates along the response.
+
+    ``span = (lambda_in, lambda_out, n)``: the noise variance per complex
+    direction in the span of ``H(f)`` and off it, in units of the fit's noise,
+    summed over ``n`` lines (:mod:`tyredamp.modal.span_noise`). Of a mode's
+    ``k`` parameters, ``a = min(4 n_in, k)`` can lie along the span (the
+    ``n_in`` complex components of the residue's shape there, the
+    participation and the pole, whose derivatives follow the shape), the
+    others off it, so that the statistic of a mode that is not there is
+    ``lambda_in chi2_a + lambda_out chi2_(k - a)`` instead of ``chi2_k``. Its
+    upper quantile at the level ``alpha / n_lines`` of
+    :func:`mode_threshold` is taken from the scaled chi-square of the same
+    mean and variance (Satterthwaite 1946; Box 1954): ``c chi2_d^-1(1 -
+    alpha / n_lines)``, ``c = var / (2 mean)``, ``d = 2 mean^2 / var``. The
+    threshold is ``threshold`` times its ratio to ``chi2_k^-1(1 - alpha /
+    n_lines)`` (the corrections for estimated weights carry over), never
+    lower than ``threshold``; unchanged unless ``lambda_in`` exceeds
+    ``max(lambda_out, 1)`` beyond its sampling scatter (its one-sided 95 %
+    lower bound from ``2 n n_in^2`` real degrees of freedom).
+    """
+    lam_in, lam_out, n = span
+    dof = 2.0 * max(int(n), 1) * int(n_in) ** 2
+    lower = lam_in * dof / float(sps.chi2.isf(0.05, dof))
+    if not lower > max(lam_out, 1.0) or not math.isfinite(lam_in):
+        return float(threshold)
+    level = false_alarm / max(int(n_lines), 1)
+    a = float(min(4 * int(n_in), int(k)))
+    b = float(k) - a
+    mean = lam_in * a + lam_out * b
+    var = 2.0 * (lam_in**2 * a + lam_out**2 * b)
+    c, d = var / (2.0 * mean), 2.0 * mean * mean / var
+    ratio = c * float(sps.chi2.isf(level, d)) / float(sps.chi2.isf(level, int(k)))
+    return float(threshold) * max(ratio, 1.0)
 
 
 def weight_factor(weight_dof: float | None) -> float:
