@@ -58,7 +58,11 @@ Mode count of step 3 (automatic selection only), decided by statistics
 statistic ``T`` (the rise of the weighted cost, in units of the noise
 variance, when the mode is removed) must exceed ``chi2_k^-1(1 - alpha /
 n_freq)`` (``k`` the mode's parameters, ``alpha`` the false-alarm rate,
-default 1 %); the weakest failing mode is dropped and the rest refitted.
+default 1 %), raised where the residual's noise lies along the response
+(:mod:`~tyredamp.modal.span_noise`, :func:`~tyredamp.modal.stats.span_threshold`:
+an H1 estimate's input noise is common to the outputs and lies in the span
+of ``H(f)``, where a mode's shape lies); the weakest failing mode is dropped
+and the rest refitted.
 Then a residual-driven search tries candidates for missed modes (diagram
 clusters that too few orders resolved, modes rejected earlier, peaks of the
 residual) and keeps those that pass the same test, until none does. After

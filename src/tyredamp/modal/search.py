@@ -9,8 +9,11 @@ mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
 2. :func:`reject_by_test`: each in-band mode's statistic ``T`` (the rise of
    the weighted cost, in units of the noise variance, when the mode is
    removed; :mod:`tyredamp.modal.stats`) against the threshold of the
-   stated false-alarm rate; the weakest failing mode is dropped and the rest
-   refitted, until every mode passes;
+   stated false-alarm rate, raised for each mode where the residual's noise
+   lies along the response (an H1 estimate's input noise, common to the
+   outputs: :mod:`tyredamp.modal.span_noise`, :func:`local_thresholds`); the
+   weakest failing mode is dropped and the rest refitted, until every mode
+   passes;
 3. :func:`residual_search`: candidates for missed modes, from the diagram
    (clusters that too few orders resolved, modes rejected earlier) and from
    the peaks of the residual (the fit's residual power per line, in units of
@@ -18,8 +21,9 @@ mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
    refined alone with the other modes held fixed
    (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`, its frequency within 3 %
    of the start); a candidate whose cost drop passes the mode test is refined
-   with all modes, and kept when it still passes; repeated until no
-   candidate passes.
+   with all modes, and kept when it still passes (its own threshold raised
+   as in 2, from the residual of that fit); repeated until no candidate
+   passes.
 """
 
 from __future__ import annotations

@@ -37,7 +37,10 @@ larger of the two (:func:`mode_threshold`). ``nu_w`` is ``nu n_out`` for
 outputs with independent noise, fewer when the noise is common to the
 outputs (an H1 estimate's input noise): measured from the scatter of the
 line factor between adjacent lines
-(:func:`~tyredamp.modal.problem.line_factor_dof`).
+(:func:`~tyredamp.modal.problem.line_factor_dof`). Noise common to the
+outputs also concentrates along the response, where a mode's shape lies; the
+search raises each mode's threshold by what the residual shows there
+(:func:`span_threshold`, :mod:`tyredamp.modal.span_noise`).
 
 Goodness of fit (:func:`goodness_of_fit`): the weighted cost of the final
 fit against its chi-square expectation ``n_obs - n_par`` when the noise is
