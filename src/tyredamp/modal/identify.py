@@ -260,19 +260,8 @@ def identify_modes(
     fitters = _Fitters.build(problem, residuals, modes, max_helpers)
     thr = _threshold(problem, "complex", false_alarm)
     test = ModeTest(mode_parameters(*problem.shape[:2], "complex"), n_f, false_alarm)
-    last, modes, more = _select(
-        fitters,
-        modes,
-        dg,
-        rej,
-        (thr, test),
-        auto,
-        refine,
-        max_helpers,
-        min_contribution,
-        search,
-        (lo, hi),
-    )
+    opts = (auto, refine, max_helpers, min_contribution, search, (lo, hi))
+    last, modes, more = _select(fitters, modes, dg, rej, (thr, test), *opts)
     rej += more
     sigma0 = _noise_per_output(problem, fitters, modes, last, refine)
     ctx = {

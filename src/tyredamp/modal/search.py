@@ -440,6 +440,50 @@ def _room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> fl
     return float(np.sum(excess[sel]))
 
 
+def _joint(
+    fitter: ModalFitter,
+    cur: ModeSet,
+    trial: tuple[complex, NDArray[np.complex128]],
+    band: tuple[float, float],
+    threshold: float,
+    test: ModeTest | None,
+) -> tuple[FitResult, ModeSet] | RejectedMode | None:
+    """Refine a passing trial mode with all modes: the fit and its modes when every
+    mode still passes (the trial its own threshold, :func:`local_thresholds`), the
+    record of the rejection otherwise, None when the fit failed."""
+    p_t, l_t = trial
+    new = ModeSet(
+        np.append(cur.poles, p_t),
+        np.concatenate([cur.part, l_t[None, :]]),
+        cur.hp,
+        cur.hl,
+        cur.n_free,
+    )
+    try:
+        r1, c1, drop = fit_checked(
+            fitter,
+            new,
+            True,
+            band,
+            passes=1,
+            tol=SEARCH_TOL,
+            uncertainty=False,
+            max_nfev=JOINT_NFEV,
+        )
+    except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+        return None
+    why = "not significant with all modes refitted: T = "
+    if drop or c1.m != new.m or np.min(r1.significance[: c1.m]) <= threshold:
+        t1 = float(np.min(r1.significance[: c1.m])) if c1.m else float("nan")
+        return rejected(p_t, f"{why}{t1:.3g}", t1, threshold)
+    t_new = float(r1.significance[c1.m - 1])
+    span = _span(fitter, r1) if test is not None else None
+    thr_new = float(local_thresholds(fitter, span, c1.poles[-1:], threshold, test)[0])
+    if t_new <= thr_new:
+        return rejected(p_t, f"{why}{t_new:.3g} <= {_thr_text(thr_new, threshold)}", t_new, thr_new)
+    return r1, c1
+
+
 def residual_search(
     fitter: ModalFitter,
     res: FitResult,
@@ -528,48 +572,13 @@ def residual_search(
                     rejected(p_t, f"not significant: T = {t:.3g} <= {threshold:.3g}", t, threshold)
                 )
                 continue
-            new = ModeSet(
-                np.append(cur.poles, p_t),
-                np.concatenate([cur.part, l_t[None, :]]),
-                cur.hp,
-                cur.hl,
-                cur.n_free,
-            )
-            try:
-                r1, c1, drop = fit_checked(
-                    fitter,
-                    new,
-                    True,
-                    band,
-                    passes=1,
-                    tol=SEARCH_TOL,
-                    uncertainty=False,
-                    max_nfev=JOINT_NFEV,
-                )
-            except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+            got_j = _joint(fitter, cur, (p_t, l_t), band, threshold, test)
+            if got_j is None:
                 continue
-            if drop or c1.m != new.m or np.min(r1.significance[: c1.m]) <= threshold:
-                t1 = float(np.min(r1.significance[: c1.m])) if c1.m else float("nan")
-                tried.append(
-                    rejected(
-                        p_t, f"not significant with all modes refitted: T = {t1:.3g}", t1, threshold
-                    )
-                )
+            if isinstance(got_j, RejectedMode):
+                tried.append(got_j)
                 continue
-            t_new = float(r1.significance[c1.m - 1])
-            thr_new = float(
-                local_thresholds(
-                    fitter,
-                    _span(fitter, r1) if test is not None else None,
-                    c1.poles[-1:],
-                    threshold,
-                    test,
-                )[0]
-            )
-            if t_new <= thr_new:
-                why = f"not significant with all modes refitted: T = {t_new:.3g} <= "
-                tried.append(rejected(p_t, why + _thr_text(thr_new, threshold), t_new, thr_new))
-                continue
+            r1, c1 = got_j
             res, cur, added = r1, c1, True
         if not added:
             break
