@@ -33,7 +33,7 @@ from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
 from .quality import FitQuality, RejectedMode
-from .search import ModeSet, fit_checked, rejected
+from .search import ModeSet, ModeTest, fit_checked, local_thresholds, rejected, residual_span
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
 __all__ = ["fit_real", "goodness", "to_model", "unscale"]
@@ -362,14 +362,18 @@ def final_complex(
     refine: bool,
     combined: ModalFitter | None,
     threshold: float | None = None,
+    test: ModeTest | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
     combinations (many outputs), whose poles then give the residues of every output.
 
-    ``threshold`` (automatic mode count): the final fit holds the mode test too.
-    A mode whose statistic fell to the threshold in the final refinement (its
-    pole moved onto noise, e.g. a damping that collapsed) is dropped, the
-    weakest first, and the fit repeated.
+    ``threshold`` (automatic mode count): the final fit holds the mode test too,
+    each mode's threshold raised with ``test`` where the noise of the fit's
+    residual lies along the response
+    (:func:`~tyredamp.modal.search.local_thresholds`). A mode whose statistic
+    fell to its threshold in the final refinement (its pole moved onto noise,
+    e.g. a damping that collapsed) is dropped, the weakest first, and the fit
+    repeated.
     """
     dropped: list[RejectedMode] = []
     cur = modes
@@ -380,11 +384,13 @@ def final_complex(
             break
         m = cur.m
         t = res.significance[:m]
-        if not np.any(t <= threshold):
+        span = residual_span(cfit, res) if test is not None else None
+        thr = local_thresholds(cfit, span, res.poles[:m], threshold, test)
+        if not np.any(t <= thr):
             break
-        worst = int(np.argmin(t))
-        why = f"final fit: not significant: T = {t[worst]:.3g} <= {threshold:.3g}"
-        dropped.append(rejected(complex(res.poles[worst]), why, float(t[worst]), threshold))
+        worst = int(np.argmin(np.where(t <= thr, t / thr, np.inf)))
+        why = f"final fit: not significant: T = {t[worst]:.3g} <= {thr[worst]:.3g}"
+        dropped.append(rejected(complex(res.poles[worst]), why, float(t[worst]), float(thr[worst])))
         keep = np.arange(m) != worst
         cur = ModeSet(cur.poles[keep], cur.part[keep], cur.hp, cur.hl, cur.n_free)
     if refine:

@@ -269,6 +269,7 @@ def identify_modes(
         "max_order": dg.order,
         "order_step": order_step,
         "threshold": thr,
+        "test": test,
         "false_alarm": false_alarm,
         "kept": None if auto else tuple(_asked(fr) for _ in range(modes.m)),
         "method": _METHOD.format(est=getattr(est, "__name__", type(est).__name__)),
@@ -526,6 +527,7 @@ def _final_models(
                 refine,
                 _combined(problem, fitters, sigma0, residuals),
                 ctx["threshold"] if ctx["kept"] is None else None,
+                ctx["test"],
             )
             rej = rej + dropped
             base = (res.poles, res.participation, cur)

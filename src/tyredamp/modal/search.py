@@ -41,7 +41,15 @@ from .quality import RejectedMode
 from .span_noise import SpanNoise, span_noise
 from .stats import FALSE_ALARM, span_threshold
 
-__all__ = ["ModeSet", "ModeTest", "reject_by_test", "residual_search", "search_helpers"]
+__all__ = [
+    "ModeSet",
+    "ModeTest",
+    "local_thresholds",
+    "reject_by_test",
+    "residual_search",
+    "residual_span",
+    "search_helpers",
+]
 
 #: convergence thresholds of the intermediate fits, in units of the residual
 #: variance s^2 (ModalFitter.fit ``tol``): the joint fits of the search and of the
@@ -113,7 +121,7 @@ class ModeTest:
     false_alarm: float = FALSE_ALARM
 
 
-def _span(fitter: ModalFitter, res: FitResult) -> SpanNoise:
+def residual_span(fitter: ModalFitter, res: FitResult) -> SpanNoise:
     """Residual noise in and off the span of the data (:mod:`~tyredamp.modal.span_noise`)."""
     residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
     s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
@@ -361,7 +369,7 @@ def reject_by_test(
         cur = cur.take(res)
         m = cur.m
         if span is None and test is not None:
-            span = _span(fitter, res)
+            span = residual_span(fitter, res)
         thr = local_thresholds(fitter, span, cur.poles, threshold, test)
         t, con = res.significance[:m], res.contribution[:m]
         bad = (t < thr) | (con < min_contribution)
@@ -477,7 +485,7 @@ def _joint(
         t1 = float(np.min(r1.significance[: c1.m])) if c1.m else float("nan")
         return rejected(p_t, f"{why}{t1:.3g}", t1, threshold)
     t_new = float(r1.significance[c1.m - 1])
-    span = _span(fitter, r1) if test is not None else None
+    span = residual_span(fitter, r1) if test is not None else None
     thr_new = float(local_thresholds(fitter, span, c1.poles[-1:], threshold, test)[0])
     if t_new <= thr_new:
         return rejected(p_t, f"{why}{t_new:.3g} <= {_thr_text(thr_new, threshold)}", t_new, thr_new)
