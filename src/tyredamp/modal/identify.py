@@ -258,8 +258,7 @@ def identify_modes(
     warnings: list[str] = []
     modes, rej = _start_modes(problem, dg, fr, n_modes, min_fraction, warnings)
     fitters = _Fitters.build(problem, residuals, modes, max_helpers)
-    thr = _threshold(problem, "complex", false_alarm)
-    test = ModeTest(mode_parameters(*problem.shape[:2], "complex"), n_f, false_alarm)
+    thr, test = _threshold(problem, "complex", false_alarm), _mode_test(problem, false_alarm)
     opts = (auto, refine, max_helpers, min_contribution, search, (lo, hi))
     last, modes, more = _select(fitters, modes, dg, rej, (thr, test), *opts)
     rej += more
@@ -297,6 +296,12 @@ def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:
     n_out, n_in, n_f = problem.shape
     k = mode_parameters(n_out, n_in, kind)
     return mode_threshold(k, n_f, false_alarm, problem.weight_dof)
+
+
+def _mode_test(problem: FitProblem, false_alarm: float) -> ModeTest:
+    """What each complex mode's own threshold needs (:class:`~tyredamp.modal.search.ModeTest`)."""
+    n_out, n_in, n_f = problem.shape
+    return ModeTest(mode_parameters(n_out, n_in, "complex"), n_f, false_alarm)
 
 
 def _start_modes(
