@@ -449,7 +449,9 @@ def _select(
         out += dropped
     if not auto:
         return last, modes, out
-    last, modes, dropped = reject_by_test(sfit, modes, problem_band, thr, refine, min_contribution)
+    last, modes, dropped = reject_by_test(
+        sfit, modes, problem_band, thr, refine, min_contribution, start=last
+    )
     out += dropped
     if search and refine:
         cands = [(c.pole, c.participation) for c in dg.weak] + [

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
+from ._added import FixedPart
 from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode
@@ -110,19 +111,22 @@ def fit_checked(
     modes: ModeSet,
     refine: bool,
     band: tuple[float, float],
+    start: FitResult | None = None,
     **fit_kw: object,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Fit the modes; drop any that left its side of the band or merged, and refit.
 
-    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`. Returns the fit,
-    the modes at the fit's values and the dropped ones.
+    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`, ``start`` (the
+    fit the modes come from, if any) to its first fit. Returns the fit, the
+    modes at the fit's values and the dropped ones.
     """
     dropped: list[RejectedMode] = []
     cur = modes
     for _ in range(modes.m + modes.hp.size + 1):
         m = cur.m
         p0, l0 = cur.all()
-        res = fitter.fit(p0, l0, refine=refine, **fit_kw)  # type: ignore[arg-type]
+        first = start if cur is modes else None
+        res = fitter.fit(p0, l0, refine=refine, start=first, **fit_kw)  # type: ignore[arg-type]
         p = res.poles
         fd = p.imag / (2 * np.pi)
         inb = (fd >= band[0]) & (fd <= band[1])
@@ -159,19 +163,42 @@ def fit_checked(
     raise ConvergenceError("refinement kept losing modes")
 
 
+class _Fixed:
+    """The fixed part of one mode set for its trials (:meth:`ModalFitter.fixed_part`),
+    formed at the first trial and passed to each; None when it cannot be formed."""
+
+    def __init__(self, fitter: ModalFitter, modes: ModeSet) -> None:
+        self.fitter, self.modes = fitter, modes
+        self.done = False
+        self.value: FixedPart | None = None
+
+    def get(self) -> FixedPart | None:
+        if not self.done:
+            self.done = True
+            try:
+                self.value = self.fitter.fixed_part(*self.modes.all())
+            except (np.linalg.LinAlgError, ValueError):
+                self.value = None
+        return self.value
+
+
 def _trial(
     fitter: ModalFitter,
     res: FitResult,
-    modes: ModeSet,
+    fixed: _Fixed,
     pole: complex,
     part: NDArray[np.complex128],
     w_lim: tuple[float, float],
     strict: bool = True,
 ) -> tuple[complex, NDArray[np.complex128], float] | None:
-    """Refine one added mode alone; its statistic ``T``. ``strict``: None when it
-    stopped at a limit of ``w_lim`` (an out-of-band residual mode that runs into
-    the band edge is not there); otherwise the limit only localises the trial."""
-    p_all, l_all = modes.all()
+    """Refine one added mode alone against the modes of ``fixed``; its statistic
+    ``T``. ``strict``: None when it stopped at a limit of ``w_lim`` (an out-of-band
+    residual mode that runs into the band edge is not there); otherwise the limit
+    only localises the trial."""
+    p_all, l_all = fixed.modes.all()
+    fx = fixed.get()
+    if fx is None:
+        return None
     try:
         p_t, l_t, sig_t = fitter.fit_added(
             p_all,
@@ -180,7 +207,7 @@ def _trial(
             part,
             omega_bounds=w_lim,
             tol=TRIAL_TOL,
-            fixed=res,
+            fixed=fx,
             max_nfev=TRIAL_NFEV,
         )
     except (np.linalg.LinAlgError, ValueError):
@@ -232,6 +259,7 @@ def search_helpers(
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
     n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
     sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= MIN_LOW_LINES else [])
+    fixed = _Fixed(fitter, cur)  # formed once per mode set
     for side in sides:
         for k in range(max_helpers):
             fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
@@ -241,7 +269,7 @@ def search_helpers(
             ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
             edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
             w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
-            got = _trial(fitter, res, cur, ph, np.ones(fitter.n_in, complex), w_lim)
+            got = _trial(fitter, res, fixed, ph, np.ones(fitter.n_in, complex), w_lim)
             if got is None or got[2] < threshold:
                 break
             p_t, l_t, _ = got
@@ -267,6 +295,7 @@ def search_helpers(
                 cur.n_free,
             )
             res = trial
+            fixed = _Fixed(fitter, cur)
     return res, cur, dropped
 
 
@@ -284,13 +313,16 @@ def reject_by_test(
     threshold: float,
     refine: bool,
     min_contribution: float = 0.0,
+    start: FitResult | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Drop the weakest mode that fails the mode test, refit; until every mode passes.
 
     The first fit refines every mode jointly (and drops modes that leave the
     band); after each removal the residues are refitted at the current poles.
     ``min_contribution`` (default 0: off) also drops modes whose synthesised
-    FRFs have an RMS below that fraction of the data's.
+    FRFs have an RMS below that fraction of the data's. ``start``: the fit the
+    modes come from (:func:`search_helpers`); when it is a joint fit at rest,
+    the first fit returns it (``ModalFitter.fit(..., start=...)``).
     """
     out: list[RejectedMode] = []
     cur = modes
@@ -299,7 +331,7 @@ def reject_by_test(
         if i == 0 and refine:
             # a converged joint fit first (modes that leave the band are dropped)
             res, cur, gone = fit_checked(
-                fitter, cur, True, band, passes=1, tol=SEARCH_TOL, uncertainty=False
+                fitter, cur, True, band, start, passes=1, tol=SEARCH_TOL, uncertainty=False
             )
             out += gone
         elif res is None:
@@ -408,6 +440,7 @@ def residual_search(
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
     pending = list(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
+    fixed = _Fixed(fitter, cur)  # formed once per mode set
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
@@ -437,7 +470,7 @@ def residual_search(
             )
             if not w_lim[0] < w_lim[1]:
                 continue
-            got = _trial(fitter, res, cur, p0, np.asarray(l0, complex), w_lim, strict=False)
+            got = _trial(fitter, res, fixed, p0, np.asarray(l0, complex), w_lim, strict=False)
             if got is None:
                 continue
             p_t, l_t, t = got
@@ -491,6 +524,7 @@ def residual_search(
                 )
                 continue
             res, cur, added = r1, c1, True
+            fixed = _Fixed(fitter, cur)
         if not added:
             break
     return res, cur, tried
