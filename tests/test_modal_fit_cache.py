@@ -316,3 +316,22 @@ def test_basis_times_data_from_the_complex_data(kind: str) -> None:
     # rows in another layout: the real product itself
     Bc = np.ascontiguousarray(B)
     assert_allclose(_basis.rows_t_data(fit, sl, Bc), want, rtol=0, atol=0)
+
+
+def test_the_search_forms_one_fixed_part_per_mode_set() -> None:
+    # FixedParts (owned by the caller of the search stages): the same mode set gives
+    # the same value, another mode set a new one, equal to the fitter's fixed_part
+    from tyredamp.modal.search import FixedParts
+
+    _, h, fixed, _, _ = _case("complex")
+    fit = _fitter(h)
+    held = FixedParts(fit)
+    a = held.of(*fixed)
+    assert a is not None
+    assert held.of(fixed[0].copy(), fixed[1].copy()) is a
+    other = (fixed[0] * 1.002, fixed[1])
+    b = held.of(*other)
+    assert b is not None
+    assert b is not a
+    assert_array_equal(b.tmap, fit.fixed_part(*other).tmap)
+    assert held.of(*fixed) is not a  # only the latest mode set is held

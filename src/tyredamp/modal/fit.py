@@ -511,14 +511,15 @@ class ModalFitter:
         return one, lay1, one.n_cols(1) + int(lay1.ecol.max()) + 1
 
     def _fixed_modes(
-        self, poles: NDArray[np.complex128], part: NDArray[np.complex128]
+        self, poles: NDArray[np.complex128], part: NDArray[np.complex128], n1: int
     ) -> tuple[NDArray[np.float64], int, NDArray[np.intp], list[slice]]:
+        """Parameters of the fixed modes and the blocks of lines of ``fit_added``
+        (``n1`` columns of the added mode)."""
         m = int(np.asarray(poles).size)
         part = self._real_part(np.asarray(part, complex).reshape(m, self.n_in))
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         th_f = self.pack(np.asarray(poles, complex), part, ref)
-        parts = _basis.blocks(self, self.n_cols(m) + self._added_fitter()[2])
-        return th_f, m, ref, parts
+        return th_f, m, ref, _basis.blocks(self, self.n_cols(m) + n1)
 
     def fixed_part(
         self, poles: NDArray[np.complex128], part: NDArray[np.complex128]
@@ -527,7 +528,7 @@ class ModalFitter:
         and ``part`` (m, n_in): an immutable value (the range of their basis and
         of the residual terms, :mod:`~tyredamp.modal._added`) to form once and
         pass as ``fixed`` to every ``fit_added`` against these modes."""
-        return _added.fixed_part(self, *self._fixed_modes(poles, part))
+        return _added.fixed_part(self, *self._fixed_modes(poles, part, self._added_fitter()[2]))
 
     def fit_added(
         self,
@@ -569,7 +570,8 @@ class ModalFitter:
             (in the units of the data), as ``FitResult.sigma_out`` of a
             one-pass fit.
         """
-        th_f, m, ref, parts = self._fixed_modes(poles, part)
+        one, lay1, n1 = self._added_fitter()
+        th_f, m, ref, parts = self._fixed_modes(poles, part, n1)
         if fixed is None:
             fixed = _added.fixed_part(self, th_f, m, ref, parts)
         elif not (fixed.matches(th_f, m, ref) and fixed.parts == tuple(parts)):
@@ -578,7 +580,6 @@ class ModalFitter:
         p1 = np.array([pole], complex)
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
         w = self._w1
-        one, lay1, _ = self._added_fitter()
         th0 = one.pack(p1, l1, ref1)
         solve = _added.added_solver(self, one, fixed, ref1, lay1)
         th, _, _, sol = self._refine(

@@ -94,6 +94,7 @@ from .order import Diagram, SelectionRules, default_order, settle_order
 from .problem import FitProblem, build_problem, max_modes
 from .quality import RejectedMode
 from .search import (
+    FixedParts,
     ModeSet,
     reject_by_test,
     rejected,
@@ -444,8 +445,11 @@ def _select(
     band = (float(sfit.f[0]), float(sfit.f[-1]))
     out: list[RejectedMode] = []
     last: FitResult | None = None
+    fixed = FixedParts(sfit)  # the trials' fixed parts, shared by the stages
     if refine and max_helpers > 0:
-        last, modes, dropped = search_helpers(sfit, modes, problem_band, band, max_helpers, thr)
+        last, modes, dropped = search_helpers(
+            sfit, modes, problem_band, band, max_helpers, thr, fixed
+        )
         out += dropped
     if not auto:
         return last, modes, out
@@ -458,7 +462,7 @@ def _select(
             (_pole_of(r), np.ones(sfit.n_in, complex)) for r in rej + out
         ]
         last, modes, tried = residual_search(
-            sfit, last, modes, cands, problem_band, thr, dg.max_damping
+            sfit, last, modes, cands, problem_band, thr, dg.max_damping, fixed
         )
         out += tried
     return last, modes, out

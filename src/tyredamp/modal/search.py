@@ -36,7 +36,7 @@ from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode
 
-__all__ = ["ModeSet", "reject_by_test", "residual_search", "search_helpers"]
+__all__ = ["FixedParts", "ModeSet", "reject_by_test", "residual_search", "search_helpers"]
 
 #: convergence thresholds of the intermediate fits, in units of the residual
 #: variance s^2 (ModalFitter.fit ``tol``): the joint fits of the search and of the
@@ -163,20 +163,27 @@ def fit_checked(
     raise ConvergenceError("refinement kept losing modes")
 
 
-class _Fixed:
-    """The fixed part of one mode set for its trials (:meth:`ModalFitter.fixed_part`),
-    formed at the first trial and passed to each; None when it cannot be formed."""
+class FixedParts:
+    """The fixed parts of the trials of one identification: each trial refines
+    an added mode against the current modes (:meth:`ModalFitter.fit_added`),
+    whose fixed part (:meth:`ModalFitter.fixed_part`, an immutable value) is
+    formed at the first trial against a mode set and passed to every trial
+    against the same modes (equal poles and participation), across the search
+    stages. Owned by the caller of the stages; the fitter keeps nothing.
+    """
 
-    def __init__(self, fitter: ModalFitter, modes: ModeSet) -> None:
-        self.fitter, self.modes = fitter, modes
-        self.done = False
+    def __init__(self, fitter: ModalFitter) -> None:
+        self.fitter = fitter
+        self.modes: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
         self.value: FixedPart | None = None
 
-    def get(self) -> FixedPart | None:
-        if not self.done:
-            self.done = True
+    def of(self, p_all: NDArray[np.complex128], l_all: NDArray[np.complex128]) -> FixedPart | None:
+        """The fixed part of these modes (None when it cannot be formed)."""
+        held = self.modes
+        if held is None or not (np.array_equal(held[0], p_all) and np.array_equal(held[1], l_all)):
+            self.modes = (p_all.copy(), l_all.copy())
             try:
-                self.value = self.fitter.fixed_part(*self.modes.all())
+                self.value = self.fitter.fixed_part(p_all, l_all)
             except (np.linalg.LinAlgError, ValueError):
                 self.value = None
         return self.value
@@ -185,18 +192,19 @@ class _Fixed:
 def _trial(
     fitter: ModalFitter,
     res: FitResult,
-    fixed: _Fixed,
+    modes: ModeSet,
+    fixed: FixedParts,
     pole: complex,
     part: NDArray[np.complex128],
     w_lim: tuple[float, float],
     strict: bool = True,
 ) -> tuple[complex, NDArray[np.complex128], float] | None:
-    """Refine one added mode alone against the modes of ``fixed``; its statistic
-    ``T``. ``strict``: None when it stopped at a limit of ``w_lim`` (an out-of-band
-    residual mode that runs into the band edge is not there); otherwise the limit
-    only localises the trial."""
-    p_all, l_all = fixed.modes.all()
-    fx = fixed.get()
+    """Refine one added mode alone against ``modes`` (their fixed part from
+    ``fixed``); its statistic ``T``. ``strict``: None when it stopped at a limit
+    of ``w_lim`` (an out-of-band residual mode that runs into the band edge is
+    not there); otherwise the limit only localises the trial."""
+    p_all, l_all = modes.all()
+    fx = fixed.of(p_all, l_all)
     if fx is None:
         return None
     try:
@@ -231,6 +239,7 @@ def search_helpers(
     data_band: tuple[float, float],
     max_helpers: int,
     threshold: float,
+    fixed: FixedParts | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Refine, then add out-of-band residual modes while they pass the mode test.
 
@@ -243,7 +252,8 @@ def search_helpers(
     these limits and its statistic ``T`` (cost drop in units of the noise
     variance per output) exceeds ``threshold``; all modes are then refined
     together, and the search stops instead if that moves the trial mode out
-    of its range or an in-band mode out of the band.
+    of its range or an in-band mode out of the band. ``fixed``: the trials'
+    fixed parts (:class:`FixedParts`, new when None).
     """
     lo, hi = band
     res, cur, dropped = fit_checked(
@@ -259,7 +269,7 @@ def search_helpers(
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
     n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
     sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= MIN_LOW_LINES else [])
-    fixed = _Fixed(fitter, cur)  # formed once per mode set
+    fixed = FixedParts(fitter) if fixed is None else fixed
     for side in sides:
         for k in range(max_helpers):
             fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
@@ -269,7 +279,7 @@ def search_helpers(
             ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
             edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
             w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
-            got = _trial(fitter, res, fixed, ph, np.ones(fitter.n_in, complex), w_lim)
+            got = _trial(fitter, res, cur, fixed, ph, np.ones(fitter.n_in, complex), w_lim)
             if got is None or got[2] < threshold:
                 break
             p_t, l_t, _ = got
@@ -295,7 +305,6 @@ def search_helpers(
                 cur.n_free,
             )
             res = trial
-            fixed = _Fixed(fitter, cur)
     return res, cur, dropped
 
 
@@ -419,6 +428,7 @@ def residual_search(
     band: tuple[float, float],
     threshold: float,
     max_damping: float = 0.2,
+    fixed: FixedParts | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
@@ -431,7 +441,9 @@ def residual_search(
     averages are too small) rather than a resonance.
 
     ``candidates`` are starting poles and participation vectors from the
-    diagram; each round adds the peaks of the current residual.
+    diagram; each round adds the peaks of the current residual. ``fixed``: the
+    trials' fixed parts (:class:`FixedParts`; shared with :func:`search_helpers`
+    by the caller, or new).
     """
     lo, hi = band
     df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
@@ -440,7 +452,7 @@ def residual_search(
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
     pending = list(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
-    fixed = _Fixed(fitter, cur)  # formed once per mode set
+    fixed = FixedParts(fitter) if fixed is None else fixed
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
@@ -470,7 +482,7 @@ def residual_search(
             )
             if not w_lim[0] < w_lim[1]:
                 continue
-            got = _trial(fitter, res, fixed, p0, np.asarray(l0, complex), w_lim, strict=False)
+            got = _trial(fitter, res, cur, fixed, p0, np.asarray(l0, complex), w_lim, strict=False)
             if got is None:
                 continue
             p_t, l_t, t = got
@@ -524,7 +536,6 @@ def residual_search(
                 )
                 continue
             res, cur, added = r1, c1, True
-            fixed = _Fixed(fitter, cur)
         if not added:
             break
     return res, cur, tried
