@@ -454,7 +454,7 @@ def _select(
     if not auto:
         return last, modes, out
     last, modes, dropped = reject_by_test(
-        sfit, modes, problem_band, thr, refine, min_contribution, start=last
+        sfit, modes, problem_band, thr, refine, min_contribution, last, dg.max_damping
     )
     out += dropped
     if search and refine:

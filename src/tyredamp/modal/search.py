@@ -106,6 +106,53 @@ def rejected(
     )
 
 
+def _lost(
+    res: FitResult, modes: ModeSet, band: tuple[float, float]
+) -> tuple[NDArray[np.intp], str]:
+    """The modes a fit of ``modes`` lost, and why: those that left their side of
+    the band (in-band modes outside it, out-of-band residual modes inside it), or
+    else the weaker of two that merged (none: an empty index)."""
+    m = modes.m
+    p = res.poles
+    fd = p.imag / (2 * np.pi)
+    inb = (fd >= band[0]) & (fd <= band[1])
+    free = np.zeros(modes.hp.size, bool)
+    free[: modes.n_free] = True
+    wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
+    if wrong.size:
+        return wrong, "crossed the band edge during refinement"
+    d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
+    np.fill_diagonal(d, np.inf)
+    if d.size and d.min() < MERGE:
+        i, j = np.unravel_index(np.argmin(d), d.shape)
+        k = i if res.contribution[i] < res.contribution[j] else j
+        return np.array([k], np.intp), "merged with another mode during refinement"
+    return wrong, ""
+
+
+def as_residual(modes: ModeSet, broad: NDArray[np.bool_]) -> ModeSet:
+    """``modes`` with the in-band modes ``broad`` (m,) moved to the front of the
+    residual modes, as free ones (not checked against the band, not reported):
+    poles damped beyond the admissible limit that the data still need (broad
+    structure, e.g. the tails of modes outside the band). The order of
+    :meth:`ModeSet.all` is kept when only the last in-band modes move."""
+    keep = ~broad
+    return ModeSet(
+        modes.poles[keep],
+        modes.part[keep],
+        np.concatenate([modes.poles[broad], modes.hp]),
+        np.concatenate([modes.part[broad], modes.hl]),
+        modes.n_free + int(np.count_nonzero(broad)),
+    )
+
+
+def too_damped(poles: NDArray[np.complex128], max_damping: float | None) -> NDArray[np.bool_]:
+    """Which poles are damped beyond ``max_damping`` (none when it is None)."""
+    if max_damping is None:
+        return np.zeros(poles.size, bool)
+    return np.asarray(-poles.real > max_damping * np.abs(poles))
+
+
 def fit_checked(
     fitter: ModalFitter,
     modes: ModeSet,
@@ -127,20 +174,8 @@ def fit_checked(
         p0, l0 = cur.all()
         first = start if cur is modes else None
         res = fitter.fit(p0, l0, refine=refine, start=first, **fit_kw)  # type: ignore[arg-type]
-        p = res.poles
-        fd = p.imag / (2 * np.pi)
-        inb = (fd >= band[0]) & (fd <= band[1])
-        free = np.zeros(cur.hp.size, bool)
-        free[: cur.n_free] = True
-        wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
-        why = "crossed the band edge during refinement"
-        if not wrong.size:
-            d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
-            np.fill_diagonal(d, np.inf)
-            if d.size and d.min() < MERGE:
-                i, j = np.unravel_index(np.argmin(d), d.shape)
-                wrong = np.array([i if res.contribution[i] < res.contribution[j] else j])
-                why = "merged with another mode during refinement"
+        fd = res.poles.imag / (2 * np.pi)
+        wrong, why = _lost(res, cur, band)
         if not wrong.size:
             return res, cur.take(res), dropped
         # every mode that crossed a band edge is dropped at once (one refit)
@@ -323,6 +358,7 @@ def reject_by_test(
     refine: bool,
     min_contribution: float = 0.0,
     start: FitResult | None = None,
+    max_damping: float | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Drop the weakest mode that fails the mode test, refit; until every mode passes.
 
@@ -331,7 +367,10 @@ def reject_by_test(
     ``min_contribution`` (default 0: off) also drops modes whose synthesised
     FRFs have an RMS below that fraction of the data's. ``start``: the fit the
     modes come from (:func:`search_helpers`); when it is a joint fit at rest,
-    the first fit returns it (``ModalFitter.fit(..., start=...)``).
+    the first fit returns it (``ModalFitter.fit(..., start=...)``). A mode that
+    the joint fit damps beyond ``max_damping`` (the diagram's admissible
+    damping; None: no limit) is not a mode: it stays in the fit as a residual
+    mode (:func:`as_residual`), and the residues are refitted.
     """
     out: list[RejectedMode] = []
     cur = modes
@@ -349,6 +388,10 @@ def reject_by_test(
             p0, l0 = cur.all()
             res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
         cur = cur.take(res)
+        broad = too_damped(cur.poles, max_damping)
+        if np.any(broad) and not np.all(broad):
+            cur, res = as_residual(cur, broad), None
+            continue
         m = cur.m
         t, con = res.significance[:m], res.contribution[:m]
         bad = (t < threshold) | (con < min_contribution)
@@ -420,6 +463,104 @@ def _room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> fl
     return float(np.sum(excess[sel]))
 
 
+def _inadmissible(p: complex, df: float, max_damping: float) -> str:
+    """Why the pole ``p`` cannot be an in-band mode of the search ('' if it can):
+    narrower than the line spacing ``df`` (Hz), or damped beyond ``max_damping``
+    (:func:`residual_search`)."""
+    if -p.real / np.pi < df:
+        return (
+            f"half-power bandwidth {-p.real / np.pi:.3g} Hz below the line "
+            f"spacing {df:.3g} Hz (not resolved)"
+        )
+    if -p.real > max_damping * abs(p):
+        return f"damping above the admissible {max_damping:.0%}"
+    return ""
+
+
+def _joint(
+    fitter: ModalFitter,
+    cur: ModeSet,
+    p_t: complex,
+    l_t: NDArray[np.complex128],
+    band: tuple[float, float],
+    threshold: float,
+    df: float,
+    max_damping: float,
+) -> tuple[FitResult, ModeSet] | RejectedMode | None:
+    """The joint refit of the modes ``cur`` with an accepted trial mode ``p_t``:
+    the fit and its modes when the trial mode stays (in the band, no merge, still
+    admissible, every mode significant); otherwise the trial's record with the
+    reason (None: the fit failed). A joint fit that loses a mode is not refitted
+    without it: the trial is rejected for what the fit did to it (crossing the
+    band edge, merging, carrying another mode across the edge)."""
+    new = ModeSet(
+        np.append(cur.poles, p_t),
+        np.concatenate([cur.part, l_t[None, :]]),
+        cur.hp,
+        cur.hl,
+        cur.n_free,
+    )
+    p_all, l_all = new.all()
+    try:
+        r1 = fitter.fit(
+            p_all, l_all, passes=1, tol=SEARCH_TOL, uncertainty=False, max_nfev=JOINT_NFEV
+        )
+    except (np.linalg.LinAlgError, ValueError):
+        return None
+    k = new.m - 1  # the trial mode
+    fd = r1.poles.imag / (2 * np.pi)
+    wrong, why = _lost(r1, new, band)
+    lo, hi = band
+    out_side = (hi < fd[k] <= 2 * hi) or (lo / 2 <= fd[k] < lo)
+    if list(wrong) == [k] and out_side and r1.significance[k] > threshold:
+        # the trial took the tail of a mode outside the band that the residual modes
+        # missed, and went there: kept as an out-of-band residual mode (as
+        # search_helpers keeps one), after the free ones; the residues refitted in
+        # that order (one linear fit at the joint fit's poles)
+        nf = new.n_free
+        hp, hl = r1.poles[new.m :], r1.participation[new.m :]
+        kept = ModeSet(
+            r1.poles[:k],
+            r1.participation[:k],
+            np.concatenate([hp[:nf], r1.poles[k : k + 1], hp[nf:]]),
+            np.concatenate([hl[:nf], r1.participation[k : k + 1], hl[nf:]]),
+            nf,
+        )
+        try:
+            res = fitter.fit(*kept.all(), refine=False, passes=1, uncertainty=False)
+        except (np.linalg.LinAlgError, ValueError):
+            return None
+        return res, kept
+    if wrong.size:
+        if k in wrong:
+            how = f"joint refit: {why} ({fd[k]:.2f} Hz)"
+        else:
+            i = int(wrong[0])
+            how = (
+                f"joint refit: the mode at {abs(p_all[i]) / (2 * np.pi):.2f} Hz "
+                f"{why} ({fd[i]:.2f} Hz)"
+            )
+        return rejected(p_t, how)
+    t1 = r1.significance[: new.m]
+    if np.min(t1) <= threshold:
+        return rejected(
+            p_t,
+            f"not significant with all modes refitted: T = {np.min(t1):.3g} <= {threshold:.3g}",
+            float(np.min(t1)),
+            threshold,
+        )
+    p1 = complex(r1.poles[k])
+    why = _inadmissible(p1, df, max_damping)
+    if why and -p1.real / np.pi >= df:
+        # too damped to be a mode, but significant: broad structure (the tails of
+        # modes outside the band) kept as a residual mode, not reported as a mode;
+        # the trial mode is the last in-band one: the order of r1 is kept
+        return r1, as_residual(new.take(r1), np.arange(new.m) == k)
+    if why:
+        return rejected(p1, f"joint refit: {why}", float(r1.significance[k]), threshold)
+    return r1, new.take(r1)
+
+
 def residual_search(
     fitter: ModalFitter,
     res: FitResult,
@@ -438,7 +579,13 @@ def residual_search(
     narrower than the line spacing: no line lies inside its resonance, so the
     lines cannot resolve its frequency and damping, and such a pole fits the
     noise of single lines (where per-line variances estimated from a few
-    averages are too small) rather than a resonance.
+    averages are too small) rather than a resonance. A trial mode that passes
+    is refitted with all modes (:func:`_joint`) and kept when it stays in the
+    band, merges with no mode, is still admissible and every mode still passes
+    the test; otherwise it is rejected for what the joint refit did (e.g.
+    "joint refit: crossed the band edge", a mode outside the band whose tail
+    the trial had taken), and a later trial that ends at the same pole (within
+    ``2 MERGE``) against the same modes is not refitted again.
 
     ``candidates`` are starting poles and participation vectors from the
     diagram; each round adds the peaks of the current residual. ``fixed``: the
@@ -452,6 +599,7 @@ def residual_search(
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
     pending = list(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
+    refused: list[complex] = []  # trial modes whose joint refit failed (current modes)
     fixed = FixedParts(fitter) if fixed is None else fixed
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's
@@ -486,56 +634,23 @@ def residual_search(
             if got is None:
                 continue
             p_t, l_t, t = got
-            if -p_t.real / np.pi < df:
-                tried.append(
-                    rejected(
-                        p_t,
-                        f"half-power bandwidth {-p_t.real / np.pi:.3g} Hz below the line "
-                        f"spacing {df:.3g} Hz (not resolved)",
-                        t,
-                        threshold,
-                    )
-                )
+            why = _inadmissible(p_t, df, max_damping)
+            if not why and t <= threshold:
+                why = f"not significant: T = {t:.3g} <= {threshold:.3g}"
+            if why:
+                tried.append(rejected(p_t, why, t, threshold))
                 continue
-            if -p_t.real > max_damping * abs(p_t):
-                tried.append(
-                    rejected(p_t, f"damping above the admissible {max_damping:.0%}", t, threshold)
-                )
+            if refused and np.min(np.abs(np.asarray(refused) - p_t)) < 2 * MERGE * abs(p_t):
+                continue  # the same trial mode: its joint refit was rejected already
+            got1 = _joint(fitter, cur, p_t, l_t, band, threshold, df, max_damping)
+            if isinstance(got1, RejectedMode):
+                tried.append(got1)
+                refused.append(p_t)
                 continue
-            if t <= threshold:
-                tried.append(
-                    rejected(p_t, f"not significant: T = {t:.3g} <= {threshold:.3g}", t, threshold)
-                )
+            if got1 is None:
                 continue
-            new = ModeSet(
-                np.append(cur.poles, p_t),
-                np.concatenate([cur.part, l_t[None, :]]),
-                cur.hp,
-                cur.hl,
-                cur.n_free,
-            )
-            try:
-                r1, c1, drop = fit_checked(
-                    fitter,
-                    new,
-                    True,
-                    band,
-                    passes=1,
-                    tol=SEARCH_TOL,
-                    uncertainty=False,
-                    max_nfev=JOINT_NFEV,
-                )
-            except (ConvergenceError, np.linalg.LinAlgError, ValueError):
-                continue
-            if drop or c1.m != new.m or np.min(r1.significance[: c1.m]) <= threshold:
-                t1 = float(np.min(r1.significance[: c1.m])) if c1.m else float("nan")
-                tried.append(
-                    rejected(
-                        p_t, f"not significant with all modes refitted: T = {t1:.3g}", t1, threshold
-                    )
-                )
-                continue
-            res, cur, added = r1, c1, True
+            res, cur = got1
+            added, refused = True, []
         if not added:
             break
     return res, cur, tried
