@@ -501,15 +501,40 @@ def _joint(
         cur.n_free,
     )
     p_all, l_all = new.all()
+    kw = {"passes": 1, "tol": SEARCH_TOL, "uncertainty": False, "max_nfev": JOINT_NFEV}
     try:
-        r1 = fitter.fit(
-            p_all, l_all, passes=1, tol=SEARCH_TOL, uncertainty=False, max_nfev=JOINT_NFEV
-        )
+        r1 = fitter.fit(p_all, l_all, **kw)  # type: ignore[arg-type]
     except (np.linalg.LinAlgError, ValueError):
         return None
     k = new.m - 1  # the trial mode
     fd = r1.poles.imag / (2 * np.pi)
     wrong, why = _lost(r1, new, band)
+    if wrong.size and np.all(wrong >= new.m):
+        # only residual modes entered the band: dropped, the rest refitted from
+        # their starts (fit_checked), and the trial judged on that fit
+        keep = np.setdiff1d(np.arange(new.hp.size), wrong - new.m)
+        new = ModeSet(
+            new.poles,
+            new.part,
+            new.hp[keep],
+            new.hl[keep],
+            int(np.count_nonzero(keep < new.n_free)),
+        )
+        try:
+            r1, c1, drop = fit_checked(
+                fitter,
+                new,
+                True,
+                band,
+                **kw,  # type: ignore[arg-type]
+            )
+        except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+            return None
+        if drop or c1.m != new.m:
+            return rejected(p_t, f"joint refit: {drop[0].reason if drop else 'lost a mode'}")
+        p_all = new.all()[0]
+        fd = r1.poles.imag / (2 * np.pi)
+        wrong, why = np.zeros(0, np.intp), ""
     lo, hi = band
     out_side = (hi < fd[k] <= 2 * hi) or (lo / 2 <= fd[k] < lo)
     if list(wrong) == [k] and out_side and r1.significance[k] > threshold:
