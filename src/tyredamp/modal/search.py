@@ -535,27 +535,6 @@ def _joint(
         p_all = new.all()[0]
         fd = r1.poles.imag / (2 * np.pi)
         wrong, why = np.zeros(0, np.intp), ""
-    lo, hi = band
-    out_side = (hi < fd[k] <= 2 * hi) or (lo / 2 <= fd[k] < lo)
-    if list(wrong) == [k] and out_side and r1.significance[k] > threshold:
-        # the trial took the tail of a mode outside the band that the residual modes
-        # missed, and went there: kept as an out-of-band residual mode (as
-        # search_helpers keeps one), after the free ones; the residues refitted in
-        # that order (one linear fit at the joint fit's poles)
-        nf = new.n_free
-        hp, hl = r1.poles[new.m :], r1.participation[new.m :]
-        kept = ModeSet(
-            r1.poles[:k],
-            r1.participation[:k],
-            np.concatenate([hp[:nf], r1.poles[k : k + 1], hp[nf:]]),
-            np.concatenate([hl[:nf], r1.participation[k : k + 1], hl[nf:]]),
-            nf,
-        )
-        try:
-            res = fitter.fit(*kept.all(), refine=False, passes=1, uncertainty=False)
-        except (np.linalg.LinAlgError, ValueError):
-            return None
-        return res, kept
     if wrong.size:
         if k in wrong:
             how = f"joint refit: {why} ({fd[k]:.2f} Hz)"
