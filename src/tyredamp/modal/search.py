@@ -486,13 +486,15 @@ def _joint(
     threshold: float,
     df: float,
     max_damping: float,
+    crossed: set[int],
 ) -> tuple[FitResult, ModeSet] | RejectedMode | None:
     """The joint refit of the modes ``cur`` with an accepted trial mode ``p_t``:
     the fit and its modes when the trial mode stays (in the band, no merge, still
     admissible, every mode significant); otherwise the trial's record with the
     reason (None: the fit failed). A joint fit that loses a mode is not refitted
     without it: the trial is rejected for what the fit did to it (crossing the
-    band edge, merging, carrying another mode across the edge)."""
+    band edge, merging, carrying another mode across the edge). ``crossed``
+    gets the side (+1 above, -1 below the band) the trial mode crossed to."""
     new = ModeSet(
         np.append(cur.poles, p_t),
         np.concatenate([cur.part, l_t[None, :]]),
@@ -538,6 +540,8 @@ def _joint(
     if wrong.size:
         if k in wrong:
             how = f"joint refit: {why} ({fd[k]:.2f} Hz)"
+            if not band[0] <= fd[k] <= band[1]:
+                crossed.add(1 if fd[k] > band[1] else -1)
         else:
             i = int(wrong[0])
             how = (
@@ -565,6 +569,22 @@ def _joint(
     return r1, new.take(r1)
 
 
+TOWARD_CROSSED = (
+    "stopped at its window's limit toward a band edge that another trial crossed in its "
+    "joint refit (the same structure outside the band)"
+)
+
+
+def _toward(p: complex, w_lim: tuple[float, float]) -> int:
+    """The side (+1 up, -1 down, 0 none) of the window ``w_lim`` (rad/s) at whose
+    limit a trial pole ``p`` stopped: it found no optimum inside its window and
+    runs toward structure beyond it."""
+    tol = 1e-4 * (w_lim[1] - w_lim[0])
+    if p.imag >= w_lim[1] - tol:
+        return 1
+    return -1 if p.imag <= w_lim[0] + tol else 0
+
+
 def residual_search(
     fitter: ModalFitter,
     res: FitResult,
@@ -589,7 +609,9 @@ def residual_search(
     the test; otherwise it is rejected for what the joint refit did (e.g.
     "joint refit: crossed the band edge", a mode outside the band whose tail
     the trial had taken), and a later trial that ends at the same pole (within
-    ``2 MERGE``) against the same modes is not refitted again.
+    ``2 MERGE``) against the same modes is not refitted again; nor is one that
+    stopped at the limit of its window toward a band edge that a trial crossed
+    (it runs toward the same structure outside the band).
 
     ``candidates`` are starting poles and participation vectors from the
     diagram; each round adds the peaks of the current residual. ``fixed``: the
@@ -604,6 +626,7 @@ def residual_search(
     pending = list(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
     refused: list[complex] = []  # trial modes whose joint refit failed (current modes)
+    crossed: set[int] = set()  # sides of the band trial modes crossed to (current modes)
     fixed = FixedParts(fitter) if fixed is None else fixed
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's
@@ -646,7 +669,10 @@ def residual_search(
                 continue
             if refused and np.min(np.abs(np.asarray(refused) - p_t)) < 2 * MERGE * abs(p_t):
                 continue  # the same trial mode: its joint refit was rejected already
-            got1 = _joint(fitter, cur, p_t, l_t, band, threshold, df, max_damping)
+            if _toward(p_t, w_lim) in crossed:
+                tried.append(rejected(p_t, TOWARD_CROSSED, t, threshold))
+                continue
+            got1 = _joint(fitter, cur, p_t, l_t, band, threshold, df, max_damping, crossed)
             if isinstance(got1, RejectedMode):
                 tried.append(got1)
                 refused.append(p_t)
@@ -654,7 +680,7 @@ def residual_search(
             if got1 is None:
                 continue
             res, cur = got1
-            added, refused = True, []
+            added, refused, crossed = True, [], set()
         if not added:
             break
     return res, cur, tried
