@@ -88,7 +88,7 @@ def test_blocks_of_lines_give_the_same_fits(kind: str, monkeypatch: pytest.Monke
     assert_allclose(many.model, one.model, rtol=0, atol=1e-10 * np.abs(one.model).max())
     assert_allclose(many.std_frequency_hz, one.std_frequency_hz, rtol=1e-6)
     assert_allclose(many.significance, one.significance, rtol=1e-6)
-    # a new fitter: ``fit`` keeps the fixed part of its last fit_added (one block)
+    # a new fitter on blocks of a few lines
     many_added = ModalFitter(F, h, 2, kind, [(0, 0), (5, 1)], line_weights=lw).fit_added(
         one.poles, one.participation, cm.poles[k] * 1.01, np.ones(2), omega_bounds=(lo, hi)
     )
@@ -125,7 +125,7 @@ def test_fit_added_gram_blocks_match_the_explicit_projection(
     assert_allclose(a[2], res.sigma_out, rtol=1e-9)
     monkeypatch.setattr(added_mod, "_PROJ_TOL", np.inf)
     monkeypatch.setattr(lin_mod, "_CANCEL_TOL", np.inf)
-    # a new fitter: ``fit`` keeps the fixed range of its last fit_added
+    # the QR route everywhere
     b = ModalFitter(F, h, 2, "complex", [(0, 0), (5, 1)]).fit_added(*args, omega_bounds=(lo, hi))
     assert_allclose(b[0], a[0], rtol=1e-10)
     assert_allclose(b[1], a[1], rtol=1e-8)

@@ -1,15 +1,18 @@
-"""What a ModalFitter keeps between calls (the fixed part of fit_added, an
-intermediate fit at rest, the data rows of one block) gives the results of
-computing everything again."""
+"""What one ModalFitter call reuses from another is passed explicitly (issue 14: a
+stateless fitter): the fixed part of fit_added (``fixed_part``), an intermediate
+fit at rest (``fit(..., start=res)``); the data rows of one block. Each gives the
+results of computing everything again, and a fitter holds no state between calls."""
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
+from tyredamp.exceptions import InputError
 from tyredamp.modal import _basis
 from tyredamp.modal._linalg import _levenberg_marquardt, at_rest
 from tyredamp.modal.fit import ModalFitter
@@ -31,38 +34,99 @@ def _fitter(h: np.ndarray, kind: str = "complex") -> ModalFitter:
     return ModalFitter(F, h, 2, kind, [(0, 0), (5, 1)])
 
 
-@pytest.mark.parametrize("kind", ["complex", "real"])
-@pytest.mark.parametrize("many_blocks", [False, True])
-def test_fit_added_again_against_the_same_modes_gives_a_new_fitters_result(
-    kind: str, many_blocks: bool, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    if many_blocks:
-        monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
-        monkeypatch.setattr(_basis, "MIN_BLOCK_LINES", 37)
+def _state(fit: ModalFitter) -> dict[str, Any]:
+    """A fitter's attributes, arrays copied (to compare before and after calls)."""
+    return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in vars(fit).items()}
+
+
+def _same_state(before: dict[str, Any], fit: ModalFitter) -> None:
+    after = vars(fit)
+    assert set(after) == set(before)
+    for k, v in before.items():
+        if isinstance(v, np.ndarray):
+            assert_array_equal(after[k], v, err_msg=k)
+        elif isinstance(v, tuple):
+            assert len(after[k]) == len(v)
+            for x, y in zip(after[k], v, strict=True):
+                assert_array_equal(x, y, err_msg=k)
+        else:
+            assert after[k] == v, k
+
+
+def _case(kind: str) -> tuple[Any, np.ndarray, tuple[Any, Any], Any, tuple[float, float]]:
     sys_, h = _noisy(1e-3, 5)
     cm = sys_.complex_modes()
     part = cm.psi[[0, 5]].T
     k = int(np.argsort(cm.poles.imag)[3])
     keep = np.delete(np.arange(cm.poles.size), k)
     lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
-    fixed = (cm.poles[keep] * 1.001, part[keep])
+    return cm, h, (cm.poles[keep] * 1.001, part[keep]), cm.poles[k], (lo, hi)
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+@pytest.mark.parametrize("many_blocks", [False, True])
+def test_fit_added_with_a_given_fixed_part_gives_the_result_of_forming_it(
+    kind: str, many_blocks: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    if many_blocks:
+        monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
+        monkeypatch.setattr(_basis, "MIN_BLOCK_LINES", 37)
+    _, h, fixed, pk, bounds = _case(kind)
     fit = _fitter(h, kind)
     assert (len(_basis.blocks(fit, 20)) > 1) == many_blocks
-    # a first candidate, then two others against the same fixed modes: the second
-    # and third reuse the fixed part the first formed
-    fit.fit_added(*fixed, cm.poles[k] * 1.03, np.ones(2), omega_bounds=(lo, hi))
-    for start in (cm.poles[k] * 1.01, cm.poles[k] * (0.99 + 0.01j)):
-        kept = fit.fit_added(*fixed, start, np.ones(2), omega_bounds=(lo, hi))
-        new = _fitter(h, kind).fit_added(*fixed, start, np.ones(2), omega_bounds=(lo, hi))
+    fx = fit.fixed_part(*fixed)
+    # an immutable value: frozen, read-only arrays, the one block's basis only
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        fx.m = 0  # type: ignore[misc]
+    assert not fx.tmap.flags.writeable
+    assert not fx.th.flags.writeable
+    assert (fx.phi0 is None) == many_blocks
+    for start in (pk * 1.03, pk * 1.01, pk * (0.99 + 0.01j)):
+        given = fit.fit_added(*fixed, start, np.ones(2), omega_bounds=bounds, fixed=fx)
+        formed = fit.fit_added(*fixed, start, np.ones(2), omega_bounds=bounds)
+        new = _fitter(h, kind).fit_added(*fixed, start, np.ones(2), omega_bounds=bounds)
         # the same arithmetic on the same arrays: identical
-        for a, b in zip(kept, new, strict=True):
+        for a, b, c in zip(given, formed, new, strict=True):
             assert_array_equal(a, b)
-    # other fixed modes: formed again (not the kept ones)
-    other = (cm.poles[keep] * 1.002, part[keep])
-    a = fit.fit_added(*other, cm.poles[k] * 1.01, np.ones(2), omega_bounds=(lo, hi))
-    b = _fitter(h, kind).fit_added(*other, cm.poles[k] * 1.01, np.ones(2), omega_bounds=(lo, hi))
-    for x, y in zip(a, b, strict=True):
-        assert_array_equal(x, y)
+            assert_array_equal(a, c)
+    # the fixed part of other modes is refused, not used
+    other = (fixed[0] * 1.002, fixed[1])
+    with pytest.raises(InputError, match="fixed"):
+        fit.fit_added(*other, pk, np.ones(2), omega_bounds=bounds, fixed=fx)
+    # another fitter's fixed part of the same modes on the same data: the same value
+    fx2 = _fitter(h, kind).fixed_part(*fixed)
+    for f in dataclasses.fields(fx):
+        x, y = getattr(fx, f.name), getattr(fx2, f.name)
+        if isinstance(x, np.ndarray):
+            assert_array_equal(x, y, err_msg=f.name)
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_a_fitter_holds_no_state_between_calls(kind: str) -> None:
+    cm, h, fixed, pk, bounds = _case(kind)
+    part = cm.psi[[0, 5]].T
+    opts = {"passes": 1, "tol": 10.0, "uncertainty": False}
+    a, b = _fitter(h, kind), _fitter(h, kind)
+    before = _state(a)
+    # a: fit_added, fit, fit_added again, a fit started at its own result
+    a1 = a.fit_added(*fixed, pk * 1.01, np.ones(2), omega_bounds=bounds)
+    a2 = a.fit(cm.poles * 1.002, part, **opts)
+    a3 = a.fit_added(*fixed, pk * 1.02, np.ones(2), omega_bounds=bounds)
+    a4 = a.fit(a2.poles, a2.participation, start=a2, **opts)
+    _same_state(before, a)  # attributes unchanged by the calls
+    # b: the same calls in another order, each on its own
+    b4_start = b.fit(cm.poles * 1.002, part, **opts)
+    b3 = b.fit_added(*fixed, pk * 1.02, np.ones(2), omega_bounds=bounds)
+    b1 = b.fit_added(*fixed, pk * 1.01, np.ones(2), omega_bounds=bounds)
+    b4 = b.fit(b4_start.poles, b4_start.participation, start=b4_start, **opts)
+    for x, y in ((a1, b1), (a3, b3)):
+        for u, v in zip(x, y, strict=True):
+            assert_array_equal(u, v)
+    for x, y in ((a2, b4_start), (a4, b4)):
+        assert_array_equal(x.poles, y.poles)
+        assert_array_equal(x.sigma_out, y.sigma_out)
+        assert_array_equal(x.significance, y.significance)
+        assert x.n_iter == y.n_iter
 
 
 def test_a_fit_started_at_a_fit_at_rest_returns_it_with_one_evaluation() -> None:
@@ -74,9 +138,10 @@ def test_a_fit_started_at_a_fit_at_rest_returns_it_with_one_evaluation() -> None
     first = fit.fit(cm.poles * 1.002, part, **opts)
     assert first.status == "converged"
     assert first.n_iter > 1
-    again = fit.fit(first.poles, first.participation, **opts)
-    # a new fitter runs the refinement from there: it stops after one evaluation
-    # at the same point (the start re-packed from the poles, round-off apart)
+    assert first.rest is not None
+    again = fit.fit(first.poles, first.participation, start=first, **opts)
+    # without ``start`` the refinement runs from there: it stops after one
+    # evaluation at the same point (the start re-packed from the poles, round-off apart)
     new = _fitter(h).fit(first.poles, first.participation, **opts)
     assert again.n_iter == new.n_iter == 1
     assert again.status == new.status == "converged"
@@ -84,11 +149,24 @@ def test_a_fit_started_at_a_fit_at_rest_returns_it_with_one_evaluation() -> None
     assert_allclose(again.sigma_out, new.sigma_out, rtol=1e-10)
     assert_allclose(again.significance, new.significance, rtol=1e-8)
     assert_array_equal(again.poles, first.poles)
+    assert again is not first
     # another tolerance is not served from it: the refinement goes on
-    other = fit.fit(first.poles, first.participation, passes=1, tol=1e-6, uncertainty=False)
+    other = fit.fit(
+        first.poles, first.participation, start=first, passes=1, tol=1e-6, uncertainty=False
+    )
     assert other.n_iter > 1
-    full = fit.fit(first.poles, first.participation, passes=1, tol=10.0)
+    # a start that is not the given poles is not used: the fit of no start
+    moved = fit.fit(first.poles * 1.001, first.participation, start=first, **opts)
+    plain = fit.fit(first.poles * 1.001, first.participation, **opts)
+    assert_array_equal(moved.poles, plain.poles)
+    assert moved.n_iter == plain.n_iter > 1
+    # a final fit (standard errors) is computed, whatever the start
+    full = fit.fit(first.poles, first.participation, start=first, passes=1, tol=10.0)
     assert np.all(np.isfinite(full.std_frequency_hz))
+    # a fit stopped at its evaluation limit is not at rest
+    short = fit.fit(cm.poles * 1.01, part, max_nfev=2, **opts)
+    assert short.status == "maxfev"
+    assert short.rest is None
 
 
 def test_at_rest_is_the_first_stop_of_levenberg_marquardt() -> None:
@@ -238,3 +316,22 @@ def test_basis_times_data_from_the_complex_data(kind: str) -> None:
     # rows in another layout: the real product itself
     Bc = np.ascontiguousarray(B)
     assert_allclose(_basis.rows_t_data(fit, sl, Bc), want, rtol=0, atol=0)
+
+
+def test_the_search_forms_one_fixed_part_per_mode_set() -> None:
+    # FixedParts (owned by the caller of the search stages): the same mode set gives
+    # the same value, another mode set a new one, equal to the fitter's fixed_part
+    from tyredamp.modal.search import FixedParts
+
+    _, h, fixed, _, _ = _case("complex")
+    fit = _fitter(h)
+    held = FixedParts(fit)
+    a = held.of(*fixed)
+    assert a is not None
+    assert held.of(fixed[0].copy(), fixed[1].copy()) is a
+    other = (fixed[0] * 1.002, fixed[1])
+    b = held.of(*other)
+    assert b is not None
+    assert b is not a
+    assert_array_equal(b.tmap, fit.fixed_part(*other).tmap)
+    assert held.of(*fixed) is not a  # only the latest mode set is held

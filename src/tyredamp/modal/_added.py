@@ -10,18 +10,16 @@ added columns ``B1 = [Phi_1 | E_1]`` against ``Phi_f``, themselves and the data
 2003, sec. 3.7; equations in the docstring of ``fit_added``).
 
 The residual search tries many candidates against the same fixed modes: the
-fitter keeps the fixed part of its latest fixed modes (``_fixed_memo``, keyed
-by their parameters and the blocks of lines), so a candidate against the same
-modes does not form their basis and range again. It is a pure cache: the
-fixed part is a function of that key and of the fitter's data. Held between
-calls are the range map and, when the data fit one block
-(:func:`~tyredamp.modal._basis.one_block`), that block's fixed basis and
-weighted data rows (no more than one block of a blocked fit).
+fixed part (:class:`FixedPart`, from :meth:`ModalFitter.fixed_part
+<tyredamp.modal.fit.ModalFitter.fixed_part>`) is an immutable value that the
+caller forms once per fixed mode set and passes to each ``fit_added``; the
+fitter keeps nothing between calls. It holds the range map and, when the data
+fit one block (:func:`~tyredamp.modal._basis.one_block`), that block's fixed
+basis and weighted data rows (no more than one block of a blocked fit).
 """
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,94 +30,87 @@ from . import _basis
 from ._linalg import _PROJ_TOL, _fixed_range, _vp_solve
 
 
-@dataclass
+@dataclass(frozen=True)
 class FixedPart:
     """The fixed basis's part of :meth:`ModalFitter.fit_added` (module docstring).
 
-    ``cols``: fixed basis ``Phi_f`` of the blocks kept (block index to rows);
-    ``keep``: whether a block's basis is kept once formed; ``yw``: the weighted
-    data rows of the one block (None with several blocks); ``tmap``, ``qty``,
-    ``yyp``: the range map ``T``, ``Q_r^T Y`` and ``||P_f Y||^2``
-    (:func:`_fixed_range`); ``qr``: ``Q_r = Phi_f T`` of the one block, formed
-    when the QR route needs it.
+    An immutable value of the fixed modes ``th`` (``m``, ``ref``) on the blocks
+    of lines ``parts``: ``phi0`` the fixed basis ``Phi_f`` and ``yw`` the
+    weighted data rows of the one block (None with several blocks, where they
+    are formed block by block when needed); ``tmap``, ``qty``, ``yyp``: the
+    range map ``T``, ``Q_r^T Y`` and ``||P_f Y||^2`` (:func:`_fixed_range`);
+    ``keep``: whether a call keeps a block's basis once formed (several blocks).
     """
 
     th: NDArray[np.float64]
     m: int
     ref: NDArray[np.intp]
-    parts: list[slice]
-    cols: dict[int, NDArray[np.float64]]
+    parts: tuple[slice, ...]
     keep: bool
+    phi0: NDArray[np.float64] | None
     yw: NDArray[np.float64] | None
     tmap: NDArray[np.float64]
     qty: NDArray[np.float64]
     yyp: NDArray[np.float64]
-    qr: NDArray[np.float64] | None = None
 
-    def basis(self, fitter: Any, i: int) -> NDArray[np.float64]:
-        """``Phi_f`` of block ``i`` (kept when ``keep``)."""
+    def matches(self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp]) -> bool:
+        """Is this the fixed part of the modes ``th`` (``m``, ``ref``)?"""
+        return self.m == m and np.array_equal(self.th, th) and np.array_equal(self.ref, ref)
+
+
+class _Rows:
+    """The fixed basis and data rows of the blocks, within one call (nothing is
+    kept between calls but what the :class:`FixedPart` holds)."""
+
+    def __init__(self, fitter: Any, fx: FixedPart | None, parts: Any, keep: bool) -> None:
+        self.fitter, self.fx, self.parts, self.keep = fitter, fx, parts, keep
+        self.cols: dict[int, NDArray[np.float64]] = {}
+        self.qr: NDArray[np.float64] | None = None
+
+    def basis(self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], i: int) -> Any:
+        """``Phi_f`` of block ``i`` (kept within the call when ``keep``)."""
+        if self.fx is not None and self.fx.phi0 is not None:
+            return self.fx.phi0
         phi = self.cols.get(i)
         if phi is None:
-            phi = fitter._basis_ek(self.th, self.m, self.ref, False, self.parts[i])[0]
+            phi = self.fitter._basis_ek(th, m, ref, False, self.parts[i])[0]
             if self.keep:
                 self.cols[i] = phi
         return phi
 
-    def data(self, fitter: Any, i: int, w: NDArray[np.float64]) -> NDArray[np.float64]:
+    def data(self, yw: NDArray[np.float64] | None, i: int, w: NDArray[np.float64]) -> Any:
         """Weighted data rows of block ``i``."""
-        if self.yw is not None:
-            return self.yw
-        return np.asarray(fitter._ydata(self.parts[i]) * w)
-
-    def q_range(self, fitter: Any, i: int) -> NDArray[np.float64]:
-        """``Q_r`` rows of block ``i`` (``Phi_f T``; kept for the one block)."""
-        if self.yw is None:
-            return np.asarray(self.basis(fitter, i) @ self.tmap)
-        if self.qr is None:
-            self.qr = np.asarray(self.basis(fitter, i) @ self.tmap)
-        return self.qr
+        if yw is not None:
+            return yw
+        return np.asarray(self.fitter._ydata(self.parts[i]) * w)
 
 
 def fixed_part(
     fitter: Any, th_f: NDArray[np.float64], m: int, ref: NDArray[np.intp], parts: list[slice]
 ) -> FixedPart:
-    """The fixed part of the modes ``th_f`` (``m``, ``ref``) on the blocks ``parts``:
-    the fitter's ``_fixed_memo`` when it holds these, else formed (and, with one
-    block, kept there; module docstring)."""
-    key = (m, th_f.tobytes(), ref.tobytes(), tuple(sl.indices(fitter.n_f) for sl in parts))
-    memo = fitter._fixed_memo
-    if memo is not None and memo[0] == key:
-        held: FixedPart = memo[1]
-        # several blocks: the range map is held, the bases are formed in this call
-        return held if held.yw is not None else dataclasses.replace(held, cols={})
+    """The fixed part of the modes ``th_f`` (``m``, ``ref``) on the blocks ``parts``
+    (module docstring); a pure function of these and of the fitter's data."""
     w = fitter._w1
     qf = fitter.n_cols(m)
     one = len(parts) == 1
     # the fixed basis is kept when it is no larger than the data (many outputs) or
     # fits one block; otherwise it is formed again block by block when needed
-    fx = FixedPart(
-        th=th_f,
-        m=m,
-        ref=ref,
-        parts=parts,
-        cols={},
-        keep=one or qf <= fitter.n_out,
-        yw=np.asarray(fitter._ydata(parts[0]) * w) if one else None,
-        tmap=np.zeros((qf, 0)),
-        qty=np.zeros((0, fitter.n_out)),
-        yyp=np.zeros(fitter.n_out),
-    )
+    keep = one or qf <= fitter.n_out
+    rows = _Rows(fitter, None, parts, keep)
+    yw = np.asarray(fitter._ydata(parts[0]) * w) if one else None
+    phi0 = rows.basis(th_f, m, ref, 0) if one else None
     # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
     # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
-    fx.tmap, fx.qty, fx.yyp = _fixed_range(
-        lambda: ((fx.basis(fitter, i), fx.data(fitter, i, w)) for i in range(len(parts))),
+    tmap, qty, yyp = _fixed_range(
+        lambda: ((rows.basis(th_f, m, ref, i), rows.data(yw, i, w)) for i in range(len(parts))),
         qf,
         fitter._yss * w**2,
-        (fx.basis(fitter, 0), fx.data(fitter, 0, w)) if one else None,
+        (phi0, yw) if phi0 is not None and yw is not None else None,
     )
-    # several blocks: only the range map is held between calls
-    fitter._fixed_memo = (key, fx if one else dataclasses.replace(fx, cols={}))
-    return fx
+    for a in (th_f, ref, phi0, yw, tmap, qty, yyp):
+        if a is not None:
+            a.flags.writeable = False
+    return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp)
 
 
 def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], lay1: Any) -> Any:
@@ -127,6 +118,20 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
     :meth:`ModalFitter._refine`); ``one``: the fitter of the added mode alone (no
     residual terms), ``lay1`` its derivative layout."""
     w = fitter._w1
+    rows = _Rows(fitter, fx, fx.parts, fx.keep)  # this call's fixed basis (several blocks)
+    th_f, m_f, ref_f = fx.th, fx.m, fx.ref
+
+    def basis(i: int) -> NDArray[np.float64]:
+        return np.asarray(rows.basis(th_f, m_f, ref_f, i))
+
+    def q_range(i: int) -> NDArray[np.float64]:
+        """``Q_r`` rows of block ``i`` (``Phi_f T``; formed once per call for the one block)."""
+        if fx.yw is None:
+            return np.asarray(basis(i) @ fx.tmap)
+        if rows.qr is None:
+            rows.qr = np.asarray(basis(i) @ fx.tmap)
+        return rows.qr
+
     q1 = one.n_cols(1)
     n1 = q1 + int(lay1.ecol.max()) + 1
     qf = fx.tmap.shape[0]
@@ -141,14 +146,14 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
         if nb == 1:  # one block: the products themselves (no sums)
             b1 = one._basis_ek(th, 1, ref1, True, fx.parts[0], (None, pp1))[0]
             b1s.append(b1)
-            cross, g0, p0 = fx.basis(fitter, 0).T @ b1, b1.T @ b1, b1.T @ fx.data(fitter, 0, w)
+            cross, g0, p0 = basis(0).T @ b1, b1.T @ b1, b1.T @ rows.data(fx.yw, 0, w)
         else:
             cross = np.zeros((qf, n1))
             g0 = np.zeros((n1, n1))
             p0 = np.zeros((n1, fitter.n_out))
             for i, sl in enumerate(fx.parts):
                 b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
-                cross += fx.basis(fitter, i).T @ b1
+                cross += basis(i).T @ b1
                 g0 += b1.T @ b1
                 p0 += _basis.rows_t_data(fitter, sl, b1) * w  # no data rows formed
         qb = fx.tmap.T @ cross
@@ -158,8 +163,8 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
         def projected() -> Any:
             for i, sl in enumerate(fx.parts):
                 b1 = b1s[i] if b1s else one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
-                pt = fx.q_range(fitter, i)
-                yield b1 - pt @ qb, fx.data(fitter, i, w) - pt @ fx.qty
+                pt = q_range(i)
+                yield b1 - pt @ qb, rows.data(fx.yw, i, w) - pt @ fx.qty
 
         # columns mostly in span(Phi_f): the QR route of the projected rows
         force = bool(np.any(np.diag(G) < _PROJ_TOL * np.diag(g0)))

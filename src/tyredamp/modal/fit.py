@@ -58,9 +58,11 @@ MB), the fitter forms them and the line factors once and keeps them (no
 more than the one block of a blocked fit), a basis is formed once per
 evaluation for both routes, and an ill-conditioned basis is orthogonalised
 by CholeskyQR2 (:func:`~tyredamp.modal._linalg._cholqr2`) rather than by
-Householder. Between calls a fitter keeps the fixed part of its latest
-``fit_added`` (:mod:`~tyredamp.modal._added`) and its latest intermediate fit
-at rest (``fit``); both are pure caches of its data (same results).
+Householder. A fitter keeps nothing between calls (issue 14: a stateless
+fitter): what one call can reuse from another is passed explicitly -- the
+fixed part of ``fit_added`` (:meth:`ModalFitter.fixed_part`, an immutable
+:class:`~tyredamp.modal._added.FixedPart` formed once per fixed mode set) and
+a previous intermediate fit at rest (``fit(..., start=res)``).
 
 Scaling (spec step 3 and eq. [10]): with drive points ``(j_k, k)`` (output
 ``j_k`` at the place of input ``k``) reciprocity ``psi_in[k] = psi_out[j_k]``
@@ -133,6 +135,10 @@ class FitResult:
     drive_phi2: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(0, complex))
     #: not filled any more (the fits keep no per-line array); kept for compatibility
     projection: tuple[Any, ...] | None = None
+    #: ``(weights, tol)`` of an intermediate one-pass refinement that stopped at
+    #: rest here: the same refinement started at this result stops at once
+    #: (``ModalFitter.fit(..., start=this)``); None when not known to be at rest
+    rest: tuple[NDArray[np.float64], float] | None = None
 
 
 class ModalFitter:
@@ -209,10 +215,6 @@ class ModalFitter:
         self.n_rows = 2 * self.n_in * self.n_f
         self._y: NDArray[np.float64] | None = None
         self._factors: tuple[NDArray[np.complex128], ...] | None = None
-        # a fit_added of the same fixed modes again: its fixed range (_fixed_memo)
-        self._fixed_memo: tuple[Any, ...] | None = None
-        # an intermediate fit at rest: the same fit started at its result (_fit_memo)
-        self._fit_memo: tuple[Any, FitResult] | None = None
         if _basis.one_block(self):
             fac = _basis.factors(self)
             y = _basis.ydata(self)
@@ -425,6 +427,7 @@ class ModalFitter:
         sigma: NDArray[np.float64] | None = None,
         tol: float = 1e-6,
         uncertainty: bool = True,
+        start: FitResult | None = None,
     ) -> FitResult:
         """Fit from initial poles (m,) and participation (m, n_in).
 
@@ -436,10 +439,21 @@ class ModalFitter:
         ``tol`` is the convergence threshold of the refinement in units of the
         residual variance (:func:`_levenberg_marquardt`); ``uncertainty=False``
         skips the standard errors (left at NaN), for intermediate fits.
+
+        ``start``: a previous result of this fitter whose poles and
+        participation are ``poles`` and ``part``. When it is an intermediate
+        one-pass refinement that stopped at rest (``start.rest``) with the
+        weights and ``tol`` of this call, this refinement would stop at once:
+        ``start`` is returned (as a copy, ``n_iter = 1``) without evaluating.
         """
         m = int(poles.size)
         part = np.asarray(part, complex).reshape(m, self.n_in)
-        start = (np.asarray(poles, complex).tobytes(), part.tobytes())
+        same = (
+            start is not None
+            and start.rest is not None
+            and np.array_equal(np.asarray(poles, complex), start.poles)
+            and np.array_equal(part, start.participation)
+        )
         if self.kind == "real":
             ph = np.exp(-1j * np.angle(part[np.arange(m), np.argmax(np.abs(part), axis=1)]))
             part = (part * ph[:, None]).real.astype(complex)
@@ -453,9 +467,10 @@ class ModalFitter:
         # one (same weights and tolerance) that stopped at rest would stop at once:
         # that result again (one evaluation)
         once = refine and not uncertainty and passes <= 1 and max_nfev >= 2
-        memo = self._fit_memo
-        if once and memo is not None and memo[0] == (*start, w.tobytes(), tol):
-            return replace(memo[1], n_iter=1, warnings=list(memo[1].warnings))
+        if once and same and start is not None and start.rest is not None:
+            w_rest, tol_rest = start.rest
+            if tol_rest == tol and np.array_equal(w_rest, w):
+                return replace(start, n_iter=1, warnings=list(start.warnings))
         q = self.n_cols(m)
         dof = self.n_rows - q
         status = "lsfd"
@@ -476,9 +491,44 @@ class ModalFitter:
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
         res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
         if once and status == "converged" and self._at_rest(th, sol):
-            end = (res.poles.tobytes(), res.participation.tobytes(), w.tobytes(), tol)
-            self._fit_memo = (end, res)
+            res.rest = (w.copy(), float(tol))
         return res
+
+    def _real_part(self, part: NDArray[np.complex128]) -> NDArray[np.complex128]:
+        """Real-mode participation: each row turned by the phase of its largest entry."""
+        if self.kind != "real":
+            return part
+        m = part.shape[0]
+        ph = np.exp(-1j * np.angle(part[np.arange(m), np.argmax(np.abs(part), axis=1)]))
+        return (part * ph[:, None]).real.astype(complex)
+
+    def _added_fitter(self) -> tuple[ModalFitter, Any, int]:
+        """The fitter of one added mode alone (no residual terms), its derivative
+        layout and its number of basis and derivative columns."""
+        one = copy.copy(self)
+        one.use_upper = one.use_lower = False
+        lay1 = one._layout(1)
+        return one, lay1, one.n_cols(1) + int(lay1.ecol.max()) + 1
+
+    def _fixed_modes(
+        self, poles: NDArray[np.complex128], part: NDArray[np.complex128], n1: int
+    ) -> tuple[NDArray[np.float64], int, NDArray[np.intp], list[slice]]:
+        """Parameters of the fixed modes and the blocks of lines of ``fit_added``
+        (``n1`` columns of the added mode)."""
+        m = int(np.asarray(poles).size)
+        part = self._real_part(np.asarray(part, complex).reshape(m, self.n_in))
+        ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+        th_f = self.pack(np.asarray(poles, complex), part, ref)
+        return th_f, m, ref, _basis.blocks(self, self.n_cols(m) + n1)
+
+    def fixed_part(
+        self, poles: NDArray[np.complex128], part: NDArray[np.complex128]
+    ) -> _added.FixedPart:
+        """The fixed part of :meth:`fit_added` for the fixed modes ``poles`` (m,)
+        and ``part`` (m, n_in): an immutable value (the range of their basis and
+        of the residual terms, :mod:`~tyredamp.modal._added`) to form once and
+        pass as ``fixed`` to every ``fit_added`` against these modes."""
+        return _added.fixed_part(self, *self._fixed_modes(poles, part, self._added_fitter()[2]))
 
     def fit_added(
         self,
@@ -490,7 +540,7 @@ class ModalFitter:
         omega_bounds: tuple[float, float] | None = None,
         max_nfev: int = 200,
         tol: float = 1e-6,
-        fixed: FitResult | None = None,
+        fixed: _added.FixedPart | None = None,
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
@@ -501,14 +551,14 @@ class ModalFitter:
         evaluation solves the joint projection of ``[Phi_f | Phi_1 | E_1]``
         (:func:`_vp_solve`), whose rows of the added mode are those of the
         projected problem (Frisch-Waugh-Lovell theorem, e.g. Seber & Lee 2003,
-        sec. 3.7); ``Phi_f^T Phi_f`` and ``Phi_f^T Y`` are summed once per call,
-        an evaluation adds the blocks of the added columns ``B1 = [Phi_1 | E_1]``
-        (``Phi_f^T B1``, ``B1^T B1``, ``B1^T Y``) over blocks of lines; the QR
-        route of :func:`_vp_solve` is taken when the subtraction would lose
-        accuracy. ``omega_bounds`` (rad/s, lower < upper) limits the damped
-        natural frequency ``Im p`` of the added mode; ``tol`` as in :meth:`fit`.
-        ``fixed``: accepted for compatibility and not used (the fitter keeps the
-        fixed part of its latest fixed modes, :mod:`~tyredamp.modal._added`).
+        sec. 3.7); ``Phi_f^T Phi_f`` and ``Phi_f^T Y`` are summed once
+        (:meth:`fixed_part`), an evaluation adds the blocks of the added columns
+        ``B1 = [Phi_1 | E_1]`` (``Phi_f^T B1``, ``B1^T B1``, ``B1^T Y``) over
+        blocks of lines; the QR route of :func:`_vp_solve` is taken when the
+        subtraction would lose accuracy. ``omega_bounds`` (rad/s, lower < upper)
+        limits the damped natural frequency ``Im p`` of the added mode; ``tol``
+        as in :meth:`fit`. ``fixed``: the :meth:`fixed_part` of ``poles`` and
+        ``part`` (formed by this call when None; another mode set's is refused).
 
         Returns
         -------
@@ -520,26 +570,18 @@ class ModalFitter:
             (in the units of the data), as ``FitResult.sigma_out`` of a
             one-pass fit.
         """
-        m = int(poles.size)
-        part = np.asarray(part, complex).reshape(m, self.n_in)
+        one, lay1, n1 = self._added_fitter()
+        th_f, m, ref, parts = self._fixed_modes(poles, part, n1)
+        if fixed is None:
+            fixed = _added.fixed_part(self, th_f, m, ref, parts)
+        elif not (fixed.matches(th_f, m, ref) and fixed.parts == tuple(parts)):
+            raise InputError("fixed: the fixed part of other modes than poles and part")
+        l1 = self._real_part(np.asarray(part_new, complex).reshape(1, self.n_in))
         p1 = np.array([pole], complex)
-        l1 = np.asarray(part_new, complex).reshape(1, self.n_in)
-        if self.kind == "real":
-            allp = np.concatenate([part, l1])
-            ph = np.exp(-1j * np.angle(allp[np.arange(m + 1), np.argmax(np.abs(allp), axis=1)]))
-            allp = (allp * ph[:, None]).real.astype(complex)
-            part, l1 = allp[:m], allp[m:]
-        ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
         w = self._w1
-        th_f = self.pack(poles, part, ref)
-        one = copy.copy(self)
-        one.use_upper = one.use_lower = False
         th0 = one.pack(p1, l1, ref1)
-        lay1 = one._layout(1)
-        n1 = one.n_cols(1) + int(lay1.ecol.max()) + 1
-        fx = _added.fixed_part(self, th_f, m, ref, _basis.blocks(self, self.n_cols(m) + n1))
-        solve = _added.added_solver(self, one, fx, ref1, lay1)
+        solve = _added.added_solver(self, one, fixed, ref1, lay1)
         th, _, _, sol = self._refine(
             th0, 1, ref1, w, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
         )

@@ -98,6 +98,7 @@ from .order import Diagram, SelectionRules, default_order, settle_order
 from .problem import FitProblem, build_problem, max_modes
 from .quality import RejectedMode
 from .search import (
+    FixedParts,
     ModeSet,
     ModeTest,
     reject_by_test,
@@ -460,13 +461,24 @@ def _select(
     band = (float(sfit.f[0]), float(sfit.f[-1]))
     out: list[RejectedMode] = []
     last: FitResult | None = None
+    fixed = FixedParts(sfit)  # the trials' fixed parts, shared by the stages
     if refine and max_helpers > 0:
-        last, modes, dropped = search_helpers(sfit, modes, problem_band, band, max_helpers, thr)
+        last, modes, dropped = search_helpers(
+            sfit, modes, problem_band, band, max_helpers, thr, fixed
+        )
         out += dropped
     if not auto:
         return last, modes, out
     last, modes, dropped = reject_by_test(
-        sfit, modes, problem_band, thr, refine, min_contribution, test
+        sfit,
+        modes,
+        problem_band,
+        thr,
+        refine,
+        min_contribution,
+        test=test,
+        start=last,
+        max_damping=dg.max_damping,
     )
     out += dropped
     if search and refine:
@@ -474,7 +486,7 @@ def _select(
             (_pole_of(r), np.ones(sfit.n_in, complex)) for r in rej + out
         ]
         last, modes, tried = residual_search(
-            sfit, last, modes, cands, problem_band, thr, dg.max_damping, test
+            sfit, last, modes, cands, problem_band, thr, dg.max_damping, test=test, fixed=fixed
         )
         out += tried
     return last, modes, out

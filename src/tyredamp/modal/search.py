@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
+from ._added import FixedPart
 from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode
@@ -42,6 +43,7 @@ from .span_noise import SpanNoise, span_noise
 from .stats import FALSE_ALARM, span_threshold
 
 __all__ = [
+    "FixedParts",
     "ModeSet",
     "ModeTest",
     "local_thresholds",
@@ -159,38 +161,76 @@ def rejected(
     )
 
 
+def _lost(
+    res: FitResult, modes: ModeSet, band: tuple[float, float]
+) -> tuple[NDArray[np.intp], str]:
+    """The modes a fit of ``modes`` lost, and why: those that left their side of
+    the band (in-band modes outside it, out-of-band residual modes inside it), or
+    else the weaker of two that merged (none: an empty index)."""
+    m = modes.m
+    p = res.poles
+    fd = p.imag / (2 * np.pi)
+    inb = (fd >= band[0]) & (fd <= band[1])
+    free = np.zeros(modes.hp.size, bool)
+    free[: modes.n_free] = True
+    wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
+    if wrong.size:
+        return wrong, "crossed the band edge during refinement"
+    d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
+    np.fill_diagonal(d, np.inf)
+    if d.size and d.min() < MERGE:
+        i, j = np.unravel_index(np.argmin(d), d.shape)
+        k = i if res.contribution[i] < res.contribution[j] else j
+        return np.array([k], np.intp), "merged with another mode during refinement"
+    return wrong, ""
+
+
+def as_residual(modes: ModeSet, broad: NDArray[np.bool_]) -> ModeSet:
+    """``modes`` with the in-band modes ``broad`` (m,) moved to the front of the
+    residual modes, as free ones (not checked against the band, not reported):
+    poles damped beyond the admissible limit that the data still need (broad
+    structure, e.g. the tails of modes outside the band). The order of
+    :meth:`ModeSet.all` is kept when only the last in-band modes move."""
+    keep = ~broad
+    return ModeSet(
+        modes.poles[keep],
+        modes.part[keep],
+        np.concatenate([modes.poles[broad], modes.hp]),
+        np.concatenate([modes.part[broad], modes.hl]),
+        modes.n_free + int(np.count_nonzero(broad)),
+    )
+
+
+def too_damped(poles: NDArray[np.complex128], max_damping: float | None) -> NDArray[np.bool_]:
+    """Which poles are damped beyond ``max_damping`` (none when it is None)."""
+    if max_damping is None:
+        return np.zeros(poles.size, bool)
+    return np.asarray(-poles.real > max_damping * np.abs(poles))
+
+
 def fit_checked(
     fitter: ModalFitter,
     modes: ModeSet,
     refine: bool,
     band: tuple[float, float],
+    start: FitResult | None = None,
     **fit_kw: object,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Fit the modes; drop any that left its side of the band or merged, and refit.
 
-    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`. Returns the fit,
-    the modes at the fit's values and the dropped ones.
+    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`, ``start`` (the
+    fit the modes come from, if any) to its first fit. Returns the fit, the
+    modes at the fit's values and the dropped ones.
     """
     dropped: list[RejectedMode] = []
     cur = modes
     for _ in range(modes.m + modes.hp.size + 1):
         m = cur.m
         p0, l0 = cur.all()
-        res = fitter.fit(p0, l0, refine=refine, **fit_kw)  # type: ignore[arg-type]
-        p = res.poles
-        fd = p.imag / (2 * np.pi)
-        inb = (fd >= band[0]) & (fd <= band[1])
-        free = np.zeros(cur.hp.size, bool)
-        free[: cur.n_free] = True
-        wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
-        why = "crossed the band edge during refinement"
-        if not wrong.size:
-            d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
-            np.fill_diagonal(d, np.inf)
-            if d.size and d.min() < MERGE:
-                i, j = np.unravel_index(np.argmin(d), d.shape)
-                wrong = np.array([i if res.contribution[i] < res.contribution[j] else j])
-                why = "merged with another mode during refinement"
+        first = start if cur is modes else None
+        res = fitter.fit(p0, l0, refine=refine, start=first, **fit_kw)  # type: ignore[arg-type]
+        fd = res.poles.imag / (2 * np.pi)
+        wrong, why = _lost(res, cur, band)
         if not wrong.size:
             return res, cur.take(res), dropped
         # every mode that crossed a band edge is dropped at once (one refit)
@@ -213,19 +253,50 @@ def fit_checked(
     raise ConvergenceError("refinement kept losing modes")
 
 
+class FixedParts:
+    """The fixed parts of the trials of one identification: each trial refines
+    an added mode against the current modes (:meth:`ModalFitter.fit_added`),
+    whose fixed part (:meth:`ModalFitter.fixed_part`, an immutable value) is
+    formed at the first trial against a mode set and passed to every trial
+    against the same modes (equal poles and participation), across the search
+    stages. Owned by the caller of the stages; the fitter keeps nothing.
+    """
+
+    def __init__(self, fitter: ModalFitter) -> None:
+        self.fitter = fitter
+        self.modes: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
+        self.value: FixedPart | None = None
+
+    def of(self, p_all: NDArray[np.complex128], l_all: NDArray[np.complex128]) -> FixedPart | None:
+        """The fixed part of these modes (None when it cannot be formed)."""
+        held = self.modes
+        if held is None or not (np.array_equal(held[0], p_all) and np.array_equal(held[1], l_all)):
+            self.modes = (p_all.copy(), l_all.copy())
+            try:
+                self.value = self.fitter.fixed_part(p_all, l_all)
+            except (np.linalg.LinAlgError, ValueError):
+                self.value = None
+        return self.value
+
+
 def _trial(
     fitter: ModalFitter,
     res: FitResult,
     modes: ModeSet,
+    fixed: FixedParts,
     pole: complex,
     part: NDArray[np.complex128],
     w_lim: tuple[float, float],
     strict: bool = True,
 ) -> tuple[complex, NDArray[np.complex128], float] | None:
-    """Refine one added mode alone; its statistic ``T``. ``strict``: None when it
-    stopped at a limit of ``w_lim`` (an out-of-band residual mode that runs into
-    the band edge is not there); otherwise the limit only localises the trial."""
+    """Refine one added mode alone against ``modes`` (their fixed part from
+    ``fixed``); its statistic ``T``. ``strict``: None when it stopped at a limit
+    of ``w_lim`` (an out-of-band residual mode that runs into the band edge is
+    not there); otherwise the limit only localises the trial."""
     p_all, l_all = modes.all()
+    fx = fixed.of(p_all, l_all)
+    if fx is None:
+        return None
     try:
         p_t, l_t, sig_t = fitter.fit_added(
             p_all,
@@ -234,7 +305,7 @@ def _trial(
             part,
             omega_bounds=w_lim,
             tol=TRIAL_TOL,
-            fixed=res,
+            fixed=fx,
             max_nfev=TRIAL_NFEV,
         )
     except (np.linalg.LinAlgError, ValueError):
@@ -258,6 +329,7 @@ def search_helpers(
     data_band: tuple[float, float],
     max_helpers: int,
     threshold: float,
+    fixed: FixedParts | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Refine, then add out-of-band residual modes while they pass the mode test.
 
@@ -270,7 +342,8 @@ def search_helpers(
     these limits and its statistic ``T`` (cost drop in units of the noise
     variance per output) exceeds ``threshold``; all modes are then refined
     together, and the search stops instead if that moves the trial mode out
-    of its range or an in-band mode out of the band.
+    of its range or an in-band mode out of the band. ``fixed``: the trials'
+    fixed parts (:class:`FixedParts`, new when None).
     """
     lo, hi = band
     res, cur, dropped = fit_checked(
@@ -286,6 +359,7 @@ def search_helpers(
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
     n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
     sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= MIN_LOW_LINES else [])
+    fixed = FixedParts(fitter) if fixed is None else fixed
     for side in sides:
         for k in range(max_helpers):
             fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
@@ -295,7 +369,7 @@ def search_helpers(
             ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
             edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
             w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
-            got = _trial(fitter, res, cur, ph, np.ones(fitter.n_in, complex), w_lim)
+            got = _trial(fitter, res, cur, fixed, ph, np.ones(fitter.n_in, complex), w_lim)
             if got is None or got[2] < threshold:
                 break
             p_t, l_t, _ = got
@@ -339,6 +413,8 @@ def reject_by_test(
     refine: bool,
     min_contribution: float = 0.0,
     test: ModeTest | None = None,
+    start: FitResult | None = None,
+    max_damping: float | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Drop the weakest mode that fails the mode test, refit; until every mode passes.
 
@@ -348,7 +424,12 @@ def reject_by_test(
     FRFs have an RMS below that fraction of the data's. With ``test``, each
     mode's threshold is raised where the noise of the first fit's residual
     (every mode in it: no mode's signal counts as noise) lies along the
-    response (:func:`local_thresholds`).
+    response (:func:`local_thresholds`). ``start``: the fit the modes come
+    from (:func:`search_helpers`); when it is a joint fit at rest, the first
+    fit returns it (``ModalFitter.fit(..., start=...)``). A mode that the
+    joint fit damps beyond ``max_damping`` (the diagram's admissible damping;
+    None: no limit) is not a mode: it stays in the fit as a residual mode
+    (:func:`as_residual`), and the residues are refitted.
     """
     out: list[RejectedMode] = []
     cur = modes
@@ -358,7 +439,7 @@ def reject_by_test(
         if i == 0 and refine:
             # a converged joint fit first (modes that leave the band are dropped)
             res, cur, gone = fit_checked(
-                fitter, cur, True, band, passes=1, tol=SEARCH_TOL, uncertainty=False
+                fitter, cur, True, band, start, passes=1, tol=SEARCH_TOL, uncertainty=False
             )
             out += gone
         elif res is None:
@@ -367,6 +448,10 @@ def reject_by_test(
             p0, l0 = cur.all()
             res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
         cur = cur.take(res)
+        broad = too_damped(cur.poles, max_damping)
+        if np.any(broad) and not np.all(broad):
+            cur, res = as_residual(cur, broad), None
+            continue
         m = cur.m
         if span is None and test is not None:
             span = residual_span(fitter, res)
@@ -448,18 +533,43 @@ def _room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> fl
     return float(np.sum(excess[sel]))
 
 
+def _inadmissible(p: complex, df: float, max_damping: float) -> str:
+    """Why the pole ``p`` cannot be an in-band mode of the search ('' if it can):
+    narrower than the line spacing ``df`` (Hz), or damped beyond ``max_damping``
+    (:func:`residual_search`)."""
+    if -p.real / np.pi < df:
+        return (
+            f"half-power bandwidth {-p.real / np.pi:.3g} Hz below the line "
+            f"spacing {df:.3g} Hz (not resolved)"
+        )
+    if -p.real > max_damping * abs(p):
+        return f"damping above the admissible {max_damping:.0%}"
+    return ""
+
+
 def _joint(
     fitter: ModalFitter,
     cur: ModeSet,
-    trial: tuple[complex, NDArray[np.complex128]],
+    p_t: complex,
+    l_t: NDArray[np.complex128],
     band: tuple[float, float],
     threshold: float,
-    test: ModeTest | None,
+    df: float,
+    max_damping: float,
+    crossed: set[int],
+    test: ModeTest | None = None,
 ) -> tuple[FitResult, ModeSet] | RejectedMode | None:
-    """Refine a passing trial mode with all modes: the fit and its modes when every
-    mode still passes (the trial its own threshold, :func:`local_thresholds`), the
-    record of the rejection otherwise, None when the fit failed."""
-    p_t, l_t = trial
+    """The joint refit of the modes ``cur`` with an accepted trial mode ``p_t``:
+    the fit and its modes when the trial mode stays (in the band, no merge, still
+    admissible, every mode significant); otherwise the trial's record with the
+    reason (None: the fit failed). A joint fit that loses a mode is not refitted
+    without it: the trial is rejected for what the fit did to it (crossing the
+    band edge, merging, carrying another mode across the edge). ``crossed``
+    gets the side (+1 above, -1 below the band) the trial mode crossed to. With
+    ``test``, the trial mode kept as a mode must also pass its own threshold,
+    raised where the noise of the joint fit's residual (the mode in it: a true
+    mode's signal does not count as noise) lies along the response
+    (:func:`local_thresholds`)."""
     new = ModeSet(
         np.append(cur.poles, p_t),
         np.concatenate([cur.part, l_t[None, :]]),
@@ -467,29 +577,99 @@ def _joint(
         cur.hl,
         cur.n_free,
     )
+    p_all, l_all = new.all()
+    kw = {"passes": 1, "tol": SEARCH_TOL, "uncertainty": False, "max_nfev": JOINT_NFEV}
     try:
-        r1, c1, drop = fit_checked(
-            fitter,
-            new,
-            True,
-            band,
-            passes=1,
-            tol=SEARCH_TOL,
-            uncertainty=False,
-            max_nfev=JOINT_NFEV,
-        )
-    except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+        r1 = fitter.fit(p_all, l_all, **kw)  # type: ignore[arg-type]
+    except (np.linalg.LinAlgError, ValueError):
         return None
-    why = "not significant with all modes refitted: T = "
-    if drop or c1.m != new.m or np.min(r1.significance[: c1.m]) <= threshold:
-        t1 = float(np.min(r1.significance[: c1.m])) if c1.m else float("nan")
-        return rejected(p_t, f"{why}{t1:.3g}", t1, threshold)
-    t_new = float(r1.significance[c1.m - 1])
-    span = residual_span(fitter, r1) if test is not None else None
-    thr_new = float(local_thresholds(fitter, span, c1.poles[-1:], threshold, test)[0])
-    if t_new <= thr_new:
-        return rejected(p_t, f"{why}{t_new:.3g} <= {_thr_text(thr_new, threshold)}", t_new, thr_new)
-    return r1, c1
+    k = new.m - 1  # the trial mode
+    fd = r1.poles.imag / (2 * np.pi)
+    wrong, why = _lost(r1, new, band)
+    if wrong.size and np.all(wrong >= new.m):
+        # only residual modes entered the band: dropped, the rest refitted from
+        # their starts (fit_checked), and the trial judged on that fit
+        keep = np.setdiff1d(np.arange(new.hp.size), wrong - new.m)
+        new = ModeSet(
+            new.poles,
+            new.part,
+            new.hp[keep],
+            new.hl[keep],
+            int(np.count_nonzero(keep < new.n_free)),
+        )
+        try:
+            r1, c1, drop = fit_checked(
+                fitter,
+                new,
+                True,
+                band,
+                **kw,  # type: ignore[arg-type]
+            )
+        except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+            return None
+        if drop or c1.m != new.m:
+            return rejected(p_t, f"joint refit: {drop[0].reason if drop else 'lost a mode'}")
+        p_all = new.all()[0]
+        fd = r1.poles.imag / (2 * np.pi)
+        wrong, why = np.zeros(0, np.intp), ""
+    if wrong.size:
+        if k in wrong:
+            how = f"joint refit: {why} ({fd[k]:.2f} Hz)"
+            if not band[0] <= fd[k] <= band[1]:
+                crossed.add(1 if fd[k] > band[1] else -1)
+        else:
+            i = int(wrong[0])
+            how = (
+                f"joint refit: the mode at {abs(p_all[i]) / (2 * np.pi):.2f} Hz "
+                f"{why} ({fd[i]:.2f} Hz)"
+            )
+        return rejected(p_t, how)
+    t1 = r1.significance[: new.m]
+    if np.min(t1) <= threshold:
+        return rejected(
+            p_t,
+            f"not significant with all modes refitted: T = {np.min(t1):.3g} <= {threshold:.3g}",
+            float(np.min(t1)),
+            threshold,
+        )
+    p1 = complex(r1.poles[k])
+    why = _inadmissible(p1, df, max_damping)
+    if why and -p1.real / np.pi >= df:
+        # too damped to be a mode, but significant: broad structure (the tails of
+        # modes outside the band) kept as a residual mode, not reported as a mode;
+        # the trial mode is the last in-band one: the order of r1 is kept
+        return r1, as_residual(new.take(r1), np.arange(new.m) == k)
+    if why:
+        return rejected(p1, f"joint refit: {why}", float(r1.significance[k]), threshold)
+    if test is not None:
+        span = residual_span(fitter, r1)
+        thr_k = float(local_thresholds(fitter, span, r1.poles[k : k + 1], threshold, test)[0])
+        t_k = float(t1[k])
+        if t_k <= thr_k:
+            return rejected(
+                p_t,
+                f"not significant with all modes refitted: T = {t_k:.3g} <= "
+                f"{_thr_text(thr_k, threshold)}",
+                t_k,
+                thr_k,
+            )
+    return r1, new.take(r1)
+
+
+TOWARD_CROSSED = (
+    "stopped at its window's limit toward a band edge that another trial crossed in its "
+    "joint refit (the same structure outside the band)"
+)
+
+
+def _toward(p: complex, w_lim: tuple[float, float]) -> int:
+    """The side (+1 up, -1 down, 0 none) of the window ``w_lim`` (rad/s) at whose
+    limit a trial pole ``p`` stopped: it found no optimum inside its window and
+    runs toward structure beyond it."""
+    tol = 1e-4 * (w_lim[1] - w_lim[0])
+    if p.imag >= w_lim[1] - tol:
+        return 1
+    return -1 if p.imag <= w_lim[0] + tol else 0
 
 
 def residual_search(
@@ -501,6 +681,7 @@ def residual_search(
     threshold: float,
     max_damping: float = 0.2,
     test: ModeTest | None = None,
+    fixed: FixedParts | None = None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
@@ -510,14 +691,24 @@ def residual_search(
     narrower than the line spacing: no line lies inside its resonance, so the
     lines cannot resolve its frequency and damping, and such a pole fits the
     noise of single lines (where per-line variances estimated from a few
-    averages are too small) rather than a resonance.
+    averages are too small) rather than a resonance. A trial mode that passes
+    is refitted with all modes (:func:`_joint`) and kept when it stays in the
+    band, merges with no mode, is still admissible and every mode still passes
+    the test; otherwise it is rejected for what the joint refit did (e.g.
+    "joint refit: crossed the band edge", a mode outside the band whose tail
+    the trial had taken), and a later trial that ends at the same pole (within
+    ``2 MERGE``) against the same modes is not refitted again; nor is one that
+    stopped at the limit of its window toward a band edge that a trial crossed
+    (it runs toward the same structure outside the band).
 
     ``candidates`` are starting poles and participation vectors from the
     diagram; each round adds the peaks of the current residual. With
     ``test``, the added mode must also pass its own threshold in the joint
     refit, raised where the noise of that fit's residual (the mode in it: a
     true mode's signal does not count as noise) lies along the response
-    (:func:`local_thresholds`).
+    (:func:`local_thresholds`). ``fixed``: the trials' fixed parts
+    (:class:`FixedParts`; shared with :func:`search_helpers` by the caller, or
+    new).
     """
     lo, hi = band
     df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
@@ -526,6 +717,9 @@ def residual_search(
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
     pending = list(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
+    refused: list[complex] = []  # trial modes whose joint refit failed (current modes)
+    crossed: set[int] = set()  # sides of the band trial modes crossed to (current modes)
+    fixed = FixedParts(fitter) if fixed is None else fixed
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
@@ -555,39 +749,30 @@ def residual_search(
             )
             if not w_lim[0] < w_lim[1]:
                 continue
-            got = _trial(fitter, res, cur, p0, np.asarray(l0, complex), w_lim, strict=False)
+            got = _trial(fitter, res, cur, fixed, p0, np.asarray(l0, complex), w_lim, strict=False)
             if got is None:
                 continue
             p_t, l_t, t = got
-            if -p_t.real / np.pi < df:
-                tried.append(
-                    rejected(
-                        p_t,
-                        f"half-power bandwidth {-p_t.real / np.pi:.3g} Hz below the line "
-                        f"spacing {df:.3g} Hz (not resolved)",
-                        t,
-                        threshold,
-                    )
-                )
+            why = _inadmissible(p_t, df, max_damping)
+            if not why and t <= threshold:
+                why = f"not significant: T = {t:.3g} <= {threshold:.3g}"
+            if why:
+                tried.append(rejected(p_t, why, t, threshold))
                 continue
-            if -p_t.real > max_damping * abs(p_t):
-                tried.append(
-                    rejected(p_t, f"damping above the admissible {max_damping:.0%}", t, threshold)
-                )
+            if refused and np.min(np.abs(np.asarray(refused) - p_t)) < 2 * MERGE * abs(p_t):
+                continue  # the same trial mode: its joint refit was rejected already
+            if _toward(p_t, w_lim) in crossed:
+                tried.append(rejected(p_t, TOWARD_CROSSED, t, threshold))
                 continue
-            if t <= threshold:
-                tried.append(
-                    rejected(p_t, f"not significant: T = {t:.3g} <= {threshold:.3g}", t, threshold)
-                )
+            got1 = _joint(fitter, cur, p_t, l_t, band, threshold, df, max_damping, crossed, test)
+            if isinstance(got1, RejectedMode):
+                tried.append(got1)
+                refused.append(p_t)
                 continue
-            got_j = _joint(fitter, cur, (p_t, l_t), band, threshold, test)
-            if got_j is None:
+            if got1 is None:
                 continue
-            if isinstance(got_j, RejectedMode):
-                tried.append(got_j)
-                continue
-            r1, c1 = got_j
-            res, cur, added = r1, c1, True
+            res, cur = got1
+            added, refused, crossed = True, [], set()
         if not added:
             break
     return res, cur, tried
