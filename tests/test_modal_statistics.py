@@ -238,7 +238,10 @@ def test_model_arrays_are_read_only_and_quality_round_trips() -> None:
     assert_allclose(back.quality.statistic, c.quality.statistic)
     assert back.quality.verdict == c.quality.verdict
     assert back.quality.kept == c.quality.kept
-    assert c.to_dict()["modes"][0]["test"]["threshold"] == c.quality.threshold
+    test0 = c.to_dict()["modes"][0]["test"]
+    assert test0["threshold"] == c.quality.thresholds[0]  # the one applied to mode 1
+    assert test0["base_threshold"] == c.quality.threshold
+    assert_allclose(back.quality.thresholds, c.quality.thresholds)
     again = FitQuality.from_dict(c.quality.to_dict())
     assert again.to_dict() == c.quality.to_dict()
 

@@ -29,28 +29,37 @@ _NOISE = {
 
 def modes_table(name: str, model: ModalModel) -> list[str]:
     """Text table of one model: frequency, damping (with standard errors), MPC, the
-    mode test's statistic, RMSD and the goodness-of-fit verdict."""
+    mode test's statistic ``T`` and the threshold applied to each mode (the base
+    one, raised where the noise lies along the response), RMSD and the
+    goodness-of-fit verdict."""
     sf = model.std.get("frequency_hz", np.full(model.n_modes, np.nan))
     sz = model.std.get("damping_ratio", np.full(model.n_modes, np.nan))
     mpc = np.asarray(model.meta.get("mpc", np.full(model.n_modes, np.nan)), float)
     q = model.quality
     stat = q.statistic if q is not None else np.full(model.n_modes, np.nan)
-    thr = f" (threshold {q.threshold:.3g}, false-alarm rate {q.false_alarm:g})" if q else ""
+    each = q.thresholds if q is not None else np.full(model.n_modes, np.nan)
+    thr = f" (base threshold {q.threshold:.3g}, false-alarm rate {q.false_alarm:g})" if q else ""
     labels = model.meta.get("wave_number_label")
     if not isinstance(labels, list) or len(labels) != model.n_modes:
         labels = None
     rows = [
         f"{name} modes ({model.n_modes}):",
-        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7} {'T':>9}"
-        + ("  wave number" if labels else "")
-        + thr,
+        f"  {'#':>3} {'f [Hz]':>10} {'+-':>8} {'zeta [%]':>9} {'+-':>8} {'MPC':>7} "
+        f"{'T':>9} {'thr':>9}" + ("  wave number" if labels else "") + thr,
     ]
     for n in range(model.n_modes):
         rows.append(
             f"  {n + 1:>3} {model.frequency_hz[n]:>10.3f} {sf[n]:>8.3g} "
             f"{100 * model.damping_ratio[n]:>9.4f} {100 * sz[n]:>8.3g} {mpc[n]:>7.4f} "
-            f"{stat[n]:>9.3g}" + (f"  {labels[n]}" if labels else "")
+            f"{stat[n]:>9.3g} {each[n]:>9.3g}" + (f"  {labels[n]}" if labels else "")
         )
+    if q is not None:
+        raised = [str(n + 1) for n in range(model.n_modes) if each[n] > q.threshold]
+        if raised:
+            rows.append(
+                f"  thr raised from {q.threshold:.3g} (noise along the response) "
+                f"for mode(s) {', '.join(raised)}"
+            )
     rmsd = model.meta.get("rmsd", float("nan"))
     rel = model.meta.get("relative_error", float("nan"))
     rows.append(f"  RMSD (eq. 19) {rmsd:.4g}, relative error {100 * rel:.3g} %")

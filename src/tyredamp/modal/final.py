@@ -32,7 +32,7 @@ from .indicators import mean_phase_deviation, modal_phase_collinearity
 from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
-from .quality import FitQuality, RejectedMode
+from .quality import FitQuality, RejectedMode, threshold_text
 from .search import ModeSet, ModeTest, fit_checked, local_thresholds, rejected, residual_span
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
@@ -243,6 +243,10 @@ class ModelContext:
     kept: tuple[str, ...] | None
     rejected: tuple[RejectedMode, ...]
     method: str
+    #: the threshold applied to each in-band mode (fit order): the base
+    #: ``threshold`` raised where the noise lies along the response
+    #: (:func:`final_complex`); None: ``threshold`` for every mode
+    thresholds: NDArray[np.float64] | None = None
 
 
 def to_model(
@@ -285,13 +289,15 @@ def to_model(
     rel = float(np.sqrt(sq.sum() / max(float(np.vdot(pr.H, pr.H).real), 1e-300)))
     per_frf = c * np.sqrt(sq.sum(axis=-1)) / n_f
     stat = res.significance[:n_band][o]
+    base = ctx.threshold
+    thr = np.full(n_band, base) if ctx.thresholds is None else np.asarray(ctx.thresholds)[o]
     kept = ctx.kept
     if kept is None:
         kept = tuple(
-            f"T = {t:.3g} > {ctx.threshold:.3g} (false-alarm rate {ctx.false_alarm:g})"
-            if t > ctx.threshold
-            else f"asked for; T = {t:.3g} <= {ctx.threshold:.3g}: not significant"
-            for t in stat
+            f"T = {t:.3g} > {threshold_text(h, base)} (false-alarm rate {ctx.false_alarm:g})"
+            if t > h
+            else f"asked for; T = {t:.3g} <= {threshold_text(h, base)}: not significant"
+            for t, h in zip(stat, thr, strict=True)
         )
     else:
         kept = tuple(kept[int(i)] for i in o)
@@ -308,12 +314,13 @@ def to_model(
         passed=gof.passed,
         verdict=gof.verdict,
         statistic=stat,
-        threshold=ctx.threshold,
+        threshold=base,
         false_alarm=ctx.false_alarm,
         kept=kept,
         rejected=ctx.rejected,
         status=res.status,
         n_evaluations=res.n_iter,
+        thresholds=thr,
     )
     meta = {
         "band_hz": [pr.band[0], pr.band[1]],
@@ -363,7 +370,7 @@ def final_complex(
     combined: ModalFitter | None,
     threshold: float | None = None,
     test: ModeTest | None = None,
-) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+) -> tuple[FitResult, ModeSet, list[RejectedMode], NDArray[np.float64] | None]:
     """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
     combinations (many outputs), whose poles then give the residues of every output.
 
@@ -373,29 +380,37 @@ def final_complex(
     (:func:`~tyredamp.modal.search.local_thresholds`). A mode whose statistic
     fell to its threshold in the final refinement (its pole moved onto noise,
     e.g. a damping that collapsed) is dropped, the weakest first, and the fit
-    repeated.
+    repeated. Also returns the threshold applied to each kept in-band mode (fit
+    order; None without ``threshold``).
     """
     dropped: list[RejectedMode] = []
     cur = modes
+    thr: NDArray[np.float64] | None = None
     for _ in range(modes.m):
         res, cur, gone = _final_fit(problem, cfit, cur, sigma0, refine, combined)
         dropped += gone
-        if threshold is None or cur.m <= 1:
+        if threshold is None or cur.m == 0:
+            thr = None
             break
         m = cur.m
         t = res.significance[:m]
         span = residual_span(cfit, res) if test is not None else None
         thr = local_thresholds(cfit, span, res.poles[:m], threshold, test)
-        if not np.any(t <= thr):
+        if m <= 1 or not np.any(t <= thr):
             break
         worst = int(np.argmin(np.where(t <= thr, t / thr, np.inf)))
-        why = f"final fit: not significant: T = {t[worst]:.3g} <= {thr[worst]:.3g}"
+        why = (
+            f"final fit: not significant: T = {t[worst]:.3g} <= "
+            f"{threshold_text(thr[worst], threshold)}"
+        )
         dropped.append(rejected(complex(res.poles[worst]), why, float(t[worst]), float(thr[worst])))
         keep = np.arange(m) != worst
         cur = ModeSet(cur.poles[keep], cur.part[keep], cur.hp, cur.hl, cur.n_free)
     if refine:
+        # the ML refinement keeps the WLS fit's statistics (:mod:`~tyredamp.modal.ml`),
+        # so the thresholds they were tested against stand
         res = maximum_likelihood(problem, cfit, res)
-    return res, cur, dropped
+    return res, cur, dropped, thr
 
 
 def _final_fit(

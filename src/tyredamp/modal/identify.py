@@ -535,8 +535,9 @@ def _final_models(
     base: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet] = (*modes.all(), modes)
     for kind in kinds:
         extra_warn: list[str] = []
+        thresholds = None
         if kind == "complex":
-            res, cur, dropped = final_complex(
+            res, cur, dropped, thresholds = final_complex(
                 problem,
                 fitters.cfit,
                 modes,
@@ -568,6 +569,7 @@ def _final_models(
             kept=kept,
             rejected=tuple(rej),
             method=ctx["method"],
+            thresholds=thresholds,
         )
         models[kind], disc[kind] = to_model(res, n_band, c)
     return models, disc

@@ -320,9 +320,12 @@ class ModalModel:
             )
             if self.quality is not None:
                 t = float(self.quality.statistic[n])
+                h = float(self.quality.thresholds[n])
                 modes[-1]["test"] = {
                     "statistic": t if np.isfinite(t) else None,
-                    "threshold": self.quality.threshold,
+                    # the threshold applied to this mode; the base one beside it
+                    "threshold": h if np.isfinite(h) else None,
+                    "base_threshold": self.quality.threshold,
                     "kept": self.quality.kept[n],
                 }
         return {

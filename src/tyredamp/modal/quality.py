@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import InputError
 
-__all__ = ["FitQuality", "RejectedMode"]
+__all__ = ["FitQuality", "RejectedMode", "threshold_text"]
 
 
 def _ro(x: ArrayLike, dtype: type = float) -> NDArray[Any]:
@@ -61,6 +61,15 @@ class RejectedMode:
         )
 
 
+def threshold_text(thr: float, base: float) -> str:
+    """A mode's threshold ``thr`` for a reason text; says when the noise along the
+    response raised it above the base threshold ``base``
+    (:func:`~tyredamp.modal.search.local_thresholds`)."""
+    if thr > base:
+        return f"{thr:.3g} (raised from {base:.3g}: noise along the response)"
+    return f"{thr:.3g}"
+
+
 def _num(x: float) -> float | None:
     return float(x) if np.isfinite(x) else None
 
@@ -98,7 +107,7 @@ class FitQuality:
         Mode statistic ``T`` of each mode (cost rise in units of the noise
         variance when the mode is removed; read-only).
     threshold : float
-        Threshold of ``T`` (:func:`tyredamp.modal.stats.mode_threshold`).
+        Base threshold of ``T`` (:func:`tyredamp.modal.stats.mode_threshold`).
     false_alarm : float
         Level of the mode test and of the goodness-of-fit test.
     kept : tuple of str
@@ -109,6 +118,13 @@ class FitQuality:
         Refinement status (``"converged"``, ``"maxfev"``, ``"lsfd"``).
     n_evaluations : int
         Cost evaluations of the refinement.
+    thresholds : ndarray, shape (m,)
+        The threshold applied to each mode's ``T`` (read-only): ``threshold``
+        raised where the residual's noise lies along the response
+        (:func:`tyredamp.modal.search.local_thresholds`), ``threshold`` itself
+        where it was not raised or no test was made (modes asked for, real
+        modes). Default (empty): ``threshold`` for every mode, as in records
+        written before it existed.
     """
 
     rmsd: float
@@ -129,6 +145,7 @@ class FitQuality:
     rejected: tuple[RejectedMode, ...] = ()
     status: str = ""
     n_evaluations: int = 0
+    thresholds: NDArray[np.float64] = field(default_factory=lambda: np.empty(0))
 
     def __post_init__(self) -> None:
         for name in ("rmsd_per_frf", "noise_rms_per_output", "statistic"):
@@ -137,6 +154,14 @@ class FitQuality:
             raise InputError(
                 f"kept: expected one reason per mode ({self.statistic.size}), got {len(self.kept)}"
             )
+        thr = np.asarray(self.thresholds, dtype=float).ravel()
+        if thr.size == 0:
+            thr = np.full(self.statistic.size, float(self.threshold))
+        if thr.size != self.statistic.size:
+            raise InputError(
+                f"thresholds: expected one per mode ({self.statistic.size}), got {thr.size}"
+            )
+        object.__setattr__(self, "thresholds", _ro(thr))
         object.__setattr__(self, "kept", tuple(self.kept))
         object.__setattr__(self, "rejected", tuple(self.rejected))
 
@@ -146,6 +171,7 @@ class FitQuality:
             **{
                 **self.__dict__,
                 "statistic": self.statistic[order],
+                "thresholds": self.thresholds[order],
                 "kept": tuple(self.kept[int(i)] for i in order),
             }
         )
@@ -166,6 +192,7 @@ class FitQuality:
             "verdict": self.verdict,
             "statistic": [_num(float(x)) for x in self.statistic],
             "threshold": _num(self.threshold),
+            "thresholds": [_num(float(x)) for x in self.thresholds],
             "false_alarm": self.false_alarm,
             "kept": list(self.kept),
             "rejected": [r.to_dict() for r in self.rejected],
@@ -196,6 +223,8 @@ class FitQuality:
                 rejected=tuple(RejectedMode.from_dict(r) for r in d.get("rejected", [])),
                 status=str(d.get("status", "")),
                 n_evaluations=int(d.get("n_evaluations", 0)),
+                # files written before the per-mode thresholds: the base one for each
+                thresholds=np.array([_flt(x) for x in d.get("thresholds") or []], float),
             )
         except KeyError as exc:
             raise InputError(f"fit quality: missing key {exc.args[0]!r}") from None

@@ -38,7 +38,7 @@ from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
 from ._basis import residual_power
 from .fit import FitResult, ModalFitter
-from .quality import RejectedMode
+from .quality import RejectedMode, threshold_text
 from .span_noise import SpanNoise, span_noise
 from .stats import FALSE_ALARM, span_threshold
 
@@ -464,7 +464,7 @@ def reject_by_test(
         why = (
             f"contribution {con[worst]:.2%} < {min_contribution:.2%}"
             if con[worst] < min_contribution
-            else f"not significant: T = {t[worst]:.3g} <= {_thr_text(thr[worst], threshold)}"
+            else f"not significant: T = {t[worst]:.3g} <= {threshold_text(thr[worst], threshold)}"
         )
         out.append(rejected(complex(cur.poles[worst]), why, float(t[worst]), float(thr[worst])))
         cur = ModeSet(
@@ -479,13 +479,6 @@ def reject_by_test(
         p0, l0 = cur.all()
         res = fitter.fit(p0, l0, refine=False, passes=1, uncertainty=False)
     return res, cur, out
-
-
-def _thr_text(thr: float, base: float) -> str:
-    """A threshold for a reason; says when the noise along the response raised it."""
-    if thr > base:
-        return f"{thr:.3g} (raised from {base:.3g}: noise along the response)"
-    return f"{thr:.3g}"
 
 
 def _residual_peaks(
@@ -649,7 +642,7 @@ def _joint(
             return rejected(
                 p_t,
                 f"not significant with all modes refitted: T = {t_k:.3g} <= "
-                f"{_thr_text(thr_k, threshold)}",
+                f"{threshold_text(thr_k, threshold)}",
                 t_k,
                 thr_k,
             )
