@@ -112,14 +112,14 @@ def _extra_ss(
 
 
 def _gram_chol(
-    g: NDArray[np.float64],
+    g: NDArray[np.float64], max_cond: float | None = None
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
     """Cholesky factor of a Gram matrix with unit diagonal scaling, or None.
 
     ``g = Phi^T Phi``: returns ``rs`` (upper) and ``d`` with ``g = diag(d) rs^T rs
     diag(d)`` (so ``Phi = Q R`` with ``R = rs diag(d)``), or None when a column
     vanishes, the factorisation fails or the condition estimate of ``rs^T rs``
-    exceeds ``_MAX_GRAM_COND``.
+    exceeds ``max_cond`` (None: ``_MAX_GRAM_COND``, read at the call).
     """
     dg = g.diagonal()
     if g.shape[0] == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):  # NaN: False
@@ -130,7 +130,8 @@ def _gram_chol(
     if info != 0:
         return None
     rcond, info = lapack.dpocon(rs, float(abs(gs).sum(axis=0).max()))
-    if info != 0 or not rcond * _MAX_GRAM_COND >= 1.0:
+    limit = _MAX_GRAM_COND if max_cond is None else max_cond
+    if info != 0 or not rcond * limit >= 1.0:
         return None
     return rs, d
 
@@ -259,17 +260,10 @@ def _cqr2_factor(
     """CholeskyQR2 of ``Phi`` (rows ``phi``, Gram matrix ``g``): ``R_1``, ``R_2``, ``D``
     and ``Q_1 = Phi D^-1 R_1^-1`` (:func:`_cholqr2`), or None when the condition
     estimate of ``D^-1 g D^-1`` exceeds :data:`_MAX_CQR2_COND` or a factorisation fails."""
-    dg = g.diagonal()
-    if g.shape[0] == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):
+    fac = _gram_chol(g, _MAX_CQR2_COND)
+    if fac is None:
         return None
-    d = np.sqrt(dg)
-    gs = g / np.multiply.outer(d, d)
-    r1, info = lapack.dpotrf(gs, lower=0, clean=1)
-    if info != 0:
-        return None
-    rcond, info = lapack.dpocon(r1, float(abs(gs).sum(axis=0).max()))
-    if info != 0 or not rcond * _MAX_CQR2_COND >= 1.0:
-        return None
+    r1, d = fac
     q1 = blas.dtrsm(1.0, r1, phi / d, side=1, lower=0)  # Phi D^-1 R_1^-1
     r2, info = lapack.dpotrf(q1.T @ q1, lower=0, clean=1)
     if info != 0:
