@@ -204,3 +204,26 @@ def shape_std(
         cross += sign * part_
     term2 = 2 * np.real(np.conj(b)[None, :] / w[:, None] * u * cross)
     return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))
+
+
+def pole_std(
+    w_ref: float, th: NDArray[np.float64], m: int, cth: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128]]:
+    """Standard errors of f (Hz), zeta and the pole (rad/s) of the ``m`` modes by the
+    delta method from the covariance ``cth`` of the parameters ``th`` (poles first:
+    ``sigma = w_ref exp(x1)``, ``Omega = w_ref x2``, the pole parametrisation of
+    :class:`~tyredamp.modal.fit.ModalFitter`)."""
+    ar = np.arange(m)
+    sig = w_ref * np.exp(th[0 : 2 * m : 2])
+    om = w_ref * th[1 : 2 * m : 2]
+    mag = np.hypot(sig, om)
+    v11 = cth[2 * ar, 2 * ar]
+    v22 = cth[2 * ar + 1, 2 * ar + 1]
+    v12 = cth[2 * ar, 2 * ar + 1]
+    # d|p|/dx1 = sig^2 / |p|, d|p|/dx2 = w_ref om / |p|; zeta = sig / |p|
+    a1, a2 = sig * sig / mag / (2 * np.pi), w_ref * om / mag / (2 * np.pi)
+    z1, z2 = om**2 * sig / mag**3, -sig * om * w_ref / mag**3
+    var_f = a1 * a1 * v11 + 2 * a1 * a2 * v12 + a2 * a2 * v22
+    var_z = z1 * z1 * v11 + 2 * z1 * z2 * v12 + z2 * z2 * v22
+    std_p = np.sqrt(np.maximum(v11, 0)) * sig + 1j * np.sqrt(np.maximum(v22, 0)) * w_ref
+    return np.sqrt(np.maximum(var_f, 0.0)), np.sqrt(np.maximum(var_z, 0.0)), std_p

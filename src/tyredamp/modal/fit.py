@@ -662,30 +662,13 @@ class ModalFitter:
         Gauss-Newton covariance ``s^2 (J^T J)^-1`` at the optimum and the delta method."""
         b, u, didx = shapes
         n_par = th.size
-        poles = self.unpack(th, m, ref)[0]
         nan = np.full(m, np.nan)
         std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
         std_psi = np.full((self.n_out, m), np.nan)
         if uncertainty:
             jtj = sol["jtj"] if "jtj" in sol else self._normal(sol, n_par)[0]
             cth = s2 * np.linalg.pinv(jtj, hermitian=True)
-            x1 = th[0 : 2 * m : 2]
-            sig = self.w_ref * np.exp(x1)
-            om = poles.imag
-            mag = np.abs(poles)
-            jf = np.zeros((m, n_par))
-            jz = np.zeros((m, n_par))
-            ar = np.arange(m)
-            jf[ar, 2 * ar] = (sig / mag) * sig / (2 * np.pi)
-            jf[ar, 2 * ar + 1] = (om / mag) * self.w_ref / (2 * np.pi)
-            jz[ar, 2 * ar] = (om**2 / mag**3) * sig
-            jz[ar, 2 * ar + 1] = (-sig * om / mag**3) * self.w_ref
-            std_f = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jf, cth, jf), 0.0))
-            std_z = np.sqrt(np.maximum(np.einsum("ni,ij,nj->n", jz, cth, jz), 0.0))
-            std_pole = (
-                np.sqrt(np.maximum(cth[2 * ar, 2 * ar], 0)) * sig
-                + 1j * np.sqrt(np.maximum(cth[2 * ar + 1, 2 * ar + 1], 0)) * self.w_ref
-            )
+            std_f, std_z, std_pole = _scaling.pole_std(self.w_ref, th, m, cth)
             std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
         return std_f, std_z, std_pole, std_psi
 

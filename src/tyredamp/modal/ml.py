@@ -52,6 +52,7 @@ from scipy import sparse
 from scipy.linalg import solve_triangular
 
 from ._linalg import _levenberg_marquardt
+from ._scaling import pole_std
 from .fit import FitResult, ModalFitter
 
 __all__ = ["fisher_scale", "line_weights_full", "ml_refine"]
@@ -126,27 +127,6 @@ def _evaluate(
         jtj += M.T @ M - qm.T @ qm
         jtr -= M.T @ r
     return cost, 0.5 * (jtj + jtj.T), jtr, {"C": C, "phi": phi, "jtj": jtj}
-
-
-def _pole_se(
-    fitter: ModalFitter, th: NDArray[np.float64], m: int, cth: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128]]:
-    """Standard errors of f (Hz), zeta and the pole by the delta method
-    (``sigma = w_ref exp(x1)``, ``Omega = w_ref x2``; as :class:`ModalFitter`)."""
-    ar = np.arange(m)
-    sig = fitter.w_ref * np.exp(th[0 : 2 * m : 2])
-    om = fitter.w_ref * th[1 : 2 * m : 2]
-    mag = np.hypot(sig, om)
-    v11 = cth[2 * ar, 2 * ar]
-    v22 = cth[2 * ar + 1, 2 * ar + 1]
-    v12 = cth[2 * ar, 2 * ar + 1]
-    # d|p|/dx1 = sig^2 / |p|, d|p|/dx2 = w_ref om / |p|; zeta = sig / |p|
-    a1, a2 = sig * sig / mag / (2 * np.pi), fitter.w_ref * om / mag / (2 * np.pi)
-    z1, z2 = om**2 * sig / mag**3, -sig * om * fitter.w_ref / mag**3
-    var_f = a1 * a1 * v11 + 2 * a1 * a2 * v12 + a2 * a2 * v22
-    var_z = z1 * z1 * v11 + 2 * z1 * z2 * v12 + z2 * z2 * v22
-    std_p = np.sqrt(np.maximum(v11, 0)) * sig + 1j * np.sqrt(np.maximum(v22, 0)) * fitter.w_ref
-    return np.sqrt(np.maximum(var_f, 0.0)), np.sqrt(np.maximum(var_z, 0.0)), std_p
 
 
 def ml_refine(
@@ -247,7 +227,7 @@ def _as_result(
     if didx.size:
         kin = np.array([k for _, k in fitter.drive], dtype=np.intp)
         phi2 = np.mean(2j * poles.imag[None, :] * psi_out[didx] * psi_in[kin], axis=0)
-    std_f, std_z, std_p = _pole_se(fitter, th, m, cth)
+    std_f, std_z, std_p = pole_std(fitter.w_ref, th, m, cth)
     status = "maximum likelihood" + ("" if ok else " (evaluation limit)")
     return dataclasses.replace(
         res,
