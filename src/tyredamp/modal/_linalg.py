@@ -211,17 +211,8 @@ def _vp_solve(
         ct2 = (Ct * Ct).sum(axis=0)
         cost_out = yy - ct2
         if not (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
-            return {
-                "R": rs * d[None, :],
-                "C": lapack.dtrtrs(rs, Ct)[0] / d[:, None],
-                "Ct": Ct,
-                "QtE": QtE,
-                "GE": G[q:, q:] - QtE.T @ QtE,
-                "Etr": P[q:] - QtE.T @ Ct if gradient else None,
-                "cost": float(cost_out.sum()),
-                "cost_out": cost_out,
-                "qr": False,
-            }
+            R, C = rs * d[None, :], lapack.dtrtrs(rs, Ct)[0] / d[:, None]
+            return _gram_solution(G, P, q, (R, C, Ct, QtE), cost_out, gradient, qr=False)
     if fac is None and not residual and one is not None:
         got = _cholqr2(G, P, q, yy, one, gradient=gradient, cancel=cancel)
         if got is not None:
@@ -311,16 +302,34 @@ def _cholqr2(
     if (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
         return None
     c = lapack.dtrtrs(r1, lapack.dtrtrs(r2, Ct)[0])[0] / d[:, None]  # R C = Q^T Y
+    R = (r2 @ r1) * d[None, :]
+    return _gram_solution(G, P, q, (R, c, Ct, QtE), cost_out, gradient, qr=True)
+
+
+def _gram_solution(
+    G: NDArray[np.float64],
+    P: NDArray[np.float64],
+    q: int,
+    factors: tuple[NDArray[np.float64], ...],
+    cost_out: NDArray[np.float64],
+    gradient: bool,
+    *,
+    qr: bool,
+) -> dict[str, Any]:
+    """The projection of :func:`_vp_solve` from ``R``, ``C``, ``Ct = Q^T Y`` and
+    ``QtE = Q^T E`` of a route that has the Gram blocks ``G = [Phi E]^T [Phi E]`` and
+    ``P = [Phi E]^T Y``: ``E^T (I - Q Q^T) E`` and ``E^T r`` follow from them."""
+    R, C, Ct, QtE = factors
     return {
-        "R": (r2 @ r1) * d[None, :],
-        "C": c,
+        "R": R,
+        "C": C,
         "Ct": Ct,
         "QtE": QtE,
         "GE": G[q:, q:] - QtE.T @ QtE,
         "Etr": P[q:] - QtE.T @ Ct if gradient else None,
         "cost": float(cost_out.sum()),
         "cost_out": cost_out,
-        "qr": True,
+        "qr": qr,
     }
 
 
