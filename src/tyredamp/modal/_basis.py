@@ -237,23 +237,35 @@ def residual_blocks(
 ) -> Iterator[tuple[slice, NDArray[np.complex128]]]:
     """The weighted residual ``H - H^`` (line weights applied), (n_out, n_in, lines),
     block by block with its lines (arguments as :func:`residual_power`)."""
+    for sl in blocks(fitter, 2 * poles.size + 2 * fitter.n_in):
+        yield sl, residual_lines(fitter, poles, residues, terms, sl)
+
+
+def residual_lines(
+    fitter: Any,
+    poles: NDArray[np.complex128],
+    residues: NDArray[np.complex128],
+    terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    sl: slice,
+) -> NDArray[np.complex128]:
+    """The weighted residual ``H - H^`` of the lines ``sl`` (arguments as
+    :func:`residual_power`), (n_out, n_in, lines)."""
     n_out, n_in, m = residues.shape
     # the modes' terms of every FRF as one product: [R | conj R] (n_out n_in, 2 m)
     # times the columns kappa / (s - p_n), kappa / (s - conj p_n) (2 m, lines)
-    rr = np.concatenate([residues, np.conj(residues)], axis=2).reshape(n_out * n_in, 2 * m)
-    pp = np.concatenate([poles, np.conj(poles)])[:, None]
-    for sl in blocks(fitter, 2 * poles.size + 2 * fitter.n_in):
-        s, kap, kap_low = factors(fitter, sl)
-        h = fitter.H[:, :, sl]
-        e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
-        if m:
-            e -= (rr @ (kap / (s - pp))).reshape(e.shape)
-        upper, lower = terms
-        if upper is not None:
-            e -= upper[:, :, None] * kap
-        if lower is not None:
-            e -= lower[:, :, None] * kap_low
-        yield sl, e
+    s, kap, kap_low = factors(fitter, sl)
+    h = fitter.H[:, :, sl]
+    e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
+    if m:
+        rr = np.concatenate([residues, np.conj(residues)], axis=2).reshape(n_out * n_in, 2 * m)
+        pp = np.concatenate([poles, np.conj(poles)])[:, None]
+        e -= (rr @ (kap / (s - pp))).reshape(e.shape)
+    upper, lower = terms
+    if upper is not None:
+        e -= upper[:, :, None] * kap
+    if lower is not None:
+        e -= lower[:, :, None] * kap_low
+    return e
 
 
 def basis_ek(

@@ -163,9 +163,11 @@ def settle_order(
     automatic: bool,
 ) -> Diagram:
     """Diagram of the automatic order (sizing rule and trial raises, up to
-    :func:`order_cap` of the modes the data show), or of ``p_start``."""
+    :func:`order_cap` of the modes the data show, or to :func:`order_limit`
+    when no mode is stable at that cap), or of ``p_start``."""
     n_in = problem.shape[1]
-    limit = order_limit(n_in, problem.shape[2])
+    full = order_limit(n_in, problem.shape[2])
+    limit = full
     if automatic:
         limit = min(limit, order_cap(n_in, problem.shape[2], p_start, modes_shown(problem)))
     cur = diagram(problem, estimator, p_start, rules)
@@ -175,7 +177,8 @@ def settle_order(
         if trial is not None:
             prev, trial = trial, None
             if len(cur.kept) <= len(prev.kept) or share <= prev.persistent_share():
-                return prev
+                cur = prev
+                break
         # sizing: the highest order must give at least 2 poles per pole needed
         # (kept modes + 2 for residual effects, conjugates counted)
         need = 2 * 2 * (len(cur.kept) + 2)
@@ -191,4 +194,8 @@ def settle_order(
         else:
             break
         cur = diagram(problem, estimator, p, rules)
+    while automatic and not cur.kept and cur.order < full:
+        # the peaks counted in noisy data are a lower bound of the modes: no
+        # stable mode up to the cap doubles the order up to the line limit
+        cur = diagram(problem, estimator, min(full, 2 * cur.order), rules)
     return cur

@@ -36,9 +36,9 @@ from numpy.typing import NDArray
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
-from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode, threshold_text
+from .residual_peaks import residual_peaks_of, room, scan_of
 from .span_noise import SpanNoise, span_noise
 from .stats import FALSE_ALARM, span_threshold
 
@@ -82,6 +82,8 @@ TRIAL_NFEV = 30
 #: mode (a band missing many modes adds a few per round), MAX_ROUNDS only bounds them
 MAX_TRIALS = 12
 MAX_ROUNDS = 50
+#: times a trial stopped at its window's limit is continued beyond it (_follow)
+FOLLOW = 3
 
 
 @dataclass
@@ -481,51 +483,6 @@ def reject_by_test(
     return res, cur, out
 
 
-def _residual_peaks(
-    fitter: ModalFitter, res: FitResult, n_max: int, threshold: float
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Frequencies (Hz) of the largest peaks of the residual power per line.
-
-    The residual of the fit (weighted as the fit weights it) is summed over
-    the FRFs in units of each output's noise variance and smoothed over 5
-    lines; its local maxima, largest first. Also returns the residual power
-    per line above its median (the excess a missed mode could explain).
-    """
-    # u l = R (u unscaled without drive points, or scaled); summed block by block
-    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
-    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    pw = residual_power(fitter, res.poles, residues, (res.upper, res.lower), s2)
-    k = min(5, pw.size)
-    sm = np.convolve(pw, np.ones(k) / k, mode="same")
-    if sm.size < 3:
-        return np.zeros(0), pw - np.median(pw)
-    peak = np.flatnonzero((sm[1:-1] > sm[:-2]) & (sm[1:-1] >= sm[2:])) + 1
-    # a missed mode explains at least the residual power it leaves above the noise
-    # level: peaks whose excess over the median within the window is below a
-    # quarter of the test's threshold cannot hold a significant mode
-    excess = k * (sm[peak] - np.median(sm))
-    peak = peak[excess > 0.25 * threshold]
-    # largest first; a peak within 1 % of a larger one is the same structure
-    out: list[float] = []
-    for i in peak[np.argsort(-sm[peak])]:
-        fi = float(fitter.f[i])
-        if all(abs(fi - g) > 0.01 * g for g in out):
-            out.append(fi)
-        if len(out) >= n_max:
-            break
-    return np.asarray(out), pw - np.median(pw)
-
-
-def _room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> float:
-    """Residual power above the noise (units of the noise variance) within the
-    half-power band ``+-2 zeta f`` of a candidate pole ``p`` (at least 5 lines)."""
-    fc = abs(p.imag) / (2 * np.pi)
-    z = -p.real / max(abs(p), 1e-300)
-    half = max(2 * z * fc, 2.5 * (f[-1] - f[0]) / max(f.size - 1, 1))
-    sel = (f >= fc - half) & (f <= fc + half)
-    return float(np.sum(excess[sel]))
-
-
 def _inadmissible(p: complex, df: float, max_damping: float) -> str:
     """Why the pole ``p`` cannot be an in-band mode of the search ('' if it can):
     narrower than the line spacing ``df`` (Hz), or damped beyond ``max_damping``
@@ -655,6 +612,43 @@ TOWARD_CROSSED = (
 )
 
 
+def _follow(
+    fitter: ModalFitter,
+    res: FitResult,
+    cur: ModeSet,
+    fixed: FixedParts,
+    start: tuple[complex, NDArray[np.complex128]],
+    w_lim: tuple[float, float],
+    band: tuple[float, float],
+) -> tuple[tuple[complex, NDArray[np.complex128], float], tuple[float, float]] | None:
+    """A trial (:func:`_trial`) that follows its pole out of its window: one that
+    stopped at a limit inside the band runs toward structure beyond it, and is
+    continued from there in a window centred on it (at most ``FOLLOW`` times),
+    unless that brings it within ``2 MERGE`` of a current mode. Returns the
+    trial's last result and window."""
+    got = _trial(fitter, res, cur, fixed, start[0], start[1], w_lim, strict=False)
+    w_band = (2 * np.pi * band[0], 2 * np.pi * band[1])
+    for _ in range(FOLLOW):
+        if got is None:
+            return None
+        p_t, l_t, _ = got
+        side = _toward(p_t, w_lim)
+        edge = w_lim[1] if side > 0 else w_lim[0]
+        if side == 0 or not w_band[0] < edge < w_band[1]:
+            break
+        if cur.m and np.min(np.abs(cur.poles - p_t)) < 2 * MERGE * abs(p_t):
+            break
+        w_new = (
+            max(abs(p_t.imag) * (1 - TRIAL_SPAN), w_band[0]),
+            min(abs(p_t.imag) * (1 + TRIAL_SPAN), w_band[1]),
+        )
+        nxt = _trial(fitter, res, cur, fixed, p_t, l_t, w_new, strict=False)
+        if nxt is None or nxt[2] <= got[2]:
+            break
+        got, w_lim = nxt, w_new
+    return (got, w_lim) if got is not None else None
+
+
 def _toward(p: complex, w_lim: tuple[float, float]) -> int:
     """The side (+1 up, -1 down, 0 none) of the window ``w_lim`` (rad/s) at whose
     limit a trial pole ``p`` stopped: it found no optimum inside its window and
@@ -713,18 +707,25 @@ def residual_search(
     refused: list[complex] = []  # trial modes whose joint refit failed (current modes)
     crossed: set[int] = set()  # sides of the band trial modes crossed to (current modes)
     fixed = FixedParts(fitter) if fixed is None else fixed
+    scanned = False  # the coherent scan ran on the current modes
     for _ in range(MAX_ROUNDS):
-        # the residual's peaks first (where the structure is), then the diagram's
+        # the residual's peaks first (where the structure is), then the diagram's;
+        # when they add nothing, the coherent scan's poles (one round per mode set)
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
-        peaks, excess = _residual_peaks(fitter, res, MAX_TRIALS, threshold)
-        for fpk in peaks:
+        found = residual_peaks_of(fitter, res, MAX_TRIALS, threshold, zeta0)
+        if scanned is None:
+            starts = [
+                (p, np.ones(fitter.n_in, complex)) for p in scan_of(fitter, res, threshold, zeta0)
+            ]
+            scanned = True
+        for fpk in found.freq if not starts else ():
             w = 2 * np.pi * fpk
             starts.append(
                 (complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), np.ones(fitter.n_in, complex))
             )
         # a diagram candidate can explain at most the residual power above the noise
         # within its half-power band (+-2 zeta f): skipped when that cannot pass
-        starts += [c for c in pending if _room(fitter.f, excess, c[0]) > 0.25 * threshold]
+        starts += [c for c in pending if room(fitter.f, found.excess, c[0]) > 0.25 * threshold]
         pending = []
         added = False
         n_tried = 0
@@ -742,10 +743,10 @@ def residual_search(
             )
             if not w_lim[0] < w_lim[1]:
                 continue
-            got = _trial(fitter, res, cur, fixed, p0, np.asarray(l0, complex), w_lim, strict=False)
+            got = _follow(fitter, res, cur, fixed, (p0, np.asarray(l0, complex)), w_lim, band)
             if got is None:
                 continue
-            p_t, l_t, t = got
+            (p_t, l_t, t), w_lim = got
             why = _inadmissible(p_t, df, max_damping)
             if not why and t <= threshold:
                 why = f"not significant: T = {t:.3g} <= {threshold:.3g}"
@@ -765,7 +766,9 @@ def residual_search(
             if got1 is None:
                 continue
             res, cur = got1
-            added, refused, crossed = True, [], set()
+            added, refused, crossed, scanned = True, [], set(), False
         if not added:
-            break
+            if scanned:
+                break
+            scanned = None  # type: ignore[assignment]
     return res, cur, tried

@@ -1,0 +1,274 @@
+"""Where a fit's residual holds structure a missed mode could explain.
+
+The residual search (:func:`~tyredamp.modal.search.residual_search`) starts
+trial modes at the peaks of the residual power per line, summed over the FRFs
+in units of each output's noise variance (a mode indicator on the residual).
+A missed mode of damping ratio ``zeta`` at ``f`` leaves its residual power
+spread over its half-power band ``f +- zeta f``, which holds one line or a
+hundred depending on the damping and the line spacing. So the excess over
+the noise is summed over windows matched to half-power bands of several
+damping ratios (a matched filter per scale, its width proportional to the
+frequency), and a line is a candidate when one of these sums stands out of
+the noise's own scatter and could hold a mode that passes the test: the cost
+drop of a mode fitted there is at least the excess within its band (the mode
+test's statistic ``T``, :mod:`tyredamp.modal.stats`).
+
+The noise level of a line is the mean of the residual power under noise,
+estimated robustly from its median: the residual power of a line is a sum of
+``K`` squared complex residuals in units of their variance, about
+``chi2(2K) / 2`` under noise, whose median lies below its mean (0.69 of it for
+``K = 1``); the median is scaled by that ratio so that sums over wide windows
+carry no bias.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import stats as sps
+
+from ._basis import factors, residual_lines, residual_power
+from .fit import FitResult, ModalFitter
+
+__all__ = [
+    "ResidualPeaks",
+    "coherent_scan",
+    "residual_peaks",
+    "residual_peaks_of",
+    "room",
+    "scan_of",
+]
+
+#: damping ratios of the windows, relative to the typical damping of the modes
+SCALES = (0.25, 0.5, 1.0, 2.0, 4.0)
+#: narrowest window (lines either side of the centre)
+MIN_HALF = 2
+#: a window's excess must stand this many of its noise standard deviations out
+Z_NOISE = 3.0
+#: and be at least this share of the mode test's threshold (a mode fitted there
+#: lowers the cost by more than the excess in its band, so a generous screen)
+SHARE = 0.25
+
+
+class ResidualPeaks:
+    """Candidate frequencies (Hz), best first, and the residual's excess over the
+    noise per line (units of the noise variance) for :func:`room`."""
+
+    def __init__(self, freq: NDArray[np.float64], excess: NDArray[np.float64]) -> None:
+        self.freq = freq
+        self.excess = excess
+
+
+def noise_mean(pw: NDArray[np.float64], k_terms: int) -> float:
+    """Mean residual power per line under noise from the median of ``pw``, whose
+    lines are ``chi2(2 k_terms) / 2`` distributed (up to a scale) under noise."""
+    k2 = 2 * max(int(k_terms), 1)
+    ratio = k2 / float(sps.chi2.ppf(0.5, k2))
+    return float(np.median(pw)) * ratio
+
+
+def _window_sums(
+    c: NDArray[np.float64], half: NDArray[np.intp]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Sums of the series whose cumulative sum (with a leading 0) is ``c`` over
+    ``[i - half_i, i + half_i]`` (clipped to the lines), and the window lengths."""
+    n = c.size - 1
+    i = np.arange(n)
+    a = np.clip(i - half, 0, n)
+    b = np.clip(i + half + 1, 0, n)
+    return c[b] - c[a], (b - a).astype(np.float64)
+
+
+def residual_peaks(
+    f: NDArray[np.float64],
+    pw: NDArray[np.float64],
+    k_terms: int,
+    zeta0: float,
+    threshold: float,
+    n_max: int,
+) -> ResidualPeaks:
+    """The lines where a missed mode could sit, best first (module docstring).
+
+    ``f`` (n,) the lines (Hz, uniform or not), ``pw`` (n,) the residual power
+    per line in units of the noise variance summed over ``k_terms`` FRFs,
+    ``zeta0`` the typical damping ratio of the modes, ``threshold`` the mode
+    test's. A line is a candidate when, for one of the window scales, it is a
+    local maximum of the window's standardised excess, that excess exceeds
+    ``Z_NOISE`` noise standard deviations and ``SHARE * threshold``; peaks
+    within 1 % of a better one are the same structure. At most ``n_max``.
+    """
+    f = np.asarray(f, dtype=np.float64)
+    pw = np.asarray(pw, dtype=np.float64)
+    if pw.size < 3:
+        return ResidualPeaks(np.zeros(0), pw - np.median(pw) if pw.size else pw)
+    mu = noise_mean(pw, k_terms)
+    ex = pw - mu
+    # the noise variance of one line's power, robustly: var of chi2(2K)/2 scaled as mu
+    var_line = mu**2 / max(int(k_terms), 1)
+    c = np.concatenate([[0.0], np.cumsum(ex)])
+    dfl = np.gradient(f) if f.size > 1 else np.ones(1)
+    score = np.full(pw.size, -np.inf)
+    for s in SCALES:
+        half = np.maximum(np.round(s * zeta0 * f / np.maximum(dfl, 1e-300)), MIN_HALF)
+        e, n = _window_sums(c, half.astype(np.intp))
+        z = e / np.sqrt(n * var_line)
+        ok = (z > Z_NOISE) & (e > SHARE * threshold)
+        zz = np.where(ok, z, -np.inf)
+        better = zz > score
+        score[better] = zz[better]
+    fin = np.isfinite(score)
+    if not np.any(fin):
+        return ResidualPeaks(np.zeros(0), ex)
+    sc = np.where(fin, score, -1e300)
+    left = np.concatenate([[-np.inf], sc[:-1]])
+    right = np.concatenate([sc[1:], [-np.inf]])
+    peak = np.flatnonzero(fin & (sc > left) & (sc >= right))
+    out: list[float] = []
+    for i in peak[np.argsort(-sc[peak])]:
+        fi = float(f[i])
+        if all(abs(fi - g) > 0.01 * g for g in out):
+            out.append(fi)
+        if len(out) >= n_max:
+            break
+    return ResidualPeaks(np.asarray(out), ex)
+
+
+def room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> float:
+    """Residual power above the noise (units of the noise variance) within the
+    half-power band ``+-2 zeta f`` of a candidate pole ``p`` (at least 5 lines)."""
+    fc = abs(p.imag) / (2 * np.pi)
+    z = -p.real / max(abs(p), 1e-300)
+    half = max(2 * z * fc, 2.5 * (f[-1] - f[0]) / max(f.size - 1, 1))
+    sel = (f >= fc - half) & (f <= fc + half)
+    return float(np.sum(excess[sel]))
+
+
+#: damping ratios of the coherent scan's trial poles, relative to the modes' typical
+SCAN_SCALES = (1.0 / 3.0, 1.0, 3.0)
+#: half-width of a trial pole's window, in half-power half-widths (``zeta f``):
+#: 92 % of the energy of its resonance lies within it
+SCAN_HALF = 8.0
+#: a grid point is a candidate when its statistic reaches this share of the threshold
+SCAN_SHARE = 0.7
+#: complex entries of one chunk's window matrix (memory bound of the scan)
+SCAN_ENTRIES = 1 << 21
+
+
+def _scan_statistic(
+    e: NDArray[np.complex128], a: NDArray[np.complex128], n_in: int
+) -> NDArray[np.float64]:
+    """Rank-one statistic of each window column ``a`` (G, L) against the
+    residual ``e`` (n_out, n_in, L): the largest squared singular value of
+    ``<a, e_jk> / ||a||`` over outputs x inputs."""
+    nrm = np.sqrt(np.sum(a.real**2 + a.imag**2, axis=1))
+    g = a.shape[0]
+    n_out = e.shape[0]
+    m = (e.reshape(-1, e.shape[-1]) @ a.conj().T) / np.maximum(nrm, 1e-300)  # (K, G)
+    mg = m.T.reshape(g, n_out, n_in)
+    if n_in == 1:
+        return np.asarray(np.sum(mg.real**2 + mg.imag**2, axis=(1, 2)))
+    return np.asarray(np.linalg.svd(mg, compute_uv=False)[:, 0] ** 2)
+
+
+def coherent_scan(
+    fitter: object,
+    model: tuple[
+        NDArray[np.complex128],
+        NDArray[np.complex128],
+        tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    ],
+    s2: NDArray[np.float64],
+    zeta0: float,
+    threshold: float,
+    n_max: int,
+) -> list[complex]:
+    """Trial poles where the residual holds a resonance coherent across the FRFs.
+
+    The residual power per line (:func:`residual_peaks`) sums every FRF's
+    residual incoherently: a mode near the threshold spread over many lines
+    does not stand out of it. This scan is the mode test's own statistic for a
+    pole held at each point of a grid: for a trial pole ``p`` (damping ratio
+    ``zeta``, each of ``SCAN_SCALES`` times ``zeta0``; grid step ``zeta f / 2``,
+    at least a line), the residual of every FRF in units of its output's noise
+    (``s2``) is projected on the pole's column ``kappa / (s - p)`` within
+    ``SCAN_HALF`` half-widths, and the statistic is the largest squared
+    singular value of those projections over outputs x inputs (a rank-one
+    residue ``psi l^T``, as a mode has), the cost drop of a mode held at ``p``
+    with only its dominant term. The local maxima that reach ``SCAN_SHARE``
+    of ``threshold`` are returned as trial poles, largest first, one per 1 %
+    of frequency, at most ``n_max``. ``model`` is the fit's ``(poles,
+    residues (n_out, n_in, m), (upper, lower))``.
+    """
+    fit: Any = fitter
+    f = np.asarray(fit.f, dtype=np.float64)
+    n = f.size
+    if n < 3:
+        return []
+    poles, residues, terms = model
+    inv = 1.0 / np.sqrt(np.maximum(np.asarray(s2, dtype=np.float64), 1e-300))
+    n_in = int(fit.n_in)
+    df = float(np.min(np.diff(f)))
+    found: list[tuple[float, complex]] = []
+    for sc in SCAN_SCALES:
+        z = float(np.clip(sc * zeta0, 1e-4, 0.1))
+        n_g = int(np.log(f[-1] / max(f[0], 1e-300)) / np.log1p(z / 2)) + 2 if f[0] > 0 else n
+        fg = f[0] * (1 + z / 2) ** np.arange(n_g) if f[0] > 0 else f.copy()
+        idx = np.unique(np.clip(np.searchsorted(f, fg[fg <= f[-1]]), 0, n - 1))
+        fg = f[idx]
+        wg = 2 * np.pi * fg
+        pg = -z * wg + 1j * wg * np.sqrt(1 - z * z)
+        half = np.maximum(SCAN_HALF * z * fg, 3 * df)
+        ia = np.searchsorted(f, fg - half)
+        ib = np.searchsorted(f, fg + half, side="right")
+        width = int(np.max(ib - ia))
+        stride = max(1, -(-width // 8192))  # at most 8192 lines per window
+        per = max(1, SCAN_ENTRIES // max(width // stride * 2, 1))
+        t = np.empty(fg.size)
+        for c0 in range(0, fg.size, per):
+            g = slice(c0, c0 + per)
+            la, lb = int(ia[g].min()), int(ib[g].max())
+            sl = slice(la, lb, stride)
+            e = residual_lines(fit, poles, residues, terms, sl) * inv[:, None, None]
+            s, kap, _ = factors(fit, sl)
+            li = np.arange(la, lb, stride)
+            inside = (li[None, :] >= ia[g, None]) & (li[None, :] < ib[g, None])
+            a = np.where(inside, kap[None, :] / (s[None, :] - pg[g, None]), 0.0)
+            t[g] = _scan_statistic(e, a, n_in)
+        ok = t >= SCAN_SHARE * threshold
+        left = np.concatenate([[-np.inf], t[:-1]])
+        right = np.concatenate([t[1:], [-np.inf]])
+        for i in np.flatnonzero(ok & (t > left) & (t >= right)):
+            found.append((float(t[i]), complex(pg[i])))
+    out: list[complex] = []
+    for _, p in sorted(found, key=lambda x: -x[0]):
+        if all(abs(abs(p) - abs(q)) > 0.01 * abs(q) for q in out):
+            out.append(p)
+        if len(out) >= n_max:
+            break
+    return out
+
+
+def residual_peaks_of(
+    fitter: ModalFitter, res: FitResult, n_max: int, threshold: float, zeta0: float
+) -> ResidualPeaks:
+    """Candidate frequencies of missed modes from the fit's residual power per
+    line, summed over the FRFs in units of each output's noise variance and
+    weighted as the fit weights the lines (:func:`residual_peaks`)."""
+    # u l = R (u unscaled without drive points, or scaled); summed block by block
+    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
+    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
+    pw = residual_power(fitter, res.poles, residues, (res.upper, res.lower), s2)
+    k_terms = fitter.n_out * fitter.n_in
+    return residual_peaks(fitter.f, pw, k_terms, zeta0, threshold, n_max)
+
+
+def scan_of(
+    fitter: ModalFitter, res: FitResult, threshold: float, zeta0: float, n_max: int = 12
+) -> list[complex]:
+    """Trial poles of the coherent scan of the fit's residual (:func:`coherent_scan`)."""
+    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
+    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
+    model = (res.poles, residues, (res.upper, res.lower))
+    return coherent_scan(fitter, model, s2, zeta0, threshold, n_max)
