@@ -151,7 +151,7 @@ SCAN_SCALES = (1.0 / 3.0, 1.0, 3.0)
 #: 92 % of the energy of its resonance lies within it
 SCAN_HALF = 8.0
 #: a grid point is a candidate when its statistic reaches this share of the threshold
-SCAN_SHARE = 0.7
+SCAN_SHARE = 0.8
 #: complex entries of one chunk's window matrix (memory bound of the scan)
 SCAN_ENTRIES = 1 << 21
 
@@ -183,7 +183,7 @@ def coherent_scan(
     zeta0: float,
     threshold: float,
     n_max: int,
-) -> list[complex]:
+) -> list[tuple[complex, float]]:
     """Trial poles where the residual holds a resonance coherent across the FRFs.
 
     The residual power per line (:func:`residual_peaks`) sums every FRF's
@@ -210,7 +210,7 @@ def coherent_scan(
     inv = 1.0 / np.sqrt(np.maximum(np.asarray(s2, dtype=np.float64), 1e-300))
     n_in = int(fit.n_in)
     df = float(np.min(np.diff(f)))
-    found: list[tuple[float, complex]] = []
+    found: list[tuple[float, complex]] = []  # (statistic, pole)
     for sc in SCAN_SCALES:
         z = float(np.clip(sc * zeta0, 1e-4, 0.1))
         n_g = int(np.log(f[-1] / max(f[0], 1e-300)) / np.log1p(z / 2)) + 2 if f[0] > 0 else n
@@ -241,10 +241,10 @@ def coherent_scan(
         right = np.concatenate([t[1:], [-np.inf]])
         for i in np.flatnonzero(ok & (t > left) & (t >= right)):
             found.append((float(t[i]), complex(pg[i])))
-    out: list[complex] = []
-    for _, p in sorted(found, key=lambda x: -x[0]):
-        if all(abs(abs(p) - abs(q)) > 0.01 * abs(q) for q in out):
-            out.append(p)
+    out: list[tuple[complex, float]] = []
+    for t_p, p in sorted(found, key=lambda x: -x[0]):
+        if all(abs(abs(p) - abs(q)) > 0.01 * abs(q) for q, _ in out):
+            out.append((p, t_p))
         if len(out) >= n_max:
             break
     return out
@@ -266,7 +266,7 @@ def residual_peaks_of(
 
 def scan_of(
     fitter: ModalFitter, res: FitResult, threshold: float, zeta0: float, n_max: int = 12
-) -> list[complex]:
+) -> list[tuple[complex, float]]:
     """Trial poles of the coherent scan of the fit's residual (:func:`coherent_scan`)."""
     residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
     s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))

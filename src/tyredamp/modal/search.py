@@ -38,7 +38,7 @@ from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode, threshold_text
-from .residual_peaks import residual_peaks_of, room, scan_of
+from .residual_peaks import SCAN_SHARE, residual_peaks_of, room, scan_of
 from .span_noise import SpanNoise, span_noise
 from .stats import FALSE_ALARM, span_threshold
 
@@ -612,6 +612,23 @@ TOWARD_CROSSED = (
 )
 
 
+def _scanned(
+    fitter: ModalFitter, res: FitResult, threshold: float, zeta0: float, test: ModeTest | None
+) -> list[complex]:
+    """The coherent scan's trial poles (:func:`~.residual_peaks.coherent_scan`) whose
+    statistic reaches ``SCAN_SHARE`` of their own threshold, raised where the
+    residual's noise lies along the response (:func:`local_thresholds`): the
+    scan weighs the residual with the separable noise model, under which noise
+    along the response makes maxima of its own (near strong modes of an H1
+    estimate with force noise)."""
+    got = scan_of(fitter, res, threshold, zeta0)
+    if test is None or not got:
+        return [p for p, _ in got]
+    poles = np.array([p for p, _ in got])
+    thr = local_thresholds(fitter, residual_span(fitter, res), poles, threshold, test)
+    return [p for (p, t), h in zip(got, thr, strict=True) if t >= SCAN_SHARE * h]
+
+
 def _follow(
     fitter: ModalFitter,
     res: FitResult,
@@ -623,9 +640,10 @@ def _follow(
 ) -> tuple[tuple[complex, NDArray[np.complex128], float], tuple[float, float]] | None:
     """A trial (:func:`_trial`) that follows its pole out of its window: one that
     stopped at a limit inside the band runs toward structure beyond it, and is
-    continued from there in a window centred on it (at most ``FOLLOW`` times),
-    unless that brings it within ``2 MERGE`` of a current mode. Returns the
-    trial's last result and window."""
+    continued from there in a window centred on it (at most ``FOLLOW`` times,
+    while its statistic grows), unless that window holds a current mode (the
+    pole runs toward that mode's misfit or noise, not toward a missed one).
+    Returns the trial's last result and window."""
     got = _trial(fitter, res, cur, fixed, start[0], start[1], w_lim, strict=False)
     w_band = (2 * np.pi * band[0], 2 * np.pi * band[1])
     for _ in range(FOLLOW):
@@ -636,12 +654,12 @@ def _follow(
         edge = w_lim[1] if side > 0 else w_lim[0]
         if side == 0 or not w_band[0] < edge < w_band[1]:
             break
-        if cur.m and np.min(np.abs(cur.poles - p_t)) < 2 * MERGE * abs(p_t):
-            break
         w_new = (
             max(abs(p_t.imag) * (1 - TRIAL_SPAN), w_band[0]),
             min(abs(p_t.imag) * (1 + TRIAL_SPAN), w_band[1]),
         )
+        if np.any((cur.poles.imag > w_new[0]) & (cur.poles.imag < w_new[1])):
+            break  # runs toward a current mode (its misfit or its noise), not beyond
         nxt = _trial(fitter, res, cur, fixed, p_t, l_t, w_new, strict=False)
         if nxt is None or nxt[2] <= got[2]:
             break
@@ -714,9 +732,8 @@ def residual_search(
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
         found = residual_peaks_of(fitter, res, MAX_TRIALS, threshold, zeta0)
         if scanned is None:
-            starts = [
-                (p, np.ones(fitter.n_in, complex)) for p in scan_of(fitter, res, threshold, zeta0)
-            ]
+            scan = _scanned(fitter, res, threshold, zeta0, test)
+            starts = [(p, np.ones(fitter.n_in, complex)) for p in scan]
             scanned = True
         for fpk in found.freq if not starts else ():
             w = 2 * np.pi * fpk
