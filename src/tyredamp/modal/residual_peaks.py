@@ -81,6 +81,16 @@ def _window_sums(
     return c[b] - c[a], (b - a).astype(np.float64)
 
 
+def _peaks(score: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Local maxima of ``score`` where it is finite, best first."""
+    fin = np.isfinite(score)
+    sc = np.where(fin, score, -1e300)
+    left = np.concatenate([[-np.inf], sc[:-1]])
+    right = np.concatenate([sc[1:], [-np.inf]])
+    peak = np.flatnonzero(fin & (sc > left) & (sc >= right))
+    return np.asarray(peak[np.argsort(-sc[peak])], dtype=np.intp)
+
+
 def residual_peaks(
     f: NDArray[np.float64],
     pw: NDArray[np.float64],
@@ -94,45 +104,47 @@ def residual_peaks(
     ``f`` (n,) the lines (Hz, uniform or not), ``pw`` (n,) the residual power
     per line in units of the noise variance summed over ``k_terms`` FRFs,
     ``zeta0`` the typical damping ratio of the modes, ``threshold`` the mode
-    test's. A line is a candidate when, for one of the window scales, it is a
-    local maximum of the window's standardised excess, that excess exceeds
-    ``Z_NOISE`` noise standard deviations and ``SHARE * threshold``; peaks
-    within 1 % of a better one are the same structure. At most ``n_max``.
+    test's. Two lists, taken in turn: the local maxima of the residual power
+    over 5 lines whose excess over the median exceeds ``SHARE * threshold``
+    (largest first; narrow structure), and the local maxima of the
+    standardised excess over windows matched to half-power bands of
+    ``SCALES`` times ``zeta0`` where that excess exceeds ``Z_NOISE`` noise
+    standard deviations and ``SHARE * threshold`` (most significant first;
+    broad structure). Peaks within 1 % of an earlier one are the same
+    structure. At most ``n_max``. The excess returned (for :func:`room`) is
+    over the median, a generous bound of the room a mode has.
     """
     f = np.asarray(f, dtype=np.float64)
     pw = np.asarray(pw, dtype=np.float64)
     if pw.size < 3:
         return ResidualPeaks(np.zeros(0), pw - np.median(pw) if pw.size else pw)
+    # narrow: 5 lines over the median
+    k = min(5, pw.size)
+    sm = np.convolve(pw, np.ones(k) / k, mode="same")
+    narrow = np.where(k * (sm - np.median(sm)) > SHARE * threshold, sm, -np.inf)
+    # broad: matched windows, excess over the noise mean (no bias in wide sums)
     mu = noise_mean(pw, k_terms)
-    ex = pw - mu
     # the noise variance of one line's power, robustly: var of chi2(2K)/2 scaled as mu
     var_line = mu**2 / max(int(k_terms), 1)
-    c = np.concatenate([[0.0], np.cumsum(ex)])
+    c = np.concatenate([[0.0], np.cumsum(pw - mu)])
     dfl = np.gradient(f) if f.size > 1 else np.ones(1)
     score = np.full(pw.size, -np.inf)
     for s in SCALES:
         half = np.maximum(np.round(s * zeta0 * f / np.maximum(dfl, 1e-300)), MIN_HALF)
         e, n = _window_sums(c, half.astype(np.intp))
         z = e / np.sqrt(n * var_line)
-        ok = (z > Z_NOISE) & (e > SHARE * threshold)
-        zz = np.where(ok, z, -np.inf)
-        better = zz > score
-        score[better] = zz[better]
-    fin = np.isfinite(score)
-    if not np.any(fin):
-        return ResidualPeaks(np.zeros(0), ex)
-    sc = np.where(fin, score, -1e300)
-    left = np.concatenate([[-np.inf], sc[:-1]])
-    right = np.concatenate([sc[1:], [-np.inf]])
-    peak = np.flatnonzero(fin & (sc > left) & (sc >= right))
+        zz = np.where((z > Z_NOISE) & (e > SHARE * threshold), z, -np.inf)
+        score = np.maximum(score, zz)
+    lists = [list(_peaks(narrow)), list(_peaks(score))]
     out: list[float] = []
-    for i in peak[np.argsort(-sc[peak])]:
-        fi = float(f[i])
-        if all(abs(fi - g) > 0.01 * g for g in out):
-            out.append(fi)
-        if len(out) >= n_max:
-            break
-    return ResidualPeaks(np.asarray(out), ex)
+    while (lists[0] or lists[1]) and len(out) < n_max:
+        for lst in lists:
+            while lst:
+                fi = float(f[lst.pop(0)])
+                if all(abs(fi - g) > 0.01 * g for g in out):
+                    out.append(fi)
+                    break
+    return ResidualPeaks(np.asarray(out[:n_max]), pw - np.median(pw))
 
 
 def room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> float:
