@@ -167,7 +167,7 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
                 yield b1 - pt @ qb, rows.data(fx.yw, i, w) - pt @ fx.qty
 
         # columns mostly in span(Phi_f): the QR route of the projected rows
-        force = bool(np.any(np.diag(G) < _PROJ_TOL * np.diag(g0)))
+        force = bool((G.diagonal() < _PROJ_TOL * g0.diagonal()).any())
         sol = _vp_solve(G, P, q1, fx.yyp, projected, residual=force, gradient=True, cancel=yy)
         sol["lay"] = lay1
         sol["coef"] = one._coef(lay1, pp1[0])

@@ -505,10 +505,14 @@ class ModalFitter:
     def _added_fitter(self) -> tuple[ModalFitter, Any, int]:
         """The fitter of one added mode alone (no residual terms), its derivative
         layout and its number of basis and derivative columns."""
-        one = copy.copy(self)
-        one.use_upper = one.use_lower = False
-        lay1 = one._layout(1)
-        return one, lay1, one.n_cols(1) + int(lay1.ecol.max()) + 1
+        got: tuple[ModalFitter, Any, int] | None = self.__dict__.get("_added_one")
+        if got is None:  # formed once per fitter (its settings do not change)
+            one = copy.copy(self)
+            one.use_upper = one.use_lower = False
+            lay1 = one._layout(1)
+            got = (one, lay1, one.n_cols(1) + int(lay1.ecol.max()) + 1)
+            self._added_one = got
+        return got
 
     def _fixed_modes(
         self, poles: NDArray[np.complex128], part: NDArray[np.complex128], n1: int
