@@ -532,7 +532,8 @@ class ModalFitter:
         and ``part`` (m, n_in): an immutable value (the range of their basis and
         of the residual terms, :mod:`~tyredamp.modal._added`) to form once and
         pass as ``fixed`` to every ``fit_added`` against these modes."""
-        return _added.fixed_part(self, *self._fixed_modes(poles, part, self._added_fitter()[2]))
+        got = self._fixed_modes(poles, part, self._added_fitter()[2])
+        return _added.fixed_part(self, *got, src=(poles, part))
 
     def fit_added(
         self,
@@ -575,11 +576,14 @@ class ModalFitter:
             one-pass fit.
         """
         one, lay1, n1 = self._added_fitter()
-        th_f, m, ref, parts = self._fixed_modes(poles, part, n1)
-        if fixed is None:
-            fixed = _added.fixed_part(self, th_f, m, ref, parts)
-        elif not (fixed.matches(th_f, m, ref) and fixed.parts == tuple(parts)):
-            raise InputError("fixed: the fixed part of other modes than poles and part")
+        if fixed is not None and fixed.made_from(poles, part):
+            m = fixed.m  # formed from these very modes: nothing to check
+        else:
+            th_f, m, ref, parts = self._fixed_modes(poles, part, n1)
+            if fixed is None:
+                fixed = _added.fixed_part(self, th_f, m, ref, parts)
+            elif not (fixed.matches(th_f, m, ref) and fixed.parts == tuple(parts)):
+                raise InputError("fixed: the fixed part of other modes than poles and part")
         l1 = self._real_part(np.asarray(part_new, complex).reshape(1, self.n_in))
         p1 = np.array([pole], complex)
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
