@@ -236,6 +236,8 @@ class ModalFitter:
             if unit_weights
             else 1.0 / np.where(self._rms > 0, self._rms, 1.0)
         )
+        # the fitter of fit_added's one added mode (formed once: settings never change)
+        self._added_one = self._make_added_one()
 
     @property
     def Y(self) -> NDArray[np.float64]:
@@ -505,14 +507,14 @@ class ModalFitter:
     def _added_fitter(self) -> tuple[ModalFitter, Any, int]:
         """The fitter of one added mode alone (no residual terms), its derivative
         layout and its number of basis and derivative columns."""
-        got: tuple[ModalFitter, Any, int] | None = self.__dict__.get("_added_one")
-        if got is None:  # formed once per fitter (its settings do not change)
-            one = copy.copy(self)
-            one.use_upper = one.use_lower = False
-            lay1 = one._layout(1)
-            got = (one, lay1, one.n_cols(1) + int(lay1.ecol.max()) + 1)
-            self._added_one = got
-        return got
+        return self._added_one
+
+    def _make_added_one(self) -> tuple[ModalFitter, Any, int]:
+        """:meth:`_added_fitter`'s value, formed once by the constructor."""
+        one = copy.copy(self)
+        one.use_upper = one.use_lower = False
+        lay1 = one._layout(1)
+        return one, lay1, one.n_cols(1) + int(lay1.ecol.max()) + 1
 
     def _fixed_modes(
         self, poles: NDArray[np.complex128], part: NDArray[np.complex128], n1: int
