@@ -43,7 +43,9 @@ class FixedPart:
     ``qy``: the rows of ``[Q_r | P_f Y]`` of the one block (``Q_r = Phi_f T``, ``P_f
     Y = Y - Q_r Q_r^T Y`` the data with the fixed basis projected out; None with
     several blocks), so that an evaluation needs one product ``B1^T [Q_r | P_f Y]``;
-    ``src``: the poles and participation it was formed from, when given.
+    ``src``: the poles and participation it was formed from, when given; ``qr``:
+    with several blocks and ``keep``, the rows of ``Q_r`` of every line (no larger
+    than the data), so that an evaluation needs no fixed basis.
     """
 
     th: NDArray[np.float64]
@@ -58,6 +60,7 @@ class FixedPart:
     yyp: NDArray[np.float64]
     qy: NDArray[np.float64] | None = None
     src: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
+    qr: NDArray[np.float64] | None = None
 
     def matches(self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp]) -> bool:
         """Is this the fixed part of the modes ``th`` (``m``, ``ref``)?"""
@@ -124,18 +127,33 @@ def fixed_part(
         fitter._yss * w**2,
         (phi0, yw) if phi0 is not None and yw is not None else None,
     )
-    qy = None
+    qy = qr = None
+    r = tmap.shape[1]
     if phi0 is not None and yw is not None:
-        r = tmap.shape[1]
         qy = np.empty((yw.shape[0], r + yw.shape[1]), order="F")
-        qr = np.matmul(phi0, tmap, out=qy[:, :r])
-        np.subtract(yw, qr @ qty, out=qy[:, r:])
+        np.subtract(yw, np.matmul(phi0, tmap, out=qy[:, :r]) @ qty, out=qy[:, r:])
+    elif keep:  # several blocks, the fixed basis no larger than the data: Q_r of every line
+        qr = np.empty((fitter.n_rows, r), order="F")
+        for i, sl in enumerate(parts):
+            qr[line_rows(fitter, sl)] = rows.basis(th_f, m, ref, i) @ tmap
     if src is not None:
         src = (np.array(src[0], complex), np.array(src[1], complex))
-    for a in (th_f, ref, phi0, yw, tmap, qty, yyp, qy, *(src or ())):
+    for a in (th_f, ref, phi0, yw, tmap, qty, yyp, qy, qr, *(src or ())):
         if a is not None:
             a.flags.writeable = False
-    return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src)
+    return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr)
+
+
+def line_rows(fitter: Any, sl: slice) -> slice | NDArray[np.intp]:
+    """The rows of the lines ``sl`` among the rows of every line (``(k, f)``, real and
+    imaginary part interleaved, :func:`~tyredamp.modal._basis.ydata`): a slice for one
+    input, else the indices in the order of the rows of a block."""
+    n_f, n_in = fitter.n_f, fitter.n_in
+    start, stop, _ = sl.indices(n_f)
+    if n_in == 1:
+        return slice(2 * start, 2 * stop)
+    e = (np.arange(n_in)[:, None] * n_f + np.arange(start, stop)[None, :]).ravel()
+    return np.stack([2 * e, 2 * e + 1], axis=1).ravel()
 
 
 def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], lay1: Any) -> Any:
@@ -198,4 +216,28 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
 
         return solution(g0, G, P, projected, pp1)
 
-    return solve_one if fx.qy is not None else solve_blocks
+    fac_all = _basis.factors(fitter) if fx.qr is not None and n1 <= fitter.n_out else None
+
+    def solve_all(th: NDArray[np.float64]) -> dict[str, Any]:
+        # several blocks, Q_r of every line kept (FixedPart.qr): the added columns of
+        # every line at once (n1 columns, no larger than the data)
+        qr = fx.qr
+        assert qr is not None
+        pp1 = one.unpack(th, 1, ref1)
+        b1 = one._basis_ek(th, 1, ref1, True, None, (fac_all, pp1))[0]
+        qbt = b1.T @ qr  # (Q_r^T B1)^T
+        g0 = b1.T @ b1
+        G = g0 - qbt @ qbt.T
+        P = _basis.rows_t_data(fitter, slice(0, fitter.n_f), b1) * w - qbt @ fx.qty
+
+        def projected() -> Any:
+            for sl in fx.parts:
+                rr = line_rows(fitter, sl)
+                pt = qr[rr]
+                yield b1[rr] - pt @ qbt.T, fitter._ydata(sl) * w - pt @ fx.qty
+
+        return solution(g0, G, P, projected, pp1)
+
+    if fx.qy is not None:
+        return solve_one
+    return solve_all if fac_all is not None else solve_blocks
