@@ -411,10 +411,10 @@ def _gn_point(
         if idx.size == 0:
             return None
         free, d_f = idx, d_a[idx]
-        An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
+        An = A[np.ix_(idx, idx)] / np.multiply.outer(d_f, d_f)
         gn = g[idx] / d_f
     else:
-        An = A / np.outer(d_a, d_a)
+        An = A / np.multiply.outer(d_a, d_a)
         gn = g / d_a
     # Gauss-Newton decrement at this point (convergence test)
     gn_step, info = _lu_solve(_plus_diag(An, 1e-12), -gn)
@@ -469,7 +469,7 @@ def _levenberg_marquardt(
     Returns the parameters, the number of evaluations, whether it converged
     and the by-product of ``evaluate`` at the returned parameters.
     """
-    x = np.clip(np.asarray(x0, float), lb, ub)
+    x = np.minimum(np.maximum(np.asarray(x0, float), lb), ub)
     cost, A, g, aux = evaluate(x)
     cost0 = max(cost, 1e-300)
     nfev = 1

@@ -620,7 +620,7 @@ class ModalFitter:
         if omega_bounds is not None:
             lb[1 : 2 * m : 2] = max(1e-6, omega_bounds[0] / self.w_ref)
             ub[1 : 2 * m : 2] = min(20.0, omega_bounds[1] / self.w_ref)
-        th0 = np.clip(th0, lb + 1e-9, ub - 1e-9)
+        th0 = np.minimum(np.maximum(th0, lb + 1e-9), ub - 1e-9)
 
         n_lin = self.n_cols(m) if solve is None else 2
         n_obs = self.n_rows * self.n_out
