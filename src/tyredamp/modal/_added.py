@@ -15,7 +15,13 @@ fixed part (:class:`FixedPart`, from :meth:`ModalFitter.fixed_part
 caller forms once per fixed mode set and passes to each ``fit_added``; the
 fitter keeps nothing between calls. It holds the range map and, when the data
 fit one block (:func:`~tyredamp.modal._basis.one_block`), that block's fixed
-basis and weighted data rows (no more than one block of a blocked fit).
+basis, weighted data rows and the rows of ``[Q_r | P_f Y]`` (an orthonormal
+basis of the range of ``Phi_f`` and the data with it projected out: an
+evaluation is then one product ``B1^T [Q_r | P_f Y]`` and ``B1^T B1``); with
+several blocks, the rows of ``Q_r`` of every line when the fixed basis is no
+larger than the data (an evaluation then forms the added columns of every line
+at once when they are no larger than the data either: one basis and three
+products instead of a fixed and an added basis and three products per block).
 """
 
 from __future__ import annotations
