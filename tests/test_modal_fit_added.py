@@ -130,3 +130,71 @@ def test_fit_added_gram_blocks_match_the_explicit_projection(
     assert_allclose(b[0], a[0], rtol=1e-10)
     assert_allclose(b[1], a[1], rtol=1e-8)
     assert_allclose(b[2], a[2], rtol=1e-9)
+
+
+@pytest.mark.parametrize("n_in", [1, 2])
+def test_blocks_with_many_outputs_give_the_same_added_mode(
+    n_in: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # with several blocks and a fixed basis no larger than the data (more outputs
+    # than its columns), the fixed part keeps Q_r of every line and an evaluation
+    # forms the added columns of every line at once: the refinement of one block
+    # (every line at once) to round-off, with line weights and one or two inputs
+    import tyredamp.modal._basis as basis_mod
+
+    sys_ = chain_system(n=12)
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(21)
+    inputs = [0, 5][:n_in]
+    h = sys_.frf(F, kind="accelerance", inputs=inputs).H  # (12, n_in, 400)
+    h = h + 1e-3 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    lw = 1.0 + 0.5 * np.cos(F)
+    drive = [(j, i) for i, j in enumerate(inputs)]
+    part = cm.psi[inputs].T
+    order = np.argsort(cm.poles.imag)
+    k = int(order[3])
+    keep = order[:3]  # few fixed modes: n_cols(3) <= 12 outputs
+    lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
+    args = (cm.poles[keep], part[keep], cm.poles[k] * 1.01, np.ones(n_in))
+    one = ModalFitter(F, h, 2, "complex", drive, line_weights=lw)
+    assert one.n_cols(3) <= one.n_out
+    ref = one.fit_added(*args, omega_bounds=(lo, hi))
+    monkeypatch.setattr(basis_mod, "BLOCK_BYTES", 1)
+    monkeypatch.setattr(basis_mod, "MIN_BLOCK_LINES", 37)  # 11 blocks, the last short
+    many = ModalFitter(F, h, 2, "complex", drive, line_weights=lw)
+    fx = many.fixed_part(cm.poles[keep], part[keep])
+    assert len(fx.parts) == 11
+    assert fx.qr is not None
+    assert fx.qy is None
+    got = many.fit_added(*args, omega_bounds=(lo, hi), fixed=fx)
+    assert_allclose(got[0], ref[0], rtol=1e-10)
+    assert_allclose(got[1], ref[1], rtol=1e-8)
+    assert_allclose(got[2], ref[2], rtol=1e-8)
+
+
+def test_residual_blocks_against_the_modal_sum() -> None:
+    # the residual H - H^ of residual_blocks (one real product of [Re R, Im R, upper,
+    # lower] and the columns a + b, i (a - b), kappa, kappa_low) against the modal sum
+    # sum_n R_n kappa / (s - p_n) + conj(R_n) kappa / (s - conj p_n) + upper kappa +
+    # lower kappa / (i w)^2 written out, line weights applied
+    import tyredamp.modal._basis as basis_mod
+
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(5)
+    h = sys_.frf(F, kind="mobility", inputs=[0, 5]).H
+    lw = 1.0 + 0.5 * np.cos(F)
+    fit = ModalFitter(F, h, 1, "complex", [(0, 0), (5, 1)], line_weights=lw)
+    r = rng.normal(size=(6, 2, 4)) + 1j * rng.normal(size=(6, 2, 4))
+    p = cm.poles[:4]
+    up, low = rng.normal(size=(6, 2)), rng.normal(size=(6, 2))
+    s = 2j * np.pi * F
+    kap = s**1  # mobility: (i w)^1
+    modes = np.einsum("jkn,nf->jkf", r, kap / (s - p[:, None]))
+    modes += np.einsum("jkn,nf->jkf", np.conj(r), kap / (s - np.conj(p)[:, None]))
+    extra = up[:, :, None] * kap + low[:, :, None] * kap / s**2
+    for terms, model in (((up, low), modes + extra), ((None, None), modes)):
+        got = np.concatenate([e for _, e in basis_mod.residual_blocks(fit, p, r, terms)], axis=2)
+        # the same sum in another order: round-off of the largest term
+        tol = 1e-12 * np.abs(modes + extra).max() * lw.max()
+        assert_allclose(got, (h - model) * lw, rtol=0, atol=tol)

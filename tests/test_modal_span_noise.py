@@ -136,3 +136,25 @@ def test_span_threshold_quantile_against_monte_carlo(lam: tuple[float, float]) -
     base = float(sps.chi2.isf(alpha, k))
     got = span_threshold(base, k, n_in, 1, (*lam, 1000), alpha)
     assert_allclose(got, np.quantile(t, 1 - alpha), rtol=0.04)
+
+
+def test_one_input_split_equals_the_qr_projection() -> None:
+    # with one input the in-span power is |u^H e|^2 / ||u||^2 (no QR): the same as
+    # the projection on the QR basis of the column, to round-off; a line where the
+    # data vanish takes the QR route (its basis is some unit vector)
+    from tyredamp.modal.span_noise import _split
+
+    rng = np.random.default_rng(11)
+    n_out, n_f = 7, 50
+    u = rng.normal(size=(n_out, 1, n_f)) + 1j * rng.normal(size=(n_out, 1, n_f))
+    e = rng.normal(size=(n_out, 1, n_f)) + 1j * rng.normal(size=(n_out, 1, n_f))
+    e_in, e_all = _split(u, e)
+    q = np.linalg.qr(u.transpose(2, 0, 1))[0]
+    p = np.conj(q).transpose(0, 2, 1) @ e.transpose(2, 0, 1)
+    assert_allclose(e_in, np.sum(np.abs(p) ** 2, axis=(1, 2)), rtol=1e-12)
+    assert_allclose(e_all, np.sum(np.abs(e) ** 2, axis=(0, 1)), rtol=1e-12)
+    assert np.all(e_in <= e_all * (1 + 1e-12))
+    u[:, :, 3] = 0.0
+    e_in0, _ = _split(u, e)
+    q0 = np.linalg.qr(u[:, :, 3])[0]
+    assert_allclose(e_in0[3], np.abs(np.conj(q0[:, 0]) @ e[:, 0, 3]) ** 2, rtol=1e-12)

@@ -15,7 +15,13 @@ fixed part (:class:`FixedPart`, from :meth:`ModalFitter.fixed_part
 caller forms once per fixed mode set and passes to each ``fit_added``; the
 fitter keeps nothing between calls. It holds the range map and, when the data
 fit one block (:func:`~tyredamp.modal._basis.one_block`), that block's fixed
-basis and weighted data rows (no more than one block of a blocked fit).
+basis, weighted data rows and the rows of ``[Q_r | P_f Y]`` (an orthonormal
+basis of the range of ``Phi_f`` and the data with it projected out: an
+evaluation is then one product ``B1^T [Q_r | P_f Y]`` and ``B1^T B1``); with
+several blocks, the rows of ``Q_r`` of every line when the fixed basis is no
+larger than the data (an evaluation then forms the added columns of every line
+at once when they are no larger than the data either: one basis and three
+products instead of a fixed and an added basis and three products per block).
 """
 
 from __future__ import annotations
@@ -39,7 +45,13 @@ class FixedPart:
     weighted data rows of the one block (None with several blocks, where they
     are formed block by block when needed); ``tmap``, ``qty``, ``yyp``: the
     range map ``T``, ``Q_r^T Y`` and ``||P_f Y||^2`` (:func:`_fixed_range`);
-    ``keep``: whether a call keeps a block's basis once formed (several blocks).
+    ``keep``: whether a call keeps a block's basis once formed (several blocks);
+    ``qy``: the rows of ``[Q_r | P_f Y]`` of the one block (``Q_r = Phi_f T``, ``P_f
+    Y = Y - Q_r Q_r^T Y`` the data with the fixed basis projected out; None with
+    several blocks), so that an evaluation needs one product ``B1^T [Q_r | P_f Y]``;
+    ``src``: the poles and participation it was formed from, when given; ``qr``:
+    with several blocks and ``keep``, the rows of ``Q_r`` of every line (no larger
+    than the data), so that an evaluation needs no fixed basis.
     """
 
     th: NDArray[np.float64]
@@ -52,10 +64,19 @@ class FixedPart:
     tmap: NDArray[np.float64]
     qty: NDArray[np.float64]
     yyp: NDArray[np.float64]
+    qy: NDArray[np.float64] | None = None
+    src: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
+    qr: NDArray[np.float64] | None = None
 
     def matches(self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp]) -> bool:
         """Is this the fixed part of the modes ``th`` (``m``, ``ref``)?"""
         return self.m == m and np.array_equal(self.th, th) and np.array_equal(self.ref, ref)
+
+    def made_from(self, poles: NDArray[np.complex128], part: NDArray[np.complex128]) -> bool:
+        """Was this formed from these poles and participation (``src``)? Then it is
+        their fixed part (a pure function of them and the fitter)."""
+        src = self.src
+        return src is not None and np.array_equal(src[0], poles) and np.array_equal(src[1], part)
 
 
 class _Rows:
@@ -65,7 +86,6 @@ class _Rows:
     def __init__(self, fitter: Any, fx: FixedPart | None, parts: Any, keep: bool) -> None:
         self.fitter, self.fx, self.parts, self.keep = fitter, fx, parts, keep
         self.cols: dict[int, NDArray[np.float64]] = {}
-        self.qr: NDArray[np.float64] | None = None
 
     def basis(self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], i: int) -> Any:
         """``Phi_f`` of block ``i`` (kept within the call when ``keep``)."""
@@ -86,10 +106,16 @@ class _Rows:
 
 
 def fixed_part(
-    fitter: Any, th_f: NDArray[np.float64], m: int, ref: NDArray[np.intp], parts: list[slice]
+    fitter: Any,
+    th_f: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    parts: list[slice],
+    src: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None,
 ) -> FixedPart:
     """The fixed part of the modes ``th_f`` (``m``, ``ref``) on the blocks ``parts``
-    (module docstring); a pure function of these and of the fitter's data."""
+    (module docstring); a pure function of these and of the fitter's data. ``src``:
+    the poles and participation ``th_f`` comes from (kept, copied)."""
     w = fitter._w1
     qf = fitter.n_cols(m)
     one = len(parts) == 1
@@ -107,10 +133,33 @@ def fixed_part(
         fitter._yss * w**2,
         (phi0, yw) if phi0 is not None and yw is not None else None,
     )
-    for a in (th_f, ref, phi0, yw, tmap, qty, yyp):
+    qy = qr = None
+    r = tmap.shape[1]
+    if phi0 is not None and yw is not None:
+        qy = np.empty((yw.shape[0], r + yw.shape[1]), order="F")
+        np.subtract(yw, np.matmul(phi0, tmap, out=qy[:, :r]) @ qty, out=qy[:, r:])
+    elif keep:  # several blocks, the fixed basis no larger than the data: Q_r of every line
+        qr = np.empty((fitter.n_rows, r), order="F")
+        for i, sl in enumerate(parts):
+            qr[line_rows(fitter, sl)] = rows.basis(th_f, m, ref, i) @ tmap
+    if src is not None:
+        src = (np.array(src[0], complex), np.array(src[1], complex))
+    for a in (th_f, ref, phi0, yw, tmap, qty, yyp, qy, qr, *(src or ())):
         if a is not None:
             a.flags.writeable = False
-    return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp)
+    return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr)
+
+
+def line_rows(fitter: Any, sl: slice) -> slice | NDArray[np.intp]:
+    """The rows of the lines ``sl`` among the rows of every line (``(k, f)``, real and
+    imaginary part interleaved, :func:`~tyredamp.modal._basis.ydata`): a slice for one
+    input, else the indices in the order of the rows of a block."""
+    n_f, n_in = fitter.n_f, fitter.n_in
+    start, stop, _ = sl.indices(n_f)
+    if n_in == 1:
+        return slice(2 * start, 2 * stop)
+    e = (np.arange(n_in)[:, None] * n_f + np.arange(start, stop)[None, :]).ravel()
+    return np.stack([2 * e, 2 * e + 1], axis=1).ravel()
 
 
 def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], lay1: Any) -> Any:
@@ -120,57 +169,81 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
     w = fitter._w1
     rows = _Rows(fitter, fx, fx.parts, fx.keep)  # this call's fixed basis (several blocks)
     th_f, m_f, ref_f = fx.th, fx.m, fx.ref
-
-    def basis(i: int) -> NDArray[np.float64]:
-        return np.asarray(rows.basis(th_f, m_f, ref_f, i))
-
-    def q_range(i: int) -> NDArray[np.float64]:
-        """``Q_r`` rows of block ``i`` (``Phi_f T``; formed once per call for the one block)."""
-        if fx.yw is None:
-            return np.asarray(basis(i) @ fx.tmap)
-        if rows.qr is None:
-            rows.qr = np.asarray(basis(i) @ fx.tmap)
-        return rows.qr
-
     q1 = one.n_cols(1)
     n1 = q1 + int(lay1.ecol.max()) + 1
-    qf = fx.tmap.shape[0]
+    qf, r = fx.tmap.shape
     yy = fitter._yss * w**2
-    nb = len(fx.parts)
 
-    def solve(th: NDArray[np.float64]) -> dict[str, Any]:
-        # Gram blocks of the added mode's [Phi_1 | E_1] projected on the complement
-        # of Phi_f: B1^T B1 - (Q_r^T B1)^T Q_r^T B1 and B1^T Y - (Q_r^T B1)^T Q_r^T Y
+    def solution(g0: Any, G: Any, P: Any, projected: Any, pp1: Any) -> dict[str, Any]:
+        # columns mostly in span(Phi_f): the QR route of the projected rows
+        force = bool((G.diagonal() < _PROJ_TOL * g0.diagonal()).any())
+        sol = _vp_solve(G, P, q1, fx.yyp, projected, residual=force, gradient=True, cancel=yy)
+        sol["lay"] = lay1
+        sol["coef"] = one._coef(lay1, pp1[0])
+        return sol
+
+    def solve_one(th: NDArray[np.float64]) -> dict[str, Any]:
+        # one block: B1^T [Q_r | P_f Y] in one product (FixedPart.qy); G = B1^T B1 -
+        # (Q_r^T B1)^T Q_r^T B1 and P = B1^T P_f Y (= B1^T Y - (Q_r^T B1)^T Q_r^T Y)
+        qy = fx.qy
+        assert qy is not None
         pp1 = one.unpack(th, 1, ref1)
-        b1s: list[NDArray[np.float64]] = []
-        if nb == 1:  # one block: the products themselves (no sums)
-            b1 = one._basis_ek(th, 1, ref1, True, fx.parts[0], (None, pp1))[0]
-            b1s.append(b1)
-            cross, g0, p0 = basis(0).T @ b1, b1.T @ b1, b1.T @ rows.data(fx.yw, 0, w)
-        else:
-            cross = np.zeros((qf, n1))
-            g0 = np.zeros((n1, n1))
-            p0 = np.zeros((n1, fitter.n_out))
-            for i, sl in enumerate(fx.parts):
-                b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
-                cross += basis(i).T @ b1
-                g0 += b1.T @ b1
-                p0 += _basis.rows_t_data(fitter, sl, b1) * w  # no data rows formed
+        b1 = one._basis_ek(th, 1, ref1, True, fx.parts[0], (None, pp1))[0]
+        z = b1.T @ qy
+        qbt = z[:, :r]  # (Q_r^T B1)^T
+        g0 = b1.T @ b1
+        G = g0 - qbt @ qbt.T
+
+        def projected() -> Any:
+            yield b1 - qy[:, :r] @ qbt.T, qy[:, r:]
+
+        return solution(g0, G, np.array(z[:, r:]), projected, pp1)
+
+    def solve_blocks(th: NDArray[np.float64]) -> dict[str, Any]:
+        # the same, the Gram blocks of the added columns summed over blocks of lines
+        pp1 = one.unpack(th, 1, ref1)
+        cross = np.zeros((qf, n1))
+        g0 = np.zeros((n1, n1))
+        p0 = np.zeros((n1, fitter.n_out))
+        for i, sl in enumerate(fx.parts):
+            b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
+            cross += rows.basis(th_f, m_f, ref_f, i).T @ b1
+            g0 += b1.T @ b1
+            p0 += _basis.rows_t_data(fitter, sl, b1) * w  # no data rows formed
         qb = fx.tmap.T @ cross
         G = g0 - qb.T @ qb
         P = p0 - qb.T @ fx.qty
 
         def projected() -> Any:
             for i, sl in enumerate(fx.parts):
-                b1 = b1s[i] if b1s else one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
-                pt = q_range(i)
+                b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
+                pt = rows.basis(th_f, m_f, ref_f, i) @ fx.tmap  # Q_r rows
                 yield b1 - pt @ qb, rows.data(fx.yw, i, w) - pt @ fx.qty
 
-        # columns mostly in span(Phi_f): the QR route of the projected rows
-        force = bool(np.any(np.diag(G) < _PROJ_TOL * np.diag(g0)))
-        sol = _vp_solve(G, P, q1, fx.yyp, projected, residual=force, gradient=True, cancel=yy)
-        sol["lay"] = lay1
-        sol["coef"] = one._coef(lay1, pp1[0])
-        return sol
+        return solution(g0, G, P, projected, pp1)
 
-    return solve
+    fac_all = _basis.factors(fitter) if fx.qr is not None and n1 <= fitter.n_out else None
+
+    def solve_all(th: NDArray[np.float64]) -> dict[str, Any]:
+        # several blocks, Q_r of every line kept (FixedPart.qr): the added columns of
+        # every line at once (n1 columns, no larger than the data)
+        qr = fx.qr
+        assert qr is not None
+        pp1 = one.unpack(th, 1, ref1)
+        b1 = one._basis_ek(th, 1, ref1, True, None, (fac_all, pp1))[0]
+        qbt = b1.T @ qr  # (Q_r^T B1)^T
+        g0 = b1.T @ b1
+        G = g0 - qbt @ qbt.T
+        P = _basis.rows_t_data(fitter, slice(0, fitter.n_f), b1) * w - qbt @ fx.qty
+
+        def projected() -> Any:
+            for sl in fx.parts:
+                rr = line_rows(fitter, sl)
+                pt = qr[rr]
+                yield b1[rr] - pt @ qbt.T, fitter._ydata(sl) * w - pt @ fx.qty
+
+        return solution(g0, G, P, projected, pp1)
+
+    if fx.qy is not None:
+        return solve_one
+    return solve_all if fac_all is not None else solve_blocks

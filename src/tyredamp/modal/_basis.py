@@ -251,20 +251,33 @@ def residual_lines(
     """The weighted residual ``H - H^`` of the lines ``sl`` (arguments as
     :func:`residual_power`), (n_out, n_in, lines)."""
     n_out, n_in, m = residues.shape
-    # the modes' terms of every FRF as one product: [R | conj R] (n_out n_in, 2 m)
-    # times the columns kappa / (s - p_n), kappa / (s - conj p_n) (2 m, lines)
+    upper, lower = terms
+    # the model of every FRF as one real product: R a + conj(R) b = Re R (a + b) +
+    # Im R i (a - b) with a = kappa / (s - p_n), b = kappa / (s - conj p_n), so
+    # [Re R_n, Im R_n, upper, lower] (n_out n_in, n_t) times the complex columns
+    # a + b, i (a - b), kappa, kappa_low as real rows (n_t, 2 lines): half the
+    # operations of the complex product, no pass per residual term
+    coef = [np.stack([residues.real, residues.imag], axis=3).reshape(n_out * n_in, 2 * m)]
+    coef += [np.asarray(t, np.float64).reshape(-1, 1) for t in (upper, lower) if t is not None]
+    rr = np.concatenate(coef, axis=1)
     s, kap, kap_low = factors(fitter, sl)
     h = fitter.H[:, :, sl]
     e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
-    if m:
-        rr = np.concatenate([residues, np.conj(residues)], axis=2).reshape(n_out * n_in, 2 * m)
-        pp = np.concatenate([poles, np.conj(poles)])[:, None]
-        e -= (rr @ (kap / (s - pp))).reshape(e.shape)
-    upper, lower = terms
-    if upper is not None:
-        e -= upper[:, :, None] * kap
-    if lower is not None:
-        e -= lower[:, :, None] * kap_low
+    if rr.shape[1]:
+        cols = np.empty((rr.shape[1], s.size), complex)
+        put_pair(
+            cols[: 2 * m, None, :],
+            0,
+            2,
+            (kap / (s - poles[:, None]))[:, None, :],
+            (kap / (s - np.conj(poles)[:, None]))[:, None, :],
+        )
+        c = 2 * m
+        for t, kk in ((upper, kap), (lower, kap_low)):
+            if t is not None:
+                cols[c] = kk
+                c += 1
+        e -= (rr @ cols.view(np.float64)).view(np.complex128).reshape(e.shape)
     return e
 
 

@@ -122,7 +122,7 @@ def _gram_chol(
     exceeds ``max_cond`` (None: ``_MAX_GRAM_COND``, read at the call).
     """
     dg = g.diagonal()
-    if g.shape[0] == 0 or not (dg.min() > 0.0 and dg.max() < np.inf):  # NaN: False
+    if g.shape[0] == 0 or not all(0.0 < v < math.inf for v in dg.tolist()):  # NaN: False
         return None
     d = np.sqrt(dg)
     gs = g / np.multiply.outer(d, d)
@@ -370,6 +370,13 @@ def _qr_blocks(
     return R, Z, rho
 
 
+def _plus_diag(a: NDArray[np.float64], lam: float) -> NDArray[np.float64]:
+    """``a + lam I`` (a new array; the same numbers as ``a + lam * np.eye(n)``)."""
+    out = np.array(a)
+    out.flat[:: a.shape[0] + 1] += lam
+    return out
+
+
 def _lu_solve(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[NDArray[np.float64], int]:
     """``a x = b`` by LAPACK ``dgesv`` (LU, partial pivoting) and its ``info`` (> 0: singular)."""
     x, info = lapack.dgesv(a, b)[2:]
@@ -404,13 +411,13 @@ def _gn_point(
         if idx.size == 0:
             return None
         free, d_f = idx, d_a[idx]
-        An = A[np.ix_(idx, idx)] / np.outer(d_f, d_f)
+        An = A[np.ix_(idx, idx)] / np.multiply.outer(d_f, d_f)
         gn = g[idx] / d_f
     else:
-        An = A / np.outer(d_a, d_a)
+        An = A / np.multiply.outer(d_a, d_a)
         gn = g / d_a
     # Gauss-Newton decrement at this point (convergence test)
-    gn_step, info = _lu_solve(An + 1e-12 * np.eye(gn.size), -gn)
+    gn_step, info = _lu_solve(_plus_diag(An, 1e-12), -gn)
     if info != 0:
         gn_step = -gn
     return free, d_f, An, gn, float(-gn @ gn_step)
@@ -462,7 +469,7 @@ def _levenberg_marquardt(
     Returns the parameters, the number of evaluations, whether it converged
     and the by-product of ``evaluate`` at the returned parameters.
     """
-    x = np.clip(np.asarray(x0, float), lb, ub)
+    x = np.minimum(np.maximum(np.asarray(x0, float), lb), ub)
     cost, A, g, aux = evaluate(x)
     cost0 = max(cost, 1e-300)
     nfev = 1
@@ -478,11 +485,10 @@ def _levenberg_marquardt(
             if point is None:
                 return x, nfev, True, aux
             free, d_f, An, gn, decrement = point
-            eye = np.eye(gn.size)
             if decrement <= max(tol * cost / dof, 1e-24 * cost0):
                 return x, nfev, True, aux
             new_point = False
-        step_n, info = _lu_solve(An + lam * eye, -gn)
+        step_n, info = _lu_solve(_plus_diag(An, lam), -gn)
         if info != 0:  # singular
             lam *= nu
             nu *= 2

@@ -236,6 +236,8 @@ class ModalFitter:
             if unit_weights
             else 1.0 / np.where(self._rms > 0, self._rms, 1.0)
         )
+        # the fitter of fit_added's one added mode (formed once: settings never change)
+        self._added_one = self._make_added_one()
 
     @property
     def Y(self) -> NDArray[np.float64]:
@@ -505,6 +507,10 @@ class ModalFitter:
     def _added_fitter(self) -> tuple[ModalFitter, Any, int]:
         """The fitter of one added mode alone (no residual terms), its derivative
         layout and its number of basis and derivative columns."""
+        return self._added_one
+
+    def _make_added_one(self) -> tuple[ModalFitter, Any, int]:
+        """:meth:`_added_fitter`'s value, formed once by the constructor."""
         one = copy.copy(self)
         one.use_upper = one.use_lower = False
         lay1 = one._layout(1)
@@ -528,7 +534,8 @@ class ModalFitter:
         and ``part`` (m, n_in): an immutable value (the range of their basis and
         of the residual terms, :mod:`~tyredamp.modal._added`) to form once and
         pass as ``fixed`` to every ``fit_added`` against these modes."""
-        return _added.fixed_part(self, *self._fixed_modes(poles, part, self._added_fitter()[2]))
+        got = self._fixed_modes(poles, part, self._added_fitter()[2])
+        return _added.fixed_part(self, *got, src=(poles, part))
 
     def fit_added(
         self,
@@ -571,11 +578,14 @@ class ModalFitter:
             one-pass fit.
         """
         one, lay1, n1 = self._added_fitter()
-        th_f, m, ref, parts = self._fixed_modes(poles, part, n1)
-        if fixed is None:
-            fixed = _added.fixed_part(self, th_f, m, ref, parts)
-        elif not (fixed.matches(th_f, m, ref) and fixed.parts == tuple(parts)):
-            raise InputError("fixed: the fixed part of other modes than poles and part")
+        if fixed is not None and fixed.made_from(poles, part):
+            m = fixed.m  # formed from these very modes: nothing to check
+        else:
+            th_f, m, ref, parts = self._fixed_modes(poles, part, n1)
+            if fixed is None:
+                fixed = _added.fixed_part(self, th_f, m, ref, parts)
+            elif not (fixed.matches(th_f, m, ref) and fixed.parts == tuple(parts)):
+                raise InputError("fixed: the fixed part of other modes than poles and part")
         l1 = self._real_part(np.asarray(part_new, complex).reshape(1, self.n_in))
         p1 = np.array([pole], complex)
         ref1 = np.argmax(np.abs(l1), axis=1).astype(np.intp)
@@ -610,7 +620,7 @@ class ModalFitter:
         if omega_bounds is not None:
             lb[1 : 2 * m : 2] = max(1e-6, omega_bounds[0] / self.w_ref)
             ub[1 : 2 * m : 2] = min(20.0, omega_bounds[1] / self.w_ref)
-        th0 = np.clip(th0, lb + 1e-9, ub - 1e-9)
+        th0 = np.minimum(np.maximum(th0, lb + 1e-9), ub - 1e-9)
 
         n_lin = self.n_cols(m) if solve is None else 2
         n_obs = self.n_rows * self.n_out

@@ -87,6 +87,25 @@ class SpanNoise:
         )
 
 
+def _split(
+    u: NDArray[np.complex128], ew: NDArray[np.complex128]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``||Q_f^H e_f||^2`` and ``||e_f||^2`` per line of the weighted data ``u`` and
+    residual ``ew`` (n_out, n_in, lines), ``Q_f`` an orthonormal basis of the columns
+    of ``u_f``. One input: ``Q_f = u_f / ||u_f||``, so ``||Q^H e||^2 = |u^H e|^2 /
+    ||u||^2`` (no QR); otherwise a QR of every line (a zero ``u_f`` too)."""
+    e_all = np.einsum("jkf,jkf->f", ew.real, ew.real) + np.einsum("jkf,jkf->f", ew.imag, ew.imag)
+    if u.shape[1] == 1:
+        u1, e1 = u[:, 0, :], ew[:, 0, :]
+        uu = np.einsum("jf,jf->f", u1.real, u1.real) + np.einsum("jf,jf->f", u1.imag, u1.imag)
+        if uu.all():
+            ue = np.einsum("jf,jf->f", np.conj(u1), e1)
+            return (ue.real**2 + ue.imag**2) / uu, e_all
+    q = np.linalg.qr(u.transpose(2, 0, 1))[0]  # (lines, n_out, n_in)
+    p = np.conj(q).transpose(0, 2, 1) @ ew.transpose(2, 0, 1)
+    return np.sum(p.real**2 + p.imag**2, axis=(1, 2)), e_all
+
+
 def span_noise(
     fitter: ModalFitter,
     poles: NDArray[np.complex128],
@@ -110,12 +129,7 @@ def span_noise(
             h = fitter.H[:, :, sl]
             if lw is not None:
                 h = h * lw[sl]
-            u = (h * isd[:, None, None]).transpose(2, 0, 1)  # (lines, n_out, n_in)
-            ew = (e * isd[:, None, None]).transpose(2, 0, 1)
-            q = np.linalg.qr(u)[0]
-            p = np.conj(q).transpose(0, 2, 1) @ ew
-            e_in = np.sum(p.real**2 + p.imag**2, axis=(1, 2))
-            e_all = np.sum(ew.real**2 + ew.imag**2, axis=(1, 2))
+            e_in, e_all = _split(h * isd[:, None, None], e * isd[:, None, None])
             # s2 is the variance of a real row: a complex entry holds 2 s2
             a[sl] = e_in / (2 * n_in**2)
             b[sl] = np.maximum(e_all - e_in, 0.0) / (2 * (n_out - n_in) * n_in)

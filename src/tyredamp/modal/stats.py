@@ -70,6 +70,7 @@ test is not defined (the caller falls back to the difference noise).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -92,6 +93,19 @@ __all__ = [
 FALSE_ALARM = 0.01
 #: lines per block of :func:`difference_noise`
 _DIFF_BLOCK = 16384
+
+
+@functools.lru_cache(maxsize=1024)
+def _chi2_isf(q: float, df: float) -> float:
+    """``chi2_df^-1(1 - q)`` (``scipy.stats.chi2.isf``), cached: an identification asks
+    for the same few quantiles many times."""
+    return float(sps.chi2.isf(q, df))
+
+
+@functools.lru_cache(maxsize=256)
+def _f_isf(q: float, dfn: float, dfd: float) -> float:
+    """``F_(dfn, dfd)^-1(1 - q)`` (``scipy.stats.f.isf``), cached as :func:`_chi2_isf`."""
+    return float(sps.f.isf(q, dfn, dfd))
 
 
 def mode_parameters(n_out: int, n_in: int, mode_kind: str) -> int:
@@ -128,11 +142,11 @@ def mode_threshold(
     if not 0.0 < false_alarm < 1.0:
         raise ValueError(f"false_alarm: expected a probability in (0, 1), got {false_alarm}")
     level = false_alarm / max(int(n_lines), 1)
-    thr = float(sps.chi2.isf(level, int(k)))
+    thr = _chi2_isf(level, int(k))
     if weight_dof is None or not math.isfinite(weight_dof):
         return thr
     # the mean bound and the F tail of a mode whose lines share one estimated factor
-    f_tail = int(k) * float(sps.f.isf(level, int(k), max(float(weight_dof), 1.0)))
+    f_tail = int(k) * _f_isf(level, int(k), max(float(weight_dof), 1.0))
     return max(thr * weight_factor(weight_dof), f_tail)
 
 
@@ -166,7 +180,7 @@ def span_threshold(
     """
     lam_in, lam_out, n = span
     dof = 2.0 * max(int(n), 1) * int(n_in) ** 2
-    lower = lam_in * dof / float(sps.chi2.isf(0.05, dof))
+    lower = lam_in * dof / _chi2_isf(0.05, dof)
     if not lower > max(lam_out, 1.0) or not math.isfinite(lam_in):
         return float(threshold)
     level = false_alarm / max(int(n_lines), 1)
@@ -175,7 +189,7 @@ def span_threshold(
     mean = lam_in * a + lam_out * b
     var = 2.0 * (lam_in**2 * a + lam_out**2 * b)
     c, d = var / (2.0 * mean), 2.0 * mean * mean / var
-    ratio = c * float(sps.chi2.isf(level, d)) / float(sps.chi2.isf(level, int(k)))
+    ratio = c * _chi2_isf(level, d) / _chi2_isf(level, int(k))
     return float(threshold) * max(ratio, 1.0)
 
 
