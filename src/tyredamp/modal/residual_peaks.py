@@ -23,6 +23,7 @@ carry no bias.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -34,6 +35,7 @@ from .fit import FitResult, ModalFitter
 
 __all__ = [
     "ResidualPeaks",
+    "ScanGrid",
     "coherent_scan",
     "residual_peaks",
     "residual_peaks_of",
@@ -164,8 +166,12 @@ SCAN_SCALES = (1.0 / 3.0, 1.0, 3.0)
 SCAN_HALF = 8.0
 #: a grid point is a candidate when its statistic reaches this share of the threshold
 SCAN_SHARE = 0.8
-#: complex entries of one chunk's window matrix (memory bound of the scan)
-SCAN_ENTRIES = 1 << 21
+#: residual entries held whole by the scan (more: formed chunk by chunk)
+SCAN_ENTRIES = 1 << 22
+#: grid points per chunk (a window spans 2 SCAN_HALF grid steps: a chunk's lines
+#: are about twice a window's) and most lines per window (more: strided)
+SCAN_CHUNK = 16
+SCAN_LINES = 8192
 
 
 def _scan_statistic(
@@ -184,6 +190,76 @@ def _scan_statistic(
     return np.asarray(np.linalg.svd(mg, compute_uv=False)[:, 0] ** 2)
 
 
+def _scan_scale(
+    fit: Any,
+    f: NDArray[np.float64],
+    z: float,
+    resid: Callable[[slice], NDArray[np.complex128]],
+) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
+    """The scan's statistic on the grid of one damping ratio ``z``
+    (:func:`coherent_scan`) and the grid's poles; ``resid(lines)`` gives the
+    residual in units of the noise."""
+    n = f.size
+    df = float(np.min(np.diff(f)))
+    n_g = int(np.log(f[-1] / f[0]) / np.log1p(z)) + 2
+    fg = f[0] * (1 + z) ** np.arange(n_g)
+    idx = np.unique(np.clip(np.searchsorted(f, fg[fg <= f[-1]]), 0, n - 1))
+    fg = f[idx]
+    wg = 2 * np.pi * fg
+    pg = -z * wg + 1j * wg * np.sqrt(1 - z * z)
+    half = np.maximum(SCAN_HALF * z * fg, 3 * df)
+    ia = np.searchsorted(f, fg - half)
+    ib = np.searchsorted(f, fg + half, side="right")
+    stride = max(1, -(-int(np.max(ib - ia)) // SCAN_LINES))
+    t = np.empty(fg.size)
+    for c0 in range(0, fg.size, SCAN_CHUNK):
+        g = slice(c0, c0 + SCAN_CHUNK)
+        la, lb = int(ia[g].min()), int(ib[g].max())
+        sl = slice(la, lb, stride)
+        s, kap, _ = factors(fit, sl)
+        li = np.arange(la, lb, stride)
+        inside = (li[None, :] >= ia[g, None]) & (li[None, :] < ib[g, None])
+        a = np.where(inside, kap[None, :] / (s[None, :] - pg[g, None]), 0.0)
+        t[g] = _scan_statistic(resid(sl), a, int(fit.n_in))
+    return t, pg
+
+
+class ScanGrid:
+    """The coherent scan's statistic on its grids (:func:`coherent_scan`): trial
+    poles (N,), their statistic (N,) and whether each is a local maximum of its
+    grid (N,)."""
+
+    def __init__(
+        self,
+        poles: NDArray[np.complex128],
+        stat: NDArray[np.float64],
+        is_max: NDArray[np.bool_],
+    ) -> None:
+        self.poles = poles
+        self.stat = stat
+        self.is_max = is_max
+
+    def candidates(self, level: float, n_max: int) -> list[tuple[complex, float]]:
+        """Local maxima whose statistic reaches ``level``, with it, largest first,
+        one per 1 % of frequency, at most ``n_max``."""
+        sel = np.flatnonzero(self.is_max & (self.stat >= level))
+        out: list[tuple[complex, float]] = []
+        for i in sel[np.argsort(-self.stat[sel])]:
+            p = complex(self.poles[i])
+            if all(abs(abs(p) - abs(q)) > 0.01 * abs(q) for q, _ in out):
+                out.append((p, float(self.stat[i])))
+            if len(out) >= n_max:
+                break
+        return out
+
+    def support(self, f_hz: float, zeta: float) -> float:
+        """Largest statistic of the grid points within ``zeta f`` of ``f_hz``
+        (0 when none): what a mode started there can explain, about."""
+        fg = np.abs(self.poles) / (2 * np.pi)
+        near = np.abs(fg - f_hz) <= max(zeta, 1e-6) * f_hz
+        return float(np.max(self.stat[near])) if np.any(near) else 0.0
+
+
 def coherent_scan(
     fitter: object,
     model: tuple[
@@ -193,73 +269,48 @@ def coherent_scan(
     ],
     s2: NDArray[np.float64],
     zeta0: float,
-    threshold: float,
-    n_max: int,
-) -> list[tuple[complex, float]]:
-    """Trial poles where the residual holds a resonance coherent across the FRFs.
+) -> ScanGrid:
+    """Where the residual holds a resonance coherent across the FRFs.
 
     The residual power per line (:func:`residual_peaks`) sums every FRF's
     residual incoherently: a mode near the threshold spread over many lines
     does not stand out of it. This scan is the mode test's own statistic for a
     pole held at each point of a grid: for a trial pole ``p`` (damping ratio
-    ``zeta``, each of ``SCAN_SCALES`` times ``zeta0``; grid step ``zeta f / 2``,
+    ``zeta``, each of ``SCAN_SCALES`` times ``zeta0``; grid step ``zeta f``,
     at least a line), the residual of every FRF in units of its output's noise
     (``s2``) is projected on the pole's column ``kappa / (s - p)`` within
     ``SCAN_HALF`` half-widths, and the statistic is the largest squared
     singular value of those projections over outputs x inputs (a rank-one
-    residue ``psi l^T``, as a mode has), the cost drop of a mode held at ``p``
-    with only its dominant term. The local maxima that reach ``SCAN_SHARE``
-    of ``threshold`` are returned as trial poles, largest first, one per 1 %
-    of frequency, at most ``n_max``. ``model`` is the fit's ``(poles,
-    residues (n_out, n_in, m), (upper, lower))``.
+    residue ``psi l^T``, as a mode has): the cost drop of a mode held at ``p``
+    with only its dominant term. ``model`` is the fit's ``(poles, residues
+    (n_out, n_in, m), (upper, lower))``.
     """
     fit: Any = fitter
     f = np.asarray(fit.f, dtype=np.float64)
-    n = f.size
-    if n < 3:
-        return []
+    empty = ScanGrid(np.zeros(0, complex), np.zeros(0), np.zeros(0, bool))
+    if f.size < 3 or not f[0] > 0:
+        return empty
     poles, residues, terms = model
     inv = 1.0 / np.sqrt(np.maximum(np.asarray(s2, dtype=np.float64), 1e-300))
-    n_in = int(fit.n_in)
-    df = float(np.min(np.diff(f)))
-    found: list[tuple[float, complex]] = []  # (statistic, pole)
+    whole = None
+    if fit.n_out * fit.n_in * f.size <= SCAN_ENTRIES:
+        whole = residual_lines(fit, poles, residues, terms, slice(0, f.size)) * inv[:, None, None]
+
+    def resid(sl: slice) -> NDArray[np.complex128]:
+        if whole is not None:
+            return whole[:, :, sl]
+        return residual_lines(fit, poles, residues, terms, sl) * inv[:, None, None]
+
+    pp, tt, mm = [], [], []
     for sc in SCAN_SCALES:
         z = float(np.clip(sc * zeta0, 1e-4, 0.1))
-        n_g = int(np.log(f[-1] / max(f[0], 1e-300)) / np.log1p(z / 2)) + 2 if f[0] > 0 else n
-        fg = f[0] * (1 + z / 2) ** np.arange(n_g) if f[0] > 0 else f.copy()
-        idx = np.unique(np.clip(np.searchsorted(f, fg[fg <= f[-1]]), 0, n - 1))
-        fg = f[idx]
-        wg = 2 * np.pi * fg
-        pg = -z * wg + 1j * wg * np.sqrt(1 - z * z)
-        half = np.maximum(SCAN_HALF * z * fg, 3 * df)
-        ia = np.searchsorted(f, fg - half)
-        ib = np.searchsorted(f, fg + half, side="right")
-        width = int(np.max(ib - ia))
-        stride = max(1, -(-width // 8192))  # at most 8192 lines per window
-        per = max(1, SCAN_ENTRIES // max(width // stride * 2, 1))
-        t = np.empty(fg.size)
-        for c0 in range(0, fg.size, per):
-            g = slice(c0, c0 + per)
-            la, lb = int(ia[g].min()), int(ib[g].max())
-            sl = slice(la, lb, stride)
-            e = residual_lines(fit, poles, residues, terms, sl) * inv[:, None, None]
-            s, kap, _ = factors(fit, sl)
-            li = np.arange(la, lb, stride)
-            inside = (li[None, :] >= ia[g, None]) & (li[None, :] < ib[g, None])
-            a = np.where(inside, kap[None, :] / (s[None, :] - pg[g, None]), 0.0)
-            t[g] = _scan_statistic(e, a, n_in)
-        ok = t >= SCAN_SHARE * threshold
+        t, pg = _scan_scale(fit, f, z, resid)
         left = np.concatenate([[-np.inf], t[:-1]])
         right = np.concatenate([t[1:], [-np.inf]])
-        for i in np.flatnonzero(ok & (t > left) & (t >= right)):
-            found.append((float(t[i]), complex(pg[i])))
-    out: list[tuple[complex, float]] = []
-    for t_p, p in sorted(found, key=lambda x: -x[0]):
-        if all(abs(abs(p) - abs(q)) > 0.01 * abs(q) for q, _ in out):
-            out.append((p, t_p))
-        if len(out) >= n_max:
-            break
-    return out
+        pp.append(pg)
+        tt.append(t)
+        mm.append((t > left) & (t >= right))
+    return ScanGrid(np.concatenate(pp), np.concatenate(tt), np.concatenate(mm))
 
 
 def residual_peaks_of(
@@ -276,11 +327,9 @@ def residual_peaks_of(
     return residual_peaks(fitter.f, pw, k_terms, zeta0, threshold, n_max)
 
 
-def scan_of(
-    fitter: ModalFitter, res: FitResult, threshold: float, zeta0: float, n_max: int = 12
-) -> list[tuple[complex, float]]:
-    """Trial poles of the coherent scan of the fit's residual (:func:`coherent_scan`)."""
+def scan_of(fitter: ModalFitter, res: FitResult, zeta0: float) -> ScanGrid:
+    """The coherent scan of the fit's residual (:func:`coherent_scan`)."""
     residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
     s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
     model = (res.poles, residues, (res.upper, res.lower))
-    return coherent_scan(fitter, model, s2, zeta0, threshold, n_max)
+    return coherent_scan(fitter, model, s2, zeta0)

@@ -38,7 +38,7 @@ from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode, threshold_text
-from .residual_peaks import SCAN_SHARE, residual_peaks_of, room, scan_of
+from .residual_peaks import SCAN_SHARE, ScanGrid, residual_peaks_of, room, scan_of
 from .span_noise import SpanNoise, span_noise
 from .stats import FALSE_ALARM, span_threshold
 
@@ -613,7 +613,11 @@ TOWARD_CROSSED = (
 
 
 def _scanned(
-    fitter: ModalFitter, res: FitResult, threshold: float, zeta0: float, test: ModeTest | None
+    fitter: ModalFitter,
+    res: FitResult,
+    grid: ScanGrid,
+    threshold: float,
+    test: ModeTest | None,
 ) -> list[complex]:
     """The coherent scan's trial poles (:func:`~.residual_peaks.coherent_scan`) whose
     statistic reaches ``SCAN_SHARE`` of their own threshold, raised where the
@@ -621,7 +625,7 @@ def _scanned(
     scan weighs the residual with the separable noise model, under which noise
     along the response makes maxima of its own (near strong modes of an H1
     estimate with force noise)."""
-    got = scan_of(fitter, res, threshold, zeta0)
+    got = grid.candidates(SCAN_SHARE * threshold, MAX_TRIALS)
     if test is None or not got:
         return [p for p, _ in got]
     poles = np.array([p for p, _ in got])
@@ -725,17 +729,26 @@ def residual_search(
     refused: list[complex] = []  # trial modes whose joint refit failed (current modes)
     crossed: set[int] = set()  # sides of the band trial modes crossed to (current modes)
     fixed = FixedParts(fitter) if fixed is None else fixed
-    scanned = False  # the coherent scan ran on the current modes
+    scanned = False  # the coherent scan's candidates were tried on the current modes
+    grid: tuple[FitResult | None, ScanGrid] = (
+        None,
+        ScanGrid(np.zeros(0, complex), np.zeros(0), np.zeros(0, bool)),
+    )
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's;
         # when they add nothing, the coherent scan's poles (one round per mode set)
         starts: list[tuple[complex, NDArray[np.complex128]]] = []
         found = residual_peaks_of(fitter, res, MAX_TRIALS, threshold, zeta0)
+        if grid[0] is not res:
+            grid = (res, scan_of(fitter, res, zeta0))
         if scanned is None:
-            scan = _scanned(fitter, res, threshold, zeta0, test)
+            scan = _scanned(fitter, res, grid[1], threshold, test)
             starts = [(p, np.ones(fitter.n_in, complex)) for p in scan]
             scanned = True
-        for fpk in found.freq if not starts else ():
+        # a residual peak is tried where the scan finds room for a mode near it
+        level = SCAN_SHARE * threshold
+        peaks = [fp for fp in found.freq if grid[1].support(fp, zeta0) >= level]
+        for fpk in peaks if not starts else ():
             w = 2 * np.pi * fpk
             starts.append(
                 (complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), np.ones(fitter.n_in, complex))
