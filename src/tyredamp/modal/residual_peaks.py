@@ -175,19 +175,46 @@ SCAN_LINES = 8192
 
 
 def _scan_statistic(
-    e: NDArray[np.complex128], a: NDArray[np.complex128], n_in: int
+    e: NDArray[np.complex128], a: NDArray[np.complex128], n_in: int, nrm2: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """Rank-one statistic of each window column ``a`` (G, L) against the
     residual ``e`` (n_out, n_in, L): the largest squared singular value of
-    ``<a, e_jk> / ||a||`` over outputs x inputs."""
-    nrm = np.sqrt(np.sum(a.real**2 + a.imag**2, axis=1))
+    ``<a, e_jk>`` over outputs x inputs, divided by ``nrm2`` (G,), the squared
+    norm of the part of ``a`` the fitted modes' columns do not explain."""
     g = a.shape[0]
     n_out = e.shape[0]
-    m = (e.reshape(-1, e.shape[-1]) @ a.conj().T) / np.maximum(nrm, 1e-300)  # (K, G)
+    m = e.reshape(-1, e.shape[-1]) @ a.conj().T  # (K, G)
     mg = m.T.reshape(g, n_out, n_in)
     if n_in == 1:
-        return np.asarray(np.sum(mg.real**2 + mg.imag**2, axis=(1, 2)))
-    return np.asarray(np.linalg.svd(mg, compute_uv=False)[:, 0] ** 2)
+        top = np.sum(mg.real**2 + mg.imag**2, axis=(1, 2))
+    else:
+        top = np.linalg.svd(mg, compute_uv=False)[:, 0] ** 2
+    return np.asarray(top / np.maximum(nrm2, 1e-300))
+
+
+def _free_norm2(
+    a: NDArray[np.complex128],
+    inside: NDArray[np.bool_],
+    s: NDArray[np.complex128],
+    kap: NDArray[np.complex128],
+    near: NDArray[np.complex128],
+) -> NDArray[np.float64]:
+    """Squared norm of each window column ``a`` (G, L) off the columns ``kappa /
+    (s - p)`` of the fitted poles ``near`` within the windows (``inside``, G x
+    L): the residual of a least-squares fit is orthogonal to those columns, so
+    ``<a, e> = <a_perp, e>`` and the statistic of a pole beside a fitted mode
+    is ``|<a, e>|^2 / ||a_perp||^2``, not ``/ ||a||^2`` (which would hide the
+    weak mode beside a strong one)."""
+    nrm2 = np.sum(a.real**2 + a.imag**2, axis=1)
+    if near.size == 0:
+        return np.asarray(nrm2)
+    b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
+    c = a @ b.conj().T  # (G, m): <b_n, a_g> over the window (a is 0 outside)
+    w = inside.astype(np.float64)
+    gram = np.einsum("gl,nl,kl->gnk", w, b.conj(), b)  # (G, m, m) per window
+    sol = np.einsum("gnk,gk->gn", np.linalg.pinv(gram, hermitian=True), c)
+    explained = np.real(np.sum(c.conj() * sol, axis=1))
+    return np.asarray(np.maximum(nrm2 - explained, 1e-12 * nrm2))
 
 
 def _scan_scale(
@@ -195,10 +222,11 @@ def _scan_scale(
     f: NDArray[np.float64],
     z: float,
     resid: Callable[[slice], NDArray[np.complex128]],
+    fitted: NDArray[np.complex128],
 ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
     """The scan's statistic on the grid of one damping ratio ``z``
     (:func:`coherent_scan`) and the grid's poles; ``resid(lines)`` gives the
-    residual in units of the noise."""
+    residual in units of the noise, ``fitted`` the fit's poles."""
     n = f.size
     df = float(np.min(np.diff(f)))
     n_g = int(np.log(f[-1] / f[0]) / np.log1p(z)) + 2
@@ -220,7 +248,9 @@ def _scan_scale(
         li = np.arange(la, lb, stride)
         inside = (li[None, :] >= ia[g, None]) & (li[None, :] < ib[g, None])
         a = np.where(inside, kap[None, :] / (s[None, :] - pg[g, None]), 0.0)
-        t[g] = _scan_statistic(resid(sl), a, int(fit.n_in))
+        fn = np.abs(fitted) / (2 * np.pi)
+        near = fitted[(fn >= f[la]) & (fn <= f[lb - 1])]
+        t[g] = _scan_statistic(resid(sl), a, int(fit.n_in), _free_norm2(a, inside, s, kap, near))
     return t, pg
 
 
@@ -281,9 +311,10 @@ def coherent_scan(
     (``s2``) is projected on the pole's column ``kappa / (s - p)`` within
     ``SCAN_HALF`` half-widths, and the statistic is the largest squared
     singular value of those projections over outputs x inputs (a rank-one
-    residue ``psi l^T``, as a mode has): the cost drop of a mode held at ``p``
-    with only its dominant term. ``model`` is the fit's ``(poles, residues
-    (n_out, n_in, m), (upper, lower))``.
+    residue ``psi l^T``, as a mode has) over the squared norm of the column's
+    part that the fitted modes within the window do not explain: the cost
+    drop of a mode held at ``p`` with only its dominant term. ``model`` is the
+    fit's ``(poles, residues (n_out, n_in, m), (upper, lower))``.
     """
     fit: Any = fitter
     f = np.asarray(fit.f, dtype=np.float64)
@@ -304,7 +335,7 @@ def coherent_scan(
     pp, tt, mm = [], [], []
     for sc in SCAN_SCALES:
         z = float(np.clip(sc * zeta0, 1e-4, 0.1))
-        t, pg = _scan_scale(fit, f, z, resid)
+        t, pg = _scan_scale(fit, f, z, resid, np.asarray(poles, complex))
         left = np.concatenate([[-np.inf], t[:-1]])
         right = np.concatenate([t[1:], [-np.inf]])
         pp.append(pg)

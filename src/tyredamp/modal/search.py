@@ -584,10 +584,14 @@ def _joint(
         )
     p1 = complex(r1.poles[k])
     why = _inadmissible(p1, df, max_damping)
-    if why and -p1.real / np.pi >= df:
+    w1 = abs(p1)
+    edge = w1 + p1.real <= 2 * np.pi * band[0] or w1 - p1.real >= 2 * np.pi * band[1]
+    if why and -p1.real / np.pi >= df and edge:
         # too damped to be a mode, but significant: broad structure (the tails of
-        # modes outside the band) kept as a residual mode, not reported as a mode;
-        # the trial mode is the last in-band one: the order of r1 is kept
+        # modes outside the band: its half-power band reaches past an edge) kept as
+        # a residual mode, not reported as a mode; the trial mode is the last
+        # in-band one: the order of r1 is kept. A broad pole within the band
+        # stands in for missed modes there and would hide them from later trials.
         return r1, as_residual(new.take(r1), np.arange(new.m) == k)
     if why:
         return rejected(p1, f"joint refit: {why}", float(r1.significance[k]), threshold)
