@@ -175,12 +175,12 @@ SCAN_LINES = 8192
 
 
 def _scan_statistic(
-    e: NDArray[np.complex128], a: NDArray[np.complex128], n_in: int, nrm2: NDArray[np.float64]
+    e: NDArray[np.complex128], a: NDArray[np.complex128], n_in: int
 ) -> NDArray[np.float64]:
     """Rank-one statistic of each window column ``a`` (G, L) against the
     residual ``e`` (n_out, n_in, L): the largest squared singular value of
-    ``<a, e_jk>`` over outputs x inputs, divided by ``nrm2`` (G,), the squared
-    norm of the part of ``a`` the fitted modes' columns do not explain."""
+    ``<a, e_jk> / ||a||`` over outputs x inputs."""
+    nrm2 = np.sum(a.real**2 + a.imag**2, axis=1)
     g = a.shape[0]
     n_out = e.shape[0]
     m = e.reshape(-1, e.shape[-1]) @ a.conj().T  # (K, G)
@@ -192,29 +192,26 @@ def _scan_statistic(
     return np.asarray(top / np.maximum(nrm2, 1e-300))
 
 
-def _free_norm2(
+def _off_fitted(
     a: NDArray[np.complex128],
     inside: NDArray[np.bool_],
     s: NDArray[np.complex128],
     kap: NDArray[np.complex128],
     near: NDArray[np.complex128],
-) -> NDArray[np.float64]:
-    """Squared norm of each window column ``a`` (G, L) off the columns ``kappa /
-    (s - p)`` of the fitted poles ``near`` within the windows (``inside``, G x
-    L): the residual of a least-squares fit is orthogonal to those columns, so
-    ``<a, e> = <a_perp, e>`` and the statistic of a pole beside a fitted mode
-    is ``|<a, e>|^2 / ||a_perp||^2``, not ``/ ||a||^2`` (which would hide the
-    weak mode beside a strong one)."""
-    nrm2 = np.sum(a.real**2 + a.imag**2, axis=1)
+) -> NDArray[np.complex128]:
+    """Each window column ``a`` (G, L) less its least-squares projection on the
+    columns ``kappa / (s - p)`` of the fitted poles ``near`` within its window
+    (``inside``, G x L): what a pole there adds to a model that refits the
+    nearby modes' residues (the statistic of a weak mode beside a strong one;
+    without it the strong mode's column takes the weak one's share)."""
     if near.size == 0:
-        return np.asarray(nrm2)
+        return a
     b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
     c = a @ b.conj().T  # (G, m): <b_n, a_g> over the window (a is 0 outside)
     w = inside.astype(np.float64)
     gram = np.einsum("gl,nl,kl->gnk", w, b.conj(), b)  # (G, m, m) per window
     sol = np.einsum("gnk,gk->gn", np.linalg.pinv(gram, hermitian=True), c)
-    explained = np.real(np.sum(c.conj() * sol, axis=1))
-    return np.asarray(np.maximum(nrm2 - explained, 1e-12 * nrm2))
+    return np.asarray(a - np.where(inside, sol @ b, 0.0))
 
 
 def _scan_scale(
@@ -250,7 +247,7 @@ def _scan_scale(
         a = np.where(inside, kap[None, :] / (s[None, :] - pg[g, None]), 0.0)
         fn = np.abs(fitted) / (2 * np.pi)
         near = fitted[(fn >= f[la]) & (fn <= f[lb - 1])]
-        t[g] = _scan_statistic(resid(sl), a, int(fit.n_in), _free_norm2(a, inside, s, kap, near))
+        t[g] = _scan_statistic(resid(sl), _off_fitted(a, inside, s, kap, near), int(fit.n_in))
     return t, pg
 
 
@@ -311,9 +308,9 @@ def coherent_scan(
     (``s2``) is projected on the pole's column ``kappa / (s - p)`` within
     ``SCAN_HALF`` half-widths, and the statistic is the largest squared
     singular value of those projections over outputs x inputs (a rank-one
-    residue ``psi l^T``, as a mode has) over the squared norm of the column's
-    part that the fitted modes within the window do not explain: the cost
-    drop of a mode held at ``p`` with only its dominant term. ``model`` is the
+    residue ``psi l^T``, as a mode has), the column taken off the columns of
+    the fitted modes within the window: the cost drop of a mode held at ``p``
+    with only its dominant term, the nearby modes' residues refitted. ``model`` is the
     fit's ``(poles, residues (n_out, n_in, m), (upper, lower))``.
     """
     fit: Any = fitter
