@@ -10,6 +10,8 @@ from numpy.testing import assert_allclose
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
 from tyredamp.modal._linalg import _fixed_range, _qr_blocks
+from tyredamp.modal.estimators import PoleEstimator
+from tyredamp.modal.lscf import PoleSet
 from tyredamp.modal.order import modes_shown, order_cap
 from tyredamp.modal.problem import build_problem
 
@@ -100,3 +102,64 @@ def test_fixed_range_projects_on_the_span(rank_deficient: bool) -> None:
     assert_allclose(qty, q_r.T @ Y, atol=1e-12)
     c = np.linalg.lstsq(phi, Y, rcond=None)[0]
     assert_allclose(yyp, np.sum((Y - phi @ c) ** 2, axis=0), rtol=1e-10)
+
+
+def _late_estimator(poles: np.ndarray, from_order: int) -> PoleEstimator:
+    """A pole estimator (public protocol) whose poles appear only from ``from_order``
+    on (below it: noise poles that change with the order, none stable)."""
+
+    def late(
+        frequency: np.ndarray,
+        H: np.ndarray,
+        max_order: int,
+        *,
+        min_order: int,
+        band: tuple[float, float],
+        order_step: int,
+    ) -> PoleSet:
+        orders = np.arange(max(1, min_order), max_order + 1)
+        ords, pp = [], []
+        rng = np.random.default_rng(max_order)
+        for o in orders:
+            if o >= from_order:
+                got = poles
+            else:
+                w = 2 * np.pi * rng.uniform(band[0], band[1], 3)
+                got = -0.3 * w + 1j * w  # 30 % damped: never stable
+            ords.append(np.full(got.size, o))
+            pp.append(got)
+        allp = np.concatenate(pp)
+        return PoleSet(
+            order=np.concatenate(ords),
+            poles=allp,
+            participation=np.ones((allp.size, H.shape[1]), complex),
+            orders=orders,
+            band_hz=band,
+        )
+
+    return late
+
+
+def test_no_stable_mode_at_the_cap_raises_the_order_to_the_line_limit(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The peaks counted in noisy data are a lower bound of the modes: when the
+    capped order shows no stable mode, the order goes on up to the line limit
+    (a 20 dB corpus system of 37 modes failed with "no stable mode up to order
+    20")."""
+    import tyredamp.modal.order as order
+
+    frf = _six_modes(2001)
+    pr = build_problem(frf, (20.0, 190.0))
+    w = 2 * np.pi * FN
+    est = _late_estimator(-ZETA * w + 1j * w * np.sqrt(1 - ZETA**2), from_order=50)
+    monkeypatch.setattr(order, "modes_shown", lambda problem: 0)
+    cap = order.order_cap(1, pr.shape[2], 20, 0)
+    assert cap < 50
+    dg = order.settle_order(pr, est, 20, order.SelectionRules(), automatic=True)
+    assert dg.order >= 50
+    assert len(dg.kept) == FN.size
+    # a fixed order is not raised
+    fixed = order.settle_order(pr, est, 20, order.SelectionRules(), automatic=False)
+    assert fixed.order == 20
+    assert not fixed.kept

@@ -200,16 +200,24 @@ def _off_fitted(
     near: NDArray[np.complex128],
 ) -> NDArray[np.complex128]:
     """Each window column ``a`` (G, L) less its least-squares projection on the
-    columns ``kappa / (s - p)`` of the fitted poles ``near`` within its window
-    (``inside``, G x L): what a pole there adds to a model that refits the
+    columns ``kappa / (s - p)`` of those of the fitted poles ``near`` whose
+    damped frequency lies within its window (``inside``, G x L), over the
+    window: what a pole there adds to a model that refits the
     nearby modes' residues (the statistic of a weak mode beside a strong one;
     without it the strong mode's column takes the weak one's share)."""
     if near.size == 0:
         return a
     b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
-    c = a @ b.conj().T  # (G, m): <b_n, a_g> over the window (a is 0 outside)
+    # the poles within each window (G, m): the others' rows and columns are 0
+    wn = np.abs(near.imag)
+    w_lo = np.where(inside.any(axis=1), np.argmax(inside, axis=1), 0)
+    w_hi = inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1)
+    own = (wn[None, :] >= np.abs(s[w_lo]).reshape(-1, 1)) & (
+        wn[None, :] <= np.abs(s[w_hi]).reshape(-1, 1)
+    )
+    c = (a @ b.conj().T) * own  # (G, m): <b_n, a_g> over the window (a is 0 outside)
     w = inside.astype(np.float64)
-    gram = np.einsum("gl,nl,kl->gnk", w, b.conj(), b)  # (G, m, m) per window
+    gram = np.einsum("gl,nl,kl->gnk", w, b.conj(), b) * (own[:, :, None] & own[:, None, :])
     sol = np.einsum("gnk,gk->gn", np.linalg.pinv(gram, hermitian=True), c)
     return np.asarray(a - np.where(inside, sol @ b, 0.0))
 

@@ -82,6 +82,9 @@ TRIAL_NFEV = 30
 #: mode (a band missing many modes adds a few per round), MAX_ROUNDS only bounds them
 MAX_TRIALS = 12
 MAX_ROUNDS = 50
+#: a residual peak is tried when the coherent scan near it reaches this share of the
+#: threshold (a screen of plain noise peaks; the scan's trial poles need SCAN_SHARE)
+SUPPORT_SHARE = 0.5
 #: times a trial stopped at its window's limit is continued beyond it (_follow)
 FOLLOW = 3
 
@@ -750,7 +753,7 @@ def residual_search(
             starts = [(p, np.ones(fitter.n_in, complex)) for p in scan]
             scanned = True
         # a residual peak is tried where the scan finds room for a mode near it
-        level = SCAN_SHARE * threshold
+        level = SUPPORT_SHARE * threshold
         peaks = [fp for fp in found.freq if grid[1].support(fp, zeta0) >= level]
         for fpk in peaks if not starts else ():
             w = 2 * np.pi * fpk

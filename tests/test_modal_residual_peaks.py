@@ -1,0 +1,119 @@
+"""Where the residual search looks for missed modes (issue 16):
+``modal.residual_peaks``.
+
+* the residual power's noise mean from its median (chi-square scaling);
+* broad structure that no 5-line window shows is found by the matched windows;
+* the coherent scan's statistic equals the least-squares extra sum of squares
+  of a pole's column added to the fitted modes' columns within its window,
+  computed independently per FRF; its best candidate lies at a weak mode that
+  the fit left out.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats as sps
+
+from tyredamp.frf import FRF
+from tyredamp.modal import ModalModel
+from tyredamp.modal._basis import factors
+from tyredamp.modal.fit import ModalFitter
+from tyredamp.modal.problem import build_problem
+from tyredamp.modal.residual_peaks import (
+    SCAN_HALF,
+    noise_mean,
+    residual_peaks,
+    scan_of,
+)
+
+
+@pytest.mark.parametrize("k", [1, 4, 32])
+def test_noise_mean_from_the_median_of_chi_square_lines(k: int) -> None:
+    rng = np.random.default_rng(k)
+    pw = 3.7 * sps.chi2.rvs(2 * k, size=200_000, random_state=rng) / 2
+    assert noise_mean(pw, k) == pytest.approx(3.7 * k, rel=0.01)
+
+
+def test_broad_structure_is_found_by_the_matched_windows() -> None:
+    rng = np.random.default_rng(1)
+    k = 8
+    f = np.arange(10.0, 200.0, 0.05)
+    pw = sps.chi2.rvs(2 * k, size=f.size, random_state=rng) / 2
+    # a resonance's excess (Lorentzian, half-width 1.5 Hz) at 100 Hz: 120 noise
+    # units in all, under 2 per line, so no 5-line window stands out of the noise
+    bump = 1.0 / (1.0 + ((f - 100.0) / 1.5) ** 2)
+    pw = pw + 120.0 * bump / bump.sum()
+    threshold = 60.0
+    five = np.convolve(pw, np.ones(5) / 5, mode="same")
+    assert 5 * np.max(five[np.abs(f - 100) < 3] - np.median(five)) < 0.25 * threshold * 4
+    got = residual_peaks(f, pw, k, 0.015, threshold, 12)
+    assert np.any(np.abs(got.freq - 100.0) < 1.5)
+    # pure noise: what the matched windows return stands within their noise
+    clean = residual_peaks(f, pw - 120.0 * bump / bump.sum(), k, 0.015, threshold, 12)
+    assert not np.any(np.abs(clean.freq - 100.0) < 1.5)
+
+
+def _four_modes() -> tuple[FRF, ModalModel]:
+    f = np.array([20.0, 41.0, 43.0, 80.0])
+    z = np.array([0.01, 0.01, 0.03, 0.01])
+    w = 2 * np.pi * f
+    p = -z * w + 1j * w * np.sqrt(1 - z * z)
+    rng = np.random.default_rng(7)
+    psi = rng.normal(size=(5, 4)) + 0.3j * rng.normal(size=(5, 4))
+    psi[:, 2] *= 0.08  # weak, broad, beside a strong mode
+    true = ModalModel(p, psi, np.ones((1, 4)))
+    fr = np.arange(10.0, 100.0, 0.05)
+    h = true.frf(fr, "receptance").H
+    sd = 1e-3 * np.sqrt(np.mean(np.abs(h) ** 2, axis=-1, keepdims=True))
+    e = (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
+    return FRF(fr, h + sd * e, kind="receptance"), true
+
+
+def test_the_scan_is_the_extra_sum_of_squares_of_a_pole_beside_the_fitted_modes() -> None:
+    frf, true = _four_modes()
+    pr = build_problem(frf, (12.0, 95.0))
+    fit = ModalFitter(pr.frequency, pr.H, pr.power, "complex", [])
+    keep = np.array([0, 1, 3])
+    res = fit.fit(true.poles[keep], np.ones((3, 1), complex), refine=True)
+    grid = scan_of(fit, res, 0.01)
+    best = grid.candidates(0.0, 1)[0]
+    p_g, t_g = best
+    assert abs(abs(p_g) / (2 * np.pi) - 43.0) < 0.6  # the left-out mode
+    # independently: per FRF, least squares of the residual on the fitted modes'
+    # columns within the window, with and without the pole's column
+    f = fit.f
+    zg = -p_g.real / abs(p_g)
+    fg = abs(p_g) / (2 * np.pi)
+    win = (f >= fg - SCAN_HALF * zg * fg) & (f <= fg + SCAN_HALF * zg * fg)
+    s, kap, _ = factors(fit, slice(None))
+    s, kap = s[win], kap[win]
+    wn = np.abs(res.poles.imag)
+    near = res.poles[(wn >= 2 * np.pi * f[win][0]) & (wn <= 2 * np.pi * f[win][-1])]
+    cols = [kap / (s - q) for q in near]
+    b = np.stack(cols, axis=1) if cols else np.zeros((s.size, 0), complex)
+    a = (kap / (s - p_g))[:, None]
+    # the fit's residual written out: modal sum with conjugates, residual terms
+    r = res.psi_out[:, None, :] * res.psi_in[None, :, :]
+    model = np.einsum("jkn,nl->jkl", r, kap[None, :] / (s[None, :] - res.poles[:, None]))
+    model += np.einsum(
+        "jkn,nl->jkl", np.conj(r), kap[None, :] / (s[None, :] - np.conj(res.poles)[:, None])
+    )
+    _, _, kap_low = factors(fit, slice(None))
+    if res.upper is not None:
+        model += res.upper[:, :, None] * kap[None, None, :]
+    if res.lower is not None:
+        model += res.lower[:, :, None] * kap_low[win][None, None, :]
+    e = pr.H[:, 0, win] - model[:, 0, :]
+    s2 = np.maximum(res.sigma_out**2, 1e-300)
+    extra = 0.0
+    for j in range(e.shape[0]):
+        ss = []
+        for basis in (b, np.hstack([b, a])):
+            c, *_ = np.linalg.lstsq(basis, e[j], rcond=None)
+            ss.append(float(np.sum(np.abs(e[j] - basis @ c) ** 2)))
+        extra += (ss[0] - ss[1]) / s2[j]
+    assert t_g == pytest.approx(extra, rel=1e-6)
+    # and it clears the mode test's scale: a mode there lowers the cost by far more
+    # than the noise of one pole's column
+    assert t_g > 10 * 2 * 5
