@@ -95,6 +95,7 @@ from .fit import FitResult, ModalFitter
 from .lscf import PoleSet, plscf
 from .model import ModalModel
 from .order import Diagram, SelectionRules, default_order, settle_order
+from .out_of_band import search_helpers
 from .problem import FitProblem, build_problem, max_modes
 from .quality import RejectedMode
 from .search import (
@@ -104,7 +105,6 @@ from .search import (
     reject_by_test,
     rejected,
     residual_search,
-    search_helpers,
 )
 from .selection import Cluster, StabilityFlags
 from .stats import FALSE_ALARM, mode_parameters, mode_threshold

@@ -160,7 +160,7 @@ def room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> flo
 
 
 #: damping ratios of the coherent scan's trial poles, relative to the modes' typical
-SCAN_SCALES = (1.0 / 3.0, 1.0, 3.0)
+SCAN_SCALES = (0.5, 2.0)
 #: half-width of a trial pole's window, in half-power half-widths (``zeta f``):
 #: 92 % of the energy of its resonance lies within it
 SCAN_HALF = 8.0
@@ -170,7 +170,7 @@ SCAN_SHARE = 0.8
 SCAN_ENTRIES = 1 << 22
 #: grid points per chunk (a window spans 2 SCAN_HALF grid steps: a chunk's lines
 #: are about twice a window's) and most lines per window (more: strided)
-SCAN_CHUNK = 16
+SCAN_CHUNK = 32
 SCAN_LINES = 8192
 
 
@@ -208,17 +208,25 @@ def _off_fitted(
     if near.size == 0:
         return a
     b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
-    # the poles within each window (G, m): the others' rows and columns are 0
+    # each window's lines [lo, hi] (G,) and the poles within it (G, m)
+    has = inside.any(axis=1)
+    lo = np.where(has, np.argmax(inside, axis=1), 0)
+    hi = np.where(has, inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1), 0)
     wn = np.abs(near.imag)
-    w_lo = np.where(inside.any(axis=1), np.argmax(inside, axis=1), 0)
-    w_hi = inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1)
-    own = (wn[None, :] >= np.abs(s[w_lo]).reshape(-1, 1)) & (
-        wn[None, :] <= np.abs(s[w_hi]).reshape(-1, 1)
-    )
+    own = (wn[None, :] >= np.abs(s[lo])[:, None]) & (wn[None, :] <= np.abs(s[hi])[:, None])
     c = (a @ b.conj().T) * own  # (G, m): <b_n, a_g> over the window (a is 0 outside)
-    w = inside.astype(np.float64)
-    gram = np.einsum("gl,nl,kl->gnk", w, b.conj(), b) * (own[:, :, None] & own[:, None, :])
-    sol = np.einsum("gnk,gk->gn", np.linalg.pinv(gram, hermitian=True), c)
+    # the Gram matrices of the windows from prefix sums over the lines (m, m, L + 1)
+    pre = np.zeros((near.size, near.size, b.shape[1] + 1), complex)
+    np.cumsum(b.conj()[:, None, :] * b[None, :, :], axis=2, out=pre[:, :, 1:])
+    gram = np.moveaxis(pre[:, :, hi + 1] - pre[:, :, lo], 2, 0)  # (G, m, m)
+    both = own[:, :, None] & own[:, None, :]
+    eye = np.eye(near.size, dtype=bool)[None, :, :]
+    scale = np.max(np.abs(gram), axis=(1, 2), keepdims=True)
+    # poles outside a window: a unit diagonal (their coefficient is 0); a tiny ridge
+    # keeps two nearly equal columns solvable
+    gram = np.where(both, gram, 0.0) + np.where(eye & ~both, 1.0, 0.0)
+    gram = gram + eye * (1e-12 * np.maximum(scale, 1e-300))
+    sol = np.linalg.solve(gram, c[:, :, None])[:, :, 0]
     return np.asarray(a - np.where(inside, sol @ b, 0.0))
 
 

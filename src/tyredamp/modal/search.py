@@ -4,8 +4,8 @@ residual-driven search for missed modes.
 Three stages of :func:`~tyredamp.modal.identify.identify_modes` (automatic
 mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
 
-1. :func:`search_helpers`: out-of-band residual modes above and below the band
-   (docstring there);
+1. :func:`~tyredamp.modal.out_of_band.search_helpers`: out-of-band residual
+   modes above and below the band (docstring there);
 2. :func:`reject_by_test`: each in-band mode's statistic ``T`` (the rise of
    the weighted cost, in units of the noise variance, when the mode is
    removed; :mod:`tyredamp.modal.stats`) against the threshold of the
@@ -50,7 +50,6 @@ __all__ = [
     "reject_by_test",
     "residual_search",
     "residual_span",
-    "search_helpers",
 ]
 
 #: convergence thresholds of the intermediate fits, in units of the residual
@@ -327,89 +326,6 @@ def _trial(
     return p_t, l_t, t
 
 
-def search_helpers(
-    fitter: ModalFitter,
-    modes: ModeSet,
-    band: tuple[float, float],
-    data_band: tuple[float, float],
-    max_helpers: int,
-    threshold: float,
-    fixed: FixedParts | None = None,
-) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
-    """Refine, then add out-of-band residual modes while they pass the mode test.
-
-    A trial pole is started at ``1.1 f_hi`` (then ``1.3 f_hi``, ...) above the
-    band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0`` and at least
-    ``MIN_LOW_LINES`` lines lie in ``[f_lo, 2 f_lo]``, with the median
-    damping of the in-band modes. Only the trial mode is refined, with every
-    other mode held fixed, its damped frequency kept outside the band but
-    within a factor 2 of its edge. It is kept when it did not stop at one of
-    these limits and its statistic ``T`` (cost drop in units of the noise
-    variance per output) exceeds ``threshold``; all modes are then refined
-    together, and the search stops instead if that moves the trial mode out
-    of its range or an in-band mode out of the band. ``fixed``: the trials'
-    fixed parts (:class:`FixedParts`, new when None).
-    """
-    lo, hi = band
-    res, cur, dropped = fit_checked(
-        fitter,
-        modes,
-        True,
-        band,
-        passes=1,
-        tol=SEARCH_TOL,
-        uncertainty=False,
-        max_nfev=FIRST_NFEV,
-    )
-    zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
-    n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
-    sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= MIN_LOW_LINES else [])
-    fixed = FixedParts(fitter) if fixed is None else fixed
-    for side in sides:
-        for k in range(max_helpers):
-            fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
-            if fh <= 0:
-                break
-            wh = 2 * np.pi * fh
-            ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
-            edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
-            w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
-            got = _trial(fitter, res, cur, fixed, ph, np.ones(fitter.n_in, complex), w_lim)
-            if got is None or got[2] < threshold:
-                break
-            p_t, l_t, _ = got
-            try:
-                trial = fitter.fit(
-                    *_with_helper(cur, p_t, l_t),
-                    passes=1,
-                    tol=SEARCH_TOL,
-                    uncertainty=False,
-                )
-            except (np.linalg.LinAlgError, ValueError):
-                break
-            fd = trial.poles[-1].imag / (2 * np.pi)
-            fin = trial.poles[: cur.m].imag / (2 * np.pi)
-            outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)
-            if not (outside and np.all((fin >= lo) & (fin <= hi))):
-                break
-            cur = ModeSet(
-                trial.poles[: cur.m],
-                trial.participation[: cur.m],
-                trial.poles[cur.m :],
-                trial.participation[cur.m :],
-                cur.n_free,
-            )
-            res = trial
-    return res, cur, dropped
-
-
-def _with_helper(
-    cur: ModeSet, p: complex, lv: NDArray[np.complex128]
-) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
-    p_all, l_all = cur.all()
-    return np.append(p_all, p), np.concatenate([l_all, lv[None, :]])
-
-
 def reject_by_test(
     fitter: ModalFitter,
     modes: ModeSet,
@@ -619,6 +535,36 @@ TOWARD_CROSSED = (
 )
 
 
+def _starts(
+    fitter: ModalFitter,
+    res: FitResult,
+    grid: ScanGrid,
+    pending: list[tuple[complex, NDArray[np.complex128]]],
+    threshold: float,
+    zeta0: float,
+    test: ModeTest | None,
+    scan: bool,
+) -> list[tuple[complex, NDArray[np.complex128]]]:
+    """The starts of one round of :func:`residual_search`: the coherent scan's
+    trial poles (``scan``), or else the residual's peaks where the scan finds
+    room for a mode near them (``SUPPORT_SHARE`` of the threshold); then the
+    diagram's candidates ``pending`` whose half-power band (+-2 zeta f) holds
+    enough residual power above the noise to pass."""
+    found = residual_peaks_of(fitter, res, MAX_TRIALS, threshold, zeta0)
+    ones = np.ones(fitter.n_in, complex)
+    starts: list[tuple[complex, NDArray[np.complex128]]] = []
+    if scan:
+        starts = [(p, ones) for p in _scanned(fitter, res, grid, threshold, test)]
+    if not starts:
+        level = SUPPORT_SHARE * threshold
+        for fpk in found.freq:
+            if grid.support(fpk, zeta0) >= level:
+                w = 2 * np.pi * fpk
+                starts.append((complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), ones))
+    room_min = 0.25 * threshold
+    return starts + [c for c in pending if room(fitter.f, found.excess, c[0]) > room_min]
+
+
 def _scanned(
     fitter: ModalFitter,
     res: FitResult,
@@ -744,25 +690,10 @@ def residual_search(
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's;
         # when they add nothing, the coherent scan's poles (one round per mode set)
-        starts: list[tuple[complex, NDArray[np.complex128]]] = []
-        found = residual_peaks_of(fitter, res, MAX_TRIALS, threshold, zeta0)
         if grid[0] is not res:
             grid = (res, scan_of(fitter, res, zeta0))
-        if scanned is None:
-            scan = _scanned(fitter, res, grid[1], threshold, test)
-            starts = [(p, np.ones(fitter.n_in, complex)) for p in scan]
-            scanned = True
-        # a residual peak is tried where the scan finds room for a mode near it
-        level = SUPPORT_SHARE * threshold
-        peaks = [fp for fp in found.freq if grid[1].support(fp, zeta0) >= level]
-        for fpk in peaks if not starts else ():
-            w = 2 * np.pi * fpk
-            starts.append(
-                (complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), np.ones(fitter.n_in, complex))
-            )
-        # a diagram candidate can explain at most the residual power above the noise
-        # within its half-power band (+-2 zeta f): skipped when that cannot pass
-        starts += [c for c in pending if room(fitter.f, found.excess, c[0]) > 0.25 * threshold]
+        starts = _starts(fitter, res, grid[1], pending, threshold, zeta0, test, scanned is None)
+        scanned = True if scanned is None else scanned
         pending = []
         added = False
         n_tried = 0

@@ -1,0 +1,109 @@
+"""Out-of-band residual modes: the first stage of the automatic mode count.
+
+:func:`search_helpers` refines the diagram's modes, then adds residual modes
+above and below the band while they pass the mode test
+(:mod:`tyredamp.modal.search` holds the trials and the other stages).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..mechanics.modal_sum import pole_quantities
+from .fit import FitResult, ModalFitter
+from .quality import RejectedMode
+from .search import (
+    FIRST_NFEV,
+    MIN_LOW_LINES,
+    SEARCH_TOL,
+    FixedParts,
+    ModeSet,
+    _trial,
+    fit_checked,
+)
+
+__all__ = ["search_helpers"]
+
+
+def search_helpers(
+    fitter: ModalFitter,
+    modes: ModeSet,
+    band: tuple[float, float],
+    data_band: tuple[float, float],
+    max_helpers: int,
+    threshold: float,
+    fixed: FixedParts | None = None,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """Refine, then add out-of-band residual modes while they pass the mode test.
+
+    A trial pole is started at ``1.1 f_hi`` (then ``1.3 f_hi``, ...) above the
+    band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0`` and at least
+    ``MIN_LOW_LINES`` lines lie in ``[f_lo, 2 f_lo]``, with the median
+    damping of the in-band modes. Only the trial mode is refined, with every
+    other mode held fixed, its damped frequency kept outside the band but
+    within a factor 2 of its edge. It is kept when it did not stop at one of
+    these limits and its statistic ``T`` (cost drop in units of the noise
+    variance per output) exceeds ``threshold``; all modes are then refined
+    together, and the search stops instead if that moves the trial mode out
+    of its range or an in-band mode out of the band. ``fixed``: the trials'
+    fixed parts (:class:`FixedParts`, new when None).
+    """
+    lo, hi = band
+    res, cur, dropped = fit_checked(
+        fitter,
+        modes,
+        True,
+        band,
+        passes=1,
+        tol=SEARCH_TOL,
+        uncertainty=False,
+        max_nfev=FIRST_NFEV,
+    )
+    zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
+    n_low = int(np.count_nonzero((fitter.f >= lo) & (fitter.f <= 2 * lo)))
+    sides = [1.0] + ([-1.0] if data_band[0] > 0 and n_low >= MIN_LOW_LINES else [])
+    fixed = FixedParts(fitter) if fixed is None else fixed
+    for side in sides:
+        for k in range(max_helpers):
+            fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
+            if fh <= 0:
+                break
+            wh = 2 * np.pi * fh
+            ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
+            edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
+            w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
+            got = _trial(fitter, res, cur, fixed, ph, np.ones(fitter.n_in, complex), w_lim)
+            if got is None or got[2] < threshold:
+                break
+            p_t, l_t, _ = got
+            try:
+                trial = fitter.fit(
+                    *_with_helper(cur, p_t, l_t),
+                    passes=1,
+                    tol=SEARCH_TOL,
+                    uncertainty=False,
+                )
+            except (np.linalg.LinAlgError, ValueError):
+                break
+            fd = trial.poles[-1].imag / (2 * np.pi)
+            fin = trial.poles[: cur.m].imag / (2 * np.pi)
+            outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)
+            if not (outside and np.all((fin >= lo) & (fin <= hi))):
+                break
+            cur = ModeSet(
+                trial.poles[: cur.m],
+                trial.participation[: cur.m],
+                trial.poles[cur.m :],
+                trial.participation[cur.m :],
+                cur.n_free,
+            )
+            res = trial
+    return res, cur, dropped
+
+
+def _with_helper(
+    cur: ModeSet, p: complex, lv: NDArray[np.complex128]
+) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+    p_all, l_all = cur.all()
+    return np.append(p_all, p), np.concatenate([l_all, lv[None, :]])
