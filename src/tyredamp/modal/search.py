@@ -17,13 +17,19 @@ mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
 3. :func:`residual_search`: candidates for missed modes, from the diagram
    (clusters that too few orders resolved, modes rejected earlier) and from
    the peaks of the residual (the fit's residual power per line, in units of
-   the noise, summed over the FRFs: a mode indicator on the residual), each
-   refined alone with the other modes held fixed
-   (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`, its frequency within 3 %
-   of the start); a candidate whose cost drop passes the mode test is refined
-   with all modes, and kept when it still passes (its own threshold raised
-   as in 2, from the residual of that fit); repeated until no candidate
-   passes.
+   the noise, summed over the FRFs, over 5 lines and over windows matched to
+   half-power bands: a mode indicator on the residual,
+   :mod:`tyredamp.modal.residual_peaks`) where the coherent scan finds room
+   for a mode; when those add nothing, the maxima of the coherent scan itself
+   (the mode test's statistic of a pole held at each point of a grid, the
+   fitted modes' columns refitted: a weak mode beside a strong one, a broad
+   mode spread over many lines). Each is refined alone with the other modes
+   held fixed (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`, its
+   frequency within 3 % of the start, followed beyond that window while its
+   statistic grows); a candidate whose cost drop passes the mode test is
+   refined with all modes, and kept when it still passes (its own threshold
+   raised as in 2, from the residual of that fit); repeated until no
+   candidate passes.
 """
 
 from __future__ import annotations
