@@ -38,15 +38,17 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import stats as sps
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
+from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode, threshold_text
 from .residual_peaks import SCAN_SHARE, ScanGrid, residual_peaks_of, room, scan_of
-from .span_noise import SpanNoise, span_noise
-from .stats import FALSE_ALARM, span_threshold
+from .span_noise import SpanNoise
+from .thresholds import ModeTest, local_thresholds, residual_span
 
 __all__ = [
     "FixedParts",
@@ -120,46 +122,6 @@ class ModeSet:
         return ModeSet(
             res.poles[:m], res.participation[:m], res.poles[m:], res.participation[m:], self.n_free
         )
-
-
-@dataclass(frozen=True)
-class ModeTest:
-    """What a mode's own threshold needs besides the base one: the parameters
-    ``k`` of a mode, the lines of the band and the false-alarm rate
-    (:func:`~tyredamp.modal.stats.span_threshold`)."""
-
-    k: int
-    n_lines: int
-    false_alarm: float = FALSE_ALARM
-
-
-def residual_span(fitter: ModalFitter, res: FitResult) -> SpanNoise:
-    """Residual noise in and off the span of the data (:mod:`~tyredamp.modal.span_noise`)."""
-    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
-    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    return span_noise(fitter, res.poles, residues, (res.upper, res.lower), s2)
-
-
-def local_thresholds(
-    fitter: ModalFitter,
-    span: SpanNoise | None,
-    poles: NDArray[np.complex128],
-    threshold: float,
-    test: ModeTest | None,
-) -> NDArray[np.float64]:
-    """Each pole's threshold: ``threshold`` raised where the residual's noise lies
-    along the response (:func:`~tyredamp.modal.stats.span_threshold`); ``threshold``
-    for every pole without ``test`` or ``span``."""
-    if test is None or span is None:
-        return np.full(poles.size, float(threshold))
-    return np.array(
-        [
-            span_threshold(
-                threshold, test.k, fitter.n_in, test.n_lines, span.at(complex(p)), test.false_alarm
-            )
-            for p in poles
-        ]
-    )
 
 
 def rejected(
@@ -689,6 +651,7 @@ def residual_search(
     crossed: set[int] = set()  # sides of the band trial modes crossed to (current modes)
     fixed = FixedParts(fitter) if fixed is None else fixed
     scanned = False  # the coherent scan's candidates were tried on the current modes
+    split_tried: list[complex] = []  # modes split already (_split)
     grid: tuple[FitResult | None, ScanGrid] = (
         None,
         ScanGrid(np.zeros(0, complex), np.zeros(0), np.zeros(0, bool)),
@@ -741,8 +704,87 @@ def residual_search(
                 continue
             res, cur = got1
             added, refused, crossed, scanned = True, [], set(), False
-        if not added:
-            if scanned:
+        if not added and scanned:
+            got2 = _split(fitter, res, cur, band, threshold, df, max_damping, test, split_tried)
+            if got2 is None:
                 break
+            res, cur = got2
+            refused, crossed, scanned = [], set(), False
+        elif not added:
             scanned = None  # type: ignore[assignment]
     return res, cur, tried
+
+
+def _split(
+    fitter: ModalFitter,
+    res: FitResult,
+    cur: ModeSet,
+    band: tuple[float, float],
+    threshold: float,
+    df: float,
+    max_damping: float,
+    test: ModeTest | None,
+    tried: list[complex],
+) -> tuple[FitResult, ModeSet] | None:
+    """A close pair where one mode stands for two: the in-band modes whose local
+    dispersion (residual power within two half-widths over the band's mean,
+    :func:`~tyredamp.modal.final.local_dispersion`) exceeds its 5 % noise level
+    (Bonferroni over the modes), most dispersed first, are each replaced by two
+    poles half a half-width either side, refitted with all modes and kept when
+    both pass the mode test (:func:`_joint`). A trial adds one mode alone with
+    the others held: it cannot move the mode that took the pair's place, so no
+    trial finds the second. ``tried`` (poles split already) grows."""
+    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
+    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
+    pw = residual_power(fitter, res.poles, residues, (res.upper, res.lower), s2)
+    f, m, k = fitter.f, cur.m, 2 * fitter.n_out * fitter.n_in
+    p = res.poles[:m]
+    half = np.maximum(-2.0 * p.real / (2 * np.pi), 3 * df)
+    c = np.concatenate([[0.0], np.cumsum(pw)])
+    i0 = np.searchsorted(f, np.abs(p) / (2 * np.pi) - half)
+    i1 = np.searchsorted(f, np.abs(p) / (2 * np.pi) + half, side="right")
+    n = np.maximum(i1 - i0, 1)
+    rho = (c[i1] - c[i0]) / n / max(float(np.mean(pw)), 1e-300)
+    level = sps.chi2.isf(0.05 / max(m, 1), k * n) / (k * n)
+    # where the noise lies along the response (threshold raised), the residual near
+    # a mode is that noise: no evidence of a second mode
+    span = residual_span(fitter, res) if test is not None else None
+    raised = local_thresholds(fitter, span, p, threshold, test) > threshold
+    for i in np.argsort(-rho):
+        if rho[i] <= level[i] or raised[i]:
+            continue
+        if any(abs(q - p[i]) < 2 * MERGE * abs(p[i]) for q in tried):
+            continue
+        tried.append(complex(p[i]))
+        shift = 0.5 * -p[i].real  # half a half-power half-width (rad/s)
+        keep = np.arange(m) != i
+        base = ModeSet(
+            np.append(cur.poles[keep], p[i] - 1j * shift),
+            np.concatenate([cur.part[keep], cur.part[i : i + 1]]),
+            cur.hp,
+            cur.hl,
+            cur.n_free,
+        )
+        got = _joint(
+            fitter,
+            base,
+            p[i] + 1j * shift,
+            cur.part[i],
+            band,
+            threshold,
+            df,
+            max_damping,
+            set(),
+            test,
+        )
+        if got is None or isinstance(got, RejectedMode):
+            continue
+        # the pair's first pole passes its own threshold too (_joint tests the trial's)
+        r1, c1 = got
+        j = c1.m - 2
+        thr_j = local_thresholds(
+            fitter, residual_span(fitter, r1), r1.poles[j : j + 1], threshold, test
+        )
+        if r1.significance[j] > thr_j[0]:
+            return got
+    return None
