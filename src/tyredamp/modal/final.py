@@ -33,6 +33,7 @@ from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
 from .quality import FitQuality, RejectedMode, threshold_text
+from .residual_peaks import local_ratio
 from .search import ModeSet, ModeTest, fit_checked, local_thresholds, rejected, residual_span
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
@@ -249,18 +250,12 @@ class ModelContext:
     thresholds: NDArray[np.float64] | None = None
 
 
-#: half-width of the lines around a mode whose residual gives its local dispersion,
-#: in half-power half-widths ``zeta f`` (at least LOCAL_LINES lines either side)
-LOCAL_HALF = 2.0
-LOCAL_LINES = 3
-
-
 def local_dispersion(
     problem: FitProblem, res: FitResult, sq: NDArray[np.float64], n_band: int
 ) -> NDArray[np.float64]:
     """Each in-band mode's local dispersion: the mean residual power per line
-    within ``LOCAL_HALF`` half-widths of the mode over its mean over the band,
-    at least 1 (n_band,).
+    within two half-widths of the mode over its mean over the band
+    (:func:`~tyredamp.modal.residual_peaks.local_ratio`), at least 1 (n_band,).
 
     The standard errors of a weighted least-squares or maximum-likelihood fit
     assume that the residual is noise of the estimated level everywhere; where
@@ -286,19 +281,11 @@ def local_dispersion(
         pw = np.einsum("jkf,j->f", sq, 1.0 / s2)
         if problem.line_weights is not None:
             pw = pw * np.asarray(problem.line_weights, dtype=np.float64) ** 2
-    mean = float(np.mean(pw))
     f = problem.frequency
-    if not mean > 0 or f.size < 2:
+    if not float(np.mean(pw)) > 0 or f.size < 2:
         return np.ones(n_band)
-    df = float(np.median(np.diff(f)))
-    p = res.poles[:n_band]
-    fc = np.abs(p) / (2 * np.pi)
-    half = np.maximum(LOCAL_HALF * -p.real / (2 * np.pi), LOCAL_LINES * df)
-    c = np.concatenate([[0.0], np.cumsum(pw)])
-    i0 = np.searchsorted(f, fc - half)
-    i1 = np.searchsorted(f, fc + half, side="right")
-    n = np.maximum(i1 - i0, 1)
-    return np.asarray(np.maximum((c[i1] - c[i0]) / n / mean, 1.0))
+    rho, _ = local_ratio(f, pw, res.poles[:n_band])
+    return np.asarray(np.maximum(rho, 1.0))
 
 
 def to_model(

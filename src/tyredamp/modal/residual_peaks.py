@@ -37,6 +37,9 @@ __all__ = [
     "ResidualPeaks",
     "ScanGrid",
     "coherent_scan",
+    "local_ratio",
+    "model_of",
+    "power_of",
     "residual_peaks",
     "residual_peaks_of",
     "room",
@@ -363,17 +366,58 @@ def residual_peaks_of(
     """Candidate frequencies of missed modes from the fit's residual power per
     line, summed over the FRFs in units of each output's noise variance and
     weighted as the fit weights the lines (:func:`residual_peaks`)."""
-    # u l = R (u unscaled without drive points, or scaled); summed block by block
-    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
-    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    pw = residual_power(fitter, res.poles, residues, (res.upper, res.lower), s2)
+    pw = power_of(fitter, res)
     k_terms = fitter.n_out * fitter.n_in
     return residual_peaks(fitter.f, pw, k_terms, zeta0, threshold, n_max)
 
 
 def scan_of(fitter: ModalFitter, res: FitResult, zeta0: float) -> ScanGrid:
     """The coherent scan of the fit's residual (:func:`coherent_scan`)."""
+    poles, residues, terms, s2 = model_of(fitter, res)
+    return coherent_scan(fitter, (poles, residues, terms), s2, zeta0)
+
+
+def model_of(
+    fitter: ModalFitter, res: FitResult
+) -> tuple[
+    NDArray[np.complex128],
+    NDArray[np.complex128],
+    tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    NDArray[np.float64],
+]:
+    """A fit's model for the residual functions of :mod:`._basis`: poles, residues
+    ``R = u l`` (n_out, n_in, m; u unscaled without drive points, or scaled),
+    residual terms, and each output's noise variance (at least the fitter's floor)."""
     residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
     s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    model = (res.poles, residues, (res.upper, res.lower))
-    return coherent_scan(fitter, model, s2, zeta0)
+    return res.poles, residues, (res.upper, res.lower), s2
+
+
+def power_of(fitter: ModalFitter, res: FitResult) -> NDArray[np.float64]:
+    """A fit's residual power per line in units of each output's noise, summed over
+    the FRFs and weighted as the fit weights the lines (block by block)."""
+    poles, residues, terms, s2 = model_of(fitter, res)
+    return residual_power(fitter, poles, residues, terms, s2)
+
+
+#: half-width of the lines around a mode whose residual gives its local ratio, in
+#: half-power half-widths ``zeta f`` (at least LOCAL_LINES lines either side)
+LOCAL_HALF = 2.0
+LOCAL_LINES = 3
+
+
+def local_ratio(
+    f: NDArray[np.float64], pw: NDArray[np.float64], poles: NDArray[np.complex128]
+) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """The mean residual power per line ``pw`` within ``LOCAL_HALF`` half-widths
+    of each pole (at least ``LOCAL_LINES`` lines either side) over its mean over
+    the lines ``f`` (Hz), and the lines of each window."""
+    mean = float(np.mean(pw)) if pw.size else 0.0
+    df = float(np.median(np.diff(f))) if f.size > 1 else 1.0
+    fc = np.abs(poles) / (2 * np.pi)
+    half = np.maximum(LOCAL_HALF * -poles.real / (2 * np.pi), LOCAL_LINES * df)
+    c = np.concatenate([[0.0], np.cumsum(pw)])
+    i0 = np.searchsorted(f, fc - half)
+    i1 = np.searchsorted(f, fc + half, side="right")
+    n = np.maximum(i1 - i0, 1)
+    return np.asarray((c[i1] - c[i0]) / n / max(mean, 1e-300)), np.asarray(n, dtype=np.intp)

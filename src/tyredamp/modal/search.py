@@ -43,10 +43,17 @@ from scipy import stats as sps
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
-from ._basis import residual_power
 from .fit import FitResult, ModalFitter
 from .quality import RejectedMode, threshold_text
-from .residual_peaks import SCAN_SHARE, ScanGrid, residual_peaks_of, room, scan_of
+from .residual_peaks import (
+    SCAN_SHARE,
+    ScanGrid,
+    local_ratio,
+    power_of,
+    residual_peaks_of,
+    room,
+    scan_of,
+)
 from .span_noise import SpanNoise
 from .thresholds import ModeTest, local_thresholds, residual_span
 
@@ -734,17 +741,10 @@ def _split(
     both pass the mode test (:func:`_joint`). A trial adds one mode alone with
     the others held: it cannot move the mode that took the pair's place, so no
     trial finds the second. ``tried`` (poles split already) grows."""
-    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
-    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    pw = residual_power(fitter, res.poles, residues, (res.upper, res.lower), s2)
-    f, m, k = fitter.f, cur.m, 2 * fitter.n_out * fitter.n_in
+    pw = power_of(fitter, res)
+    m, k = cur.m, 2 * fitter.n_out * fitter.n_in
     p = res.poles[:m]
-    half = np.maximum(-2.0 * p.real / (2 * np.pi), 3 * df)
-    c = np.concatenate([[0.0], np.cumsum(pw)])
-    i0 = np.searchsorted(f, np.abs(p) / (2 * np.pi) - half)
-    i1 = np.searchsorted(f, np.abs(p) / (2 * np.pi) + half, side="right")
-    n = np.maximum(i1 - i0, 1)
-    rho = (c[i1] - c[i0]) / n / max(float(np.mean(pw)), 1e-300)
+    rho, n = local_ratio(fitter.f, pw, p)
     level = sps.chi2.isf(0.05 / max(m, 1), k * n) / (k * n)
     # where the noise lies along the response (threshold raised), the residual near
     # a mode is that noise: no evidence of a second mode

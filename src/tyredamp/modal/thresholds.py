@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .fit import FitResult, ModalFitter
+from .residual_peaks import model_of
 from .span_noise import SpanNoise, span_noise
 from .stats import FALSE_ALARM, span_threshold
 
@@ -29,9 +30,8 @@ class ModeTest:
 
 def residual_span(fitter: ModalFitter, res: FitResult) -> SpanNoise:
     """Residual noise in and off the span of the data (:mod:`~tyredamp.modal.span_noise`)."""
-    residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
-    s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    return span_noise(fitter, res.poles, residues, (res.upper, res.lower), s2)
+    poles, residues, terms, s2 = model_of(fitter, res)
+    return span_noise(fitter, poles, residues, terms, s2)
 
 
 def local_thresholds(
