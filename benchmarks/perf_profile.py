@@ -46,7 +46,7 @@ STAGES = (
     ("out-of-band residual modes (search_helpers)", "out_of_band.py", "search_helpers"),
     ("mode test (reject_by_test)", "search.py", "reject_by_test"),
     ("residual search (residual_search)", "search.py", "residual_search"),
-    ("  residual peaks", "residual_peaks.py", "residual_peaks_of"),
+    ("  residual peaks", "residual_peaks.py", "residual_peaks"),
     ("  coherent scan", "residual_peaks.py", "coherent_scan"),
     ("  trials (_trial)", "search.py", "_trial"),
     ("  joint refits (_joint)", "search.py", "_joint"),

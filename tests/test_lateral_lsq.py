@@ -14,27 +14,14 @@ import pytest
 from numpy.testing import assert_allclose
 
 import tyredamp.lateral._lsq as lsq
-from tyredamp.lateral import (
-    ClassicModel,
-    HystereticModel,
-    LateralModel,
-    MaxwellModel,
-    RelaxationLengthModel,
-    StretchedStringModel,
-    ViscoPlasticModel,
-)
+from tyredamp.lateral import ClassicModel, HystereticModel, LateralModel, StretchedStringModel
 from tyredamp.lateral._lsq import Lines, Problem, Segment
 
-SPEED = 5 / 3.6
+from .test_lateral_fit import TRUTHS
+
 F = np.linspace(0.25, 9.0, 57)
-MODELS: list[LateralModel] = [
-    ClassicModel(k=1.3e5, c=2e3),
-    MaxwellModel(k=1.3e5, c=5e4),
-    ViscoPlasticModel(k=1.3e5, c1=1.5e3, c2=5e4),
-    HystereticModel(K=1.3e5, h=1.8e4, C_r=5e4),
-    RelaxationLengthModel(C_alpha=8e4, sigma=0.4, speed=SPEED),
-    StretchedStringModel(C_alpha=8e4, sigma=0.4, a=0.2, speed=SPEED),
-]
+#: the six models with their parameters (test_lateral_fit's truths)
+MODELS: list[LateralModel] = TRUTHS
 
 
 def _central(fun, x: np.ndarray, h: float = 1e-6) -> np.ndarray:

@@ -17,6 +17,7 @@ from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel
 from tyredamp.modal.fit import FitResult, ModalFitter
 from tyredamp.modal.problem import build_problem
+from tyredamp.modal.residual_peaks import power_of
 from tyredamp.modal.search import ModeSet, ModeTest, _split
 from tyredamp.modal.stats import mode_parameters, mode_threshold
 
@@ -50,7 +51,7 @@ def test_a_mode_standing_for_a_pair_is_split() -> None:
     res = fit.fit(merged, np.ones((3, 1), complex), refine=True)
     assert res.poles.size == 3
     tried: list[complex] = []
-    got = _split(fit, res, _modes(res), band, thr, 0.02, 0.2, test, tried)
+    got = _split(fit, res, _modes(res), power_of(fit, res), band, thr, 0.02, 0.2, test, tried)
     assert got is not None
     f = np.sort(np.abs(got[0].poles) / (2 * np.pi))
     assert_allclose(f, F_TRUE, atol=0.02)
@@ -61,7 +62,9 @@ def test_a_complete_fit_tries_no_pair() -> None:
     fit, p, band, thr, test = _setup()
     res = fit.fit(p, np.ones((4, 1), complex), refine=True)
     tried: list[complex] = []
-    assert _split(fit, res, _modes(res), band, thr, 0.02, 0.2, test, tried) is None
+    assert (
+        _split(fit, res, _modes(res), power_of(fit, res), band, thr, 0.02, 0.2, test, tried) is None
+    )
     assert tried == []
 
 

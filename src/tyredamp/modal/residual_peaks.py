@@ -24,6 +24,7 @@ carry no bias.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -41,7 +42,7 @@ __all__ = [
     "model_of",
     "power_of",
     "residual_peaks",
-    "residual_peaks_of",
+    "residual_view",
     "room",
     "scan_of",
 ]
@@ -57,13 +58,13 @@ Z_NOISE = 3.0
 SHARE = 0.25
 
 
+@dataclass(frozen=True)
 class ResidualPeaks:
     """Candidate frequencies (Hz), best first, and the residual's excess over the
     noise per line (units of the noise variance) for :func:`room`."""
 
-    def __init__(self, freq: NDArray[np.float64], excess: NDArray[np.float64]) -> None:
-        self.freq = freq
-        self.excess = excess
+    freq: NDArray[np.float64]
+    excess: NDArray[np.float64]
 
 
 def noise_mean(pw: NDArray[np.float64], k_terms: int) -> float:
@@ -270,20 +271,15 @@ def _scan_scale(
     return t, pg
 
 
+@dataclass(frozen=True)
 class ScanGrid:
     """The coherent scan's statistic on its grids (:func:`coherent_scan`): trial
     poles (N,), their statistic (N,) and whether each is a local maximum of its
     grid (N,)."""
 
-    def __init__(
-        self,
-        poles: NDArray[np.complex128],
-        stat: NDArray[np.float64],
-        is_max: NDArray[np.bool_],
-    ) -> None:
-        self.poles = poles
-        self.stat = stat
-        self.is_max = is_max
+    poles: NDArray[np.complex128]
+    stat: NDArray[np.float64]
+    is_max: NDArray[np.bool_]
 
     def candidates(self, level: float, n_max: int) -> list[tuple[complex, float]]:
         """Local maxima whose statistic reaches ``level``, with it, largest first,
@@ -360,17 +356,6 @@ def coherent_scan(
     return ScanGrid(np.concatenate(pp), np.concatenate(tt), np.concatenate(mm))
 
 
-def residual_peaks_of(
-    fitter: ModalFitter, res: FitResult, n_max: int, threshold: float, zeta0: float
-) -> ResidualPeaks:
-    """Candidate frequencies of missed modes from the fit's residual power per
-    line, summed over the FRFs in units of each output's noise variance and
-    weighted as the fit weights the lines (:func:`residual_peaks`)."""
-    pw = power_of(fitter, res)
-    k_terms = fitter.n_out * fitter.n_in
-    return residual_peaks(fitter.f, pw, k_terms, zeta0, threshold, n_max)
-
-
 def scan_of(fitter: ModalFitter, res: FitResult, zeta0: float) -> ScanGrid:
     """The coherent scan of the fit's residual (:func:`coherent_scan`)."""
     poles, residues, terms, s2 = model_of(fitter, res)
@@ -421,3 +406,12 @@ def local_ratio(
     i1 = np.searchsorted(f, fc + half, side="right")
     n = np.maximum(i1 - i0, 1)
     return np.asarray((c[i1] - c[i0]) / n / max(mean, 1e-300)), np.asarray(n, dtype=np.intp)
+
+
+def residual_view(
+    fitter: ModalFitter, res: FitResult, zeta0: float
+) -> tuple[ScanGrid, NDArray[np.float64]]:
+    """The coherent scan of a fit's residual (:func:`scan_of`) and its residual power
+    per line (n_f,) in units of each output's noise (:func:`power_of`): what one
+    round of the residual search reads, formed once per fit."""
+    return scan_of(fitter, res, zeta0), power_of(fitter, res)

@@ -49,10 +49,9 @@ from .residual_peaks import (
     SCAN_SHARE,
     ScanGrid,
     local_ratio,
-    power_of,
-    residual_peaks_of,
+    residual_peaks,
+    residual_view,
     room,
-    scan_of,
 )
 from .span_noise import SpanNoise
 from .thresholds import ModeTest, local_thresholds, residual_span
@@ -513,7 +512,7 @@ TOWARD_CROSSED = (
 def _starts(
     fitter: ModalFitter,
     res: FitResult,
-    grid: ScanGrid,
+    view: tuple[ScanGrid, NDArray[np.float64]],
     pending: list[tuple[complex, NDArray[np.complex128]]],
     threshold: float,
     zeta0: float,
@@ -524,8 +523,10 @@ def _starts(
     trial poles (``scan``), or else the residual's peaks where the scan finds
     room for a mode near them (``SUPPORT_SHARE`` of the threshold); then the
     diagram's candidates ``pending`` whose half-power band (+-2 zeta f) holds
-    enough residual power above the noise to pass."""
-    found = residual_peaks_of(fitter, res, MAX_TRIALS, threshold, zeta0)
+    enough residual power above the noise to pass. ``view``: the scan of the
+    fit's residual and its power per line (:func:`~.residual_peaks.residual_view`)."""
+    grid, pw = view
+    found = residual_peaks(fitter.f, pw, fitter.n_out * fitter.n_in, zeta0, threshold, MAX_TRIALS)
     ones = np.ones(fitter.n_in, complex)
     starts: list[tuple[complex, NDArray[np.complex128]]] = []
     if scan:
@@ -657,19 +658,17 @@ def residual_search(
     refused: list[complex] = []  # trial modes whose joint refit failed (current modes)
     crossed: set[int] = set()  # sides of the band trial modes crossed to (current modes)
     fixed = FixedParts(fitter) if fixed is None else fixed
-    scanned = False  # the coherent scan's candidates were tried on the current modes
+    scan_next = False  # this round tries the coherent scan's poles
+    scanned = False  # the coherent scan's poles were tried on the current modes
     split_tried: list[complex] = []  # modes split already (_split)
-    grid: tuple[FitResult | None, ScanGrid] = (
-        None,
-        ScanGrid(np.zeros(0, complex), np.zeros(0), np.zeros(0, bool)),
-    )
+    view_of: FitResult | None = None  # the fit whose residual ``view`` holds
     for _ in range(MAX_ROUNDS):
         # the residual's peaks first (where the structure is), then the diagram's;
         # when they add nothing, the coherent scan's poles (one round per mode set)
-        if grid[0] is not res:
-            grid = (res, scan_of(fitter, res, zeta0))
-        starts = _starts(fitter, res, grid[1], pending, threshold, zeta0, test, scanned is None)
-        scanned = True if scanned is None else scanned
+        if view_of is not res:
+            view, view_of = residual_view(fitter, res, zeta0), res
+        starts = _starts(fitter, res, view, pending, threshold, zeta0, test, scan_next)
+        scanned, scan_next = scanned or scan_next, False
         pending = []
         added = False
         n_tried = 0
@@ -712,13 +711,15 @@ def residual_search(
             res, cur = got1
             added, refused, crossed, scanned = True, [], set(), False
         if not added and scanned:
-            got2 = _split(fitter, res, cur, band, threshold, df, max_damping, test, split_tried)
+            got2 = _split(
+                fitter, res, cur, view[1], band, threshold, df, max_damping, test, split_tried
+            )
             if got2 is None:
                 break
             res, cur = got2
             refused, crossed, scanned = [], set(), False
         elif not added:
-            scanned = None  # type: ignore[assignment]
+            scan_next = True
     return res, cur, tried
 
 
@@ -726,6 +727,7 @@ def _split(
     fitter: ModalFitter,
     res: FitResult,
     cur: ModeSet,
+    pw: NDArray[np.float64],
     band: tuple[float, float],
     threshold: float,
     df: float,
@@ -740,12 +742,14 @@ def _split(
     poles half a half-width either side, refitted with all modes and kept when
     both pass the mode test (:func:`_joint`). A trial adds one mode alone with
     the others held: it cannot move the mode that took the pair's place, so no
-    trial finds the second. ``tried`` (poles split already) grows."""
-    pw = power_of(fitter, res)
+    trial finds the second. ``pw``: the fit's residual power per line (n_f,),
+    in units of each output's noise; ``tried`` (poles split already) grows."""
     m, k = cur.m, 2 * fitter.n_out * fitter.n_in
     p = res.poles[:m]
     rho, n = local_ratio(fitter.f, pw, p)
     level = sps.chi2.isf(0.05 / max(m, 1), k * n) / (k * n)
+    if not np.any(rho > level):
+        return None
     # where the noise lies along the response (threshold raised), the residual near
     # a mode is that noise: no evidence of a second mode
     span = residual_span(fitter, res) if test is not None else None
