@@ -19,12 +19,17 @@ pure output noise reach about 80).
 Measured, not assumed. At each line the weighted residual ``e`` (n_out x
 n_in, each output divided by its noise RMS, the line weight applied, as the
 fit weights it) is split by an orthonormal basis ``Q_f`` of the columns of the
-equally weighted data ``H(f)`` into its part in the span, ``a_f = ||Q^H e||^2
+equally weighted model ``H^(f)`` into its part in the span, ``a_f = ||Q^H e||^2
 / (2 n_in^2)`` per complex dimension, and the rest, ``b_f = (||e||^2 - ||Q^H
 e||^2) / (2 (n_out - n_in) n_in)`` (a complex entry holds two real units of
 the noise variance ``s^2``); for independent noise of the assumed
-variance both are 1 in expectation (the span of the data's own columns is
-fixed by the data, independent of white noise to first order). The sums over
+variance both are 1 in expectation. The span is the fitted model's, which
+depends on the noise only through the few parameters of the fit, not the
+noisy data's own columns: where the noise is as large as the response (a weak
+mode at 20 dB, an antiresonance) those columns are mostly the noise itself,
+and white noise projected on them looked concentrated along the response
+(``a_f`` about 1.7 for noise 0.3 times the mean response), raising the
+thresholds of weak true modes. The sums over
 the lines near a candidate (its half-power band, at least ``WINDOW`` lines
 either side) give ``lambda_in`` and ``lambda_out``, the noise variance per
 direction in and off the span in units of the fit's noise
@@ -90,7 +95,7 @@ class SpanNoise:
 def _split(
     u: NDArray[np.complex128], ew: NDArray[np.complex128]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``||Q_f^H e_f||^2`` and ``||e_f||^2`` per line of the weighted data ``u`` and
+    """``||Q_f^H e_f||^2`` and ``||e_f||^2`` per line of the weighted model ``u`` and
     residual ``ew`` (n_out, n_in, lines), ``Q_f`` an orthonormal basis of the columns
     of ``u_f``. One input: ``Q_f = u_f / ||u_f||``, so ``||Q^H e||^2 = |u^H e|^2 /
     ||u||^2`` (no QR); otherwise a QR of every line (a zero ``u_f`` too)."""
@@ -129,7 +134,8 @@ def span_noise(
             h = fitter.H[:, :, sl]
             if lw is not None:
                 h = h * lw[sl]
-            e_in, e_all = _split(h * isd[:, None, None], e * isd[:, None, None])
+            # the span of the model's columns (h - e: the weighted model), not the data's
+            e_in, e_all = _split((h - e) * isd[:, None, None], e * isd[:, None, None])
             # s2 is the variance of a real row: a complex entry holds 2 s2
             a[sl] = e_in / (2 * n_in**2)
             b[sl] = np.maximum(e_all - e_in, 0.0) / (2 * (n_out - n_in) * n_in)
