@@ -21,9 +21,7 @@ F = np.linspace(0.5, 40.0, 1200)
 INPUTS = [0, 5]
 
 
-def _data(
-    common: float, seed: int, white: float = 1e-3
-) -> tuple[np.ndarray, np.ndarray, Any]:
+def _data(common: float, seed: int, white: float = 1e-3) -> tuple[np.ndarray, np.ndarray, Any]:
     """Accelerances of the chain with white noise of RMS ``white`` times the mean |H|
     per entry, plus ``common`` times an H1 input-noise error ``H(f) M(f)`` (``M``
     complex Gaussian n_in x n_in per line, common to all outputs)."""
