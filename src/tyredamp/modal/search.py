@@ -44,7 +44,6 @@ from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
 from .fit import FitResult, ModalFitter
-from .pairs import pair_screen
 from .quality import RejectedMode, threshold_text
 from .residual_peaks import (
     SCAN_SHARE,
@@ -55,7 +54,6 @@ from .residual_peaks import (
     room,
 )
 from .span_noise import SpanNoise
-from .stats import FALSE_ALARM
 from .thresholds import ModeTest, local_thresholds, residual_span
 
 __all__ = [
@@ -737,31 +735,27 @@ def _split(
     test: ModeTest | None,
     tried: list[complex],
 ) -> tuple[FitResult, ModeSet] | None:
-    """A close pair where one mode stands for two: the in-band modes whose
-    second-order pole column holds a significant part of the residual
-    (:func:`~tyredamp.modal.pairs.pair_screen`) or whose local dispersion
-    (residual power within two half-widths over the band's mean,
+    """A close pair where one mode stands for two: the in-band modes whose local
+    dispersion (residual power within two half-widths over the band's mean,
     :func:`~tyredamp.modal.final.local_dispersion`) exceeds its 5 % noise level
-    (both Bonferroni over the modes), the most significant first, are each
-    replaced by two poles half a half-width either side, refitted with all
-    modes and kept when both pass the mode test (:func:`_joint`). A trial adds
-    one mode alone with the others held: it cannot move the mode that took the
-    pair's place, so no trial finds the second. ``pw``: the fit's residual power
-    per line (n_f,), in noise units; ``tried`` (poles split already) grows."""
+    (Bonferroni over the modes), most dispersed first, are each replaced by two
+    poles half a half-width either side, refitted with all modes and kept when
+    both pass the mode test (:func:`_joint`). A trial adds one mode alone with
+    the others held: it cannot move the mode that took the pair's place, so no
+    trial finds the second. ``pw``: the fit's residual power per line (n_f,),
+    in units of each output's noise; ``tried`` (poles split already) grows."""
     m, k = cur.m, 2 * fitter.n_out * fitter.n_in
     p = res.poles[:m]
     rho, n = local_ratio(fitter.f, pw, p)
-    alpha = FALSE_ALARM if test is None else test.false_alarm
     level = sps.chi2.isf(0.05 / max(m, 1), k * n) / (k * n)
-    score = np.maximum(rho / level, pair_screen(fitter, res, m, alpha))
-    if not np.any(score > 1.0):
+    if not np.any(rho > level):
         return None
     # where the noise lies along the response (threshold raised), the residual near
     # a mode is that noise: no evidence of a second mode
     span = residual_span(fitter, res) if test is not None else None
     raised = local_thresholds(fitter, span, p, threshold, test) > threshold
-    for i in np.argsort(-score):
-        if score[i] <= 1.0 or raised[i]:
+    for i in np.argsort(-rho):
+        if rho[i] <= level[i] or raised[i]:
             continue
         if any(abs(q - p[i]) < 2 * MERGE * abs(p[i]) for q in tried):
             continue

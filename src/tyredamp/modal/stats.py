@@ -100,7 +100,6 @@ __all__ = [
     "mode_null_sf",
     "mode_parameters",
     "mode_threshold",
-    "rank_one_isf",
     "rank_one_sf",
     "span_threshold",
     "weight_factor",
@@ -181,31 +180,6 @@ def mode_null_sf(x: float, n_out: int, n_in: int) -> float:
 
     val = integrate.quad(f, 0.0, float(x), epsabs=0.0, epsrel=1e-8, limit=200)[0]
     return float(math.exp(-0.5 * x) + val)
-
-
-@functools.lru_cache(maxsize=256)
-def rank_one_isf(level: float, n_out: int, n_in: int) -> float:
-    """The upper ``level`` quantile of :func:`rank_one_sf` (``chi2_(2 n_out)`` with
-    one input; the parameter count's ``chi2_(2 (n_out + n_in - 1))`` beyond
-    ``_RANK_ONE_MAX``)."""
-    m, n = min(int(n_out), int(n_in)), max(int(n_out), int(n_in))
-    if m == 1:
-        return _chi2_isf(level, 2 * n)
-    lo = _chi2_isf(level, 2 * (m + n - 1))
-    if m > _RANK_ONE_MAX:
-        return lo
-    hi = 2.0 * lo + 10.0
-    while rank_one_sf(hi, n_out, n_in) > level:
-        hi *= 2.0
-    lv = math.log(level)
-    return float(
-        optimize.brentq(
-            lambda x: math.log(max(rank_one_sf(x, n_out, n_in), 1e-300)) - lv,
-            lo * 0.9,
-            hi,
-            xtol=1e-6,
-        )
-    )
 
 
 @functools.lru_cache(maxsize=256)
