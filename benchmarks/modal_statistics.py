@@ -243,6 +243,8 @@ def _refitted_lr(
     mode beside them, which the statistic at the true poles (``t_fixed``, the
     other poles held) does not allow. Computed where ``t_fixed`` lies within
     ``LR_RANGE`` times ``thr`` (in band); outside it ``t_fixed`` stands."""
+    from tyredamp.exceptions import ConvergenceError
+
     out = np.asarray(t_fixed, float).copy()
     todo = np.flatnonzero(inb & (out > LR_RANGE[0] * thr) & (out < LR_RANGE[1] * thr))
     if not todo.size:
@@ -253,8 +255,8 @@ def _refitted_lr(
         keep = np.arange(poles.size) != i
         try:
             out[i] = 2.0 * (fit.fit(poles[keep], part[keep], **kw).cost - full)
-        except Exception:  # a refit that fails leaves the fixed-pole statistic
-            continue
+        except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+            continue  # a refit that fails leaves the fixed-pole statistic
     return out
 
 

@@ -93,6 +93,15 @@ def test_quantile_inverts_the_tail_and_lies_beyond_the_parameter_count() -> None
 def test_rank_one_law_refuses_what_it_cannot_evaluate() -> None:
     with pytest.raises(ValueError, match="min"):
         rank_one_sf(100.0, 20, 17)
+    # an empty residue block or a level that is no probability: named, not a number
+    with pytest.raises(ValueError, match="n_out, n_in >= 1"):
+        rank_one_sf(10.0, 0, 3)
+    with pytest.raises(ValueError, match="n_out, n_in >= 1"):
+        mode_null_sf(10.0, 4, 0)
+    with pytest.raises(ValueError, match="probability"):
+        mode_null_isf(0.0, 4, 3)
+    with pytest.raises(ValueError, match="probability"):
+        mode_null_isf(1.5, 4, 3)
     # mode_threshold keeps the parameter count's quantile there
     k = mode_parameters(20, 17, "complex")
     assert mode_threshold(k, 100, 0.01, None, (20, 17)) == mode_threshold(k, 100, 0.01)

@@ -257,6 +257,7 @@ def _scan_scale(
     ib = np.searchsorted(f, fg + half, side="right")
     stride = max(1, -(-int(np.max(ib - ia)) // SCAN_LINES))
     t = np.empty(fg.size)
+    fn = np.abs(fitted) / (2 * np.pi)
     for c0 in range(0, fg.size, SCAN_CHUNK):
         g = slice(c0, c0 + SCAN_CHUNK)
         la, lb = int(ia[g].min()), int(ib[g].max())
@@ -265,7 +266,6 @@ def _scan_scale(
         li = np.arange(la, lb, stride)
         inside = (li[None, :] >= ia[g, None]) & (li[None, :] < ib[g, None])
         a = np.where(inside, kap[None, :] / (s[None, :] - pg[g, None]), 0.0)
-        fn = np.abs(fitted) / (2 * np.pi)
         near = fitted[(fn >= f[la]) & (fn <= f[lb - 1])]
         t[g] = _scan_statistic(resid(sl), _off_fitted(a, inside, s, kap, near), int(fit.n_in))
     return t, pg

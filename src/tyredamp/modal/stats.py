@@ -131,11 +131,19 @@ def _f_isf(q: float, dfn: float, dfd: float) -> float:
 _RANK_ONE_MAX = 16
 
 
+def _check_shape(n_out: int, n_in: int) -> tuple[int, int]:
+    """``min`` and ``max`` of a residue block's dimensions, both at least 1."""
+    if int(n_out) < 1 or int(n_in) < 1:
+        raise ValueError(f"residue block: expected n_out, n_in >= 1, got {n_out} x {n_in}")
+    return min(int(n_out), int(n_in)), max(int(n_out), int(n_in))
+
+
 def rank_one_sf(x: float, n_out: int, n_in: int) -> float:
     """``P(T_0 > x)`` for the statistic of a complex mode that is not there, at a
     given pole: ``T_0 = 2 lambda_max(W)``, ``W`` the complex Wishart matrix
     ``Z^H Z`` of an ``n_out x n_in`` residue block ``Z`` of independent unit
-    complex Gaussian entries (module docstring).
+    complex Gaussian entries (module docstring). ``x`` in the units of the mode
+    statistic ``T``: the noise variance of one real row.
 
     Khatri (1964), *Ann. Math. Statist.* 35, 1807-1810: with ``m = min(n_out,
     n_in)``, ``n = max(n_out, n_in)``, ``P(lambda_max <= y) = det[gamma(n - m + i + j
@@ -146,8 +154,8 @@ def rank_one_sf(x: float, n_out: int, n_in: int) -> float:
     (``-expm1(sum log1p(-mu))``: no cancellation at small tails). With one input
     it is ``chi2_(2 n_out)``.
     """
-    m, n = min(int(n_out), int(n_in)), max(int(n_out), int(n_in))
-    if m < 1 or not x > 0.0:
+    m, n = _check_shape(n_out, n_in)
+    if not x > 0.0:
         return 1.0
     if m > _RANK_ONE_MAX:
         raise ValueError(f"rank_one_sf: min(n_out, n_in) = {m} > {_RANK_ONE_MAX}")
@@ -169,11 +177,12 @@ def mode_null_sf(x: float, n_out: int, n_in: int) -> float:
     ``T_0`` the rank-one residue's (:func:`rank_one_sf`) and ``B ~ chi2_2`` its pole,
     independent (module docstring): ``e^(-x/2) + int_0^x e^(-b/2) / 2 P(T_0 > x -
     b) db``. With one input it is ``chi2_(2 n_out + 2)``, the ``chi2_k`` of
-    :func:`mode_parameters`."""
+    :func:`mode_parameters`. ``x`` in the units of ``T`` (:func:`rank_one_sf`)."""
+    m, n = _check_shape(n_out, n_in)
     if not x > 0.0:
         return 1.0
-    if min(int(n_out), int(n_in)) == 1:
-        return float(sps.chi2.sf(x, 2 * max(int(n_out), int(n_in)) + 2))
+    if m == 1:
+        return float(sps.chi2.sf(x, 2 * n + 2))
 
     def f(b: float) -> float:
         return 0.5 * math.exp(-0.5 * b) * rank_one_sf(x - b, n_out, n_in)
@@ -184,11 +193,15 @@ def mode_null_sf(x: float, n_out: int, n_in: int) -> float:
 
 @functools.lru_cache(maxsize=256)
 def mode_null_isf(level: float, n_out: int, n_in: int) -> float:
-    """The upper ``level`` quantile of :func:`mode_null_sf` (``chi2_k`` with one input)."""
-    if min(int(n_out), int(n_in)) == 1:
-        return _chi2_isf(level, 2 * max(int(n_out), int(n_in)) + 2)
-    k = 2 * (n_out + n_in - 1) + 2
-    lo = _chi2_isf(level, k)  # the parameter count's quantile: the law lies beyond it
+    """The upper ``level`` quantile (a probability in (0, 1)) of :func:`mode_null_sf`,
+    in the units of ``T`` (``chi2_k`` with one input)."""
+    if not 0.0 < level < 1.0:
+        raise ValueError(f"level: expected a probability in (0, 1), got {level}")
+    m, n = _check_shape(n_out, n_in)
+    if m == 1:
+        return _chi2_isf(level, 2 * n + 2)
+    # the parameter count's quantile: the law lies beyond it
+    lo = _chi2_isf(level, mode_parameters(n_out, n_in, "complex"))
     hi = 2.0 * lo + 10.0
     while mode_null_sf(hi, n_out, n_in) > level:
         hi *= 2.0
