@@ -296,8 +296,8 @@ def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:
     """Threshold of the mode test for ``kind`` modes on ``problem`` (:func:`mode_threshold`)."""
     n_out, n_in, n_f = problem.shape
     k = mode_parameters(n_out, n_in, kind)
-    shape = (n_out, n_in) if kind == "complex" else None  # the rank-one law of a residue
-    return mode_threshold(k, n_f, false_alarm, problem.weight_dof, shape)
+    # the rank-one law of a residue (complex or real, :func:`rank_one_sf`)
+    return mode_threshold(k, n_f, false_alarm, problem.weight_dof, (n_out, n_in), kind)
 
 
 def _mode_test(problem: FitProblem, false_alarm: float) -> ModeTest:

@@ -25,7 +25,10 @@ is 4.5 units beyond it for 4 outputs and 3 inputs, 10 for 8 and 4. The law of
 ``T`` is then taken as ``T_0 + B``, ``B ~ chi2_2`` the pole's share
 (:func:`mode_null_sf`; exactly ``chi2_k`` with one input), and the threshold
 as its quantile (:func:`mode_null_isf`); the corrections for estimated line
-weights below scale with it.
+weights below scale with it. A real mode's residue is ``u l^T`` with real
+``u`` and ``l`` on one complex column: ``T_0 = lambda_max(Z^T Z)`` with ``Z``
+real, the largest eigenvalue of a real Wishart matrix (Chiani 2017,
+``kind="real"``).
 The threshold depends neither on the noise level nor on the scale of the
 data; ``T`` is measured in units of the noise. ``T`` is divided by the
 residual variance of the weighted fit itself (``s^2 = cost / dof`` over
@@ -83,6 +86,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,6 +104,7 @@ __all__ = [
     "mode_null_sf",
     "mode_parameters",
     "mode_threshold",
+    "rank_one_available",
     "rank_one_sf",
     "span_threshold",
     "weight_factor",
@@ -138,25 +143,36 @@ def _check_shape(n_out: int, n_in: int) -> tuple[int, int]:
     return min(int(n_out), int(n_in)), max(int(n_out), int(n_in))
 
 
-def rank_one_sf(x: float, n_out: int, n_in: int) -> float:
-    """``P(T_0 > x)`` for the statistic of a complex mode that is not there, at a
-    given pole: ``T_0 = 2 lambda_max(W)``, ``W`` the complex Wishart matrix
-    ``Z^H Z`` of an ``n_out x n_in`` residue block ``Z`` of independent unit
-    complex Gaussian entries (module docstring). ``x`` in the units of the mode
-    statistic ``T``: the noise variance of one real row.
+def rank_one_sf(x: float, n_out: int, n_in: int, kind: str = "complex") -> float:
+    """``P(T_0 > x)`` for the statistic of a mode that is not there, at a given
+    pole (module docstring). ``x`` in the units of the mode statistic ``T``: the
+    noise variance of one real row.
 
-    Khatri (1964), *Ann. Math. Statist.* 35, 1807-1810: with ``m = min(n_out,
-    n_in)``, ``n = max(n_out, n_in)``, ``P(lambda_max <= y) = det[gamma(n - m + i + j
-    - 1, y)] / det[Gamma(n - m + i + j - 1)]`` (``i, j = 1..m``, ``gamma`` the lower
-    incomplete gamma function; the denominator is ``prod Gamma(n - i + 1) Gamma(m - i
-    + 1)``). The upper tail is taken as ``1 - det(I - G^-1 U)``, ``G`` and ``U`` the
-    complete and upper incomplete gammas, from the eigenvalues of ``G^-1 U``
-    (``-expm1(sum log1p(-mu))``: no cancellation at small tails). With one input
-    it is ``chi2_(2 n_out)``.
+    Complex modes: ``T_0 = 2 lambda_max(W)``, ``W`` the complex Wishart matrix
+    ``Z^H Z`` of an ``n_out x n_in`` residue block ``Z`` of independent unit
+    complex Gaussian entries. Khatri (1964), *Ann. Math. Statist.* 35,
+    1807-1810: with ``m = min(n_out, n_in)``, ``n = max(n_out, n_in)``,
+    ``P(lambda_max <= y) = det[gamma(n - m + i + j - 1, y)] / det[Gamma(n - m + i +
+    j - 1)]`` (``i, j = 1..m``, ``gamma`` the lower incomplete gamma function; the
+    denominator is ``prod Gamma(n - i + 1) Gamma(m - i + 1)``). The upper tail is
+    taken as ``1 - det(I - G^-1 U)``, ``G`` and ``U`` the complete and upper
+    incomplete gammas, from the eigenvalues of ``G^-1 U`` (``-expm1(sum
+    log1p(-mu))``: no cancellation at small tails). With one input it is
+    ``chi2_(2 n_out)``.
+
+    Real modes (``kind="real"``): ``T_0 = lambda_max(Z^T Z)``, ``Z`` real with
+    independent unit Gaussian entries (:func:`_real_rank_one_sf`, Chiani 2017);
+    ``chi2_n`` with one input. Raises ValueError where the law is not evaluated
+    (:func:`rank_one_available`).
     """
     m, n = _check_shape(n_out, n_in)
+    _check_kind(kind)
     if not x > 0.0:
         return 1.0
+    if kind == "real":
+        if m == 1:
+            return float(sps.chi2.sf(x, n))
+        return _real_rank_one_sf(float(x), m, n)
     if m > _RANK_ONE_MAX:
         raise ValueError(f"rank_one_sf: min(n_out, n_in) = {m} > {_RANK_ONE_MAX}")
     y = 0.5 * float(x)
@@ -172,43 +188,138 @@ def rank_one_sf(x: float, n_out: int, n_in: int) -> float:
     return float(min(max(-np.expm1(np.sum(np.log1p(-mu)).real), 0.0), 1.0))
 
 
-def mode_null_sf(x: float, n_out: int, n_in: int) -> float:
-    """``P(T_0 + B > x)``: the statistic of a complex mode that is not there,
-    ``T_0`` the rank-one residue's (:func:`rank_one_sf`) and ``B ~ chi2_2`` its pole,
-    independent (module docstring): ``e^(-x/2) + int_0^x e^(-b/2) / 2 P(T_0 > x -
-    b) db``. With one input it is ``chi2_(2 n_out + 2)``, the ``chi2_k`` of
-    :func:`mode_parameters`. ``x`` in the units of ``T`` (:func:`rank_one_sf`)."""
+def _check_kind(kind: str) -> None:
+    if kind not in ("complex", "real"):
+        raise ValueError(f"kind: expected 'complex' or 'real', got {kind!r}")
+
+
+#: the largest condition number of the real law's skew-symmetric matrix at
+#: infinity (:func:`_real_terms`) for which the law is evaluated: at 2e13 (16 x 16)
+#: and 7e11 (8 x 64) it agrees with Monte Carlo samples, at 3e16 (16 x 40) it does
+#: not; beyond, :func:`rank_one_available` is False and the threshold stays chi2_k
+_REAL_MAX_COND = 5e13
+
+
+@functools.lru_cache(maxsize=64)
+def _real_terms(m: int, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    """The constant parts of the real law (``2 <= m <= n``): the skew-symmetric
+    matrix ``A(inf)`` (:func:`_real_rank_one_sf`), the coefficients ``c_ij =
+    2^(1 - a_i - a_j) Gamma(a_i + a_j) / (Gamma(a_j + 1) Gamma(a_i))`` and the
+    condition number of ``A(inf)``; ``a_i = (n - m - 1) / 2 + i``."""
+    a = 0.5 * (n - m - 1) + np.arange(1, m + 1)
+    aij = a[:, None] + a[None, :]
+    lc = (1.0 - aij) * math.log(2.0) + sps_special.gammaln(aij)
+    lc -= sps_special.gammaln(a[None, :] + 1.0) + sps_special.gammaln(a[:, None])
+    c = np.exp(lc)
+    a_inf = _skew(c, np.ones(m) if m % 2 else None)
+    for arr in (a_inf, c):
+        arr.flags.writeable = False
+    return a_inf, c, float(np.linalg.cond(a_inf))
+
+
+def _skew(terms: NDArray[np.float64], last: NDArray[np.float64] | None) -> NDArray[np.float64]:
+    """The skew-symmetric matrix of the real law: ``a_(i,j+1) = a_(i,j) +
+    terms_(i,j)`` from ``a_ii = 0`` (``i < j``), and the column ``last`` appended
+    (odd ``m``)."""
+    m = terms.shape[0]
+    size = m + (last is not None)
+    top = np.zeros((size, size))
+    for i in range(m - 1):
+        top[i, i + 1 : m] = np.cumsum(terms[i, i : m - 1])
+    if last is not None:
+        top[:m, m] = last
+    return np.asarray(top - top.T)
+
+
+def rank_one_available(n_out: int, n_in: int, kind: str = "complex") -> bool:
+    """Is the exact law of :func:`rank_one_sf` evaluated for this residue block?
+    Complex modes: ``min(n_out, n_in) <= 16``; real modes: the condition number
+    of the law's matrix at most ``_REAL_MAX_COND`` (all blocks up to 16 x 16)."""
     m, n = _check_shape(n_out, n_in)
+    _check_kind(kind)
+    if kind == "complex":
+        return m <= _RANK_ONE_MAX
+    return m == 1 or _real_terms(m, n)[2] <= _REAL_MAX_COND
+
+
+def _real_rank_one_sf(x: float, m: int, n: int) -> float:
+    """``P(lambda_max(W) > x)``, ``W`` real Wishart ``W_m(n, I)`` (``2 <= m <= n``).
+
+    Chiani (2017), *IEEE Trans. Inf. Theory* 63, 4521-4531, Algorithm 1 with
+    ``a = 0`` (the real case of Chiani 2014, *J. Multivariate Anal.* 129,
+    69-81): ``P(lambda_max <= x) = K sqrt(det A(x))``, ``A`` skew-symmetric of
+    size ``m`` (``m + 1`` for odd ``m``) with ``a_(i,j+1) = a_(i,j) + c_ij
+    P(a_i + a_j, x) - P(a_i, x/2) (x/2)^a_j e^(-x/2) / Gamma(a_j + 1)`` (``P``
+    the regularised lower incomplete gamma function, ``a_ii = 0``) and, for odd
+    ``m``, ``a_(i,m+1) = P(a_i, x/2)``. Written as ``A(x) = A(inf) - D(x)``,
+    whose terms ``c_ij Q(a_i + a_j, x) + P(a_i, x/2) (x/2)^a_j e^(-x/2) /
+    Gamma(a_j + 1)`` and ``Q(a_i, x/2)`` (``Q = 1 - P``) are all positive, with
+    ``K sqrt(det A(inf)) = 1``: the tail is ``1 - sqrt(det(I - A(inf)^-1 D))``,
+    taken from the eigenvalues of ``A(inf)^-1 D`` as for the complex law.
+    """
+    a_inf, c, cond = _real_terms(m, n)
+    if cond > _REAL_MAX_COND:
+        raise ValueError(f"rank_one_sf: the real law of a {m} x {n} block is not evaluated")
+    a = 0.5 * (n - m - 1) + np.arange(1, m + 1)
+    y = 0.5 * x
+    # P(a_i, y) y^a_j e^-y / Gamma(a_j + 1), the power in logs (no overflow)
+    ey = np.exp(a * math.log(y) - y - sps_special.gammaln(a + 1.0))
+    terms = sps_special.gammaincc(a[:, None] + a[None, :], x) * c
+    terms += sps_special.gammainc(a, y)[:, None] * ey[None, :]
+    d = _skew(terms, sps_special.gammaincc(a, y) if m % 2 else None)
+    mm = np.linalg.solve(a_inf, d)
+    cdf = math.sqrt(max(float(np.linalg.det(np.eye(mm.shape[0]) - mm)), 0.0))
+    if cdf < 0.5:  # the body: 1 - F directly
+        return min(max(1.0 - cdf, 0.0), 1.0)
+    mu = np.linalg.eigvals(mm)
+    return float(min(max(-np.expm1(0.5 * np.sum(np.log1p(-mu)).real), 0.0), 1.0))
+
+
+def mode_null_sf(x: float, n_out: int, n_in: int, kind: str = "complex") -> float:
+    """``P(T_0 + B > x)``: the statistic of a mode that is not there, ``T_0`` the
+    rank-one residue's (:func:`rank_one_sf`, of ``kind``) and ``B ~ chi2_2`` its
+    pole, independent (module docstring): ``e^(-x/2) + int_0^x e^(-b/2) / 2 P(T_0
+    > x - b) db``. With one input it is the ``chi2_k`` of :func:`mode_parameters`
+    (``k = 2 n_out + 2`` complex, ``n_out + 2`` real). ``x`` in the units of ``T``
+    (:func:`rank_one_sf`)."""
+    m, _ = _check_shape(n_out, n_in)
+    _check_kind(kind)
     if not x > 0.0:
         return 1.0
     if m == 1:
-        return float(sps.chi2.sf(x, 2 * n + 2))
+        return float(sps.chi2.sf(x, mode_parameters(n_out, n_in, kind)))
 
     def f(b: float) -> float:
-        return 0.5 * math.exp(-0.5 * b) * rank_one_sf(x - b, n_out, n_in)
+        return 0.5 * math.exp(-0.5 * b) * rank_one_sf(x - b, n_out, n_in, kind)
 
-    val = integrate.quad(f, 0.0, float(x), epsabs=0.0, epsrel=1e-8, limit=200)[0]
+    # far in the tail (below ~1e-12) the round-off of P(T_0 > .) (~1e-16 absolute)
+    # makes quad report slow convergence; the value is right to that round-off
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", integrate.IntegrationWarning)
+        val = integrate.quad(f, 0.0, float(x), epsabs=0.0, epsrel=1e-8, limit=200)[0]
     return float(math.exp(-0.5 * x) + val)
 
 
 @functools.lru_cache(maxsize=256)
-def mode_null_isf(level: float, n_out: int, n_in: int) -> float:
+def mode_null_isf(level: float, n_out: int, n_in: int, kind: str = "complex") -> float:
     """The upper ``level`` quantile (a probability in (0, 1)) of :func:`mode_null_sf`,
     in the units of ``T`` (``chi2_k`` with one input)."""
     if not 0.0 < level < 1.0:
         raise ValueError(f"level: expected a probability in (0, 1), got {level}")
-    m, n = _check_shape(n_out, n_in)
+    m, _ = _check_shape(n_out, n_in)
+    _check_kind(kind)
+    k = mode_parameters(n_out, n_in, kind)
     if m == 1:
-        return _chi2_isf(level, 2 * n + 2)
+        return _chi2_isf(level, k)
     # the parameter count's quantile: the law lies beyond it
-    lo = _chi2_isf(level, mode_parameters(n_out, n_in, "complex"))
+    lo = _chi2_isf(level, k)
     hi = 2.0 * lo + 10.0
-    while mode_null_sf(hi, n_out, n_in) > level:
+    while mode_null_sf(hi, n_out, n_in, kind) > level:
         hi *= 2.0
     lv = math.log(level)
     return float(
         optimize.brentq(
-            lambda x: math.log(max(mode_null_sf(x, n_out, n_in), 1e-300)) - lv,
+            lambda x: math.log(max(mode_null_sf(x, n_out, n_in, kind), 1e-300)) - lv,
             lo * 0.9,
             hi,
             xtol=1e-6,
@@ -229,10 +340,12 @@ def mode_threshold(
     false_alarm: float = FALSE_ALARM,
     weight_dof: float | None = None,
     shape: tuple[int, int] | None = None,
+    kind: str = "complex",
 ) -> float:
     """Threshold of the mode statistic ``T``: ``chi2_k^-1(1 - alpha / n_lines)``, or
-    with ``shape = (n_out, n_in)`` of complex modes the same quantile of the
-    rank-one law (:func:`mode_null_isf`; equal to it with one input).
+    with ``shape = (n_out, n_in)`` the same quantile of the rank-one law of
+    ``kind`` modes (:func:`mode_null_isf`; equal to it with one input; ``k`` must
+    then be :func:`mode_parameters` of that shape and kind).
 
     When the line weights are estimated with ``nu_w`` degrees of freedom, the
     larger of that times ``(nu_w - 2) / (nu_w - 4)`` (at most 2; the bound of
@@ -258,8 +371,12 @@ def mode_threshold(
     level = false_alarm / max(int(n_lines), 1)
     thr = _chi2_isf(level, int(k))
     law = 1.0  # the rank-one law's quantile over the parameter count's
-    if shape is not None and min(int(shape[0]), int(shape[1])) <= _RANK_ONE_MAX:
-        law = max(mode_null_isf(level, int(shape[0]), int(shape[1])) / thr, 1.0)
+    if shape is not None:
+        n_out, n_in = int(shape[0]), int(shape[1])
+        if int(k) != mode_parameters(n_out, n_in, kind):
+            raise ValueError(f"k = {k} is not the parameter count of {kind} modes of {shape}")
+        if rank_one_available(n_out, n_in, kind):
+            law = max(mode_null_isf(level, n_out, n_in, kind) / thr, 1.0)
     if weight_dof is None or not math.isfinite(weight_dof):
         return thr * law
     # the mean bound and the F tail of a mode whose lines share one estimated factor
