@@ -33,6 +33,7 @@ from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
 from .quality import FitQuality, RejectedMode, threshold_text
+from .refitted import refitted_statistics
 from .residual_peaks import local_ratio
 from .search import ModeSet, ModeTest, fit_checked, local_thresholds, rejected, residual_span
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
@@ -423,7 +424,11 @@ def final_complex(
     fell to its threshold in the final refinement (its pole moved onto noise,
     e.g. a damping that collapsed) is dropped, the weakest first, and the fit
     repeated. Also returns the threshold applied to each kept in-band mode (fit
-    order; None without ``threshold``).
+    order; None without ``threshold``). When every mode passes with the other
+    poles held, modes beside a stronger one are tested once more with the
+    neighbours' poles refitted (:mod:`~tyredamp.modal.refitted`: the likelihood
+    ratio of the maximised models) and dropped, the weakest first, when that
+    fails.
     """
     dropped: list[RejectedMode] = []
     cur = modes
@@ -438,11 +443,23 @@ def final_complex(
         t = res.significance[:m]
         span = residual_span(cfit, res) if test is not None else None
         thr = local_thresholds(cfit, span, res.poles[:m], threshold, test)
+        refitted = np.zeros(m, bool)
+        if refine and m > 1 and not np.any(t <= thr):
+            # the held-pole statistic passes: the likelihood ratio with the
+            # neighbours' poles refitted where they could take a mode up
+            # on the re-weighted output combinations when the final fit used them
+            lr_fit = combined if combined is not None and sigma0 is not None else cfit
+            t, refitted = refitted_statistics(lr_fit, res, cur, t, thr, sigma0)
         if m <= 1 or not np.any(t <= thr):
+            if refitted.any():  # the statistic the mode passed, reported
+                sig = np.array(res.significance, dtype=float)
+                sig[:m] = t
+                res = dataclasses.replace(res, significance=sig)
             break
         worst = int(np.argmin(np.where(t <= thr, t / thr, np.inf)))
+        how = " with its neighbours' poles refitted" if refitted[worst] else ""
         why = (
-            f"final fit: not significant: T = {t[worst]:.3g} <= "
+            f"final fit: not significant{how}: T = {t[worst]:.3g} <= "
             f"{threshold_text(thr[worst], threshold)}"
         )
         dropped.append(rejected(complex(res.poles[worst]), why, float(t[worst]), float(thr[worst])))
