@@ -446,8 +446,8 @@ def final_complex(
         refitted = np.zeros(m, bool)
         if refine and m > 1 and not np.any(t <= thr):
             # the held-pole statistic passes: the likelihood ratio with the
-            # neighbours' poles refitted where they could take a mode up
-            # on the re-weighted output combinations when the final fit used them
+            # neighbours' poles refitted where they could take a mode up, on the
+            # re-weighted output combinations when the final fit used them
             lr_fit = combined if combined is not None and sigma0 is not None else cfit
             t, refitted = refitted_statistics(lr_fit, res, cur, t, thr, sigma0)
         if m <= 1 or not np.any(t <= thr):
