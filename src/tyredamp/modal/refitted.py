@@ -45,10 +45,10 @@ __all__ = ["OVERLAP", "REFIT_NFEV", "refit_candidates", "refitted_statistics"]
 OVERLAP = 2.0
 #: evaluations of a refit without a mode: the cost falls monotonically, so a
 #: refit stopped there bounds the refitted statistic from above; a mode is dropped
-#: only when that bound fails the test (beside modes 1e9 times the threshold a
-#: refit can take 30 evaluations to move their poles, none of which changes a
-#: verdict)
-REFIT_NFEV = 10
+#: only when that bound fails the test (the first Gauss-Newton steps take most
+#: of what the neighbours can take up; dense bands of modes 1e4-1e9 times the
+#: threshold took 10-30 evaluations per refit, none of which changed a verdict)
+REFIT_NFEV = 4
 
 
 def refit_candidates(
