@@ -461,10 +461,7 @@ class ModalFitter:
             part = (part * ph[:, None]).real.astype(complex)
         ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
         th = self.pack(np.asarray(poles, complex), part, ref)
-        floor = 1e-9 * self._rms
-        w = self._w1
-        if sigma is not None and not self.unit_weights:
-            w = 1.0 / np.maximum(np.asarray(sigma, float), np.maximum(floor, 1e-300))
+        w = self.weights(sigma)
         # an intermediate one-pass refinement started at the result of the previous
         # one (same weights and tolerance) that stopped at rest would stop at once:
         # that result again (one evaluation)
@@ -487,14 +484,23 @@ class ModalFitter:
                     th, m, ref, w, residual=False, gradient=False, derivatives=uncertainty
                 )
             sig_out = np.sqrt(sol["cost_out"] / w**2 / max(dof, 1))
-            if ip + 1 < passes and refine and not self.unit_weights:
-                w = 1.0 / np.maximum(sig_out, np.maximum(floor, 1e-300))
+            if ip + 1 < passes and refine:
+                w = self.weights(sig_out)
         if status == "maxfev":
             warn.append(f"refinement stopped at the evaluation limit ({max_nfev})")
         res = self._result(th, m, ref, w, sol, sig_out, nit, status, warn, uncertainty)
         if once and status == "converged" and self._at_rest(th, sol):
             res.rest = (w.copy(), float(tol))
         return res
+
+    def weights(self, sigma: NDArray[np.float64] | None) -> NDArray[np.float64]:
+        """Row weights of each output (n_out,) for a noise RMS per output ``sigma``
+        (units of the data): ``1 / sigma``, ``sigma`` at least 1e-9 of the output's
+        RMS; the first-pass weights when None or with unit weights."""
+        if sigma is None or self.unit_weights:
+            return self._w1
+        floor = np.maximum(1e-9 * self._rms, 1e-300)
+        return np.asarray(1.0 / np.maximum(np.asarray(sigma, float), floor))
 
     def _real_part(self, part: NDArray[np.complex128]) -> NDArray[np.complex128]:
         """Real-mode participation: each row turned by the phase of its largest entry."""

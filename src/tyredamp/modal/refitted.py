@@ -153,9 +153,7 @@ def _decrement(
     m = int(poles.size)
     part = np.asarray(part, complex).reshape(m, fitter.n_in)
     ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
-    w = fitter._w1
-    if not fitter.unit_weights:
-        w = 1.0 / np.maximum(sigma, np.maximum(1e-9 * fitter._rms, 1e-300))
+    w = fitter.weights(sigma)
     try:
         th = fitter.pack(np.asarray(poles, complex), part, ref)
         x, _, _, sol = fitter._refine(th, m, ref, w, 1)
