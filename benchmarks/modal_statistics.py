@@ -423,7 +423,7 @@ def main() -> None:
             got = json.load(fh)
         seeds = [r["seed"] for r in got["new"]]
         args.systems, args.old_from = len(seeds), args.from_dump
-        _print_all(args, seeds, got["truth"], got["new"], got.get("old"))
+        _print_tables(args, seeds, got["truth"], got["new"], got.get("old"))
         return
     if args.identify_only:  # subprocess of --old-src: identification results as JSON
         print(json.dumps([identify(s) for s in seeds]))
@@ -458,25 +458,7 @@ def main() -> None:
     if args.dump:
         with open(args.dump, "w", encoding="utf-8") as fh:
             json.dump({"new": new, "old": old, "truth": truths}, fh)
-    _print_all(args, seeds, truths, new, old)
-
-
-def _print_all(
-    args: argparse.Namespace,
-    seeds: list[int],
-    truths: list[dict[str, Any]],
-    new: list[dict[str, Any]],
-    old: list[dict[str, Any]] | None,
-) -> None:
-    """The tables of both matching rules."""
-    for rule, what in (
-        ("crlb", "matched within max(0.5 zeta f, 3 CRLB_f)"),
-        ("zeta", "matched within 0.5 zeta f"),
-    ):
-        MATCH["rule"] = rule
-        print(f"== {what}")
-        _print_tables(args, seeds, truths, new, old)
-        print()
+    _print_tables(args, seeds, truths, new, old)
 
 
 def _one(seed: int, noise: str) -> tuple[dict[str, Any], dict[str, Any]]:
@@ -509,24 +491,27 @@ def _print_tables(
     new: list[dict[str, Any]],
     old: list[dict[str, Any]] | None,
 ) -> None:
-    rows_new = [
-        (system(s)["snr"], {**score(t, r), "time": r["time"]})
-        for s, t, r in zip(seeds, truths, new, strict=True)
-    ]
-    errors = [r["error"] for r in new if "error" in r]
-    for line in table(f"this code ({args.systems} systems; {len(errors)} failed fits)", rows_new):
-        print(line)
-    if old is not None:
-        rows_old = [
-            (system(s)["snr"], {**score(t, r), "time": r["time"]})
-            for s, t, r in zip(seeds, truths, old, strict=True)
-        ]
-        err_old = [r["error"] for r in old if "error" in r]
+    """The tables of this code and, when given, of the old rules, for both matching
+    rules."""
+    runs = [("this code", new)] + ([] if old is None else [("old rules", old)])
+    for rule, what in (
+        ("crlb", "matched within max(0.5 zeta f, 3 CRLB_f)"),
+        ("zeta", "matched within 0.5 zeta f"),
+    ):
+        MATCH["rule"] = rule
+        print(f"== {what}")
+        for k, (name, got) in enumerate(runs):
+            rows = [
+                (system(s)["snr"], {**score(t, r), "time": r["time"]})
+                for s, t, r in zip(seeds, truths, got, strict=True)
+            ]
+            n_err = sum("error" in r for r in got)
+            src = f"{args.systems} systems" if k == 0 else args.old_src or args.old_from
+            if k:
+                print()
+            for line in table(f"{name} ({src}; {n_err} failed fits)", rows):
+                print(line)
         print()
-        for line in table(
-            f"old rules ({args.old_src or args.old_from}; {len(err_old)} failed fits)", rows_old
-        ):
-            print(line)
 
 
 if __name__ == "__main__":
