@@ -334,11 +334,16 @@ def to_model(
     base = ctx.threshold
     thr = np.full(n_band, base) if ctx.thresholds is None else np.asarray(ctx.thresholds)[o]
     kept = ctx.kept
-    if kept is None:
+    if kept is None:  # automatic mode count
+        why_not = (
+            "a mode of the complex model, not significant as a real mode"
+            if ctx.kind == "real"
+            else "the only mode left, not significant (no mode passes the test)"
+        )
         kept = tuple(
             f"T = {t:.3g} > {threshold_text(h, base)} (false-alarm rate {ctx.false_alarm:g})"
             if t > h
-            else f"asked for; T = {t:.3g} <= {threshold_text(h, base)}: not significant"
+            else f"{why_not}: T = {t:.3g} <= {threshold_text(h, base)}"
             for t, h in zip(stat, thr, strict=True)
         )
     else:
@@ -455,6 +460,13 @@ def final_complex(
                 sig = np.array(res.significance, dtype=float)
                 sig[:m] = t
                 res = dataclasses.replace(res, significance=sig)
+            if m == 1 and t[0] <= thr[0]:
+                lo, hi = problem.band
+                res.warnings.append(
+                    f"no mode passes the mode test in [{lo:g}, {hi:g}] Hz (T = {t[0]:.3g} <= "
+                    f"{thr[0]:.3g}): the FRFs show no resonance above their noise; the one "
+                    "mode reported (a model needs one) is not significant"
+                )
             break
         worst = int(np.argmin(np.where(t <= thr, t / thr, np.inf)))
         how = " with its neighbours' poles refitted" if refitted[worst] else ""

@@ -94,7 +94,7 @@ from .final import ModelContext, final_complex, fit_real, to_model
 from .fit import FitResult, ModalFitter
 from .lscf import PoleSet, plscf
 from .model import ModalModel
-from .order import Diagram, SelectionRules, default_order, settle_order
+from .order import Diagram, SelectionRules, default_order, modes_shown, settle_order
 from .out_of_band import search_helpers
 from .problem import FitProblem, build_problem, max_modes
 from .quality import RejectedMode
@@ -319,7 +319,8 @@ def _start_modes(
         rejected(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}")
         for c in dg.weak
     ]
-    cand, extra, rej = _candidates(dg, fr, n_modes, rej, warnings)
+    n_shown = modes_shown(problem) if fr is None and n_modes is None and not dg.kept else None
+    cand, extra, rej = _candidates(dg, fr, n_modes, rej, warnings, n_shown)
     if not cand:
         lo, hi = problem.band
         raise InputError(
@@ -374,8 +375,11 @@ def _candidates(
     n_modes: int | None,
     rej: list[RejectedMode],
     warnings: list[str],
+    n_shown: int | None = None,
 ) -> tuple[list[Cluster], list[Cluster], list[RejectedMode]]:
-    """Modes to fit and other persistent modes to fit as in-band residual modes."""
+    """Modes to fit and other persistent modes to fit as in-band residual modes;
+    ``n_shown``: the peaks the data show (:func:`~.order.modes_shown`), for the
+    start of an automatic count whose diagram kept no cluster."""
     if fr is not None:
         cand = _pick_frequencies(fr, dg.kept + dg.weak, dg.poles, dg.flags)
     elif n_modes is not None:
@@ -385,8 +389,17 @@ def _candidates(
         cand = sorted(pool[: int(n_modes)], key=lambda c: c.frequency_hz)
         chosen = {id(c) for c in cand}
         rej = [r for r, c in zip(rej, dg.weak, strict=True) if id(c) not in chosen]
-    else:
+    elif dg.kept or not dg.weak or n_shown is None:
         return list(dg.kept), [], rej
+    else:
+        # no cluster persists (few orders of many inputs, noisy data): the most
+        # persistent ones, as many as the peaks the data show (at least one),
+        # start the fit; the mode test decides on them and the residual search,
+        # from the other clusters and the residual, on the rest
+        first = sorted(dg.weak, key=lambda c: -c.fraction)[: max(1, n_shown)]
+        cand = sorted(first, key=lambda c: c.frequency_hz)
+        rej = [r for r, c in zip(rej, dg.weak, strict=True) if all(c is not d for d in cand)]
+        return cand, [], rej
     # modes the user did not ask for still shape the FRFs: keep the persistent
     # clusters that are not chosen (and not within 1 % of a chosen one) as
     # residual modes, so that the refinement does not pull the chosen poles

@@ -213,16 +213,11 @@ def _off_fitted(
         return a
     b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
     # each window's lines [lo, hi] (G,) and the poles within it (G, m)
-    has = inside.any(axis=1)
-    lo = np.where(has, np.argmax(inside, axis=1), 0)
-    hi = np.where(has, inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1), 0)
+    lo, hi = _windows(inside)
     wn = np.abs(near.imag)
     own = (wn[None, :] >= np.abs(s[lo])[:, None]) & (wn[None, :] <= np.abs(s[hi])[:, None])
     c = (a @ b.conj().T) * own  # (G, m): <b_n, a_g> over the window (a is 0 outside)
-    # the Gram matrices of the windows from prefix sums over the lines (m, m, L + 1)
-    pre = np.zeros((near.size, near.size, b.shape[1] + 1), complex)
-    np.cumsum(b.conj()[:, None, :] * b[None, :, :], axis=2, out=pre[:, :, 1:])
-    gram = np.moveaxis(pre[:, :, hi + 1] - pre[:, :, lo], 2, 0)  # (G, m, m)
+    gram = _window_gram(b, lo, hi)  # (G, m, m)
     both = own[:, :, None] & own[:, None, :]
     eye = np.eye(near.size, dtype=bool)[None, :, :]
     scale = np.max(np.abs(gram), axis=(1, 2), keepdims=True)
@@ -234,16 +229,104 @@ def _off_fitted(
     return np.asarray(a - np.where(inside, sol @ b, 0.0))
 
 
+def _window_gram(
+    b: NDArray[np.complex128], lo: NDArray[np.intp], hi: NDArray[np.intp]
+) -> NDArray[np.complex128]:
+    """``<b_n, b_k>`` over each window's lines ``[lo, hi]`` (G, m, m), from prefix
+    sums over the lines."""
+    pre = np.zeros((b.shape[0], b.shape[0], b.shape[1] + 1), complex)
+    np.cumsum(b.conj()[:, None, :] * b[None, :, :], axis=2, out=pre[:, :, 1:])
+    return np.moveaxis(pre[:, :, hi + 1] - pre[:, :, lo], 2, 0)
+
+
+def _windows(inside: NDArray[np.bool_]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """First and last line of each window (rows of ``inside``; 0, 0 when empty)."""
+    has = inside.any(axis=1)
+    lo = np.where(has, np.argmax(inside, axis=1), 0)
+    hi = np.where(has, inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1), 0)
+    return lo, hi
+
+
+def _rank_one_off_fitted(
+    e: NDArray[np.complex128],
+    a: NDArray[np.complex128],
+    inside: NDArray[np.bool_],
+    s: NDArray[np.complex128],
+    kap: NDArray[np.complex128],
+    near: NDArray[np.complex128],
+    l_near: NDArray[np.complex128],
+) -> NDArray[np.float64]:
+    """The scan's statistic of each window column ``a`` (G, L) against the residual
+    ``e`` (n_out, n_in, L) with the fitted modes ``near`` within the window
+    refitted as the model holds them: rank-one residues ``psi_n l_n^T`` with
+    their participation ``l_near`` (m, n_in) held, ``psi_n`` refitted (several
+    inputs; :func:`_off_fitted` frees every input's coefficient, right for one).
+
+    Per output ``j`` the data are a vector over inputs x lines; a fitted mode's
+    column is ``l_n (x) b_n``, the trial's ``l (x) a`` with ``l`` free. With
+    ``G = [(l_n^H l_k) <b_n, b_k>]``, ``H = [<b_n, a> conj(l_nk)]`` and ``C =
+    G^-1 H``, the trial column off the fitted ones is linear in ``l``; its
+    projection on output ``j`` is ``l^H z_j``, ``z_j = <a, e_j.> - C^H y_j``
+    (``y_jn = sum_k conj(l_nk) <b_n, e_jk>``), its squared norm ``l^H N l``,
+    ``N = ||a||^2 I - H^H C``. The statistic ``max_l sum_j |l^H z_j|^2 / l^H N
+    l`` is the largest squared singular value of ``L^-1 Z``, ``N = L L^H``
+    (the extra sum of squares of a rank-one residue, as
+    :func:`_scan_statistic` without fitted modes)."""
+    g = a.shape[0]
+    n_out, n_in = e.shape[0], e.shape[1]
+    x = (e.reshape(-1, e.shape[-1]) @ a.conj().T).T.reshape(g, n_out, n_in)
+    nrm2 = np.sum(a.real**2 + a.imag**2, axis=1)
+    eye_in = np.eye(n_in)[None, :, :]
+    if near.size == 0:
+        nmat = nrm2[:, None, None] * eye_in
+        z = x
+    else:
+        m = near.size
+        b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
+        lo, hi = _windows(inside)
+        wn = np.abs(near.imag)
+        own = (wn[None, :] >= np.abs(s[lo])[:, None]) & (wn[None, :] <= np.abs(s[hi])[:, None])
+        beta = (a @ b.conj().T) * own  # (G, m): <b_n, a> over the window
+        ll = l_near.conj() @ l_near.T  # (m, m): l_n^H l_k
+        gram = _window_gram(b, lo, hi) * ll[None, :, :]
+        both = own[:, :, None] & own[:, None, :]
+        eye = np.eye(m, dtype=bool)[None, :, :]
+        scale = np.max(np.abs(gram), axis=(1, 2), keepdims=True)
+        gram = np.where(both, gram, 0.0) + np.where(eye & ~both, 1.0, 0.0)
+        gram = gram + eye * (1e-12 * np.maximum(scale, 1e-300))
+        hmat = beta[:, :, None] * l_near.conj()[None, :, :]  # (G, m, n_in)
+        cmat = np.linalg.solve(gram, hmat)
+        # y[g, j, n] = sum_k conj(l_nk) <b_n, e_jk> over window g (prefix sums)
+        w = np.einsum("nk,jkt->njt", l_near.conj(), e) * b.conj()[:, None, :]
+        pre = np.zeros((m, n_out, w.shape[-1] + 1), complex)
+        np.cumsum(w, axis=2, out=pre[:, :, 1:])
+        y = np.moveaxis(pre[:, :, hi + 1] - pre[:, :, lo], 2, 0) * own[:, :, None]  # (G,m,n_out)
+        z = x - np.einsum("gnk,gnj->gjk", cmat.conj(), y)
+        nmat = nrm2[:, None, None] * eye_in - np.einsum("gnk,gnl->gkl", hmat.conj(), cmat)
+        nmat = 0.5 * (nmat + nmat.conj().transpose(0, 2, 1))
+    ridge = 1e-12 * np.maximum(nrm2, 1e-300)[:, None, None] * eye_in
+    try:
+        low = np.linalg.cholesky(nmat + ridge)
+    except np.linalg.LinAlgError:  # a trial column inside the fitted ones' span
+        ev, vec = np.linalg.eigh(nmat)
+        low = vec * np.sqrt(np.maximum(ev, 1e-12 * np.maximum(nrm2, 1e-300)[:, None]))[:, None]
+    wz = np.linalg.solve(low, z.transpose(0, 2, 1))  # (G, n_in, n_out)
+    return np.asarray(np.linalg.svd(wz, compute_uv=False)[:, 0] ** 2)
+
+
 def _scan_scale(
     fit: Any,
     f: NDArray[np.float64],
     z: float,
     resid: Callable[[slice], NDArray[np.complex128]],
     fitted: NDArray[np.complex128],
+    l_fitted: NDArray[np.complex128] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
     """The scan's statistic on the grid of one damping ratio ``z``
     (:func:`coherent_scan`) and the grid's poles; ``resid(lines)`` gives the
-    residual in units of the noise, ``fitted`` the fit's poles."""
+    residual in units of the noise, ``fitted`` the fit's poles and ``l_fitted``
+    (m, n_in) their participation vectors (several inputs: the fitted modes'
+    rank-one residues, :func:`_rank_one_off_fitted`)."""
     n = f.size
     df = float(np.min(np.diff(f)))
     n_g = int(np.log(f[-1] / f[0]) / np.log1p(z)) + 2
@@ -266,8 +349,12 @@ def _scan_scale(
         li = np.arange(la, lb, stride)
         inside = (li[None, :] >= ia[g, None]) & (li[None, :] < ib[g, None])
         a = np.where(inside, kap[None, :] / (s[None, :] - pg[g, None]), 0.0)
-        near = fitted[(fn >= f[la]) & (fn <= f[lb - 1])]
-        t[g] = _scan_statistic(resid(sl), _off_fitted(a, inside, s, kap, near), int(fit.n_in))
+        sel = (fn >= f[la]) & (fn <= f[lb - 1])
+        if l_fitted is not None and int(fit.n_in) > 1:
+            t[g] = _rank_one_off_fitted(resid(sl), a, inside, s, kap, fitted[sel], l_fitted[sel])
+            continue
+        a_off = _off_fitted(a, inside, s, kap, fitted[sel])
+        t[g] = _scan_statistic(resid(sl), a_off, int(fit.n_in))
     return t, pg
 
 
@@ -325,7 +412,10 @@ def coherent_scan(
     singular value of those projections over outputs x inputs (a rank-one
     residue ``psi l^T``, as a mode has), the column taken off the columns of
     the fitted modes within the window: the cost drop of a mode held at ``p``
-    with only its dominant term, the nearby modes' residues refitted. ``model`` is the
+    with only its dominant term, the nearby modes' residues refitted (with
+    several inputs as the model holds them, rank-one with their participation
+    held, :func:`_rank_one_off_fitted`: freeing every input's coefficient took up
+    most of a weak mode's share between two strong ones). ``model`` is the
     fit's ``(poles, residues (n_out, n_in, m), (upper, lower))``.
     """
     fit: Any = fitter
@@ -344,10 +434,16 @@ def coherent_scan(
             return whole[:, :, sl]
         return residual_lines(fit, poles, residues, terms, sl) * inv[:, None, None]
 
+    # each fitted mode's participation: the row space of its rank-one residue
+    l_fit = None
+    res3 = np.asarray(residues)
+    if fit.n_in > 1 and res3.ndim == 3 and res3.shape[-1] == np.size(poles):
+        # R = u l^T = s1 u1 v1^H: l is proportional to the first row of V^H
+        l_fit = np.linalg.svd(res3.transpose(2, 0, 1))[2][:, 0, :]
     pp, tt, mm = [], [], []
     for sc in SCAN_SCALES:
         z = float(np.clip(sc * zeta0, 1e-4, 0.1))
-        t, pg = _scan_scale(fit, f, z, resid, np.asarray(poles, complex))
+        t, pg = _scan_scale(fit, f, z, resid, np.asarray(poles, complex), l_fit)
         left = np.concatenate([[-np.inf], t[:-1]])
         right = np.concatenate([t[1:], [-np.inf]])
         pp.append(pg)

@@ -22,7 +22,8 @@ mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
    :mod:`tyredamp.modal.residual_peaks`) where the coherent scan finds room
    for a mode; when those add nothing, the maxima of the coherent scan itself
    (the mode test's statistic of a pole held at each point of a grid, the
-   fitted modes' columns refitted: a weak mode beside a strong one, a broad
+   fitted modes' residues refitted, rank-one with their participation held when
+   there are several inputs: a weak mode beside a strong one, a broad
    mode spread over many lines). Each is refined alone with the other modes
    held fixed (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`, its
    frequency within 3 % of the start, followed beyond that window while its
