@@ -211,22 +211,28 @@ def _off_fitted(
     without it the strong mode's column takes the weak one's share)."""
     if near.size == 0:
         return a
-    b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
-    # each window's lines [lo, hi] (G,) and the poles within it (G, m)
-    lo, hi = _windows(inside)
-    wn = np.abs(near.imag)
-    own = (wn[None, :] >= np.abs(s[lo])[:, None]) & (wn[None, :] <= np.abs(s[hi])[:, None])
+    b, lo, hi, own = _fitted_in_windows(inside, s, kap, near)
     c = (a @ b.conj().T) * own  # (G, m): <b_n, a_g> over the window (a is 0 outside)
-    gram = _window_gram(b, lo, hi)  # (G, m, m)
-    both = own[:, :, None] & own[:, None, :]
-    eye = np.eye(near.size, dtype=bool)[None, :, :]
-    scale = np.max(np.abs(gram), axis=(1, 2), keepdims=True)
-    # poles outside a window: a unit diagonal (their coefficient is 0); a tiny ridge
-    # keeps two nearly equal columns solvable
-    gram = np.where(both, gram, 0.0) + np.where(eye & ~both, 1.0, 0.0)
-    gram = gram + eye * (1e-12 * np.maximum(scale, 1e-300))
+    gram = _solvable(_window_gram(b, lo, hi), own)  # (G, m, m)
     sol = np.linalg.solve(gram, c[:, :, None])[:, :, 0]
     return np.asarray(a - np.where(inside, sol @ b, 0.0))
+
+
+def _fitted_in_windows(
+    inside: NDArray[np.bool_],
+    s: NDArray[np.complex128],
+    kap: NDArray[np.complex128],
+    near: NDArray[np.complex128],
+) -> tuple[NDArray[np.complex128], NDArray[np.intp], NDArray[np.intp], NDArray[np.bool_]]:
+    """The fitted poles' columns ``kappa / (s - p)`` (m, L), each window's first and
+    last line (G,) and which poles' damped frequencies lie within it (G, m)."""
+    b = kap[None, :] / (s[None, :] - near[:, None])
+    has = inside.any(axis=1)
+    lo = np.where(has, np.argmax(inside, axis=1), 0)
+    hi = np.where(has, inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1), 0)
+    wn = np.abs(near.imag)
+    own = (wn[None, :] >= np.abs(s[lo])[:, None]) & (wn[None, :] <= np.abs(s[hi])[:, None])
+    return b, lo, hi, own
 
 
 def _window_gram(
@@ -239,12 +245,15 @@ def _window_gram(
     return np.moveaxis(pre[:, :, hi + 1] - pre[:, :, lo], 2, 0)
 
 
-def _windows(inside: NDArray[np.bool_]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """First and last line of each window (rows of ``inside``; 0, 0 when empty)."""
-    has = inside.any(axis=1)
-    lo = np.where(has, np.argmax(inside, axis=1), 0)
-    hi = np.where(has, inside.shape[1] - 1 - np.argmax(inside[:, ::-1], axis=1), 0)
-    return lo, hi
+def _solvable(gram: NDArray[np.complex128], own: NDArray[np.bool_]) -> NDArray[np.complex128]:
+    """The windows' Gram matrices (G, m, m) restricted to the poles within each
+    window ``own`` (G, m): the others get a unit diagonal (their coefficient is 0),
+    and a tiny ridge keeps two nearly equal columns solvable."""
+    both = own[:, :, None] & own[:, None, :]
+    eye = np.eye(own.shape[1], dtype=bool)[None, :, :]
+    scale = np.max(np.abs(gram), axis=(1, 2), keepdims=True)
+    gram = np.where(both, gram, 0.0) + np.where(eye & ~both, 1.0, 0.0)
+    return np.asarray(gram + eye * (1e-12 * np.maximum(scale, 1e-300)))
 
 
 def _rank_one_off_fitted(
@@ -282,18 +291,10 @@ def _rank_one_off_fitted(
         z = x
     else:
         m = near.size
-        b = kap[None, :] / (s[None, :] - near[:, None])  # (m, L)
-        lo, hi = _windows(inside)
-        wn = np.abs(near.imag)
-        own = (wn[None, :] >= np.abs(s[lo])[:, None]) & (wn[None, :] <= np.abs(s[hi])[:, None])
+        b, lo, hi, own = _fitted_in_windows(inside, s, kap, near)
         beta = (a @ b.conj().T) * own  # (G, m): <b_n, a> over the window
         ll = l_near.conj() @ l_near.T  # (m, m): l_n^H l_k
-        gram = _window_gram(b, lo, hi) * ll[None, :, :]
-        both = own[:, :, None] & own[:, None, :]
-        eye = np.eye(m, dtype=bool)[None, :, :]
-        scale = np.max(np.abs(gram), axis=(1, 2), keepdims=True)
-        gram = np.where(both, gram, 0.0) + np.where(eye & ~both, 1.0, 0.0)
-        gram = gram + eye * (1e-12 * np.maximum(scale, 1e-300))
+        gram = _solvable(_window_gram(b, lo, hi) * ll[None, :, :], own)
         hmat = beta[:, :, None] * l_near.conj()[None, :, :]  # (G, m, n_in)
         cmat = np.linalg.solve(gram, hmat)
         # y[g, j, n] = sum_k conj(l_nk) <b_n, e_jk> over window g (prefix sums)
