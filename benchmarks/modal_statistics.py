@@ -284,18 +284,15 @@ def _refitted_lr(
     mode beside them, which the statistic at the true poles (``t_fixed``, the
     other poles held) does not allow. Computed (in band) where ``t_fixed`` lies
     within ``LR_RANGE`` times ``thr``, and beyond it for a mode whose resonance
-    overlaps a stronger mode's (:data:`tyredamp.modal.refitted.OVERLAP`): a broad
+    overlaps a stronger mode's (:func:`tyredamp.modal.refitted.overlapping`): a broad
     mode 0.65 half-widths from one 800 times stronger gave ``t_fixed`` 33 times
     the threshold and 1.3 times refitted (seed 194). Elsewhere ``t_fixed``
     stands (isolated modes far above the threshold)."""
     from tyredamp.exceptions import ConvergenceError
-    from tyredamp.modal.refitted import OVERLAP
+    from tyredamp.modal.refitted import overlapping
 
     out = np.asarray(t_fixed, float).copy()
-    sg, wd = -poles.real, poles.imag
-    near = np.abs(wd[:, None] - wd[None, :]) < OVERLAP * (sg[:, None] + sg[None, :])
-    np.fill_diagonal(near, False)
-    stronger = np.any(near & (out[None, :] > out[:, None]), axis=1)
+    stronger = np.any(overlapping(poles) & (out[None, :] > out[:, None]), axis=1)
     span = (out > LR_RANGE[0] * thr) & ((out < LR_RANGE[1] * thr) | stronger)
     todo = np.flatnonzero(inb & span)
     if not todo.size:

@@ -382,24 +382,22 @@ def _candidates(
     start of an automatic count whose diagram kept no cluster."""
     if fr is not None:
         cand = _pick_frequencies(fr, dg.kept + dg.weak, dg.poles, dg.flags)
-    elif n_modes is not None:
+    else:
+        n_pick = n_modes
+        if n_pick is None:
+            if dg.kept or not dg.weak or n_shown is None:
+                return list(dg.kept), [], rej
+            # no cluster persists (few orders of many inputs, noisy data): the most
+            # persistent ones, as many as the peaks the data show (at least one),
+            # start the fit; the mode test decides on them and the residual search,
+            # from the other clusters and the residual, on the rest
+            n_pick = max(1, n_shown)
         pool = sorted(dg.kept + dg.weak, key=lambda c: -c.fraction)
-        if len(pool) < n_modes:
+        if n_modes is not None and len(pool) < n_modes:
             warnings.append(f"n_modes: asked for {n_modes}, only {len(pool)} stable clusters")
-        cand = sorted(pool[: int(n_modes)], key=lambda c: c.frequency_hz)
+        cand = sorted(pool[: int(n_pick)], key=lambda c: c.frequency_hz)
         chosen = {id(c) for c in cand}
         rej = [r for r, c in zip(rej, dg.weak, strict=True) if id(c) not in chosen]
-    elif dg.kept or not dg.weak or n_shown is None:
-        return list(dg.kept), [], rej
-    else:
-        # no cluster persists (few orders of many inputs, noisy data): the most
-        # persistent ones, as many as the peaks the data show (at least one),
-        # start the fit; the mode test decides on them and the residual search,
-        # from the other clusters and the residual, on the rest
-        first = sorted(dg.weak, key=lambda c: -c.fraction)[: max(1, n_shown)]
-        cand = sorted(first, key=lambda c: c.frequency_hz)
-        rej = [r for r, c in zip(rej, dg.weak, strict=True) if all(c is not d for d in cand)]
-        return cand, [], rej
     # modes the user did not ask for still shape the FRFs: keep the persistent
     # clusters that are not chosen (and not within 1 % of a chosen one) as
     # residual modes, so that the refinement does not pull the chosen poles

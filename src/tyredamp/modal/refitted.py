@@ -38,7 +38,7 @@ from ._linalg import _gn_point
 from .fit import FitResult, ModalFitter
 from .search import JOINT_NFEV, SEARCH_TOL, ModeSet
 
-__all__ = ["OVERLAP", "REFIT_NFEV", "refit_candidates", "refitted_statistics"]
+__all__ = ["OVERLAP", "REFIT_NFEV", "overlapping", "refit_candidates", "refitted_statistics"]
 
 #: resonances overlap when their damped frequencies lie within this many times
 #: the sum of their half-power half-widths (rad/s)
@@ -57,17 +57,20 @@ def refit_candidates(
     """The in-band modes (of the first ``m`` poles of ``res``) whose held-pole
     statistic ``t`` passes ``thr`` and whose resonance overlaps a stronger in-band
     mode's or a residual mode's (module docstring)."""
-    p = res.poles
-    sig, wd = -p.real, p.imag
-    out = []
-    for i in range(m):
-        if not t[i] > thr[i]:
-            continue
-        near = np.abs(wd - wd[i]) < OVERLAP * (sig + sig[i])
-        near[i] = False
-        if np.any(near[:m] & (t > t[i])) or np.any(near[m:]):
-            out.append(i)
-    return np.asarray(out, dtype=np.intp)
+    near = overlapping(res.poles)
+    stronger = np.any(near[:m, :m] & (t[None, :m] > t[:m, None]), axis=1)
+    by_residual = np.any(near[:m, m:], axis=1)
+    return np.flatnonzero((t[:m] > thr[:m]) & (stronger | by_residual)).astype(np.intp)
+
+
+def overlapping(poles: NDArray[np.complex128]) -> NDArray[np.bool_]:
+    """Which resonances overlap (n, n; the diagonal False): damped frequencies within
+    ``OVERLAP`` times the sum of the two half-power half-widths (rad/s), where one
+    pole can take up the other's response."""
+    sig, wd = -poles.real, poles.imag
+    near = np.abs(wd[:, None] - wd[None, :]) < OVERLAP * (sig[:, None] + sig[None, :])
+    np.fill_diagonal(near, False)
+    return np.asarray(near)
 
 
 def refitted_statistics(

@@ -235,14 +235,21 @@ def _fitted_in_windows(
     return b, lo, hi, own
 
 
+def _sums_over_windows(
+    w: NDArray[np.complex128], lo: NDArray[np.intp], hi: NDArray[np.intp]
+) -> NDArray[np.complex128]:
+    """Sums of ``w`` (..., L) over each window's lines ``[lo, hi]``, windows first
+    (G, ...), from prefix sums over the lines."""
+    pre = np.zeros((*w.shape[:-1], w.shape[-1] + 1), complex)
+    np.cumsum(w, axis=-1, out=pre[..., 1:])
+    return np.moveaxis(pre[..., hi + 1] - pre[..., lo], -1, 0)
+
+
 def _window_gram(
     b: NDArray[np.complex128], lo: NDArray[np.intp], hi: NDArray[np.intp]
 ) -> NDArray[np.complex128]:
-    """``<b_n, b_k>`` over each window's lines ``[lo, hi]`` (G, m, m), from prefix
-    sums over the lines."""
-    pre = np.zeros((b.shape[0], b.shape[0], b.shape[1] + 1), complex)
-    np.cumsum(b.conj()[:, None, :] * b[None, :, :], axis=2, out=pre[:, :, 1:])
-    return np.moveaxis(pre[:, :, hi + 1] - pre[:, :, lo], 2, 0)
+    """``<b_n, b_k>`` over each window's lines ``[lo, hi]`` (G, m, m)."""
+    return _sums_over_windows(b.conj()[:, None, :] * b[None, :, :], lo, hi)
 
 
 def _solvable(gram: NDArray[np.complex128], own: NDArray[np.bool_]) -> NDArray[np.complex128]:
@@ -290,7 +297,6 @@ def _rank_one_off_fitted(
         nmat = nrm2[:, None, None] * eye_in
         z = x
     else:
-        m = near.size
         b, lo, hi, own = _fitted_in_windows(inside, s, kap, near)
         beta = (a @ b.conj().T) * own  # (G, m): <b_n, a> over the window
         ll = l_near.conj() @ l_near.T  # (m, m): l_n^H l_k
@@ -299,9 +305,7 @@ def _rank_one_off_fitted(
         cmat = np.linalg.solve(gram, hmat)
         # y[g, j, n] = sum_k conj(l_nk) <b_n, e_jk> over window g (prefix sums)
         w = np.einsum("nk,jkt->njt", l_near.conj(), e) * b.conj()[:, None, :]
-        pre = np.zeros((m, n_out, w.shape[-1] + 1), complex)
-        np.cumsum(w, axis=2, out=pre[:, :, 1:])
-        y = np.moveaxis(pre[:, :, hi + 1] - pre[:, :, lo], 2, 0) * own[:, :, None]  # (G,m,n_out)
+        y = _sums_over_windows(w, lo, hi) * own[:, :, None]  # (G, m, n_out)
         z = x - np.einsum("gnk,gnj->gjk", cmat.conj(), y)
         nmat = nrm2[:, None, None] * eye_in - np.einsum("gnk,gnl->gkl", hmat.conj(), cmat)
         nmat = 0.5 * (nmat + nmat.conj().transpose(0, 2, 1))
