@@ -152,24 +152,69 @@ def test_plscf_order_step_counts_down_from_the_highest_order() -> None:
             plscf(F, h, 24, order_step=bad)  # type: ignore[arg-type]
 
 
-def _rule3_distance(p: np.ndarray, lv: np.ndarray, od: np.ndarray) -> np.ndarray:
-    """Dense rule-3 distance matrix (1e6 for two poles of the same order)."""
+def _span_share(v: np.ndarray, vecs: np.ndarray) -> float:
+    """Share of |v|^2 in the span of the rows of ``vecs`` (singular values >= 0.1 max)."""
+    u, sv, _ = np.linalg.svd(vecs.T, full_matrices=False)
+    q = u[:, sv >= 0.1 * sv[0]]
+    return float(np.linalg.norm(q.conj().T @ v) ** 2 / np.linalg.norm(v) ** 2)
+
+
+def _rule3_distance(
+    p: np.ndarray, lv: np.ndarray, od: np.ndarray, cut: float = 0.01, repeated: bool = False
+) -> np.ndarray:
+    """Dense rule-3 distance matrix (1e6 for two poles of the same order); with
+    ``repeated``, the participation term of a repeated root: a pole's twins are the
+    poles of its order within the cut and half a half-width of it, and an edge's MAC
+    is the larger share of either pole's vector in the span of its partner and the
+    partner's twins."""
     d = np.abs(p[:, None] - p[None, :]) / np.maximum(np.abs(p)[:, None], np.abs(p)[None, :])
-    if lv.shape[1] > 1:
+    if lv.shape[1] > 1 and not repeated:
         d = d + 1 - mac(lv.T, lv.T)
+    elif lv.shape[1] > 1:
+        m = mac(lv.T, lv.T)
+        half = np.minimum(np.abs(p.real)[:, None], np.abs(p.real)[None, :])
+        twin = (
+            (od[:, None] == od[None, :])
+            & (d <= cut)
+            & (np.abs(p[:, None] - p[None, :]) <= 0.5 * half)
+        )
+        np.fill_diagonal(twin, False)
+        for i in np.flatnonzero(twin.any(axis=1)):
+            span = lv[np.append(i, np.flatnonzero(twin[i]))]
+            for j in np.flatnonzero((od != od[i]) & (d[i] <= cut)):
+                share = _span_share(lv[j], span)
+                m[i, j] = m[j, i] = max(m[i, j], share)
+        d = d + 1 - m
     d = np.where(od[:, None] == od[None, :], 1e6, d)
     np.fill_diagonal(d, 0.0)
     return np.clip(0.5 * (d + d.T), 0, 1e6)
 
 
 def _one_linkage(ps: PoleSet, flags: StabilityFlags, cut: float = 0.01) -> list[tuple[int, ...]]:
-    """Reference clusters: one complete linkage over all stable poles, cut at ``cut``."""
+    """Reference clusters: one complete linkage over all stable poles, cut at ``cut``
+    (then, with several inputs, the poles of a repeated root split linkage into more
+    clusters than its multiplicity regrouped by ``_repeated_slots``, tested apart)."""
     from scipy.cluster.hierarchy import fcluster, linkage
     from scipy.spatial.distance import squareform
 
+    from tyredamp.modal.selection import _repeated_slots
+
     idx = np.flatnonzero(flags.stable)
-    d = _rule3_distance(ps.poles[idx], ps.participation[idx], ps.order[idx])
-    lab = fcluster(linkage(squareform(d, checks=False), "complete"), t=cut, criterion="distance")
+    p, lv, od = ps.poles[idx], ps.participation[idx], ps.order[idx]
+
+    def link(sel: np.ndarray, repeated: bool) -> np.ndarray:
+        d = _rule3_distance(p[sel], lv[sel], od[sel], cut, repeated)
+        return fcluster(
+            linkage(squareform(d, checks=False), "complete"), t=cut, criterion="distance"
+        )
+
+    lab = link(np.arange(idx.size), False)
+    if lv.shape[1] > 1:  # the poles of clusters spanning < 30 % of the orders, again
+        n_ord = np.array([np.unique(od[lab == k]).size for k in range(lab.max() + 1)])
+        rest = np.flatnonzero(n_ord[lab] < 0.3 * ps.orders.size)
+        if rest.size > 1:
+            sub = _repeated_slots(p[rest], od[rest], link(rest, True) - 1)
+            lab[rest] = lab.max() + 1 + sub
     return sorted(tuple(idx[lab == k].tolist()) for k in np.unique(lab))
 
 
@@ -242,9 +287,9 @@ def test_threshold_edges_hold_every_pair_within_the_cut() -> None:
     for n_in in (1, 2):
         lv = rng.normal(size=(400, n_in)) + 1j * rng.normal(size=(400, n_in))
         lv[1::2] = lv[::2] + 0.05 * rng.normal(size=(200, n_in))  # MAC near 1 for half the pairs
-        d_ref = _rule3_distance(p, lv, od)
-        for cut in (0.01, 0.05, 0.5, 1.5):
-            i, j, d = _threshold_edges(p, lv, od, cut)
+        for cut, repeated in [(c, r) for c in (0.01, 0.05, 0.5, 1.5) for r in (False, True)]:
+            d_ref = _rule3_distance(p, lv, od, cut, repeated)
+            i, j, d = _threshold_edges(p, lv, od, cut, repeated)
             ri, rj = np.nonzero(np.triu(d_ref <= cut, 1))
             assert ri.size > 50
             o = np.lexsort((j, i))

@@ -67,7 +67,9 @@ Then a residual-driven search tries candidates for missed modes (diagram
 clusters that too few orders resolved, modes rejected earlier, peaks of the
 residual) and keeps those that pass the same test, until none does. After
 the refinement a mode that left the band, or that merged with another
-(poles closer than 0.05 % of ``|p|``), is dropped and the fit repeated.
+(poles closer than 0.05 % of ``|p|``; with several inputs, participation
+vectors parallel too: two modes at one pole with different participation
+are a repeated root), is dropped and the fit repeated.
 
 The data are cut to the band and normalised first
 (:func:`~tyredamp.modal.problem.build_problem`): the result does not depend

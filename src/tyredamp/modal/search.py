@@ -54,6 +54,7 @@ from .residual_peaks import (
     residual_view,
     room,
 )
+from .selection import same_place_distinct
 from .span_noise import SpanNoise
 from .thresholds import ModeTest, local_thresholds, residual_span
 
@@ -145,7 +146,8 @@ def _lost(
 ) -> tuple[NDArray[np.intp], str]:
     """The modes a fit of ``modes`` lost, and why: those that left their side of
     the band (in-band modes outside it, out-of-band residual modes inside it), or
-    else the weaker of two that merged (none: an empty index)."""
+    else the weaker of two that merged (none: an empty index); residual modes (tails
+    shaped together) and modes of distinct participation (repeated roots) do not."""
     m = modes.m
     p = res.poles
     fd = p.imag / (2 * np.pi)
@@ -157,6 +159,9 @@ def _lost(
         return wrong, "crossed the band edge during refinement"
     d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
     np.fill_diagonal(d, np.inf)
+    d[m:, m:] = np.inf
+    if res.participation.shape[1] > 1:
+        d[same_place_distinct(res.participation)] = np.inf
     if d.size and d.min() < MERGE:
         i, j = np.unravel_index(np.argmin(d), d.shape)
         k = i if res.contribution[i] < res.contribution[j] else j
@@ -674,7 +679,9 @@ def residual_search(
         added = False
         n_tried = 0
         for p0, l0 in starts:
-            p_all = np.concatenate([cur.all()[0], np.asarray(seen, complex)])
+            # several inputs: a second mode at a current mode's pole (a repeated root)
+            held = cur.all()[0] if fitter.n_in == 1 else cur.hp
+            p_all = np.concatenate([held, np.asarray(seen, complex)])
             if p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE:
                 continue
             if n_tried >= MAX_TRIALS:

@@ -9,7 +9,10 @@ Rules (all thresholds are arguments with the defaults stated here):
    previous computed order (``p - 1``, or ``p - order_step``) differs by at
    most ``tol_frequency`` (1 %) in natural frequency,
    ``tol_damping`` (5 %) relative in damping ratio and, with several inputs,
-   has participation-vector MAC >= ``tol_mac`` (0.95).
+   has participation-vector MAC >= ``tol_mac`` (0.95); where several poles of the
+   previous order lie at one place with it (within half a half-power
+   half-width: a repeated root, whose vectors turn within the space they
+   share), the MAC is the share of its vector in the space theirs span.
 3. *Clustering*: the stable poles are grouped by complete-linkage hierarchical
    clustering with the distance
    ``d_ij = |p_i - p_j| / max(|p_i|, |p_j|) + (1 - MAC(l_i, l_j))``
@@ -17,7 +20,12 @@ Rules (all thresholds are arguments with the defaults stated here):
    frequency difference ``df/f`` and a damping difference ``d zeta`` alike,
    plus the participation term with several inputs), cut at
    ``cluster_distance`` (0.01). Two poles of the same order never share a
-   cluster, so two close modes that some orders resolve stay apart.
+   cluster, so two close modes that some orders resolve stay apart. With
+   several inputs, the poles of the clusters that do not persist (rule 4) are
+   clustered again as repeated roots: the participation term of a pole with
+   twins (poles of its order at one place) is its partner's share in the space
+   the twins span, and the clusters at one place are regrouped one per
+   multiplicity.
 4. *Persistence*: a cluster is a mode when it holds poles of at least
    ``min_fraction`` (0.3) of the computed orders.
 5. Each kept cluster gives the median of its frequencies and damping ratios
@@ -41,7 +49,13 @@ from .lscf import PoleSet
 
 _SLACK = 1e-6  # relative widening of the candidate search (rounding of log|p|, arg p)
 
-__all__ = ["Cluster", "StabilityFlags", "cluster_poles", "stability_flags"]
+__all__ = [
+    "Cluster",
+    "StabilityFlags",
+    "cluster_poles",
+    "same_place_distinct",
+    "stability_flags",
+]
 
 
 @dataclass(frozen=True)
@@ -105,6 +119,50 @@ def _mac_rows(a: NDArray[np.complex128], b: NDArray[np.complex128]) -> NDArray[n
     return np.asarray(num / np.where(den > 0, den, 1.0))
 
 
+#: poles closer than this share of the smaller half-power half-width ``|Re p|`` are at
+#: one place: a repeated root (several inputs), whose poles no line can tell apart
+TWIN = 0.5
+
+
+def _same_place(a: NDArray[np.complex128], b: NDArray[np.complex128]) -> NDArray[np.bool_]:
+    """Whether poles ``a`` and ``b`` (broadcast) lie within ``TWIN`` half-widths."""
+    return np.asarray(np.abs(a - b) <= TWIN * np.minimum(np.abs(a.real), np.abs(b.real)))
+
+
+#: participation MAC below which two modes at one place are a repeated root (their
+#: residues together have rank two) rather than one mode held twice
+REPEATED_MAC = 0.99
+
+
+def same_place_distinct(part: NDArray[np.complex128]) -> NDArray[np.bool_]:
+    """Pairs of modes (m, m) whose participation vectors (m, n_in) are not parallel
+    (MAC below ``REPEATED_MAC``): at one pole they are a repeated root."""
+    g = part.conj() @ part.T
+    nn = np.real(np.diag(g))
+    mac = np.abs(g) ** 2 / np.maximum(nn[:, None] * nn[None, :], 1e-300)
+    return np.asarray(mac < REPEATED_MAC)
+
+
+#: singular values of a set of participation vectors below this share of the largest
+#: span no direction of it (two estimates of one vector are not a plane)
+SPAN_TOL = 0.1
+
+
+def _span(vecs: NDArray[np.complex128]) -> NDArray[np.complex128]:
+    """Orthonormal basis (n_in, r) of the space the participation vectors ``vecs``
+    (k, n_in) span: the left singular vectors of ``vecs^T`` whose singular value is at
+    least ``SPAN_TOL`` of the largest."""
+    u, sv, _ = np.linalg.svd(np.asarray(vecs).T, full_matrices=False)
+    return np.asarray(u[:, sv >= SPAN_TOL * sv[0]]) if sv.size and sv[0] > 0 else u[:, :0]
+
+
+def _share_in(v: NDArray[np.complex128], basis: NDArray[np.complex128]) -> float:
+    """Share of ``||v||^2`` in the span of the orthonormal columns ``basis``: the MAC of
+    ``v`` with that space (the MAC of two vectors when it is one vector's line)."""
+    nv = float(np.sum(np.abs(v) ** 2))
+    return float(np.sum(np.abs(basis.conj().T @ v) ** 2) / nv) if nv > 0 else 0.0
+
+
 def stability_flags(
     ps: PoleSet,
     *,
@@ -150,7 +208,14 @@ def stability_flags(
         fstab[cur] = np.abs(fn[cur] - fn[j]) <= tol_frequency * fn[cur]
         zstab[cur] = np.abs(z[cur] - z[j]) <= tol_damping * np.abs(z[cur])
         if multi:
-            vstab[cur] = _mac_rows(ps.participation[cur], ps.participation[j]) >= tol_mac
+            mac = _mac_rows(ps.participation[cur], ps.participation[j])
+            # a repeated root: the previous order's poles at the same place span the
+            # participation space of this pole, any vector of which it may take
+            near = _same_place(ps.poles[cur][:, None], ps.poles[prev][None, :])
+            for r in np.flatnonzero(np.count_nonzero(near, axis=1) > 1):
+                span = _span(ps.participation[prev[near[r]]])
+                mac[r] = _share_in(ps.participation[cur[r]], span)
+            vstab[cur] = mac >= tol_mac
         else:
             vstab[cur] = True
     return StabilityFlags(admissible=adm, frequency=fstab, damping=zstab, vector=vstab)
@@ -161,6 +226,7 @@ def _threshold_edges(
     lv: NDArray[np.complex128],
     od: NDArray[np.int64],
     cut: float,
+    repeated: bool = False,
 ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
     """Pairs of poles of different orders at rule-3 distance ``<= cut``.
 
@@ -173,7 +239,8 @@ def _threshold_edges(
     every such pair lies within a unit max-norm ball (widened by ``_SLACK`` for
     rounding); the participation term ``1 - MAC >= 0`` only adds, so the
     candidates hold every pair within the cut. Their exact distance, element by
-    element, then keeps the pairs ``<= cut``.
+    element, then keeps the pairs ``<= cut``. ``repeated``: the participation term
+    of repeated roots (:func:`_repeated_roots`).
     """
     n = p.size
     mag = np.abs(p)
@@ -195,6 +262,7 @@ def _threshold_edges(
     else:  # no bound: every pair is a candidate
         i, j = (np.asarray(k, np.int64) for k in np.triu_indices(n, 1))
     keep = od[i] != od[j]  # same order: never in one cluster
+    twins = (i[~keep], j[~keep])
     i, j = i[keep], j[keep]
     d = np.abs(p[i] - p[j]) / np.maximum(mag[i], mag[j])
     if lv.shape[1] > 1:
@@ -202,9 +270,51 @@ def _threshold_edges(
         s = np.zeros(i.size, np.complex128)
         for k in range(lv.shape[1]):
             s += lv[i, k].conj() * lv[j, k]
-        d = np.maximum(d + (1.0 - np.abs(s) ** 2 / (nn[i] * nn[j])), 0.0)
+        mac = np.abs(s) ** 2 / (nn[i] * nn[j])
+        if repeated:
+            _repeated_roots(p, lv, twins, cut, (i, j, mac))
+        d = np.maximum(d + (1.0 - mac), 0.0)
     keep = d <= cut
     return i[keep], j[keep], d[keep]
+
+
+def _repeated_roots(
+    p: NDArray[np.complex128],
+    lv: NDArray[np.complex128],
+    twins: tuple[NDArray[np.int64], NDArray[np.int64]],
+    cut: float,
+    edges: tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]],
+) -> None:
+    """The participation term of a repeated root (several inputs), in place.
+
+    A root of multiplicity ``r`` gives ``r`` poles of one order at the same place
+    whose participation vectors are any basis of an ``r``-dimensional space: from
+    order to order they turn within it, and their pairwise MAC says nothing. For a
+    pole with such twins (poles of its own order at one place with it,
+    :func:`_same_place`, and within ``cut``: among the candidate pairs
+    ``twins``), the MAC of an edge ``(i, j, mac)`` becomes the larger share of
+    either pole's participation in the space its partner and the partner's twins
+    span (:func:`_span`); for poles without twins it is their MAC.
+    """
+    a, b = twins
+    if not a.size:
+        return
+    big = np.maximum(np.abs(p[a]), np.abs(p[b]))
+    close = _same_place(p[a], p[b]) & (np.abs(p[a] - p[b]) <= cut * big)
+    a, b = a[close], b[close]
+    if not a.size:
+        return
+    group: dict[int, list[int]] = {}
+    for x, y in zip(a.tolist(), b.tolist(), strict=True):
+        group.setdefault(x, [x]).append(y)
+        group.setdefault(y, [y]).append(x)
+    basis = {k: _span(lv[v]) for k, v in group.items()}
+    i, j, mac = edges
+    for e in np.flatnonzero(np.isin(i, a) | np.isin(i, b) | np.isin(j, a) | np.isin(j, b)):
+        x, y = int(i[e]), int(j[e])
+        in_y = _share_in(lv[x], basis[y]) if y in basis else 0.0
+        in_x = _share_in(lv[y], basis[x]) if x in basis else 0.0
+        mac[e] = max(mac[e], in_y, in_x)
 
 
 def _complete_linkage(
@@ -269,6 +379,149 @@ def _complete_linkage(
     return np.asarray(np.unique(lab, return_inverse=True)[1], np.int64)
 
 
+def _linkage(
+    p: NDArray[np.complex128],
+    lv: NDArray[np.complex128],
+    od: NDArray[np.int64],
+    cut: float,
+    repeated: bool = False,
+) -> NDArray[np.int64]:
+    """Complete-linkage labels of the poles (rule 3; ``repeated``: with the
+    participation term of repeated roots, :func:`_repeated_roots`)."""
+    # poles numbered by increasing |p|, so the clusters are numbered by their member
+    # of smallest |p|
+    order = np.argsort(np.abs(p), kind="stable")
+    labels = np.empty(p.size, np.int64)
+    labels[order] = _complete_linkage(
+        p.size, *_threshold_edges(p[order], lv[order], od[order], cut, repeated)
+    )
+    return labels
+
+
+def _second_pass(
+    p: NDArray[np.complex128],
+    lv: NDArray[np.complex128],
+    od: NDArray[np.int64],
+    labels: NDArray[np.int64],
+    cut: float,
+    min_orders: float,
+) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:
+    """The poles of the clusters that do not persist, clustered again as repeated
+    roots (several inputs); the new labels and which poles were clustered again.
+
+    Rule 3 keeps the clusters of distinct modes apart by their participation
+    vectors; the poles of a repeated root, whose vectors turn from order to order
+    within the space they share, it scatters into clusters too sparse to persist
+    (fewer than ``min_orders`` orders). Those poles alone are linked again with the
+    participation term of repeated roots (:func:`_repeated_roots`) and their
+    clusters regrouped one per multiplicity (:func:`_repeated_slots`); the
+    persistent clusters of the first pass are kept as they are.
+    """
+    n_lab = int(labels.max()) + 1
+    span = np.bincount(
+        np.unique(labels * (int(od.max()) + 1) + od) // (int(od.max()) + 1), minlength=n_lab
+    )
+    again = span[labels] < min_orders
+    rest = np.flatnonzero(again)
+    if rest.size < 2:
+        return labels, np.zeros(p.size, bool)
+    sub = _repeated_slots(p[rest], od[rest], _linkage(p[rest], lv[rest], od[rest], cut, True))
+    out = labels.copy()
+    out[rest] = n_lab + sub
+    return np.asarray(np.unique(out, return_inverse=True)[1], np.int64), again
+
+
+def _repeated_slots(
+    p: NDArray[np.complex128], od: NDArray[np.int64], labels: NDArray[np.int64]
+) -> NDArray[np.int64]:
+    """Clusters of a repeated root, one per multiplicity (several inputs).
+
+    The poles of a root of multiplicity ``r`` lie at one place, up to ``r`` per
+    order; no pole distance or participation vector tells which of them belongs
+    with which of the next order, and complete linkage under the rule that two
+    poles of one order never share a cluster can split them into more than ``r``
+    clusters, each too sparse to persist. Clusters whose mean poles lie at one
+    place (:func:`_same_place`, joined transitively) are pooled, ``r`` is the
+    most poles of one order among them, and the ``k``-th of each order's poles
+    (by damped frequency) goes to the ``k``-th cluster: ``r`` clusters, the
+    ``k``-th holding the orders with at least ``k`` poles there (a group that
+    linkage split into ``r`` clusters already is left as it is). Labels are
+    renumbered ``0..`` keeping their order.
+    """
+    n_lab = int(labels.max()) + 1
+    count = np.bincount(labels, minlength=n_lab)
+    mean = (
+        np.bincount(labels, p.real, n_lab) / count + 1j * np.bincount(labels, p.imag, n_lab) / count
+    )
+    root = np.arange(n_lab)
+
+    def find(a: int) -> int:
+        while root[a] != a:
+            root[a] = root[root[a]]
+            a = int(root[a])
+        return a
+
+    for a, b in zip(
+        *np.nonzero(np.triu(_same_place(mean[:, None], mean[None, :]), 1)), strict=True
+    ):
+        root[find(int(a))] = find(int(b))
+    comp = np.array([find(a) for a in range(n_lab)])
+    out = labels.copy()
+    for c in np.unique(comp):
+        group = np.flatnonzero(comp == c)
+        if group.size < 2:
+            continue
+        mem = np.flatnonzero(np.isin(labels, group))
+        mem = mem[np.lexsort((p.imag[mem], od[mem]))]  # by order, then damped frequency
+        first = np.concatenate([[True], od[mem][1:] != od[mem][:-1]])
+        start = np.flatnonzero(first)
+        slot = np.arange(mem.size) - np.repeat(start, np.diff(np.append(start, mem.size)))
+        if int(slot.max()) + 1 < group.size:  # more clusters than the multiplicity
+            out[mem] = group[slot]  # each slot keeps one of the labels
+    return np.asarray(np.unique(out, return_inverse=True)[1], np.int64)
+
+
+def _spanning_representatives(
+    poles: NDArray[np.complex128],
+    lv: NDArray[np.complex128],
+    dist: NDArray[np.float64],
+    members: list[NDArray[np.intp]],
+    best: NDArray[np.intp],
+    again: NDArray[np.bool_],
+) -> NDArray[np.intp]:
+    """Representatives of clusters at one place (a repeated root, several inputs)
+    whose participation vectors span the space their members share.
+
+    The clusters of a repeated root hold its poles order by order with
+    participation vectors that turn within one space (:func:`_repeated_roots`):
+    the members closest to their medians may carry nearly the same vector, and a
+    fit started from them would hold one vector twice. Within a group of
+    clusters of repeated roots (``again``: from :func:`_second_pass`) whose
+    representative poles lie at one place (:func:`_same_place`), the
+    most populous keeps its representative; each other takes, among the half of
+    its members closest to its pole, the one with the least share in the space
+    the representatives chosen so far span.
+    """
+    best = best.copy()
+    close = _same_place(poles[:, None], poles[None, :]) & again[:, None] & again[None, :]
+    done = np.zeros(poles.size, bool)
+    for c in np.argsort([-m.size for m in members], kind="stable"):
+        if done[c] or np.count_nonzero(close[c]) < 2:
+            continue
+        group = np.flatnonzero(close[c] & ~done)
+        group = group[np.argsort([-members[g].size for g in group], kind="stable")]
+        done[group] = True
+        chosen = [int(best[group[0]])]
+        for g in group[1:]:
+            mem = members[g][np.argsort(dist[members[g]], kind="stable")]
+            mem = mem[: max(1, (mem.size + 1) // 2)]
+            basis = _span(lv[chosen])
+            share = [_share_in(lv[k], basis) for k in mem]
+            best[g] = mem[int(np.argmin(share))]
+            chosen.append(int(best[g]))
+    return best
+
+
 def cluster_poles(
     ps: PoleSet,
     flags: StabilityFlags,
@@ -309,14 +562,13 @@ def cluster_poles(
     # complete linkage on the graph of the pole pairs within the cut (exact, no
     # n^2 matrix: see _complete_linkage); poles numbered by increasing |p|, so
     # the clusters are numbered by their member of smallest |p|
-    order = np.argsort(np.abs(p), kind="stable")
-    labels = np.empty(idx.size, np.int64)
-    labels[order] = _complete_linkage(
-        idx.size, *_threshold_edges(p[order], lv[order], od[order], cluster_distance)
-    )
+    labels = _linkage(p, lv, od, cluster_distance)
+    n_orders = ps.orders.size
+    second = np.zeros(p.size, bool)  # poles clustered as repeated roots
+    if lv.shape[1] > 1:
+        labels, second = _second_pass(p, lv, od, labels, cluster_distance, min_fraction * n_orders)
     n_lab = int(labels.max()) + 1
     # per-cluster medians, spread, persistence and representative, all at once
-    n_orders = ps.orders.size
     n_cl = n_lab
     fn_all, zz_all = pole_quantities(p)
     count = np.bincount(labels, minlength=n_cl)
@@ -336,6 +588,9 @@ def cluster_poles(
     mean = np.bincount(labels, fn_all, n_cl) / count
     var = np.maximum(np.bincount(labels, (fn_all - mean[labels]) ** 2, n_cl) / count, 0.0)
     members = np.split(np.argsort(labels, kind="stable"), np.cumsum(count)[:-1])
+    if lv.shape[1] > 1:
+        again = np.bincount(labels, second, n_cl) > 0
+        best = _spanning_representatives(poles, lv, dist, members, best, again)
     kept: list[Cluster] = []
     rejected: list[Cluster] = []
     for c in range(n_cl):
