@@ -106,3 +106,38 @@ def test_modes_at_one_place_merge_only_with_parallel_participation() -> None:
     assert distinct[0, 1]
     assert distinct[1, 2]
     assert not distinct[0, 2]  # MAC 0.999999: one mode held twice
+
+
+def test_residual_search_adds_the_second_mode_of_a_repeated_root() -> None:
+    # the second mode of a root holds its own participation: its residual is not
+    # in the span of the first's column, and a trial mode near the first's pole
+    # takes it; the joint refit keeps both (different participation: no merge)
+    from tyredamp.modal.fit import ModalFitter
+    from tyredamp.modal.problem import build_problem
+    from tyredamp.modal.search import ModeSet, fit_checked, residual_search
+    from tyredamp.modal.stats import mode_parameters, mode_threshold
+
+    mdl = _repeated_system(2, 9)
+    frf = mdl.frf(np.linspace(5.0, 220.0, 1500), "receptance")
+    rng = np.random.default_rng(2)
+    h = frf.H
+    sd = 1e-3 * np.sqrt(np.mean(np.abs(h) ** 2))
+    frf = frf.with_H(h + sd * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)))
+    pr = build_problem(frf, (20.0, 200.0))
+    fit = ModalFitter(pr.frequency, pr.H, pr.power, "complex", [])
+    fn = np.abs(mdl.poles) / (2 * np.pi)
+    drop = int(np.flatnonzero(np.abs(fn - 88.0) < 1)[1])  # one mode of the 88 Hz root
+    keep = np.arange(fn.size) != drop
+    modes = ModeSet(
+        mdl.poles[keep],
+        mdl.psi_in.T[keep].astype(complex),
+        np.zeros(0, complex),
+        np.zeros((0, 2), complex),
+    )
+    res, cur, _ = fit_checked(fit, modes, True, (20.0, 200.0), passes=1, uncertainty=False)
+    assert cur.m == 7
+    thr = mode_threshold(mode_parameters(6, 2, "complex"), pr.shape[2], 0.01)
+    _, got, _ = residual_search(fit, res, cur, [], (20.0, 200.0), thr)
+    f_got = np.abs(got.poles) / (2 * np.pi)
+    assert got.m == 8
+    assert np.count_nonzero(np.abs(f_got - 88.0) < 0.01) == 2
