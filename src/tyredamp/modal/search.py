@@ -84,12 +84,11 @@ FIRST_NFEV = 2
 #: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
 #: starts at the first lines) it cannot be told from the lower residual term
 MIN_LOW_LINES = 10
-#: poles closer than this (relative to |p|) are one mode
+#: poles closer than this (relative to |p|) are one mode (but see :func:`_lost`)
 MERGE = 5e-4
 #: residual search: a candidate's frequency stays within this factor of its start
 TRIAL_SPAN = 0.03
-#: evaluation limit of the joint refit after an accepted trial (it only decides
-#: whether the mode stays; the final fit converges)
+#: evaluation limit of the joint refit of an accepted trial (the final fit converges)
 JOINT_NFEV = 30
 #: evaluation limit of a trial mode (a mode that is there converges in a few steps)
 TRIAL_NFEV = 30
@@ -676,10 +675,9 @@ def residual_search(
         starts = _starts(fitter, res, view, pending, threshold, zeta0, test, scan_next)
         scanned, scan_next = scanned or scan_next, False
         pending = []
-        added = False
-        n_tried = 0
+        added, n_tried = False, 0
         for p0, l0 in starts:
-            # several inputs: a second mode at a current mode's pole (a repeated root)
+            # several inputs: a start at a current mode's pole may be a repeated root's
             held = cur.all()[0] if fitter.n_in == 1 else cur.hp
             p_all = np.concatenate([held, np.asarray(seen, complex)])
             if p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE:
