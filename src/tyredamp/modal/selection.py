@@ -560,8 +560,7 @@ def cluster_poles(
     lv = ps.participation[idx]
     od = ps.order[idx]
     # complete linkage on the graph of the pole pairs within the cut (exact, no
-    # n^2 matrix: see _complete_linkage); poles numbered by increasing |p|, so
-    # the clusters are numbered by their member of smallest |p|
+    # n^2 matrix: see _complete_linkage)
     labels = _linkage(p, lv, od, cluster_distance)
     n_orders = ps.orders.size
     second = np.zeros(p.size, bool)  # poles clustered as repeated roots
