@@ -27,6 +27,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..exceptions import ConvergenceError
 from .fit import FitResult, ModalFitter
 from .indicators import mean_phase_deviation, modal_phase_collinearity
 from .ml import ml_refine
@@ -492,7 +493,34 @@ def _final_fit(
     refine: bool,
     combined: ModalFitter | None,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
-    """One weighted least-squares final fit of ``modes`` (:func:`final_complex`)."""
+    """One weighted least-squares final fit of ``modes`` (:func:`final_complex`).
+
+    A refinement that moves every mode out of the band (a few modes standing for
+    a band that holds many) leaves no model: the residues are then fitted at the
+    search's poles, with a warning, rather than no result."""
+    try:
+        return _refined_fit(problem, cfit, modes, sigma0, refine, combined)
+    except ConvergenceError as exc:
+        p0, l0 = modes.all()
+        res = cfit.fit(p0, l0, refine=False, sigma=sigma0)
+        lo, hi = problem.band
+        res.warnings.append(
+            f"the final refinement failed ({exc}): the poles in [{lo:g}, {hi:g}] Hz are the "
+            "search's, only the residues are fitted; the band likely holds more modes than "
+            "were found (raise the maximum order or give the mode count)"
+        )
+        return res, modes, []
+
+
+def _refined_fit(
+    problem: FitProblem,
+    cfit: ModalFitter,
+    modes: ModeSet,
+    sigma0: NDArray[np.float64] | None,
+    refine: bool,
+    combined: ModalFitter | None,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """The final fit's refinement (:func:`_final_fit`)."""
     if combined is not None and sigma0 is not None:
         r0, cur, dropped = fit_checked(
             combined, modes, True, problem.band, passes=1, tol=FINAL_TOL, uncertainty=False

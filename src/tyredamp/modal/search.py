@@ -35,8 +35,6 @@ mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numpy.typing import NDArray
 from scipy import stats as sps
@@ -45,6 +43,15 @@ from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
 from ._added import FixedPart
 from .fit import FitResult, ModalFitter
+from .modeset import (
+    MERGE,
+    ModeSet,
+    _lost,
+    as_residual,
+    fit_checked,
+    rejected,
+    too_damped,
+)
 from .quality import RejectedMode, threshold_text
 from .residual_peaks import (
     SCAN_SHARE,
@@ -54,7 +61,6 @@ from .residual_peaks import (
     residual_view,
     room,
 )
-from .selection import same_place_distinct
 from .span_noise import SpanNoise
 from .thresholds import ModeTest, local_thresholds, residual_span
 
@@ -84,8 +90,6 @@ FIRST_NFEV = 2
 #: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
 #: starts at the first lines) it cannot be told from the lower residual term
 MIN_LOW_LINES = 10
-#: poles closer than this (relative to |p|) are one mode (but see :func:`_lost`)
-MERGE = 5e-4
 #: residual search: a candidate's frequency stays within this factor of its start
 TRIAL_SPAN = 0.03
 #: evaluation limit of the joint refit of an accepted trial (the final fit converges)
@@ -101,139 +105,6 @@ MAX_ROUNDS = 50
 SUPPORT_SHARE = 0.5
 #: times a trial stopped at its window's limit is continued beyond it (_follow)
 FOLLOW = 3
-
-
-@dataclass
-class ModeSet:
-    """Current modes of a search: ``m`` in-band, then ``len(hp)`` residual modes.
-
-    The first ``n_free`` residual modes are in-band modes the user did not ask
-    for (not checked against the band), the others lie outside the band.
-    """
-
-    poles: NDArray[np.complex128]
-    part: NDArray[np.complex128]
-    hp: NDArray[np.complex128]
-    hl: NDArray[np.complex128]
-    n_free: int = 0
-
-    @property
-    def m(self) -> int:
-        return int(self.poles.size)
-
-    def all(self) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
-        return np.concatenate([self.poles, self.hp]), np.concatenate([self.part, self.hl])
-
-    def take(self, res: FitResult) -> ModeSet:
-        m = self.m
-        return ModeSet(
-            res.poles[:m], res.participation[:m], res.poles[m:], res.participation[m:], self.n_free
-        )
-
-
-def rejected(
-    p: complex, why: str, t: float = float("nan"), thr: float = float("nan")
-) -> RejectedMode:
-    """Record of a candidate that was not kept."""
-    return RejectedMode(
-        float(abs(p) / (2 * np.pi)), float(-p.real / abs(p)), why, float(t), float(thr)
-    )
-
-
-def _lost(
-    res: FitResult, modes: ModeSet, band: tuple[float, float]
-) -> tuple[NDArray[np.intp], str]:
-    """The modes a fit of ``modes`` lost, and why: those that left their side of
-    the band (in-band modes outside it, out-of-band residual modes inside it), or
-    else the weaker of two that merged (none: an empty index); residual modes (tails
-    shaped together) and modes of distinct participation (repeated roots) do not."""
-    m = modes.m
-    p = res.poles
-    fd = p.imag / (2 * np.pi)
-    inb = (fd >= band[0]) & (fd <= band[1])
-    free = np.zeros(modes.hp.size, bool)
-    free[: modes.n_free] = True
-    wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
-    if wrong.size:
-        return wrong, "crossed the band edge during refinement"
-    d = np.abs(p[:, None] - p[None, :]) / np.abs(p)[:, None]
-    np.fill_diagonal(d, np.inf)
-    d[m:, m:] = np.inf
-    if res.participation.shape[1] > 1:
-        d[same_place_distinct(res.participation)] = np.inf
-    if d.size and d.min() < MERGE:
-        i, j = np.unravel_index(np.argmin(d), d.shape)
-        k = i if res.contribution[i] < res.contribution[j] else j
-        return np.array([k], np.intp), "merged with another mode during refinement"
-    return wrong, ""
-
-
-def as_residual(modes: ModeSet, broad: NDArray[np.bool_]) -> ModeSet:
-    """``modes`` with the in-band modes ``broad`` (m,) moved to the front of the
-    residual modes, as free ones (not checked against the band, not reported):
-    poles damped beyond the admissible limit that the data still need (broad
-    structure, e.g. the tails of modes outside the band). The order of
-    :meth:`ModeSet.all` is kept when only the last in-band modes move."""
-    keep = ~broad
-    return ModeSet(
-        modes.poles[keep],
-        modes.part[keep],
-        np.concatenate([modes.poles[broad], modes.hp]),
-        np.concatenate([modes.part[broad], modes.hl]),
-        modes.n_free + int(np.count_nonzero(broad)),
-    )
-
-
-def too_damped(poles: NDArray[np.complex128], max_damping: float | None) -> NDArray[np.bool_]:
-    """Which poles are damped beyond ``max_damping`` (none when it is None)."""
-    if max_damping is None:
-        return np.zeros(poles.size, bool)
-    return np.asarray(-poles.real > max_damping * np.abs(poles))
-
-
-def fit_checked(
-    fitter: ModalFitter,
-    modes: ModeSet,
-    refine: bool,
-    band: tuple[float, float],
-    start: FitResult | None = None,
-    **fit_kw: object,
-) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
-    """Fit the modes; drop any that left its side of the band or merged, and refit.
-
-    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`, ``start`` (the
-    fit the modes come from, if any) to its first fit. Returns the fit, the
-    modes at the fit's values and the dropped ones.
-    """
-    dropped: list[RejectedMode] = []
-    cur = modes
-    for _ in range(modes.m + modes.hp.size + 1):
-        m = cur.m
-        p0, l0 = cur.all()
-        first = start if cur is modes else None
-        res = fitter.fit(p0, l0, refine=refine, start=first, **fit_kw)  # type: ignore[arg-type]
-        fd = res.poles.imag / (2 * np.pi)
-        wrong, why = _lost(res, cur, band)
-        if not wrong.size:
-            return res, cur.take(res), dropped
-        # every mode that crossed a band edge is dropped at once (one refit)
-        inband = wrong[wrong < m]
-        if inband.size >= m:
-            raise ConvergenceError(f"every mode {why}")
-        dropped += [
-            rejected(complex(cur.poles[i]), f"complex fit: {why} ({fd[i]:.2f} Hz)") for i in inband
-        ]
-        out = wrong[wrong >= m] - m
-        keep_m = np.setdiff1d(np.arange(m), inband)
-        keep_h = np.setdiff1d(np.arange(cur.hp.size), out)
-        cur = ModeSet(
-            cur.poles[keep_m],
-            cur.part[keep_m],
-            cur.hp[keep_h],
-            cur.hl[keep_h],
-            int(np.count_nonzero(keep_h < cur.n_free)),
-        )
-    raise ConvergenceError("refinement kept losing modes")
 
 
 class FixedParts:
@@ -337,12 +208,17 @@ def reject_by_test(
     span: SpanNoise | None = None
     for i in range(modes.m + 1):
         if i == 0 and refine:
-            # a converged joint fit first (modes that leave the band are dropped)
-            res, cur, gone = fit_checked(
-                fitter, cur, True, band, start, passes=1, tol=SEARCH_TOL, uncertainty=False
-            )
-            out += gone
-        elif res is None:
+            # a converged joint fit first (modes that leave the band are dropped); if
+            # it loses every mode (the few modes of a band missing most are dragged
+            # out), the residues at the current poles, and the search adds the rest
+            try:
+                res, cur, gone = fit_checked(
+                    fitter, cur, True, band, start, passes=1, tol=SEARCH_TOL, uncertainty=False
+                )
+                out += gone
+            except ConvergenceError:
+                res = None
+        if res is None:
             # after a removal the others barely move: the residues are refitted at
             # the current poles (the final fit refines them all)
             p0, l0 = cur.all()
