@@ -499,7 +499,22 @@ def _final_fit(
     a band that holds many) leaves no model: the residues are then fitted at the
     search's poles, with a warning, rather than no result."""
     try:
-        return _refined_fit(problem, cfit, modes, sigma0, refine, combined)
+        if combined is not None and sigma0 is not None:
+            r0, cur, dropped = fit_checked(
+                combined, modes, True, problem.band, passes=1, tol=FINAL_TOL, uncertainty=False
+            )
+            res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
+            res.status, res.n_iter = r0.status, r0.n_iter
+            return res, cur, dropped
+        return fit_checked(
+            cfit,
+            modes,
+            refine,
+            problem.band,
+            passes=1 if sigma0 is not None else 2,
+            sigma=sigma0,
+            tol=FINAL_TOL,
+        )
     except ConvergenceError as exc:
         p0, l0 = modes.all()
         res = cfit.fit(p0, l0, refine=False, sigma=sigma0)
@@ -510,33 +525,6 @@ def _final_fit(
             "were found (raise the maximum order or give the mode count)"
         )
         return res, modes, []
-
-
-def _refined_fit(
-    problem: FitProblem,
-    cfit: ModalFitter,
-    modes: ModeSet,
-    sigma0: NDArray[np.float64] | None,
-    refine: bool,
-    combined: ModalFitter | None,
-) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
-    """The final fit's refinement (:func:`_final_fit`)."""
-    if combined is not None and sigma0 is not None:
-        r0, cur, dropped = fit_checked(
-            combined, modes, True, problem.band, passes=1, tol=FINAL_TOL, uncertainty=False
-        )
-        res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
-        res.status, res.n_iter = r0.status, r0.n_iter
-        return res, cur, dropped
-    return fit_checked(
-        cfit,
-        modes,
-        refine,
-        problem.band,
-        passes=1 if sigma0 is not None else 2,
-        sigma=sigma0,
-        tol=FINAL_TOL,
-    )
 
 
 def full_weights(problem: FitProblem) -> bool:
