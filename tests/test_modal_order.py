@@ -51,10 +51,12 @@ def test_modes_shown_of_pure_noise_is_zero() -> None:
 
 
 def test_order_cap_is_twice_the_sizing_of_the_modes_shown() -> None:
-    # ceil(8 (M + 2) / n_in), never below the start, never above the line limit
+    # ceil(8 (n_in M + 2) / n_in) (a peak of several inputs can hold a repeated root
+    # of n_in modes), never below the start, never above the line limit
     assert order_cap(1, 100_000, 60, 1) == 60
     assert order_cap(1, 100_000, 60, 30) == 256
-    assert order_cap(2, 100_000, 30, 30) == 128
+    assert order_cap(2, 100_000, 30, 30) == 248
+    assert order_cap(3, 100_000, 20, 5) == 46
     assert order_cap(1, 40, 60, 30) == 2 * 40 // 2 - 2
 
 

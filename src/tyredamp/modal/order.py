@@ -4,7 +4,8 @@
 estimator and raises the order by the sizing rule and by trials of an
 unsettled diagram, as the docstring of :mod:`tyredamp.modal.identify` states,
 up to :func:`order_cap`: twice the roots the sizing rule asks for the
-resonances the data show (:func:`modes_shown`), so that the order follows the
+resonances the data show (:func:`modes_shown`; with several inputs each may be
+a repeated root of as many modes as inputs), so that the order follows the
 modes of the band and not its number of lines.
 """
 
@@ -133,9 +134,12 @@ def modes_shown(problem: FitProblem, false_alarm: float = FALSE_ALARM) -> int:
 
 
 def order_cap(n_in: int, n_f: int, p_start: int, n_shown: int) -> int:
-    """Highest automatic order: ``max(p_start, ceil(8 (n_shown + 2) / n_in))``, at most
-    :func:`order_limit` (twice the roots the sizing rule asks for the modes shown)."""
-    return max(2, min(order_limit(n_in, n_f), max(p_start, math.ceil(8 * (n_shown + 2) / n_in))))
+    """Highest automatic order: ``max(p_start, ceil(8 (n_in n_shown + 2) / n_in))``, at
+    most :func:`order_limit`: twice the roots the sizing rule asks for the modes the
+    peaks shown can hold (with several inputs a peak can hold a repeated root, up to
+    ``n_in`` modes at one pole)."""
+    modes = n_in * n_shown
+    return max(2, min(order_limit(n_in, n_f), max(p_start, math.ceil(8 * (modes + 2) / n_in))))
 
 
 def diagram(
