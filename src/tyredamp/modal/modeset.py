@@ -3,7 +3,7 @@
 :class:`ModeSet` holds the current modes of the search stages
 (:mod:`tyredamp.modal.search`, :mod:`tyredamp.modal.out_of_band`,
 :mod:`tyredamp.modal.final`); :func:`fit_checked` fits them and drops the
-modes a fit lost (:func:`_lost`: left their side of the band, or merged).
+modes a fit lost (:func:`lost_modes`: left their side of the band, or merged).
 """
 
 from __future__ import annotations
@@ -18,9 +18,17 @@ from .fit import FitResult, ModalFitter
 from .quality import RejectedMode
 from .selection import same_place_distinct
 
-__all__ = ["MERGE", "ModeSet", "as_residual", "fit_checked", "rejected", "too_damped"]
+__all__ = [
+    "MERGE",
+    "ModeSet",
+    "as_residual",
+    "fit_checked",
+    "lost_modes",
+    "rejected",
+    "too_damped",
+]
 
-#: poles closer than this (relative to |p|) are one mode (but see :func:`_lost`)
+#: poles closer than this (relative to |p|) are one mode (but see :func:`lost_modes`)
 MERGE = 5e-4
 
 
@@ -61,7 +69,7 @@ def rejected(
     )
 
 
-def _lost(
+def lost_modes(
     res: FitResult, modes: ModeSet, band: tuple[float, float]
 ) -> tuple[NDArray[np.intp], str]:
     """The modes a fit of ``modes`` lost, and why: those that left their side of
@@ -134,7 +142,7 @@ def fit_checked(
         first = start if cur is modes else None
         res = fitter.fit(p0, l0, refine=refine, start=first, **fit_kw)  # type: ignore[arg-type]
         fd = res.poles.imag / (2 * np.pi)
-        wrong, why = _lost(res, cur, band)
+        wrong, why = lost_modes(res, cur, band)
         if not wrong.size:
             return res, cur.take(res), dropped
         # every mode that crossed a band edge is dropped at once (one refit)

@@ -93,7 +93,7 @@ def search_helpers(
             except (ConvergenceError, np.linalg.LinAlgError, ValueError):
                 break
             if new.hp.size <= cur.hp.size:
-                continue  # the joint refit merged it with a residual mode: the next start
+                continue  # the joint refit lost it (into the band, or merged): the next start
             # the helper must stay on its side of the band, within a factor 2 of the edge
             fd = new.hp[-1].imag / (2 * np.pi)
             outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)

@@ -46,9 +46,9 @@ from .fit import FitResult, ModalFitter
 from .modeset import (
     MERGE,
     ModeSet,
-    _lost,
     as_residual,
     fit_checked,
+    lost_modes,
     rejected,
     too_damped,
 )
@@ -309,7 +309,7 @@ def _joint(
         return None
     k = new.m - 1  # the trial mode
     fd = r1.poles.imag / (2 * np.pi)
-    wrong, why = _lost(r1, new, band)
+    wrong, why = lost_modes(r1, new, band)
     if wrong.size and np.all(wrong >= new.m):
         # only residual modes entered the band: dropped, the rest refitted from
         # their starts (fit_checked), and the trial judged on that fit

@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..exceptions import InputError
@@ -398,6 +399,12 @@ def _linkage(
     return labels
 
 
+def _orders_of(labels: NDArray[np.int64], od: NDArray[np.int64], n_lab: int) -> NDArray[np.intp]:
+    """How many distinct orders ``od`` each of the ``n_lab`` clusters ``labels`` holds."""
+    pairs = np.unique(labels * (int(od.max()) + 1) + od)
+    return np.asarray(np.bincount(pairs // (int(od.max()) + 1), minlength=n_lab))
+
+
 def _second_pass(
     p: NDArray[np.complex128],
     lv: NDArray[np.complex128],
@@ -418,10 +425,7 @@ def _second_pass(
     persistent clusters of the first pass are kept as they are.
     """
     n_lab = int(labels.max()) + 1
-    span = np.bincount(
-        np.unique(labels * (int(od.max()) + 1) + od) // (int(od.max()) + 1), minlength=n_lab
-    )
-    again = span[labels] < min_orders
+    again = _orders_of(labels, od, n_lab)[labels] < min_orders
     rest = np.flatnonzero(again)
     if rest.size < 2:
         return labels, np.zeros(p.size, bool)
@@ -453,19 +457,7 @@ def _repeated_slots(
     mean = (
         np.bincount(labels, p.real, n_lab) / count + 1j * np.bincount(labels, p.imag, n_lab) / count
     )
-    root = np.arange(n_lab)
-
-    def find(a: int) -> int:
-        while root[a] != a:
-            root[a] = root[root[a]]
-            a = int(root[a])
-        return a
-
-    for a, b in zip(
-        *np.nonzero(np.triu(_same_place(mean[:, None], mean[None, :]), 1)), strict=True
-    ):
-        root[find(int(a))] = find(int(b))
-    comp = np.array([find(a) for a in range(n_lab)])
+    _, comp = connected_components(_same_place(mean[:, None], mean[None, :]), directed=False)
     out = labels.copy()
     for c in np.unique(comp):
         group = np.flatnonzero(comp == c)
@@ -582,8 +574,7 @@ def cluster_poles(
     dist = np.abs(p - poles[labels])
     by_dist = np.lexsort((np.arange(idx.size), dist, labels))
     best = by_dist[start]
-    pairs = np.unique(labels * (int(od.max()) + 1) + od)
-    frac = np.bincount(pairs // (int(od.max()) + 1), minlength=n_cl) / n_orders
+    frac = _orders_of(labels, od, n_cl) / n_orders
     mean = np.bincount(labels, fn_all, n_cl) / count
     var = np.maximum(np.bincount(labels, (fn_all - mean[labels]) ** 2, n_cl) / count, 0.0)
     members = np.split(np.argsort(labels, kind="stable"), np.cumsum(count)[:-1])
