@@ -170,6 +170,10 @@ def identify(seed: int) -> dict[str, Any]:
         "z": c.damping_ratio.tolist(),
         "sf": np.asarray(c.std["frequency_hz"]).tolist(),
         "sz": np.asarray(c.std["damping_ratio"]).tolist(),
+        # the 95 % intervals (likelihood intervals where the pole's standard error is
+        # a noticeable share of its half-width, :mod:`tyredamp.modal.profile`)
+        "fi": np.asarray(c.meta.get("interval_frequency_hz", np.zeros((0, 2)))).tolist(),
+        "zi": np.asarray(c.meta.get("interval_damping_ratio", np.zeros((0, 2)))).tolist(),
         "time": time.perf_counter() - t,
     }
 

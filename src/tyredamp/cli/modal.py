@@ -60,6 +60,7 @@ def modes_table(name: str, model: ModalModel) -> list[str]:
                 f"  thr raised from {q.threshold:.3g} (noise along the response) "
                 f"for mode(s) {', '.join(raised)}"
             )
+    rows += _likelihood_rows(model)
     rmsd = model.meta.get("rmsd", float("nan"))
     rel = model.meta.get("relative_error", float("nan"))
     rows.append(f"  RMSD (eq. 19) {rmsd:.4g}, relative error {100 * rel:.3g} %")
@@ -73,6 +74,23 @@ def modes_table(name: str, model: ModalModel) -> list[str]:
     for w in model.meta.get("warnings", []):
         rows.append(f"  warning: {w}")
     return rows
+
+
+def _likelihood_rows(model: ModalModel) -> list[str]:
+    """The 95 % likelihood intervals of the modes that have one (a weak mode, whose
+    linearised interval would be too short; :mod:`tyredamp.modal.profile`): the
+    +- columns hold the half-width of the symmetric interval around them."""
+    how = model.meta.get("interval_method")
+    fi, zi = model.meta.get("interval_frequency_hz"), model.meta.get("interval_damping_ratio")
+    if not isinstance(how, list) or len(how) != model.n_modes or fi is None or zi is None:
+        return []
+    fa, za = np.asarray(fi, float), np.asarray(zi, float)
+    return [
+        f"  mode {n + 1}: 95 % likelihood interval f [{fa[n, 0]:.4f}, {fa[n, 1]:.4f}] Hz, "
+        f"zeta [{100 * za[n, 0]:.4f}, {100 * za[n, 1]:.4f}] % (+- holds it)"
+        for n in range(model.n_modes)
+        if how[n] == "likelihood"
+    ]
 
 
 def _parse_frequencies(text: str | None) -> list[float] | None:

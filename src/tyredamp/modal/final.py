@@ -33,6 +33,7 @@ from .indicators import mean_phase_deviation, modal_phase_collinearity
 from .ml import ml_refine
 from .model import ModalModel
 from .problem import FitProblem
+from .profile import Z95, fit_intervals
 from .quality import FitQuality, RejectedMode, threshold_text
 from .refitted import refitted_statistics
 from .residual_peaks import local_ratio
@@ -290,6 +291,44 @@ def local_dispersion(
     return np.asarray(np.maximum(rho, 1.0))
 
 
+def _intervals_95(
+    res: FitResult,
+    u: FitResult,
+    o: NDArray[np.intp],
+    poles: NDArray[np.complex128],
+    inflate: NDArray[np.float64],
+) -> tuple[dict[str, ArrayLike], dict[str, object]]:
+    """The standard errors and 95 % intervals of the in-band modes (sorted by ``o``;
+    ``u`` the unscaled fit, ``inflate`` the square root of each mode's local
+    dispersion): the likelihood interval where it was formed
+    (:mod:`~tyredamp.modal.profile`), else the linearised one, each half scaled by
+    the local dispersion; the standard error of a mode with a likelihood interval
+    is the half-width of the symmetric interval that holds it, over 1.96. Returns
+    the ``std`` entries and the ``meta`` entries of the intervals."""
+    f_hat, z_hat = np.abs(poles) / (2 * np.pi), -poles.real / np.abs(poles)
+    sd_f, sd_z = u.std_frequency_hz[o], u.std_damping_ratio[o]
+    iv = res.intervals
+    lik = np.zeros(o.size, bool) if iv is None else np.asarray(iv.likelihood)[o]
+    half_f = np.stack([Z95 * sd_f, Z95 * sd_f], axis=1)
+    half_z = np.stack([Z95 * sd_z, Z95 * sd_z], axis=1)
+    if iv is not None and lik.any():
+        fi, zi = np.asarray(iv.frequency_hz)[o], np.asarray(iv.damping_ratio)[o]
+        half_f[lik] = np.abs(fi[lik] - f_hat[lik, None])
+        half_z[lik] = np.abs(zi[lik] - z_hat[lik, None])
+    half_f, half_z = half_f * inflate[:, None], half_z * inflate[:, None]
+    std: dict[str, ArrayLike] = {
+        "frequency_hz": np.where(lik, np.max(half_f, axis=1) / Z95, sd_f * inflate),
+        "damping_ratio": np.where(lik, np.max(half_z, axis=1) / Z95, sd_z * inflate),
+        "psi_out": u.std_psi_out[:, o] * inflate[None, :],
+    }
+    meta: dict[str, object] = {
+        "interval_frequency_hz": np.stack([f_hat - half_f[:, 0], f_hat + half_f[:, 1]], axis=1),
+        "interval_damping_ratio": np.stack([z_hat - half_z[:, 0], z_hat + half_z[:, 1]], axis=1),
+        "interval_method": ["likelihood" if b else "linearised" for b in lik],
+    }
+    return std, meta
+
+
 def to_model(
     res: FitResult, n_band: int, ctx: ModelContext
 ) -> tuple[ModalModel, NDArray[np.float64]]:
@@ -322,11 +361,7 @@ def to_model(
     poles, psi_out, psi_in = u.poles[o], u.psi_out[:, o], u.psi_in[:, o]
     disp = local_dispersion(pr, res, sq, n_band)[o]
     inflate = np.sqrt(disp)
-    std: dict[str, ArrayLike] = {
-        "frequency_hz": u.std_frequency_hz[o] * inflate,
-        "damping_ratio": u.std_damping_ratio[o] * inflate,
-        "psi_out": u.std_psi_out[:, o] * inflate[None, :],
-    }
+    std, intervals = _intervals_95(res, u, o, poles, inflate)
     n_f = pr.H.shape[-1]
     rmsd = float(c * np.sqrt(sq.sum()) / sq.size)
     rel = float(np.sqrt(sq.sum() / max(float(np.vdot(pr.H, pr.H).real), 1e-300)))
@@ -390,6 +425,7 @@ def to_model(
         "drive_point_phi2": u.drive_phi2[o],
         "std_pole": res.std_pole[o] * inflate,
         "local_dispersion": disp,
+        **intervals,
         "n_residual_modes": len(res.poles) - n_band,
         "warnings": list(res.warnings),
     }
@@ -482,6 +518,9 @@ def final_complex(
         # the ML refinement keeps the WLS fit's statistics (:mod:`~tyredamp.modal.ml`),
         # so the thresholds they were tested against stand
         res = maximum_likelihood(problem, cfit, res)
+        if combined is None or sigma0 is None:
+            # likelihood intervals where the linearised ones would be too short
+            res.intervals = fit_intervals(problem, cfit, res, cur.m, sigma0)
     return res, cur, dropped, thr
 
 

@@ -139,6 +139,9 @@ class FitResult:
     #: rest here: the same refinement started at this result stops at once
     #: (``ModalFitter.fit(..., start=this)``); None when not known to be at rest
     rest: tuple[NDArray[np.float64], float] | None = None
+    #: 95 % intervals of the in-band modes' f and zeta (fit order;
+    #: :class:`~tyredamp.modal.profile.Intervals`), set by the final stage
+    intervals: Any = None
 
 
 class ModalFitter:
