@@ -53,6 +53,10 @@ Per SNR the table prints:
   true model at the true parameters; 1 for an efficient estimator);
 * ``cover f, zeta``: share of those errors within the reported 95 % interval
   (``1.96`` standard errors; 0.95 for honest intervals);
+* ``interval f, zeta``: the same share for the 95 % intervals in the model's
+  meta (the likelihood intervals of :mod:`tyredamp.modal.profile` where the
+  pole's standard error is a noticeable share of its half-width, which the
+  symmetric ``1.96 std`` holds; the linearised interval elsewhere);
 * ``no hidden f, zeta``: the coverage over the matched significant modes that
   have no *hidden* neighbour, a true mode within twice the sum of the two
   half-power half-widths that no identified mode stands for (significant and
@@ -361,6 +365,8 @@ def score(tr: dict[str, Any], idr: dict[str, Any]) -> dict[str, Any]:
         "ez": [],
         "cf": [],
         "cz": [],
+        "lf": [],
+        "lz": [],
         "ocf": list(tr.get("oracle_cf", [])),
         "ocz": list(tr.get("oracle_cz", [])),
     }
@@ -374,6 +380,10 @@ def score(tr: dict[str, Any], idr: dict[str, Any]) -> dict[str, Any]:
         sf, sz = idr["sf"][j], idr["sz"][j]
         out["cf"].append(bool(abs(ef) <= 1.96 * sf))
         out["cz"].append(bool(abs(ez) <= 1.96 * sz))
+        if len(idr.get("fi", [])) == fi.size:  # the 95 % intervals themselves
+            (f_lo, f_hi), (z_lo, z_hi) = idr["fi"][j], idr["zi"][j]
+            out["lf"].append(bool(f_lo <= ft[i] <= f_hi))
+            out["lz"].append(bool(z_lo <= zt[i] <= z_hi))
         # a true mode that no identified mode stands for, within twice the sum of
         # the half-widths: its response is in the data but not in the model
         near = np.abs(ft - ft[i]) < HIDDEN * (hw + hw[i])
@@ -393,7 +403,8 @@ def table(title: str, rows: list[tuple[float, dict[str, Any]]]) -> list[str]:
         f"{'SNR':>5} {'fits':>5} {'found':>8} {'found LR':>8} {'false/fit':>9} "
         f"{'err/CRLB f':>10} "
         f"{'zeta':>6} {'cover f':>8} {'zeta':>6} {'oracle f':>8} {'zeta':>6} "
-        f"{'no hidden f':>11} {'zeta':>6} {'share':>6} {'time/fit':>9}",
+        f"{'no hidden f':>11} {'zeta':>6} {'share':>6} {'interval f':>10} {'zeta':>6} "
+        f"{'time/fit':>9}",
     ]
     for snr in SNRS:
         sel = [r for s, r in rows if s == snr]
@@ -417,13 +428,17 @@ def table(title: str, rows: list[tuple[float, dict[str, Any]]]) -> list[str]:
         rms_f = float(np.sqrt(np.mean(ef**2))) if ef.size else float("nan")
         rms_z = float(np.sqrt(np.mean(ez**2))) if ez.size else float("nan")
         tpf = float(np.mean([r["time"] for r in sel]))
+        lf = np.concatenate([r.get("lf", []) for r in sel] + [np.zeros(0, bool)])
+        lz = np.concatenate([r.get("lz", []) for r in sel] + [np.zeros(0, bool)])
+        lcf = np.mean(lf) if lf.size else np.nan
+        lcz = np.mean(lz) if lz.size else np.nan
         lines.append(
             f"{snr:>5.0f} {len(sel):>5} {found:>8.2%} {found_lr:>8.2%} {false:>9.3f} "
             f"{rms_f:>10.2f} {rms_z:>6.2f} {np.mean(cf) if cf.size else np.nan:>8.2%} "
             f"{np.mean(cz) if cz.size else np.nan:>6.2%} "
             f"{np.mean(ocf) if ocf.size else np.nan:>8.2%} "
             f"{np.mean(ocz) if ocz.size else np.nan:>6.2%} "
-            f"{hcf:>11.2%} {hcz:>6.2%} {share:>6.0%} {tpf:>8.2f}s"
+            f"{hcf:>11.2%} {hcz:>6.2%} {share:>6.0%} {lcf:>10.2%} {lcz:>6.2%} {tpf:>8.2f}s"
         )
     return lines
 

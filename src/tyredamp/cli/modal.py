@@ -88,8 +88,9 @@ def _likelihood_rows(model: ModalModel) -> list[str]:
     return [
         f"  mode {n + 1}: 95 % likelihood interval f [{fa[n, 0]:.4f}, {fa[n, 1]:.4f}] Hz, "
         f"zeta [{100 * za[n, 0]:.4f}, {100 * za[n, 1]:.4f}] % (+- holds it)"
+        + ("; the data do not tell it from a neighbour" if how[n] != "likelihood" else "")
         for n in range(model.n_modes)
-        if how[n] == "likelihood"
+        if str(how[n]).startswith("likelihood")
     ]
 
 

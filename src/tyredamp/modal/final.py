@@ -309,6 +309,7 @@ def _intervals_95(
     sd_f, sd_z = u.std_frequency_hz[o], u.std_damping_ratio[o]
     iv = res.intervals
     lik = np.zeros(o.size, bool) if iv is None else np.asarray(iv.likelihood)[o]
+    opn = np.zeros(o.size, bool) if iv is None else np.asarray(iv.open)[o]
     half_f = np.stack([Z95 * sd_f, Z95 * sd_f], axis=1)
     half_z = np.stack([Z95 * sd_z, Z95 * sd_z], axis=1)
     if iv is not None and lik.any():
@@ -321,12 +322,31 @@ def _intervals_95(
         "damping_ratio": np.where(lik, np.max(half_z, axis=1) / Z95, sd_z * inflate),
         "psi_out": u.std_psi_out[:, o] * inflate[None, :],
     }
+    f_lo, f_hi = f_hat - half_f[:, 0], f_hat + half_f[:, 1]
     meta: dict[str, object] = {
-        "interval_frequency_hz": np.stack([f_hat - half_f[:, 0], f_hat + half_f[:, 1]], axis=1),
+        "interval_frequency_hz": np.stack([f_lo, f_hi], axis=1),
         "interval_damping_ratio": np.stack([z_hat - half_z[:, 0], z_hat + half_z[:, 1]], axis=1),
-        "interval_method": ["likelihood" if b else "linearised" for b in lik],
+        "interval_method": [
+            (f"likelihood, {MERGED}" if o else "likelihood") if b else "linearised"
+            for b, o in zip(lik, opn | _holds_other(f_hat, f_lo, f_hi), strict=True)
+        ],
     }
     return std, meta
+
+
+#: the interval method of a mode whose likelihood interval holds another mode's
+#: frequency, or has an end where the profile never reached the cut
+MERGED = "not told from a neighbour"
+
+
+def _holds_other(
+    f_hat: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64]
+) -> NDArray[np.bool_]:
+    """Whether each mode's frequency interval ``[lo, hi]`` holds another mode's
+    frequency (the data do not tell the two apart at that level)."""
+    inside = (f_hat[None, :] >= lo[:, None]) & (f_hat[None, :] <= hi[:, None])
+    np.fill_diagonal(inside, False)
+    return np.asarray(np.any(inside, axis=1))
 
 
 def to_model(
@@ -518,9 +538,8 @@ def final_complex(
         # the ML refinement keeps the WLS fit's statistics (:mod:`~tyredamp.modal.ml`),
         # so the thresholds they were tested against stand
         res = maximum_likelihood(problem, cfit, res)
-        if combined is None or sigma0 is None:
-            # likelihood intervals where the linearised ones would be too short
-            res.intervals = fit_intervals(problem, cfit, res, cur.m, sigma0)
+        # likelihood intervals where the linearised ones would be too short
+        res.intervals = fit_intervals(cfit, res, cur.m, sigma0)
     return res, cur, dropped, thr
 
 
