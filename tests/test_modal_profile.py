@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
+from tyredamp.cli.modal import modes_table
 from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
 from tyredamp.modal import profile as prof
@@ -183,6 +184,9 @@ def test_identified_model_reports_the_intervals(given_variance: bool) -> None:
     np.testing.assert_allclose(m.std["frequency_hz"], half / prof.Z95, rtol=1e-12)
     half_z = np.max(np.abs(zi - m.damping_ratio[:, None]), axis=1)
     np.testing.assert_allclose(m.std["damping_ratio"], half_z / prof.Z95, rtol=1e-12)
+    # the command line's table gives them
+    table = "\n".join(modes_table("complex", m))
+    assert "mode 2: 95 % likelihood interval f [" in table
     # strict JSON, and read back
     d = json.loads(json.dumps(m.to_dict(), allow_nan=False))
     back = ModalModel.from_dict(d)

@@ -6,36 +6,48 @@ are linearised (Gauss-Newton, ``s^2 (J^T J)^-1``): the interval ``theta^ +-
 optimum. A mode's FRF is not linear in its pole on the scale of its half-power
 half-width ``sigma = -Re p``: when the pole's standard error is a noticeable
 fraction of ``sigma`` (a weak mode, a mode beside a stronger one, few lines
-across the resonance), the linearised interval of a 95 % level covers its
-true value far less often (on a weak mode one half-width from a strong one,
-at a mode statistic of 46 / 68 / 129 in noise units: 71 / 85 / 92 %, 300
-draws; the likelihood interval below 87 / 91 / 95 %).
+across the resonance), the linearised interval of a 95 % level covers the
+true value far less often. On a weak mode one half-width above a strong one
+(four outputs), identified as a user would, with a mode statistic of about 60
+/ 120 in noise units, the linearised intervals of f and zeta cover 80 / 88 %
+and the likelihood intervals below 86-90 / 92-93 % (300 draws,
+``benchmarks/modal_intervals.py``).
 
-For those modes the interval is the profile-likelihood interval (e.g. Seber
-& Wild, *Nonlinear Regression*, 1989, sec. 5.4; Pawitan, *In All
-Likelihood*, 2001, sec. 3.4): the set of values ``v`` of the natural
-frequency (or damping ratio) whose profile cost ``P(v)`` -- the fit's
-cost minimised over every other parameter with that one held at ``v``
-(residues by variable projection, the other poles and participation by
-Levenberg-Marquardt from the optimum) -- rises above the optimum by at most
-``1.96^2 s^2``, with ``s^2`` the scale of the fit's covariance (the residual
-variance of a weighted least-squares fit, the Fisher scale of a
-maximum-likelihood one): the likelihood-ratio test of that value at 5 %.
-For a model linear in its parameters it is the linearised interval exactly.
+For those modes the interval is the profile-likelihood interval (Seber &
+Wild, *Nonlinear Regression*, 1989, sec. 5.4; Pawitan, *In All Likelihood*,
+2001, sec. 3.4): the values ``v`` of the natural frequency (or damping ratio)
+whose profile cost ``P(v)`` -- the cost minimised over every other parameter
+with that one held at ``v`` (residues by variable projection, the other
+poles and participation by Levenberg-Marquardt from the optimum) -- rises
+above the optimum by at most ``1.96^2 s^2``, ``s^2`` the noise scale of the
+fit: the likelihood-ratio test of that value at 5 %. For a model linear in
+its parameters it is the linearised interval exactly.
 
-Its ends are found on the signed root ``r(v) = sign(v - v^) sqrt((P(v) -
-P(v^)) / s^2)``, which is linear in ``v`` for a linear model and close to it
-otherwise: secant steps from the linearised end, each a profile fit started
-from the nearest profile point, until ``|r - 1.96| <= R_TOL`` (the end within
-about 1 % of the interval's half-width).
+:func:`profile_mode` finds its ends on the signed root ``r(v) = sign(v - v^)
+sqrt((P(v) - P(v^)) / s^2)``, linear in ``v`` for a linear model and close to
+it otherwise: secant steps from the linearised end, each a profile fit
+started from the nearest profile point, false position once the end is
+bracketed, until ``|r - 1.96| <= R_TOL`` (the end within about 1 % of the
+half-width). Pushed toward a neighbour that the data do not tell apart, the
+profile can dip where the two modes trade places; the interval then holds
+the neighbour's frequency (or, never reaching the cut, its end is *open*),
+and the model says so (``meta["interval_method"]``).
+
+The final stage (:func:`fit_intervals`) profiles each mode on its own lines
+(within ``WINDOW`` half-widths, the fitted response of the modes and
+residual terms beyond subtracted) and stretches each half of the whole fit's
+linearised interval by the factor by which the local likelihood interval's
+half exceeds the local linearised one: the cost does not grow with the band
+or the mode count, and the whole fit's standard errors (weighted least
+squares or maximum likelihood) stand in the linear limit.
 
 Which modes: those whose pole's linearised standard error exceeds ``KAPPA``
-times the half-power half-width ``sigma`` (real or imaginary part). The
-curvature of the resonance ``1 / (i w - p)`` in ``p`` has the scale
-``sigma``; the end of a linearised interval then errs by a share of the
-order of ``1.96 sd / sigma`` of its half-width (measured:
-``benchmarks/modal_intervals.py``), so below ``KAPPA`` the two intervals
-agree to about a per cent and the profile fits would only cost time.
+times the half-width ``sigma`` (real or imaginary part). The curvature of the
+resonance ``1 / (i w - p)`` in ``p`` has the scale ``sigma``; the ends of the
+linearised interval of an isolated mode err by about 1.3 times that ratio of
+the half-width (measured: ``benchmarks/modal_intervals.py``), so below
+``KAPPA`` the two intervals agree to about a per cent (0.3 points of
+coverage) and profiles would only cost time.
 """
 
 from __future__ import annotations
@@ -157,15 +169,14 @@ def _profile_cost(
         a[:, i : i + 2] = a[:, i : i + 2] @ jac
         a[i : i + 2, :] = jac.T @ a[i : i + 2, :]
         g[i : i + 2] = jac.T @ g[i : i + 2]
-        return cost, a[np.ix_(free, free)], g[free], y
+        return cost, a[np.ix_(free, free)], g[free], (cost, y)
 
     z0 = np.clip(y0[free], lb[free] + 1e-12, ub[free] - 1e-12)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         try:
-            _, _, _, y = _levenberg_marquardt(
+            _, _, _, (cost, y) = _levenberg_marquardt(
                 ev, z0, lb[free], ub[free], PROFILE_NFEV, dof=dof, tol=PROFILE_TOL
             )
-            cost = float(evaluate(mode.to_x(y)[0])[0])
         except (np.linalg.LinAlgError, ValueError, FloatingPointError):
             return None
     if not np.isfinite(cost):
