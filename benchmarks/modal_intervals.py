@@ -114,7 +114,7 @@ def main() -> None:
     ap.add_argument("--draws", type=int, default=300)
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args()
-    cases = [(0.15, 1.0), (0.2, 1.0), (0.3, 1.0), (0.5, 1.0), (0.2, 20.0)]
+    cases = [(0.15, 1.0), (0.2, 1.0), (0.3, 1.0), (0.5, 1.0), (0.2, 8.0)]
     t0 = time.perf_counter()
     print(
         f"{'weak':>5} {'sep':>5} {'T med':>6} {'found':>6} | likelihood: "

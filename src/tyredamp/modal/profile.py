@@ -9,8 +9,9 @@ fraction of ``sigma`` (a weak mode, a mode beside a stronger one, few lines
 across the resonance), the linearised interval of a 95 % level covers the
 true value far less often. On a weak mode one half-width above a strong one
 (four outputs), identified as a user would, with a mode statistic of about 60
-/ 120 in noise units, the linearised intervals of f and zeta cover 80 / 88 %
-and the likelihood intervals below 86-90 / 92-93 % (300 draws,
+/ 120 in noise units, the linearised intervals of f cover 77 / 92 % and of
+zeta 83 / 92 %; the symmetric intervals that hold the likelihood intervals
+below (the ``std`` reported) 93 / 97 % and 94 / 97 % (150 draws,
 ``benchmarks/modal_intervals.py``).
 
 For those modes the interval is the profile-likelihood interval (Seber &
@@ -44,8 +45,8 @@ squares or maximum likelihood) stand in the linear limit.
 Which modes: those whose pole's linearised standard error exceeds ``KAPPA``
 times the half-width ``sigma`` (real or imaginary part). The curvature of the
 resonance ``1 / (i w - p)`` in ``p`` has the scale ``sigma``; the ends of the
-linearised interval of an isolated mode err by about 1.3 times that ratio of
-the half-width (measured: ``benchmarks/modal_intervals.py``), so below
+linearised interval of an isolated mode err by about 1.3-1.4 times that ratio
+of the half-width (measured at 1.5 and 5 %: ``benchmarks/modal_intervals.py``), so below
 ``KAPPA`` the two intervals agree to about a per cent (0.3 points of
 coverage) and profiles would only cost time.
 """
