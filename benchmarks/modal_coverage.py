@@ -9,8 +9,8 @@ that SNR), each identified twice as that benchmark identifies them: with the
 likelihood intervals (the default) and with them off (``KAPPA`` infinite, the
 linearised intervals of earlier versions). Scored by its :func:`score` (the
 significant true modes at the true poles, matched within max(0.5 zeta f, 3
-CRLB_f)), with a cheaper truth: the significance and Cramer-Rao bounds at the
-true poles, without the refitted likelihood ratio or the oracle. Printed for
+CRLB_f)), with a cheaper truth: its ``truth_stats`` without the refitted
+likelihood ratio or the oracle. Printed for
 each: the share of the matched significant modes whose error lies within
 ``1.96`` reported standard errors (``std``: the symmetric interval, which
 holds the likelihood interval) and within the 95 % interval of the model's
@@ -33,36 +33,6 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 
-def truth(seed: int) -> dict[str, Any]:
-    """True modes, their significance at the true poles and Cramer-Rao bounds."""
-    import modal_statistics as ms
-
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.stats import mode_parameters, mode_threshold
-
-    s = ms.system(seed)
-    frf, _ = ms.frf_of(s, seed)
-    pr = build_problem(frf, s["band"])
-    n_out, n_in, n_f = pr.shape
-    fit = ModalFitter(pr.frequency, pr.H, pr.power, "complex", [], line_weights=pr.line_weights)
-    p_all = s["poles"]
-    fn = np.abs(p_all) / (2 * np.pi)
-    inb = (fn >= pr.band[0]) & (fn <= pr.band[1])
-    rms = np.sqrt(np.mean(np.abs(pr.H) ** 2, axis=(1, 2)))
-    res = fit.fit(p_all, s["psi_in"].T.copy(), refine=False, sigma=rms * 10 ** (-s["snr"] / 20))
-    k = mode_parameters(n_out, n_in, "complex")
-    thr = mode_threshold(k, n_f, 0.01, pr.weight_dof, (n_out, n_in))
-    return {
-        "f": fn.tolist(),
-        "z": (-p_all.real / np.abs(p_all)).tolist(),
-        "sig": (res.significance > thr).tolist(),
-        "inb": inb.tolist(),
-        "crlb_f": np.asarray(res.std_frequency_hz).tolist(),
-        "crlb_z": np.asarray(res.std_damping_ratio).tolist(),
-    }
-
-
 def one(args: tuple[int, float]) -> tuple[int, float, dict[str, Any], dict[str, Any] | None]:
     """One identification (likelihood intervals at ``kappa``) and, once, the truth."""
     seed, kappa = args
@@ -73,7 +43,7 @@ def one(args: tuple[int, float]) -> tuple[int, float, dict[str, Any], dict[str, 
     prof.KAPPA = kappa
     warnings.simplefilter("ignore")
     got = ms.identify(seed)
-    return seed, kappa, got, truth(seed) if np.isfinite(kappa) else None
+    return seed, kappa, got, ms.truth_stats(seed, refitted=False) if np.isfinite(kappa) else None
 
 
 def main() -> None:

@@ -182,8 +182,11 @@ def identify(seed: int) -> dict[str, Any]:
     }
 
 
-def truth_stats(seed: int) -> dict[str, Any]:
+def truth_stats(seed: int, refitted: bool = True) -> dict[str, Any]:
     """Significance and Cramer-Rao bounds of the true modes (true poles, linear residues).
+
+    ``refitted=False``: without the refitted likelihood ratio and the oracle's
+    coverage (the costly part; ``sig_lr`` is then ``sig``).
 
     White noise: the Gauss-Newton standard errors of the fit at the true poles
     with the noise RMS per output. Noise that follows the response: the
@@ -228,8 +231,9 @@ def truth_stats(seed: int) -> dict[str, Any]:
     k = mode_parameters(n_out, n_in, "complex")
     thr = mode_threshold(k, n_f, 0.01, pr.weight_dof, (n_out, n_in))
     sig = res.significance > thr
-    lr = _refitted_lr(fit, p_all, part, sigma, res.significance, thr, inb) if white else None
-    oracle = _oracle_cover(fit, p_all, part, sigma, sig & inb) if white else ([], [])
+    full = white and refitted
+    lr = _refitted_lr(fit, p_all, part, sigma, res.significance, thr, inb) if full else None
+    oracle = _oracle_cover(fit, p_all, part, sigma, sig & inb) if full else ([], [])
     return {
         "f": (np.abs(p_all) / (2 * np.pi)).tolist(),
         "z": (-p_all.real / np.abs(p_all)).tolist(),

@@ -15,7 +15,7 @@ from tyredamp.cli.modal import modes_table
 from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
 from tyredamp.modal import profile as prof
-from tyredamp.modal.fit import ModalFitter
+from tyredamp.modal.fit import ModalFitter, pole_bounds
 from tyredamp.modal.model import ModalModel
 
 F = np.arange(40.0, 60.0, 0.075)
@@ -49,7 +49,7 @@ def _intervals(h: np.ndarray, sd: float) -> tuple[object, prof.Intervals]:
     std = (res.std_frequency_hz, res.std_damping_ratio, res.std_pole)
     ev = prof.fitter_cost(fit, 2, ref, fit.weights(np.full(4, sd)))
     iv = prof.likelihood_intervals(
-        ev, th, res.poles, std, 2, fit.w_ref, (res.cost, s2), prof._bounds(2, th.size)
+        ev, th, res.poles, std, 2, fit.w_ref, (res.cost, s2), pole_bounds(2, th.size)
     )
     return res, iv
 

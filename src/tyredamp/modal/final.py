@@ -327,8 +327,8 @@ def _intervals_95(
         "interval_frequency_hz": np.stack([f_lo, f_hi], axis=1),
         "interval_damping_ratio": np.stack([z_hat - half_z[:, 0], z_hat + half_z[:, 1]], axis=1),
         "interval_method": [
-            (f"likelihood, {MERGED}" if o else "likelihood") if b else "linearised"
-            for b, o in zip(lik, opn | _holds_other(f_hat, f_lo, f_hi), strict=True)
+            (f"likelihood, {MERGED}" if merged else "likelihood") if b else "linearised"
+            for b, merged in zip(lik, opn | _holds_other(f_hat, f_lo, f_hi), strict=True)
         ],
     }
     return std, meta

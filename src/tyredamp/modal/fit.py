@@ -144,6 +144,17 @@ class FitResult:
     intervals: Any = None
 
 
+def pole_bounds(m: int, n_par: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Bounds of a parameter vector of ``m`` modes (:meth:`ModalFitter.pack` layout,
+    ``n_par`` entries) that keep every pole finite: ``sigma`` in [1e-7, 5] ``w_ref``,
+    ``Omega`` in (0, 20] ``w_ref``; the participation free."""
+    lb = np.full(n_par, -np.inf)
+    ub = np.full(n_par, np.inf)
+    lb[0 : 2 * m : 2], ub[0 : 2 * m : 2] = np.log(1e-7), np.log(5.0)
+    lb[1 : 2 * m : 2], ub[1 : 2 * m : 2] = 1e-6, 20.0
+    return lb, ub
+
+
 class ModalFitter:
     """Fit poles, participation and residues to FRFs (one model kind).
 
@@ -621,11 +632,7 @@ class ModalFitter:
         tol: float = 1e-6,
     ) -> tuple[NDArray[np.float64], int, str, dict[str, Any]]:
         n_par = th0.size
-        # bounds keep every pole finite: sigma in [1e-7, 5] w_ref, Omega in (0, 20] w_ref
-        lb = np.full(n_par, -np.inf)
-        ub = np.full(n_par, np.inf)
-        lb[0 : 2 * m : 2], ub[0 : 2 * m : 2] = np.log(1e-7), np.log(5.0)
-        lb[1 : 2 * m : 2], ub[1 : 2 * m : 2] = 1e-6, 20.0
+        lb, ub = pole_bounds(m, n_par)
         if omega_bounds is not None:
             lb[1 : 2 * m : 2] = max(1e-6, omega_bounds[0] / self.w_ref)
             ub[1 : 2 * m : 2] = min(20.0, omega_bounds[1] / self.w_ref)

@@ -53,7 +53,7 @@ from scipy.linalg import solve_triangular
 
 from ._linalg import _levenberg_marquardt
 from ._scaling import pole_std
-from .fit import FitResult, ModalFitter
+from .fit import FitResult, ModalFitter, pole_bounds
 
 __all__ = ["fisher_scale", "line_weights_full", "ml_refine"]
 
@@ -170,11 +170,7 @@ def ml_refine(
     ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
     th0 = fitter.pack(res.poles, part, ref)
     n_par = th0.size
-    lb = np.full(n_par, -np.inf)
-    ub = np.full(n_par, np.inf)
-    # the bounds of ModalFitter's refinement: sigma in [1e-7, 5] w_ref, Omega in (0, 20] w_ref
-    lb[0 : 2 * m_all : 2], ub[0 : 2 * m_all : 2] = np.log(1e-7), np.log(5.0)
-    lb[1 : 2 * m_all : 2], ub[1 : 2 * m_all : 2] = 1e-6, 20.0
+    lb, ub = pole_bounds(m_all, n_par)  # the bounds of ModalFitter's refinement
     q = fitter.n_cols(m_all)
     n_obs = fitter.n_rows * fitter.n_out
     dof = max(n_obs - q * fitter.n_out - n_par, 1)

@@ -62,7 +62,7 @@ from numpy.typing import NDArray
 
 from . import _basis
 from ._linalg import _levenberg_marquardt
-from .fit import FitResult, ModalFitter
+from .fit import FitResult, ModalFitter, pole_bounds
 
 __all__ = [
     "KAPPA",
@@ -108,12 +108,14 @@ class Intervals:
     open: NDArray[np.bool_]
 
 
-def needs_profile(poles: NDArray[np.complex128], std_pole: NDArray[np.complex128]) -> Any:
+def needs_profile(
+    poles: NDArray[np.complex128], std_pole: NDArray[np.complex128]
+) -> NDArray[np.bool_]:
     """Modes whose pole's standard error exceeds ``KAPPA`` half-power half-widths."""
     sig = np.maximum(-np.asarray(poles).real, 1e-300)
     sd = np.asarray(std_pole)
     worst = np.maximum(np.abs(sd.real), np.abs(sd.imag))
-    return np.isfinite(worst) & (worst > KAPPA * sig)
+    return np.asarray(np.isfinite(worst) & (worst > KAPPA * sig))
 
 
 class _Mode:
@@ -322,16 +324,6 @@ def _linearised(
     return fi, zi
 
 
-def _bounds(m: int, n_par: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The refinement's bounds (:meth:`ModalFitter._refine`): sigma in [1e-7, 5]
-    w_ref, Omega in (0, 20] w_ref, participation free."""
-    lb = np.full(n_par, -np.inf)
-    ub = np.full(n_par, np.inf)
-    lb[0 : 2 * m : 2], ub[0 : 2 * m : 2] = np.log(1e-7), np.log(5.0)
-    lb[1 : 2 * m : 2], ub[1 : 2 * m : 2] = 1e-6, 20.0
-    return lb, ub
-
-
 def fitter_cost(
     fitter: ModalFitter, m: int, ref: NDArray[np.intp], w: NDArray[np.float64]
 ) -> Evaluate:
@@ -392,10 +384,10 @@ def fit_intervals(
     hw = -res.poles.real / (2 * np.pi)  # half-power half-widths (Hz)
     f = cfit.f
     df = float(np.min(np.diff(f))) if f.size > 1 else 1.0
+    inb = np.arange(m_all) < n_band
     for k in todo:
         half = max(WINDOW * hw[k], MIN_LINES * df)
         i0, i1 = int(np.searchsorted(f, fn[k] - half)), int(np.searchsorted(f, fn[k] + half))
-        inb = np.arange(m_all) < n_band
         near = inb & (np.abs(fn - fn[k]) <= half + 2 * hw)
         if i1 - i0 < 2 * MIN_LINES or not near[k]:
             continue
@@ -473,7 +465,7 @@ def _local_factors(
     ref = np.argmax(np.abs(r.participation), axis=1).astype(np.intp)
     th = loc.pack(r.poles, r.participation, ref)
     ev = fitter_cost(loc, m, ref, loc.weights(sigma0))
-    got = profile_mode(ev, th, kk, (lf, lz), loc.w_ref, (r.cost, s2), _bounds(m, th.size))
+    got = profile_mode(ev, th, kk, (lf, lz), loc.w_ref, (r.cost, s2), pole_bounds(m, th.size))
     if got is None:
         return None
     flo, fhi, zlo, zhi, is_open = got
