@@ -116,9 +116,9 @@ def execute(task: Task) -> Outcome:
 
     BLAS is limited to one thread inside the task (threadpoolctl): the
     matrices are small and several threads per worker on shared cores slow
-    everything down (see ``single_threaded_blas`` in :mod:`tyredamp.demo`).
+    everything down (:mod:`tyredamp._blas`).
     """
-    from threadpoolctl import threadpool_limits
+    from .._blas import single_threaded_blas
 
     t0, c0 = time.perf_counter(), time.process_time()
     try:
@@ -136,7 +136,7 @@ def execute(task: Task) -> Outcome:
         return Outcome(
             task.test_id, {}, task.steps[0], f"{task.rel}: the file changed during the campaign"
         )
-    with threadpool_limits(limits=1, user_api="blas"):
+    with single_threaded_blas():
         docs, failure = steps.run_steps_from_bytes(
             task.study,
             task.rel,

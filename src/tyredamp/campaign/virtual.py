@@ -299,8 +299,7 @@ def _virtual_files(root: Path) -> list[str] | None:
 
 
 def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
-    from threadpoolctl import threadpool_limits
-
+    from .._blas import single_threaded_blas
     from ..signal import estimate_frf
     from ..virtual import run_modal_test
     from ..virtual.lateral_rig import VirtualLateralRig
@@ -312,7 +311,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
     tests: list[dict[str, Any]] = []
     held: list[dict[str, Any]] = []
     tyres: dict[str, Any] = {}
-    with threadpool_limits(limits=1, user_api="blas"):  # small matrices: one thread is fastest
+    with single_threaded_blas():  # small matrices: one thread is fastest
         for t in range(s.n_tyres):
             tid = f"T{t + 1}"
             params = tyre_parameters(t, s.seed)

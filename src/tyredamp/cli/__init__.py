@@ -217,9 +217,9 @@ def main(argv: list[str] | None = None) -> None:
                 # Small dense solves dominate; several BLAS threads on busy cores make them
                 # 10-15x slower (benchmarks/demo_timing.py), so the CLI uses one
                 # (imported here so that --help and --version start fast).
-                from threadpoolctl import threadpool_limits
+                from .._blas import single_threaded_blas
 
-                with threadpool_limits(limits=1, user_api="blas"):
+                with single_threaded_blas():
                     rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
                 if isinstance(rv, int) and rv != 0:
                     # ctx.exit(n) hands its code back as the return value here

@@ -87,6 +87,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._blas import blas_threads as blas_limit
 from .._validate import as_finite
 from ..exceptions import InputError
 from ..frf import FRF
@@ -192,6 +193,7 @@ def identify_modes(
     variance: ArrayLike | None = None,
     estimator: PoleEstimator | None = None,
     search: bool = True,
+    blas_threads: int | None = 1,
 ) -> ModalIdentification:
     """Identify modes from measured FRFs without hand-holding (module docstring).
 
@@ -239,6 +241,10 @@ def identify_modes(
         in :mod:`tyredamp.modal.estimators`).
     search : bool
         Residual-driven search for missed modes (default True; automatic count).
+    blas_threads : int or None
+        BLAS threads while the identification runs (default 1: its matrices
+        are small, and more threads make it several times slower,
+        :mod:`tyredamp._blas`); None leaves the process's setting as it is.
 
     Returns
     -------
@@ -246,6 +252,51 @@ def identify_modes(
         Raises :class:`InputError` on bad arguments, a band without lines, a
         non-uniform axis, more modes than the data support, or no mode found.
     """
+    with blas_limit(blas_threads):
+        return _identify(
+            frf,
+            band,
+            model,
+            n_modes=n_modes,
+            frequencies=frequencies,
+            max_order=max_order,
+            order_step=order_step,
+            residuals=residuals,
+            refine=refine,
+            max_damping=max_damping,
+            cluster_distance=cluster_distance,
+            min_fraction=min_fraction,
+            false_alarm=false_alarm,
+            min_contribution=min_contribution,
+            max_helpers=max_helpers,
+            variance=variance,
+            estimator=estimator,
+            search=search,
+        )
+
+
+def _identify(
+    frf: FRF,
+    band: tuple[float, float] | None,
+    model: ModelChoice,
+    *,
+    n_modes: int | None,
+    frequencies: ArrayLike | None,
+    max_order: int | None,
+    order_step: int,
+    residuals: bool,
+    refine: bool,
+    max_damping: float,
+    cluster_distance: float,
+    min_fraction: float,
+    false_alarm: float,
+    min_contribution: float,
+    max_helpers: int,
+    variance: ArrayLike | None,
+    estimator: PoleEstimator | None,
+    search: bool,
+) -> ModalIdentification:
+    """The body of :func:`identify_modes` (its parameters but ``blas_threads``)."""
     if model not in ("both", "complex", "real"):
         raise InputError(f"model: expected 'both', 'complex' or 'real', got {model!r}")
     problem = build_problem(frf, band, variance=variance)

@@ -33,11 +33,10 @@ done, total)``, called before each stage (``done`` stages finished out of
 
 from __future__ import annotations
 
-import contextlib
 import time
 from collections.abc import Callable
-from typing import Any
 
+from .._blas import single_threaded_blas
 from ..exceptions import InputError
 from .lateral import conditions, run_lateral
 from .radial import run_radial
@@ -78,23 +77,6 @@ class _Stages:
         self._close()
         if self.progress is not None:
             self.progress("done", self.total, self.total)
-
-
-def single_threaded_blas() -> contextlib.AbstractContextManager[Any]:
-    """Context limiting BLAS/LAPACK to one thread (threadpoolctl; a no-op without it).
-
-    The matrices here are small (a 128-DOF tyre, batched 130 x 130 solves,
-    least squares of a few hundred columns): extra BLAS threads gain little
-    and, on a machine whose cores are busy, slow everything down many times
-    (measured on two shared cores: the full demo's computation took 111 s
-    with the default two OpenBLAS threads and 7.9 s with one;
-    ``benchmarks/demo_timing.py --compare-threads``).
-    """
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-        return contextlib.nullcontext()
-    return threadpool_limits(limits=1, user_api="blas")
 
 
 # ------------------------------------------------------------------------------- running

@@ -1,0 +1,47 @@
+"""The BLAS thread limit of the identification (tyredamp._blas)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from threadpoolctl import threadpool_info, threadpool_limits
+
+from tyredamp._blas import blas_threads
+from tyredamp.exceptions import InputError
+from tyredamp.modal import identify_modes
+from tyredamp.modal.lscf import plscf
+
+from .test_modal_statistics import weak_beside_strong
+
+
+def _threads() -> set[int]:
+    return {int(d["num_threads"]) for d in threadpool_info() if d["user_api"] == "blas"}
+
+
+def _recording(seen: list[set[int]]) -> Any:
+    def estimator(*args: Any, **kwargs: Any) -> Any:
+        seen.append(_threads())
+        return plscf(*args, **kwargs)
+
+    return estimator
+
+
+@pytest.mark.parametrize(("asked", "inside"), [(1, {1}), (None, {2})])
+def test_identification_limits_blas_and_restores_it(asked: int | None, inside: set[int]) -> None:
+    frf = weak_beside_strong().frf(np.arange(60.0, 140.0, 0.25), "receptance")
+    seen: list[set[int]] = []
+    with threadpool_limits(limits=2, user_api="blas"):
+        res = identify_modes(frf, model="complex", estimator=_recording(seen), blas_threads=asked)
+        after = _threads()
+    assert res.models["complex"].n_modes == 2
+    assert seen
+    assert all(s == inside for s in seen)
+    assert after == {2}  # the caller's setting is back
+
+
+@pytest.mark.parametrize("bad", [0, -1, 1.5, True, "2"])
+def test_bad_thread_count_is_refused(bad: Any) -> None:
+    with pytest.raises(InputError, match="blas_threads"):
+        blas_threads(bad)
