@@ -128,9 +128,10 @@ def test_a_joint_refit_that_loses_every_mode_leaves_the_search_going() -> None:
     assert np.isfinite(res.cost)
 
 
-def _strong_at_both_edges(seed: int) -> FRF:
+def _strong_at_both_edges(seed: int) -> tuple[FRF, float]:
     """Strong modes just below (293 Hz) and just above (734, 827 Hz) the band 300-700 Hz,
-    four weaker ones in it; 2 x 1 mobility, noise at 1 % of each output's RMS."""
+    four weaker ones in it; 2 x 1 mobility, noise at 1 % of each output's RMS. Also the
+    noise's relative level in the band (higher: the band's response is weaker)."""
     rng = np.random.default_rng(seed)
     f = np.array([293.0, 375.5, 537.2, 577.0, 659.4, 734.4, 827.0])
     z = np.array([0.0036, 0.017, 0.0042, 0.013, 0.025, 0.0035, 0.008])
@@ -144,20 +145,28 @@ def _strong_at_both_edges(seed: int) -> FRF:
     h = frf.H
     rms = np.sqrt(np.mean(np.abs(h) ** 2, axis=(1, 2), keepdims=True))
     e = (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
-    return frf.with_H(h + 0.01 * rms * e)
+    noisy = frf.with_H(h + 0.01 * rms * e)
+    inb = (frf.frequency >= 300.0) & (frf.frequency <= 700.0)
+    level = np.linalg.norm(0.01 * rms * e[..., inb]) / np.linalg.norm(noisy.H[..., inb])
+    return noisy, float(level)
 
 
-@pytest.mark.parametrize("seed", [1, 3])
-def test_a_side_is_tried_again_once_the_other_side_holds_its_tail(seed: int) -> None:
+@pytest.mark.parametrize("seed", [0, 1, 3])
+def test_strong_modes_at_both_edges_are_held_by_residual_modes(seed: int) -> None:
     # the first residual mode above the band fails while the strong mode just below
     # it is unmodelled (its tail is better fitted by a broad pole far away); once a
     # residual mode below holds it, the side above is tried again (before: no
-    # residual mode above, a mode of the band lost or moved, the fit 10-19 % off)
-    res = identify_modes(_strong_at_both_edges(seed), band=(300.0, 700.0), model="complex")
+    # residual mode above, a mode of the band lost or moved, the fit 10-19 % off).
+    # A trial in the band whose joint refit takes it across the edge to the second
+    # mode above is kept as a residual mode (before: rejected, and the mode at
+    # 659 Hz moved 5 Hz toward the edge to hold that tail, seed 0)
+    frf, level = _strong_at_both_edges(seed)
+    res = identify_modes(frf, band=(300.0, 700.0), model="complex")
     model = res.models["complex"]
-    np.testing.assert_allclose(model.frequency_hz, [375.5, 537.2, 577.0, 659.4], rtol=5e-3)
+    np.testing.assert_allclose(model.frequency_hz, [375.5, 537.2, 577.0, 659.4], rtol=2e-3)
     assert model.residual_modes is not None
     f_res = np.abs(model.residual_modes.poles) / (2 * np.pi)
     assert np.any(f_res < 300.0)
     assert np.any((f_res > 700.0) & (np.abs(f_res - 734.4) < 15.0))
-    assert model.meta["relative_error"] < 0.04
+    # the model explains the band to its noise
+    assert model.meta["relative_error"] < 1.1 * level

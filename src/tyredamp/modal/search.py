@@ -271,6 +271,29 @@ def _inadmissible(p: complex, df: float, max_damping: float) -> str:
     return ""
 
 
+def _held_outside(
+    r1: FitResult,
+    k: int,
+    wrong: NDArray[np.intp],
+    band: tuple[float, float],
+    threshold: float,
+    df: float,
+    max_damping: float,
+) -> bool:
+    """Whether the joint refit ``r1`` lost only the trial mode ``k``, across a band
+    edge to within a factor 2 of it (the range of the residual modes of
+    :func:`~tyredamp.modal.out_of_band.search_helpers`), where it is admissible and
+    passes the mode test."""
+    if wrong.size != 1 or int(wrong[0]) != k:
+        return False
+    p1 = complex(r1.poles[k])
+    fd = p1.imag / (2 * np.pi)
+    outside = band[1] < fd <= 2 * band[1] or band[0] / 2 <= fd < band[0]
+    return bool(
+        outside and not _inadmissible(p1, df, max_damping) and float(r1.significance[k]) > threshold
+    )
+
+
 def _joint(
     fitter: ModalFitter,
     cur: ModeSet,
@@ -336,6 +359,11 @@ def _joint(
         p_all = new.all()[0]
         fd = r1.poles.imag / (2 * np.pi)
         wrong, why = np.zeros(0, np.intp), ""
+    if wrong.size and _held_outside(r1, k, wrong, band, threshold, df, max_damping):
+        # the trial mode alone crossed the band edge, to a significant pole within a
+        # factor 2 of it: a mode outside the band whose tail the data hold, kept as a
+        # residual mode (the order of r1 is kept, as for a broad pole below)
+        return r1, as_residual(new.take(r1), np.arange(new.m) == k)
     if wrong.size:
         if k in wrong:
             how = f"joint refit: {why} ({fd[k]:.2f} Hz)"
@@ -513,9 +541,12 @@ def residual_search(
     averages are too small) rather than a resonance. A trial mode that passes
     is refitted with all modes (:func:`_joint`) and kept when it stays in the
     band, merges with no mode, is still admissible and every mode still passes
-    the test; otherwise it is rejected for what the joint refit did (e.g.
-    "joint refit: crossed the band edge", a mode outside the band whose tail
-    the trial had taken), and a later trial that ends at the same pole (within
+    the test; a trial mode that alone crosses a band edge in the joint refit,
+    to an admissible pole within a factor 2 of the edge that passes the test, is
+    a mode outside the band whose tail the data hold: it is kept as a residual
+    mode. Otherwise it is rejected for what the joint refit did (e.g. "joint
+    refit: crossed the band edge", a mode outside the band whose tail the trial
+    had taken), and a later trial that ends at the same pole (within
     ``2 MERGE``) against the same modes is not refitted again; nor is one that
     stopped at the limit of its window toward a band edge that a trial crossed
     (it runs toward the same structure outside the band).
