@@ -24,25 +24,33 @@ ZETA = 0.01
 POLES = np.array([complex(-ZETA * W1, W1), complex(-ZETA * W1, W1) * (1 + ZETA)])
 
 
-def _data(weak: float, sd: float, seed: int) -> tuple[np.ndarray, float]:
-    """Two modes one half-power half-width apart, the second ``weak`` times the first."""
+def _data(weak: float, sd: float, seed: int, kind: str = "complex") -> tuple[np.ndarray, float]:
+    """Two modes one half-power half-width apart, the second ``weak`` times the first
+    (complex modes, or real ones: residues ``phi phi / (2 i Omega)``, real ``phi``, here
+    scaled by ``2 Omega``)."""
     rng = np.random.default_rng(1)
-    psi = (rng.normal(size=(4, 2)) + 1j * rng.normal(size=(4, 2))) * np.array([1.0, weak])
-    h = ModalModel(POLES, psi, np.ones((1, 2))).frf(F, "receptance").H
+    if kind == "complex":
+        psi = (rng.normal(size=(4, 2)) + 1j * rng.normal(size=(4, 2))) * np.array([1.0, weak])
+        part = np.ones((1, 2)) + 0j
+    else:
+        unit = np.abs(np.sqrt(2j * POLES.imag)) / np.sqrt(2j * POLES.imag)
+        psi = rng.normal(size=(4, 2)) * np.array([1.0, weak]) * unit  # R = -i phi (scaled)
+        part = np.ones((1, 2)) * unit
+    h = ModalModel(POLES, psi, part).frf(F, "receptance").H
     rng = np.random.default_rng(seed)
     e = (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape)) / np.sqrt(2)
     return h + sd * e, sd
 
 
-def _fit(h: np.ndarray, sd: float) -> tuple[ModalFitter, object]:
-    fit = ModalFitter(F, h, 0, "complex", [], upper=False, lower=False)
+def _fit(h: np.ndarray, sd: float, kind: str = "complex") -> tuple[ModalFitter, object]:
+    fit = ModalFitter(F, h, 0, kind, [], upper=False, lower=False)
     res = fit.fit(POLES, np.ones((2, 1)), passes=1, sigma=np.full(4, sd), tol=1e-10)
     return fit, res
 
 
-def _intervals(h: np.ndarray, sd: float) -> tuple[object, prof.Intervals]:
+def _intervals(h: np.ndarray, sd: float, kind: str = "complex") -> tuple[object, prof.Intervals]:
     """The likelihood intervals of the whole fit (its own cost profiled)."""
-    fit, res = _fit(h, sd)
+    fit, res = _fit(h, sd, kind)
     ref = np.zeros(2, np.intp)
     th = fit.pack(res.poles, res.participation, ref)
     s2 = res.cost / (res.n_obs - res.n_par)
@@ -54,9 +62,9 @@ def _intervals(h: np.ndarray, sd: float) -> tuple[object, prof.Intervals]:
     return res, iv
 
 
-def _local(h: np.ndarray, sd: float) -> tuple[object, prof.Intervals]:
+def _local(h: np.ndarray, sd: float, kind: str = "complex") -> tuple[object, prof.Intervals]:
     """The intervals of the final stage (each mode profiled on its own lines)."""
-    fit, res = _fit(h, sd)
+    fit, res = _fit(h, sd, kind)
     iv = prof.fit_intervals(fit, res, 2, np.full(4, sd))
     assert iv is not None
     return res, iv
@@ -66,14 +74,17 @@ def _pole(wn: float, z: float) -> complex:
     return complex(-z * wn, wn * np.sqrt(1 - z * z))
 
 
-def _profile_rise(h: np.ndarray, sd: float, k: int, which: str, value: float) -> float:
+def _profile_rise(
+    h: np.ndarray, sd: float, k: int, which: str, value: float, kind: str = "complex"
+) -> float:
     """The rise of the weighted cost, in units of the residual variance, when mode
     ``k``'s natural frequency (Hz) or damping ratio is held at ``value`` and every
     other pole parameter refitted, the residues solved by least squares: written
     here from the model ``sum_n R_n / (s - p_n) + conj(R_n) / (s - conj p_n)``
     (``R_n = a + i b`` per output: real columns ``1/(s-p) + 1/(s-conj p)`` and
-    ``i (1/(s-p) - 1/(s-conj p))``) with scipy's least squares, without the
-    package's fitter."""
+    ``i (1/(s-p) - 1/(s-conj p))``; for real modes ``R_n = -i a / (2 Omega_n)``
+    with real ``a``: the one column ``i (1/(s-p) - 1/(s-conj p))``) with scipy's
+    least squares, without the package's fitter."""
     s = 2j * np.pi * F
     y = (h[:, 0, :] / sd).T  # (n_f, n_out), units of the noise
     yr = np.vstack([y.real, y.imag])
@@ -83,14 +94,14 @@ def _profile_rise(h: np.ndarray, sd: float, k: int, which: str, value: float) ->
         for n in range(2):
             p = _pole(x[2 * n], x[2 * n + 1])
             u, v = 1 / (s - p), 1 / (s - np.conj(p))
-            cols += [u + v, 1j * (u - v)]
+            cols += [u + v, 1j * (u - v)] if kind == "complex" else [1j * (u - v)]
         a = np.stack(cols, axis=1)
         ar = np.vstack([a.real, a.imag])
         c, *_ = np.linalg.lstsq(ar, yr, rcond=None)
         r = yr - ar @ c
         return float(np.sum(r * r))
 
-    _, res = _fit(h, sd)
+    _, res = _fit(h, sd, kind)
     x_hat = np.ravel(np.column_stack([np.abs(res.poles), -res.poles.real / np.abs(res.poles)]))
     scale = np.array([1.0, 1e-3, 1.0, 1e-3])
     opt = {"x_scale": scale, "xtol": 1e-15, "ftol": 1e-15, "gtol": 1e-15}
@@ -106,22 +117,24 @@ def _profile_rise(h: np.ndarray, sd: float, k: int, which: str, value: float) ->
 
     opt["x_scale"] = scale[free]
     c1 = least_squares(lambda z: [np.sqrt(cost(full(z)))], x_hat[free], **opt).fun[0] ** 2
-    dof = 2 * F.size * 4 - 4 * 4 - 4  # 4 real residue coefficients per output, 4 pole parameters
+    # 4 (complex) or 2 (real modes) real residue coefficients per output, 4 pole parameters
+    dof = 2 * F.size * 4 - (4 if kind == "complex" else 2) * 4 - 4
     return (float(c1) - c0) / (c0 / dof)
 
 
-def test_the_ends_are_the_likelihood_ratio_cut_of_an_independent_profile() -> None:
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_the_ends_are_the_likelihood_ratio_cut_of_an_independent_profile(kind: str) -> None:
     # a weak mode (statistic about 100) one half-width above a strong one at a
     # noise of 5 % of the strong mode's peak response: both modes are profiled
-    h, sd = _data(0.3, 0.05, seed=5)
-    _, iv = _intervals(h, sd)
+    h, sd = _data(0.3, 0.05, seed=5, kind=kind)
+    _, iv = _intervals(h, sd, kind)
     assert iv.likelihood.all()
     assert not iv.open.any()
     lo, hi = (prof.Z95 - prof.R_TOL) ** 2 - 0.01, (prof.Z95 + prof.R_TOL) ** 2 + 0.01
     for k in (0, 1):
         for which, ends in (("f", iv.frequency_hz[k]), ("z", iv.damping_ratio[k])):
             for v in ends:
-                rise = _profile_rise(h, sd, k, which, float(v))
+                rise = _profile_rise(h, sd, k, which, float(v), kind)
                 # signed root within R_TOL of 1.96 (1.94^2 = 3.76 .. 1.98^2 = 3.92), and
                 # the independent profile's own convergence (1e-3 of the cut)
                 assert lo <= rise <= hi
@@ -236,3 +249,30 @@ def test_modes_not_told_apart_have_intervals_that_hold_each_other() -> None:
     m = identify_modes(FRF(F, h, kind="receptance"), model="complex").models["complex"]
     assert m.n_modes == 2
     assert m.meta["interval_method"] == ["likelihood, not told from a neighbour"] * 2
+
+
+def test_real_modes_get_likelihood_intervals_too() -> None:
+    # the real-mode model (proportional damping, spec eq. [2]/[3]) of the same weak
+    # mode beside a strong one: profiled on the mode's own lines with the real-mode
+    # fitter, within 0.2 half-widths of the whole fit's profile, and reported by the
+    # identified real model (it kept the linearised intervals before)
+    h, sd = _data(0.3, 0.05, seed=5, kind="real")
+    _, whole = _intervals(h, sd, "real")
+    _, local = _local(h, sd, "real")
+    assert whole.likelihood.all()
+    assert local.likelihood.all()
+    for got, ref in (
+        (local.frequency_hz, whole.frequency_hz),
+        (local.damping_ratio, whole.damping_ratio),
+    ):
+        half = 0.5 * (ref[:, 1] - ref[:, 0])[:, None]
+        assert np.all(np.abs(got - ref) <= 0.2 * half)
+    m = identify_modes(FRF(F, h, kind="receptance"), model="both").models["real"]
+    assert m.n_modes == 2
+    assert m.meta["interval_method"] == ["likelihood", "likelihood"]
+    fi = np.asarray(m.meta["interval_frequency_hz"])
+    zi = np.asarray(m.meta["interval_damping_ratio"])
+    assert np.all((fi[:, 0] < m.frequency_hz) & (m.frequency_hz < fi[:, 1]))
+    assert np.all((zi[:, 0] < m.damping_ratio) & (m.damping_ratio < zi[:, 1]))
+    half = np.max(np.abs(fi - m.frequency_hz[:, None]), axis=1)
+    np.testing.assert_allclose(m.std["frequency_hz"], half / prof.Z95, rtol=1e-12)

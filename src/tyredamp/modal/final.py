@@ -90,6 +90,7 @@ def fit_real(
     refine: bool,
     search: ModalFitter | None,
     start: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet],
+    sigma0: NDArray[np.float64] | None = None,
 ) -> tuple[FitResult, int, list[str]]:
     """Real-mode fit (pole-pair optimisation) started from the complex-mode poles.
 
@@ -99,7 +100,10 @@ def fit_real(
     complex-mode values, only the real residues are fitted, and a warning
     says so. ``search``: the compressed search fitter (a pre-fit on the
     output combinations) or None. ``start``: poles and participation of all
-    modes (in-band first) and the mode set they belong to.
+    modes (in-band first) and the mode set they belong to. ``sigma0``: the
+    noise per output of the final fits; with it, the modes whose linearised
+    intervals would be too short get likelihood intervals
+    (:func:`~tyredamp.modal.profile.fit_intervals`), as in the complex model.
     """
     p0, l0, modes = start
     m, nf = modes.m, modes.n_free
@@ -146,6 +150,8 @@ def fit_real(
             ml = maximum_likelihood(problem, fitter, res)
             if not _problem(ml, m, nf, problem.band)[0]:
                 res = ml
+            # likelihood intervals where the linearised ones would be too short
+            res.intervals = fit_intervals(fitter, res, m, sigma0)
             return res, m, []
         if bad >= m + nf:
             keep = np.arange(start_p.size) != bad

@@ -344,9 +344,10 @@ def fit_intervals(
     n_band: int,
     sigma0: NDArray[np.float64] | None,
 ) -> Intervals | None:
-    """The 95 % intervals of the in-band modes of a final complex fit ``res`` of
-    ``cfit`` (weighted least squares with the noise ``sigma0`` per output, or its
-    maximum-likelihood refinement); None without a model or standard errors.
+    """The 95 % intervals of the in-band modes of a final fit ``res`` of ``cfit``
+    (complex or real modes; weighted least squares with the noise ``sigma0`` per
+    output, or its maximum-likelihood refinement); None without a model or
+    standard errors.
 
     The intervals are the linearised ones, ``+-1.96 sd``, with each half of a
     mode that :func:`needs_profile` names stretched by the factor by which the
@@ -434,7 +435,7 @@ def _local_factors(
         f,
         h_loc,
         cfit.power,
-        "complex",
+        cfit.kind,
         [],
         upper=cfit.use_upper,
         lower=cfit.use_lower,
