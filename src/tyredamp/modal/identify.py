@@ -551,7 +551,16 @@ def _select(
             (_pole_of(r), np.ones(sfit.n_in, complex)) for r in rej + out
         ]
         last, modes, tried = residual_search(
-            sfit, last, modes, cands, problem_band, thr, dg.max_damping, test=test, fixed=fixed
+            sfit,
+            last,
+            modes,
+            cands,
+            problem_band,
+            thr,
+            dg.max_damping,
+            test=test,
+            fixed=fixed,
+            max_helpers=max_helpers,
         )
         out += tried
     return last, modes, out

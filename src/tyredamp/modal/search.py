@@ -276,21 +276,28 @@ def _held_outside(
     k: int,
     wrong: NDArray[np.intp],
     band: tuple[float, float],
-    threshold: float,
-    df: float,
-    max_damping: float,
+    limits: tuple[float, float, float],
+    max_helpers: int,
 ) -> bool:
     """Whether the joint refit ``r1`` lost only the trial mode ``k``, across a band
     edge to within a factor 2 of it (the range of the residual modes of
-    :func:`~tyredamp.modal.out_of_band.search_helpers`), where it is admissible and
-    passes the mode test."""
+    :func:`~tyredamp.modal.out_of_band.search_helpers`), where it is admissible,
+    passes the mode test and fewer than ``max_helpers`` residual modes lie on that
+    side. ``limits``: the mode test's threshold, the line spacing and the
+    admissible damping ratio."""
+    threshold, df, max_damping = limits
     if wrong.size != 1 or int(wrong[0]) != k:
         return False
     p1 = complex(r1.poles[k])
     fd = p1.imag / (2 * np.pi)
     outside = band[1] < fd <= 2 * band[1] or band[0] / 2 <= fd < band[0]
+    f_all = r1.poles.imag[np.arange(r1.poles.size) != k] / (2 * np.pi)
+    held = np.count_nonzero(f_all > band[1]) if fd > band[1] else np.count_nonzero(f_all < band[0])
     return bool(
-        outside and not _inadmissible(p1, df, max_damping) and float(r1.significance[k]) > threshold
+        held < max_helpers
+        and outside
+        and not _inadmissible(p1, df, max_damping)
+        and float(r1.significance[k]) > threshold
     )
 
 
@@ -305,6 +312,7 @@ def _joint(
     max_damping: float,
     crossed: set[int],
     test: ModeTest | None = None,
+    max_helpers: int = 0,
 ) -> tuple[FitResult, ModeSet] | RejectedMode | None:
     """The joint refit of the modes ``cur`` with an accepted trial mode ``p_t``:
     the fit and its modes when the trial mode stays (in the band, no merge, still
@@ -359,7 +367,8 @@ def _joint(
         p_all = new.all()[0]
         fd = r1.poles.imag / (2 * np.pi)
         wrong, why = np.zeros(0, np.intp), ""
-    if wrong.size and _held_outside(r1, k, wrong, band, threshold, df, max_damping):
+    limits = (threshold, df, max_damping)
+    if wrong.size and _held_outside(r1, k, wrong, band, limits, max_helpers):
         # the trial mode alone crossed the band edge, to a significant pole within a
         # factor 2 of it: a mode outside the band whose tail the data hold, kept as a
         # residual mode (the order of r1 is kept, as for a broad pole below)
@@ -529,6 +538,7 @@ def residual_search(
     max_damping: float = 0.2,
     test: ModeTest | None = None,
     fixed: FixedParts | None = None,
+    max_helpers: int = 4,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
@@ -544,9 +554,11 @@ def residual_search(
     the test; a trial mode that alone crosses a band edge in the joint refit,
     to an admissible pole within a factor 2 of the edge that passes the test, is
     a mode outside the band whose tail the data hold: it is kept as a residual
-    mode. Otherwise it is rejected for what the joint refit did (e.g. "joint
-    refit: crossed the band edge", a mode outside the band whose tail the trial
-    had taken), and a later trial that ends at the same pole (within
+    mode while fewer than ``max_helpers`` lie on that side (the limit of
+    :func:`~tyredamp.modal.out_of_band.search_helpers`). Otherwise it is
+    rejected for what the joint refit did (e.g. "joint refit: crossed the band
+    edge", a mode outside the band whose tail the trial had taken), and a later
+    trial that ends at the same pole (within
     ``2 MERGE``) against the same modes is not refitted again; nor is one that
     stopped at the limit of its window toward a band edge that a trial crossed
     (it runs toward the same structure outside the band).
@@ -614,7 +626,9 @@ def residual_search(
             if _toward(p_t, w_lim) in crossed:
                 tried.append(rejected(p_t, TOWARD_CROSSED, t, threshold))
                 continue
-            got1 = _joint(fitter, cur, p_t, l_t, band, threshold, df, max_damping, crossed, test)
+            got1 = _joint(
+                fitter, cur, p_t, l_t, band, threshold, df, max_damping, crossed, test, max_helpers
+            )
             if isinstance(got1, RejectedMode):
                 tried.append(got1)
                 refused.append(p_t)
