@@ -211,8 +211,11 @@ def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> No
         assert_allclose(pp["T0"]["value"], tp.hoop_tension, rtol=0.02)
         assert_allclose(pp["k_r"]["value"], tp.radial_stiffness, rtol=0.02)
         assert_allclose(pp["k_r"]["true"], tp.radial_stiffness, rtol=1e-12)
-    # what two pressures cannot separate is reported as such, with its verdict
-    assert tm["not_identifiable"]
+    # what two pressures cannot separate is reported as such, with its verdict. Since
+    # stop 29 the 9 bar fit reaches its noise (a residual mode above the band holds the
+    # mode at 199 Hz whose half-power band crosses the edge; before, the fit was 3.6x
+    # the noise there), its standard errors are 2-4x smaller, and on these data the
+    # two pressures separate every parameter
     for name in tm["not_identifiable"]:
         assert par[name]["verdict"] != "identified"
     # rigid ring at the main pressure equals the one from the exact modes within 2 %
@@ -226,7 +229,7 @@ def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> No
     section = html[start : html.index("<h2", start + 10)]
     assert "Tyre model: natural frequencies identified" in section  # figure caption
     assert "fit to exact modes" in section
-    assert "Not identified from these modes" in section
+    assert ("Not identified from these modes" in section) == bool(tm["not_identifiable"])
     for name in tm["not_identifiable"]:
         assert f"<li>{name}: " in section
     assert "[STRUCTURAL]" in section
