@@ -324,7 +324,9 @@ def _joint(
     ``test``, the trial mode kept as a mode must also pass its own threshold,
     raised where the noise of the joint fit's residual (the mode in it: a true
     mode's signal does not count as noise) lies along the response
-    (:func:`local_thresholds`)."""
+    (:func:`local_thresholds`). A trial mode that alone crossed an edge is kept as
+    a residual mode outside the band when :func:`_held_outside` says so (at most
+    ``max_helpers`` a side; 0: never)."""
     new = ModeSet(
         np.append(cur.poles, p_t),
         np.concatenate([cur.part, l_t[None, :]]),
@@ -558,10 +560,10 @@ def residual_search(
     :func:`~tyredamp.modal.out_of_band.search_helpers`). Otherwise it is
     rejected for what the joint refit did (e.g. "joint refit: crossed the band
     edge", a mode outside the band whose tail the trial had taken), and a later
-    trial that ends at the same pole (within
-    ``2 MERGE``) against the same modes is not refitted again; nor is one that
-    stopped at the limit of its window toward a band edge that a trial crossed
-    (it runs toward the same structure outside the band).
+    trial that ends at the same pole (within ``2 MERGE``) against the same modes
+    is not refitted again; nor is one that stopped at the limit of its window
+    toward a band edge that a trial crossed (it runs toward the same structure
+    outside the band).
 
     ``candidates`` are starting poles and participation vectors from the
     diagram; each round adds the peaks of the current residual. With
