@@ -1,13 +1,15 @@
 """Coverage of the 95 % intervals of f and zeta: likelihood against linearised.
 
-Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/modal_intervals.py [--draws 300] [--jobs 2]``
-(about 5 minutes with 2 jobs).
+Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/modal_intervals.py [--draws 300] [--jobs 2]
+[--kind real]`` (about 5 minutes with 2 jobs).
 
 Two modes one half-power half-width apart (damping 1 %, 4 outputs, one input,
 0.15 half-widths per line, receptance), the second weaker by the factor
 ``weak``, and an isolated weak mode; white complex Gaussian noise, a new draw
-per fit. :func:`~tyredamp.modal.identify_modes` as a user calls it (automatic
-mode count, noise from the residual), once with the likelihood intervals of
+per fit. ``--kind real``: the modes are real (proportional damping) and the
+first table scores the real-mode model (``model="both"``).
+:func:`~tyredamp.modal.identify_modes` as a user calls it (automatic mode
+count, noise from the residual), once with the likelihood intervals of
 :mod:`tyredamp.modal.profile` (the default) and once with them switched off
 (``KAPPA`` infinite: the linearised intervals of every earlier version). Per
 case it prints the weak mode's median statistic ``T``, the share of draws
@@ -48,24 +50,37 @@ def poles_of(sep: float) -> np.ndarray:
     return np.array([p, p * (1 + sep * ZETA)])
 
 
-def clean(weak: float, sep: float) -> np.ndarray:
+def clean(weak: float, sep: float, kind: str = "complex") -> np.ndarray:
+    """The two modes' FRFs: complex modes, or real ones (residues ``-i phi phi``, real
+    ``phi``: proportional damping, scaled to the complex case's size)."""
     rng = np.random.default_rng(1)
-    psi = (rng.normal(size=(4, 2)) + 1j * rng.normal(size=(4, 2))) * np.array([1.0, weak])
-    return ModalModel(poles_of(sep), psi, np.ones((1, 2))).frf(F, "receptance").H
+    p = poles_of(sep)
+    if kind == "complex":
+        psi = (rng.normal(size=(4, 2)) + 1j * rng.normal(size=(4, 2))) * np.array([1.0, weak])
+        part = np.ones((1, 2)) + 0j
+    else:
+        unit = np.abs(np.sqrt(2j * p.imag)) / np.sqrt(2j * p.imag)
+        psi = rng.normal(size=(4, 2)) * np.array([1.0, weak]) * unit
+        part = np.ones((1, 2)) * unit
+    return ModalModel(p, psi, part).frf(F, "receptance").H
 
 
-def one(args: tuple[float, float, int, float]) -> dict[str, Any] | None:
-    """One draw: the weak mode's coverage by each interval, with profiling at ``kappa``."""
-    weak, sep, seed, kappa = args
+def one(args: tuple[float, float, int, float, str]) -> dict[str, Any] | None:
+    """One draw: the weak mode's coverage by each interval of the ``kind`` model, with
+    profiling at ``kappa``."""
+    weak, sep, seed, kappa, kind = args
     prof.KAPPA = kappa
-    h0 = clean(weak, sep)
+    h0 = clean(weak, sep, kind)
     rng = np.random.default_rng(seed)
     e = (rng.normal(size=h0.shape) + 1j * rng.normal(size=h0.shape)) / np.sqrt(2)
     try:
-        m = identify_modes(FRF(F, h0 + NOISE * e, kind="receptance"), model="complex")
+        m = identify_modes(
+            FRF(F, h0 + NOISE * e, kind="receptance"),
+            model="complex" if kind == "complex" else "both",
+        )
     except Exception:  # a failed identification counts as not found
         return None
-    c = m.models["complex"]
+    c = m.models[kind]
     if c.n_modes != 2:
         return None
     p = poles_of(sep)
@@ -113,6 +128,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--draws", type=int, default=300)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument(
+        "--kind",
+        choices=("complex", "real"),
+        default="complex",
+        help="complex modes, or real ones (proportional damping) and the real-mode model",
+    )
     args = ap.parse_args()
     cases = [(0.15, 1.0), (0.2, 1.0), (0.3, 1.0), (0.5, 1.0), (0.2, 8.0)]
     t0 = time.perf_counter()
@@ -124,7 +145,7 @@ def main() -> None:
         for weak, sep in cases:
             rows = {}
             for name, kappa in (("lik", prof.KAPPA), ("lin", np.inf)):
-                jobs = [(weak, sep, 1000 + i, kappa) for i in range(args.draws)]
+                jobs = [(weak, sep, 1000 + i, kappa, args.kind) for i in range(args.draws)]
                 rows[name] = [r for r in pool.map(one, jobs) if r is not None]
             lik, lin = rows["lik"], rows["lin"]
 
