@@ -301,6 +301,35 @@ def _held_outside(
     )
 
 
+def _as_outside(
+    fitter: ModalFitter,
+    modes: ModeSet,
+    k: int,
+    band: tuple[float, float],
+    kw: dict[str, float],
+    p_t: complex,
+) -> tuple[FitResult, ModeSet] | RejectedMode | None:
+    """``modes`` with the in-band mode ``k`` moved to the residual modes outside the
+    band (last, checked against the band), refitted (:func:`fit_checked`); the
+    trial ``p_t``'s record when that refit loses a mode (None: the fit failed)."""
+    keep = np.arange(modes.m) != k
+    held = ModeSet(
+        modes.poles[keep],
+        modes.part[keep],
+        np.append(modes.hp, modes.poles[k]),
+        np.concatenate([modes.hl, modes.part[k : k + 1]]),
+        modes.n_free,
+    )
+    try:
+        r2, c2, drop = fit_checked(fitter, held, True, band, **kw)  # type: ignore[arg-type]
+    except (ConvergenceError, np.linalg.LinAlgError, ValueError):
+        return None
+    if drop or c2.m != held.m or c2.hp.size != held.hp.size:
+        why = drop[0].reason if drop else "lost a mode"
+        return rejected(p_t, f"joint refit, held outside the band: {why}")
+    return r2, c2
+
+
 def _joint(
     fitter: ModalFitter,
     cur: ModeSet,
@@ -373,8 +402,9 @@ def _joint(
     if wrong.size and _held_outside(r1, k, wrong, band, limits, max_helpers):
         # the trial mode alone crossed the band edge, to a significant pole within a
         # factor 2 of it: a mode outside the band whose tail the data hold, kept as a
-        # residual mode (the order of r1 is kept, as for a broad pole below)
-        return r1, as_residual(new.take(r1), np.arange(new.m) == k)
+        # residual mode that must stay outside (checked against the band in every
+        # later fit, as the residual modes of search_helpers)
+        return _as_outside(fitter, new.take(r1), k, band, kw, p_t)
     if wrong.size:
         if k in wrong:
             how = f"joint refit: {why} ({fd[k]:.2f} Hz)"
