@@ -353,9 +353,8 @@ def _joint(
     ``test``, the trial mode kept as a mode must also pass its own threshold,
     raised where the noise of the joint fit's residual (the mode in it: a true
     mode's signal does not count as noise) lies along the response
-    (:func:`local_thresholds`). A trial mode that alone crossed an edge is kept as
-    a residual mode outside the band when :func:`_held_outside` says so (at most
-    ``max_helpers`` a side; 0: never)."""
+    (:func:`local_thresholds`). A trial mode that alone crossed an edge may stay
+    outside the band (:func:`_held_outside`; ``max_helpers`` a side, 0: never)."""
     new = ModeSet(
         np.append(cur.poles, p_t),
         np.concatenate([cur.part, l_t[None, :]]),
@@ -400,10 +399,8 @@ def _joint(
         wrong, why = np.zeros(0, np.intp), ""
     limits = (threshold, df, max_damping)
     if wrong.size and _held_outside(r1, k, wrong, band, limits, max_helpers):
-        # the trial mode alone crossed the band edge, to a significant pole within a
-        # factor 2 of it: a mode outside the band whose tail the data hold, kept as a
-        # residual mode that must stay outside (checked against the band in every
-        # later fit, as the residual modes of search_helpers)
+        # a mode outside the band whose tail the data hold: a residual mode that must
+        # stay outside (checked in every later fit, as those of search_helpers)
         return _as_outside(fitter, new.take(r1), k, band, kw, p_t)
     if wrong.size:
         if k in wrong:
