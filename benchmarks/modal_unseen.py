@@ -30,8 +30,9 @@ below 1e-6 or within 10 % of the noise's own relative level in the band (the
 model explains the data to the noise: every mode found, none extra; a
 sub-band's response is weaker than the whole axis's, so its relative noise is
 higher than the SNR says), the identified modes per true mode, fits that
-raised an error, and the median and largest time per fit. With ``--old-src`` the same systems are
-identified by the code at that path as well (a second table).
+raised an error, and the median and largest time per fit. With ``--old-src``
+the same systems are identified by the code at that path as well (a second
+table).
 """
 
 from __future__ import annotations

@@ -17,6 +17,8 @@ from __future__ import annotations
 import contextlib
 from typing import Any
 
+from .exceptions import InputError
+
 __all__ = ["blas_threads", "single_threaded_blas"]
 
 
@@ -31,8 +33,6 @@ def blas_threads(n: int | None) -> contextlib.AbstractContextManager[Any]:
     if n is None:
         return contextlib.nullcontext()
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        from .exceptions import InputError
-
         raise InputError(f"blas_threads: expected a positive integer or None, got {n!r}")
     try:
         from threadpoolctl import threadpool_limits

@@ -24,8 +24,10 @@ __all__ = [
     "as_residual",
     "fit_checked",
     "lost_modes",
+    "outside_side",
     "rejected",
     "too_damped",
+    "with_residual",
 ]
 
 #: poles closer than this (relative to |p|) are one mode (but see :func:`lost_modes`)
@@ -111,6 +113,28 @@ def as_residual(modes: ModeSet, broad: NDArray[np.bool_]) -> ModeSet:
         np.concatenate([modes.part[broad], modes.hl]),
         modes.n_free + int(np.count_nonzero(broad)),
     )
+
+
+def with_residual(modes: ModeSet, p: complex, lv: NDArray[np.complex128]) -> ModeSet:
+    """``modes`` with the residual mode ``p`` (participation ``lv``, (n_in,)) added
+    last: outside the band, checked against it in every later fit."""
+    return ModeSet(
+        modes.poles,
+        modes.part,
+        np.append(modes.hp, p),
+        np.concatenate([modes.hl, np.asarray(lv)[None, :]]),
+        modes.n_free,
+    )
+
+
+def outside_side(f_hz: float, band: tuple[float, float]) -> int:
+    """The side of ``band`` (Hz) on which a residual mode of damped frequency ``f_hz``
+    (Hz) lies within the range of the residual modes outside the band (a factor 2
+    beyond its edge): +1 above, -1 below, 0 neither."""
+    lo, hi = band
+    if hi < f_hz <= 2 * hi:
+        return 1
+    return -1 if lo / 2 <= f_hz < lo else 0
 
 
 def too_damped(poles: NDArray[np.complex128], max_damping: float | None) -> NDArray[np.bool_]:

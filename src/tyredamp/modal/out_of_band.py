@@ -10,11 +10,11 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
 from .fit import FitResult, ModalFitter
+from .modeset import outside_side, with_residual
 from .quality import RejectedMode
 from .search import (
     FIRST_NFEV,
@@ -121,7 +121,7 @@ def _helper(
     try:
         trial, new, lost = fit_checked(
             fitter,
-            _with_helper(cur, p_t, l_t),
+            with_residual(cur, p_t, l_t),
             True,
             band,
             passes=1,
@@ -133,16 +133,8 @@ def _helper(
     if new.hp.size <= cur.hp.size:
         return "lost"
     # the helper must stay on its side of the band, within a factor 2 of the edge
-    fd = new.hp[-1].imag / (2 * np.pi)
-    outside = (hi < fd <= 2 * hi) if side > 0 else (lo / 2 <= fd < lo)
-    return (trial, new, lost) if outside else None
-
-
-def _with_helper(cur: ModeSet, p: complex, lv: NDArray[np.complex128]) -> ModeSet:
-    """``cur`` with the residual mode ``p`` (participation ``lv``) added last."""
-    return ModeSet(
-        cur.poles, cur.part, np.append(cur.hp, p), np.concatenate([cur.hl, lv[None, :]]), cur.n_free
-    )
+    on_side = outside_side(new.hp[-1].imag / (2 * np.pi), band) == side
+    return (trial, new, lost) if on_side else None
 
 
 def _took_tail(r: RejectedMode) -> RejectedMode:

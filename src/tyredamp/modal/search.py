@@ -49,8 +49,10 @@ from .modeset import (
     as_residual,
     fit_checked,
     lost_modes,
+    outside_side,
     rejected,
     too_damped,
+    with_residual,
 )
 from .quality import RejectedMode, threshold_text
 from .residual_peaks import (
@@ -289,13 +291,12 @@ def _held_outside(
     if wrong.size != 1 or int(wrong[0]) != k:
         return False
     p1 = complex(r1.poles[k])
-    fd = p1.imag / (2 * np.pi)
-    outside = band[1] < fd <= 2 * band[1] or band[0] / 2 <= fd < band[0]
+    side = outside_side(p1.imag / (2 * np.pi), band)
     f_all = r1.poles.imag[np.arange(r1.poles.size) != k] / (2 * np.pi)
-    held = np.count_nonzero(f_all > band[1]) if fd > band[1] else np.count_nonzero(f_all < band[0])
+    held = np.count_nonzero(f_all > band[1]) if side > 0 else np.count_nonzero(f_all < band[0])
     return bool(
-        held < max_helpers
-        and outside
+        side != 0
+        and held < max_helpers
         and not _inadmissible(p1, df, max_damping)
         and float(r1.significance[k]) > threshold
     )
@@ -313,13 +314,8 @@ def _as_outside(
     band (last, checked against the band), refitted (:func:`fit_checked`); the
     trial ``p_t``'s record when that refit loses a mode (None: the fit failed)."""
     keep = np.arange(modes.m) != k
-    held = ModeSet(
-        modes.poles[keep],
-        modes.part[keep],
-        np.append(modes.hp, modes.poles[k]),
-        np.concatenate([modes.hl, modes.part[k : k + 1]]),
-        modes.n_free,
-    )
+    rest = ModeSet(modes.poles[keep], modes.part[keep], modes.hp, modes.hl, modes.n_free)
+    held = with_residual(rest, complex(modes.poles[k]), modes.part[k])
     try:
         r2, c2, drop = fit_checked(fitter, held, True, band, **kw)  # type: ignore[arg-type]
     except (ConvergenceError, np.linalg.LinAlgError, ValueError):
