@@ -47,3 +47,20 @@ def test_identification_limits_blas_and_restores_it(asked: int | None) -> None:
 def test_bad_thread_count_is_refused(bad: Any) -> None:
     with pytest.raises(InputError, match="blas_threads"):
         blas_threads(bad)
+
+
+def test_the_controller_is_kept_until_a_module_is_imported() -> None:
+    import sys
+
+    from tyredamp import _blas
+
+    first = _blas._controller()
+    assert _blas._controller() is first  # kept: no library listing per call
+    sys.modules["_tyredamp_test_marker"] = sys  # an import since: made again
+    try:
+        again = _blas._controller()
+        assert again is not first
+        with blas_threads(1):
+            assert _threads() == {1}
+    finally:
+        del sys.modules["_tyredamp_test_marker"]

@@ -15,6 +15,8 @@ OpenBLAS threads and 0.13 s with one, the 128-output case 2.8 s against
 from __future__ import annotations
 
 import contextlib
+import sys
+import threading
 from typing import Any
 
 from .exceptions import InputError
@@ -34,11 +36,35 @@ def blas_threads(n: int | None) -> contextlib.AbstractContextManager[Any]:
         return contextlib.nullcontext()
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:
         raise InputError(f"blas_threads: expected a positive integer or None, got {n!r}")
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+    controller = _controller()
+    if controller is None:  # pragma: no cover - threadpoolctl is a dependency
         return contextlib.nullcontext()
-    return threadpool_limits(limits=n, user_api="blas")
+    return controller.limit(limits=n, user_api="blas")
+
+
+_LOCK = threading.Lock()
+#: the controller of the loaded BLAS libraries and the number of modules imported
+#: when it was made (a later import may load another library: it is made again)
+_HELD: list[Any] = [None, -1]
+
+
+def _controller() -> Any:
+    """threadpoolctl's controller of the BLAS libraries loaded in the process.
+
+    Making one lists the process's shared libraries (about 1 ms, each call of
+    ``threadpool_limits`` does it); a limit through a kept one costs 20 us.
+    It is made again when modules were imported since (a new extension module
+    may bring its own BLAS). None without threadpoolctl.
+    """
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+        return None
+    with _LOCK:
+        n_mod = len(sys.modules)
+        if _HELD[0] is None or _HELD[1] != n_mod:
+            _HELD[0], _HELD[1] = ThreadpoolController(), n_mod
+        return _HELD[0]
 
 
 def single_threaded_blas() -> contextlib.AbstractContextManager[Any]:
