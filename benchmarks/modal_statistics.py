@@ -79,11 +79,14 @@ With ``--old-src`` the same corpus is identified by the code at that path
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -472,6 +475,12 @@ def main() -> None:
         help="print the tables of a JSON file written by --dump (no identification; "
         "the scoring of this code)",
     )
+    ap.add_argument(
+        "--store",
+        help="directory of per-system results: each system's truth and identification "
+        "is written there when done and read back by a later run instead of computed "
+        "again (keyed by the code they depend on; an interrupted run resumes)",
+    )
     ap.add_argument("--identify-only", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     NOISE["model"] = args.noise
@@ -503,7 +512,7 @@ def main() -> None:
             stdout=subprocess.PIPE,
             text=True,
         )
-    new, truths = _run(seeds, args.jobs, args.noise)
+    new, truths = _run(seeds, args.jobs, args.noise, args.store)
     if args.old_src:
         out, _ = proc.communicate()
         old = json.loads(out)
@@ -519,26 +528,112 @@ def main() -> None:
     _print_tables(args, seeds, truths, new, old)
 
 
-def _one(seed: int, noise: str) -> tuple[dict[str, Any], dict[str, Any]]:
-    """Identification and truth of one system (a worker of :func:`_run`)."""
+#: the modules the truths depend on (the fitter, the problem's set-up, the mode
+#: test's threshold, the refitted ratio; not the identification's search): their
+#: sources and this file's key the stored truths (``--store``)
+TRUTH_MODULES = (
+    "frf",
+    "_validate",
+    "mechanics/modal_sum",
+    "modal/fit",
+    "modal/_added",
+    "modal/_basis",
+    "modal/_linalg",
+    "modal/_scaling",
+    "modal/model",
+    "modal/problem",
+    "modal/span_noise",
+    "modal/stats",
+    "modal/ml",
+    "modal/refitted",
+)
+
+
+def code_keys() -> tuple[str, str]:
+    """Keys of the stored results (``--store``): of the truths (this file and
+    ``TRUTH_MODULES``) and of the identifications (this file and every source
+    file of the package)."""
+    import tyredamp
+
+    root = Path(tyredamp.__file__).parent
+    own = Path(__file__).read_bytes()
+
+    def key(files: list[Path]) -> str:
+        h = hashlib.sha256(own)
+        for f in files:
+            h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes())
+        return h.hexdigest()[:16]
+
+    truth = key([root / f"{m}.py" for m in TRUTH_MODULES])
+    return truth, key(sorted(root.rglob("*.py")))
+
+
+def _stored(store: str | None, name: str) -> Any:
+    """A stored result (None when absent or unreadable: computed again)."""
+    if store is None:
+        return None
+    try:
+        with open(Path(store) / name, encoding="utf-8") as fh:
+            return json.load(fh)
+    except (OSError, ValueError):
+        return None
+
+
+def _store(store: str | None, name: str, value: Any) -> None:
+    """Write a result to the store whole or not at all (temporary file, rename)."""
+    if store is None:
+        return
+    d = Path(store)
+    fd, tmp = tempfile.mkstemp(dir=d, prefix=f".{name}.", suffix=".part")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            json.dump(value, fh)
+        os.replace(tmp, d / name)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _one(
+    seed: int, noise: str, store: str | None = None, keys: tuple[str, str] = ("", "")
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Identification and truth of one system (a worker of :func:`_run`), each read
+    from ``store`` when held there under ``keys`` (:func:`code_keys`) and written
+    there when computed."""
     NOISE["model"] = noise
-    return identify(seed), truth_stats(seed)
+    names = (f"truth-{noise}-{keys[0]}-{seed}.json", f"new-{noise}-{keys[1]}-{seed}.json")
+    truth = _stored(store, names[0])
+    if truth is None:
+        truth = truth_stats(seed)
+        _store(store, names[0], truth)
+    new = _stored(store, names[1])
+    if new is None:
+        new = identify(seed)
+        _store(store, names[1], new)
+    return new, truth
 
 
 def _run(
-    seeds: list[int], jobs: int, noise: str
+    seeds: list[int], jobs: int, noise: str, store: str | None = None
 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Identification results and truths of the systems ``seeds``, over ``jobs``
-    processes (each with one BLAS thread, set before NumPy loads in the workers)."""
+    processes (each with one BLAS thread, set before NumPy loads in the workers);
+    with ``store``, each system's results are kept there as they are done."""
+    from functools import partial
+
+    keys = ("", "")
+    if store is not None:
+        Path(store).mkdir(parents=True, exist_ok=True)
+        keys = code_keys()
+    one = partial(_one, noise=noise, store=store, keys=keys)
     if jobs <= 1:
-        pairs = [_one(s, noise) for s in seeds]
+        pairs = [one(s) for s in seeds]
     else:
         import multiprocessing as mp
-        from functools import partial
 
         os.environ["OPENBLAS_NUM_THREADS"] = os.environ["OMP_NUM_THREADS"] = "1"
         with mp.get_context("spawn").Pool(jobs) as pool:
-            pairs = pool.map(partial(_one, noise=noise), seeds, chunksize=1)
+            pairs = pool.map(one, seeds, chunksize=1)
     return [p[0] for p in pairs], [p[1] for p in pairs]
 
 
