@@ -94,6 +94,27 @@ def test_a_wrong_model_fails_and_names_the_missing_edge_mode() -> None:
     assert modal_fit_verdict(shifted, meas).status == "failed"
 
 
+def test_a_model_form_misfit_at_the_edge_is_not_a_missing_mode() -> None:
+    """A model off at the upper edge, beside a model of the same band within the noise
+    (the complex-mode fit beside a real-mode one): the better model refutes a mode
+    missing at the edge; the reason is the model form, the misfit's region is given."""
+    true = two_modes(f2=99.0)
+    meas = measured(true, 8, 300.0, 1)
+    good = modal_fit_verdict(true, meas, subject="complex-mode fit")
+    assert good.passed
+    shifted = two_modes(f2=99.0 * 1.01)
+    alone = modal_fit_verdict(shifted, meas)
+    assert "upper band edge" in " ".join(alone.reasons)
+    v = modal_fit_verdict(shifted, meas, subject="real-mode fit", better=good)
+    text = " ".join(v.reasons)
+    assert v.status == "failed"
+    assert "band edge" not in text
+    assert "the complex-mode fit is within the noise: the model form misses" in text
+    assert v.test is not None
+    assert v.test.misfit_hz is not None
+    assert f"the misfit lies at {v.test.misfit_hz[0]:.4g}" in text
+
+
 def test_band_edge_and_complex_shape_cautions() -> None:
     m = two_modes(f2=99.5)
     meas = measured(m, 8, 300.0, 2)

@@ -353,7 +353,8 @@ def modal_fit_verdict(
     better : FitVerdict, optional
         Verdict of another model of the same data (the complex-mode fit for a
         real-mode one): when it is within the noise and this one is not, the
-        likely cause is the model form (non-proportional damping).
+        likely cause is the model form (non-proportional damping), and a
+        misfit at a band edge is not put down to a mode missing there.
     alpha : float
         Significance level of the test against the noise.
     """
@@ -377,7 +378,10 @@ def modal_fit_verdict(
                 f"{100 * test.relative_error:.3g} % against {100 * test.noise_relative_error:.3g}"
                 f" % from the coherence; {_p(test.p_value)})"
             )
-            edge = _edge_reason(test, band)
+            # another model of the same band within the noise refutes a missing mode
+            # at an edge: the misfit is this model's form
+            form = better is not None and better.passed
+            edge = None if form else _edge_reason(test, band)
             if edge:
                 reasons.append(edge)
             elif test.misfit_hz is not None:
@@ -392,7 +396,7 @@ def modal_fit_verdict(
                     "its refinement fell back to the complex-mode poles (only the residues "
                     "are fitted)"
                 )
-            if better is not None and better.passed:
+            if form:
                 reasons.append(
                     f"the {better.subject} is within the noise: the model form misses (real "
                     "modes cannot hold damping that couples the modes)"
