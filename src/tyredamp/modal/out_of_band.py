@@ -13,9 +13,11 @@ import numpy as np
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
+from ._basis import factors, residual_lines
 from .fit import FitResult, ModalFitter
 from .modeset import outside_side, with_residual
 from .quality import RejectedMode
+from .residual_peaks import _scan_statistic, model_of
 from .search import (
     FIRST_NFEV,
     MIN_LOW_LINES,
@@ -40,10 +42,13 @@ def search_helpers(
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Refine, then add out-of-band residual modes while they pass the mode test.
 
-    A trial pole is started at ``1.1 f_hi`` (then ``1.3 f_hi``, ...) above the
-    band, and at ``0.9 f_lo`` (...) below it when ``f_lo > 0`` and at least
-    ``MIN_LOW_LINES`` lines lie in ``[f_lo, 2 f_lo]``, with the median
-    damping of the in-band modes. Only the trial mode is refined, with every
+    A trial pole is started above the band, and below it when ``f_lo > 0`` and
+    at least ``MIN_LOW_LINES`` lines lie in ``[f_lo, 2 f_lo]``, where the
+    current fit's residual asks for a pole on that side (:func:`_scan_start`:
+    the pole within a factor 2 of the edge whose column explains most of the
+    residual; a fixed ladder of starts, ``1.1 f_hi``, ``1.3 f_hi``, ..., began
+    a trial far from a strong mode just beyond the edge and lost it behind a
+    broad pole or a residual mode piled at the edge). Only the trial mode is refined, with every
     other mode held fixed, its damped frequency kept outside the band but
     within a factor 2 of its edge. It is kept when it did not stop at one of
     these limits and its statistic ``T`` (cost drop in units of the noise
@@ -75,19 +80,20 @@ def search_helpers(
     # a side whose trial failed is tried again once a helper on the other side
     # changed the residual (a strong mode below the band leaves a tail that an
     # upper helper far away fits better than the mode just above the edge)
-    k_next = dict.fromkeys(sides, 0)
+    k_next = dict.fromkeys(sides, 0)  # residual modes added per side
     failed_at: dict[float, int] = {}  # helpers held when the side's last trial failed
     while any(failed_at.get(s) != cur.hp.size and k_next[s] < max_helpers for s in sides):
         for side in sides:
             while failed_at.get(side) != cur.hp.size and k_next[side] < max_helpers:
-                got = _helper(fitter, res, cur, fixed, band, side, k_next[side], zeta0, threshold)
-                if got is None:
+                got = _helper(fitter, res, cur, fixed, band, side, zeta0, threshold)
+                if got is None or isinstance(got, str):
+                    # failed, or the joint refit lost it (into the band): the same
+                    # residual would start the same trial
                     failed_at[side] = cur.hp.size
                     continue
-                k_next[side] += 1  # the next start is further out
-                if not isinstance(got, str):  # else the joint refit lost it (into the band)
-                    res, cur, lost = got
-                    dropped += [_took_tail(r) for r in lost]
+                k_next[side] += 1
+                res, cur, lost = got
+                dropped += [_took_tail(r) for r in lost]
     return res, cur, dropped
 
 
@@ -98,22 +104,19 @@ def _helper(
     fixed: FixedParts,
     band: tuple[float, float],
     side: float,
-    k: int,
     zeta0: float,
     threshold: float,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]] | str | None:
-    """The ``k``-th helper trial on ``side`` (+1 above the band, -1 below) of
+    """A helper trial on ``side`` (+1 above the band, -1 below) of
     :func:`search_helpers`: the refit with it, "lost" when the joint refit lost
     it (into the band, or merged), None when it failed (not significant, at a
     limit, or moved out of its range)."""
     lo, hi = band
-    fh = hi * (1.1 + 0.2 * k) if side > 0 else lo * (0.9 - 0.2 * k)
-    if fh <= 0:
-        return None
-    wh = 2 * np.pi * fh
-    ph = complex(-zeta0 * wh, wh * np.sqrt(1 - zeta0**2))
     edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
     w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
+    ph = _scan_start(fitter, res, edge, side, zeta0)
+    if ph is None:
+        return None
     got = _trial(fitter, res, cur, fixed, ph, np.ones(fitter.n_in, complex), w_lim)
     if got is None or got[2] < threshold:
         return None
@@ -135,6 +138,50 @@ def _helper(
     # the helper must stay on its side of the band, within a factor 2 of the edge
     on_side = outside_side(new.hp[-1].imag / (2 * np.pi), band) == side
     return (trial, new, lost) if on_side else None
+
+
+#: damping ratios of the scan for a residual mode's start, relative to the modes'
+SCAN_SCALES = (0.5, 1.0, 2.0)
+#: grid points of the scan formed at once
+SCAN_CHUNK = 64
+
+
+def _scan_start(
+    fitter: ModalFitter,
+    res: FitResult,
+    edge: tuple[float, float],
+    side: float,
+    zeta0: float,
+) -> complex | None:
+    """Where the fit's residual asks for a pole outside the band: the trial pole
+    of the range ``edge`` (Hz, the side's factor 2 beyond the band edge) whose
+    column ``kappa / (s - p)`` over the band's lines explains most of the
+    residual, in units of each output's noise (the rank-one statistic of the
+    coherent scan, :func:`~tyredamp.modal.residual_peaks.coherent_scan`, over
+    every line: a mode outside the band reaches into it with its tail). Grids of
+    damping ``SCAN_SCALES`` times ``zeta0``, step ``zeta f``. None when the
+    range holds no grid point."""
+    poles, residues, terms, s2 = model_of(fitter, res)
+    n_f = fitter.f.size
+    e = residual_lines(fitter, poles, residues, terms, slice(0, n_f))
+    e = e / np.sqrt(s2)[:, None, None]
+    s, kap, _ = factors(fitter, slice(0, n_f))
+    best, top = None, -np.inf
+    for sc in SCAN_SCALES:
+        z = float(np.clip(sc * zeta0, 1e-3, 0.2))
+        a0, b0 = (edge[0] * (1 + z), edge[1]) if side > 0 else (edge[0], edge[1] / (1 + z))
+        if not 0 < a0 < b0:
+            continue
+        fg = a0 * (1 + z) ** np.arange(int(np.log(b0 / a0) / np.log1p(z)) + 1)
+        wg = 2 * np.pi * fg
+        pg = -z * wg + 1j * wg * np.sqrt(1 - z * z)
+        for c0 in range(0, pg.size, SCAN_CHUNK):
+            pc = pg[c0 : c0 + SCAN_CHUNK]
+            t = _scan_statistic(e, kap[None, :] / (s[None, :] - pc[:, None]), fitter.n_in)
+            i = int(np.argmax(t))
+            if t[i] > top:
+                best, top = complex(pc[i]), float(t[i])
+    return best
 
 
 def _took_tail(r: RejectedMode) -> RejectedMode:

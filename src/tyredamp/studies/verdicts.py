@@ -396,7 +396,7 @@ def modal_fit_verdict(
                     "its refinement fell back to the complex-mode poles (only the residues "
                     "are fitted)"
                 )
-            if form:
+            if form and better is not None:
                 reasons.append(
                     f"the {better.subject} is within the noise: the model form misses (real "
                     "modes cannot hold damping that couples the modes)"
