@@ -13,11 +13,11 @@ import numpy as np
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
-from ._basis import factors, residual_lines
+from ._basis import factors, residual_blocks
 from .fit import FitResult, ModalFitter
 from .modeset import outside_side, with_residual
 from .quality import RejectedMode
-from .residual_peaks import _scan_statistic, model_of
+from .residual_peaks import model_of, rank_one_statistic
 from .search import (
     FIRST_NFEV,
     MIN_LOW_LINES,
@@ -142,7 +142,7 @@ def _helper(
 
 #: damping ratios of the scan for a residual mode's start, relative to the modes'
 SCAN_SCALES = (0.5, 1.0, 2.0)
-#: grid points of the scan formed at once
+#: grid points of the scan formed at once (per block of lines)
 SCAN_CHUNK = 64
 
 
@@ -161,27 +161,32 @@ def _scan_start(
     every line: a mode outside the band reaches into it with its tail). Grids of
     damping ``SCAN_SCALES`` times ``zeta0``, step ``zeta f``. None when the
     range holds no grid point."""
-    poles, residues, terms, s2 = model_of(fitter, res)
-    n_f = fitter.f.size
-    e = residual_lines(fitter, poles, residues, terms, slice(0, n_f))
-    e = e / np.sqrt(s2)[:, None, None]
-    s, kap, _ = factors(fitter, slice(0, n_f))
-    best, top = None, -np.inf
+    grids = []
     for sc in SCAN_SCALES:
         z = float(np.clip(sc * zeta0, 1e-3, 0.2))
         a0, b0 = (edge[0] * (1 + z), edge[1]) if side > 0 else (edge[0], edge[1] / (1 + z))
-        if not 0 < a0 < b0:
-            continue
-        fg = a0 * (1 + z) ** np.arange(int(np.log(b0 / a0) / np.log1p(z)) + 1)
-        wg = 2 * np.pi * fg
-        pg = -z * wg + 1j * wg * np.sqrt(1 - z * z)
+        if 0 < a0 < b0:
+            wg = 2 * np.pi * a0 * (1 + z) ** np.arange(int(np.log(b0 / a0) / np.log1p(z)) + 1)
+            grids.append(-z * wg + 1j * wg * np.sqrt(1 - z * z))
+    if not grids:
+        return None
+    pg = np.concatenate(grids)
+    poles, residues, terms, s2 = model_of(fitter, res)
+    inv = 1.0 / np.sqrt(s2)
+    # the inner products <a_g, e_jk> and ||a_g||^2, summed over blocks of lines (the
+    # residual of a long axis with many FRFs is never held whole)
+    m = np.zeros((fitter.n_out * fitter.n_in, pg.size), complex)
+    nrm2 = np.zeros(pg.size)
+    for sl, e in residual_blocks(fitter, poles, residues, terms):
+        eb = (e * inv[:, None, None]).reshape(-1, e.shape[-1])
+        s, kap, _ = factors(fitter, sl)
         for c0 in range(0, pg.size, SCAN_CHUNK):
-            pc = pg[c0 : c0 + SCAN_CHUNK]
-            t = _scan_statistic(e, kap[None, :] / (s[None, :] - pc[:, None]), fitter.n_in)
-            i = int(np.argmax(t))
-            if t[i] > top:
-                best, top = complex(pc[i]), float(t[i])
-    return best
+            g = slice(c0, c0 + SCAN_CHUNK)
+            a = kap[None, :] / (s[None, :] - pg[g, None])
+            m[:, g] += eb @ a.conj().T
+            nrm2[g] += np.sum(a.real**2 + a.imag**2, axis=1)
+    t = rank_one_statistic(m, nrm2, fitter.n_out, fitter.n_in)
+    return complex(pg[int(np.argmax(t))])
 
 
 def _took_tail(r: RejectedMode) -> RejectedMode:

@@ -41,6 +41,7 @@ __all__ = [
     "local_ratio",
     "model_of",
     "power_of",
+    "rank_one_statistic",
     "residual_peaks",
     "residual_view",
     "room",
@@ -185,9 +186,17 @@ def _scan_statistic(
     residual ``e`` (n_out, n_in, L): the largest squared singular value of
     ``<a, e_jk> / ||a||`` over outputs x inputs."""
     nrm2 = np.sum(a.real**2 + a.imag**2, axis=1)
-    g = a.shape[0]
-    n_out = e.shape[0]
     m = e.reshape(-1, e.shape[-1]) @ a.conj().T  # (K, G)
+    return rank_one_statistic(m, nrm2, e.shape[0], n_in)
+
+
+def rank_one_statistic(
+    m: NDArray[np.complex128], nrm2: NDArray[np.float64], n_out: int, n_in: int
+) -> NDArray[np.float64]:
+    """The rank-one statistic of :func:`_scan_statistic` from its inner products
+    ``m`` (n_out n_in, G) = ``<a_g, e_jk>`` (rows output-major) and the columns'
+    squared norms ``nrm2`` (G,): sums over blocks of lines give the same."""
+    g = m.shape[1]
     mg = m.T.reshape(g, n_out, n_in)
     if n_in == 1:
         top = np.sum(mg.real**2 + mg.imag**2, axis=(1, 2))
