@@ -162,12 +162,13 @@ def identify(seed: int) -> dict[str, Any]:
 
     s = system(seed)
     frf, var = frf_of(s, seed)
-    given = var if NOISE["model"] == "response" else None
+    # the variance only when given (the code before issue 16 has no such argument)
+    given: dict[str, Any] = {"variance": var} if NOISE["model"] == "response" else {}
     t = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            res = identify_modes(frf, band=s["band"], model="complex", variance=given)
+            res = identify_modes(frf, band=s["band"], model="complex", **given)
         except Exception as exc:  # a failed fit counts as nothing found
             return {"seed": seed, "error": f"{type(exc).__name__}: {exc}", "time": 0.0}
     c = res.models["complex"]
@@ -493,7 +494,7 @@ def main() -> None:
         _print_tables(args, seeds, got["truth"], got["new"], got.get("old"))
         return
     if args.identify_only:  # subprocess of --old-src: identification results as JSON
-        print(json.dumps([identify(s) for s in seeds]))
+        print(json.dumps(_identified(seeds, args.noise, args.store)))
         return
     old = None
     if args.old_src:
@@ -507,6 +508,7 @@ def main() -> None:
                 "--noise",
                 args.noise,
                 "--identify-only",
+                *(["--store", args.store] if args.store else []),
             ],
             env=env,
             stdout=subprocess.PIPE,
@@ -550,22 +552,39 @@ TRUTH_MODULES = (
 
 
 def code_keys() -> tuple[str, str]:
-    """Keys of the stored results (``--store``): of the truths (this file and
-    ``TRUTH_MODULES``) and of the identifications (this file and every source
-    file of the package)."""
+    """Keys of the stored results (``--store``): of the truths (the corpus and the
+    truth's functions of this file, and ``TRUTH_MODULES``) and of the
+    identifications (:func:`identify_key`). The functions' own sources, not this
+    whole file's: a change to the tables, the scoring or the options keeps the
+    stored results, a change to what they compute does not."""
+    root = _package_root()
+    funcs = [system, frf_of, truth_stats, _oracle_cover, _refitted_lr]
+    return _key(funcs, [root / f"{m}.py" for m in TRUTH_MODULES]), identify_key()
+
+
+def identify_key() -> str:
+    """Key of the stored identifications: the corpus, :func:`identify` and every
+    source file of the package on the import path (an old checkout's under
+    ``--old-src``, so one code's results are never taken for another's)."""
+    return _key([system, frf_of, identify], sorted(_package_root().rglob("*.py")))
+
+
+def _package_root() -> Path:
     import tyredamp
 
-    root = Path(tyredamp.__file__).parent
-    own = Path(__file__).read_bytes()
+    return Path(tyredamp.__file__).parent
 
-    def key(files: list[Path]) -> str:
-        h = hashlib.sha256(own)
-        for f in files:
-            h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes())
-        return h.hexdigest()[:16]
 
-    truth = key([root / f"{m}.py" for m in TRUTH_MODULES])
-    return truth, key(sorted(root.rglob("*.py")))
+def _key(funcs: list[Any], files: list[Path]) -> str:
+    import inspect
+
+    root = _package_root()
+    h = hashlib.sha256(repr((KINDS, SNRS, LR_RANGE)).encode())
+    for fn in funcs:
+        h.update(inspect.getsource(fn).encode())
+    for f in files:
+        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()[:16]
 
 
 def _stored(store: str | None, name: str) -> Any:
@@ -611,6 +630,25 @@ def _one(
         new = identify(seed)
         _store(store, names[1], new)
     return new, truth
+
+
+def _identified(seeds: list[int], noise: str, store: str | None) -> list[dict[str, Any]]:
+    """Identification results of the code on the import path (the old code's, in the
+    ``--old-src`` subprocess), each read from ``store`` when held there under that
+    code's key (:func:`code_keys`: a stored result of one code is never taken for
+    another's) and written there when computed."""
+    key = identify_key() if store is not None else ""
+    if store is not None:
+        Path(store).mkdir(parents=True, exist_ok=True)
+    out = []
+    for s in seeds:
+        name = f"new-{noise}-{key}-{s}.json"
+        got = _stored(store, name)
+        if got is None:
+            got = identify(s)
+            _store(store, name, got)
+        out.append(got)
+    return out
 
 
 def _run(
