@@ -23,6 +23,7 @@ import argparse
 import cProfile
 import pstats
 import time
+from pathlib import Path
 from typing import Any
 
 from perf_common import (
@@ -42,8 +43,9 @@ STAGES = (
     ("pLSCF (plscf)", "lscf.py", "plscf"),
     ("  companion eigenvalues", "lscf.py", "_companion_eigvals"),
     ("stability + clustering", "selection.py", "stability_flags|cluster_poles"),
-    ("output compression", "fit.py", "compress_outputs"),
+    ("output compression", "compress.py", "_compress"),
     ("out-of-band residual modes (search_helpers)", "out_of_band.py", "search_helpers"),
+    ("  scan for their starts (_scan_start)", "out_of_band.py", "_scan_start"),
     ("mode test (reject_by_test)", "search.py", "reject_by_test"),
     ("residual search (residual_search)", "search.py", "residual_search"),
     ("  residual peaks", "residual_peaks.py", "residual_peaks"),
@@ -59,6 +61,19 @@ STAGES = (
     ("  result assembly (_result)", "fit.py", "_result"),
     ("model object and indicators (to_model)", "final.py", "to_model"),
 )
+
+
+def check_stages() -> None:
+    """Every stage's functions are defined in its file (a renamed or moved function
+    would otherwise show as a stage that takes no time)."""
+    import tyredamp.modal
+
+    root = Path(tyredamp.modal.__file__).parent
+    for label, file, funcs in STAGES:
+        text = (root / file).read_text(encoding="utf-8")
+        for fn in funcs.split("|"):
+            if f"def {fn}(" not in text:
+                raise SystemExit(f"perf_profile: stage {label.strip()!r}: no {fn}() in {file}")
 
 
 def profile_case(name: str, case: Any) -> dict[str, Any]:
@@ -89,6 +104,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (default 1)")
     ap.add_argument("--json", default=str(RESULTS_DIR / "profile.json"), help="output JSON")
     a = ap.parse_args(argv)
+    check_stages()
     pool = limit_blas(a.blas_threads)
     t_start = time.perf_counter()
     cases = [

@@ -100,7 +100,7 @@ from .model import ModalModel
 from .order import Diagram, SelectionRules, default_order, modes_shown, settle_order
 from .out_of_band import search_helpers
 from .problem import FitProblem, build_problem, max_modes
-from .quality import RejectedMode
+from .quality import RejectedMode, merge_rejected
 from .search import (
     FixedParts,
     ModeSet,
@@ -315,7 +315,7 @@ def _identify(
     thr, test = _threshold(problem, "complex", false_alarm), _mode_test(problem, false_alarm)
     opts = (auto, refine, max_helpers, min_contribution, search, (lo, hi))
     last, modes, more = _select(fitters, modes, dg, rej, (thr, test), *opts)
-    rej += more
+    rej = merge_rejected(rej + more)
     sigma0 = _noise_per_output(problem, fitters, modes, last, refine)
     ctx = {
         "problem": problem,

@@ -61,6 +61,40 @@ class RejectedMode:
         )
 
 
+#: the reason of a record that marks a candidate as kept after all (a cluster of
+#: the diagram rejected at first, whose trial the residual search kept):
+#: :func:`merge_rejected` drops every record of that candidate
+KEPT = "kept: its trial mode passed the mode test and the joint refit"
+
+
+def merge_rejected(rej: list[RejectedMode]) -> list[RejectedMode]:
+    """One record per candidate: records of the same pole (frequency and damping
+    equal to 1e-9) become one, their reasons joined in order (each once), with the
+    first test statistic and threshold among them (a cluster of the diagram that
+    too few orders resolved, and then found too weak in the residual, is one
+    candidate with both reasons). A candidate with a record ``KEPT`` is a mode,
+    not a rejected candidate: it is left out."""
+    out: list[RejectedMode] = []
+    for r in rej:
+        for i, o in enumerate(out):
+            same_f = abs(o.frequency_hz - r.frequency_hz) <= 1e-9 * abs(o.frequency_hz)
+            same_z = abs(o.damping_ratio - r.damping_ratio) <= 1e-9 * abs(o.damping_ratio)
+            if same_f and same_z:
+                why = o.reason if r.reason in o.reason.split("; ") else f"{o.reason}; {r.reason}"
+                tested = np.isfinite(o.statistic)
+                out[i] = RejectedMode(
+                    o.frequency_hz,
+                    o.damping_ratio,
+                    why,
+                    o.statistic if tested else r.statistic,
+                    o.threshold if tested else r.threshold,
+                )
+                break
+        else:
+            out.append(r)
+    return [r for r in out if KEPT not in r.reason.split("; ")]
+
+
 def threshold_text(thr: float, base: float) -> str:
     """A mode's threshold ``thr`` for a reason text; says when the noise along the
     response raised it above the base threshold ``base``

@@ -19,7 +19,9 @@ mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
    the peaks of the residual (the fit's residual power per line, in units of
    the noise, summed over the FRFs, over 5 lines and over windows matched to
    half-power bands: a mode indicator on the residual,
-   :mod:`tyredamp.modal.residual_peaks`) where the coherent scan finds room
+   :mod:`tyredamp.modal.residual_peaks`; the starts of a round and the records
+   of the candidates not kept for a reason of their own are in
+   :mod:`tyredamp.modal.search_starts`) where the coherent scan finds room
    for a mode; when those add nothing, the maxima of the coherent scan itself
    (the mode test's statistic of a pole held at each point of a grid, the
    fitted modes' residues refitted, rank-one with their participation held when
@@ -54,14 +56,17 @@ from .modeset import (
     too_damped,
     with_residual,
 )
-from .quality import RejectedMode, threshold_text
+from .quality import KEPT, RejectedMode, threshold_text
 from .residual_peaks import (
-    SCAN_SHARE,
-    ScanGrid,
     local_ratio,
-    residual_peaks,
     residual_view,
-    room,
+)
+from .search_starts import (
+    MAX_TRIALS,
+    SAME_START,
+    round_starts,
+    start_records,
+    unique_candidates,
 )
 from .span_noise import SpanNoise
 from .thresholds import ModeTest, local_thresholds, residual_span
@@ -92,19 +97,14 @@ FIRST_NFEV = 2
 #: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
 #: starts at the first lines) it cannot be told from the lower residual term
 MIN_LOW_LINES = 10
+#: residual search: most rounds (they go on while one adds a mode; this only bounds them)
+MAX_ROUNDS = 50
 #: residual search: a candidate's frequency stays within this factor of its start
 TRIAL_SPAN = 0.03
 #: evaluation limit of the joint refit of an accepted trial (the final fit converges)
 JOINT_NFEV = 30
 #: evaluation limit of a trial mode (a mode that is there converges in a few steps)
 TRIAL_NFEV = 30
-#: residual search: most candidates tried per round; rounds go on while one adds a
-#: mode (a band missing many modes adds a few per round), MAX_ROUNDS only bounds them
-MAX_TRIALS = 12
-MAX_ROUNDS = 50
-#: a residual peak is tried when the coherent scan near it reaches this share of the
-#: threshold (a screen of plain noise peaks; the scan's trial poles need SCAN_SHARE)
-SUPPORT_SHARE = 0.5
 #: times a trial stopped at its window's limit is continued beyond it (_follow)
 FOLLOW = 3
 
@@ -452,59 +452,6 @@ TOWARD_CROSSED = (
 )
 
 
-def _starts(
-    fitter: ModalFitter,
-    res: FitResult,
-    view: tuple[ScanGrid, NDArray[np.float64]],
-    pending: list[tuple[complex, NDArray[np.complex128]]],
-    threshold: float,
-    zeta0: float,
-    test: ModeTest | None,
-    scan: bool,
-) -> list[tuple[complex, NDArray[np.complex128]]]:
-    """The starts of one round of :func:`residual_search`: the coherent scan's
-    trial poles (``scan``), or else the residual's peaks where the scan finds
-    room for a mode near them (``SUPPORT_SHARE`` of the threshold); then the
-    diagram's candidates ``pending`` whose half-power band (+-2 zeta f) holds
-    enough residual power above the noise to pass. ``view``: the scan of the
-    fit's residual and its power per line (:func:`~.residual_peaks.residual_view`)."""
-    grid, pw = view
-    found = residual_peaks(fitter.f, pw, fitter.n_out * fitter.n_in, zeta0, threshold, MAX_TRIALS)
-    ones = np.ones(fitter.n_in, complex)
-    starts: list[tuple[complex, NDArray[np.complex128]]] = []
-    if scan:
-        starts = [(p, ones) for p in _scanned(fitter, res, grid, threshold, test)]
-    if not starts:
-        level = SUPPORT_SHARE * threshold
-        for fpk in found.freq:
-            if grid.support(fpk, zeta0) >= level:
-                w = 2 * np.pi * fpk
-                starts.append((complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), ones))
-    room_min = 0.25 * threshold
-    return starts + [c for c in pending if room(fitter.f, found.excess, c[0]) > room_min]
-
-
-def _scanned(
-    fitter: ModalFitter,
-    res: FitResult,
-    grid: ScanGrid,
-    threshold: float,
-    test: ModeTest | None,
-) -> list[complex]:
-    """The coherent scan's trial poles (:func:`~.residual_peaks.coherent_scan`) whose
-    statistic reaches ``SCAN_SHARE`` of their own threshold, raised where the
-    residual's noise lies along the response (:func:`local_thresholds`): the
-    scan weighs the residual with the separable noise model, under which noise
-    along the response makes maxima of its own (near strong modes of an H1
-    estimate with force noise)."""
-    got = grid.candidates(SCAN_SHARE * threshold, MAX_TRIALS)
-    if test is None or not got:
-        return [p for p, _ in got]
-    poles = np.array([p for p, _ in got])
-    thr = local_thresholds(fitter, residual_span(fitter, res), poles, threshold, test)
-    return [p for (p, t), h in zip(got, thr, strict=True) if t >= SCAN_SHARE * h]
-
-
 def _follow(
     fitter: ModalFitter,
     res: FitResult,
@@ -589,7 +536,13 @@ def residual_search(
     outside the band).
 
     ``candidates`` are starting poles and participation vectors from the
-    diagram; each round adds the peaks of the current residual. With
+    diagram; each round adds the peaks of the current residual. Every candidate
+    of the diagram gets a record: not tried (too little residual power in its
+    half-power band, the same pole as a mode or an earlier start, the round's
+    ``MAX_TRIALS`` reached), where its trial mode went and why it was rejected,
+    or ``KEPT`` (its trial mode is now a mode;
+    :func:`~tyredamp.modal.quality.merge_rejected` joins a candidate's records
+    and leaves the kept ones out). With
     ``test``, the added mode must also pass its own threshold in the joint
     refit, raised where the noise of that fit's residual (the mode in it: a
     true mode's signal does not count as noise) lies along the response
@@ -597,12 +550,11 @@ def residual_search(
     (:class:`FixedParts`; shared with :func:`search_helpers` by the caller, or
     new).
     """
-    lo, hi = band
     df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
     tried: list[RejectedMode] = []
     cur = modes
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.002, 0.1))
-    pending = list(candidates)
+    pending = unique_candidates(candidates)
     seen: list[complex] = []  # starts tried (a start is tried once)
     refused: list[complex] = []  # trial modes whose joint refit failed (current modes)
     crossed: set[int] = set()  # sides of the band trial modes crossed to (current modes)
@@ -616,52 +568,46 @@ def residual_search(
         # when they add nothing, the coherent scan's poles (one round per mode set)
         if view_of is not res:
             view, view_of = residual_view(fitter, res, zeta0), res
-        starts = _starts(fitter, res, view, pending, threshold, zeta0, test, scan_next)
+        late: dict[complex, RejectedMode] = {}  # the diagram's starts' records if untried
+        starts, screened = round_starts(
+            fitter, res, view, pending, threshold, zeta0, test, scan_next, late
+        )
+        tried += screened
         scanned, scan_next = scanned or scan_next, False
-        pending = []
         added, n_tried = False, 0
-        for p0, l0 in starts:
+        from_diagram = set(late)
+        pending = []
+        for k, (p0, l0) in enumerate(starts):
             # several inputs: a start at a current mode's pole may be a repeated root's
             held = cur.all()[0] if fitter.n_in == 1 else cur.hp
             p_all = np.concatenate([held, np.asarray(seen, complex)])
             if p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE:
+                if complex(p0) in from_diagram:
+                    tried.append(rejected(p0, SAME_START))
                 continue
             if n_tried >= MAX_TRIALS:
+                tried += [late[complex(c)] for c, _ in starts[k:] if complex(c) in late]
                 break
             n_tried += 1
             seen.append(complex(p0))
-            w_lim = (
-                max(abs(p0.imag) * (1 - TRIAL_SPAN), 2 * np.pi * lo),
-                min(abs(p0.imag) * (1 + TRIAL_SPAN), 2 * np.pi * hi),
+            got = _try_start(
+                fitter,
+                (res, cur),
+                fixed,
+                (p0, np.asarray(l0, complex)),
+                band,
+                (threshold, df, max_damping),
+                (refused, crossed),
+                test,
+                max_helpers,
             )
-            if not w_lim[0] < w_lim[1]:
+            if isinstance(got, RejectedMode) or got is None:
+                tried += start_records(got, p0, complex(p0) in from_diagram)
                 continue
-            got = _follow(fitter, res, cur, fixed, (p0, np.asarray(l0, complex)), w_lim, band)
-            if got is None:
-                continue
-            (p_t, l_t, t), w_lim = got
-            why = _inadmissible(p_t, df, max_damping)
-            if not why and t <= threshold:
-                why = f"not significant: T = {t:.3g} <= {threshold:.3g}"
-            if why:
-                tried.append(rejected(p_t, why, t, threshold))
-                continue
-            if refused and np.min(np.abs(np.asarray(refused) - p_t)) < 2 * MERGE * abs(p_t):
-                continue  # the same trial mode: its joint refit was rejected already
-            if _toward(p_t, w_lim) in crossed:
-                tried.append(rejected(p_t, TOWARD_CROSSED, t, threshold))
-                continue
-            got1 = _joint(
-                fitter, cur, p_t, l_t, band, threshold, df, max_damping, crossed, test, max_helpers
-            )
-            if isinstance(got1, RejectedMode):
-                tried.append(got1)
-                refused.append(p_t)
-                continue
-            if got1 is None:
-                continue
-            res, cur = got1
+            res, cur = got
             added, refused, crossed, scanned = True, [], set(), False
+            if complex(p0) in from_diagram:
+                tried.append(rejected(p0, KEPT))
         if not added and scanned:
             got2 = _split(
                 fitter, res, cur, view[1], band, threshold, df, max_damping, test, split_tried
@@ -673,6 +619,55 @@ def residual_search(
         elif not added:
             scan_next = True
     return res, cur, tried
+
+
+def _try_start(
+    fitter: ModalFitter,
+    current: tuple[FitResult, ModeSet],
+    fixed: FixedParts,
+    start: tuple[complex, NDArray[np.complex128]],
+    band: tuple[float, float],
+    limits: tuple[float, float, float],
+    state: tuple[list[complex], set[int]],
+    test: ModeTest | None,
+    max_helpers: int,
+) -> tuple[FitResult, ModeSet] | RejectedMode | None:
+    """One start of :func:`residual_search`: its trial (followed out of its window,
+    :func:`_follow`) and, when the trial mode passes, the joint refit with it
+    (:func:`_joint`). Returns the new fit and modes when the mode is kept, else the
+    trial's record with the reason, or None (no trial mode, or the same trial mode
+    as one whose joint refit was refused). ``limits``: the threshold, the line
+    spacing and the largest damping ratio; ``state``: the refused trial modes
+    (extended here) and the sides of the band that trial modes crossed to."""
+    res, cur = current
+    threshold, df, max_damping = limits
+    refused, crossed = state
+    p0, l0 = start
+    w_lim = (
+        max(abs(p0.imag) * (1 - TRIAL_SPAN), 2 * np.pi * band[0]),
+        min(abs(p0.imag) * (1 + TRIAL_SPAN), 2 * np.pi * band[1]),
+    )
+    if not w_lim[0] < w_lim[1]:
+        return rejected(p0, "not tried: its window lies outside the band")
+    got = _follow(fitter, res, cur, fixed, (p0, l0), w_lim, band)
+    if got is None:
+        return None
+    (p_t, l_t, t), w_lim = got
+    why = _inadmissible(p_t, df, max_damping)
+    if not why and t <= threshold:
+        why = f"not significant: T = {t:.3g} <= {threshold:.3g}"
+    if why:
+        return rejected(p_t, why, t, threshold)
+    if refused and np.min(np.abs(np.asarray(refused) - p_t)) < 2 * MERGE * abs(p_t):
+        return None  # the same trial mode: its joint refit was rejected already
+    if _toward(p_t, w_lim) in crossed:
+        return rejected(p_t, TOWARD_CROSSED, t, threshold)
+    got1 = _joint(
+        fitter, cur, p_t, l_t, band, threshold, df, max_damping, crossed, test, max_helpers
+    )
+    if isinstance(got1, RejectedMode):
+        refused.append(p_t)
+    return got1
 
 
 def _split(
