@@ -148,13 +148,14 @@ def start_records(got: RejectedMode | None, p0: complex, own: bool) -> list[Reje
         return out
     if got is None:
         return [rejected(p0, "tried: its trial mode did not converge or repeated a refused one")]
-    f_t = got.frequency_hz
-    if abs(f_t - abs(p0) / (2 * np.pi)) > 1e-9 * f_t:
+    f_t, z_t = got.frequency_hz, got.damping_ratio
+    f0, z0 = (float(x[0]) for x in pole_quantities(np.array([p0])))
+    # a record at the start itself (the trial did not move) is merged with its others
+    if abs(f_t - f0) > 1e-9 * f_t or abs(z_t - z0) > 1e-9 * abs(z_t):
         out.append(
             rejected(
                 p0,
-                f"tried: its trial mode went to {f_t:.6g} Hz, zeta {got.damping_ratio:.3g} "
-                f"({got.reason})",
+                f"tried: its trial mode went to {f_t:.6g} Hz, zeta {z_t:.3g} ({got.reason})",
                 got.statistic,
                 got.threshold,
             )
