@@ -294,3 +294,26 @@ def test_files_report_shows_the_demo_verdicts_and_warnings(
             assert f'<div class="{cls}">{html.escape(v["summary"])}</div>' in page
     for w in doc["warnings"]:
         assert html.escape(w["message"]) in page
+
+
+def test_report_summarises_the_rejected_candidates(demo: tuple[DemoResult, Path]) -> None:
+    """The report gives the count of rejected candidates and those closest to the
+    threshold; every reason is in the modes JSON it names."""
+    import html
+
+    from tyredamp.modal.quality import RejectedMode, closest_rejected
+
+    result, out = demo
+    ident = result.radial.main.identification
+    assert ident.rejected
+    page = _sections((out / "report.html").read_text(encoding="utf-8"))["radial"]
+    assert f"{len(ident.rejected)} candidate(s) rejected" in page
+    near = closest_rejected([RejectedMode.from_dict(x) for x in ident.rejected])
+    assert near
+    assert html.escape(f"{near[0].frequency_hz:.2f} Hz (T = {near[0].statistic:.3g}") in page
+    name = f"modes_{result.radial.main.pressure_bar:g}bar.json"
+    assert name in page
+    doc = json.loads((out / name).read_text(encoding="utf-8"))
+    got = doc["models"]["complex"]["quality"]["rejected"]
+    reasons = {r["reason"] for r in got}
+    assert {x["reason"] for x in ident.rejected} <= reasons

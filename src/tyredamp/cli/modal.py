@@ -14,7 +14,7 @@ from ..io import read_frf
 from ..io._safety import check_output_file
 from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
-from ..modal.quality import RejectedMode
+from ..modal.quality import rejected_summary
 from ..studies.radial import label_wave_numbers, modes_from_frf
 from ..studies.verdicts import modal_verdicts
 from ._common import out_file_option
@@ -68,26 +68,10 @@ def modes_table(name: str, model: ModalModel) -> list[str]:
     if q is not None:
         rows.append(f"  goodness of fit (ML): {q.verdict}")
         if q.rejected:
-            rows.append(_rejected_row(q.rejected))
+            rows.append(f"  {rejected_summary(q.rejected)} (every reason in the modes JSON)")
     for w in model.meta.get("warnings", []):
         rows.append(f"  warning: {w}")
     return rows
-
-
-def _rejected_row(rejected: tuple[RejectedMode, ...]) -> str:
-    """The rejected candidates in one line: how many, and the three that came
-    closest to the mode test's threshold (their statistic over it; every reason
-    is in the modes JSON's ``quality.rejected``)."""
-    tested = [r for r in rejected if np.isfinite(r.statistic) and r.threshold > 0]
-    tested.sort(key=lambda r: r.statistic / r.threshold, reverse=True)
-    row = f"  {len(rejected)} candidate(s) rejected (reasons in the modes JSON)"
-    if not tested:
-        return row
-    near = ", ".join(
-        f"{r.frequency_hz:.2f} Hz (T = {r.statistic:.3g}, threshold {r.threshold:.3g})"
-        for r in tested[:3]
-    )
-    return f"{row}; closest to the threshold: {near}"
 
 
 def _likelihood_rows(model: ModalModel) -> list[str]:

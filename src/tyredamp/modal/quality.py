@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -93,6 +94,28 @@ def merge_rejected(rej: list[RejectedMode]) -> list[RejectedMode]:
         else:
             out.append(r)
     return [r for r in out if KEPT not in r.reason.split("; ")]
+
+
+def closest_rejected(rejected: Sequence[RejectedMode], n: int = 3) -> list[RejectedMode]:
+    """The ``n`` rejected candidates whose mode-test statistic came closest to their
+    threshold (largest ``statistic / threshold``; candidates without a test left
+    out): the ones a reader checks first."""
+    tested = [r for r in rejected if np.isfinite(r.statistic) and r.threshold > 0]
+    tested.sort(key=lambda r: r.statistic / r.threshold, reverse=True)
+    return tested[:n]
+
+
+def rejected_summary(rejected: Sequence[RejectedMode], n: int = 3) -> str:
+    """One line on the rejected candidates: how many, and the ``n`` closest to the
+    threshold with their statistic (:func:`closest_rejected`)."""
+    row = f"{len(rejected)} candidate(s) rejected"
+    near = closest_rejected(rejected, n)
+    if not near:
+        return row
+    return f"{row}; closest to the threshold: " + ", ".join(
+        f"{r.frequency_hz:.2f} Hz (T = {r.statistic:.3g}, threshold {r.threshold:.3g})"
+        for r in near
+    )
 
 
 def threshold_text(thr: float, base: float) -> str:

@@ -22,6 +22,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from .. import __version__
+from ..modal.quality import RejectedMode, rejected_summary
 from ._cells import _image, _num, _warnings, fmt_pm
 from .html import HtmlReport
 from .tyremodel import tyre_model_brief, tyre_model_report
@@ -316,10 +317,11 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     _image(rep, images, "stabilisation")
     ident = r.main.identification
     if ident.rejected:
+        line = rejected_summary([RejectedMode.from_dict(x) for x in ident.rejected])
         rep.paragraph(
-            "Candidates rejected: "
-            + "; ".join(f"{x['frequency_hz']:.1f} Hz ({x['reason']})" for x in ident.rejected[:8])
-            + ("; ..." if len(ident.rejected) > 8 else "")
+            f"{line[0].upper()}{line[1:]}. Every candidate's reason (the statistic of its "
+            f"trial, or why it was not tried) is in modes_{rad['pressure_bar']:g}bar.json "
+            "under quality.rejected."
         )
 
     rep.heading("Modes: identified with standard errors, beside the truth", 3)
