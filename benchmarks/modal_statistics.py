@@ -84,8 +84,9 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -532,7 +533,7 @@ def main() -> None:
 
 #: the modules the truths depend on (the fitter, the problem's set-up, the mode
 #: test's threshold, the refitted ratio; not the identification's search): their
-#: sources and this file's key the stored truths (``--store``)
+#: sources and those of the truth's functions key the stored truths (``--store``)
 TRUTH_MODULES = (
     "frf",
     "_validate",
@@ -598,19 +599,23 @@ def _stored(store: str | None, name: str) -> Any:
         return None
 
 
-def _store(store: str | None, name: str, value: Any) -> None:
-    """Write a result to the store whole or not at all (temporary file, rename)."""
-    if store is None:
-        return
-    d = Path(store)
-    fd, tmp = tempfile.mkstemp(dir=d, prefix=f".{name}.", suffix=".part")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            json.dump(value, fh)
-        os.replace(tmp, d / name)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+def _cached(store: str | None, name: str, compute: Callable[[], Any]) -> Any:
+    """The result ``name`` read from ``store``, or computed and written there whole
+    or not at all (the package's :func:`~tyredamp.io._atomic.atomic_path`)."""
+    got = _stored(store, name)
+    if got is None:
+        got = compute()
+        if store is not None:
+            from tyredamp.io._atomic import atomic_path
+
+            with atomic_path(Path(store) / name) as tmp:
+                tmp.write_text(json.dumps(got), encoding="utf-8")
+    return got
+
+
+def _name(what: str, noise: str, key: str, seed: int) -> str:
+    """File of one stored result: ``what`` is "truth" or "new" (an identification)."""
+    return f"{what}-{noise}-{key}-{seed}.json"
 
 
 def _one(
@@ -620,35 +625,20 @@ def _one(
     from ``store`` when held there under ``keys`` (:func:`code_keys`) and written
     there when computed."""
     NOISE["model"] = noise
-    names = (f"truth-{noise}-{keys[0]}-{seed}.json", f"new-{noise}-{keys[1]}-{seed}.json")
-    truth = _stored(store, names[0])
-    if truth is None:
-        truth = truth_stats(seed)
-        _store(store, names[0], truth)
-    new = _stored(store, names[1])
-    if new is None:
-        new = identify(seed)
-        _store(store, names[1], new)
+    truth = _cached(store, _name("truth", noise, keys[0], seed), lambda: truth_stats(seed))
+    new = _cached(store, _name("new", noise, keys[1], seed), lambda: identify(seed))
     return new, truth
 
 
 def _identified(seeds: list[int], noise: str, store: str | None) -> list[dict[str, Any]]:
     """Identification results of the code on the import path (the old code's, in the
     ``--old-src`` subprocess), each read from ``store`` when held there under that
-    code's key (:func:`code_keys`: a stored result of one code is never taken for
-    another's) and written there when computed."""
+    code's key (:func:`identify_key`, computed once: a stored result of one code is
+    never taken for another's) and written there when computed."""
     key = identify_key() if store is not None else ""
     if store is not None:
         Path(store).mkdir(parents=True, exist_ok=True)
-    out = []
-    for s in seeds:
-        name = f"new-{noise}-{key}-{s}.json"
-        got = _stored(store, name)
-        if got is None:
-            got = identify(s)
-            _store(store, name, got)
-        out.append(got)
-    return out
+    return [_cached(store, _name("new", noise, key, s), partial(identify, s)) for s in seeds]
 
 
 def _run(
@@ -657,8 +647,6 @@ def _run(
     """Identification results and truths of the systems ``seeds``, over ``jobs``
     processes (each with one BLAS thread, set before NumPy loads in the workers);
     with ``store``, each system's results are kept there as they are done."""
-    from functools import partial
-
     keys = ("", "")
     if store is not None:
         Path(store).mkdir(parents=True, exist_ok=True)

@@ -12,7 +12,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..exceptions import ConvergenceError
-from ..mechanics.modal_sum import pole_quantities
+from ..mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
 from ._basis import factors, residual_blocks
 from .fit import FitResult, ModalFitter
 from .modeset import outside_side, with_residual
@@ -166,8 +166,8 @@ def _scan_start(
         z = float(np.clip(sc * zeta0, 1e-3, 0.2))
         a0, b0 = (edge[0] * (1 + z), edge[1]) if side > 0 else (edge[0], edge[1] / (1 + z))
         if 0 < a0 < b0:
-            wg = 2 * np.pi * a0 * (1 + z) ** np.arange(int(np.log(b0 / a0) / np.log1p(z)) + 1)
-            grids.append(-z * wg + 1j * wg * np.sqrt(1 - z * z))
+            fg = a0 * (1 + z) ** np.arange(int(np.log(b0 / a0) / np.log1p(z)) + 1)
+            grids.append(pole_from_frequency_damping(fg, z))
     if not grids:
         return None
     pg = np.concatenate(grids)

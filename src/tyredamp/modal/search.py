@@ -64,6 +64,7 @@ from .residual_peaks import (
 from .search_starts import (
     MAX_TRIALS,
     SAME_START,
+    capped,
     round_starts,
     start_records,
     unique_candidates,
@@ -568,14 +569,13 @@ def residual_search(
         # when they add nothing, the coherent scan's poles (one round per mode set)
         if view_of is not res:
             view, view_of = residual_view(fitter, res, zeta0), res
-        late: dict[complex, RejectedMode] = {}  # the diagram's starts' records if untried
         starts, screened = round_starts(
-            fitter, res, view, pending, threshold, zeta0, test, scan_next, late
+            fitter, res, view, pending, threshold, zeta0, test, scan_next
         )
         tried += screened
         scanned, scan_next = scanned or scan_next, False
         added, n_tried = False, 0
-        from_diagram = set(late)
+        from_diagram = {complex(c[0]) for c in pending}
         pending = []
         for k, (p0, l0) in enumerate(starts):
             # several inputs: a start at a current mode's pole may be a repeated root's
@@ -586,7 +586,7 @@ def residual_search(
                     tried.append(rejected(p0, SAME_START))
                 continue
             if n_tried >= MAX_TRIALS:
-                tried += [late[complex(c)] for c, _ in starts[k:] if complex(c) in late]
+                tried += capped(view[0], starts[k:], from_diagram, zeta0, threshold)
                 break
             n_tried += 1
             seen.append(complex(p0))

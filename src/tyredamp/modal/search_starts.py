@@ -44,17 +44,16 @@ def round_starts(
     zeta0: float,
     test: ModeTest | None,
     scan: bool,
-    late: dict[complex, RejectedMode],
 ) -> tuple[list[tuple[complex, NDArray[np.complex128]]], list[RejectedMode]]:
     """The starts of one round of the residual search: the coherent scan's trial
     poles (``scan``), or else the residual's peaks where the scan finds room for
     a mode near them (``SUPPORT_SHARE`` of the threshold); then the diagram's
     candidates ``pending`` whose half-power band (+-2 zeta f) holds enough
     residual power above the noise to pass (``ROOM_SHARE`` of the threshold; the
-    others are returned as rejected, with that power). ``late`` receives, for
-    each candidate that passes (by its pole), the record it gets when the
-    round's trials run out before it. ``view``: the scan of the fit's residual
-    and its power per line (:func:`~.residual_peaks.residual_view`)."""
+    others are returned as rejected, with that power; one that passes and that
+    the round's trials do not reach gets :func:`capped`'s reason). ``view``: the
+    scan of the fit's residual and its power per line
+    (:func:`~.residual_peaks.residual_view`)."""
     grid, pw = view
     found = residual_peaks(fitter.f, pw, fitter.n_out * fitter.n_in, zeta0, threshold, MAX_TRIALS)
     ones = np.ones(fitter.n_in, complex)
@@ -73,23 +72,36 @@ def round_starts(
         r = room(fitter.f, found.excess, c[0])
         if r > room_min:
             starts.append(c)
-            late[complex(c[0])] = rejected(c[0], _capped(grid, c[0], zeta0, threshold))
         else:
             why = _too_little(r, room_min, threshold, c[0], res.poles)
             screened.append(rejected(c[0], why))
     return starts, screened
 
 
-def _capped(grid: ScanGrid, p: complex, zeta0: float, threshold: float) -> str:
-    """Why a candidate with room for a mode was not tried: the round's trials were
-    spent; with the coherent scan's statistic near it (a pole held there, the
-    modes' residues refitted: about what a trial there would find)."""
-    f, z = pole_quantities(np.array([p]))
-    t = grid.support(float(f[0]), max(float(z[0]), zeta0))
-    return (
-        f"not tried: the round had tried its {MAX_TRIALS} candidates already; the "
-        f"coherent scan's statistic near it is {t:.3g} against the threshold {threshold:.3g}"
-    )
+def capped(
+    grid: ScanGrid,
+    left: list[tuple[complex, NDArray[np.complex128]]],
+    own: set[complex],
+    zeta0: float,
+    threshold: float,
+) -> list[RejectedMode]:
+    """Records of the diagram's candidates (poles in ``own``, rad/s) among the
+    starts ``left`` that a round did not reach, its trials spent: with the
+    coherent scan's statistic (``grid``) within ``max(zeta, zeta0) f`` of each (a
+    pole held there, the modes' residues refitted: about what a trial there would
+    find), against ``threshold``."""
+    out = []
+    for p, _ in left:
+        if complex(p) not in own:
+            continue
+        f, z = pole_quantities(np.array([p]))
+        t = grid.support(float(f[0]), max(float(z[0]), zeta0))
+        why = (
+            f"not tried: the round had tried its {MAX_TRIALS} candidates already; the "
+            f"coherent scan's statistic near it is {t:.3g} against the threshold {threshold:.3g}"
+        )
+        out.append(rejected(p, why))
+    return out
 
 
 def _too_little(
