@@ -91,6 +91,7 @@ from .._blas import blas_threads as blas_limit
 from .._validate import as_finite
 from ..exceptions import InputError
 from ..frf import FRF
+from ..mechanics.modal_sum import pole_from_frequency_damping
 from .compress import _compress, combine_outputs
 from .estimators import PoleEstimator
 from .final import ModelContext, final_complex, fit_real, to_model
@@ -567,9 +568,9 @@ def _select(
 
 
 def _pole_of(r: RejectedMode) -> complex:
-    w = 2 * np.pi * r.frequency_hz
+    """The start pole of a rejected candidate (damping ratio clipped to [1e-4, 0.5])."""
     z = min(max(r.damping_ratio, 1e-4), 0.5)
-    return complex(-z * w, w * np.sqrt(1 - z**2))
+    return complex(pole_from_frequency_damping(r.frequency_hz, z))
 
 
 def _noise_per_output(

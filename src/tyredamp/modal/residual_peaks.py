@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats as sps
 
+from ..mechanics.modal_sum import pole_from_frequency_damping
 from ._basis import factors, residual_lines, residual_power
 from .fit import FitResult, ModalFitter
 
@@ -347,8 +348,7 @@ def _scan_scale(
     fg = f[0] * (1 + z) ** np.arange(n_g)
     idx = np.unique(np.clip(np.searchsorted(f, fg[fg <= f[-1]]), 0, n - 1))
     fg = f[idx]
-    wg = 2 * np.pi * fg
-    pg = -z * wg + 1j * wg * np.sqrt(1 - z * z)
+    pg = pole_from_frequency_damping(fg, np.full(fg.size, z))
     half = np.maximum(SCAN_HALF * z * fg, 3 * df)
     ia = np.searchsorted(f, fg - half)
     ib = np.searchsorted(f, fg + half, side="right")
