@@ -1,6 +1,12 @@
 """Spread of the identified natural frequencies and damping ratios against the Cramér-Rao bound.
 
-Run: ``python benchmarks/perf_crlb.py [--quick] [--seeds N] [--snr 40] [--json PATH]``.
+Run: ``python benchmarks/perf_crlb.py [--quick] [--seeds N] [--snr 40] [--json PATH]
+[--identify KEY=VALUE ...] [--no-sdypy]``.
+
+``--identify`` passes an option to ``identify_modes`` (a Python literal, e.g.
+``--identify search=False --identify max_helpers=0``): what a stage of the
+identification contributes to its accuracy and time (``--json`` then names
+another file, so the default run's results stay).
 
 Data: the exact accelerances of the virtual truck tyre (16 points, drive at
 point 1, lines 0.25-200 Hz every 0.25 Hz) plus circular complex Gaussian
@@ -22,11 +28,12 @@ just above the band (215 and 248 Hz) as free nuisance modes (the estimator may
 fit such out-of-band residual modes).
 
 Monte Carlo: :func:`~tyredamp.modal.identify_modes` (automatic, complex
-model, default options) on ``--seeds`` noise realisations; the ratio of the
-sample standard deviation of each mode's estimates to the bound (ideal 1,
-target <= 1.5), over the fits that found every true mode; a fit that also kept
-a noise mode (the mode test's false alarm, at its stated 1 % rate) counts, and
-is listed under ``extra``; one that missed a true mode is a failure.
+model, default options or those given with ``--identify``) on ``--seeds``
+noise realisations; the ratio of the sample standard deviation of each
+mode's estimates to the bound (ideal 1, target <= 1.5), over the fits that
+found every true mode; a fit that also kept a noise mode (the mode test's
+false alarm, at its stated 1 % rate) counts, and is listed under ``extra``;
+one that missed a true mode is a failure.
 sdypy-EMA (LSCF + LSFD with the true frequencies, as in ``perf_compare.py``)
 on the same data for comparison, when installed.
 """
@@ -34,6 +41,7 @@ on the same data for comparison, when installed.
 from __future__ import annotations
 
 import argparse
+import ast
 import time
 from typing import Any
 
@@ -128,6 +136,24 @@ def crlb(
     return {"frequency_hz": np.array(sf), "damping_ratio": np.array(sz), "cov_pole": cov}
 
 
+def identify_options(items: list[str]) -> dict[str, Any]:
+    """``KEY=VALUE`` items (values Python literals) as keyword arguments."""
+    out: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.isidentifier():
+            raise SystemExit(f"--identify {item!r}: expected KEY=VALUE")
+        try:
+            out[key] = ast.literal_eval(value)
+        except (ValueError, SyntaxError):
+            raise SystemExit(f"--identify {item!r}: the value is not a Python literal") from None
+    return out
+
+
+def _text(options: dict[str, Any]) -> str:
+    return "".join(f", {k}={v!r}" for k, v in options.items())
+
+
 def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="100 seeds (default 400)")
@@ -135,7 +161,16 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--snr", type=float, default=40.0, help="SNR in dB (default 40)")
     ap.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (default 1)")
     ap.add_argument("--json", default=str(RESULTS_DIR / "crlb.json"), help="output JSON")
+    ap.add_argument(
+        "--identify",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an identify_modes option (Python literal), e.g. search=False; repeatable",
+    )
+    ap.add_argument("--no-sdypy", action="store_true", help="skip sdypy-EMA")
     a = ap.parse_args(argv)
+    options = identify_options(a.identify)
     n_seeds = a.seeds if a.seeds is not None else (100 if a.quick else 400)
     pool = limit_blas(a.blas_threads)
     t_start = time.perf_counter()
@@ -160,7 +195,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     both = np.concatenate([inb, above])
     bound2 = crlb(f, tr.poles[both], res_of(both), sigma, m)
 
-    use_sdypy = sdypy_available()
+    use_sdypy = sdypy_available() and not a.no_sdypy
     est: dict[str, dict[str, list[Any]]] = {
         "tyredamp": {"f": [], "z": [], "sf": [], "sz": [], "t": []},
         "sdypy-EMA": {"f": [], "z": [], "sf": [], "sz": [], "t": []},
@@ -174,7 +209,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         h = add_noise(h0, a.snr, seed)
         frf = exact.with_H(h)
         t0 = time.perf_counter()
-        r = identify_modes(frf, band=(0.0, 200.0), model="complex").models["complex"]
+        r = identify_modes(frf, band=(0.0, 200.0), model="complex", **options)
+        r = r.models["complex"]
         dt = time.perf_counter() - t0
         idx = match_modes(r.frequency_hz, f_true)
         if np.any(idx < 0):
@@ -241,6 +277,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             "rmse_ratio_damping": np.sqrt(np.mean((Z - z_true) ** 2, axis=0))
             / bound["damping_ratio"],
             "mean_time_s": float(np.mean(e["t"])),
+            "median_time_s": float(np.median(e["t"])),
         }
         if e["sf"]:
             tools[tool]["reported_std_over_bound_frequency"] = (
@@ -265,6 +302,8 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
                 t.get("ratio_damping", [np.nan] * m)[n],
                 t.get("ratio_frequency_bound2", [np.nan] * m)[n],
                 t.get("ratio_damping_bound2", [np.nan] * m)[n],
+                t.get("rmse_ratio_frequency", [np.nan] * m)[n],
+                t.get("rmse_ratio_damping", [np.nan] * m)[n],
                 t.get("reported_std_over_bound_damping", [np.nan] * m)[n],
                 s.get("ratio_frequency", [np.nan] * m)[n],
                 s.get("ratio_damping", [np.nan] * m)[n],
@@ -282,13 +321,16 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             "std/CRLB z",
             "f (bound 2)",
             "z (bound 2)",
+            "rmse/CRLB f",
+            "rmse/CRLB z",
             "reported/CRLB z",
             "sdypy f",
             "sdypy z",
         ],
         rows,
         title=(
-            f"\n== tyredamp identify_modes (complex) std over the CRLB, virtual tyre, "
+            f"\n== tyredamp identify_modes (complex{_text(options)}) std over the CRLB, "
+            f"virtual tyre, median {1e3 * t.get('median_time_s', np.nan):.1f} ms, "
             f"{a.snr:g} dB, {t.get('n_ok', 0)} seeds ok ({t.get('n_extra', 0)} of them kept a "
             f"noise mode beside the true ones), {t.get('n_failed', 0)} missed a true mode "
             f"(95 % interval of each ratio about "
@@ -307,6 +349,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         "elapsed_s": time.perf_counter() - t_start,
         "snr_db": a.snr,
         "n_seeds": n_seeds,
+        "identify_options": options,
         "noise_model": (
             "circular complex Gaussian on the FRF, per line and output, "
             "E|e_j|^2 = (rms_f|H_j| 10^(-SNR/20))^2; defined on the FRF, not derived from averages"
