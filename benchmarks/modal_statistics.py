@@ -4,7 +4,12 @@ no noise mode, and report honest uncertainties? (issue 16)
 Run::
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/modal_statistics.py [--systems 200]
-        [--old-src /path/to/checkout-of-c34c232/src] [--noise white|response]
+        [--first 0] [--snr 40] [--old-src /path/to/checkout-of-c34c232/src]
+        [--noise white|response]
+
+``--first`` and ``--systems`` choose the seeds ``first .. first + systems - 1``;
+``--snr`` keeps only those of that SNR (each seed's SNR is fixed by the seed:
+more fits at one SNR without changing the corpus).
 
 Corpus (generated from the seed, truth known): ``--systems`` random systems of
 4-40 modes in 20-180 Hz with 1-4 inputs and 2-8 outputs; complex
@@ -455,6 +460,8 @@ def table(title: str, rows: list[tuple[float, dict[str, Any]]]) -> list[str]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--systems", type=int, default=200)
+    ap.add_argument("--first", type=int, default=0, help="first seed (default 0)")
+    ap.add_argument("--snr", type=float, choices=SNRS, help="only the systems of this SNR (dB)")
     ap.add_argument("--old-src", help="src directory of the code to compare with (c34c232)")
     ap.add_argument(
         "--noise",
@@ -486,7 +493,13 @@ def main() -> None:
     ap.add_argument("--identify-only", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
     NOISE["model"] = args.noise
-    seeds = list(range(args.systems))
+    if args.systems < 1 or args.first < 0:
+        raise SystemExit("--systems must be >= 1 and --first >= 0")
+    seeds = [
+        s
+        for s in range(args.first, args.first + args.systems)
+        if args.snr is None or system(s)["snr"] == args.snr
+    ]
     if args.from_dump:
         with open(args.from_dump, encoding="utf-8") as fh:
             got = json.load(fh)
@@ -506,6 +519,9 @@ def main() -> None:
                 __file__,
                 "--systems",
                 str(args.systems),
+                "--first",
+                str(args.first),
+                *(["--snr", str(args.snr)] if args.snr is not None else []),
                 "--noise",
                 args.noise,
                 "--identify-only",
@@ -522,9 +538,10 @@ def main() -> None:
     elif args.old_from:
         with open(args.old_from, encoding="utf-8") as fh:
             got = json.load(fh).get("old")
-        if not got or [r["seed"] for r in got][: len(seeds)] != seeds:
-            raise SystemExit(f"{args.old_from}: no old results for systems 0-{len(seeds) - 1}")
-        old = got[: len(seeds)]
+        held = {r["seed"]: r for r in got or []}
+        if any(s not in held for s in seeds):
+            raise SystemExit(f"{args.old_from}: no old results for some of the systems")
+        old = [held[s] for s in seeds]
     if args.dump:
         with open(args.dump, "w", encoding="utf-8") as fh:
             json.dump({"new": new, "old": old, "truth": truths}, fh)
@@ -685,7 +702,11 @@ def _print_tables(
                 for s, t, r in zip(seeds, truths, got, strict=True)
             ]
             n_err = sum("error" in r for r in got)
-            src = f"{args.systems} systems" if k == 0 else args.old_src or args.old_from
+            src = (
+                f"{len(seeds)} systems, seeds {seeds[0]}-{seeds[-1]}"
+                if k == 0
+                else args.old_src or args.old_from
+            )
             if k:
                 print()
             for line in table(f"{name} ({src}; {n_err} failed fits)", rows):
