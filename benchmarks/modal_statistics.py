@@ -500,6 +500,11 @@ def main() -> None:
         for s in range(args.first, args.first + args.systems)
         if args.snr is None or system(s)["snr"] == args.snr
     ]
+    if not seeds:
+        raise SystemExit(
+            f"no system of SNR {args.snr:g} dB among seeds {args.first}-"
+            f"{args.first + args.systems - 1}"
+        )
     if args.from_dump:
         with open(args.from_dump, encoding="utf-8") as fh:
             got = json.load(fh)

@@ -5,8 +5,9 @@ Run: ``python benchmarks/perf_crlb.py [--quick] [--seeds N] [--snr 40] [--json P
 
 ``--identify`` passes an option to ``identify_modes`` (a Python literal, e.g.
 ``--identify search=False --identify max_helpers=0``): what a stage of the
-identification contributes to its accuracy and time (``--json`` then names
-another file, so the default run's results stay).
+identification contributes to its accuracy and time. Its results go to
+``results/crlb-<options>.json`` unless ``--json`` says otherwise, so the
+default run's ``results/crlb.json`` (read by ``run_all.py``) stays.
 
 Data: the exact accelerances of the virtual truck tyre (16 points, drive at
 point 1, lines 0.25-200 Hz every 0.25 Hz) plus circular complex Gaussian
@@ -136,13 +137,27 @@ def crlb(
     return {"frequency_hz": np.array(sf), "damping_ratio": np.array(sz), "cov_pole": cov}
 
 
+#: identify_modes arguments that this benchmark sets itself
+FIXED_ARGS = ("frf", "band", "model")
+
+
 def identify_options(items: list[str]) -> dict[str, Any]:
-    """``KEY=VALUE`` items (values Python literals) as keyword arguments."""
+    """``KEY=VALUE`` items (values Python literals) as keyword arguments of
+    ``identify_modes`` (a key it does not take, or one of ``FIXED_ARGS``, is
+    refused with one line)."""
+    import inspect
+
+    known = set(inspect.signature(identify_modes).parameters) - set(FIXED_ARGS)
     out: dict[str, Any] = {}
     for item in items:
         key, sep, value = item.partition("=")
         if not sep or not key.isidentifier():
             raise SystemExit(f"--identify {item!r}: expected KEY=VALUE")
+        if key not in known:
+            raise SystemExit(
+                f"--identify {item!r}: not an identify_modes option this benchmark leaves "
+                f"open ({', '.join(sorted(known))})"
+            )
         try:
             out[key] = ast.literal_eval(value)
         except (ValueError, SyntaxError):
@@ -160,7 +175,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--seeds", type=int, default=None, help="number of noise seeds")
     ap.add_argument("--snr", type=float, default=40.0, help="SNR in dB (default 40)")
     ap.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (default 1)")
-    ap.add_argument("--json", default=str(RESULTS_DIR / "crlb.json"), help="output JSON")
+    ap.add_argument(
+        "--json",
+        help="output JSON (default results/crlb.json; crlb-<options>.json with --identify)",
+    )
     ap.add_argument(
         "--identify",
         action="append",
@@ -171,6 +189,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--no-sdypy", action="store_true", help="skip sdypy-EMA")
     a = ap.parse_args(argv)
     options = identify_options(a.identify)
+    if a.json is None:
+        tag = "".join(f"-{k}={v!r}" for k, v in options.items())
+        a.json = str(RESULTS_DIR / f"crlb{tag}.json")
     n_seeds = a.seeds if a.seeds is not None else (100 if a.quick else 400)
     pool = limit_blas(a.blas_threads)
     t_start = time.perf_counter()

@@ -348,7 +348,7 @@ def _scan_scale(
     fg = f[0] * (1 + z) ** np.arange(n_g)
     idx = np.unique(np.clip(np.searchsorted(f, fg[fg <= f[-1]]), 0, n - 1))
     fg = f[idx]
-    pg = pole_from_frequency_damping(fg, np.full(fg.size, z))
+    pg = pole_from_frequency_damping(fg, z)
     half = np.maximum(SCAN_HALF * z * fg, 3 * df)
     ia = np.searchsorted(f, fg - half)
     ib = np.searchsorted(f, fg + half, side="right")

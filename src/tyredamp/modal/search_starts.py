@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..mechanics.modal_sum import pole_quantities
+from ..mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
 from .fit import FitResult, ModalFitter
 from .modeset import rejected
 from .quality import RejectedMode
@@ -64,8 +64,7 @@ def round_starts(
         level = SUPPORT_SHARE * threshold
         for fpk in found.freq:
             if grid.support(fpk, zeta0) >= level:
-                w = 2 * np.pi * fpk
-                starts.append((complex(-zeta0 * w, w * np.sqrt(1 - zeta0**2)), ones))
+                starts.append((complex(pole_from_frequency_damping(fpk, zeta0)), ones))
     room_min = ROOM_SHARE * threshold
     screened: list[RejectedMode] = []
     for c in pending:
