@@ -14,7 +14,8 @@ from typing import Any
 import click
 import numpy as np
 
-from ..damping import METHODS, DampingModel, missing_std, no_std_note
+from ..damping import METHODS, DampingModel, no_std_note
+from ..damping.modeset import parse_mode_numbers
 from ..documents.damping import write_damping_json
 from ..documents.modes import read_modes
 from ..exceptions import InputError
@@ -34,6 +35,7 @@ def damping_summary(dm: DampingModel) -> list[str]:
     k, n = np.unravel_index(int(np.argmax(np.abs(off))), off.shape) if dm.n_modes > 1 else (0, 0)
     rows = [
         f"damping ({dm.method}): {dm.n_modes} modes at {dm.n_points} points",
+        *_used_rows(dm),
         "modes [Hz]: " + ", ".join(f"{f:.2f}" for f in dm.frequency_hz),
         "C'_nn [1/s]: " + ", ".join(f"{c:.4g}" for c in np.diag(cp)),
     ]
@@ -44,6 +46,32 @@ def damping_summary(dm: DampingModel) -> list[str]:
         )
     rows += [f"- {s}" for s in dm.findings]
     return rows
+
+
+def _used_rows(dm: DampingModel) -> list[str]:
+    """Which modes of the file and which points (inputs of a roving-hammer test) were used."""
+    rows = []
+    used = dm.meta.get("modes_used")
+    avail = dm.meta.get("n_modes_available")
+    if isinstance(used, list) and isinstance(avail, int) and len(used) < avail:
+        rows.append(f"modes used: {_ranges(used)} of 1-{avail}")
+    if dm.meta.get("shape_points") == "inputs":
+        rows.append(
+            "points: the inputs (" + ", ".join(c.label for c in dm.points) + "); one response, "
+            "the excitation roving over the points (shapes by reciprocity)"
+        )
+    return rows
+
+
+def _ranges(nums: list[int]) -> str:
+    """``[1, 2, 3, 5]`` as ``"1-3, 5"``."""
+    out: list[str] = []
+    for k in sorted(nums):
+        if out and k == int(out[-1].split("-")[-1]) + 1:
+            out[-1] = out[-1].split("-")[0] + f"-{k}"
+        else:
+            out.append(str(k))
+    return ", ".join(out)
 
 
 @click.command("damping")
@@ -73,6 +101,19 @@ def damping_summary(dm: DampingModel) -> list[str]:
 )
 @seed_option("Monte Carlo seed.")
 @click.option(
+    "--modes",
+    "mode_numbers",
+    metavar="LIST",
+    help="Modes to use, numbered from 1 in order of frequency: e.g. 1,2,5-7 (default all).",
+)
+@click.option(
+    "--band",
+    type=(float, float),
+    default=None,
+    metavar="F1 F2",
+    help="Use only the modes with natural frequency in F1..F2 Hz.",
+)
+@click.option(
     "--no-normalise",
     is_flag=True,
     help="Skip the alpha_n^(n) = 1 phase normalisation of the complex shapes.",
@@ -84,6 +125,8 @@ def damping_command(
     model_name: str,
     samples: int,
     seed: int,
+    mode_numbers: str | None,
+    band: tuple[float, float] | None,
     no_normalise: bool,
 ) -> None:
     """Identify the viscous damping matrix from the complex modes in MODES_JSON.
@@ -91,6 +134,13 @@ def damping_command(
     MODES_JSON is a modes JSON file (tyredamp modal) or a UFF file (.uff,
     .unv) of data sets 55 from another program (real or complex modes,
     scaled by their modal mass or modal A; see tyredamp.io.uff55).
+
+    The shapes are taken where they are: at the responses, or at the
+    excitation points of a roving-hammer test (one response, several
+    inputs). The points must be at least as many as the modes: choose a
+    subset with --modes or --band. Unscaled modes (no drive point in the
+    FRFs, no modal A or modal mass in a UFF 55 file) are refused: the
+    matrices would have no meaning.
 
     Writes C' (modal coordinates) and C, M, K at the measured points, the
     point labels, diagnostics (symmetry, definiteness, truncation), the best
@@ -102,12 +152,19 @@ def damping_command(
     Example:
       tyredamp damping tyre_modes.json --out tyre_damping.json
       tyredamp damping tyre_modes.json -o damping.json --method refined --samples 500
+      tyredamp damping beam_modes.uff -o beam_damping.json --modes 1-3,5
     """
     check_output_file(out, [modes_json])
     models = read_modes(check_input_file(modes_json))
     if model_name not in models:
         raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")
     meta: dict[str, Any] = {"source": str(modes_json), "model": model_name}
+    try:
+        numbers = None if mode_numbers is None else parse_mode_numbers(mode_numbers)
+    except InputError as exc:
+        raise InputError(f"--{exc}") from None
+    if band is not None and not band[0] < band[1]:
+        raise InputError(f"--band: expected F1 < F2 in Hz, got {band[0]:g} {band[1]:g}")
     dm = damping_from_modes(
         models,
         model=model_name,
@@ -116,12 +173,14 @@ def damping_command(
         n_samples=samples,
         seed=seed,
         meta=meta,
+        modes=numbers,
+        band=band,
     )
     write_damping_json(out, dm)
     for row in damping_summary(dm):
         click.echo(row)
     click.echo(f"wrote {out}")
-    chosen = models[model_name]
-    missing = missing_std(chosen.std, chosen.frequency_hz, [c.label for c in chosen.outputs])
-    if missing and samples > 0:  # the run goes on; the gap is said where scripts look
-        click.echo(f"tyredamp: warning: {no_std_note(missing)}", err=True)
+    gap = no_std_note("")[: no_std_note("").index("for ")]
+    for note in dm.findings:  # the run goes on; the gap is said where scripts look
+        if note.startswith(gap):
+            click.echo(f"tyredamp: warning: {note}", err=True)

@@ -13,16 +13,22 @@ scaling of spec eq. [10], ``H(omega) = sum_n psi_n psi_n^T / (i omega - p_n)
 
 * Complex modes (type 3) with modal A ``a_n``: the residue is
   ``phi phi^T / a_n`` (first-order, state-space normalisation), so
-  ``psi = phi / sqrt(a_n)``. A modal A of 0 (not given) is taken as 1, the
-  shapes being already unity-modal-A scaled. tyredamp writes ``a_n = 1`` and
+  ``psi = phi / sqrt(a_n)``. A modal A of 0 (not given) is taken as 1 and
+  the modes are marked unscaled (``meta["scaled"] = False``): another
+  program writes 0 when it has no scale (no drive point), and the shapes
+  then hold no mass information. tyredamp writes ``a_n = 1`` and
   ``b_n = -p_n a_n`` (the identity ``b = -lambda a`` of that normalisation).
 * Real modes (type 2) with modal mass ``m_n``, viscous ratio ``zeta_n`` and
   frequency ``f_n`` (undamped, Hz): ``phi phi^T / (m_n (omega_n^2 - omega^2 +
   2 i zeta_n omega_n omega))`` equals the eq. [10] form with the pole
   ``p_n = -zeta_n omega_n + i omega_n sqrt(1 - zeta_n^2)`` and
   ``psi = phi / sqrt(m_n 2 i Omega_n)``, ``Omega_n = Im p_n``. A modal mass of
-  0 (not given) is taken as 1 (mass-normalised shapes); without a viscous
-  ratio, a hysteretic loss factor ``eta`` gives ``zeta = eta / 2``.
+  0 (not given) is taken as 1 and the modes are marked unscaled, as for
+  modal A; without a viscous ratio, a hysteretic loss factor ``eta`` gives
+  ``zeta = eta / 2``.
+
+``meta["scaled"]`` is True when every mode states its modal A (modal mass),
+False otherwise, with the reason in ``meta["scaling_note"]``.
 
 Channels and drive points: every node and direction (X, Y, Z = UFF codes 1,
 2, 3) with a non-zero value in some mode becomes an output. The drive points
@@ -56,6 +62,8 @@ from ._common import check_input_file, uff_set_types
 __all__ = ["read_uff55", "uff_has_modes", "write_uff55"]
 
 _MARK = "tyredamp_inputs"
+_NO_A = "modal A not given (0): shapes unscaled, taken as unity modal A"
+_NO_MASS = "modal mass not given (0): shapes unscaled, taken as mass-normalised"
 
 
 def _field(v: float) -> str:
@@ -254,6 +262,12 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
             raise FileFormatError(f"{p}: drive point {c.label} has no mode-shape value")
         rows.append(np.sign(c.direction) * psi_out[hit[0]])
     meta: dict[str, Any] = {"source": str(p), "format": "uff55", "assumptions": sorted(notes)}
+    missing = "modal A" if _NO_A in notes else "modal mass" if _NO_MASS in notes else ""
+    meta["scaled"] = not missing
+    if missing:
+        meta["scaling_note"] = (
+            f"the UFF 55 file gives no {missing} for some modes (0), so the shapes are unscaled"
+        )
     return ModalModel(
         np.array(poles),
         psi_out,
@@ -282,7 +296,7 @@ def _mode(
             )
         if m == 0.0:
             m = 1.0
-            notes.add("modal mass not given: shapes taken as mass-normalised")
+            notes.add(_NO_MASS)
         if m < 0:
             raise FileFormatError(f"{where}: negative modal mass {m}")
         wn = 2 * np.pi * f
@@ -300,7 +314,7 @@ def _mode(
             raise FileFormatError(f"{where}: modal A {a} is not finite")
         if a == 0:
             a = 1.0
-            notes.add("modal A not given: shapes taken as unity-modal-A scaled")
+            notes.add(_NO_A)
         if pole.imag < 0:  # the other pole of the pair: conjugate everything
             pole, vals, a = pole.conjugate(), vals.conj(), a.conjugate()
         psi = vals / np.sqrt(a)

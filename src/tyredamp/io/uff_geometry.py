@@ -1,4 +1,4 @@
-"""Test geometry from UFF: nodes (15, 2411), trace lines (82), coordinate systems (18, 2420).
+"""Test geometry from UFF: nodes (15, 2411), trace lines (82), elements (2412), systems (18, 2420).
 
 Node coordinates are given in their definition coordinate system (record
 field ``def_cs``); systems come from data set 2420 (a 4 x 3 matrix per system:
@@ -13,7 +13,11 @@ displacement system ``disp_cs`` of a node sets its measuring axes
 spherical systems the local radial, tangential, axial axes at the node).
 Units: data set 164's length factor (file units per metre, as the standard
 says: divide by it for SI); without 164, metres are assumed. Trace lines
-(82) are split at node 0 ("move to") into polylines.
+(82) are split at node 0 ("move to") into polylines; each element of data
+set 2412 (triangles, quadrilaterals, beams) adds its outline as a closed
+polyline. The same file may hold mode shapes (data sets 55) beside the
+geometry, as some modal programs export them: :func:`read_uff_geometry`
+reads the geometry part, :func:`uff_geometry_or_none` only when there is one.
 """
 
 from __future__ import annotations
@@ -31,9 +35,9 @@ from ..exceptions import FileFormatError
 from ..geometry import Geometry
 from ._common import check_input_file, uff_set_types
 
-__all__ = ["read_uff_geometry", "uff_has_geometry"]
+__all__ = ["read_uff_geometry", "uff_geometry_or_none", "uff_has_geometry"]
 
-_WANTED = (15, 2411, 82, 18, 2420, 164)
+_WANTED = (15, 2411, 82, 2412, 18, 2420, 164)
 
 
 class _CS:
@@ -85,6 +89,36 @@ def uff_has_geometry(path: str | os.PathLike[str]) -> bool:
     """True when the UFF file holds nodes (15 or 2411) and no data set 58 or 55."""
     types = uff_set_types(path)
     return bool(types & {15, 2411}) and not types & {55, 58}
+
+
+def uff_geometry_or_none(path: str | os.PathLike[str]) -> Geometry | None:
+    """The geometry of a UFF file that holds nodes (15 or 2411), else None.
+
+    For a file of mode shapes (data sets 55) that carries its geometry, or a
+    geometry file; errors in the geometry records raise as in
+    :func:`read_uff_geometry`.
+    """
+    if not uff_set_types(path) & {15, 2411}:
+        return None
+    return read_uff_geometry(path)
+
+
+def _element_lines(p: Any, s: dict[str, Any]) -> list[list[int]]:
+    """Closed outlines of the elements of one data set 2412 (pyuff's layout)."""
+    out: list[list[int]] = []
+    for key, val in s.items():
+        if key == "type" or not isinstance(val, dict) or "nodes_nums" not in val:
+            continue
+        try:
+            for nn in val["nodes_nums"]:
+                ring = [int(v) for v in np.atleast_1d(np.asarray(nn, dtype=float))]
+                if len(ring) > 2:
+                    ring.append(ring[0])
+                if len(ring) > 1:
+                    out.append(ring)
+        except (TypeError, ValueError) as exc:
+            raise FileFormatError(f"{p}: malformed element data set 2412 ({exc})") from None
+    return out
 
 
 def _systems(p: Any, sets: list[dict[str, Any]]) -> dict[int, _CS]:
@@ -208,6 +242,8 @@ def read_uff_geometry(path: str | os.PathLike[str]) -> Geometry:
             axes.append(ax)
     lines: list[list[int]] = []
     for s in sets:
+        if int(s.get("type", 0)) == 2412:
+            lines += _element_lines(p, s)
         if int(s.get("type", 0)) != 82:
             continue
         try:

@@ -214,8 +214,19 @@ def damping_from_modes(
     n_samples: int = 200,
     seed: int = 0,
     meta: dict[str, Any] | None = None,
+    modes: Sequence[int] | None = None,
+    band: tuple[float, float] | None = None,
 ) -> DampingModel:
     """The damping matrix in modal and physical coordinates (eq. [14]-[18]).
+
+    The shapes are taken where they are (:func:`tyredamp.damping.modeset.at_shape_points`:
+    at the inputs of a roving-hammer test), the modes chosen by ``modes`` and
+    ``band`` (:func:`~tyredamp.damping.modeset.select_modes`), and unscaled
+    modes are refused (:func:`~tyredamp.damping.modeset.scaling_problem`):
+    without mass-normalised shapes the damping, mass and stiffness matrices
+    have no meaning. ``meta`` of the result records ``modes_used`` (1-based
+    numbers in the file), ``n_modes_available``, ``shape_points``
+    (``"outputs"`` or ``"inputs"``) and ``scaling``.
 
     Parameters
     ----------
@@ -225,11 +236,46 @@ def damping_from_modes(
         Which of them to use.
     method, normalise, n_samples, seed, meta
         See :func:`tyredamp.damping.identify_damping`.
+    modes : sequence of int, optional
+        Mode numbers to use (1-based, in order of frequency); default all.
+    band : (float, float), optional
+        Natural frequency range of the modes to use, Hz.
+
+    Raises
+    ------
+    InputError
+        Unknown model, mode numbers or band that choose nothing, unscaled modes.
+    ShapeError
+        More modes than shape points (the message says how many the points allow).
     """
+    from ..damping.modeset import (
+        at_shape_points,
+        check_point_count,
+        scaling_problem,
+        select_modes,
+    )
+
     if model not in models:
         raise InputError(f"model: the modes hold models {sorted(models)}, not {model!r}")
+    full = at_shape_points(models[model])
+    why = scaling_problem(full)
+    if why:
+        src = (meta or {}).get("source") or "the modes"
+        raise InputError(
+            f"{src}: the mode shapes are unscaled ({why}); a damping matrix from them would be "
+            "meaningless. Scale them with a drive-point FRF (an input at the node and direction "
+            "of a response) in the modal fit, or give the modal A (complex modes) or modal mass "
+            "(real modes) with the shapes"
+        )
+    chosen, numbers = select_modes(full, modes, band)
+    check_point_count(chosen, full.n_modes if chosen.n_modes == full.n_modes else None)
+    info = dict(meta or {})
+    info["modes_used"] = numbers
+    info["n_modes_available"] = full.n_modes
+    info["shape_points"] = str(full.meta.get("shapes_from", "outputs"))
+    info["scaling"] = "mass-normalised"
     return identify_damping(
-        models[model], method, normalise=normalise, n_samples=n_samples, seed=seed, meta=meta
+        chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
     )
 
 
