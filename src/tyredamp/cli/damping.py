@@ -165,17 +165,22 @@ def damping_command(
         raise InputError(f"--{exc}") from None
     if band is not None and not band[0] < band[1]:
         raise InputError(f"--band: expected F1 < F2 in Hz, got {band[0]:g} {band[1]:g}")
-    dm = damping_from_modes(
-        models,
-        model=model_name,
-        method=method,  # type: ignore[arg-type]
-        normalise=not no_normalise,
-        n_samples=samples,
-        seed=seed,
-        meta=meta,
-        modes=numbers,
-        band=band,
-    )
+    try:
+        dm = damping_from_modes(
+            models,
+            model=model_name,
+            method=method,  # type: ignore[arg-type]
+            normalise=not no_normalise,
+            n_samples=samples,
+            seed=seed,
+            meta=meta,
+            modes=numbers,
+            band=band,
+        )
+    except InputError as exc:  # the option's name, as the user typed it
+        if str(exc).startswith(("modes:", "band:")):
+            raise InputError(f"--{exc}") from None
+        raise
     write_damping_json(out, dm)
     for row in damping_summary(dm):
         click.echo(row)

@@ -266,7 +266,7 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
     meta["scaled"] = not missing
     if missing:
         meta["scaling_note"] = (
-            f"the UFF 55 file gives no {missing} for some modes (0), so the shapes are unscaled"
+            f"the UFF 55 file gives no {missing} (0 in the file)"
         )
     return ModalModel(
         np.array(poles),

@@ -14,6 +14,8 @@ function                               figure
 :func:`plot_matrix`                    damping matrices as heat maps (Fig. 5)
 :func:`plot_mode_shapes_ring`          mode shapes around the circumference
 :func:`plot_mode_shapes_geometry`      mode shapes on the test geometry (wireframe)
+:func:`plot_mode_shapes_points`        mode shapes against the point (no ring, no geometry)
+:func:`plot_mode_shapes`               every view the data call for (geometry, ring, points)
 :func:`plot_stabilisation`             stabilisation diagram of the pole search
 :func:`plot_figure7`                   lateral amplitude ratio, asymptotes, f0 (Fig. 7)
 :func:`plot_lateral_fit`               one lateral fit (Figs. 11-14)
@@ -32,6 +34,7 @@ from .frf import plot_frf, plot_frf_comparison
 from .geometry import plot_mode_shapes_geometry
 from .lateral import plot_figure7, plot_lateral_fit, plot_ranking, plot_time_comparison
 from .modal import plot_discrepancy, plot_mode_shapes_ring
+from .modeshapes import plot_mode_shapes, plot_mode_shapes_points
 from .stabilisation import plot_stabilisation
 from .tyremodel import plot_ring_frequencies
 
@@ -43,7 +46,9 @@ __all__ = [
     "plot_lateral_fit",
     "plot_lateral_models",
     "plot_matrix",
+    "plot_mode_shapes",
     "plot_mode_shapes_geometry",
+    "plot_mode_shapes_points",
     "plot_mode_shapes_ring",
     "plot_ranking",
     "plot_ring_frequencies",

@@ -70,12 +70,16 @@ class ResultFile:
         document, :class:`FRF` or :class:`TimeData`.
     doc : dict or None
         The JSON document (JSON inputs).
+    geometry : Geometry or None
+        Node coordinates read from the same file (a UFF file of modes that
+        carries its geometry).
     """
 
     path: Path
     kind: str
     obj: Any
     doc: dict[str, Any] | None = None
+    geometry: Any = None
 
     @property
     def is_truth(self) -> bool:
@@ -96,7 +100,8 @@ def _uff_modes_or_geometry(p: Path) -> ResultFile | None:
     if 55 in types:
         models = read_modes(p)
         doc = {"kind": "modes", "source": str(p), "band_hz": None, "frf_kind": None}
-        return ResultFile(p, "modes", models, doc)
+        geo = read_uff_geometry(p) if types & {15, 2411} else None
+        return ResultFile(p, "modes", models, doc, geo)
     if types & {15, 2411}:
         return ResultFile(p, "geometry", read_uff_geometry(p))
     return None
@@ -296,28 +301,45 @@ def _modes_section(
     if frf is not None:
         _fit_figures(rep, frf, models)
     shapes = models.get("complex") or any_model
-    if geometry is not None and shapes.n_modes:
-        from ..plot import plot_mode_shapes_geometry
+    _shape_notes(rep, shapes)
+    if shapes.n_modes:
+        _shape_figures(rep, item, shapes, item.geometry if item.geometry is not None else geometry)
 
-        gaxs = plot_mode_shapes_geometry(shapes, geometry)
-        rep.figure(
-            gaxs[0].figure,
-            f"{item.path.name}: mode shapes on the test geometry (real part; grey undeformed)",
+
+def _shape_notes(rep: HtmlReport, model: ModalModel) -> None:
+    """Where the shapes are (roving hammer: at the inputs) and whether they are scaled."""
+    from ..damping.modeset import at_shape_points, scaling_problem
+
+    pts = at_shape_points(model)
+    if pts.meta.get("shapes_from") == "inputs":
+        rep.paragraph(
+            f"Shapes at the {len(pts.outputs)} excitation points "
+            f"({', '.join(c.label for c in pts.outputs)}): one response, the excitation moved "
+            "over the points (roving hammer); by reciprocity the residues give the shape at "
+            "the inputs."
         )
-        angles = geometry.ring_angles(shapes.outputs)
-        if angles is not None:  # the ring view at the measured angles of the geometry
-            from dataclasses import replace as _replace
-
-            shapes = _replace(shapes, outputs=geometry.with_angles(shapes.outputs))
-    if shapes.n_modes and shapes.psi_out.shape[0] >= 3:
-        from ..plot import plot_mode_shapes_ring
-
-        axs = plot_mode_shapes_ring(shapes)
-        rep.figure(
-            axs[0].figure,
-            f"{item.path.name}: mode shapes around the circumference "
-            "(real part solid, imaginary part dashed)",
+    why = scaling_problem(pts)
+    if why:
+        rep.paragraph(
+            f"Unscaled mode shapes: {why}. Frequencies, damping ratios and the shapes' form "
+            "hold; modal masses and damping, mass and stiffness matrices cannot be computed "
+            "from them (a drive-point FRF, or the modal A or modal mass, would scale them).",
+            css_class="bad",
         )
+
+
+def _shape_figures(rep: HtmlReport, item: ResultFile, shapes: ModalModel, geometry: Any) -> None:
+    """The mode shapes in the views the data call for (:func:`tyredamp.plot.plot_mode_shapes`)."""
+    from ..plot import plot_mode_shapes
+
+    captions = {
+        "geometry": "mode shapes on the test geometry (real part; grey undeformed)",
+        "ring": "mode shapes around the circumference (real part solid, imaginary part dashed)",
+        "points": "mode shapes against the point (real part solid, imaginary part dashed; "
+        "normalised to the largest entry)",
+    }
+    for view, axs in plot_mode_shapes(shapes, geometry):
+        rep.figure(axs[0].figure, f"{item.path.name}: {captions[view]}")
 
 
 def _frf_for(
@@ -368,6 +390,7 @@ def _damping_section(rep: HtmlReport, item: ResultFile) -> None:
         ["diagnostic", "value"],
         [
             ["method", f"{dm.method} ({dm.n_modes} modes at {dm.n_points} points)"],
+            *_damping_scope(dm),
             ["asymmetry of C'", f"{100 * d.symmetry_modal:.3g} %"],
             ["definiteness of C'", d.definiteness_modal],
             ["non-proportionality", f"{100 * d.non_proportionality:.3g} %"],
@@ -400,6 +423,21 @@ def _damping_section(rep: HtmlReport, item: ResultFile) -> None:
         ax=axs[1],
     )
     rep.figure(fig, "Damping matrices as heat maps (as the paper's Fig. 5).")
+
+
+def _damping_scope(dm: Any) -> list[list[str]]:
+    """Rows for the modes used (a subset of the file's), the points and the scaling."""
+    rows = []
+    used = dm.meta.get("modes_used")
+    avail = dm.meta.get("n_modes_available")
+    if isinstance(used, list) and used:
+        of = f" of {avail}" if isinstance(avail, int) else ""
+        rows.append(["modes used", ", ".join(str(k) for k in used) + of])
+    if dm.meta.get("shape_points") == "inputs":
+        rows.append(["points", "the excitation points (roving hammer, shapes by reciprocity)"])
+    if dm.meta.get("scaling"):
+        rows.append(["shape scaling", str(dm.meta["scaling"])])
+    return rows
 
 
 def _lateral_section(rep: HtmlReport, item: ResultFile, frfs: list[ResultFile]) -> None:
