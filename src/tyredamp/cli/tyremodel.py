@@ -27,7 +27,7 @@ from typing import Any
 import click
 
 from ..documents.jsonfile import json_text
-from ..documents.modes import read_modes_json
+from ..documents.modes import read_modes, read_modes_json
 from ..exceptions import FileFormatError, InputError
 from ..io._safety import atomic_dir, check_output_dir, private_matplotlib_config
 from ..modal.model import ModalModel
@@ -186,6 +186,12 @@ def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]])
     metavar="BAR",
     help="Pressure of the lateral tests when their files do not record it.",
 )
+@click.option(
+    "--geometry",
+    "geometry_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="UFF test geometry (data sets 15/2411) for UFF 55 modes files without their own.",
+)
 def tyre_model_command(
     modes_files: tuple[Path, ...],
     out: Path,
@@ -199,6 +205,7 @@ def tyre_model_command(
     predict: str | None,
     lateral_files: tuple[Path, ...],
     lateral_pressure: float | None,
+    geometry_file: Path | None,
 ) -> None:
     """Flexible-ring and rigid-ring tyre models from modes files at one or more pressures.
 
@@ -209,6 +216,11 @@ def tyre_model_command(
     parameters (BELT_MASS, FREQ_LONG, DAMP_LONG) come from the n = 1 modes.
     Fields a radial test cannot give (wind-up, lateral, yaw) are listed, not
     invented.
+
+    A modes file may also be a UFF file of data sets 55 (modes from another
+    program) whose nodes (data sets 15/2411 in the file, or --geometry) lie
+    evenly around a circle: the radial part of each node's motion is used.
+    Modes that are not a ring, or unscaled (no modal A), are refused.
 
     \b
     Example:
@@ -230,7 +242,56 @@ def tyre_model_command(
             predict,
             lateral_files,
             lateral_pressure,
+            geometry_file,
         )
+
+
+def _read_tyre_modes(path: Path, model_kind: str, geometry_file: Path | None) -> ModalModel:
+    """The modes of one file as radial shapes with their angles around the tread.
+
+    A modes JSON (``tyredamp modal``) is used as it is (shapes at the inputs
+    of a roving-hammer test taken there). A UFF file of data sets 55 (modes
+    from another program) needs node coordinates (its own data sets 15/2411,
+    or ``--geometry``) that make a ring: the radial part of every node's
+    motion becomes its shape (:func:`tyredamp.tyremodel.layout.radial_ring_model`);
+    a file that is not a ring, has no geometry or unscaled shapes is refused
+    in one line.
+    """
+    from ..damping.modeset import at_shape_points, scaling_problem
+    from ..io import FILE_FORMATS
+
+    uff = path.suffix.lower() in FILE_FORMATS["uff58b"].extensions
+    models = read_modes(path) if uff else read_modes_json(path)
+    if model_kind == "auto":
+        mdl = models.get("complex") or models["real"]
+    elif model_kind not in models:
+        raise FileFormatError(f"{path}: no {model_kind!r} modes in the file")
+    else:
+        mdl = models[model_kind]
+    mdl = at_shape_points(mdl)
+    if not uff:
+        return mdl
+    from ..io.uff_geometry import read_uff_geometry, uff_geometry_or_none
+    from ..tyremodel.layout import radial_ring_model
+
+    geo = read_uff_geometry(geometry_file) if geometry_file else uff_geometry_or_none(path)
+    if geo is None:
+        raise InputError(
+            f"{path}: the modes carry no node coordinates (no data set 15 or 2411); the tyre "
+            "model needs the points' places around the tread: give the test geometry with "
+            "--geometry"
+        )
+    try:
+        ring = radial_ring_model(mdl, geo, bool(mdl.meta.get("drive_points_stated", True)))
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}; no tyre model from these modes") from None
+    why = scaling_problem(mdl)
+    if why:
+        raise InputError(
+            f"{path}: the mode shapes are unscaled ({why}); the ring's mass and stiffness come "
+            "from mass-normalised shapes: export the modes with modal A (or modal mass)"
+        )
+    return ring
 
 
 def _tyre_model(
@@ -246,6 +307,7 @@ def _tyre_model(
     predict: str | None,
     lateral_files: tuple[Path, ...],
     lateral_pressure: float | None,
+    geometry_file: Path | None = None,
 ) -> None:
     from matplotlib.figure import Figure
 
@@ -261,13 +323,7 @@ def _tyre_model(
         )
     inputs: list[tuple[float, ModalModel, str]] = []
     for i, path in enumerate(modes_files):
-        models = read_modes_json(path)
-        if model_kind == "auto":
-            mdl = models.get("complex") or models["real"]
-        elif model_kind not in models:
-            raise FileFormatError(f"{path}: no {model_kind!r} modes in the file")
-        else:
-            mdl = models[model_kind]
+        mdl = _read_tyre_modes(path, model_kind, geometry_file)
         pb = p_list[i] if p_list is not None else _meta_pressure_bar(path, mdl)
         if pb is None:
             raise InputError(

@@ -12,6 +12,9 @@ Schema (all frequencies in Hz, complex numbers as ``[re, im]``)::
         "complex": {                        # and/or "real"
           ...ModalModel.to_dict()...,       # mode_kind, outputs, inputs, modes, residuals,
                                             # meta, residual_modes
+          "shapes_at": "outputs" | "inputs",  # where the mode shapes are ("inputs": roving
+                                            # hammer, the shapes are the participations)
+          "scaled": bool, "scaling_note": str | None,  # mass-normalised or not, and why not
           "rmsd": float,                    # spec eq. [19], unit of the FRF kind
           "relative_error": float           # RMS(H_model - H) / RMS(H), dimensionless
         }
@@ -88,6 +91,7 @@ def modes_document(
         if not isinstance(mdl, ModalModel):
             raise InputError(f"models[{key!r}]: expected a ModalModel, got {type(mdl).__name__}")
         d = mdl.to_dict()
+        d.update(_shape_facts(mdl))
         d["rmsd"] = float(mdl.meta.get("rmsd", float("nan")))
         d["relative_error"] = float(mdl.meta.get("relative_error", float("nan")))
         out[key] = d
@@ -101,6 +105,14 @@ def modes_document(
         "frf_kind": frf_kind if frf_kind is not None else first.meta.get("frf_kind"),
         "models": out,
     }
+
+
+def _shape_facts(mdl: ModalModel) -> dict[str, Any]:
+    """Where the shapes are and whether they are scaled (:mod:`tyredamp.damping.modeset`)."""
+    from ..damping.modeset import scaling_problem, shape_side
+
+    why = scaling_problem(mdl)
+    return {"shapes_at": shape_side(mdl), "scaled": not why, "scaling_note": why or None}
 
 
 def write_modes_json(

@@ -27,8 +27,10 @@ scaling of spec eq. [10], ``H(omega) = sum_n psi_n psi_n^T / (i omega - p_n)
   modal A; without a viscous ratio, a hysteretic loss factor ``eta`` gives
   ``zeta = eta / 2``.
 
-``meta["scaled"]`` is True when every mode states its modal A (modal mass),
-False otherwise, with the reason in ``meta["scaling_note"]``.
+``meta["drive_points_stated"]`` says whether the drive points were known
+(given, or stored by tyredamp). ``meta["scaled"]`` is True when every mode
+states its modal A (modal mass), False otherwise, with the reason in
+``meta["scaling_note"]``.
 
 Channels and drive points: every node and direction (X, Y, Z = UFF codes 1,
 2, 3) with a non-zero value in some mode becomes an output. The drive points
@@ -250,6 +252,7 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
     psi_out = np.array([arr[:, c.direction - 1, list(nodes0).index(c.node)] for c in outs])
     if inputs is None:
         inputs = _stored_inputs(sets[0])
+    stated = inputs is not None
     if inputs is None:
         inputs = list(outs)
         notes.add("no drive points stated: every measured DOF taken as an input")
@@ -262,12 +265,11 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
             raise FileFormatError(f"{p}: drive point {c.label} has no mode-shape value")
         rows.append(np.sign(c.direction) * psi_out[hit[0]])
     meta: dict[str, Any] = {"source": str(p), "format": "uff55", "assumptions": sorted(notes)}
+    meta["drive_points_stated"] = stated
     missing = "modal A" if _NO_A in notes else "modal mass" if _NO_MASS in notes else ""
     meta["scaled"] = not missing
     if missing:
-        meta["scaling_note"] = (
-            f"the UFF 55 file gives no {missing} (0 in the file)"
-        )
+        meta["scaling_note"] = f"the UFF 55 file gives no {missing} (0 in the file)"
     return ModalModel(
         np.array(poles),
         psi_out,

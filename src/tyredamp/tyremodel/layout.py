@@ -74,7 +74,9 @@ def ring_angles(
     return ang
 
 
-def radial_ring_model(model: ModalModel, geometry: Geometry) -> ModalModel:
+def radial_ring_model(
+    model: ModalModel, geometry: Geometry, drive_points: bool = True
+) -> ModalModel:
     """The radial shapes of a ring's modes at its nodes, with their angles.
 
     Every node of the outputs contributes the component of its displacement
@@ -83,7 +85,9 @@ def radial_ring_model(model: ModalModel, geometry: Geometry) -> ModalModel:
     the fitted circle; the outputs become one radial channel per node
     (direction 1, ``angle_deg`` from :meth:`Geometry.ring_angles`, name
     ``"radial"``). The inputs are mapped the same way when they are nodes of
-    the ring; an input that is not is dropped (no drive point then).
+    the ring; an input that is not is dropped, and all are when
+    ``drive_points`` is False (the file did not say where the excitation
+    was: its "inputs" are only the measured points).
 
     Raises
     ------
@@ -126,8 +130,8 @@ def radial_ring_model(model: ModalModel, geometry: Geometry) -> ModalModel:
 
     angle = {c.node: float(a_) for c, a_ in zip(pts, ang, strict=True)}
     outs, psi_out = radial(model.outputs, model.psi_out)
-    ins_all = [c for c in model.inputs if c.node in angle]
-    rows_in = [i for i, c in enumerate(model.inputs) if c.node in angle]
+    ins_all = [c for c in model.inputs if c.node in angle and drive_points]
+    rows_in = [i for i, c in enumerate(model.inputs) if c.node in angle and drive_points]
     ins, psi_in = radial(ins_all, model.psi_in[rows_in]) if ins_all else ([], np.zeros((0, 0)))
     if not ins:
         psi_in = np.zeros((0, model.n_modes), complex)
