@@ -653,7 +653,8 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
     ``frequency_std_hz``, ``damping_ratio``, ``damping_ratio_std``, ``mpc``,
     ``modal_damping`` and ``modal_damping_std`` (the diagonal ``C'_nn`` in 1/s
     and its standard error, from the damping step when there is one),
-    ``points`` (output labels) and ``shape`` (complex, one per point). A
+    ``points`` (output labels; input labels when the shapes are at the
+    inputs, a roving-hammer test) and ``shape`` (complex, one per point). A
     lateral test has no modes (empty list).
     """
     if study != "radial" or "modal" not in documents:
@@ -661,8 +662,11 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
     models = documents["modal"]["models"]
     name = model if model in models else sorted(models)[0]
     m = models[name]
+    # the shapes where they are: the inputs of a roving-hammer test (modes JSON "shapes_at")
+    at_inputs = m.get("shapes_at") == "inputs"
     points = [
-        str(o.get("name") or f"{o.get('node')}{o.get('direction', '')}") for o in m["outputs"]
+        str(o.get("name") or f"{o.get('node')}{o.get('direction', '')}")
+        for o in m["inputs" if at_inputs else "outputs"]
     ]
     damp = documents.get("damping")
     cdiag: list[float] | None = None
@@ -690,7 +694,7 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
                 "modal_damping": None if cdiag is None else cdiag[i],
                 "modal_damping_std": None if cstd is None else cstd[i],
                 "points": points,
-                "shape": _complex_vec(md["shape"]),
+                "shape": _complex_vec(md["participation" if at_inputs else "shape"]),
             }
         )
     return out
