@@ -323,6 +323,14 @@ def test_tyre_modes_drawn_as_a_ring() -> None:
     assert shape_views(m) == ["ring"]
     no_angles = ModalModel(m.poles, m.psi_out, m.psi_in)
     assert shape_views(no_angles) == ["points"]
+    # the same points given by a geometry: the wireframe and the ring, shapes as measured
+    th = np.radians([c.angle_deg for c in m.outputs])
+    g = Geometry([c.node for c in m.outputs], np.column_stack([np.cos(th), np.sin(th), 0 * th]))
+    assert shape_views(no_angles, g) == ["geometry", "ring"]
+    drawn = dict(plot_mode_shapes(no_angles, g, modes=[0]))
+    ring_line = drawn["ring"][0].lines[1].get_ydata()
+    s = m.second_order_shapes()[:, 0]
+    assert_allclose(ring_line[:-1], 1 + 0.3 * (s / np.max(np.abs(s))).real, rtol=1e-12)  # rounding
 
 
 def test_report_of_a_beam_uff55_with_its_geometry(beam_files: dict[str, Path]) -> None:

@@ -270,6 +270,12 @@ def _read_tyre_modes(path: Path, model_kind: str, geometry_file: Path | None) ->
         mdl = models[model_kind]
     mdl = at_shape_points(mdl)
     if not uff:
+        why = scaling_problem(mdl)
+        if why:
+            raise InputError(
+                f"{path}: the mode shapes are unscaled ({why}); the ring's mass and stiffness "
+                "come from mass-normalised shapes: identify the modes with a drive-point FRF"
+            )
         return mdl
     from ..io.uff_geometry import read_uff_geometry, uff_geometry_or_none
     from ..tyremodel.layout import radial_ring_model

@@ -8,10 +8,11 @@ are first taken where they are (at the inputs of a roving-hammer test,
   (:func:`~tyredamp.plot.plot_mode_shapes_geometry`);
 * points evenly spaced on a circle (a tyre's tread: the channels' angles, or
   the geometry's coordinates; :func:`tyredamp.tyremodel.layout.ring_angles`):
-  the polar ring view (:func:`~tyredamp.plot.plot_mode_shapes_ring`; with a
-  geometry, of the radial part of each node's motion,
-  :func:`tyredamp.tyremodel.layout.radial_ring_model`), as well as the
-  wireframe when there is a geometry;
+  the polar ring view (:func:`~tyredamp.plot.plot_mode_shapes_ring`; of the
+  shapes as measured when every node has one channel, as tyredamp's tyre
+  data; of the radial part of each node's motion when a geometry gives
+  several directions per node, :func:`tyredamp.tyremodel.layout.radial_ring_model`),
+  as well as the wireframe when there is a geometry;
 * anything else: the shape against the point (:func:`plot_mode_shapes_points`).
 """
 
@@ -26,6 +27,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..damping.modeset import at_shape_points
+from ..exceptions import InputError
 from ..frf import Channel
 from ..geometry import Geometry
 from ..modal.model import ModalModel
@@ -115,6 +117,20 @@ def _ring(model: ModalModel, geometry: Geometry | None) -> tuple[Channel, ...] |
     )
 
 
+def _ring_model(model: ModalModel, geometry: Geometry | None) -> ModalModel | None:
+    """The shapes around the ring: one channel per node as measured (tyredamp's tyre data),
+    several (X, Y, Z) as the radial part of each node's motion; None without radial motion."""
+    geo = geometry if geometry is not None and _on_geometry(model, geometry) else None
+    nodes = [c.node for c in model.outputs]
+    if geo is None or len(set(nodes)) == len(nodes):
+        ring = _ring(model, geo)
+        return None if ring is None else replace(model, outputs=ring)
+    try:
+        return radial_ring_model(model, geo)
+    except InputError:
+        return None
+
+
 def plot_mode_shapes(
     model: ModalModel, geometry: Geometry | None = None, modes: Sequence[int] | None = None
 ) -> list[tuple[ShapeView, list[Axes]]]:
@@ -143,13 +159,9 @@ def plot_mode_shapes(
             assert geometry is not None
             out.append((view, plot_mode_shapes_geometry(pts, geometry, modes)))
         elif view == "ring":
-            if geometry is not None and _on_geometry(pts, geometry):
-                on_ring = radial_ring_model(pts, geometry)  # radial part of X, Y, Z
-            else:
-                ring = _ring(pts, None)
-                assert ring is not None
-                on_ring = replace(pts, outputs=ring)
-            out.append((view, plot_mode_shapes_ring(on_ring, modes)))
+            on_ring = _ring_model(pts, geometry)
+            if on_ring is not None:
+                out.append((view, plot_mode_shapes_ring(on_ring, modes)))
         else:
             out.append((view, plot_mode_shapes_points(pts, modes)))
     return out

@@ -92,7 +92,8 @@ def radial_ring_model(
     Raises
     ------
     InputError
-        The output nodes are not a ring (:func:`ring_angles`).
+        The output nodes are not a ring (:func:`ring_angles`), or the shapes
+        have no radial component there.
     """
     from ..exceptions import InputError
 
@@ -135,6 +136,12 @@ def radial_ring_model(
     ins, psi_in = radial(ins_all, model.psi_in[rows_in]) if ins_all else ([], np.zeros((0, 0)))
     if not ins:
         psi_in = np.zeros((0, model.n_modes), complex)
+
+    if not np.any(np.abs(psi_out) > 1e-9 * np.max(np.abs(model.psi_out))):
+        raise InputError(
+            "the mode shapes have no radial motion at the ring's nodes (the measured "
+            "directions are all across the radius)"
+        )
 
     def lab(cs: list[Channel]) -> list[Channel]:
         return [Channel(c.node, 1, angle[c.node], "radial") for c in cs]
