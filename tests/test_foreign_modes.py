@@ -497,6 +497,9 @@ def test_roving_hammer_damping_at_the_hammer_points(beam_models: dict[str, Modal
     dm = damping_from_modes(beam_models, modes=[1, 2, 3], n_samples=0)
     assert [c.node for c in dm.points] == [1, 2, 3]
     assert dm.meta["shape_points"] == "inputs"
+    assert not any("excitation points carry no standard errors" in f for f in dm.findings)
+    with_std = damping_from_modes(beam_models, modes=[1, 2, 3], n_samples=20)
+    assert any("excitation points carry no standard errors" in f for f in with_std.findings)
     assert dm.meta["modes_used"] == [1, 2, 3]
     # eq. [15]: C'_nn = -2 Re p_n, here of modes 1-3 of the file (not of any others)
     m = beam_models["complex"]

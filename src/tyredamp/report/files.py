@@ -10,9 +10,15 @@ damping JSON (``"kind": "damping"``)    ``tyredamp damping``
 lateral JSON (``"tyredamp": "lateral-fit"``)  ``tyredamp lateral fit``
 demo results (``"kind": "tyredamp-demo-results"``)  ``tyredamp demo``
 FRF or time data (extensions of :data:`tyredamp.io.FILE_FORMATS`)  ``tyredamp frf``, a DAQ
-UFF modes (data sets 55)   another modal program
+UFF modes (data sets 55)   another modal program (with its geometry when the file has nodes)
 UFF test geometry (data sets 15, 82)  another modal program (mode shapes drawn on it)
 ===========================  ==============================================
+
+Mode shapes are drawn as the data call for (:func:`tyredamp.plot.plot_mode_shapes`):
+on the geometry (of the modes file itself, else a geometry file), around the
+circumference only for points evenly spaced on a circle (a tyre), else
+against the point; at the excitation points of a roving-hammer test.
+Unscaled shapes (no drive point, no modal A) are said so.
 
 Modes files are drawn against an FRF file of the same channels (the one
 named in the modes file's ``source`` when given): measured against fitted

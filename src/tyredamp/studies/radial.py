@@ -274,9 +274,19 @@ def damping_from_modes(
     info["n_modes_available"] = full.n_modes
     info["shape_points"] = str(full.meta.get("shapes_from", "outputs"))
     info["scaling"] = "mass-normalised"
-    return identify_damping(
+    dm = identify_damping(
         chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
     )
+    if info["shape_points"] == "inputs" and dm.std and "psi_out" not in chosen.std:
+        from dataclasses import replace
+
+        note = (
+            "The shapes at the excitation points carry no standard errors (the fit gives them "
+            "at the responses only): the standard errors of C' and C cover the uncertainty of "
+            "the poles, not of the shapes, and understate the spread."
+        )
+        dm = replace(dm, findings=(*dm.findings, note))
+    return dm
 
 
 # ---------------------------------------------------------------- on the virtual tyre
