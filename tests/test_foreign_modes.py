@@ -173,6 +173,24 @@ def test_uff55_modal_a_zero_is_unscaled(beam_files: dict[str, Path]) -> None:
     assert m0.meta["drive_points_stated"] is False  # the file does not say where it was hit
 
 
+@pytest.mark.parametrize(("modal_m", "scaled"), [(0.0, False), (2.0, True)])
+def test_uff55_real_modes_without_modal_mass_are_unscaled(
+    tmp_path: Path, modal_m: float, scaled: bool
+) -> None:
+    nodes = np.arange(1, 4)
+    s = pyuff.prepare_55(
+        id1="real", id2="NONE", id3="NONE", id4="NONE", id5="NONE", model_type=1,
+        analysis_type=2, data_ch=2, spec_data_type=8, data_type=2, n_data_per_node=3,
+        r1=np.zeros(3), r2=np.zeros(3), r3=np.array([1.0, 0.5, -0.5]), load_case=1, mode_n=1,
+        freq=12.0, modal_m=modal_m, modal_damp_vis=0.01, modal_damp_his=0.0, node_nums=nodes,
+    )  # fmt: skip
+    path = tmp_path / "real.uff"
+    pyuff.UFF(str(path)).write_sets([s], mode="overwrite")
+    m = read_uff55(path)
+    assert m.meta["scaled"] is scaled
+    assert ("modal mass" in scaling_problem(m)) is not scaled
+
+
 def test_damping_refuses_unscaled_modes_in_one_line(
     beam_files: dict[str, Path], tmp_path: Path, run: Run
 ) -> None:
@@ -280,6 +298,8 @@ def test_select_modes_keeps_per_mode_records() -> None:
     assert nums == [2, 4]
     assert sub.meta["mpc"] == [m.meta["mpc"][1], m.meta["mpc"][3]]
     assert_allclose(sub.poles, m.poles[[1, 3]], rtol=0)  # copied, not computed
+    two = ModalModel(m.poles[:2], m.psi_out[:, :2], m.psi_in[:, :2], meta={"band_hz": [0, 9]})
+    assert select_modes(two, [2])[0].meta["band_hz"] == [0, 9]  # not a per-mode list
     with pytest.raises(InputError, match="no mode chosen"):
         select_modes(m, band=(1e5, 2e5))
 

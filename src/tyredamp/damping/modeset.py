@@ -46,6 +46,11 @@ __all__ = [
 
 ShapeSide = Literal["outputs", "inputs"]
 
+#: Lists in a model's ``meta`` that are not one entry per mode (whatever their length).
+_NOT_PER_MODE = frozenset(
+    {"band_hz", "warnings", "assumptions", "noise_rms_per_output", "rmsd_per_frf", "modes_used"}
+)
+
 
 def shape_side(model: ModalModel) -> ShapeSide:
     """Where the mode shapes of ``model`` are: ``"outputs"`` or ``"inputs"``.
@@ -226,7 +231,7 @@ def select_modes(
         std[k] = a[..., idx] if a.ndim and a.shape[-1] == m else a
     meta: dict[str, Any] = {}
     for k, v in model.meta.items():
-        if isinstance(v, list | tuple | np.ndarray) and len(v) == m and m > 1:
+        if isinstance(v, list | tuple | np.ndarray) and len(v) == m and k not in _NOT_PER_MODE:
             meta[k] = [v[int(i)] for i in idx]
         else:
             meta[k] = v
