@@ -74,7 +74,13 @@ def _load(p: Any) -> list[dict[str, Any]]:
             uff = pyuff.UFF(str(p))
             types = list(uff.get_set_types())
             idx = [k for k, t in enumerate(types) if t in _WANTED]
-            sets = uff.read_sets(idx) if idx else []
+            try:
+                sets = uff.read_sets(idx) if idx else []
+            except Exception:  # an element kind pyuff cannot parse: the geometry without it
+                idx = [k for k in idx if types[k] != 2412]
+                if len(idx) == len([k for k, t in enumerate(types) if t in _WANTED]):
+                    raise
+                sets = uff.read_sets(idx) if idx else []
             gc.collect()
     except Exception as exc:  # pyuff raises bare Exception, and others on garbage
         raise FileFormatError(f"{p}: not a readable UFF file ({exc})") from None
@@ -242,8 +248,9 @@ def read_uff_geometry(path: str | os.PathLike[str]) -> Geometry:
             axes.append(ax)
     lines: list[list[int]] = []
     for s in sets:
-        if int(s.get("type", 0)) == 2412:
-            lines += _element_lines(p, s)
+        if int(s.get("type", 0)) == 2412:  # outlines through nodes the file does not give
+            known = set(nodes)  # (finite-element nodes not exported) are left out
+            lines += [e for e in _element_lines(p, s) if known.issuperset(e)]
         if int(s.get("type", 0)) != 82:
             continue
         try:
