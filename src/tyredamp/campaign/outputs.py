@@ -16,12 +16,20 @@ Files written into the output folder ``DIR`` (each atomically):
     change across conditions, couplings included).
 ``lateral.parquet``, ``lateral.csv``
     One row per fitted parameter of every lateral model of every lateral test.
+``steps.parquet``, ``steps.csv``
+    One row per step of every test: its outcome (``ran``, ``skipped`` with
+    the reason, ``failed`` with the error, ``not run`` after a failure,
+    ``off``), whether it came from the cache, and the quality verdict of its
+    result (:data:`STEP_COLUMNS`, :func:`quality_checks`).
 ``tests/<test_id>/modes.json``, ``damping.json``, ``lateral.json``
     Each test's own documents (the modes JSON of ``tyredamp modal``, the
     damping JSON of ``tyredamp damping``, the lateral-fit JSON).
 ``campaign.json``
-    Summary: every test with its status, one-line reason if it failed, the
-    steps computed and reused, and the families.
+    Summary: every test with its status (``ok``: every step ran;
+    ``partial``: some steps could not run on its data and were skipped, with
+    the reasons; ``failed``: a step failed, with the one-line error), the
+    outcome of each step, its quality checks (data quality, fit verdicts),
+    the steps computed and reused, and the families.
 ``report.html``
     One self-contained page: trend plots, families, failed tests, links
     (written by :mod:`tyredamp.report.campaign`, above this package).
@@ -48,16 +56,19 @@ from ..io._safety import atomic_path, check_output_dir
 from . import steps
 from .runner import TestRun
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign
-from .tracking import ModeSet, TrendFit, fit_trend, track_modes
+from .tracking import ModeSet, Tracking, TrendFit, fit_trend, track_modes
 
 __all__ = [
     "MODE_COLUMNS",
+    "STEP_COLUMNS",
     "TREND_COLUMNS",
     "CampaignResults",
     "campaign_files",
     "check_campaign_output",
     "lateral_rows",
     "mode_rows",
+    "quality_checks",
+    "step_rows",
     "trend_rows",
     "write_outputs",
 ]
@@ -74,7 +85,9 @@ MODE_COLUMNS: dict[str, str] = {
     "mode": "int",
     "family": "string",
     "slot": "string",
+    "match": "string",
     "match_mac": "float",
+    "match_z": "float",
     "frequency_hz": "float",
     "frequency_std_hz": "float",
     "damping_ratio": "float",
@@ -126,6 +139,19 @@ LATERAL_COLUMNS: dict[str, str] = {
     "value": "float",
     "stderr": "float",
     "unit": "string",
+}
+#: Columns of the step table (one row per step of every test).
+STEP_COLUMNS: dict[str, str] = {
+    "test_id": "string",
+    "file": "string",
+    **_COND_TYPES,
+    "study": "string",
+    "step": "string",
+    "outcome": "string",
+    "cached": "string",
+    "reason": "string",
+    "verdict": "string",
+    "verdict_summary": "string",
 }
 _QUANTITIES = (
     ("frequency_hz", "frequency_std_hz"),
@@ -258,14 +284,23 @@ def mode_sets(runs: Sequence[TestRun], model: str) -> list[ModeSet]:
                 np.array([_float(m["damping_ratio"]) for m in recs]),
                 np.column_stack([m["shape"] for m in recs]),
                 tuple(recs[0]["points"]),
+                np.array([_float(m["frequency_std_hz"]) for m in recs]),
+                np.array([_float(m["damping_ratio_std"]) for m in recs]),
             )
         )
     return out
 
 
-def mode_rows(runs: Sequence[TestRun], model: str = "complex") -> list[dict[str, Any]]:
-    """The tidy table: one row per mode of every test, with conditions and family."""
-    tracking = track_modes(mode_sets(runs, model))
+def mode_rows(
+    runs: Sequence[TestRun], model: str = "complex", tracking: Tracking | None = None
+) -> list[dict[str, Any]]:
+    """The tidy table: one row per mode of every test, with conditions and family.
+
+    ``tracking`` is :func:`~.tracking.track_modes` of :func:`mode_sets` (computed
+    when not given).
+    """
+    if tracking is None:
+        tracking = track_modes(mode_sets(runs, model))
     rows = []
     for r in runs:
         for m in steps.mode_records(r.spec.study, r.documents, model):
@@ -278,7 +313,9 @@ def mode_rows(runs: Sequence[TestRun], model: str = "complex") -> list[dict[str,
                     "mode": m["mode"],
                     "family": tracking.family.get(q),
                     "slot": tracking.slot.get(q, ""),
+                    "match": tracking.method.get(q, ""),
                     "match_mac": tracking.mac.get(q),
+                    "match_z": tracking.distance.get(q),
                 }
             )
             for k in (
@@ -358,6 +395,143 @@ def lateral_rows(runs: Sequence[TestRun]) -> list[dict[str, Any]]:
                     }
                 )
                 rows.append(row)
+    return rows
+
+
+def _fit_checks(modal: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    out = {}
+    for name, m in (modal.get("models") or {}).items():
+        v = (m.get("meta") or {}).get("verdict")
+        if isinstance(v, dict):
+            out[name] = {
+                "status": str(v.get("status")),
+                "brief": str(v.get("brief") or ""),
+                "summary": str(v.get("summary") or ""),
+            }
+    return out
+
+
+def quality_checks(run: TestRun, model: str = "complex") -> dict[str, Any]:
+    """The quality checks of a test's results, as the campaign reports them.
+
+    Returns a dict with, when the step ran:
+
+    ``data_quality``
+        The FRF quality check of the modal step (``tyredamp check quality``):
+        ``status`` ``"passed"``/``"failed"``/``"off"`` and its ``summary``.
+    ``fit``
+        The fit verdict of every identified model (:mod:`tyredamp.studies.verdicts`)
+        by model name: ``status`` (``"ok"``, ``"failed"``, ``"not judged"``),
+        ``brief`` and ``summary``; ``tracked`` names the model that is tracked.
+    ``damping``
+        ``status`` ``"ok"`` when ``C'`` is positive definite (every mode
+        dissipates), else ``"caution"``, and a ``summary``.
+    ``lateral``
+        The best lateral model and the problems its fit shows (``status``
+        ``"ok"`` without problems, else ``"caution"``).
+    ``failed``
+        The names of the checks that failed (``"data quality"``, ``"fit
+        <model>"``), empty when none did.
+    """
+    out: dict[str, Any] = {}
+    failed: list[str] = []
+    modal = run.documents.get("modal")
+    if modal is not None:
+        q = (modal.get("campaign") or {}).get("quality")
+        if q is None:
+            out["data_quality"] = {"status": "off", "summary": "not checked (switched off)"}
+        else:
+            ok = bool(q.get("passed"))
+            out["data_quality"] = {"status": "passed" if ok else "failed", "summary": q["summary"]}
+            if not ok:
+                failed.append("data quality")
+        fits = _fit_checks(modal)
+        out["fit"] = fits
+        names = sorted(fits)
+        out["tracked"] = model if model in fits else (names[0] if names else None)
+        failed += [f"fit {k}" for k in names if fits[k]["status"] == "failed"]
+    damp = run.documents.get("damping")
+    if damp is not None:
+        d = damp.get("diagnostics") or {}
+        definite = str(d.get("definiteness_modal") or "")
+        out["damping"] = {
+            "status": "ok" if definite == "positive definite" else "caution",
+            "summary": f"C' is {definite}" if definite else "no diagnostics",
+        }
+    fit = run.documents.get("fit")
+    if fit is not None:
+        best = next((r["model"] for r in fit.get("table", []) if r.get("rank") == 1), None)
+        problems = list((fit.get("problems") or {}).get(best, [])) if best else []
+        out["lateral"] = {
+            "status": "ok" if best and not problems else "caution",
+            "best": best,
+            "summary": (
+                f"best model {best}" + (": " + "; ".join(problems) if problems else "")
+                if best
+                else "no model ranked"
+            ),
+        }
+    out["failed"] = failed
+    return out
+
+
+def _step_verdict(step: str, checks: dict[str, Any]) -> tuple[str | None, str | None]:
+    """The verdict of one step's result and its summary (None when nothing was judged)."""
+    if step == "modal" and "fit" in checks:
+        parts, bad = [], False
+        dq = checks.get("data_quality", {})
+        if dq.get("status") in ("passed", "failed"):
+            parts.append(dq["summary"])
+            bad |= dq["status"] == "failed"
+        tracked = checks.get("tracked")
+        for name, v in sorted(checks["fit"].items(), key=lambda kv: kv[0] != tracked):
+            parts.append(f"{name}-mode fit: {v['brief']}")
+        bad |= any(v["status"] == "failed" for v in checks["fit"].values())
+        return ("failed" if bad else "ok"), "; ".join(parts)
+    if step == "damping" and "damping" in checks:
+        return checks["damping"]["status"], checks["damping"]["summary"]
+    if step == "fit" and "lateral" in checks:
+        return checks["lateral"]["status"], checks["lateral"]["summary"]
+    return None, None
+
+
+def _test_status(run: TestRun) -> str:
+    if not run.ok:
+        return "failed"
+    return "partial" if run.skipped else "ok"
+
+
+def step_rows(runs: Sequence[TestRun], model: str = "complex") -> list[dict[str, Any]]:
+    """One row per step of every test: outcome, reason, cache use and verdict (STEP_COLUMNS)."""
+    rows = []
+    for r in runs:
+        checks = quality_checks(r, model)
+        for step in steps.STUDIES[r.spec.study].steps:
+            outcome = r.outcome(step)
+            reason = None
+            if outcome == "skipped":
+                reason = r.skipped[step]["reason"]
+            elif outcome == "failed":
+                reason = r.reason
+            elif outcome == "not run":
+                reason = f"the {r.failed_step} step failed"
+            verdict, summary = _step_verdict(step, checks) if outcome == "ran" else (None, None)
+            row: dict[str, Any] = {"test_id": r.spec.test_id, "file": r.spec.rel}
+            row.update({c: r.spec.conditions.get(c) for c in CONDITIONS})
+            row.update(
+                {
+                    "study": r.spec.study,
+                    "step": step,
+                    "outcome": outcome,
+                    "cached": (
+                        "yes" if step in r.reused else ("no" if step in r.computed else None)
+                    ),
+                    "reason": reason,
+                    "verdict": verdict,
+                    "verdict_summary": summary,
+                }
+            )
+            rows.append(row)
     return rows
 
 
@@ -523,6 +697,8 @@ def _write_table(rows: Sequence[dict[str, Any]], columns: dict[str, str], stem: 
 _FILES = (
     "modes.parquet",
     "modes.csv",
+    "steps.parquet",
+    "steps.csv",
     "damping.parquet",
     "damping.csv",
     "trends.parquet",
@@ -547,12 +723,14 @@ def write_outputs(
     earlier = _summary(out)
     written = set() if earlier is None else set(_listed(earlier))
     model = campaign.tracking.get("model", "complex")
-    rows = mode_rows(runs, model)
+    tracking = track_modes(mode_sets(runs, model))
+    rows = mode_rows(runs, model, tracking)
     lrows = lateral_rows(runs)
     lat_obs, lat_quantities = lateral_trend_rows(lrows)
     fits = trend_fits(rows) + trend_fits(lat_obs, lat_quantities)
     trows = trend_rows(fits)
     drows = damping_rows(runs, rows)
+    srows = step_rows(runs, model)
     files = [*_FILES, *(["report.html"] if report else [])]
     docs = {
         (r.spec.test_id, step): f"tests/{r.spec.test_id}/{_DOC_FILES[step]}"
@@ -566,6 +744,7 @@ def write_outputs(
         out / "campaign.json",
     )
     _write_table(rows, MODE_COLUMNS, out / "modes")
+    _write_table(srows, STEP_COLUMNS, out / "steps")
     _write_table(drows, DAMPING_COLUMNS, out / "damping")
     _write_table(trows, TREND_COLUMNS, out / "trends")
     _write_table(lrows, LATERAL_COLUMNS, out / "lateral")
@@ -577,6 +756,7 @@ def write_outputs(
             rel = docs[(r.spec.test_id, step)]
             write_json(doc, out / rel)
             test_docs[step] = rel
+        mine = [x for x in srows if x["test_id"] == r.spec.test_id]
         tests.append(
             {
                 "test_id": r.spec.test_id,
@@ -584,9 +764,15 @@ def write_outputs(
                 "study": r.spec.study,
                 "conditions": r.spec.conditions,
                 "sha256": r.digest,
-                "status": "ok" if r.ok else "failed",
+                "status": _test_status(r),
                 "failed_step": r.failed_step,
                 "reason": r.reason,
+                "steps": [
+                    {k: x[k] for k in ("step", "outcome", "cached", "reason", "verdict")}
+                    for x in mine
+                ],
+                "skipped": {k: v["reason"] for k, v in r.skipped.items()},
+                "checks": quality_checks(r, model),
                 "computed": r.computed,
                 "reused": r.reused,
                 "documents": test_docs,
@@ -622,10 +808,22 @@ def write_outputs(
         "campaign_file": str(campaign.path),
         "n_tests": len(runs),
         "n_ok": sum(r.ok for r in runs),
+        "n_partial": sum(r.ok and bool(r.skipped) for r in runs),
         "n_failed": sum(not r.ok for r in runs),
+        "n_checks_failed": sum(bool(quality_checks(r, model)["failed"]) for r in runs),
+        "n_skipped_steps": sum(len(r.skipped) for r in runs),
         "steps_computed": sum(len(r.computed) for r in runs),
         "steps_reused": sum(len(r.reused) for r in runs),
         "tracking_model": model,
+        "tracking": {
+            "model": model,
+            "matched_by_shape": sum(r["match"] == "shape" for r in rows),
+            "matched_by_frequency": sum(r["match"] == "frequency" for r in rows),
+            # scatter of one mode between neighbouring tests (tracking module, step 4)
+            "scatter_ln_frequency": tracking.scatter.get("tau_f"),
+            "scatter_ln_damping_ratio": tracking.scatter.get("tau_zeta"),
+            "scatter_pairs": int(tracking.scatter.get("n", 0)),
+        },
         "families": fam_list,
         "tests": tests,
         "complete": True,
@@ -635,7 +833,7 @@ def write_outputs(
     }
 
     write_json(summary, out / "campaign.json")
-    return CampaignResults(summary, rows, fits, lrows, drows)
+    return CampaignResults(summary, rows, fits, lrows, drows, srows)
 
 
 @dataclass(frozen=True)
@@ -647,3 +845,4 @@ class CampaignResults:
     fits: list[tuple[dict[str, Any], TrendFit, list[dict[str, Any]]]]
     lateral: list[dict[str, Any]]
     damping: list[dict[str, Any]] = field(default_factory=list)
+    steps: list[dict[str, Any]] = field(default_factory=list)

@@ -31,6 +31,25 @@ those of :mod:`tyredamp.documents` (the files the commands write):
   (a test where no model fits fails with the reasons); the document is
   :func:`tyredamp.documents.lateral.lateral_fit_document`.
 
+Skipped steps
+-------------
+A step that cannot run on a test's data is *skipped*, not failed: it raises
+:class:`StepSkipped` with the reason in words (which step, why, what data
+would let it run) before any computation, and the campaign records a *skip
+document* (:func:`skip_document`, ``kind`` ``"tyredamp-campaign-skip"``) in
+the step's place. A skip is cached under the step's key like any result
+(the same file, settings and tyredamp give the same skip), and every later
+step of the test is skipped with it. A *failed* step is a genuine error (a
+corrupt file, no modes, a bad setting); a step that ran but whose quality
+check or fit verdict failed has its document like any other. The radial
+``damping`` step is skipped when
+
+* the tracked model has fewer response points (outputs) than modes: the
+  damping matrix in physical coordinates inverts the real parts of the
+  shapes at the points (``N >= m``); or
+* no response was measured at an excitation point (no drive point): the
+  shapes are then not mass-normalised and ``C'`` has no physical scale.
+
 Settings
 --------
 Each study's settings are a nested dictionary ``{step: {key: value}}`` with
@@ -55,13 +74,18 @@ from ..exceptions import InputError
 
 __all__ = [
     "DEFAULTS",
+    "SKIP_KIND",
     "STUDIES",
+    "StepSkipped",
     "StudySteps",
     "TestResult",
+    "damping_skip_reason",
+    "is_skip",
     "mode_records",
     "process_lateral_test",
     "process_radial_test",
     "run_step",
+    "skip_document",
     "step_settings",
     "validate_settings",
 ]
@@ -357,6 +381,114 @@ def step_enabled(study: str, step: str, settings: Mapping[str, Any]) -> bool:
     return bool(settings[step].get("enabled", True))
 
 
+# ------------------------------------------------------------------ skipped steps
+#: ``kind`` of the document that stands in for a skipped step.
+SKIP_KIND = "tyredamp-campaign-skip"
+
+
+class StepSkipped(Exception):  # a signal, not an error: the test goes on
+    """A step that cannot run on this test's data; not an error of the test.
+
+    Parameters
+    ----------
+    why : str
+        Why the step cannot run, in words (for example ``"1 response point
+        for 8 modes"``).
+    needs : str
+        What data would let it run.
+    """
+
+    def __init__(self, why: str, needs: str) -> None:
+        super().__init__(f"{why}; {needs}")
+        self.why = why
+        self.needs = needs
+
+
+def skip_document(study: str, step: str, why: str, needs: str) -> dict[str, Any]:
+    """The document that stands in for a skipped step (cached like a result).
+
+    Keys: ``kind`` (:data:`SKIP_KIND`), ``version``, ``study``, ``step``,
+    ``why``, ``needs`` and ``reason`` (one line: ``"<step> step skipped: <why>;
+    <needs>"``).
+    """
+    return {
+        "kind": SKIP_KIND,
+        "version": 1,
+        "study": study,
+        "step": step,
+        "why": why,
+        "needs": needs,
+        "reason": f"{step} step skipped: {why}; {needs}",
+    }
+
+
+def is_skip(doc: Any) -> bool:
+    """True for the document of a skipped step (:func:`skip_document`)."""
+    return isinstance(doc, dict) and doc.get("kind") == SKIP_KIND
+
+
+def _upstream_skip(study: str, step: str, docs: Mapping[str, Any]) -> StepSkipped | None:
+    """A skip of ``step`` because a step before it was skipped (None when none was)."""
+    chain = STUDIES[study].steps
+    for before in chain[: chain.index(step)]:
+        if is_skip(docs.get(before)):
+            return StepSkipped(
+                f"it needs the {before} step, which was skipped", docs[before]["needs"]
+            )
+    return None
+
+
+def _drive_point(model_doc: Mapping[str, Any]) -> bool:
+    """True when an output and an input of a modes-document model share node and direction."""
+
+    def ids(chs: Any) -> set[tuple[Any, int]]:
+        out = set()
+        for c in chs or []:
+            if c.get("node") is not None:
+                out.add((c.get("node"), abs(int(c.get("direction") or 0))))
+        return out
+
+    return bool(ids(model_doc.get("outputs")) & ids(model_doc.get("inputs")))
+
+
+def damping_skip_reason(modes_doc: Mapping[str, Any], model: str) -> StepSkipped | None:
+    """Why the damping step cannot run on the ``model`` of a modes document (None: it can).
+
+    The damping matrix in physical coordinates needs at least as many
+    response points as modes (it inverts ``Re Psi^``, N x m, eq. [14]-[18]),
+    and mass-normalised shapes, which need a response measured at an
+    excitation point (a drive point, spec eq. [10]). Checked from the
+    document's channels, before any computation.
+    """
+    models = modes_doc.get("models") or {}
+    m = models.get(model)
+    if m is None:
+        return None  # a wrong setting: the step fails with its message
+    n_modes = len(m.get("modes") or [])
+    n_points = len(m.get("outputs") or [])
+    why: list[str] = []
+    needs: list[str] = []
+    if n_modes and n_points < n_modes:
+        pts = f"{n_points} response point{'' if n_points == 1 else 's'}"
+        why.append(
+            "the damping matrix in physical coordinates needs at least as many response "
+            f"points as modes, and this test has {pts} for {n_modes} modes"
+        )
+        needs.append(
+            f"at least {n_modes} response points (or a band holding at most {n_points} "
+            f"mode{'' if n_points == 1 else 's'})"
+        )
+    if n_modes and not _drive_point(m):
+        why.append(
+            "the mode shapes are not mass-normalised, as no response was measured at an "
+            "excitation point (no drive point)"
+        )
+        needs.append("a response measured at an excitation point, in its direction")
+    if why:
+        return StepSkipped("; ".join(why), "it runs on a test with " + " and ".join(needs))
+    return None
+
+
 # ------------------------------------------------------------------ steps
 def plain(doc: Any) -> Any:
     """``doc`` as it reads back from its strict JSON file (NaN as None, plain types).
@@ -460,6 +592,9 @@ def _radial_damping(
     from ..studies.radial import damping_from_modes
 
     ds = settings["damping"]
+    skip = damping_skip_reason(upstream["modal"], ds["model"])
+    if skip is not None:
+        raise skip
     models = models_from_document(dict(upstream["modal"]))
     if ds["model"] not in models:
         raise InputError(
@@ -558,17 +693,33 @@ def run_step(
         The study's complete settings (:func:`validate_settings`).
     conditions : dict, optional
         The test's conditions (the lateral fit uses ``speed_kmh``).
+
+    Raises
+    ------
+    StepSkipped
+        The step cannot run on this test's data (or a step before it was
+        skipped): the reason in words.
     """
+    skip = _upstream_skip(study, step, upstream)
+    if skip is not None:
+        raise skip
     fn = _STEP_FUNCTIONS[(study, step)]
     return fn(Path(path), upstream, settings, conditions)
 
 
 @dataclass(frozen=True)
 class TestResult:
-    """The documents of one test, by step name (``modal``, ``damping`` or ``fit``)."""
+    """The documents of one test, by step name (``modal``, ``damping`` or ``fit``).
+
+    ``skipped`` holds the skip document (:func:`skip_document`) of every step
+    that could not run on the test's data, by step name.
+    """
+
+    __test__ = False  # not a pytest class
 
     study: str
     documents: dict[str, dict[str, Any]]
+    skipped: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 def _process(
@@ -578,8 +729,15 @@ def _process(
     docs: dict[str, dict[str, Any]] = {}
     for step in STUDIES[study].steps:
         if step_enabled(study, step, full):
-            docs[step] = plain(run_step(study, step, path, docs, full, conditions))
-    return TestResult(study, docs)
+            try:
+                docs[step] = plain(run_step(study, step, path, docs, full, conditions))
+            except StepSkipped as skip:
+                docs[step] = skip_document(study, step, skip.why, skip.needs)
+    return TestResult(
+        study,
+        {k: v for k, v in docs.items() if not is_skip(v)},
+        {k: v for k, v in docs.items() if is_skip(v)},
+    )
 
 
 def process_radial_test(
@@ -589,7 +747,8 @@ def process_radial_test(
 
     ``settings`` is the radial settings table (``{section: {key: value}}``,
     defaults of :data:`DEFAULTS`). Returns the ``modal`` and ``damping``
-    documents.
+    documents (the damping step skipped, with its reason, when the test's
+    data cannot give a damping matrix).
     """
     return _process("radial", path, conditions, settings)
 
@@ -619,7 +778,8 @@ def run_steps_from_bytes(
     Returns
     -------
     documents : dict of str to dict
-        The documents of the steps that finished (as :func:`plain` gives them).
+        The documents of the steps that finished (as :func:`plain` gives them),
+        a skip document (:func:`skip_document`) for a step that could not run.
     failure : (str, str) or None
         The step that failed and its one-line reason; the later steps are not run.
     """
@@ -631,6 +791,8 @@ def run_steps_from_bytes(
         for step in steps:
             try:
                 doc = plain(run_step(study, step, path, docs, settings, conditions))
+            except StepSkipped as skip:  # not a failure: recorded (and cached) as a skip
+                doc = skip_document(study, step, skip.why, skip.needs)
             except Exception as exc:  # any failure of one test is that test's result
                 # name the test file as the campaign knows it, not the temporary copy
                 reason = _one_line(exc).replace(str(path), name).replace(tmp, "")
@@ -656,7 +818,7 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
     ``points`` (output labels) and ``shape`` (complex, one per point). A
     lateral test has no modes (empty list).
     """
-    if study != "radial" or "modal" not in documents:
+    if study != "radial" or "modal" not in documents or is_skip(documents["modal"]):
         return []
     models = documents["modal"]["models"]
     name = model if model in models else sorted(models)[0]
@@ -665,6 +827,8 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
         str(o.get("name") or f"{o.get('node')}{o.get('direction', '')}") for o in m["outputs"]
     ]
     damp = documents.get("damping")
+    if is_skip(damp):
+        damp = None
     cdiag: list[float] | None = None
     cstd: list[float] | None = None
     if damp is not None and damp.get("meta", {}).get("model") == name:
@@ -699,7 +863,7 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
 def lateral_records(documents: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One record per fitted lateral model of a test: rank, name, BIC/AIC, parameters."""
     doc = documents.get("fit")
-    if doc is None:
+    if doc is None or is_skip(doc):
         return []
     ranks = {row["model"]: row for row in doc["table"]}
     out = []
