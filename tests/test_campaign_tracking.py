@@ -14,6 +14,7 @@ from tyredamp.campaign.tracking import (
     fit_trend,
     group_pairs,
     mode_scatter,
+    single_member_wave_numbers,
     subspace_mac,
     track_modes,
 )
@@ -300,3 +301,14 @@ def test_the_scatter_between_tests_is_estimated_from_the_data() -> None:
     # ~ 1.67 / sqrt(312) = 9 %, so 30 % is more than 3 standard errors
     assert_allclose(tau_f, np.sqrt(2) * tau, rtol=0.3)
     assert_allclose(tau_z, np.sqrt(2) * 0.1, rtol=0.3)  # damping scattered by 10 %
+
+
+def test_single_member_wave_numbers_of_a_shaker_layout() -> None:
+    # 90 deg apart: sin(n 90 deg) = 0 for every even n
+    assert single_member_wave_numbers([0.0, 90.0], 8) == [2, 4, 6, 8]
+    # one shaker never drives the member with a node at it
+    assert single_member_wave_numbers([30.0], 3) == [1, 2, 3]
+    # 45 deg apart: n 45 deg a multiple of 180 deg at n = 4, 8
+    assert single_member_wave_numbers([10.0, 55.0], 8) == [4, 8]
+    # three shakers at 0, 90 and 45 deg: n = 4 and 8 stay blind, the rest is seen
+    assert single_member_wave_numbers([0.0, 90.0, 45.0], 8) == [4, 8]

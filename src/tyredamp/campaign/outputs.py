@@ -56,7 +56,14 @@ from ..io._safety import atomic_path, check_output_dir
 from . import steps
 from .runner import TestRun
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign
-from .tracking import ModeSet, Tracking, TrendFit, fit_trend, track_modes
+from .tracking import (
+    ModeSet,
+    Tracking,
+    TrendFit,
+    fit_trend,
+    single_member_wave_numbers,
+    track_modes,
+)
 
 __all__ = [
     "MODE_COLUMNS",
@@ -65,6 +72,7 @@ __all__ = [
     "CampaignResults",
     "campaign_files",
     "check_campaign_output",
+    "excitation_layout",
     "lateral_rows",
     "mode_rows",
     "quality_checks",
@@ -480,6 +488,32 @@ def quality_checks(run: TestRun, model: str = "complex") -> dict[str, Any]:
     return out
 
 
+def excitation_layout(run: TestRun, model: str = "complex") -> dict[str, Any] | None:
+    """Shaker angles of a ring test with several shakers, and the pairs they cannot split.
+
+    From the channels of the test's modes document: when at least two
+    inputs and three outputs carry an angular position, returns
+    ``angles_deg`` (the inputs) and ``single_member`` (the wave numbers up to
+    the outputs' spatial Nyquist limit of which only one member of the
+    doubled pair is driven, :func:`~.tracking.single_member_wave_numbers`);
+    None otherwise.
+    """
+    modal = run.documents.get("modal")
+    if modal is None:
+        return None
+    models = modal.get("models") or {}
+    m = models.get(model) or next(iter(models.values()), None)
+    if m is None:
+        return None
+    ins = [c.get("angle_deg") for c in m.get("inputs") or []]
+    outs = [c.get("angle_deg") for c in m.get("outputs") or []]
+    if len(ins) < 2 or any(a is None for a in ins) or sum(a is not None for a in outs) < 3:
+        return None
+    n_max = len({round(float(a) % 360.0, 6) for a in outs if a is not None}) // 2
+    angles = [float(a) for a in ins]
+    return {"angles_deg": angles, "single_member": single_member_wave_numbers(angles, n_max)}
+
+
 def _step_verdict(step: str, checks: dict[str, Any]) -> tuple[str | None, str | None]:
     """The verdict of one step's result and its summary (None when nothing was judged)."""
     if step == "modal" and "fit" in checks:
@@ -778,6 +812,7 @@ def write_outputs(
                 ],
                 "skipped": {k: v["reason"] for k, v in r.skipped.items()},
                 "checks": quality_checks(r, model),
+                "excitation": excitation_layout(r, model),
                 "computed": r.computed,
                 "reused": r.reused,
                 "documents": test_docs,

@@ -195,6 +195,29 @@ def _family_figures(rep: HtmlReport, modes: list[dict[str, Any]]) -> None:
         )
 
 
+def _excitation_note(rep: HtmlReport, s: dict[str, Any]) -> None:
+    """Say which doubled pairs the shaker layout cannot show both members of."""
+    layouts: dict[tuple[tuple[float, ...], tuple[int, ...]], list[str]] = defaultdict(list)
+    for t in s["tests"]:
+        ex = t.get("excitation")
+        if ex and ex["single_member"]:
+            key = (tuple(ex["angles_deg"]), tuple(ex["single_member"]))
+            layouts[key].append(t["test_id"])
+    for (angles, waves), ids in layouts.items():
+        where = ", ".join(f"{a:g}" for a in angles)
+        ns = ", ".join(str(n) for n in waves)
+        rep.paragraph(
+            f"Shakers at {where} deg ({len(ids)} test{'s' if len(ids) != 1 else ''}) drive "
+            f"only one member of the doubled modes of wave number n = {ns}: for these n every "
+            "shaker lies on a nodal line of the same member (n times the angle between the "
+            "shakers is a multiple of 180 deg), so the second member cannot appear in these "
+            "FRFs and such families hold a single mode, not a pair. Two shakers see both "
+            "members of wave number n when n times their angular spacing is not a multiple "
+            "of 180 deg (0 and 45 deg: n = 1, 2, 3).",
+            "note",
+        )
+
+
 def _outcome_text(step: dict[str, Any]) -> str:
     o = step["outcome"]
     if o == "ran":
@@ -380,6 +403,7 @@ def campaign_report(results: Any) -> str:
             for f in s["families"]
         ],
     )
+    _excitation_note(rep, s)
     if results.modes:
         _family_figures(rep, results.modes)
     if results.fits:
