@@ -312,3 +312,25 @@ def test_single_member_wave_numbers_of_a_shaker_layout() -> None:
     assert single_member_wave_numbers([10.0, 55.0], 8) == [4, 8]
     # three shakers at 0, 90 and 45 deg: n = 4 and 8 stay blind, the rest is seen
     assert single_member_wave_numbers([0.0, 90.0, 45.0], 8) == [4, 8]
+
+
+def test_excitation_layout_of_a_ring_test_with_two_shakers() -> None:
+    from pathlib import Path
+
+    from tyredamp.campaign.outputs import excitation_layout
+    from tyredamp.campaign.runner import TestRun
+    from tyredamp.campaign.spec import TestSpec
+
+    def run(inputs: list[float | None]) -> TestRun:
+        outs = [{"node": k + 1, "direction": 3, "angle_deg": 22.5 * k} for k in range(16)]
+        ins = [{"node": 1, "direction": 3, "angle_deg": a} for a in inputs]
+        doc = {"models": {"complex": {"outputs": outs, "inputs": ins, "modes": []}}}
+        r = TestRun(TestSpec("t", Path("t.uff"), "t.uff", "radial", {}))
+        r.documents["modal"] = doc
+        return r
+
+    # 16 points: wave numbers up to 8; shakers 90 deg apart miss every even n
+    ex = excitation_layout(run([0.0, 90.0]))
+    assert ex == {"angles_deg": [0.0, 90.0], "single_member": [2, 4, 6, 8]}
+    assert excitation_layout(run([0.0])) is None  # one shaker: the usual case, no note
+    assert excitation_layout(run([0.0, None])) is None  # an angle unknown: nothing said
