@@ -317,9 +317,9 @@ def test_single_member_wave_numbers_of_a_shaker_layout() -> None:
 def test_excitation_layout_of_a_ring_test_with_two_shakers() -> None:
     from pathlib import Path
 
-    from tyredamp.campaign.outputs import excitation_layout
     from tyredamp.campaign.runner import TestRun
     from tyredamp.campaign.spec import TestSpec
+    from tyredamp.campaign.status import excitation_layout
 
     def run(inputs: list[float | None]) -> TestRun:
         outs = [{"node": k + 1, "direction": 3, "angle_deg": 22.5 * k} for k in range(16)]

@@ -20,7 +20,7 @@ Files written into the output folder ``DIR`` (each atomically):
     One row per step of every test: its outcome (``ran``, ``skipped`` with
     the reason, ``failed`` with the error, ``not run`` after a failure,
     ``off``), whether it came from the cache, and the quality verdict of its
-    result (:data:`STEP_COLUMNS`, :func:`quality_checks`).
+    result (:mod:`.status`).
 ``tests/<test_id>/modes.json``, ``damping.json``, ``lateral.json``
     Each test's own documents (the modes JSON of ``tyredamp modal``, the
     damping JSON of ``tyredamp damping``, the lateral-fit JSON).
@@ -31,8 +31,10 @@ Files written into the output folder ``DIR`` (each atomically):
     outcome of each step, its quality checks (data quality, fit verdicts),
     the steps computed and reused, and the families.
 ``report.html``
-    One self-contained page: trend plots, families, failed tests, links
-    (written by :mod:`tyredamp.report.campaign`, above this package).
+    One self-contained page: problems (failed tests, failed quality checks,
+    skipped steps), families and their figures, trend plots, every test's
+    step outcomes and verdicts, links (written by
+    :mod:`tyredamp.report.campaign`, above this package).
 """
 
 from __future__ import annotations
@@ -56,27 +58,17 @@ from ..io._safety import atomic_path, check_output_dir
 from . import steps
 from .runner import TestRun
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign
-from .tracking import (
-    ModeSet,
-    Tracking,
-    TrendFit,
-    fit_trend,
-    single_member_wave_numbers,
-    track_modes,
-)
+from .status import STEP_COLUMNS, quality_checks, step_rows, summary_entry
+from .tracking import ModeSet, Tracking, TrendFit, fit_trend, track_modes
 
 __all__ = [
     "MODE_COLUMNS",
-    "STEP_COLUMNS",
     "TREND_COLUMNS",
     "CampaignResults",
     "campaign_files",
     "check_campaign_output",
-    "excitation_layout",
     "lateral_rows",
     "mode_rows",
-    "quality_checks",
-    "step_rows",
     "trend_rows",
     "write_outputs",
 ]
@@ -147,19 +139,6 @@ LATERAL_COLUMNS: dict[str, str] = {
     "value": "float",
     "stderr": "float",
     "unit": "string",
-}
-#: Columns of the step table (one row per step of every test).
-STEP_COLUMNS: dict[str, str] = {
-    "test_id": "string",
-    "file": "string",
-    **_COND_TYPES,
-    "study": "string",
-    "step": "string",
-    "outcome": "string",
-    "cached": "string",
-    "reason": "string",
-    "verdict": "string",
-    "verdict_summary": "string",
 }
 _QUANTITIES = (
     ("frequency_hz", "frequency_std_hz"),
@@ -406,174 +385,6 @@ def lateral_rows(runs: Sequence[TestRun]) -> list[dict[str, Any]]:
     return rows
 
 
-def _fit_checks(modal: dict[str, Any]) -> dict[str, dict[str, Any]]:
-    out = {}
-    for name, m in (modal.get("models") or {}).items():
-        v = (m.get("meta") or {}).get("verdict")
-        if isinstance(v, dict):
-            out[name] = {
-                "status": str(v.get("status")),
-                "brief": str(v.get("brief") or ""),
-                "summary": str(v.get("summary") or ""),
-            }
-    return out
-
-
-def quality_checks(run: TestRun, model: str = "complex") -> dict[str, Any]:
-    """The quality checks of a test's results, as the campaign reports them.
-
-    Returns a dict with, when the step ran:
-
-    ``data_quality``
-        The FRF quality check of the modal step (``tyredamp check quality``):
-        ``status`` ``"passed"``/``"failed"``/``"off"`` and its ``summary``.
-    ``fit``
-        The fit verdict of every identified model (:mod:`tyredamp.studies.verdicts`)
-        by model name: ``status`` (``"ok"``, ``"failed"``, ``"not judged"``),
-        ``brief`` and ``summary``; ``tracked`` names the model that is tracked.
-    ``damping``
-        ``status`` ``"ok"`` when ``C'`` is positive definite (every mode
-        dissipates), else ``"caution"``, and a ``summary``.
-    ``lateral``
-        The best lateral model and the problems its fit shows (``status``
-        ``"ok"`` without problems, else ``"caution"``).
-    ``failed``
-        The names of the checks that failed, empty when none did: ``"data
-        quality"`` and ``"fit <model>"`` for the tracked model (the verdicts
-        of the other models stay in ``fit``: a real-mode fit that misses where
-        the complex-mode fit is within the noise tells of non-proportional
-        damping, not of a bad test).
-    """
-    out: dict[str, Any] = {}
-    failed: list[str] = []
-    modal = run.documents.get("modal")
-    if modal is not None:
-        q = (modal.get("campaign") or {}).get("quality")
-        if q is None:
-            out["data_quality"] = {"status": "off", "summary": "not checked (switched off)"}
-        else:
-            ok = bool(q.get("passed"))
-            out["data_quality"] = {"status": "passed" if ok else "failed", "summary": q["summary"]}
-            if not ok:
-                failed.append("data quality")
-        fits = _fit_checks(modal)
-        out["fit"] = fits
-        names = sorted(fits)
-        tracked = model if model in fits else (names[0] if names else None)
-        out["tracked"] = tracked
-        if tracked is not None and fits[tracked]["status"] == "failed":
-            failed.append(f"fit {tracked}")
-    damp = run.documents.get("damping")
-    if damp is not None:
-        d = damp.get("diagnostics") or {}
-        definite = str(d.get("definiteness_modal") or "")
-        out["damping"] = {
-            "status": "ok" if definite == "positive definite" else "caution",
-            "summary": f"C' is {definite}" if definite else "no diagnostics",
-        }
-    fit = run.documents.get("fit")
-    if fit is not None:
-        best = next((r["model"] for r in fit.get("table", []) if r.get("rank") == 1), None)
-        problems = list((fit.get("problems") or {}).get(best, [])) if best else []
-        out["lateral"] = {
-            "status": "ok" if best and not problems else "caution",
-            "best": best,
-            "summary": (
-                f"best model {best}" + (": " + "; ".join(problems) if problems else "")
-                if best
-                else "no model ranked"
-            ),
-        }
-    out["failed"] = failed
-    return out
-
-
-def excitation_layout(run: TestRun, model: str = "complex") -> dict[str, Any] | None:
-    """Shaker angles of a ring test with several shakers, and the pairs they cannot split.
-
-    From the channels of the test's modes document: when at least two
-    inputs and three outputs carry an angular position, returns
-    ``angles_deg`` (the inputs) and ``single_member`` (the wave numbers up to
-    the outputs' spatial Nyquist limit of which only one member of the
-    doubled pair is driven, :func:`~.tracking.single_member_wave_numbers`);
-    None otherwise.
-    """
-    modal = run.documents.get("modal")
-    if modal is None:
-        return None
-    models = modal.get("models") or {}
-    m = models.get(model) or next(iter(models.values()), None)
-    if m is None:
-        return None
-    ins = [c.get("angle_deg") for c in m.get("inputs") or []]
-    outs = [c.get("angle_deg") for c in m.get("outputs") or []]
-    if len(ins) < 2 or any(a is None for a in ins) or sum(a is not None for a in outs) < 3:
-        return None
-    n_max = len({round(float(a) % 360.0, 6) for a in outs if a is not None}) // 2
-    angles = [float(a) for a in ins]
-    return {"angles_deg": angles, "single_member": single_member_wave_numbers(angles, n_max)}
-
-
-def _step_verdict(step: str, checks: dict[str, Any]) -> tuple[str | None, str | None]:
-    """The verdict of one step's result and its summary (None when nothing was judged)."""
-    if step == "modal" and "fit" in checks:
-        parts, bad = [], False
-        dq = checks.get("data_quality", {})
-        if dq.get("status") in ("passed", "failed"):
-            parts.append(dq["summary"])
-            bad |= dq["status"] == "failed"
-        tracked = checks.get("tracked")
-        for name, v in sorted(checks["fit"].items(), key=lambda kv: kv[0] != tracked):
-            parts.append(f"{name}-mode fit{' (tracked)' if name == tracked else ''}: {v['brief']}")
-        bad |= any(n.startswith("fit ") for n in checks["failed"])
-        return ("failed" if bad else "ok"), "; ".join(parts)
-    if step == "damping" and "damping" in checks:
-        return checks["damping"]["status"], checks["damping"]["summary"]
-    if step == "fit" and "lateral" in checks:
-        return checks["lateral"]["status"], checks["lateral"]["summary"]
-    return None, None
-
-
-def _test_status(run: TestRun) -> str:
-    if not run.ok:
-        return "failed"
-    return "partial" if run.skipped else "ok"
-
-
-def step_rows(runs: Sequence[TestRun], model: str = "complex") -> list[dict[str, Any]]:
-    """One row per step of every test: outcome, reason, cache use and verdict (STEP_COLUMNS)."""
-    rows = []
-    for r in runs:
-        checks = quality_checks(r, model)
-        for step in steps.STUDIES[r.spec.study].steps:
-            outcome = r.outcome(step)
-            reason = None
-            if outcome == "skipped":
-                reason = r.skipped[step]["reason"]
-            elif outcome == "failed":
-                reason = r.reason
-            elif outcome == "not run":
-                reason = f"the {r.failed_step} step failed"
-            verdict, summary = _step_verdict(step, checks) if outcome == "ran" else (None, None)
-            row: dict[str, Any] = {"test_id": r.spec.test_id, "file": r.spec.rel}
-            row.update({c: r.spec.conditions.get(c) for c in CONDITIONS})
-            row.update(
-                {
-                    "study": r.spec.study,
-                    "step": step,
-                    "outcome": outcome,
-                    "cached": (
-                        "yes" if step in r.reused else ("no" if step in r.computed else None)
-                    ),
-                    "reason": reason,
-                    "verdict": verdict,
-                    "verdict_summary": summary,
-                }
-            )
-            rows.append(row)
-    return rows
-
-
 def _series_key(row: dict[str, Any], condition: str) -> tuple[Any, ...]:
     others = tuple(
         (c, row.get(c)) for c in NUMERIC_CONDITIONS if c != condition and row.get(c) is not None
@@ -796,28 +607,7 @@ def write_outputs(
             write_json(doc, out / rel)
             test_docs[step] = rel
         mine = [x for x in srows if x["test_id"] == r.spec.test_id]
-        tests.append(
-            {
-                "test_id": r.spec.test_id,
-                "file": r.spec.rel,
-                "study": r.spec.study,
-                "conditions": r.spec.conditions,
-                "sha256": r.digest,
-                "status": _test_status(r),
-                "failed_step": r.failed_step,
-                "reason": r.reason,
-                "steps": [
-                    {k: x[k] for k in ("step", "outcome", "cached", "reason", "verdict")}
-                    for x in mine
-                ],
-                "skipped": {k: v["reason"] for k, v in r.skipped.items()},
-                "checks": quality_checks(r, model),
-                "excitation": excitation_layout(r, model),
-                "computed": r.computed,
-                "reused": r.reused,
-                "documents": test_docs,
-            }
-        )
+        tests.append(summary_entry(r, mine, test_docs, model))
     families: dict[str, dict[str, Any]] = {}
     for row in rows:
         if row["family"] is None:
