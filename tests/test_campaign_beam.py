@@ -296,3 +296,19 @@ def test_plot_family_draws_into_the_given_axes(beam: dict[str, Any]) -> None:
     out = plot_family(num, "pressure_bar")
     assert out["x"].tolist() == [6.0, 7.0, 8.0, 9.0]
     assert out["axes"][0].figure is out["axes"][1].figure
+
+
+def test_a_step_switched_off_is_neither_run_nor_skipped(
+    beam: dict[str, Any], tmp_path: Path
+) -> None:
+    campaign = load_campaign(
+        beam_campaign(tmp_path, extra="[settings.radial.damping]\nenabled = false\n")
+    )
+    runs = run_tests(campaign, tmp_path / "out", mode="serial")
+    results = write_outputs(campaign, runs, tmp_path / "out")
+    for r in runs:
+        assert r.outcome("damping") == "off"
+        assert r.skipped == {}
+    assert {t["status"] for t in results.summary["tests"]} == {"ok"}
+    assert {row["outcome"] for row in results.steps if row["step"] == "damping"} == {"off"}
+    assert results.summary["n_partial"] == 0

@@ -180,7 +180,7 @@ def campaign_command(
                 f"failed: {reason if reason.startswith(t['file']) else t['file'] + ': ' + reason}"
             )
     click.echo(
-        f"wrote {out_dir}/ (modes.parquet, modes.csv, trends.csv, campaign.json"
+        f"wrote {out_dir}/ (modes.parquet, modes.csv, steps.csv, trends.csv, campaign.json"
         + ("" if no_report else ", report.html")
         + ")"
     )
