@@ -13,6 +13,8 @@ from tyredamp.campaign.tracking import (
     ModeSet,
     fit_trend,
     group_pairs,
+    mode_scatter,
+    single_member_wave_numbers,
     subspace_mac,
     track_modes,
 )
@@ -199,3 +201,136 @@ def test_tracking_does_not_depend_on_the_order_of_the_tests(perm: list[int]) -> 
     got = track_modes([sets[i] for i in perm])
     assert got.family == ref.family
     assert got.slot == ref.slot
+
+
+# ---------------------------------------------------------------- without shapes to compare
+def _single_point_sweep(
+    rng: np.random.Generator,
+    freqs: np.ndarray,
+    pressures: np.ndarray,
+    slope: np.ndarray,
+    scatter: float,
+    point: str = "P1",
+) -> tuple[list[ModeSet], dict[str, list[int]]]:
+    """Tests with one response point: modes ``freqs * (1 + slope (p - p0))`` with relative
+    scatter ``scatter``, in a random order in each test; returns the true mode of each entry."""
+    sets, labels = [], {}
+    for k, p in enumerate(pressures):
+        f = (
+            freqs
+            * (1 + slope * (p - pressures[0]))
+            * np.exp(scatter * rng.standard_normal(freqs.size))
+        )
+        z = 0.01 * np.exp(0.1 * rng.standard_normal(freqs.size))
+        order = rng.permutation(freqs.size)
+        tid = f"t{k}"
+        labels[tid] = [int(i) for i in order]
+        sets.append(
+            ModeSet(
+                tid,
+                {"tyre": "A", "pressure_bar": float(p)},
+                f[order],
+                z[order],
+                np.ones((1, freqs.size), complex),
+                (point,),
+                np.full(freqs.size, 1e-4) * f[order],
+                np.full(freqs.size, 1e-3),
+            )
+        )
+    return sets, labels
+
+
+def test_one_response_point_tracks_by_frequency_and_damping() -> None:
+    rng = np.random.default_rng(11)
+    freqs = np.array([50.0, 80.0, 95.0, 140.0, 200.0])
+    # every mode stiffens with pressure, some twice as fast as others (1-2 %/bar)
+    slope = np.array([0.01, 0.02, 0.015, 0.01, 0.02])
+    sets, labels = _single_point_sweep(rng, freqs, np.linspace(5, 9, 9), slope, 2e-3)
+    tr = track_modes(sets)
+    by_family: dict[str, set[int]] = {}
+    for s in sets:
+        for q in range(freqs.size):
+            by_family.setdefault(tr.family[(s.test_id, q)], set()).add(labels[s.test_id][q])
+            assert tr.method[(s.test_id, q)] in ("", "frequency")
+            assert np.isnan(tr.mac[(s.test_id, q)])  # no MAC with one point
+    # one family per mode, no swap (80 and 95 Hz come within 10 % of each other)
+    assert sorted(by_family.values(), key=min) == [{i} for i in range(freqs.size)]
+    assert tr.scatter["n"] > 0
+
+
+def test_a_missing_mode_is_not_replaced_by_another_one_nearby() -> None:
+    # test b lacks the 100 Hz mode and has a mode at 108 Hz instead: 8 % away, far beyond
+    # the scatter of the modes seen in both tests, so it starts a family of its own
+    f_a = np.array([50.0, 100.0, 170.0, 240.0])
+    f_b = np.array([50.02, 108.0, 170.05, 239.97])
+    mk = lambda tid, f, p: ModeSet(  # noqa: E731
+        tid, {"pressure_bar": p}, f, np.full(4, 0.01), np.ones((1, 4)), ("P1",)
+    )
+    tr = track_modes([mk("a", f_a, 6.0), mk("b", f_b, 7.0)])
+    for q in (0, 2, 3):
+        assert tr.family[("a", q)] == tr.family[("b", q)]
+        assert tr.method[("b", q)] == "frequency"
+    assert tr.family[("a", 1)] != tr.family[("b", 1)]
+    assert tr.method[("b", 1)] == ""  # it started a family
+
+
+def test_shapes_at_disjoint_points_fall_back_and_common_points_use_the_mac() -> None:
+    f = np.array([60.0, 90.0, 130.0])
+    shapes = np.column_stack([ring_shape(2), ring_shape(3), ring_shape(4)])
+    a = ModeSet("a", {"pressure_bar": 6.0}, f, np.full(3, 0.02), shapes[:8], POINTS[:8])
+    b = ModeSet("b", {"pressure_bar": 7.0}, f * 1.001, np.full(3, 0.02), shapes[8:], POINTS[8:])
+    c = ModeSet("c", {"pressure_bar": 8.0}, f * 1.002, np.full(3, 0.02), shapes[8:], POINTS[8:])
+    tr = track_modes([a, b, c])
+    for q in range(3):
+        assert tr.family[("a", q)] == tr.family[("b", q)] == tr.family[("c", q)]
+        assert tr.method[("b", q)] == "frequency"  # b and a share no point
+        assert tr.method[("c", q)] == "shape"  # c is compared with b: 8 common points
+        assert_allclose(tr.mac[("c", q)], 1.0, atol=1e-12)  # the same shapes at the points
+
+
+def test_the_scatter_between_tests_is_estimated_from_the_data() -> None:
+    # 40 tests of 8 modes at one condition, each frequency scattered by tau = 1e-3
+    # (log-normal); neighbouring tests then differ by sqrt(2) tau in ln f
+    rng = np.random.default_rng(2)
+    freqs = 40.0 * 1.3 ** np.arange(8)
+    tau = 1e-3
+    sets, _ = _single_point_sweep(rng, freqs, np.full(40, 7.0), np.zeros(8), tau)
+    tau_f, tau_z, n = mode_scatter(sets)
+    assert n == 39 * 8  # every mode of every test pairs with the previous test's
+    # the MAD estimate of sqrt(2) tau from 312 differences: relative standard error
+    # ~ 1.67 / sqrt(312) = 9 %, so 30 % is more than 3 standard errors
+    assert_allclose(tau_f, np.sqrt(2) * tau, rtol=0.3)
+    assert_allclose(tau_z, np.sqrt(2) * 0.1, rtol=0.3)  # damping scattered by 10 %
+
+
+def test_single_member_wave_numbers_of_a_shaker_layout() -> None:
+    # 90 deg apart: sin(n 90 deg) = 0 for every even n
+    assert single_member_wave_numbers([0.0, 90.0], 8) == [2, 4, 6, 8]
+    # one shaker never drives the member with a node at it
+    assert single_member_wave_numbers([30.0], 3) == [1, 2, 3]
+    # 45 deg apart: n 45 deg a multiple of 180 deg at n = 4, 8
+    assert single_member_wave_numbers([10.0, 55.0], 8) == [4, 8]
+    # three shakers at 0, 90 and 45 deg: n = 4 and 8 stay blind, the rest is seen
+    assert single_member_wave_numbers([0.0, 90.0, 45.0], 8) == [4, 8]
+
+
+def test_excitation_layout_of_a_ring_test_with_two_shakers() -> None:
+    from pathlib import Path
+
+    from tyredamp.campaign.runner import TestRun
+    from tyredamp.campaign.spec import TestSpec
+    from tyredamp.campaign.status import excitation_layout
+
+    def run(inputs: list[float | None]) -> TestRun:
+        outs = [{"node": k + 1, "direction": 3, "angle_deg": 22.5 * k} for k in range(16)]
+        ins = [{"node": 1, "direction": 3, "angle_deg": a} for a in inputs]
+        doc = {"models": {"complex": {"outputs": outs, "inputs": ins, "modes": []}}}
+        r = TestRun(TestSpec("t", Path("t.uff"), "t.uff", "radial", {}))
+        r.documents["modal"] = doc
+        return r
+
+    # 16 points: wave numbers up to 8; shakers 90 deg apart miss every even n
+    ex = excitation_layout(run([0.0, 90.0]))
+    assert ex == {"angles_deg": [0.0, 90.0], "single_member": [2, 4, 6, 8]}
+    assert excitation_layout(run([0.0])) is None  # one shaker: the usual case, no note
+    assert excitation_layout(run([0.0, None])) is None  # an angle unknown: nothing said

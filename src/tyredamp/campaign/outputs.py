@@ -16,15 +16,25 @@ Files written into the output folder ``DIR`` (each atomically):
     change across conditions, couplings included).
 ``lateral.parquet``, ``lateral.csv``
     One row per fitted parameter of every lateral model of every lateral test.
+``steps.parquet``, ``steps.csv``
+    One row per step of every test: its outcome (``ran``, ``skipped`` with
+    the reason, ``failed`` with the error, ``not run`` after a failure,
+    ``off``), whether it came from the cache, and the quality verdict of its
+    result (:mod:`.status`).
 ``tests/<test_id>/modes.json``, ``damping.json``, ``lateral.json``
     Each test's own documents (the modes JSON of ``tyredamp modal``, the
     damping JSON of ``tyredamp damping``, the lateral-fit JSON).
 ``campaign.json``
-    Summary: every test with its status, one-line reason if it failed, the
-    steps computed and reused, and the families.
+    Summary: every test with its status (``ok``: every step ran;
+    ``partial``: some steps could not run on its data and were skipped, with
+    the reasons; ``failed``: a step failed, with the one-line error), the
+    outcome of each step, its quality checks (data quality, fit verdicts),
+    the steps computed and reused, and the families.
 ``report.html``
-    One self-contained page: trend plots, families, failed tests, links
-    (written by :mod:`tyredamp.report.campaign`, above this package).
+    One self-contained page: problems (failed tests, failed quality checks,
+    skipped steps), families and their figures, trend plots, every test's
+    step outcomes and verdicts, links (written by
+    :mod:`tyredamp.report.campaign`, above this package).
 """
 
 from __future__ import annotations
@@ -48,7 +58,8 @@ from ..io._safety import atomic_path, check_output_dir
 from . import steps
 from .runner import TestRun
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign
-from .tracking import ModeSet, TrendFit, fit_trend, track_modes
+from .status import STEP_COLUMNS, quality_checks, step_rows, summary_entry
+from .tracking import ModeSet, Tracking, TrendFit, fit_trend, track_modes
 
 __all__ = [
     "MODE_COLUMNS",
@@ -74,7 +85,9 @@ MODE_COLUMNS: dict[str, str] = {
     "mode": "int",
     "family": "string",
     "slot": "string",
+    "match": "string",
     "match_mac": "float",
+    "match_z": "float",
     "frequency_hz": "float",
     "frequency_std_hz": "float",
     "damping_ratio": "float",
@@ -258,14 +271,23 @@ def mode_sets(runs: Sequence[TestRun], model: str) -> list[ModeSet]:
                 np.array([_float(m["damping_ratio"]) for m in recs]),
                 np.column_stack([m["shape"] for m in recs]),
                 tuple(recs[0]["points"]),
+                np.array([_float(m["frequency_std_hz"]) for m in recs]),
+                np.array([_float(m["damping_ratio_std"]) for m in recs]),
             )
         )
     return out
 
 
-def mode_rows(runs: Sequence[TestRun], model: str = "complex") -> list[dict[str, Any]]:
-    """The tidy table: one row per mode of every test, with conditions and family."""
-    tracking = track_modes(mode_sets(runs, model))
+def mode_rows(
+    runs: Sequence[TestRun], model: str = "complex", tracking: Tracking | None = None
+) -> list[dict[str, Any]]:
+    """The tidy table: one row per mode of every test, with conditions and family.
+
+    ``tracking`` is :func:`~.tracking.track_modes` of :func:`mode_sets` (computed
+    when not given).
+    """
+    if tracking is None:
+        tracking = track_modes(mode_sets(runs, model))
     rows = []
     for r in runs:
         for m in steps.mode_records(r.spec.study, r.documents, model):
@@ -278,7 +300,9 @@ def mode_rows(runs: Sequence[TestRun], model: str = "complex") -> list[dict[str,
                     "mode": m["mode"],
                     "family": tracking.family.get(q),
                     "slot": tracking.slot.get(q, ""),
+                    "match": tracking.method.get(q, ""),
                     "match_mac": tracking.mac.get(q),
+                    "match_z": tracking.distance.get(q),
                 }
             )
             for k in (
@@ -523,6 +547,8 @@ def _write_table(rows: Sequence[dict[str, Any]], columns: dict[str, str], stem: 
 _FILES = (
     "modes.parquet",
     "modes.csv",
+    "steps.parquet",
+    "steps.csv",
     "damping.parquet",
     "damping.csv",
     "trends.parquet",
@@ -547,12 +573,14 @@ def write_outputs(
     earlier = _summary(out)
     written = set() if earlier is None else set(_listed(earlier))
     model = campaign.tracking.get("model", "complex")
-    rows = mode_rows(runs, model)
+    tracking = track_modes(mode_sets(runs, model))
+    rows = mode_rows(runs, model, tracking)
     lrows = lateral_rows(runs)
     lat_obs, lat_quantities = lateral_trend_rows(lrows)
     fits = trend_fits(rows) + trend_fits(lat_obs, lat_quantities)
     trows = trend_rows(fits)
     drows = damping_rows(runs, rows)
+    srows = step_rows(runs, model)
     files = [*_FILES, *(["report.html"] if report else [])]
     docs = {
         (r.spec.test_id, step): f"tests/{r.spec.test_id}/{_DOC_FILES[step]}"
@@ -566,6 +594,7 @@ def write_outputs(
         out / "campaign.json",
     )
     _write_table(rows, MODE_COLUMNS, out / "modes")
+    _write_table(srows, STEP_COLUMNS, out / "steps")
     _write_table(drows, DAMPING_COLUMNS, out / "damping")
     _write_table(trows, TREND_COLUMNS, out / "trends")
     _write_table(lrows, LATERAL_COLUMNS, out / "lateral")
@@ -577,21 +606,8 @@ def write_outputs(
             rel = docs[(r.spec.test_id, step)]
             write_json(doc, out / rel)
             test_docs[step] = rel
-        tests.append(
-            {
-                "test_id": r.spec.test_id,
-                "file": r.spec.rel,
-                "study": r.spec.study,
-                "conditions": r.spec.conditions,
-                "sha256": r.digest,
-                "status": "ok" if r.ok else "failed",
-                "failed_step": r.failed_step,
-                "reason": r.reason,
-                "computed": r.computed,
-                "reused": r.reused,
-                "documents": test_docs,
-            }
-        )
+        mine = [x for x in srows if x["test_id"] == r.spec.test_id]
+        tests.append(summary_entry(r, mine, test_docs, model))
     families: dict[str, dict[str, Any]] = {}
     for row in rows:
         if row["family"] is None:
@@ -622,10 +638,22 @@ def write_outputs(
         "campaign_file": str(campaign.path),
         "n_tests": len(runs),
         "n_ok": sum(r.ok for r in runs),
+        "n_partial": sum(r.ok and bool(r.skipped) for r in runs),
         "n_failed": sum(not r.ok for r in runs),
+        "n_checks_failed": sum(bool(quality_checks(r, model)["failed"]) for r in runs),
+        "n_skipped_steps": sum(len(r.skipped) for r in runs),
         "steps_computed": sum(len(r.computed) for r in runs),
         "steps_reused": sum(len(r.reused) for r in runs),
         "tracking_model": model,
+        "tracking": {
+            "model": model,
+            "matched_by_shape": sum(r["match"] == "shape" for r in rows),
+            "matched_by_frequency": sum(r["match"] == "frequency" for r in rows),
+            # scatter of one mode between neighbouring tests (tracking module, step 4)
+            "scatter_ln_frequency": tracking.scatter.get("tau_f"),
+            "scatter_ln_damping_ratio": tracking.scatter.get("tau_zeta"),
+            "scatter_pairs": int(tracking.scatter.get("n", 0)),
+        },
         "families": fam_list,
         "tests": tests,
         "complete": True,
@@ -635,7 +663,7 @@ def write_outputs(
     }
 
     write_json(summary, out / "campaign.json")
-    return CampaignResults(summary, rows, fits, lrows, drows)
+    return CampaignResults(summary, rows, fits, lrows, drows, srows)
 
 
 @dataclass(frozen=True)
@@ -647,3 +675,4 @@ class CampaignResults:
     fits: list[tuple[dict[str, Any], TrendFit, list[dict[str, Any]]]]
     lateral: list[dict[str, Any]]
     damping: list[dict[str, Any]] = field(default_factory=list)
+    steps: list[dict[str, Any]] = field(default_factory=list)

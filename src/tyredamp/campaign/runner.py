@@ -4,7 +4,11 @@ The runner plans each test from the cache (:mod:`.cache`): the steps whose
 keys are stored are read back, the others are sent as one task per test to
 :func:`execute`, which runs them with BLAS limited to one thread and returns
 the new step documents, or the step that failed with its one-line reason. A
-failing test never stops the others. Results are stored in the cache as they
+failing test never stops the others. A step that cannot run on a test's data
+(:class:`.steps.StepSkipped`) comes back as a skip document: it is cached
+under its key like a result and listed in :attr:`TestRun.skipped`, so a rerun
+reads the skip from the cache instead of trying again; failures are not
+cached. Results are stored in the cache as they
 arrive, so an interruption loses nothing that finished. With Dask a task
 whose worker dies is run again on another worker (the scheduler's
 ``allowed-failures``, and ``retries`` on the task).
@@ -84,8 +88,12 @@ class TestRun:
         Cache key of each (enabled) step.
     documents : dict of str to dict
         The step documents available (from the cache or computed now).
+    skipped : dict of str to dict
+        The skip document (:func:`.steps.skip_document`: ``reason``, ``why``,
+        ``needs``) of every step that could not run on the test's data.
     computed, reused : list of str
-        Steps computed in this run and steps read from the cache.
+        Steps computed (or found to be skipped) in this run and steps read from
+        the cache (skips included).
     seconds, cpu_seconds : float
         Wall and CPU time of the task in this run (0 when nothing ran).
     failed_step, reason : str or None
@@ -97,6 +105,7 @@ class TestRun:
     spec: TestSpec
     keys: dict[str, str] = field(default_factory=dict)
     documents: dict[str, dict[str, Any]] = field(default_factory=dict)
+    skipped: dict[str, dict[str, Any]] = field(default_factory=dict)
     computed: list[str] = field(default_factory=list)
     reused: list[str] = field(default_factory=list)
     failed_step: str | None = None
@@ -107,8 +116,28 @@ class TestRun:
 
     @property
     def ok(self) -> bool:
-        """True when every enabled step has its document."""
-        return self.reason is None and all(s in self.documents for s in self.keys)
+        """True when no step failed: every enabled step has its document or was skipped."""
+        return self.reason is None and all(
+            s in self.documents or s in self.skipped for s in self.keys
+        )
+
+    def outcome(self, step: str) -> str:
+        """``"ran"``, ``"skipped"``, ``"failed"``, ``"not run"`` (after a failure) or ``"off"``."""
+        if step not in self.keys and self.digest is not None:
+            return "off"  # an optional step switched off in the settings
+        if step in self.documents:
+            return "ran"
+        if step in self.skipped:
+            return "skipped"
+        if step == self.failed_step:
+            return "failed"
+        return "not run"
+
+    def _put(self, step: str, doc: dict[str, Any]) -> None:
+        if steps.is_skip(doc):
+            self.skipped[step] = doc
+        else:
+            self.documents[step] = doc
 
 
 def execute(task: Task) -> Outcome:
@@ -185,7 +214,7 @@ def plan_tests(campaign: Campaign, cache: ResultCache) -> tuple[list[TestRun], l
             if doc is None:
                 todo.append(step)
             else:
-                run.documents[step] = doc
+                run._put(step, doc)
                 run.reused.append(step)
         if todo:
             tasks.append(
@@ -196,7 +225,7 @@ def plan_tests(campaign: Campaign, cache: ResultCache) -> tuple[list[TestRun], l
                     spec.rel,
                     run.digest,
                     tuple(todo),
-                    {s: run.documents[s] for s in run.reused},
+                    {s: run.documents.get(s) or run.skipped[s] for s in run.reused},
                     settings,
                     dict(spec.conditions),
                     tuple(run.keys[s] for s in todo),
@@ -210,7 +239,7 @@ def _record(run: TestRun, out: Outcome, cache: ResultCache) -> None:
         cache.put(
             run.keys[step], doc, {"test": run.spec.rel, "study": run.spec.study, "step": step}
         )
-        run.documents[step] = doc
+        run._put(step, doc)
         run.computed.append(step)
     run.failed_step, run.reason = out.failed_step, out.reason
     run.seconds, run.cpu_seconds = out.seconds, out.cpu_seconds

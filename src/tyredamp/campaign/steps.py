@@ -31,6 +31,25 @@ those of :mod:`tyredamp.documents` (the files the commands write):
   (a test where no model fits fails with the reasons); the document is
   :func:`tyredamp.documents.lateral.lateral_fit_document`.
 
+Skipped steps
+-------------
+A step that cannot run on a test's data is *skipped*, not failed: it raises
+:class:`StepSkipped` with the reason in words (which step, why, what data
+would let it run) before any computation, and the campaign records a *skip
+document* (:func:`skip_document`, ``kind`` ``"tyredamp-campaign-skip"``) in
+the step's place. A skip is cached under the step's key like any result
+(the same file, settings and tyredamp give the same skip), and every later
+step of the test is skipped with it. A *failed* step is a genuine error (a
+corrupt file, no modes, a bad setting); a step that ran but whose quality
+check or fit verdict failed has its document like any other. The radial
+``damping`` step is skipped when
+
+* the tracked model has fewer response points (outputs) than modes: the
+  damping matrix in physical coordinates inverts the real parts of the
+  shapes at the points (``N >= m``); or
+* no response was measured at an excitation point (no drive point): the
+  shapes are then not mass-normalised and ``C'`` has no physical scale.
+
 Settings
 --------
 Each study's settings are a nested dictionary ``{step: {key: value}}`` with
@@ -52,16 +71,29 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import InputError
+from .skips import (
+    SKIP_KIND,
+    StepSkipped,
+    damping_skip_reason,
+    is_skip,
+    skip_document,
+    upstream_skip,
+)
 
 __all__ = [
     "DEFAULTS",
+    "SKIP_KIND",
     "STUDIES",
+    "StepSkipped",
     "StudySteps",
     "TestResult",
+    "damping_skip_reason",
+    "is_skip",
     "mode_records",
     "process_lateral_test",
     "process_radial_test",
     "run_step",
+    "skip_document",
     "step_settings",
     "validate_settings",
 ]
@@ -460,6 +492,9 @@ def _radial_damping(
     from ..studies.radial import damping_from_modes
 
     ds = settings["damping"]
+    skip = damping_skip_reason(upstream["modal"], ds["model"])
+    if skip is not None:
+        raise skip
     models = models_from_document(dict(upstream["modal"]))
     if ds["model"] not in models:
         raise InputError(
@@ -558,17 +593,33 @@ def run_step(
         The study's complete settings (:func:`validate_settings`).
     conditions : dict, optional
         The test's conditions (the lateral fit uses ``speed_kmh``).
+
+    Raises
+    ------
+    StepSkipped
+        The step cannot run on this test's data (or a step before it was
+        skipped): the reason in words.
     """
+    skip = upstream_skip(STUDIES[study].steps, step, upstream)
+    if skip is not None:
+        raise skip
     fn = _STEP_FUNCTIONS[(study, step)]
     return fn(Path(path), upstream, settings, conditions)
 
 
 @dataclass(frozen=True)
 class TestResult:
-    """The documents of one test, by step name (``modal``, ``damping`` or ``fit``)."""
+    """The documents of one test, by step name (``modal``, ``damping`` or ``fit``).
+
+    ``skipped`` holds the skip document (:func:`skip_document`) of every step
+    that could not run on the test's data, by step name.
+    """
+
+    __test__ = False  # not a pytest class
 
     study: str
     documents: dict[str, dict[str, Any]]
+    skipped: dict[str, dict[str, Any]] = field(default_factory=dict)
 
 
 def _process(
@@ -578,8 +629,15 @@ def _process(
     docs: dict[str, dict[str, Any]] = {}
     for step in STUDIES[study].steps:
         if step_enabled(study, step, full):
-            docs[step] = plain(run_step(study, step, path, docs, full, conditions))
-    return TestResult(study, docs)
+            try:
+                docs[step] = plain(run_step(study, step, path, docs, full, conditions))
+            except StepSkipped as skip:
+                docs[step] = skip_document(study, step, skip.why, skip.needs)
+    return TestResult(
+        study,
+        {k: v for k, v in docs.items() if not is_skip(v)},
+        {k: v for k, v in docs.items() if is_skip(v)},
+    )
 
 
 def process_radial_test(
@@ -589,7 +647,8 @@ def process_radial_test(
 
     ``settings`` is the radial settings table (``{section: {key: value}}``,
     defaults of :data:`DEFAULTS`). Returns the ``modal`` and ``damping``
-    documents.
+    documents (the damping step skipped, with its reason, when the test's
+    data cannot give a damping matrix).
     """
     return _process("radial", path, conditions, settings)
 
@@ -619,7 +678,8 @@ def run_steps_from_bytes(
     Returns
     -------
     documents : dict of str to dict
-        The documents of the steps that finished (as :func:`plain` gives them).
+        The documents of the steps that finished (as :func:`plain` gives them),
+        a skip document (:func:`skip_document`) for a step that could not run.
     failure : (str, str) or None
         The step that failed and its one-line reason; the later steps are not run.
     """
@@ -631,6 +691,8 @@ def run_steps_from_bytes(
         for step in steps:
             try:
                 doc = plain(run_step(study, step, path, docs, settings, conditions))
+            except StepSkipped as skip:  # not a failure: recorded (and cached) as a skip
+                doc = skip_document(study, step, skip.why, skip.needs)
             except Exception as exc:  # any failure of one test is that test's result
                 # name the test file as the campaign knows it, not the temporary copy
                 reason = _one_line(exc).replace(str(path), name).replace(tmp, "")
@@ -657,7 +719,7 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
     inputs, a roving-hammer test) and ``shape`` (complex, one per point). A
     lateral test has no modes (empty list).
     """
-    if study != "radial" or "modal" not in documents:
+    if study != "radial" or "modal" not in documents or is_skip(documents["modal"]):
         return []
     models = documents["modal"]["models"]
     name = model if model in models else sorted(models)[0]
@@ -669,6 +731,8 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
         for o in m["inputs" if at_inputs else "outputs"]
     ]
     damp = documents.get("damping")
+    if is_skip(damp):
+        damp = None
     cdiag: list[float] | None = None
     cstd: list[float] | None = None
     if damp is not None and damp.get("meta", {}).get("model") == name:
@@ -703,7 +767,7 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
 def lateral_records(documents: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One record per fitted lateral model of a test: rank, name, BIC/AIC, parameters."""
     doc = documents.get("fit")
-    if doc is None:
+    if doc is None or is_skip(doc):
         return []
     ranks = {row["model"]: row for row in doc["table"]}
     out = []

@@ -29,6 +29,30 @@ physical mode seen at different pressures, loads, speeds, tyres):
    mode is closer to this family than its look-alike neighbour was, which
    also keeps spatially aliased wave numbers apart); modes left over start
    new families. Shapes are compared at the points common to both tests.
+4. Where the MAC cannot be formed (fewer than 2 points common to the two
+   tests: one response point each, as with a single accelerometer or a
+   roving hammer, or shapes at disjoint points), modes are matched by
+   frequency and damping instead. The distance is
+
+   ``z^2 = ln(f_u / f_r)^2 / s_f^2 + ln(zeta_u / zeta_r)^2 / s_zeta^2``,
+
+   ``s_f^2 = (sigma_f,u / f_u)^2 + (sigma_f,r / f_r)^2 + tau_f^2`` (and the same
+   for the damping ratio): the identification's standard errors of both modes
+   plus ``tau``, the scatter of the same mode between tests. ``tau`` comes from
+   the campaign's own data (:func:`mode_scatter`): for every test and the
+   already visited test nearest to it in conditions, the modes that are each
+   other's nearest neighbour in frequency, and nearer to each other than half
+   the distance to any other mode of either test, are taken as the same
+   mode; ``tau`` is the scatter of their log ratios, ``1.4826 median |ln ratio|``
+   (the median absolute deviation about zero, robust to the occasional wrong
+   pair). Under the hypothesis that two modes are one, ``z^2`` is
+   chi-square with 2 degrees of freedom (1 without a positive damping ratio
+   on both sides), and a match is admissible when ``z^2`` is below its
+   ``1 - 1e-3`` quantile (:data:`FALLBACK_ALPHA`) *and* the frequencies are
+   nearer than half the distance to any other mode of either test (a match
+   must be unambiguous). The assignment then uses the cost ``z^2 / limit``
+   (below 1, as the MAC cost of an admissible match). A mode matched this
+   way has no match MAC (NaN) and its ``method`` is ``"frequency"``.
 
 Trends
 ------
@@ -62,18 +86,25 @@ from scipy.optimize import linear_sum_assignment
 from ..exceptions import InputError
 
 __all__ = [
+    "FALLBACK_ALPHA",
     "MAC_MIN",
     "ModeSet",
     "Tracking",
     "TrendFit",
     "fit_trend",
     "group_pairs",
+    "mode_scatter",
+    "single_member_wave_numbers",
     "subspace_mac",
     "track_modes",
 ]
 
 #: Smallest (subspace) MAC of an admissible match: the shapes share more than they do not.
 MAC_MIN = 0.5
+#: Significance level of the frequency-and-damping match where the MAC cannot be formed.
+FALLBACK_ALPHA = 1e-3
+#: Fewest points common to two tests for their shapes to be compared by the MAC.
+MIN_COMMON_POINTS = 2
 _FAR = 1.0e6
 
 
@@ -93,6 +124,9 @@ class ModeSet:
         Mode shapes at the points (any scaling).
     points : tuple of str
         Point labels (rows of ``shapes``).
+    frequency_std_hz, damping_ratio_std : ndarray, shape (m,), optional
+        Standard errors of the frequencies (Hz) and damping ratios (NaN or
+        None where unknown, taken as 0); used where shapes cannot be compared.
     """
 
     test_id: str
@@ -101,10 +135,20 @@ class ModeSet:
     damping_ratio: NDArray[np.float64]
     shapes: NDArray[np.complex128]
     points: tuple[str, ...]
+    frequency_std_hz: NDArray[np.float64] | None = None
+    damping_ratio_std: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         f = np.asarray(self.frequency_hz, dtype=float).reshape(-1)
         z = np.asarray(self.damping_ratio, dtype=float).reshape(-1)
+        for name in ("frequency_std_hz", "damping_ratio_std"):
+            v = getattr(self, name)
+            v = np.full(f.size, np.nan) if v is None else np.asarray(v, dtype=float).reshape(-1)
+            if v.size != f.size:
+                raise InputError(
+                    f"ModeSet {self.test_id}: expected {f.size} values of {name}, got {v.size}"
+                )
+            object.__setattr__(self, name, v)
         s = np.asarray(self.shapes, dtype=complex)
         if s.ndim != 2 or s.shape[1] != f.size or z.size != f.size:
             raise InputError(
@@ -186,6 +230,122 @@ class _Unit:
     test: int
     modes: tuple[int, ...]
     frequency: float
+    damping: float = math.nan
+    frequency_std: float = 0.0
+    damping_std: float = 0.0
+
+
+def _units(s: ModeSet, i: int) -> list[_Unit]:
+    """The matching units (pairs and singles) of one test, with their mean f and zeta."""
+    out = []
+    for u in group_pairs(s.frequency_hz, s.damping_ratio):
+        q = list(u)
+        sf = np.nan_to_num(s.frequency_std_hz[q], nan=0.0)  # type: ignore[index]
+        sz = np.nan_to_num(s.damping_ratio_std[q], nan=0.0)  # type: ignore[index]
+        out.append(
+            _Unit(
+                i,
+                u,
+                float(np.mean(s.frequency_hz[q])),
+                float(np.mean(s.damping_ratio[q])),
+                float(np.sqrt(np.sum(sf**2)) / len(q)),  # standard error of the mean
+                float(np.sqrt(np.sum(sz**2)) / len(q)),
+            )
+        )
+    return out
+
+
+def _log_ratio(a: float, b: float) -> float:
+    return math.log(a / b) if a > 0 and b > 0 and math.isfinite(a / b) else math.nan
+
+
+def _nearest_gap(unit: _Unit, others: Sequence[_Unit]) -> float:
+    """Distance (Hz) from ``unit`` to the nearest other unit of its test (inf: none)."""
+    gaps = [abs(unit.frequency - o.frequency) for o in others if o is not unit]
+    return min(gaps, default=math.inf)
+
+
+def mode_scatter(
+    sets: Sequence[ModeSet], order: Sequence[int] | None = None
+) -> tuple[float, float, int]:
+    """Scatter of the same mode's ``ln f`` and ``ln zeta`` between neighbouring tests.
+
+    For every test (in ``order``, default the tracking order) and the already
+    visited test nearest to it in conditions, the units (modes, or pairs of
+    overlapping modes) that are each other's nearest neighbour in frequency
+    and nearer to each other than half the distance to any other unit of
+    either test are taken as one mode (module docstring, step 4).
+
+    Returns
+    -------
+    tau_f, tau_zeta : float
+        ``1.4826 median |ln(f_u / f_r)|`` and the same for the damping ratios
+        (0 when there is no such pair).
+    n : int
+        Number of pairs of modes the scatter is taken from.
+    """
+    names = _numeric_conditions(sets)
+    dist = _distance_fn(sets)
+    if order is None:
+        order = sorted(range(len(sets)), key=lambda i: _sort_key(sets[i], names))
+    units = {i: _units(sets[i], i) for i in order}
+    rf: list[float] = []
+    rz: list[float] = []
+    visited: list[int] = []
+    for i in order:
+        if visited and units[i]:
+            j = min(visited, key=lambda t: (dist(sets[i], sets[t]), t))
+            rf_ij, rz_ij = _mutual_nearest(units[j], units[i])
+            rf += rf_ij
+            rz += rz_ij
+        visited.append(i)
+    k = 1.4826  # MAD -> standard deviation for normal scatter
+    tau_f = k * float(np.median(np.abs(rf))) if rf else 0.0
+    zs = [v for v in rz if math.isfinite(v)]
+    tau_z = k * float(np.median(np.abs(zs))) if zs else 0.0
+    return tau_f, tau_z, len(rf)
+
+
+def _mutual_nearest(a: Sequence[_Unit], b: Sequence[_Unit]) -> tuple[list[float], list[float]]:
+    """Log ratios (f, zeta) of the unambiguous mutual nearest neighbours of ``a`` and ``b``."""
+    if not a or not b:
+        return [], []
+    fa = np.array([u.frequency for u in a])
+    fb = np.array([u.frequency for u in b])
+    d = np.abs(fa[:, None] - fb[None, :])
+    rf, rz = [], []
+    for x in range(len(a)):
+        y = int(np.argmin(d[x]))
+        if int(np.argmin(d[:, y])) != x:
+            continue
+        half = 0.5 * min(_nearest_gap(a[x], a), _nearest_gap(b[y], b))
+        if d[x, y] < half:
+            rf.append(_log_ratio(b[y].frequency, a[x].frequency))
+            rz.append(_log_ratio(b[y].damping, a[x].damping))
+    return rf, rz
+
+
+def _fallback_z2(rep: _Unit, unit: _Unit, tau_f: float, tau_z: float) -> tuple[float, int]:
+    """``z^2`` of two units by frequency and damping (module docstring, step 4), its dof."""
+    r = _log_ratio(unit.frequency, rep.frequency)
+    var = (rep.frequency_std / rep.frequency) ** 2 + (unit.frequency_std / unit.frequency) ** 2
+    var += tau_f**2
+    z2 = _ratio2(r, var)
+    dof = 1
+    rz = _log_ratio(unit.damping, rep.damping)
+    if math.isfinite(rz):
+        vz = (rep.damping_std / rep.damping) ** 2 + (unit.damping_std / unit.damping) ** 2
+        z2 += _ratio2(rz, vz + tau_z**2)
+        dof = 2
+    return z2, dof
+
+
+def _ratio2(r: float, var: float) -> float:
+    if not math.isfinite(r):
+        return math.inf
+    if var > 0:
+        return r * r / var
+    return 0.0 if r == 0 else math.inf
 
 
 @dataclass
@@ -202,15 +362,28 @@ class Tracking:
         pair.
     mac : dict of (test_id, mode index) to float
         The (subspace) MAC of the match that put the mode in its family (NaN
-        for the mode that started the family).
+        for the mode that started the family and for a match by frequency).
+    method : dict of (test_id, mode index) to str
+        How the mode joined its family: ``"shape"`` (MAC), ``"frequency"``
+        (frequency and damping, where the MAC cannot be formed) or ``""`` (it
+        started the family).
+    distance : dict of (test_id, mode index) to float
+        ``z`` of a match by frequency and damping (module docstring, step 4;
+        NaN otherwise).
     pairs : set of str
         Families holding a pair in at least one test.
+    scatter : dict
+        ``tau_f``, ``tau_zeta`` and ``n`` of :func:`mode_scatter` (used by the
+        matches by frequency).
     """
 
     family: dict[tuple[str, int], str] = field(default_factory=dict)
     slot: dict[tuple[str, int], str] = field(default_factory=dict)
     mac: dict[tuple[str, int], float] = field(default_factory=dict)
+    method: dict[tuple[str, int], str] = field(default_factory=dict)
+    distance: dict[tuple[str, int], float] = field(default_factory=dict)
     pairs: set[str] = field(default_factory=set)
+    scatter: dict[str, float] = field(default_factory=dict)
 
 
 def _numeric_conditions(sets: Sequence[ModeSet]) -> list[str]:
@@ -265,30 +438,42 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
     -------
     Tracking
     """
+    from scipy.stats import chi2
+
     names = _numeric_conditions(sets)
     dist = _distance_fn(sets)
     order = sorted(range(len(sets)), key=lambda i: _sort_key(sets[i], names))
-    units: list[list[_Unit]] = [[] for _ in sets]
-    for i, s in enumerate(sets):
-        for u in group_pairs(s.frequency_hz, s.damping_ratio):
-            units[i].append(_Unit(i, u, float(np.mean(s.frequency_hz[list(u)]))))
+    units: list[list[_Unit]] = [_units(s, i) for i, s in enumerate(sets)]
+    tau_f, tau_z, n_scatter = mode_scatter(sets, order)
+    limit = {k: float(chi2.ppf(1.0 - FALLBACK_ALPHA, k)) for k in (1, 2)}
     members: list[dict[int, _Unit]] = []  # family -> {test index: unit}
-    match_mac: dict[tuple[int, tuple[int, ...]], float] = {}
-    visited: list[int] = []
+    # how each unit joined its family: (method, MAC, z)
+    how: dict[tuple[int, tuple[int, ...]], tuple[str, float, float]] = {}
     for i in order:
         s = sets[i]
         cur = units[i]
         if not cur:
-            visited.append(i)
             continue
         reps: list[_Unit] = []
         for fam in members:
             j = min(fam, key=lambda t: (dist(s, sets[t]), t))
             reps.append(fam[j])
         cost = np.full((len(reps), len(cur)), _FAR)
-        macs = np.zeros((len(reps), len(cur)))
+        macs = np.full((len(reps), len(cur)), np.nan)
+        zs = np.full((len(reps), len(cur)), np.nan)
         for a, rep in enumerate(reps):
             rs = sets[rep.test]
+            common = [p for p in rs.points if p in s.points]
+            if len(common) < MIN_COMMON_POINTS:
+                # no shapes to compare: frequency and damping (module docstring, step 4)
+                gap_r = _nearest_gap(rep, units[rep.test])
+                for b, unit in enumerate(cur):
+                    df = abs(unit.frequency - rep.frequency)
+                    z2, dof = _fallback_z2(rep, unit, tau_f, tau_z)
+                    zs[a, b] = math.sqrt(z2)
+                    if z2 < limit[dof] and 2 * df < min(gap_r, _nearest_gap(unit, cur)):
+                        cost[a, b] = z2 / limit[dof]
+                continue
             own = rs.shapes[:, list(rep.modes)]
             alike = [
                 u.frequency
@@ -296,9 +481,6 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
                 if u is not rep and subspace_mac(own, rs.shapes[:, list(u.modes)]) >= MAC_MIN
             ]
             gap = min((abs(rep.frequency - f) for f in alike), default=math.inf)
-            common = [p for p in rs.points if p in s.points]
-            if len(common) < 2:
-                continue
             ur = _shapes_at(rs, rep.modes, common)
             for b, unit in enumerate(cur):
                 m = subspace_mac(ur, _shapes_at(s, unit.modes, common))
@@ -313,16 +495,20 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
             for a, b in zip(rows, cols, strict=True):
                 if cost[a, b] < _FAR:
                     members[a][i] = cur[b]
-                    match_mac[(i, cur[b].modes)] = float(macs[a, b])
+                    by_shape = bool(np.isfinite(macs[a, b]))
+                    how[(i, cur[b].modes)] = (
+                        ("shape", float(macs[a, b]), math.nan)
+                        if by_shape
+                        else ("frequency", math.nan, float(zs[a, b]))
+                    )
                     taken.add(int(b))
         for b, unit in enumerate(cur):
             if b not in taken:
                 members.append({i: unit})
-                match_mac[(i, unit.modes)] = float("nan")
-        visited.append(i)
+                how[(i, unit.modes)] = ("", math.nan, math.nan)
     # name families by increasing median frequency
     med = [float(np.median([u.frequency for u in fam.values()])) for fam in members]
-    result = Tracking()
+    result = Tracking(scatter={"tau_f": tau_f, "tau_zeta": tau_z, "n": float(n_scatter)})
     for rank, k in enumerate(np.argsort(med, kind="stable")):
         name = f"F{rank + 1}"
         fam = members[int(k)]
@@ -334,6 +520,7 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
             tid = sets[t].test_id
             f = sets[t].frequency_hz
             ordered = sorted(unit.modes, key=lambda q: f[q])
+            method, mac, z = how[(t, unit.modes)]
             for pos, q in enumerate(ordered):
                 if len(ordered) == 2:
                     slot = "ab"[pos]
@@ -343,7 +530,9 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
                     slot = ""
                 result.family[(tid, q)] = name
                 result.slot[(tid, q)] = slot
-                result.mac[(tid, q)] = match_mac[(t, unit.modes)]
+                result.mac[(tid, q)] = mac
+                result.method[(tid, q)] = method
+                result.distance[(tid, q)] = z
     return result
 
 
@@ -361,6 +550,46 @@ def _pair_slot_means(sets: Sequence[ModeSet], fam: Mapping[int, _Unit]) -> tuple
 
 def _nearest_slot(f: float, means: tuple[float, float]) -> str:
     return "a" if abs(f - means[0]) <= abs(f - means[1]) else "b"
+
+
+# ---------------------------------------------------------------------- excitation
+def single_member_wave_numbers(
+    input_angles_deg: Sequence[float], n_max: int, ratio: float = 0.1
+) -> list[int]:
+    """Wave numbers of which the excitation drives only one member of the doubled pair.
+
+    The doubled modes of wave number ``n`` of a ring have the shapes
+    ``cos n(theta - theta_0)`` and ``sin n(theta - theta_0)``; shakers at the
+    angles ``theta_k`` drive them through the rows ``[cos n theta_k, sin n theta_k]``.
+    When this ``K x 2`` matrix has rank one, every shaker sits on a nodal line of
+    the same member, whatever ``theta_0``, and that member never appears in
+    the FRFs (for two shakers 90 deg apart: every even ``n``; for one shaker:
+    every ``n``). A wave number is listed when the smaller singular value of
+    the matrix is below ``ratio`` times the larger.
+
+    Parameters
+    ----------
+    input_angles_deg : sequence of float
+        Angular positions of the excitations, degrees.
+    n_max : int
+        Largest wave number to check (for ``N`` equally spaced points the
+        spatial Nyquist limit ``N // 2``).
+    ratio : float
+        Singular value ratio below which the second member counts as not driven.
+
+    Returns
+    -------
+    list of int
+        The wave numbers ``1..n_max`` with only one driven member.
+    """
+    th = np.radians(np.asarray(input_angles_deg, dtype=float).reshape(-1))
+    out = []
+    for n in range(1, int(n_max) + 1):
+        a = np.column_stack([np.cos(n * th), np.sin(n * th)])
+        sv = np.linalg.svd(a, compute_uv=False)
+        if sv.size < 2 or sv[1] < ratio * sv[0]:
+            out.append(n)
+    return out
 
 
 # ---------------------------------------------------------------------- trends

@@ -113,7 +113,9 @@ def campaign_command(
     version: a rerun recomputes only what changed, and an interrupted
     campaign resumes. A test that fails is reported with its reason and does
     not stop the others (exit code 1 when any failed, after every result is
-    written). Writes the tidy mode table (Parquet and CSV), the mode
+    written). A step that cannot run on a test's data (e.g. the damping
+    matrix of a test with one response point) is skipped with its reason,
+    and the test's other results are kept. Writes the tidy mode table (Parquet and CSV), the mode
     families' trends, each test's documents and report.html.
 
     \b
@@ -159,20 +161,26 @@ def campaign_command(
         write_campaign_report(results, out_dir)
     s = results.summary
     dt = time.perf_counter() - t0
+    partial = f" ({s['n_partial']} with skipped steps)" if s["n_partial"] else ""
+    checks = f"; {s['n_checks_failed']} with a failed quality check" if s["n_checks_failed"] else ""
     click.echo(
-        f"campaign {campaign.name}: {s['n_tests']} tests, {s['n_ok']} ok, {s['n_failed']} failed; "
+        f"campaign {campaign.name}: {s['n_tests']} tests, {s['n_ok']} ok{partial}, "
+        f"{s['n_failed']} failed{checks}; "
         f"{s['steps_computed']} steps computed, {s['steps_reused']} from the cache; "
         f"{len(s['families'])} mode families; {dt:.1f} s ({mode})"
     )
     for t in s["tests"]:
-        if t["status"] != "ok":
+        for reason in t["skipped"].values():  # the data cannot give this result: not an error
+            click.echo(f"skipped: {t['file']}: {reason}")
+    for t in s["tests"]:
+        if t["status"] == "failed":
             reason = str(t["reason"])
             # the reason names the file when the reader raised it; say it once
             click.echo(
                 f"failed: {reason if reason.startswith(t['file']) else t['file'] + ': ' + reason}"
             )
     click.echo(
-        f"wrote {out_dir}/ (modes.parquet, modes.csv, trends.csv, campaign.json"
+        f"wrote {out_dir}/ (modes.parquet, modes.csv, steps.csv, trends.csv, campaign.json"
         + ("" if no_report else ", report.html")
         + ")"
     )
