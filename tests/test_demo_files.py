@@ -15,7 +15,10 @@ from numpy.testing import assert_allclose, assert_array_equal
 from tyredamp.cli import main
 from tyredamp.io import read_frf, read_timedata
 from tyredamp.lateral import DEFAULT_MODELS, LateralData, rank_models
+from tyredamp.report._cells import anchor_id
+from tyredamp.studies.findings import outcome_groups
 from tyredamp.studies.results import DemoResult
+from tyredamp.studies.verdicts import CAUSE_MEANING
 
 from .test_studies_demo import quick_demo
 
@@ -137,12 +140,39 @@ def test_every_stage_warning_reaches_the_report_beside_its_result(
         assert any(core in m for m in messages), w
     fnd = demo_findings(result)
     assert [f.to_dict() for f in fnd.findings] == doc["warnings"]
-    assert doc["warnings"]  # the quick demo has failures to report (9 bar, real modes)
+    assert doc["warnings"]  # the quick demo has findings to report (9 bar, real modes)
+    summary = page[: page.index('<h2 id="s2"')]
     for w in doc["warnings"]:
         text = html.escape(w["message"])
         where = "radial" if w["about"].startswith("radial") else "lateral"
-        assert text in sec[where], w  # beside the result it concerns
-        assert page.count(text) >= 2, w  # and in the summary's list
+        anchor = f'id="{anchor_id(w["about"])}"'
+        assert page.count(anchor) == 1, w  # the result has one place in the page
+        assert anchor in sec[where], w  # in the section of the result it concerns
+        # the summary's list links to it
+        assert f'href="#{anchor_id(w["about"])}"' in summary, w
+        if w["severity"] == "expected":
+            # a miss the data explain: its fit beside the result in a neutral block, its
+            # cause's meaning once in the page, never as a failure
+            v = _verdict_of(doc, w)
+            at = sec[where].index(html.escape(v["subject"]) + ": residual")
+            box = sec[where].rfind('<div class="verdict', 0, at)
+            assert sec[where].startswith('<div class="verdict expected"', box), w
+            assert "FAILED" not in w["message"]
+            meaning = html.escape(CAUSE_MEANING[v["expected_cause"]][1:])
+            assert page.count(meaning) == 1, w
+        else:
+            assert page.count(text) == 1, w  # stated once, beside the result it concerns
+            assert text in sec[where], w
+
+
+def _verdict_of(doc: dict, w: dict) -> dict:
+    """The verdict a finding about a fit states."""
+    if w["about"].startswith("radial:"):
+        p = float(w["about"].split(":", 1)[1])
+        pr = next(x for x in doc["radial"]["pressures"] if x["pressure_bar"] == p)
+        return pr["verdict"][w["fit"]]
+    c = next(x for x in doc["lateral"]["conditions"] if f"lateral:{x['label']}" == w["about"])
+    return c["verdicts"][w["fit"]]
 
 
 def test_every_pressure_and_condition_fits_or_says_why(demo: tuple[DemoResult, Path]) -> None:
@@ -154,29 +184,52 @@ def test_every_pressure_and_condition_fits_or_says_why(demo: tuple[DemoResult, P
     doc = json.loads((out / "results.json").read_text())
     page = (out / "report.html").read_text(encoding="utf-8")
     rows = dict(demo_summary_rows(result, doc))
+    groups = outcome_groups(doc)
     verdicts = []
     for pr in doc["radial"]["pressures"]:
         for name in ("complex", "real"):
-            verdicts.append((f"{name}-mode fit {pr['pressure_bar']:g} bar", pr["verdict"][name]))
+            verdicts.append(
+                (f"{name}-mode fit", f"{pr['pressure_bar']:g} bar", pr["verdict"][name])
+            )
     for c in doc["lateral"]["conditions"]:
-        verdicts.append((f"{c['best']} fit {c['label']}", c["verdict"]))
+        verdicts.append(("best lateral fit", c["label"], c["verdict"]))
     assert len(verdicts) == 2 * len(result.radial.runs) + len(result.lateral.conditions)
     # every warning reaches the summary too (failures through the verdict rows)
     shown = " ".join(rows.values())
     for w in doc["warnings"]:
         if w["severity"] == "warning":
             assert w["message"] in shown, w
-    for key, v in verdicts:
+    for kind, label, v in verdicts:
         if v["status"] == "ok":
+            assert v["outcome"] == "ok"
             assert v["residual_to_noise"] <= v["threshold"]
-            assert rows[key] == "within noise"
-            continue
-        assert v["status"] == "failed"
-        assert v["reasons"], key
-        assert rows[key].startswith("FAILED")
-        assert rows[key] == v["brief"]
-        assert v["reasons"][-1] in rows[key]  # the likely cause
-        assert f'<div class="verdict bad">{html.escape(v["summary"])}</div>' in page
+        else:
+            assert v["status"] == "failed"
+            assert v["residual_to_noise"] > v["threshold"]
+            assert v["reasons"], v["subject"]
+        # each verdict in exactly one row of the summary, which says its outcome
+        about = ("radial:" + label[: -len(" bar")]) if kind != "best lateral fit" else label
+        mine = [
+            g
+            for g in groups
+            if g.title.startswith(kind) and any(a.endswith(about) for a in g.about)
+        ]
+        assert len(mine) == 1, v["subject"]
+        g = mine[0]
+        assert rows[g.title] == g.detail
+        if v["outcome"] == "failed":
+            assert g.title == v["subject"]
+            assert rows[v["subject"]] == v["brief"]
+            assert rows[v["subject"]].startswith("FAILED")
+            assert v["reasons"][-1] in rows[v["subject"]]  # the likely cause
+            summary = html.escape(v["summary"])
+            assert page.count(f'<div class="verdict bad">{summary}</div>') == 1
+        elif v["outcome"] == "expected":
+            assert g.detail.startswith("expected")
+            assert v["expected_cause"] in g.detail
+            assert "FAILED" not in g.detail + v["summary"] + v["brief"]
+        else:
+            assert g.detail.startswith("within noise")
     # the 9 bar fit misses its band-edge mode: failed, and the report says why
     nine = next(p for p in doc["radial"]["pressures"] if p["pressure_bar"] == 9.0)
     reasons = " ".join(nine["verdict"]["complex"]["reasons"])
@@ -290,8 +343,8 @@ def test_files_report_shows_the_demo_verdicts_and_warnings(
     page = build_files_report([out / "results.json"])
     for pr in doc["radial"]["pressures"]:
         for v in pr["verdict"].values():
-            cls = "verdict" if v["passed"] else "verdict bad"
-            assert f'<div class="{cls}">{html.escape(v["summary"])}</div>' in page
+            cls = {"ok": "verdict", "expected": "verdict expected", "failed": "verdict bad"}
+            assert f'<div class="{cls[v["outcome"]]}">{html.escape(v["summary"])}</div>' in page
     for w in doc["warnings"]:
         assert html.escape(w["message"]) in page
 

@@ -539,7 +539,8 @@ def _demo_section(rep: HtmlReport, item: ResultFile) -> None:
     for c in lat.get("conditions", []):
         if c.get("verdict"):
             _verdict(rep, c["verdict"])
-    ws = doc.get("warnings", [])
+    # the fit verdicts are stated above; the other findings of every stage here
+    ws = [w for w in doc.get("warnings", []) if not w.get("fit")]
     if ws:
         rep.paragraph(f"Warnings of every stage of the run ({len(ws)}):")
         rep.bullets([f"{w['stage']}: {w['message']}" for w in ws])
