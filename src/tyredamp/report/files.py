@@ -43,7 +43,8 @@ from ..io import FILE_FORMATS, read
 from ..io._common import check_input_file
 from ..modal.model import ModalModel
 from ..timedata import TimeData
-from .build import _verdict, fmt_pm
+from ._outcomes import _verdict
+from .build import fmt_pm
 from .html import HtmlReport
 
 __all__ = ["ResultFile", "build_files_report", "load_result_file"]

@@ -45,7 +45,8 @@ h2{break-before:page;margin-top:0}h2#s1{break-before:auto}h2,h3,h4{break-after:a
 figure,table,.verdict,.warn,ul.findings li{break-inside:avoid}
 figure{margin:.5em 0}img{max-height:23cm;max-width:100%;width:auto}
 a{color:inherit;text-decoration:none}
-.first table{font-size:8.5pt;margin:.3em 0 .6em 0}.first td,.first th{padding:.1em .4em}
+.first table{font-size:8.5pt;margin:.3em 0 .6em 0}.first td,.first th{padding:.1em .4em;
+text-align:left}
 .first p{margin:.3em 0}ul.findings{margin:.2em 0}ul.findings li{margin:.15em 0}
 .verdict,.warn,ul.findings li{-webkit-print-color-adjust:exact;print-color-adjust:exact}}
 """

@@ -526,20 +526,22 @@ def modal_fit_verdict(
     cause = why = ""
     # a miss that only the model form explains (no expected mode lost) is a result
     if status == "failed" and form and better is not None and not missing:
-        if getattr(model, "mode_kind", None) == "real":
-            cause = CAUSE_NON_PROPORTIONAL
-            why = (
-                f"the {better.subject} of the same band is within the noise, so the damping "
-                "couples the modes, which real modes cannot hold: an identification result, "
-                "not a failure of the fit"
-            )
-        else:
-            cause = CAUSE_MODEL_FORM
-            why = (
-                f"the {better.subject} of the same band is within the noise, so this model's "
-                "form cannot hold the data: an identification result, not a failure of the fit"
-            )
+        cause, why = _form_cause(model, better)
     return FitVerdict(subject, status, tuple(reasons), tuple(cautions), test, cause, why)
+
+
+def _form_cause(model: Any, better: FitVerdict) -> tuple[str, str]:
+    """Cause and explanation of a modal model's miss beside a better model within the noise."""
+    if getattr(model, "mode_kind", None) == "real":
+        return CAUSE_NON_PROPORTIONAL, (
+            f"the {better.subject} of the same band is within the noise, so the damping "
+            "couples the modes, which real modes cannot hold: an identification result, "
+            "not a failure of the fit"
+        )
+    return CAUSE_MODEL_FORM, (
+        f"the {better.subject} of the same band is within the noise, so this model's "
+        "form cannot hold the data: an identification result, not a failure of the fit"
+    )
 
 
 def lateral_fit_verdict(
