@@ -475,3 +475,27 @@ def test_a_genuine_failure_is_stated_once_beside_its_result(demo: tuple[DemoResu
     # the other pressures' real-mode fits stay expected
     others = [p for p in doc["radial"]["pressures"] if p is not pr]
     assert all(p["verdict"]["real"]["outcome"] == "expected" for p in others)
+
+
+def test_a_failed_check_is_stated_once_in_red(demo: tuple[DemoResult, Path]) -> None:
+    """A check that fails on the data is a genuine failure: red, once, beside the checks;
+    the summary links to it and states nothing itself."""
+    import html
+    from dataclasses import replace
+
+    from tyredamp.report.build import build_demo_report
+    from tyredamp.studies.document import build_results
+
+    result, _ = demo
+    summary = "linearity: FAIL - 12 % RMS between the force levels (threshold 5 %)"
+    bad = replace(result.radial.linearity, passed=False, summary=summary)
+    res2 = replace(result, radial=replace(result.radial, linearity=bad))
+    doc = build_results(res2)
+    page = build_demo_report(res2, doc, {})
+    text = html.escape(summary)
+    assert page.count(text) == 1
+    assert f'<div class="verdict bad">{text}</div>' in _sections(page)["radial"]
+    first = page[: page.index('<h2 id="s2"')]
+    assert '<li class="failed"><a href="#radial-checks">radial checks</a>: failed.</li>' in first
+    assert "No genuine failure" not in first
+    assert page.count('id="radial-checks"') == 1

@@ -144,6 +144,9 @@ def _findings(rep: HtmlReport, doc: dict[str, Any]) -> None:
         title = html.escape(g.title)
         span = g.residual + " the noise" if g.residual else ""
         if g.outcome == "failed":
+            if g.stage:  # a check or the tyre model: its name is the link
+                items.append(f'<li class="failed">{links}: failed.</li>')
+                continue
             what = "does not fit within the noise" if span.startswith("residual") else "failed"
             text = f"{title}: {what}" + (f" ({html.escape(span)})" if span else "")
             items.append(f'<li class="failed">{text}: see {links}.</li>')
