@@ -128,7 +128,7 @@ def test_report_sections_and_self_contained(demo: tuple[DemoResult, Path]) -> No
         "Model ranking",
         "Vehicle model and time response",
     ):
-        assert f"<h3>{sub}</h3>" in html
+        assert re.search(rf'<h3( id="[a-z0-9-]+")?>{re.escape(sub)}</h3>', html), sub
     n_png = len(list((out / "figures").glob("*.png")))
     assert html.count('src="data:image/png;base64,') == n_png
     # readable offline: no external resource of any kind
@@ -285,7 +285,10 @@ def test_tyre_model_failure_is_reported_not_raised(
     assert len(w) == 1
     assert w[0]["severity"] == "failed"
     html = build_demo_report(res2, doc, {})
-    assert html.count("Tyre model not fitted: InputError: model: no n = 1 mode") == 2
+    # stated once, in its section; the summary links to it
+    assert html.count("Tyre model not fitted: InputError: model: no n = 1 mode") == 1
+    assert html.count('class="verdict bad"') == 1  # the one failure, in red
+    assert 'href="#radial-tyre-model"' in html[: html.index('<h2 id="s2"')]
     from tyredamp.cli.demo import demo_summary_rows
 
     rows = dict(demo_summary_rows(res2, doc))

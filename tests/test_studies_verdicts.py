@@ -9,7 +9,11 @@ from tyredamp import Channel
 from tyredamp.frf import FRF
 from tyredamp.modal.model import ModalModel
 from tyredamp.studies.verdicts import (
+    CAUSE_MODEL_FORM,
+    CAUSE_NON_PROPORTIONAL,
+    CAUSE_OUTSIDE_FAMILY,
     frf_noise_variance,
+    lateral_family_verdicts,
     lateral_fit_verdict,
     modal_fit_verdict,
     noise_test,
@@ -113,6 +117,43 @@ def test_a_model_form_misfit_at_the_edge_is_not_a_missing_mode() -> None:
     assert v.test is not None
     assert v.test.misfit_hz is not None
     assert f"the misfit lies at {v.test.misfit_hz[0]:.4g}" in text
+    # its outcome: a miss the data explain (the better model holds them), not a failure
+    assert v.outcome == "expected"
+    assert v.expected_cause == CAUSE_MODEL_FORM
+    assert "FAILED" not in v.summary() + v.brief()
+    assert v.to_dict()["outcome"] == "expected"
+    assert v.to_dict()["passed"] is False  # the test against the noise is unchanged
+    # the same miss of a real-mode model: the data are non-proportionally damped
+    real = ModalModel(shifted.poles, shifted.psi_out, shifted.psi_in, "real", meta=shifted.meta)
+    vr = modal_fit_verdict(real, meas, subject="real-mode fit", better=good)
+    assert (vr.status, vr.outcome) == ("failed", "expected")
+    assert vr.expected_cause == CAUSE_NON_PROPORTIONAL
+    assert vr.brief().startswith("expected (residual ")
+    # alone, or beside a better model that also misses, the same miss is a failure
+    assert alone.outcome == "failed"
+    assert "FAILED" in alone.summary()
+    bad = modal_fit_verdict(shifted, meas, subject="complex-mode fit")
+    assert modal_fit_verdict(real, meas, better=bad).outcome == "failed"
+
+
+def test_a_lost_mode_is_a_failure_even_beside_a_better_model() -> None:
+    """A model that misses an expected mode fails, whatever another model does."""
+    true = two_modes(f2=99.0)
+    meas = measured(true, 8, 300.0, 1)
+    good = modal_fit_verdict(true, meas, subject="complex-mode fit")
+    assert good.outcome == "ok"
+    one = ModalModel(
+        true.poles[:1],
+        true.psi_out[:, :1],
+        true.psi_in[:, :1],
+        "real",
+        meta={"band_hz": [5.0, 100.0]},
+    )
+    v = modal_fit_verdict(one, meas, expected_hz=[30.0, 99.0], better=good)
+    assert v.status == "failed"
+    assert v.outcome == "failed"
+    assert v.expected_cause == ""
+    assert "expected mode at 99 Hz not identified" in v.outcome_reason
 
 
 def test_band_edge_and_complex_shape_cautions() -> None:
@@ -176,6 +217,50 @@ def test_lateral_verdict_on_the_rig() -> None:
     # misses by more than the 3 % noise, and the verdict says where
     assert v.status == "failed"
     assert "model form" in " ".join(v.reasons)
+    assert v.outcome == "failed"  # one model alone: nothing tells form from a bad fit
+
+
+def test_lateral_family_outcomes_on_the_rig() -> None:
+    """The rig's tyre (a string with contact length) is none of the models: every
+    converged fit misses, and each miss is the family's, not the fit's."""
+    from dataclasses import replace
+
+    from tyredamp.lateral import fit_model
+    from tyredamp.virtual import VirtualLateralRig
+
+    rig = VirtualLateralRig()
+    data = rig.measure(5.0, 1.7, "ground", 0)
+    fits = [fit_model(data, m) for m in ("hysteretic", "maxwell", "classic")]
+    vs = lateral_family_verdicts(fits, data.frf, label="1.7 bar, 5 km/h")
+    assert list(vs) == ["hysteretic", "maxwell", "classic"]
+    for name, v in vs.items():
+        assert v.subject == f"{name} fit at 1.7 bar, 5 km/h"
+        assert v.test is not None
+        assert v.test.ratio > v.test.threshold  # each misses the noise, judged alone
+        assert v.status == "failed"
+        assert v.outcome == "expected"
+        assert v.expected_cause == CAUSE_OUTSIDE_FAMILY
+        assert "FAILED" not in v.summary() + v.brief()
+        # the same numbers as the verdict of the fit alone
+        alone = lateral_fit_verdict(fits[list(vs).index(name)], data.frf)
+        assert alone.test is not None
+        assert v.test.ratio == alone.test.ratio
+    # a model that holds the data (its fitted FRF the measured one) makes the others'
+    # misses their form
+    exact = replace(fits[0], fitted=fits[0].measured.copy())
+    vs = lateral_family_verdicts([exact, *fits[1:]], data.frf)
+    assert vs["hysteretic"].outcome == "ok"
+    assert {vs[n].outcome for n in ("maxwell", "classic")} == {"expected"}
+    assert vs["maxwell"].expected_cause == CAUSE_MODEL_FORM
+    assert "hysteretic fit of the same FRF is within the noise" in vs["maxwell"].expected_why
+    # a fit whose optimiser stopped on its limit may be what misses: a failure, and the
+    # family can no longer be said to miss
+    stuck = replace(fits[1], message="The maximum number of function evaluations is exceeded.")
+    vs = lateral_family_verdicts([fits[0], stuck, fits[2]], data.frf)
+    assert {v.outcome for v in vs.values()} == {"failed"}
+    # a single model: nothing to compare with
+    vs = lateral_family_verdicts(fits[:1], data.frf)
+    assert vs["hysteretic"].outcome == "failed"
 
 
 def test_mimo_noise_from_the_multiple_coherence() -> None:

@@ -103,15 +103,12 @@ def _tyre_model_row(tm: dict[str, Any]) -> str:
 
 
 def _verdict_rows(doc: dict[str, Any]) -> list[tuple[str, str]]:
-    """One row per identification: within the noise, or FAILED and why."""
-    rows = []
-    for pr in doc["radial"]["pressures"]:
-        v = pr["verdict"]
-        for name in ("complex", "real"):
-            rows.append((f"{name}-mode fit {pr['pressure_bar']:g} bar", v[name]["brief"]))
-    for c in doc["lateral"]["conditions"]:
-        rows.append((f"{c['best']} fit {c['label']}", c["verdict"]["brief"]))
-    return rows
+    """One row per finding of the fits: each genuine failure alone (``FAILED`` and why),
+    the fits that share an outcome and its cause together (``expected`` and why, or
+    ``within noise``); the failed checks and tyre model have rows of their own."""
+    from ..studies.findings import outcome_groups
+
+    return [(g.title, g.detail) for g in outcome_groups(doc) if not g.stage]
 
 
 @click.command("demo")

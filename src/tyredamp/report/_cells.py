@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import html
 import math
+import re
 from collections.abc import Mapping
 from typing import Any
 
 from .html import HtmlReport
 
-__all__ = ["fmt_pm"]
+__all__ = ["anchor_id", "fmt_pm"]
 
 
 def fmt_pm(value: float | None, std: float | None, digits: int = 4, scale: float = 1.0) -> str:
@@ -34,18 +35,21 @@ def _image(rep: HtmlReport, images: Mapping[str, tuple[bytes, str]], name: str) 
         rep.image(png, caption)
 
 
+def anchor_id(about: str) -> str:
+    """The page anchor of a result by its ``about`` key (``"radial:7.5"`` -> ``"radial-7-5"``)."""
+    return re.sub(r"[^a-z0-9]+", "-", about.lower()).strip("-")
+
+
 def _warnings(rep: HtmlReport, doc: dict[str, Any], about: str) -> None:
-    """The warnings of the stage that produced a result, beside that result."""
-    ws = [w for w in doc.get("warnings", []) if w["about"] == about]
+    """The warnings of the stage that produced a result, beside that result.
+
+    Only findings of severity ``"warning"``: a fit verdict and a failed stage are
+    stated by their result's own block (once).
+    """
+    ws = [w for w in doc.get("warnings", []) if w["about"] == about and w["severity"] == "warning"]
     if not ws:
         return
-    bad = any(w["severity"] == "failed" for w in ws)
-    items = "".join(
-        f"<li>{'<b>FAILED</b> ' if w['severity'] == 'failed' else ''}{html.escape(w['message'])}"
-        "</li>"
-        for w in ws
-    )
+    items = "".join(f"<li>{html.escape(w['message'])}</li>" for w in ws)
     rep.raw(
-        f'<div class="warn{" bad" if bad else ""}"><b>Warnings ({html.escape(ws[0]["stage"])})'
-        f"</b><ul>{items}</ul></div>"
+        f'<div class="warn"><b>Cautions ({html.escape(ws[0]["stage"])})</b><ul>{items}</ul></div>'
     )

@@ -23,7 +23,8 @@ from typing import TYPE_CHECKING, Any
 
 from .. import __version__
 from ..modal.quality import RejectedMode, rejected_summary
-from ._cells import _image, _num, _warnings, fmt_pm
+from ._cells import _image, _num, _warnings, anchor_id, fmt_pm
+from ._outcomes import _findings, _Page, _status, _verdict_block
 from .html import HtmlReport
 from .tyremodel import tyre_model_brief, tyre_model_report
 
@@ -57,14 +58,6 @@ def _fallback_mark(doc: dict[str, Any], pressure_bar: float) -> str:
         for w in doc.get("warnings", [])
     )
     return " (real-mode fit fell back to the complex poles: not a refined real fit)" if fell else ""
-
-
-def _verdict(rep: HtmlReport, v: dict[str, Any] | None) -> None:
-    """A fit verdict: green when within the noise, red with its reasons when not."""
-    if v is None:
-        return
-    cls = "verdict" if v["passed"] else "verdict bad"
-    rep.raw(f'<div class="{cls}">{html.escape(v["summary"])}</div>')
 
 
 def _modes_table(rep: HtmlReport, modes: list[dict[str, Any]], caption: str) -> None:
@@ -122,6 +115,7 @@ def _summary(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
     rad, lat = doc["radial"], doc["lateral"]
     dmp = rad["damping"]
     best = lat["ranking"][0]
+    rep.raw('<div class="first">')
     rep.heading(SECTIONS[0])
     rep.paragraph(
         "Both studies of the papers run end to end on virtual tyres with a known truth; every "
@@ -159,57 +153,17 @@ def _summary(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
                 f"{best['model']} ({best['mean_rank']:.2g}, best at {best['wins']} of "
                 f"{best['n_conditions']} conditions)",
             ],
-            ["tyre model (flexible ring, all pressures)", tyre_model_brief(rad["tyre_model"])],
+            [
+                "tyre model (flexible ring, all pressures)",
+                tyre_model_brief(rad["tyre_model"])
+                if rad["tyre_model"]["status"] == "ok"
+                else "not fitted (the tyre model section says why)",
+            ],
             ["computation time", f"{result.elapsed_s:.1f} s"],
         ],
     )
-    if rad["tyre_model"]["status"] != "ok":
-        rep.raw(
-            '<div class="verdict bad">Tyre model not fitted: '
-            f"{html.escape(str(rad['tyre_model']['error']))}</div>"
-        )
-    _summary_verdicts(rep, doc)
-
-
-def _status(v: dict[str, Any] | None) -> str:
-    return (
-        "-"
-        if v is None
-        else {"ok": "within noise", "failed": "FAILED"}.get(v["status"], v["status"])
-    )
-
-
-def _summary_verdicts(rep: HtmlReport, doc: dict[str, Any]) -> None:
-    """Every fit's verdict, the failures in red, and every warning of every stage."""
-    rad, lat = doc["radial"], doc["lateral"]
-    rep.heading("Fit verdicts and warnings", 3)
-    rows = []
-    failed: list[dict[str, Any]] = []
-    for pr in rad["pressures"]:
-        v = pr["verdict"]
-        rows.append(
-            [f"radial {pr['pressure_bar']:g} bar", _status(v["complex"]), _status(v["real"])]
-        )
-        failed += [x for x in (v["complex"], v["real"]) if not x["passed"]]
-    for c in lat["conditions"]:
-        rows.append([f"lateral {c['label']} ({c['best']})", _status(c["verdict"]), "-"])
-        if not c["verdict"]["passed"]:
-            failed.append(c["verdict"])
-    rep.table(
-        ["identification", "complex-mode / best-model fit", "real-mode fit"],
-        rows,
-        caption="Each fit judged against the noise its FRF's coherence implies (residual power "
-        "within the 99.9 % quantile of noise alone), the band-edge position and shape of its "
-        "modes and, on the virtual tyre, the modes it should find.",
-    )
-    for v in failed:
-        _verdict(rep, v)
-    ws = doc.get("warnings", [])
-    if ws:
-        rep.paragraph(f"Warnings of every stage ({len(ws)}; each is repeated beside its result):")
-        rep.bullets([f"{w['stage']}: {w['message']}" for w in ws])
-    else:
-        rep.paragraph("No stage issued a warning.")
+    _findings(rep, doc)
+    rep.raw("</div>")
 
 
 def _excitation(meta: dict[str, Any], force_rms: float) -> str:
@@ -296,13 +250,19 @@ def _settings(rep: HtmlReport, result: DemoResult, doc: dict[str, Any]) -> None:
     rep.paragraph(f"tyredamp {__version__}, seed {s.seed}.")
 
 
-def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: Any) -> None:
+def _radial(
+    rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: Any, page: _Page
+) -> None:
     rad = doc["radial"]
     r = result.radial
     p = f"{rad['pressure_bar']:g} bar"
     rep.heading(SECTIONS[2])
-    rep.heading("Linearity, reciprocity and data quality", 3)
-    rep.bullets([c.summary for c in (r.linearity, r.reciprocity, r.quality)])
+    rep.heading("Linearity, reciprocity and data quality", 3, anchor=anchor_id("radial:checks"))
+    checks = (r.linearity, r.reciprocity, r.quality)
+    rep.bullets([c.summary for c in checks if c.passed])
+    for c in checks:
+        if not c.passed:  # a check that fails on these data is a genuine failure
+            rep.raw(f'<div class="verdict bad">{html.escape(c.summary)}</div>')
     _warnings(rep, doc, "radial:checks")
     rep.paragraph(
         "A linear model with a symmetric damping matrix needs both checks to pass. The quality "
@@ -353,9 +313,9 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
         caption=f"Fit quality at {p} over {rad['n_lines']} lines and 16 FRFs ({rad['frf_kind']}, "
         f"{r.main.fitted_frf.unit}).",
     )
-    _verdict(rep, rad["verdict"]["complex"])
-    _verdict(rep, rad["verdict"]["real"])
-    _warnings(rep, doc, f"radial:{rad['pressure_bar']:g}")
+    key = f"radial:{rad['pressure_bar']:g}"
+    _verdict_block(rep, page, [(key, rad["verdict"]["complex"]), (key, rad["verdict"]["real"])])
+    _warnings(rep, doc, key)
     ratio = rad["rmsd_ratio"]
     rep.paragraph(
         f"The complex-mode fit is {_num(ratio, '.3g')} times better in RMSD (the paper found "
@@ -370,12 +330,12 @@ def _radial(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: An
     _image(rep, images, "mac")
 
     _radial_damping(rep, doc, images)
-    _radial_pressures(rep, doc, images)
+    _radial_pressures(rep, doc, images, page)
 
 
 def _radial_damping(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
     dmp = doc["radial"]["damping"]
-    rep.heading("Damping matrices", 3)
+    rep.heading("Damping matrices", 3, anchor=anchor_id("radial:damping"))
     rep.table(
         ["diagnostic", "value"],
         [
@@ -399,7 +359,7 @@ def _radial_damping(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
     _image(rep, images, "fig05_damping")
 
 
-def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
+def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any, page: _Page) -> None:
     rad = doc["radial"]
     rep.heading("Inflation pressure", 3)
     rows = []
@@ -442,9 +402,10 @@ def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None
     for pr in rad["pressures"]:
         if pr["pressure_bar"] == rad["pressure_bar"]:
             continue  # the main pressure's verdicts stand beside its fit above
-        _verdict(rep, pr["verdict"]["complex"])
-        _verdict(rep, pr["verdict"]["real"])
-        _warnings(rep, doc, f"radial:{pr['pressure_bar']:g}")
+        key = f"radial:{pr['pressure_bar']:g}"
+        rep.heading(f"At {pr['pressure_bar']:g} bar", 4)
+        _verdict_block(rep, page, [(key, pr["verdict"]["complex"]), (key, pr["verdict"]["real"])])
+        _warnings(rep, doc, key)
         _modes_table(
             rep,
             pr["modes"],
@@ -453,7 +414,9 @@ def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None
     _image(rep, images, "pressures")
 
 
-def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: Any) -> None:
+def _lateral(
+    rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: Any, page: _Page
+) -> None:
     lat = doc["lateral"]
     rep.heading(SECTIONS[4])
     f7 = lat["figure7"]
@@ -479,6 +442,7 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
             "C_r fitted (kN s/m)",
             "C_alpha/V true (kN s/m)",
             "C_r / (C_alpha/V)",
+            "best fit against the noise",
         ],
         [
             [
@@ -488,6 +452,7 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
                 fmt_pm(c["road_damping"]["fitted"], c["road_damping"]["stderr"], 4, 1e-3),
                 _num(c["road_damping"]["true"] / 1e3, ".4g"),
                 _num(c["road_damping"]["ratio"], ".3g"),
+                _status(c["verdict"]),
             ]
             for c in conds
         ],
@@ -497,8 +462,8 @@ def _lateral(rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: A
         "transition region, where the rig's stiffening foundation and contact length depart "
         "from the model: a model-form difference, not noise (compare the standard error).",
     )
+    _verdict_block(rep, page, [(f"lateral:{c['label']}", c["verdict"]) for c in conds])
     for c in conds:
-        _verdict(rep, c["verdict"])
         _warnings(rep, doc, f"lateral:{c['label']}")
     _lateral_parameters(rep, result)
     speeds = result.settings.lateral_speeds_kmh
@@ -620,7 +585,7 @@ def _lateral_parameters(rep: HtmlReport, result: DemoResult) -> None:
 def _lateral_vehicle(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
     lat = doc["lateral"]
     models = lat["models"]
-    rep.heading("Vehicle model and time response", 3)
+    rep.heading("Vehicle model and time response", 3, anchor=anchor_id("lateral:time"))
     veh = lat["vehicle"]
     tr = lat["time_response"]
     rows = [
@@ -711,9 +676,11 @@ def build_demo_report(
     rep = HtmlReport("tyredamp demo: damping of pneumatic tyres on virtual tyres")
     _summary(rep, result, doc)
     _settings(rep, result, doc)
-    _radial(rep, result, doc, images)
+    page = _Page()
+    _radial(rep, result, doc, images, page)
+    rep.raw(f'<span id="{anchor_id("radial:tyre_model")}"></span>')
     tyre_model_report(rep, result, doc, images, SECTIONS[3])
-    _lateral(rep, result, doc, images)
+    _lateral(rep, result, doc, images, page)
     rep.heading(SECTIONS[5])
     listed = doc.get("files", []) if files is None else files
     rep.paragraph(

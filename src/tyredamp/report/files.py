@@ -49,7 +49,8 @@ from ..io import FILE_FORMATS, read
 from ..io._common import check_input_file
 from ..modal.model import ModalModel
 from ..timedata import TimeData
-from .build import _verdict, fmt_pm
+from ._outcomes import _verdict
+from .build import fmt_pm
 from .html import HtmlReport
 
 __all__ = ["ResultFile", "build_files_report", "load_result_file"]
@@ -583,7 +584,8 @@ def _demo_section(rep: HtmlReport, item: ResultFile) -> None:
     for c in lat.get("conditions", []):
         if c.get("verdict"):
             _verdict(rep, c["verdict"])
-    ws = doc.get("warnings", [])
+    # the fit verdicts are stated above; the other findings of every stage here
+    ws = [w for w in doc.get("warnings", []) if not w.get("fit")]
     if ws:
         rep.paragraph(f"Warnings of every stage of the run ({len(ws)}):")
         rep.bullets([f"{w['stage']}: {w['message']}" for w in ws])

@@ -26,13 +26,29 @@ img{max-width:100%}.note{background:#f6f6ee;border-left:4px solid #cc9;padding:.
 .ok{color:#185}.bad{color:#a22}code{background:#f3f3f3;padding:0 .2em}
 nav.toc{background:#f4f6f9;padding:.3em 1em;border:1px solid #dde}nav.toc ul{margin:.3em 0}
 .verdict{padding:.4em 1em;margin:.6em 0;border-left:4px solid #185;background:#eef7f1}
+.verdict.expected{border-left-color:#678;background:#f2f4f7;color:#222}
+.verdict.nj{border-left-color:#999;background:#f5f5f5}
 .verdict.bad{border-left-color:#c22;background:#fdeeee;color:#a11;font-weight:600}
 .warn{border-left:4px solid #d80;background:#fff6e8;padding:.3em 1em;margin:.6em 0}
 .warn.bad{border-left-color:#c22;background:#fdeeee;color:#a11}
 .warn ul{margin:.2em 0}
-@media print{body{max-width:none;margin:0;font-size:10pt}nav.toc{display:none}
-h2{break-before:page}h2,h3{break-after:avoid}figure,table,.verdict,.warn{break-inside:avoid}
-img{max-height:90vh}}
+ul.findings{padding-left:1.2em}ul.findings li{margin:.25em 0;padding-left:.4em;
+border-left:4px solid #bbb;list-style:none}
+ul.findings li.ok{border-left-color:#185;color:#222}
+ul.findings li.expected{border-left-color:#678}
+ul.findings li.warning{border-left-color:#d80}
+ul.findings li.failed{border-left-color:#c22;color:#a11;font-weight:600}
+@page{size:A4;margin:12mm 12mm 14mm 12mm}
+@media print{body{max-width:none;margin:0;padding:0;font-size:9.5pt;line-height:1.3}
+nav.toc{display:none}h1{font-size:16pt;margin:0 0 .3em 0}
+h2{break-before:page;margin-top:0}h2#s1{break-before:auto}h2,h3,h4{break-after:avoid}
+figure,table,.verdict,.warn,ul.findings li{break-inside:avoid}
+figure{margin:.5em 0}img{max-height:23cm;max-width:100%;width:auto}
+a{color:inherit;text-decoration:none}
+.first table{font-size:8.5pt;margin:.3em 0 .6em 0}.first td,.first th{padding:.1em .4em;
+text-align:left}
+.first p{margin:.3em 0}ul.findings{margin:.2em 0}ul.findings li{margin:.15em 0}
+.verdict,.warn,ul.findings li{-webkit-print-color-adjust:exact;print-color-adjust:exact}}
 """
 
 
@@ -54,15 +70,19 @@ class HtmlReport:
         self._parts: list[str] = []
         self._sections: list[tuple[str, str]] = []
 
-    def heading(self, text: str, level: int = 2) -> None:
-        """Add a heading (level 2-4); level-2 headings get an anchor and a TOC entry."""
+    def heading(self, text: str, level: int = 2, anchor: str | None = None) -> None:
+        """Add a heading (level 2-4); level-2 headings get an anchor and a TOC entry.
+
+        ``anchor`` gives a level-3 or level-4 heading an ``id`` to link to.
+        """
         lvl = min(max(int(level), 2), 4)
         if lvl == 2:
             anchor = f"s{len(self._sections) + 1}"
             self._sections.append((anchor, text))
             self._parts.append(f'<h2 id="{anchor}">{html.escape(text)}</h2>')
         else:
-            self._parts.append(f"<h{lvl}>{html.escape(text)}</h{lvl}>")
+            ident = f' id="{html.escape(anchor)}"' if anchor else ""
+            self._parts.append(f"<h{lvl}{ident}>{html.escape(text)}</h{lvl}>")
 
     def paragraph(self, text: str, css_class: str | None = None) -> None:
         """Add a paragraph of plain text (escaped)."""

@@ -46,8 +46,26 @@ The verdict judges a fit from the data alone:
   caller knows them, for example the truth of a virtual tyre) that are not
   identified.
 
-A verdict is ``"ok"`` (within the noise), ``"failed"`` (with the reasons
-and likely causes) or ``"not judged"`` (no coherence to judge against).
+A verdict's ``status`` is ``"ok"`` (within the noise), ``"failed"`` (with
+the reasons and likely causes) or ``"not judged"`` (no coherence to judge
+against). Its ``outcome`` says what a miss means, from the verdict's own
+cause:
+
+* ``"expected"``: the miss is an identification result, not a failure of the
+  fit, because another model of the same data shows where it comes from.
+  A real-mode fit that misses while the complex-mode fit of the same band is
+  within the noise: the data are non-proportional (the damping couples the
+  modes), which real modes cannot hold; the complex-mode model is the general
+  form of a linear viscously damped structure, so nothing else explains the
+  gap. A lateral model that misses while another model of the family holds
+  the tyre (its form does not), or while every model of the family misses
+  although each fit converged (the measured tyre is none of the models: the
+  ranking names the closest, :func:`lateral_family_verdicts`).
+* ``"failed"``: a fit that should hold and does not (the complex-mode fit
+  outside its noise, an expected mode not found, a lateral fit whose optimiser
+  did not converge, or the only model fitted), with its reasons;
+* ``"ok"`` and ``"not judged"`` as the status.
+
 Core-free of plotting and I/O: the report, the CLI summary and results.json
 render :class:`FitVerdict`.
 """
@@ -56,7 +74,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -69,9 +87,14 @@ from ..modal.identify import ModalIdentification
 
 __all__ = [
     "ALPHA",
+    "CAUSE_MEANING",
+    "CAUSE_MODEL_FORM",
+    "CAUSE_NON_PROPORTIONAL",
+    "CAUSE_OUTSIDE_FAMILY",
     "FitVerdict",
     "NoiseTest",
     "frf_noise_variance",
+    "lateral_family_verdicts",
     "lateral_fit_verdict",
     "modal_fit_verdict",
     "modal_verdicts",
@@ -86,6 +109,23 @@ _REGION = 0.8
 _MPC_LOW = 0.5
 
 Status = Literal["ok", "failed", "not judged"]
+Outcome = Literal["ok", "expected", "failed", "not judged"]
+
+#: Short causes of an expected miss (``FitVerdict.expected_cause``).
+CAUSE_NON_PROPORTIONAL = "non-proportional damping"
+CAUSE_MODEL_FORM = "model form"
+CAUSE_OUTSIDE_FAMILY = "tyre outside the model family"
+#: What an expected miss of each cause means, said once for every fit it concerns.
+CAUSE_MEANING = {
+    CAUSE_NON_PROPORTIONAL: "the complex-mode fit of the same band is within the noise, so the "
+    "damping couples the modes, which real modes cannot hold: an identification result (the "
+    "data are non-proportionally damped), not a failure of the fit",
+    CAUSE_MODEL_FORM: "another model of the same data is within the noise, so this model's form "
+    "cannot hold the data: a result of the model comparison, not a failure of the fit",
+    CAUSE_OUTSIDE_FAMILY: "every model fitted misses the measured tyre although every fit "
+    "converged: the tyre is none of these models, and the ranking names the closest: a result "
+    "of the model comparison, not a failure of the fit",
+}
 
 
 @dataclass(frozen=True)
@@ -140,6 +180,12 @@ class FitVerdict:
         Findings that do not fail the fit but qualify it.
     test : NoiseTest or None
         The test against the noise (None without coherence).
+    expected_cause : str
+        For a miss that is an identification result rather than a failure
+        (module docstring), its short cause (``"non-proportional damping"``);
+        empty otherwise.
+    expected_why : str
+        Why that miss is expected, in words; empty otherwise.
     """
 
     subject: str
@@ -147,15 +193,47 @@ class FitVerdict:
     reasons: tuple[str, ...] = ()
     cautions: tuple[str, ...] = ()
     test: NoiseTest | None = None
+    expected_cause: str = ""
+    expected_why: str = ""
 
     @property
     def passed(self) -> bool:
-        """True for ``"ok"``."""
+        """True for ``"ok"``: the fit is within the noise."""
         return self.status == "ok"
 
-    def summary(self) -> str:
-        """One line: status, the residual against the noise, the first reason."""
+    @property
+    def outcome(self) -> Outcome:
+        """``"ok"``, ``"expected"`` (a miss explained by the data), ``"failed"`` or
+        ``"not judged"`` (module docstring)."""
+        if self.status == "failed" and self.expected_cause:
+            return "expected"
+        return self.status
+
+    @property
+    def outcome_reason(self) -> str:
+        """Why the outcome: the expected miss's cause, the failure's reasons, or the
+        residual of a fit within the noise."""
         t = self.test
+        if self.outcome == "expected":
+            return f"{self.expected_cause}: {self.expected_why}"
+        if self.outcome == "failed":
+            return "; ".join(self.reasons)
+        if self.outcome == "ok" and t is not None:
+            return f"residual {math.sqrt(t.ratio):.3g}x the noise level"
+        return self.cautions[0] if self.cautions else ""
+
+    def summary(self) -> str:
+        """One line: outcome, the residual against the noise, the reasons."""
+        t = self.test
+        if self.outcome == "expected":
+            # the reasons without the model-form one, which the explanation replaces
+            rs = [r for r in self.reasons if "model form misses" not in r]
+            text = "; ".join(rs)
+            return (
+                f"{self.subject}: not within the noise, as the data explain "
+                f"({self.expected_cause}): {self.expected_why}"
+                + (f". {text[0].upper()}{text[1:]}" if text else "")
+            )
         head = {"ok": "OK", "failed": "FAILED", "not judged": "NOT JUDGED"}[self.status]
         if self.reasons:
             return f"{self.subject}: {head}: " + "; ".join(self.reasons)
@@ -168,13 +246,16 @@ class FitVerdict:
         return f"{self.subject}: {head}" + (f": {self.cautions[0]}" if self.cautions else "")
 
     def brief(self) -> str:
-        """A short form for a summary table: ``"FAILED (residual 11x the noise): <cause>"``."""
+        """A short form for a summary table: ``"FAILED (residual 11x the noise): <cause>"``,
+        ``"expected (residual 11x the noise): non-proportional damping"``."""
         t = self.test
         if self.status == "ok":
             return "within noise"
         if self.status == "not judged":
             return "not judged (no coherence)"
         size = "" if t is None else f" (residual {math.sqrt(t.ratio):.3g}x the noise)"
+        if self.outcome == "expected":
+            return f"expected{size}: {self.expected_cause}"
         causes = [r for r in self.reasons if not r.startswith("the residual is")]
         return f"FAILED{size}: " + ("; ".join(causes) or "see the report")
 
@@ -185,6 +266,9 @@ class FitVerdict:
             "subject": self.subject,
             "status": self.status,
             "passed": self.passed,
+            "outcome": self.outcome,
+            "outcome_reason": self.outcome_reason,
+            "expected_cause": self.expected_cause,
             "summary": self.summary(),
             "brief": self.brief(),
             "reasons": list(self.reasons),
@@ -370,6 +454,8 @@ def modal_fit_verdict(
     cautions: list[str] = []
     noise = frf_noise_variance(measured)
     test = None
+    form = False
+    missing = False
     if noise is not None:
         test = noise_test(f, measured.H, synth, noise[0], noise[1], alpha)
         if not test.passed:
@@ -426,6 +512,7 @@ def modal_fit_verdict(
             if fn.size == 0 or np.min(np.abs(fn - fe)) > 0.05 * fe:
                 gap = min(fe - band[0], band[1] - fe)
                 at_edge = gap < 0.05 * (band[1] - band[0])
+                missing = True
                 reasons.append(
                     f"expected mode at {fe:.4g} Hz not identified"
                     + (f" ({gap:.3g} Hz from the band edge)" if at_edge else "")
@@ -436,7 +523,25 @@ def modal_fit_verdict(
             cautions.insert(0, "no coherence (or a single average): not judged against the noise")
     else:
         status = "ok" if not reasons else "failed"
-    return FitVerdict(subject, status, tuple(reasons), tuple(cautions), test)
+    cause = why = ""
+    # a miss that only the model form explains (no expected mode lost) is a result
+    if status == "failed" and form and better is not None and not missing:
+        cause, why = _form_cause(model, better)
+    return FitVerdict(subject, status, tuple(reasons), tuple(cautions), test, cause, why)
+
+
+def _form_cause(model: Any, better: FitVerdict) -> tuple[str, str]:
+    """Cause and explanation of a modal model's miss beside a better model within the noise."""
+    if getattr(model, "mode_kind", None) == "real":
+        return CAUSE_NON_PROPORTIONAL, (
+            f"the {better.subject} of the same band is within the noise, so the damping "
+            "couples the modes, which real modes cannot hold: an identification result, "
+            "not a failure of the fit"
+        )
+    return CAUSE_MODEL_FORM, (
+        f"the {better.subject} of the same band is within the noise, so this model's "
+        "form cannot hold the data: an identification result, not a failure of the fit"
+    )
 
 
 def lateral_fit_verdict(
@@ -479,6 +584,81 @@ def lateral_fit_verdict(
             f"the model form misses the measured tyre{where} (noise does not explain it)"
         )
     return FitVerdict(name, "ok" if not reasons else "failed", tuple(reasons), (), test)
+
+
+def _converged(fit: Any) -> bool:
+    """True when the lateral fit's optimiser ran and did not stop on its evaluation limit."""
+    return (
+        int(getattr(fit, "nfev", 1)) > 0
+        and "maximum" not in str(getattr(fit, "message", "")).lower()
+    )
+
+
+def lateral_family_verdicts(
+    fits: Sequence[Any], frf: FRF, *, label: str = "", alpha: float = ALPHA
+) -> dict[str, FitVerdict]:
+    """Verdicts of every lateral model fitted to one FRF, a miss classified by the others.
+
+    Each fit is judged alone (:func:`lateral_fit_verdict`); a fit that misses
+    the noise is then an *expected* outcome (module docstring) when
+
+    * another model of the same FRF is within the noise: this model's form
+      does not hold the tyre (``"model form"``), or
+    * every one of two or more models misses and every fit converged: the
+      measured tyre is none of the models, and the ranking names the closest
+      (``"tyre outside the model family"``).
+
+    A fit whose optimiser did not converge, and a single model fitted alone,
+    keep the outcome ``"failed"``.
+
+    Parameters
+    ----------
+    fits : sequence of LateralFit
+        The fits of one FRF (one per model).
+    frf : FRF
+        The measured FRF they were fitted to (1x1, with coherence).
+    label : str
+        Condition label for the subjects (``"hysteretic fit at 1.7 bar, 5 km/h"``).
+    alpha : float
+        Significance level of the test against the noise.
+
+    Returns
+    -------
+    dict of str to FitVerdict
+        By model name, in the order of ``fits``.
+    """
+    at = f" at {label}" if label else ""
+    out = {
+        f.name: lateral_fit_verdict(f, frf, subject=f"{f.name} fit{at}", alpha=alpha) for f in fits
+    }
+    conv = {f.name: _converged(f) for f in fits}
+    within = [n for n, v in out.items() if v.status == "ok"]
+    missed = [n for n, v in out.items() if v.status == "failed"]
+    if within:
+        names = ", ".join(within)
+        for n in missed:
+            if conv[n]:
+                out[n] = replace(
+                    out[n],
+                    expected_cause=CAUSE_MODEL_FORM,
+                    expected_why=(
+                        f"the {names} fit{'s' if len(within) > 1 else ''} of the same FRF "
+                        f"{'are' if len(within) > 1 else 'is'} within the noise, so this "
+                        "model's form does not hold the measured tyre: a result of the model "
+                        "comparison, not a failure of the fit"
+                    ),
+                )
+    elif len(fits) >= 2 and len(missed) == len(fits) and all(conv.values()):
+        r = [math.sqrt(v.test.ratio) for v in out.values() if v.test is not None]
+        why = (
+            f"none of the {len(fits)} models fitted holds the measured tyre within the noise "
+            f"(residuals {min(r):.3g}-{max(r):.3g}x the noise) although every fit converged: "
+            "the tyre is none of these models, and the ranking names the closest: a result "
+            "of the model comparison, not a failure of the fit"
+        )
+        for n in missed:
+            out[n] = replace(out[n], expected_cause=CAUSE_OUTSIDE_FAMILY, expected_why=why)
+    return out
 
 
 def modal_verdicts(frf: FRF, res: ModalIdentification) -> dict[str, FitVerdict]:
