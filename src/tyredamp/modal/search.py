@@ -262,10 +262,13 @@ def reject_by_test(
 
 def _inadmissible(p: complex, df: float, max_damping: float) -> str:
     """Why the pole ``p`` cannot be an in-band mode of the search ('' if it can):
-    damped beyond ``max_damping`` (:func:`residual_search`). A pole narrower than
-    the line spacing ``df`` (Hz) is admissible: its frequency is resolved, its
-    damping is not, and the model says so (:func:`unresolved_damping`)."""
-    del df  # a half-power band narrower than the lines is a resolved frequency
+    narrower than the line spacing ``df`` (Hz), or damped beyond ``max_damping``
+    (:func:`residual_search`)."""
+    if -p.real / np.pi < df:
+        return (
+            f"half-power bandwidth {-p.real / np.pi:.3g} Hz below the line "
+            f"spacing {df:.3g} Hz (not resolved)"
+        )
     if -p.real > max_damping * abs(p):
         return f"damping above the admissible {max_damping:.0%}"
     return ""
@@ -513,11 +516,13 @@ def residual_search(
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
     A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
-    of the diagram) is not a mode: it is rejected whatever its statistic. One
-    whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is narrower
-    than the line spacing is tested like any other (a lightly damped mode of a
-    measurement with coarse lines: its frequency is resolved, its damping only
-    bounded, :func:`unresolved_damping`). A trial mode that passes
+    of the diagram) is not a mode: it is rejected whatever its statistic. Nor
+    is a trial whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
+    narrower than the line spacing: such a pole fits single lines (an outlier,
+    the tail of an impact test's low-frequency end) as well as a resonance.
+    A mode of the diagram may be that narrow (a lightly damped mode measured
+    with coarse lines): its frequency is resolved and its damping only bounded
+    (:func:`unresolved_damping`). A trial mode that passes
     is refitted with all modes (:func:`_joint`) and kept when it stays in the
     band, merges with no mode, is still admissible and every mode still passes
     the test; a trial mode that alone crosses a band edge in the joint refit,
