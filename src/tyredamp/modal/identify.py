@@ -302,10 +302,17 @@ def _with_model_error(
     leaves structure beyond the measured noise (:mod:`tyredamp.modal.model_error`)."""
     kind = "complex" if "complex" in first.models else "real"
     q = first.models[kind].quality
+    if first.noise_source != "residual":
+        return first  # a measured noise: a fit that misses it has failed, and says so
     if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
         return first
     problem = build_problem(frf, first.band_hz, variance=variance)
-    floor = noise_floor(frf, problem, None if variance is None else np.asarray(variance, float))
+    floor = noise_floor(
+        frf,
+        problem,
+        None if variance is None else np.asarray(variance, float),
+        q.noise_rms_per_output,
+    )
     lines = problem.lines
     H = np.asarray(frf.H)[:, :, lines]
     V = floor.variance[:, :, lines]
@@ -327,6 +334,8 @@ def _with_model_error(
         v = floor.variance.copy()
         v[:, :, lines] += eps**2 * np.abs(H) ** 2
         res = run(v, f"{floor.what} plus a model error of {eps:.2%} of the response")
+        if not _fewer_modes(res.models[kind].poles, first.models[kind].poles):
+            break  # a larger noise may only take modes away: an inconsistent pass is not used
         again = eps_of(res)
         gap = abs(math.log(again / eps)) if again > 0.0 else math.inf
         if best is None or gap < best[0]:
@@ -334,9 +343,10 @@ def _with_model_error(
         if gap < math.log1p(EPS_TOLERANCE):
             break
         eps = again
-    if best is None:
-        return first
+    if best is None or best[2].models[kind].n_modes == first.models[kind].n_modes:
+        return first  # the same modes: the first fit's own values and errors stand
     _, eps, res = best
+
     res.warnings.append(
         f"the fit left structure beyond {floor.what} that no modal sum explains (leakage, "
         "a window, a non-linearity, ...): modes were decided and their uncertainty stated "
@@ -415,6 +425,11 @@ def _identify(
         warnings=warnings,
         noise_source=problem.noise_source,
     )
+
+
+def _fewer_modes(poles: NDArray[np.complex128], before: NDArray[np.complex128]) -> bool:
+    """Whether every pole of ``poles`` is one of ``before`` (within 1 % of ``|p|``)."""
+    return all(before.size and np.min(np.abs(before - p)) <= 0.01 * abs(p) for p in poles)
 
 
 def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:

@@ -11,19 +11,27 @@ noise floor at the peaks and at the floor elsewhere. Tested against the noise
 floor alone, a second pole beside each peak is "significant" although it only
 fits the peak's distortion: the data do not prove two modes there.
 
+This applies where the data carry no measured noise (no variance, no
+coherence: an impact test's FRFs as exported, a file of FRFs alone), where
+the noise is estimated from the fit's residual and the second differences of
+adjacent lines. Where the noise was measured (a variance, or the coherence of
+averages), a fit that leaves structure beyond it has failed, and its verdict
+says so: the lack of fit is not renamed noise.
+
 The noise model used instead (the additive-plus-proportional error model of
 measurement practice; Pintelon & Schoukens, *System Identification*, 2nd ed.
 2012, sec. 3.5 and 4.3, treat non-linear distortions the same way, as a noise
 whose level follows the signal)::
 
-    Var H_jkf = V_jkf + eps^2 |H^_jkf|^2                                (1)
+    Var H_jkf = V_jkf + eps^2 |H_jkf|^2                                 (1)
 
-``V`` the measured variance (given, from the coherence, or the noise floor
-from second differences of adjacent lines), ``H^`` the fitted model and
-``eps`` the relative model error, estimated from the data by the moment
+``V`` the noise the first fit used (estimated from its residual and the
+second differences of adjacent lines), ``H`` the data (its magnitude, not the
+model's, so that a mode the model lacks is not taken for noise-free lines),
+``H^`` the fitted model and ``eps`` the relative model error, estimated from the data by the moment
 equation of the weighted cost (its expectation for a correct noise model)::
 
-    sum 2 |H^ - H|^2 / (V + eps^2 |H^|^2) = n_obs - n_par               (2)
+    sum 2 |H^ - H|^2 / (V + eps^2 |H|^2) = n_obs - n_par                (2)
 
 whose left side falls monotonically in ``eps``: (2) has one root when the
 cost at ``eps = 0`` exceeds ``n_obs - n_par`` (the fit leaves structure) and
@@ -31,7 +39,14 @@ none otherwise (``eps = 0``: the measured noise explains the residual, and
 nothing changes). The identification is repeated with (1) as the per-line
 variance (the mode count decided again against it, standard errors widened by
 it) and ``eps`` re-estimated from the new fit, until it changes by less than
-:data:`EPS_TOLERANCE` (at most :data:`PASSES` repetitions).
+:data:`EPS_TOLERANCE` (at most :data:`PASSES` repetitions). Eq. (1) is
+never below the noise the first identification used, so a repetition can
+only take modes away; one that finds a mode the first did not (a noise
+model inconsistent with the data: a floor from second differences below the
+noise of some lines) is not used, and the first result stands. So does the first result when the
+repetition keeps as many modes: eq. (1) is there to decide which peaks the
+data prove to be modes, and a fit whose modes it confirms keeps its values
+and the errors of its own noise.
 """
 
 from __future__ import annotations
@@ -77,12 +92,21 @@ class NoiseFloor:
     what: str
 
 
-def noise_floor(frf: FRF, problem: FitProblem, variance: NDArray[np.float64] | None) -> NoiseFloor:
+def noise_floor(
+    frf: FRF,
+    problem: FitProblem,
+    variance: NDArray[np.float64] | None,
+    sigma_out: NDArray[np.float64] | None = None,
+) -> NoiseFloor:
     """``V`` of eq. (1) on the whole axis of ``frf``: the variance the fit of
     ``problem`` used (given, carried by the FRF or from the coherence), or, for
-    a fit whose noise was estimated from its residual, the noise floor per
-    output from second differences of the band's lines
-    (:func:`~tyredamp.modal.stats.difference_noise`)."""
+    a fit whose noise was estimated from its residual, per output the larger of
+    that estimate ``sigma_out`` (RMS, units of ``H``) and the noise floor from
+    second differences of the band's lines
+    (:func:`~tyredamp.modal.stats.difference_noise`). ``V`` is never below the
+    noise the first fit decided its modes with, so eq. (1) can only raise it:
+    the repeated identification does not find modes in noise the first one
+    did not call noise."""
     n = frf.frequency.size
     source, v = line_variance(frf, np.arange(n), np.asarray(frf.H), variance)
     if v is not None and source == "variance":
@@ -90,8 +114,11 @@ def noise_floor(frf: FRF, problem: FitProblem, variance: NDArray[np.float64] | N
     if v is not None:
         return NoiseFloor(np.asarray(v, dtype=float), "the noise from the coherence")
     full = np.empty(frf.H.shape)
-    full[:] = (difference_noise(problem.H) * problem.scale**2)[:, None, None]
-    return NoiseFloor(full, "the noise floor from second differences of adjacent lines")
+    s2 = difference_noise(problem.H) * problem.scale**2
+    if sigma_out is not None and np.all(np.isfinite(sigma_out)):
+        s2 = np.fmax(s2, np.asarray(sigma_out, dtype=float) ** 2)
+    full[:] = s2[:, None, None]
+    return NoiseFloor(full, "the noise estimated from the residual")
 
 
 def relative_model_error(
