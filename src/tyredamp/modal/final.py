@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import ConvergenceError
+from ..mechanics.modal_sum import pole_quantities
 from .fit import FitResult, ModalFitter
 from .indicators import mean_phase_deviation, modal_phase_collinearity
 from .ml import ml_refine
@@ -37,7 +38,15 @@ from .profile import Z95, fit_intervals
 from .quality import FitQuality, RejectedMode, threshold_text
 from .refitted import refitted_statistics
 from .residual_peaks import local_ratio
-from .search import ModeSet, ModeTest, fit_checked, local_thresholds, rejected, residual_span
+from .search import (
+    ModeSet,
+    ModeTest,
+    fit_checked,
+    local_thresholds,
+    rejected,
+    residual_span,
+    unresolved_damping,
+)
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
 __all__ = ["fit_real", "goodness", "to_model", "unscale"]
@@ -207,7 +216,9 @@ def goodness(
         pos = v > 0
         # E|e|^2 = V: real and imaginary part each of variance V / 2, 2 dof per entry
         chi2 = 2.0 * float(np.sum(sq[pos] / v[pos]))
-        if problem.noise_source == "variance" and nu is None:
+        if problem.noise_note:
+            label = problem.noise_note
+        elif problem.noise_source == "variance" and nu is None:
             label = "per-line variance given"
         else:
             what = "variance" if problem.noise_source == "variance" else "variance from coherence"
@@ -431,6 +442,13 @@ def to_model(
         n_evaluations=res.n_iter,
         thresholds=thr,
     )
+    df = float(pr.frequency[1] - pr.frequency[0]) if n_f > 1 else 0.0
+    fn_z = pole_quantities(poles)
+    unresolved = [
+        w
+        for w in (unresolved_damping(float(a), float(b), df) for a, b in zip(*fn_z, strict=True))
+        if w
+    ]
     meta = {
         "band_hz": [pr.band[0], pr.band[1]],
         "frf_kind": data.kind,
@@ -453,7 +471,7 @@ def to_model(
         "local_dispersion": disp,
         **intervals,
         "n_residual_modes": len(res.poles) - n_band,
-        "warnings": list(res.warnings),
+        "warnings": list(res.warnings) + unresolved,
     }
     mdl = ModalModel(
         poles,

@@ -81,6 +81,9 @@ fit is tested against the noise (``ModalModel.quality``).
 
 from __future__ import annotations
 
+import dataclasses
+import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -91,13 +94,15 @@ from .._blas import blas_threads as blas_limit
 from .._validate import as_finite
 from ..exceptions import InputError
 from ..frf import FRF
-from ..mechanics.modal_sum import pole_from_frequency_damping
+from ..mechanics.modal_sum import kind_factor, pole_from_frequency_damping
 from .compress import _compress, combine_outputs
 from .estimators import PoleEstimator
 from .final import ModelContext, final_complex, fit_real, to_model
 from .fit import FitResult, ModalFitter
 from .lscf import PoleSet, plscf
 from .model import ModalModel
+from .model_error import EPS_TOLERANCE, noise_floor, relative_model_error
+from .model_error import PASSES as MODEL_ERROR_PASSES
 from .order import Diagram, SelectionRules, default_order, modes_shown, settle_order
 from .out_of_band import search_helpers
 from .problem import FitProblem, build_problem, max_modes
@@ -159,6 +164,10 @@ class ModalIdentification:
         Pipeline-level remarks.
     noise_source : str
         Noise model of the fit: ``"variance"``, ``"coherence"`` or ``"residual"``.
+    model_error : float
+        Relative model error ``eps`` included in the noise (0: none;
+        :mod:`tyredamp.modal.model_error`): the fit of the measured noise alone
+        left structure, and the modes were decided against eq. (1) there.
     """
 
     models: dict[str, ModalModel]
@@ -172,6 +181,7 @@ class ModalIdentification:
     discrepancy: dict[str, NDArray[np.float64]] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     noise_source: str = "residual"
+    model_error: float = 0.0
 
 
 def identify_modes(
@@ -253,7 +263,8 @@ def identify_modes(
         Raises :class:`InputError` on bad arguments, a band without lines, a
         non-uniform axis, more modes than the data support, or no mode found.
     """
-    with blas_limit(blas_threads):
+
+    def run(v: ArrayLike | None, note: str = "") -> ModalIdentification:
         return _identify(
             frf,
             band,
@@ -270,10 +281,78 @@ def identify_modes(
             false_alarm=false_alarm,
             min_contribution=min_contribution,
             max_helpers=max_helpers,
-            variance=variance,
+            variance=v,
             estimator=estimator,
             search=search,
+            noise_note=note,
         )
+
+    with blas_limit(blas_threads):
+        first = run(variance)
+        return _with_model_error(frf, variance, first, run)
+
+
+def _with_model_error(
+    frf: FRF,
+    variance: ArrayLike | None,
+    first: ModalIdentification,
+    run: Callable[[ArrayLike | None, str], ModalIdentification],
+) -> ModalIdentification:
+    """``first`` again with a noise level that includes the model error, when its fit
+    leaves structure beyond the measured noise (:mod:`tyredamp.modal.model_error`)."""
+    kind = "complex" if "complex" in first.models else "real"
+    q = first.models[kind].quality
+    if first.noise_source != "residual":
+        return first  # a measured noise: a fit that misses it has failed, and says so
+    if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
+        return first
+    problem = build_problem(frf, first.band_hz, variance=variance)
+    floor = noise_floor(
+        frf,
+        problem,
+        None if variance is None else np.asarray(variance, float),
+        q.noise_rms_per_output,
+    )
+    lines = problem.lines
+    H = np.asarray(frf.H)[:, :, lines]
+    V = floor.variance[:, :, lines]
+
+    def eps_of(res: ModalIdentification) -> float:
+        m = res.models[kind]
+        Hm = m.receptance(problem.frequency) * kind_factor(2 * np.pi * problem.frequency, frf.kind)
+        dof = m.quality.dof if m.quality is not None else 0
+        return relative_model_error(H, Hm, V, dof)
+
+    eps = eps_of(first)
+    # each pass decides the modes against the eps of the previous fit; the result is
+    # the pass whose fit gives back the eps it was decided with (the fixed point of
+    # eq. (2)), or the closest to it when the passes do not settle
+    best: tuple[float, float, ModalIdentification] | None = None
+    for _ in range(MODEL_ERROR_PASSES):
+        if eps <= 0.0:
+            break
+        v = floor.variance.copy()
+        v[:, :, lines] += eps**2 * np.abs(H) ** 2
+        res = run(v, f"{floor.what} plus a model error of {eps:.2%} of the response")
+        if not _fewer_modes(res.models[kind].poles, first.models[kind].poles):
+            break  # a larger noise may only take modes away: an inconsistent pass is not used
+        again = eps_of(res)
+        gap = abs(math.log(again / eps)) if again > 0.0 else math.inf
+        if best is None or gap < best[0]:
+            best = (gap, eps, res)
+        if gap < math.log1p(EPS_TOLERANCE):
+            break
+        eps = again
+    if best is None or best[2].models[kind].n_modes == first.models[kind].n_modes:
+        return first  # the same modes: the first fit's own values and errors stand
+    _, eps, res = best
+
+    res.warnings.append(
+        f"the fit left structure beyond {floor.what} that no modal sum explains (leakage, "
+        "a window, a non-linearity, ...): modes were decided and their uncertainty stated "
+        f"against a noise that includes a model error of {eps:.2%} of the response"
+    )
+    return dataclasses.replace(res, model_error=eps)
 
 
 def _identify(
@@ -296,11 +375,13 @@ def _identify(
     variance: ArrayLike | None,
     estimator: PoleEstimator | None,
     search: bool,
+    noise_note: str = "",
 ) -> ModalIdentification:
-    """The body of :func:`identify_modes` (its parameters but ``blas_threads``)."""
+    """The body of :func:`identify_modes` (its parameters but ``blas_threads``;
+    ``noise_note`` says what a given ``variance`` is)."""
     if model not in ("both", "complex", "real"):
         raise InputError(f"model: expected 'both', 'complex' or 'real', got {model!r}")
-    problem = build_problem(frf, band, variance=variance)
+    problem = build_problem(frf, band, variance=variance, noise_note=noise_note)
     _, n_in, n_f = problem.shape
     lo, hi = problem.band
     fr = _check_counts(problem, n_modes, frequencies)
@@ -344,6 +425,11 @@ def _identify(
         warnings=warnings,
         noise_source=problem.noise_source,
     )
+
+
+def _fewer_modes(poles: NDArray[np.complex128], before: NDArray[np.complex128]) -> bool:
+    """Whether every pole of ``poles`` is one of ``before`` (within 1 % of ``|p|``)."""
+    return all(before.size and np.min(np.abs(before - p)) <= 0.01 * abs(p) for p in poles)
 
 
 def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:

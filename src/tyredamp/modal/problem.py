@@ -53,7 +53,14 @@ from .._validate import as_band
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, KIND_POWER
 
-__all__ = ["FitProblem", "NoiseSource", "build_problem", "line_factor_dof", "max_modes"]
+__all__ = [
+    "FitProblem",
+    "NoiseSource",
+    "build_problem",
+    "line_factor_dof",
+    "line_variance",
+    "max_modes",
+]
 
 NoiseSource = Literal["variance", "coherence", "residual"]
 #: relative spread of the line spacing accepted as uniform (float32 axes of
@@ -97,6 +104,9 @@ class FitProblem:
         docstring); None when the variance is known or there is none.
     n_averages : int or None
         Averages the variance was estimated from (``meta["n_averages"]``), for the verdict.
+    noise_note : str
+        What a given variance is, for people (e.g. a noise floor plus a model
+        error, :mod:`tyredamp.modal.model_error`); "" when nothing is to be said.
     """
 
     frequency: NDArray[np.float64]
@@ -114,6 +124,7 @@ class FitProblem:
     lines: slice
     noise_dof: float | None = None
     n_averages: int | None = None
+    noise_note: str = ""
 
     @property
     def weight_dof(self) -> float | None:
@@ -189,10 +200,14 @@ def check_uniform(f: NDArray[np.float64]) -> None:
         )
 
 
-def _line_variance(
+def line_variance(
     frf: FRF, lines: NDArray[np.intp], H: NDArray[np.complex128], variance: ArrayLike | None
 ) -> tuple[NoiseSource, NDArray[np.float64] | None]:
-    """Variance of each line of the band (data units) and where it comes from."""
+    """Variance of each line of ``lines`` (data units ``H``) and where it comes from.
+
+    ``variance`` (given) or ``frf.variance``: ``"variance"``; else from the
+    coherence and ``meta["n_averages"]``: ``"coherence"``; else
+    ``("residual", None)``."""
     full = frf.H.shape
     v_given = variance if variance is not None else frf.variance
     if v_given is not None:
@@ -257,6 +272,7 @@ def build_problem(
     band: tuple[float, float] | None = None,
     *,
     variance: ArrayLike | None = None,
+    noise_note: str = "",
 ) -> FitProblem:
     """Cut ``frf`` to the band, normalise it and state its noise model.
 
@@ -270,6 +286,8 @@ def build_problem(
         Variance of each line of ``H`` (units of ``H`` squared); default
         ``FRF.variance`` when the FRF carries it, else from the coherence and
         ``meta["n_averages"]``, else none (estimated from the residual).
+    noise_note : str
+        What a given ``variance`` is (:attr:`FitProblem.noise_note`).
 
     Returns
     -------
@@ -312,7 +330,7 @@ def build_problem(
     rms = float(np.sqrt(np.vdot(Hn, Hn).real / Hn.size))
     Hn /= rms  # in place: one copy of the band's data
     scale = peak * rms
-    source, v = _line_variance(frf, lines, Hb, variance)
+    source, v = line_variance(frf, lines, Hb, variance)
     nu = variance_dof(frf, source, variance is not None)
     n_avg = _meta_number(frf, "n_averages")
     sig = lw = vn = None
@@ -341,4 +359,5 @@ def build_problem(
         lines=slice(i0, i1),
         noise_dof=nu if source != "residual" else None,
         n_averages=None if n_avg is None else int(n_avg),
+        noise_note=noise_note if source == "variance" else "",
     )

@@ -517,11 +517,12 @@ def residual_search(
 
     A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
     of the diagram) is not a mode: it is rejected whatever its statistic. Nor
-    is one whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
-    narrower than the line spacing: no line lies inside its resonance, so the
-    lines cannot resolve its frequency and damping, and such a pole fits the
-    noise of single lines (where per-line variances estimated from a few
-    averages are too small) rather than a resonance. A trial mode that passes
+    is a trial whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
+    narrower than the line spacing: such a pole fits single lines (an outlier,
+    the tail of an impact test's low-frequency end) as well as a resonance.
+    A mode of the diagram may be that narrow (a lightly damped mode measured
+    with coarse lines): its frequency is resolved and its damping only bounded
+    (:func:`unresolved_damping`). A trial mode that passes
     is refitted with all modes (:func:`_joint`) and kept when it stays in the
     band, merges with no mode, is still admissible and every mode still passes
     the test; a trial mode that alone crosses a band edge in the joint refit,
@@ -739,3 +740,21 @@ def _split(
         if r1.significance[j] > thr_j[0]:
             return got
     return None
+
+
+def unresolved_damping(frequency_hz: float, damping_ratio: float, df: float) -> str:
+    """The statement for a mode whose half-power band is narrower than the lines ('' if not).
+
+    The half-power bandwidth ``2 zeta f_n`` (Hz) of such a mode lies between two
+    lines ``df`` apart: the lines fix its frequency, but any damping with a
+    bandwidth below ``df`` fits them alike, so the data bound the damping ratio,
+    ``zeta < df / (2 f_n)``, and do not measure it.
+    """
+    if not (df > 0 and frequency_hz > 0) or 2.0 * damping_ratio * frequency_hz >= df:
+        return ""
+    return (
+        f"mode at {frequency_hz:.5g} Hz: half-power bandwidth "
+        f"{2.0 * damping_ratio * frequency_hz:.2g} Hz below the line spacing {df:.3g} Hz: "
+        f"its damping is not resolved by the lines (zeta < {df / (2.0 * frequency_hz):.2%}, "
+        "an upper bound; measure with finer lines for a value)"
+    )
