@@ -16,16 +16,27 @@ from ._validate import as_finite, check_positive
 from .exceptions import InputError, ShapeError
 from .frf import Channel
 
-__all__ = ["ACQUISITION_KEYS", "QUANTITY_UNITS", "Acquisition", "Quantity", "TimeData"]
+__all__ = [
+    "ACQUISITION_KEYS",
+    "MOTION_QUANTITIES",
+    "QUANTITY_UNITS",
+    "Acquisition",
+    "Quantity",
+    "TimeData",
+]
 
-Quantity = Literal["force", "displacement", "velocity", "acceleration"]
+Quantity = Literal["force", "displacement", "velocity", "acceleration", "pressure", "voltage"]
 #: SI unit of each measured quantity.
 QUANTITY_UNITS: dict[str, str] = {
     "force": "N",
     "displacement": "m",
     "velocity": "m/s",
     "acceleration": "m/s^2",
+    "pressure": "Pa",
+    "voltage": "V",
 }
+#: The quantities of structural responses (what an FRF relates to a force).
+MOTION_QUANTITIES: tuple[str, ...] = ("displacement", "velocity", "acceleration")
 
 
 def _count(v: Any, name: str, minimum: int) -> int:
@@ -226,14 +237,17 @@ class TimeData:
     Parameters
     ----------
     data : array_like, shape (n_channels, n_samples)
-        Samples in SI units (N, m, m/s, m/s^2 by quantity).
+        Samples in SI units (N, m, m/s, m/s^2, Pa, V by quantity).
     sample_rate : float
         Samples per second (Hz).
     channels : sequence of Channel
         Point and direction of each channel.
     quantities : sequence of str
-        ``"force"``, ``"displacement"``, ``"velocity"`` or ``"acceleration"``
-        per channel.
+        ``"force"``, ``"displacement"``, ``"velocity"``, ``"acceleration"``,
+        ``"pressure"`` (a microphone, Pa) or ``"voltage"`` (a sensor whose
+        sensitivity was not given, V) per channel. Pressure and voltage
+        channels are kept and shown but are neither forces nor structural
+        responses: FRF estimation leaves them out.
     meta : dict, optional
         Free notes (test description, operator ...); never read by the
         estimators. Legacy acquisition keys (``"period_samples"``,
@@ -328,8 +342,37 @@ class TimeData:
 
     @property
     def response_indices(self) -> list[int]:
-        """Positions of the response (non-force) channels."""
-        return [i for i, q in enumerate(self.quantities) if q != "force"]
+        """Positions of the structural response channels (displacement, velocity, acceleration)."""
+        return [i for i, q in enumerate(self.quantities) if q in MOTION_QUANTITIES]
+
+    @property
+    def other_indices(self) -> list[int]:
+        """Positions of the channels that are neither force nor motion (pressure, voltage)."""
+        return [i for i, q in enumerate(self.quantities) if q not in MOTION_QUANTITIES + ("force",)]
+
+    @property
+    def output_only(self) -> bool:
+        """True when no channel is a force: an operational (output-only) recording."""
+        return not self.force_indices
+
+    def require_force(self, what: str = "an FRF") -> None:
+        """Raise :class:`InputError` in one line when there is no force channel.
+
+        The message says that this is output-only data, names the channels and
+        says what to do: name a force channel (``--channel NAME=force:N``) or
+        use output-only identification, which tyredamp does not offer yet.
+        """
+        if self.force_indices:
+            return
+        names = ", ".join(
+            f"{c.name or c.label} ({q})" for c, q in zip(self.channels, self.quantities, strict=True)
+        )
+        raise InputError(
+            f"output-only data (no force channel): channels {names}; {what} needs a measured "
+            "force: name the force channel with --channel NAME=force:N (Python: a ChannelMap), "
+            "or identify modes from output-only data with another tool (operational modal "
+            "analysis is not available in tyredamp yet)"
+        )
 
     def __repr__(self) -> str:
         return (

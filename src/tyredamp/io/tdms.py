@@ -1,11 +1,11 @@
 """NI TDMS time data (LabVIEW) through npTDMS.
 
-All channels of one group (the first group holding data, or ``group``) are
-read. The sample rate comes from the channels' ``wf_increment`` property
+All channels of one group (the first group holding data, the group of the
+channels a channel map names, or ``group``) are read. The sample rate comes from the channels' ``wf_increment`` property
 (seconds per sample, the LabVIEW waveform attribute; all equal), the units
 from ``unit_string`` (read by :mod:`.units` and converted to SI), the channel
-names from the TDMS channel names. The force is the channel with a force
-unit (or the one named ``"force"`` in ``quantities``); see :mod:`._channels`.
+names from the TDMS channel names. Channels without a ``unit_string`` (or
+with one that is wrong) are named with a channel map; see :mod:`._channels`.
 Channels are numbered as nodes 1..n in file order (direction +Z), named as
 in the file.
 """
@@ -21,6 +21,7 @@ from ..exceptions import FileFormatError
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
+from .channelmap import ChannelMap
 
 __all__ = ["read_tdms"]
 
@@ -29,6 +30,7 @@ def read_tdms(
     path: str | os.PathLike[str],
     quantities: Mapping[str, str] | None = None,
     group: str | None = None,
+    channel_map: ChannelMap | None = None,
 ) -> TimeData:
     """Read time data from a TDMS file.
 
@@ -39,7 +41,11 @@ def read_tdms(
         ``"force"``, ``"displacement"``, ``"velocity"`` or ``"acceleration"``
         for channels whose ``unit_string`` is blank (or to override it).
     group : str, optional
-        Group to read; default the first group with channels.
+        Group to read; default the group of the channels the channel map
+        names, else the first group with channels.
+    channel_map : ChannelMap, optional
+        Roles, units and sensitivities of channels (:mod:`.channelmap`);
+        channels answer to their name and to ``group/name``.
 
     Raises
     ------
@@ -65,6 +71,15 @@ def read_tdms(
             raise FileFormatError(f"{p}: no group {group!r} with channels")
     if not groups:
         raise FileFormatError(f"{p}: no channels in the TDMS file")
+    if group is None and channel_map:
+        keys = set(channel_map.keys)
+        named = [
+            g
+            for g in groups
+            if any(c.name in keys or f"{g.name}/{c.name}" in keys for c in g.channels())
+        ]
+        if named:
+            groups = named
     chans = groups[0].channels()
     names, units, arrays, steps = [], [], [], []
     for c in chans:
@@ -83,4 +98,14 @@ def read_tdms(
     dt = steps[0]
     if not np.isfinite(dt) or dt <= 0 or any(abs(s - dt) > 1e-12 * dt for s in steps):
         raise FileFormatError(f"{p}: channels have different or invalid sample intervals {steps}")
-    return timedata_from_channels(p, names, units, arrays, snap_rate(1.0 / dt), quantities)
+    gname = str(groups[0].name)
+    return timedata_from_channels(
+        p,
+        names,
+        units,
+        arrays,
+        snap_rate(1.0 / dt),
+        quantities,
+        channel_map,
+        aliases=[[f"{gname}/{n}"] for n in names],
+    )

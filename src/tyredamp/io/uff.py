@@ -89,23 +89,55 @@ __all__ = ["read_uff", "uff_contents", "write_uff"]
 _MARK = "tyredamp1"
 #: ID line 1 of the extra data sets (function type 0) holding FRF.variance.
 _VARIANCE_ID = "tyredamp FRF variance"
-_SDT = {"displacement": 8, "velocity": 11, "acceleration": 12, "force": 13}
-_SDT_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 13: "force", 9: "force"}
+# specific data types (record 8): 15 pressure, 21 sound pressure, 1 general (volts)
+_SDT = {
+    "displacement": 8,
+    "velocity": 11,
+    "acceleration": 12,
+    "force": 13,
+    "pressure": 15,
+    "voltage": 1,
+}
+_SDT_QUANTITY = {
+    8: "displacement",
+    11: "velocity",
+    12: "acceleration",
+    13: "force",
+    9: "force",
+    15: "pressure",
+    21: "pressure",
+}
 _KIND_QUANTITY = {
     "receptance": "displacement",
     "mobility": "velocity",
     "accelerance": "acceleration",
 }
 _QUANTITY_KIND: dict[str, FRFKind] = {v: k for k, v in _KIND_QUANTITY.items()}  # type: ignore[misc]
-_SI_LABEL = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2", "force": "N"}
+_SI_LABEL = {
+    "displacement": "m",
+    "velocity": "m/s",
+    "acceleration": "m/s^2",
+    "force": "N",
+    "pressure": "Pa",
+    "voltage": "V",
+}
 _AXIS_LABEL = {
     "displacement": "Displacement",
     "velocity": "Velocity",
     "acceleration": "Acceleration",
     "force": "Force",
+    "pressure": "Pressure",
+    "voltage": "Voltage",
 }
 # (length exponent, force exponent) of each quantity in SI
-_EXP = {"displacement": (1, 0), "velocity": (1, 0), "acceleration": (1, 0), "force": (0, 1)}
+_EXP = {
+    "displacement": (1, 0),
+    "velocity": (1, 0),
+    "acceleration": (1, 0),
+    "force": (0, 1),
+    "pressure": (-2, 1),
+    "voltage": (0, 0),
+}
 
 
 # ------------------------------------------------------------------ writing
