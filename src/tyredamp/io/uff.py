@@ -69,6 +69,7 @@ import gc
 import itertools
 import json
 import os
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -80,8 +81,11 @@ from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
 from ._atomic import atomic_path
+from ._channels import timedata_from_channels
 from ._common import check_input_file, meta_to_json, wrap_errors
+from ._text import decode_text
 from ._uff_meta import meta_record, read_meta_record
+from .channelmap import ChannelMap
 from .units import frf_units, quantity_units
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
@@ -479,9 +483,7 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
         types = list(uff.get_set_types())
         idx = [k for k, t in enumerate(types) if t == 58]
         if not idx:
-            raise FileFormatError(
-                f"{p}: no data set 58 (function at nodal DOF); found types {sorted(set(types))}"
-            )
+            raise FileFormatError(f"{p}: {_what_instead(types)}")
         sets = uff.read_sets(idx)
         record = read_meta_record(p, uff, types)
     except FileFormatError:
@@ -494,15 +496,100 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
         data = s.get("data")
         if data is None or "num_pts" not in s or len(data) != int(s["num_pts"]):
             got = "no" if data is None else len(data)
+            declared = s.get("num_pts")
+            if isinstance(got, int) and isinstance(declared, int) and 0 < got < declared:
+                raise FileFormatError(
+                    f"{p}: data set #{k + 1} is corrupt or truncated: its header declares {declared} "
+                    f"values, the file stores {got} (a cut-off excerpt of a longer recording, "
+                    "not a complete measurement)"
+                )
             raise FileFormatError(
                 f"{p}: data set #{k + 1} is corrupt or truncated: header says "
-                f"{s.get('num_pts')} values, found {got}"
+                f"{declared} values, found {got}"
             )
         s["_index"] = k + 1
+    _redecode_strings(raw, sets)
     if record is not None:
         for s in sets:
             s["_meta"] = record
     return sets
+
+
+#: UFF data-set types that hold geometry (nodes, coordinate systems, lines, elements, units).
+_GEOMETRY_SETS = {15, 18, 82, 164, 2411, 2412, 2420, 151}
+#: Function types of data set 58 (record 6), by the UFF specification.
+_FUNCTION_TYPES = {
+    0: "a general function",
+    1: "a time response",
+    2: "an auto spectrum",
+    3: "a cross spectrum",
+    4: "an FRF",
+    5: "a transmissibility",
+    6: "a coherence",
+    7: "an auto-correlation",
+    8: "a cross-correlation",
+    9: "a PSD",
+    10: "an ESD",
+    11: "a probability density",
+    12: "a spectrum",
+    13: "a cumulative frequency distribution",
+    18: "a mode indicator function",
+    24: "a shock response spectrum",
+    26: "a multiple coherence",
+    27: "an order function",
+}
+
+
+def _what_instead(types: list[int]) -> str:
+    """One line saying what a UFF file without data sets 58 holds instead."""
+    found = sorted({int(t) for t in types})
+    listed = ", ".join(str(t) for t in found)
+    if found and set(found) <= _GEOMETRY_SETS:
+        return (
+            f"holds geometry only (data sets {listed}: nodes, coordinate systems, lines, "
+            "elements), not time data or an FRF; use it as a geometry file (tyredamp modal "
+            "--geometry)"
+        )
+    if 55 in found:
+        return f"holds mode shapes (data sets {listed}), not time data or an FRF"
+    return f"no data set 58 (time data or FRF); found data sets {listed}"
+
+
+def _function_name(t: int) -> str:
+    return _FUNCTION_TYPES.get(int(t), "an unknown function")
+
+
+def _not_frf_or_time(p: Path, types: set[int]) -> FileFormatError:
+    kinds = ", ".join(f"{_function_name(t)} (function type {t})" for t in sorted(types))
+    return FileFormatError(f"{p}: holds {kinds}, not time data or an FRF")
+
+
+def _redecode_strings(raw: bytes, sets: list[dict[str, Any]]) -> None:
+    """Header strings pyuff decoded with replacement characters, read again as cp1252.
+
+    pyuff decodes header lines as UTF-8 with ``errors="replace"``; a label
+    such as ``g²/Hz`` written by Windows software as cp1252/Latin-1 (``²`` =
+    byte 0xB2) comes back as ``g\ufffd/Hz``. The original bytes are found in
+    the file around the intact parts and decoded as cp1252 (Latin-1 for the
+    bytes cp1252 leaves undefined); the set's ``_encoding`` records it.
+    """
+    cache: dict[str, str | None] = {}
+    for s in sets:
+        for key, value in list(s.items()):
+            if not isinstance(value, str) or "\ufffd" not in value:
+                continue
+            if value not in cache:
+                parts = [re.escape(x.encode("utf-8")) for x in value.split("\ufffd")]
+                m = re.search(b"(?:.{1,3}?)".join(parts), raw, flags=re.DOTALL)
+                text = None
+                if m is not None:
+                    text, _ = decode_text(m.group(0))
+                    if "\ufffd" in text:
+                        text = None
+                cache[value] = text
+            if cache[value] is not None:
+                s[key] = cache[value]
+                s["_encoding"] = "cp1252"
 
 
 def _tokens(s: dict[str, Any]) -> dict[str, str] | None:
@@ -574,14 +661,14 @@ def uff_contents(path: str | os.PathLike[str]) -> str:
         return "frf"
     if 1 in types:
         return "timedata"
-    raise FileFormatError(
-        f"{p}: no FRF (function type 4) or time response (type 1) in data sets 58; found "
-        f"function types {sorted(types)}"
-    )
+    raise _not_frf_or_time(p, types)
 
 
 def read_uff(
-    path: str | os.PathLike[str], what: str | None = None, kind: FRFKind | None = None
+    path: str | os.PathLike[str],
+    what: str | None = None,
+    kind: FRFKind | None = None,
+    channel_map: ChannelMap | None = None,
 ) -> FRF | TimeData:
     """Read FRFs (function type 4) or time data (type 1) from a UFF file.
 
@@ -593,6 +680,10 @@ def read_uff(
     kind : {"receptance", "mobility", "accelerance"}, optional
         FRF kind when the file does not tell it (ordinate data type and units
         label missing); when given it overrides the file.
+    channel_map : ChannelMap, optional
+        Time data: roles, units and sensitivities of channels (keys: the
+        response entity name, ID line 1 or the point label such as ``1+Z``,
+        or the position 1, 2 ...).
 
     Raises
     ------
@@ -602,19 +693,24 @@ def read_uff(
     """
     p = check_input_file(path)
     sets = _load_sets(p)
+    types = {int(s.get("func_type", -1)) for s in sets}
     if what is None:
-        types = {int(s.get("func_type", -1)) for s in sets}
         what = "frf" if 4 in types else "timedata" if 1 in types else ""
         if not what:
-            raise FileFormatError(
-                f"{p}: no FRF (function type 4) or time response (type 1) in data sets 58; "
-                f"found function types {sorted(types)}"
-            )
+            raise _not_frf_or_time(p, types)
+    if what == "frf" and 4 not in types:
+        if 1 in types:
+            raise FileFormatError(f"{p}: holds time data (function type 1), not an FRF")
+        raise _not_frf_or_time(p, types)
+    if what == "timedata" and 1 not in types:
+        if 4 in types:
+            raise FileFormatError(f"{p}: holds FRFs (function type 4), not time data")
+        raise _not_frf_or_time(p, types)
     with wrap_errors(p):
         if what == "frf":
             return _read_frf(p, sets, kind)
         if what == "timedata":
-            return _read_time(p, sets)
+            return _read_time(p, sets, channel_map)
     raise InputError(f"what: expected 'frf' or 'timedata', got {what!r}")
 
 
@@ -715,6 +811,9 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
             h[a, b] = cells[(ko, ki)]
     coh = _read_coherence(sets, list(outs), list(ins), n)
     var = _read_variance(sets, list(outs), list(ins), n, h.shape)
+    meta = _meta(first, tok)
+    if any("_encoding" in s for s in frf_sets):
+        meta["text_encoding"] = "cp1252"
     return FRF(
         x,
         h,
@@ -722,7 +821,7 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
         outputs=list(outs.values()),
         inputs=list(ins.values()),
         coherence=coh,
-        meta=_meta(first, tok),
+        meta=meta,
         variance=var,
     )
 
@@ -765,7 +864,19 @@ def _read_variance(
     return np.array([[found[(o, i)] for i in ins] for o in outs]).reshape(shape)
 
 
-def _read_time(p: Path, sets: list[dict[str, Any]]) -> TimeData:
+def _uff_name(s: dict[str, Any], tok: dict[str, str] | None) -> str:
+    """The name a data set's channel goes by: tyredamp's, the response entity, ID line 1."""
+    name = str(_extras(s.get("id4")).get("name", "")) if tok else ""
+    for key in ("rsp_ent_name", "id1"):
+        if not name:
+            v = str(s.get(key, "") or "").strip()
+            name = "" if v.upper() in ("", "NONE") else v
+    return name
+
+
+def _read_time(
+    p: Path, sets: list[dict[str, Any]], channel_map: ChannelMap | None = None
+) -> TimeData:
     ts = [s for s in sets if int(s["func_type"]) == 1]
     if not ts:
         raise FileFormatError(f"{p}: no time response (function type 1) data set")
@@ -784,19 +895,49 @@ def _read_time(p: Path, sets: list[dict[str, Any]]) -> TimeData:
                 f"{where}: {len(s['data'])} samples, but data set #{first['_index']} has {n}; "
                 "channels must have equal length"
             )
+    meta = _meta(first, tok)
+    if any("_encoding" in s for s in ts):
+        meta["text_encoding"] = "cp1252"
+    fs = _sample_rate(p, ts, tok)
+    if channel_map:
+        points, names, aliases, labels, hints = [], [], [], [], []
+        for k, s in enumerate(ts):
+            ch = _channel(s["rsp_node"], s["rsp_dir"], {}, f"{p}: data set #{s['_index']}")
+            name = _uff_name(s, tok) or f"{ch.label}"
+            names.append(name)
+            aliases.append([ch.label, str(s.get("id1", "")).strip(), f"#{k + 1}"])
+            points.append((ch.node, ch.direction))
+            labels.append(str(s.get("ordinate_axis_units_lab", "") or ""))
+            hints.append(_SDT_QUANTITY.get(int(s.get("ordinate_spec_data_type", 0) or 0)))
+        return timedata_from_channels(
+            p,
+            names,
+            labels,
+            [np.asarray(s["data"], dtype=float) for s in ts],
+            fs,
+            None,
+            channel_map,
+            aliases=aliases,
+            hints=hints,
+            points=points,
+            meta=meta,
+        )
+    for s in ts:
+        where = f"{p}: data set #{s['_index']}"
         q, scale = _quantity(s, where)
         if q is None:
+            name = _uff_name(s, tok) or str(s["rsp_node"])
             raise FileFormatError(
                 f"{where}: cannot tell the measured quantity (ordinate data type "
-                f"{s.get('ordinate_spec_data_type')}, no units label)"
+                f"{s.get('ordinate_spec_data_type')}, no units label); name it, for example "
+                f"--channel '{name}=acceleration:m/s^2'"
             )
         rows.append(np.asarray(s["data"], dtype=float) * scale)
         chans.append(
             _channel(s["rsp_node"], s["rsp_dir"], _extras(s.get("id4")) if tok else {}, where)
         )
         quants.append(q)
-    fs = _sample_rate(p, ts, tok)
-    return TimeData(np.array(rows), fs, chans, quants, meta=_meta(first, tok))
+    return TimeData(np.array(rows), fs, chans, quants, meta=meta)
 
 
 def _sample_rate(p: Path, ts: list[dict[str, Any]], tok: dict[str, str] | None) -> float:
