@@ -348,7 +348,7 @@ class TimeData:
     @property
     def other_indices(self) -> list[int]:
         """Positions of the channels that are neither force nor motion (pressure, voltage)."""
-        return [i for i, q in enumerate(self.quantities) if q not in MOTION_QUANTITIES + ("force",)]
+        return [i for i, q in enumerate(self.quantities) if q not in (*MOTION_QUANTITIES, "force")]
 
     @property
     def output_only(self) -> bool:
@@ -365,7 +365,8 @@ class TimeData:
         if self.force_indices:
             return
         names = ", ".join(
-            f"{c.name or c.label} ({q})" for c, q in zip(self.channels, self.quantities, strict=True)
+            f"{c.name or c.label} ({q})"
+            for c, q in zip(self.channels, self.quantities, strict=True)
         )
         raise InputError(
             f"output-only data (no force channel): channels {names}; {what} needs a measured "

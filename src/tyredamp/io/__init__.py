@@ -62,9 +62,7 @@ __all__ = [
     "write_timedata",
 ]
 
-Format = Literal[
-    "uff58b", "uff58", "csv", "npz", "netcdf", "tdms", "mdf", "lvm", "mat", "wav"
-]
+Format = Literal["uff58b", "uff58", "csv", "npz", "netcdf", "tdms", "mdf", "lvm", "mat", "wav"]
 
 
 @dataclass(frozen=True)
@@ -174,9 +172,7 @@ FILE_FORMATS: dict[str, FileFormat] = {
         FileFormat("npz", (".npz",), ".npz", "read_npz", "write_npz"),
         FileFormat("netcdf", (".nc",), ".netcdf", "read_netcdf", "write_netcdf", holds="frf"),
         FileFormat("tdms", (".tdms",), ".tdms", "read_tdms", None, holds="timedata", maps=True),
-        FileFormat(
-            "mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None, holds="timedata", maps=True
-        ),
+        FileFormat("mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None, holds="timedata", maps=True),
         FileFormat("lvm", (".lvm",), ".lvm", "read_lvm", None, holds="timedata", maps=True),
         FileFormat("mat", (".mat",), ".mat", "read_mat", None, True, maps=True),
         FileFormat("wav", (".wav",), ".wav", "read_wav", None, holds="timedata", maps=True),
@@ -258,9 +254,7 @@ def read_frf(
     return obj
 
 
-def read_timedata(
-    path: str | os.PathLike[str], channel_map: ChannelMap | None = None
-) -> TimeData:
+def read_timedata(path: str | os.PathLike[str], channel_map: ChannelMap | None = None) -> TimeData:
     """Read time data from a UFF, CSV, NPZ, TDMS, MDF, LVM, MATLAB or WAV file.
 
     Parameters

@@ -44,6 +44,10 @@ _EXAMPLE_SENS = {
 }
 
 
+class _Unnamed(FileFormatError):
+    """A channel without a unit that the channel map does not name."""
+
+
 def snap_rate(fs: float) -> float:
     """A sample rate from a stored interval, snapped to the integer it stands for (1e-9)."""
     r = round(fs)
@@ -129,20 +133,17 @@ def channel_values(
         return sens.quantity, v * factor / sens.volts_per_si
     if role is None:
         if q_file is None:
-            raise FileFormatError(
+            raise _Unnamed(
                 f"{where}: no units label tells what it measures; name it, for example "
                 f"{_opt(name, 'force:N')} or {_opt(name, 'acceleration:m/s^2')}"
             )
         if q_file == "voltage":
-            notes.append(
-                f"channel {name!r} is in volts (no sensitivity given): kept as a voltage"
-            )
+            notes.append(f"channel {name!r} is in volts (no sensitivity given): kept as a voltage")
         return q_file, v * factor
     if role == "voltage" or q_file is None or q_file == role:
         if q_file is None:
             notes.append(
-                f"channel {name!r}: no unit in the file, taken as {QUANTITY_UNITS[role]} "
-                f"({role})"
+                f"channel {name!r}: no unit in the file, taken as {QUANTITY_UNITS[role]} ({role})"
             )
         elif role == "voltage" and q_file != "voltage":
             raise InputError(
@@ -222,6 +223,7 @@ def timedata_from_channels(
     rows, quants, chans = [], [], []
     read_notes = list(notes)
     skipped = []
+    unnamed: list[tuple[str, FileFormatError]] = []
     for i, (name, unit, a) in enumerate(zip(names, units, arrays, strict=True)):
         where = f"{path}: channel {name!r}"
         spec = specs.get(i)
@@ -237,9 +239,19 @@ def timedata_from_channels(
             values = np.asarray(a, dtype=float)
         except (TypeError, ValueError):
             raise FileFormatError(f"{where}: values are not numbers") from None
-        q, si = channel_values(
-            where, str(name), str(unit or ""), values, spec, hints[i] if hints else None, read_notes
-        )
+        try:
+            q, si = channel_values(
+                where,
+                str(name),
+                str(unit or ""),
+                values,
+                spec,
+                hints[i] if hints else None,
+                read_notes,
+            )
+        except _Unnamed as exc:
+            unnamed.append((str(name), exc))
+            continue
         rows.append(si)
         quants.append(q)
         node, direction = points[i] if points else (i + 1, 3)
@@ -248,6 +260,16 @@ def timedata_from_channels(
         if spec is not None and spec.direction is not None:
             direction = spec.direction
         chans.append(Channel(node=node, direction=direction, name=str(name)))
+    if len(unnamed) == 1:
+        raise unnamed[0][1]
+    if unnamed:
+        listed = ", ".join(repr(n) for n, _ in unnamed)
+        first = unnamed[0][0]
+        raise FileFormatError(
+            f"{path}: no units label tells what channels {listed} measure; name them, for "
+            f"example {_opt(first, 'force:N')} {_opt(unnamed[1][0], 'acceleration:m/s^2')} "
+            "(or a --channel-map file)"
+        )
     if skipped:
         read_notes.append(f"left out as the channel map asks: {', '.join(skipped)}")
     if not rows:

@@ -272,10 +272,7 @@ class ChannelMap:
 
         text, _ = decode_text(raw, p)
         try:
-            if p.suffix.lower() == ".json":
-                doc = json.loads(text)
-            else:
-                doc = tomllib.loads(text)
+            doc = json.loads(text) if p.suffix.lower() == ".json" else tomllib.loads(text)
         except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
             kind = "JSON" if p.suffix.lower() == ".json" else "TOML"
             raise FileFormatError(f"{p}: not a valid {kind} channel map ({exc})") from None
@@ -363,6 +360,24 @@ class ChannelMap:
             i = hits[0]
             out[i] = out[i].merged(spec) if i in out else spec
         return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """The map as a document ``{"channels": {key: {...}}}`` (inverse of :meth:`from_dict`)."""
+        out: dict[str, Any] = {}
+        for s in self.channels:
+            d: dict[str, Any] = {}
+            if s.role is not None:
+                d["role"] = s.role
+            if s.unit is not None:
+                d["unit"] = s.unit
+            if s.sensitivity is not None:
+                d["sensitivity"] = s.sensitivity.text
+            if s.node is not None:
+                d["node"] = s.node
+            if s.direction is not None:
+                d["direction"] = s.direction
+            out[s.key] = d
+        return {"channels": out}
 
     @classmethod
     def from_quantities(cls, quantities: Mapping[str, str] | None) -> ChannelMap:

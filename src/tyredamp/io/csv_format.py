@@ -67,8 +67,6 @@ from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, UNITS
 from ..timedata import Acquisition, TimeData
 from ._atomic import atomic_path
-from ._text import decode_text
-from .channelmap import ChannelMap
 from ._common import (
     channel_from_dict,
     channel_to_dict,
@@ -77,6 +75,8 @@ from ._common import (
     meta_to_json,
     wrap_errors,
 )
+from ._text import decode_text
+from .channelmap import ChannelMap
 
 __all__ = ["read_csv", "write_csv"]
 
@@ -177,9 +177,7 @@ def _one(fields: dict[str, list[str]], key: str, p: Path) -> str:
     return vals[0]
 
 
-def read_csv(
-    path: str | os.PathLike[str], channel_map: ChannelMap | None = None
-) -> FRF | TimeData:
+def read_csv(path: str | os.PathLike[str], channel_map: ChannelMap | None = None) -> FRF | TimeData:
     """Read a CSV file: the layout of the module docstring, or a plain export.
 
     A file that does not start with ``# tyredamp csv 1`` is read as a plain

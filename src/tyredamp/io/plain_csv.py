@@ -93,7 +93,7 @@ def _delimiter(lines: Sequence[str]) -> tuple[str, bool]:
     """``(delimiter, decimal_comma)`` that splits the last lines into equal numeric rows."""
     sample = [ln for ln in lines if ln.strip()][-20:]
     for delim in ("\t", ";", ","):
-        for dec_comma in ((False, True) if delim != "," else (False,)):
+        for dec_comma in (False, True) if delim != "," else (False,):
             widths = set()
             ok = True
             for ln in sample:
@@ -134,7 +134,7 @@ def read_plain_csv(
         frequency column, uneven time steps, a channel whose quantity cannot
         be told (name it with a channel map).
     """
-    lines = [ln for ln in text.splitlines()]
+    lines = text.splitlines()
     body_start = None
     numeric = 0
     for k, ln in enumerate(lines):
@@ -150,9 +150,7 @@ def read_plain_csv(
             body_start, numeric = None, 0
     if body_start is None:
         raise FileFormatError(f"{p}: no rows of numbers found (not a CSV export of data?)")
-    head = [
-        ln for ln in lines[:body_start] if ln.strip() and not ln.lstrip().startswith("#")
-    ]
+    head = [ln for ln in lines[:body_start] if ln.strip() and not ln.lstrip().startswith("#")]
     if not head:
         raise FileFormatError(
             f"{p}: no header row of column names above the numbers (expected for example "
@@ -177,7 +175,9 @@ def read_plain_csv(
         try:
             rows.append([float(c.replace(",", ".") if dec_comma else c) for c in cells])
         except ValueError:
-            raise FileFormatError(f"{p}: data row {k + 1} holds a value that is not a number") from None
+            raise FileFormatError(
+                f"{p}: data row {k + 1} holds a value that is not a number"
+            ) from None
     table = np.array(rows, dtype=float)
     if table.shape[0] < 2:
         raise FileFormatError(f"{p}: fewer than 2 data rows")
@@ -245,10 +245,22 @@ def _rate(p: Path, t: np.ndarray, texts: Sequence[str], scale: float) -> float:
 
 _ROLE_KIND = {"acceleration": "accelerance", "velocity": "mobility", "displacement": "receptance"}
 _PAIRS = (
-    (re.compile(r"^(?P<n>.+?)[._ ]?(re|real)$", re.I), re.compile(r"^(?P<n>.+?)[._ ]?(im|imag)$", re.I)),
-    (re.compile(r"^(re|real)[(_ ]\s*(?P<n>.+?)\)?$", re.I), re.compile(r"^(im|imag)[(_ ]\s*(?P<n>.+?)\)?$", re.I)),
-    (re.compile(r"^(?P<n>.+?)[._ ]?(mag|magnitude|amp|abs)$", re.I), re.compile(r"^(?P<n>.+?)[._ ]?(phase|phi|arg)$", re.I)),
-    (re.compile(r"^(mag|magnitude|amp|abs)[(_ ]\s*(?P<n>.+?)\)?$", re.I), re.compile(r"^(phase|phi|arg)[(_ ]\s*(?P<n>.+?)\)?$", re.I)),
+    (
+        re.compile(r"^(?P<n>.+?)[._ ]?(re|real)$", re.I),
+        re.compile(r"^(?P<n>.+?)[._ ]?(im|imag)$", re.I),
+    ),
+    (
+        re.compile(r"^(re|real)[(_ ]\s*(?P<n>.+?)\)?$", re.I),
+        re.compile(r"^(im|imag)[(_ ]\s*(?P<n>.+?)\)?$", re.I),
+    ),
+    (
+        re.compile(r"^(?P<n>.+?)[._ ]?(mag|magnitude|amp|abs)$", re.I),
+        re.compile(r"^(?P<n>.+?)[._ ]?(phase|phi|arg)$", re.I),
+    ),
+    (
+        re.compile(r"^(mag|magnitude|amp|abs)[(_ ]\s*(?P<n>.+?)\)?$", re.I),
+        re.compile(r"^(phase|phi|arg)[(_ ]\s*(?P<n>.+?)\)?$", re.I),
+    ),
 )
 
 

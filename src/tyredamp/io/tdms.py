@@ -1,8 +1,9 @@
 """NI TDMS time data (LabVIEW) through npTDMS.
 
 All channels of one group (the first group holding data, the group of the
-channels a channel map names, or ``group``) are read. The sample rate comes from the channels' ``wf_increment`` property
-(seconds per sample, the LabVIEW waveform attribute; all equal), the units
+channels a channel map names, or ``group``) are read. The sample rate comes
+from the channels' ``wf_increment`` property (seconds per sample, the
+LabVIEW waveform attribute; all equal), the units
 from ``unit_string`` (read by :mod:`.units` and converted to SI), the channel
 names from the TDMS channel names. Channels without a ``unit_string`` (or
 with one that is wrong) are named with a channel map; see :mod:`._channels`.

@@ -499,9 +499,9 @@ def _load_sets(p: Path) -> list[dict[str, Any]]:
             declared = s.get("num_pts")
             if isinstance(got, int) and isinstance(declared, int) and 0 < got < declared:
                 raise FileFormatError(
-                    f"{p}: data set #{k + 1} is corrupt or truncated: its header declares {declared} "
-                    f"values, the file stores {got} (a cut-off excerpt of a longer recording, "
-                    "not a complete measurement)"
+                    f"{p}: data set #{k + 1} is corrupt or truncated: its header declares "
+                    f"{declared} values, the file stores {got} (a cut-off excerpt of a longer "
+                    "recording, not a complete measurement)"
                 )
             raise FileFormatError(
                 f"{p}: data set #{k + 1} is corrupt or truncated: header says "

@@ -110,7 +110,7 @@ _ATOMS3: dict[str, tuple[float, tuple[int, ...]]] = {
 }
 Dims = tuple[int, int, int, int]
 _ATOMS: dict[str, tuple[float, Dims]] = {
-    k: (f, (*d, 0, 0, 0, 0)[:4]) for k, (f, d) in _ATOMS3.items()  # type: ignore[misc]
+    k: (f, (d[0], d[1], d[2], d[3] if len(d) > 3 else 0)) for k, (f, d) in _ATOMS3.items()
 }
 # case-insensitive look-up where unambiguous (MN, mN clash: neither taken from upper case)
 _LOWER: dict[str, str] = {}
