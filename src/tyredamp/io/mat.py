@@ -286,7 +286,14 @@ def _read_frf(
         vec = next((m for m in match if m is not None and m.size == n), None)
         if vec is not None:
             used.update(hit)
-        coh.append(None if vec is None else np.clip(vec.real.astype(float), 0.0, 1.0))
+            c = vec.real.astype(float)
+            over = int(np.sum((c > 1.0) | (c < 0.0)))
+            if over:
+                notes.append(
+                    f"{name}: coherence outside 0..1 at {over} line(s) (as stored), clipped"
+                )
+            vec = np.clip(c, 0.0, 1.0)
+        coh.append(vec)
     cmat = np.array(coh) if all(c is not None for c in coh) else None
     left = sorted(k for k in vars_ if k not in frfs and k not in used)
     if used:

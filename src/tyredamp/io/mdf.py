@@ -43,6 +43,38 @@ def _is_vibration_unit(unit: str) -> bool:
     return True
 
 
+def _choose_group(
+    p: Any,
+    sigs: Sequence[Any],
+    names: list[str],
+    groups: list[int],
+    numeric: list[int],
+    wanted: list[str],
+    skipped: list[str],
+) -> int:
+    """The channel group to read: that of the named channels, else the one with the most
+    numeric channels of vibration units (or without a unit)."""
+    named = [k for k in numeric if names[k] in wanted]
+    if named:
+        group_of = {groups[k] for k in named}
+        if len(group_of) > 1:
+            raise FileFormatError(
+                f"{p}: the channels named ({', '.join(names[k] for k in named)}) are on "
+                "different time bases; name channels of one rate"
+            )
+        return group_of.pop()
+    counts: dict[int, int] = {}
+    for k in numeric:
+        if _is_vibration_unit(str(sigs[k].unit or "")) or not str(sigs[k].unit or "").strip():
+            counts[groups[k]] = counts.get(groups[k], 0) + 1
+    if not counts:
+        for k in numeric:
+            counts[groups[k]] = counts.get(groups[k], 0) + 1
+    if not counts:
+        raise FileFormatError(f"{p}: no numeric channels in the MDF file; {'; '.join(skipped)}")
+    return max(counts, key=lambda g: (counts[g], -g))
+
+
 def read_mdf(
     path: str | os.PathLike[str],
     quantities: Mapping[str, str] | None = None,
@@ -103,26 +135,7 @@ def read_mdf(
             raise FileFormatError(
                 f"{p}: no channel named {missing[0]!r}; channels: {', '.join(names)}"
             )
-    named = [k for k in numeric if names[k] in wanted]
-    if named:
-        group_of = {groups[k] for k in named}
-        if len(group_of) > 1:
-            raise FileFormatError(
-                f"{p}: the channels named ({', '.join(names[k] for k in named)}) are on "
-                "different time bases; name channels of one rate"
-            )
-        group = group_of.pop()
-    else:
-        counts: dict[int, int] = {}
-        for k in numeric:
-            if _is_vibration_unit(str(sigs[k].unit or "")) or not str(sigs[k].unit or "").strip():
-                counts[groups[k]] = counts.get(groups[k], 0) + 1
-        if not counts:
-            for k in numeric:
-                counts[groups[k]] = counts.get(groups[k], 0) + 1
-        if not counts:
-            raise FileFormatError(f"{p}: no numeric channels in the MDF file; {'; '.join(skipped)}")
-        group = max(counts, key=lambda g: (counts[g], -g))
+    group = _choose_group(p, sigs, names, groups, numeric, wanted, skipped)
     keep = []
     for k in numeric:
         if groups[k] != group:

@@ -69,7 +69,6 @@ import gc
 import itertools
 import json
 import os
-import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -83,16 +82,14 @@ from ..timedata import TimeData
 from ._atomic import atomic_path
 from ._channels import timedata_from_channels
 from ._common import check_input_file, meta_to_json, wrap_errors
-from ._text import decode_text
-from ._uff_meta import meta_record, read_meta_record
+from ._uff_load import VARIANCE_ID, load_sets, not_frf_or_time, read_coherence, read_variance
+from ._uff_meta import meta_record
 from .channelmap import ChannelMap
 from .units import frf_units, quantity_units
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
 
 _MARK = "tyredamp1"
-#: ID line 1 of the extra data sets (function type 0) holding FRF.variance.
-_VARIANCE_ID = "tyredamp FRF variance"
 # specific data types (record 8): 15 pressure, 21 sound pressure, 1 general (volts)
 _SDT = {
     "displacement": 8,
@@ -385,7 +382,7 @@ def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
         for o, co in enumerate(obj.outputs):
             for i, ci in enumerate(obj.inputs):
                 fid += 1
-                d = _base_set(binary, q, _VARIANCE_ID, id2, id3)
+                d = _base_set(binary, q, VARIANCE_ID, id2, id3)
                 d.update(
                     func_type=0,
                     func_id=fid,
@@ -454,144 +451,6 @@ def _abscissa(
 
 
 # ------------------------------------------------------------------ reading
-def _markers(raw: bytes) -> int:
-    """Count data-set delimiters as pyuff does (``    -1`` ending a record)."""
-    count, i, n = 0, -1, len(raw)
-    while True:
-        i = raw.find(b"    -1", i + 1)
-        if i == -1:
-            return count
-        if (
-            i + 6 == n
-            or (i + 6 < n and raw[i + 6] in (10, 13))
-            or (i + 80 < n and raw[i + 6 : i + 80] == b" " * 74)
-        ):
-            count += 1
-
-
-def _load_sets(p: Path) -> list[dict[str, Any]]:
-    raw = p.read_bytes()
-    n_marks = _markers(raw)
-    if n_marks == 0:
-        raise FileFormatError(f"{p}: no UFF data set found (no '    -1' delimiters)")
-    if n_marks % 2:
-        raise FileFormatError(
-            f"{p}: truncated UFF file: the last data set has no closing '    -1' delimiter"
-        )
-    try:
-        uff = pyuff.UFF(str(p))
-        types = list(uff.get_set_types())
-        idx = [k for k, t in enumerate(types) if t == 58]
-        if not idx:
-            raise FileFormatError(f"{p}: {_what_instead(types)}")
-        sets = uff.read_sets(idx)
-        record = read_meta_record(p, uff, types)
-    except FileFormatError:
-        raise
-    except Exception as exc:  # pyuff raises bare Exception, and others on garbage
-        raise FileFormatError(f"{p}: corrupt UFF data set 58 ({exc})") from None
-    if isinstance(sets, dict):
-        sets = [sets]
-    for k, s in zip(idx, sets, strict=True):
-        data = s.get("data")
-        if data is None or "num_pts" not in s or len(data) != int(s["num_pts"]):
-            got = "no" if data is None else len(data)
-            declared = s.get("num_pts")
-            if isinstance(got, int) and isinstance(declared, int) and 0 < got < declared:
-                raise FileFormatError(
-                    f"{p}: data set #{k + 1} is corrupt or truncated: its header declares "
-                    f"{declared} values, the file stores {got} (a cut-off excerpt of a longer "
-                    "recording, not a complete measurement)"
-                )
-            raise FileFormatError(
-                f"{p}: data set #{k + 1} is corrupt or truncated: header says "
-                f"{declared} values, found {got}"
-            )
-        s["_index"] = k + 1
-    _redecode_strings(raw, sets)
-    if record is not None:
-        for s in sets:
-            s["_meta"] = record
-    return sets
-
-
-#: UFF data-set types that hold geometry (nodes, coordinate systems, lines, elements, units).
-_GEOMETRY_SETS = {15, 18, 82, 164, 2411, 2412, 2420, 151}
-#: Function types of data set 58 (record 6), by the UFF specification.
-_FUNCTION_TYPES = {
-    0: "a general function",
-    1: "a time response",
-    2: "an auto spectrum",
-    3: "a cross spectrum",
-    4: "an FRF",
-    5: "a transmissibility",
-    6: "a coherence",
-    7: "an auto-correlation",
-    8: "a cross-correlation",
-    9: "a PSD",
-    10: "an ESD",
-    11: "a probability density",
-    12: "a spectrum",
-    13: "a cumulative frequency distribution",
-    18: "a mode indicator function",
-    24: "a shock response spectrum",
-    26: "a multiple coherence",
-    27: "an order function",
-}
-
-
-def _what_instead(types: list[int]) -> str:
-    """One line saying what a UFF file without data sets 58 holds instead."""
-    found = sorted({int(t) for t in types})
-    listed = ", ".join(str(t) for t in found)
-    if found and set(found) <= _GEOMETRY_SETS:
-        return (
-            f"holds geometry only (data sets {listed}: nodes, coordinate systems, lines, "
-            "elements), not time data or an FRF; use it as a geometry file (tyredamp modal "
-            "--geometry)"
-        )
-    if 55 in found:
-        return f"holds mode shapes (data sets {listed}), not time data or an FRF"
-    return f"no data set 58 (time data or FRF); found data sets {listed}"
-
-
-def _function_name(t: int) -> str:
-    return _FUNCTION_TYPES.get(int(t), "an unknown function")
-
-
-def _not_frf_or_time(p: Path, types: set[int]) -> FileFormatError:
-    kinds = ", ".join(f"{_function_name(t)} (function type {t})" for t in sorted(types))
-    return FileFormatError(f"{p}: holds {kinds}, not time data or an FRF")
-
-
-def _redecode_strings(raw: bytes, sets: list[dict[str, Any]]) -> None:
-    """Header strings pyuff decoded with replacement characters, read again as cp1252.
-
-    pyuff decodes header lines as UTF-8 with ``errors="replace"``; a label
-    such as ``g²/Hz`` written by Windows software as cp1252/Latin-1 (``²`` =
-    byte 0xB2) comes back as ``g\ufffd/Hz``. The original bytes are found in
-    the file around the intact parts and decoded as cp1252 (Latin-1 for the
-    bytes cp1252 leaves undefined); the set's ``_encoding`` records it.
-    """
-    cache: dict[str, str | None] = {}
-    for s in sets:
-        for key, value in list(s.items()):
-            if not isinstance(value, str) or "\ufffd" not in value:
-                continue
-            if value not in cache:
-                parts = [re.escape(x.encode("utf-8")) for x in value.split("\ufffd")]
-                m = re.search(b"(?:.{1,3}?)".join(parts), raw, flags=re.DOTALL)
-                text = None
-                if m is not None:
-                    text, _ = decode_text(m.group(0))
-                    if "\ufffd" in text:
-                        text = None
-                cache[value] = text
-            if cache[value] is not None:
-                s[key] = cache[value]
-                s["_encoding"] = "cp1252"
-
-
 def _tokens(s: dict[str, Any]) -> dict[str, str] | None:
     parts = str(s.get("id2", "")).split()
     if not parts or parts[0] != _MARK:
@@ -656,12 +515,12 @@ def _quantity(s: dict[str, Any], where: str) -> tuple[str | None, float]:
 def uff_contents(path: str | os.PathLike[str]) -> str:
     """``"frf"`` or ``"timedata"``: what the UFF file at ``path`` holds."""
     p = check_input_file(path)
-    types = {int(s.get("func_type", -1)) for s in _load_sets(p)}
+    types = {int(s.get("func_type", -1)) for s in load_sets(p)}
     if 4 in types:
         return "frf"
     if 1 in types:
         return "timedata"
-    raise _not_frf_or_time(p, types)
+    raise not_frf_or_time(p, types)
 
 
 def read_uff(
@@ -692,20 +551,20 @@ def read_uff(
         of different length or sampling; unknown units.
     """
     p = check_input_file(path)
-    sets = _load_sets(p)
+    sets = load_sets(p)
     types = {int(s.get("func_type", -1)) for s in sets}
     if what is None:
         what = "frf" if 4 in types else "timedata" if 1 in types else ""
         if not what:
-            raise _not_frf_or_time(p, types)
+            raise not_frf_or_time(p, types)
     if what == "frf" and 4 not in types:
         if 1 in types:
             raise FileFormatError(f"{p}: holds time data (function type 1), not an FRF")
-        raise _not_frf_or_time(p, types)
+        raise not_frf_or_time(p, types)
     if what == "timedata" and 1 not in types:
         if 4 in types:
             raise FileFormatError(f"{p}: holds FRFs (function type 4), not time data")
-        raise _not_frf_or_time(p, types)
+        raise not_frf_or_time(p, types)
     with wrap_errors(p):
         if what == "frf":
             return _read_frf(p, sets, kind)
@@ -809,8 +668,8 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
                     f"{ko[1]} and reference node {ki[0]} dir {ki[1]}"
                 )
             h[a, b] = cells[(ko, ki)]
-    coh = _read_coherence(sets, list(outs), list(ins), n)
-    var = _read_variance(sets, list(outs), list(ins), n, h.shape)
+    coh = read_coherence(sets, list(outs), list(ins), n)
+    var = read_variance(sets, list(outs), list(ins), n, h.shape)
     meta = _meta(first, tok)
     if any("_encoding" in s for s in frf_sets):
         meta["text_encoding"] = "cp1252"
@@ -824,44 +683,6 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
         meta=meta,
         variance=var,
     )
-
-
-def _read_coherence(
-    sets: list[dict[str, Any]], outs: list[tuple[int, int]], ins: list[tuple[int, int]], n: int
-) -> np.ndarray | None:
-    want = ins[0] if len(ins) == 1 else (0, 0)
-    found: dict[tuple[int, int], np.ndarray] = {}
-    for s in sets:
-        if int(s["func_type"]) not in (6, 26) or len(s["data"]) != n:
-            continue
-        if (int(s["ref_node"]), int(s["ref_dir"])) != want:
-            continue
-        found[(int(s["rsp_node"]), int(s["rsp_dir"]))] = np.real(np.asarray(s["data"]))
-    if not all(o in found for o in outs):
-        return None
-    return np.array([found[o] for o in outs])
-
-
-def _read_variance(
-    sets: list[dict[str, Any]],
-    outs: list[tuple[int, int]],
-    ins: list[tuple[int, int]],
-    n: int,
-    shape: tuple[int, ...],
-) -> np.ndarray | None:
-    """FRF.variance from tyredamp's extra type-0 data sets, when every pair has one."""
-    found: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray] = {}
-    for s in sets:
-        if int(s["func_type"]) != 0 or str(s.get("id1", "")).strip() != _VARIANCE_ID:
-            continue
-        if len(s["data"]) != n:
-            continue
-        ko = (int(s["rsp_node"]), int(s["rsp_dir"]))
-        ki = (int(s["ref_node"]), int(s["ref_dir"]))
-        found[(ko, ki)] = np.real(np.asarray(s["data"], dtype=float))
-    if not all((o, i) in found for o in outs for i in ins):
-        return None
-    return np.array([[found[(o, i)] for i in ins] for o in outs]).reshape(shape)
 
 
 def _uff_name(s: dict[str, Any], tok: dict[str, str] | None) -> str:
