@@ -27,9 +27,13 @@ The file is TOML (or JSON with the same structure)::
     [channels]
     m_1 = "acceleration:m/s^2@2+Z" # the command-line form also works as a value
 
-A key is a channel name as the file writes it; a key of digits that is not
-a channel name is the channel's position (1-based). A key that matches no
-channel is an error that lists the channels of the file.
+A key is a channel name as the file writes it (or another name the format
+gives it, such as a UFF point label ``1+Z`` or a TDMS ``group/channel``); a
+key of digits that is not a channel name is the channel's position
+(1-based). A key that matches several channels (a MATLAB matrix variable
+``data`` for ``data(:,1)``, ``data(:,2)`` ...) applies to each, and a key
+naming one of them is laid over it. A key that matches no channel is an
+error that lists the channels of the file.
 """
 
 from __future__ import annotations
@@ -340,9 +344,11 @@ class ChannelMap:
         InputError
             A key that names no channel (the message lists the file's channels).
         """
-        out: dict[int, ChannelSpec] = {}
+        found: list[tuple[ChannelSpec, list[int]]] = []
         for spec in self.channels:
-            hits = [i for i, ns in enumerate(names) if spec.key in ns]
+            hits = [i for i, ns in enumerate(names) if ns and ns[0] == spec.key]
+            if not hits:
+                hits = [i for i, ns in enumerate(names) if spec.key in ns]
             if not hits and spec.key.isdigit() and 1 <= int(spec.key) <= len(names):
                 hits = [int(spec.key) - 1]
             if not hits:
@@ -352,13 +358,15 @@ class ChannelMap:
                     f"{path}: the channel map{src} names channel {spec.key!r}, which the file "
                     f"does not have; its channels are {listed}"
                 )
-            if len(hits) > 1:
-                raise InputError(
-                    f"{path}: channel {spec.key!r} of the channel map matches channels "
-                    f"{', '.join(str(h + 1) for h in hits)}; name it by position"
-                )
-            i = hits[0]
-            out[i] = out[i].merged(spec) if i in out else spec
+            found.append((spec, hits))
+        # a key matching several channels (a matrix variable, a point label) applies to
+        # each of them; a key naming one channel is laid over it
+        out: dict[int, ChannelSpec] = {}
+        for group in (True, False):
+            for spec, hits in found:
+                if (len(hits) > 1) == group:
+                    for i in hits:
+                        out[i] = out[i].merged(spec) if i in out else spec
         return out
 
     def to_dict(self) -> dict[str, Any]:

@@ -52,6 +52,7 @@ __all__ = ["read_plain_csv", "split_column_name"]
 
 _TIME_NAMES = {"time", "t", "zeit", "temps", "tiempo", "x_value", "sec", "seconds", "timestamp"}
 _TIME_UNITS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+_ANGLE = {"deg", "°", "degree", "degrees", "rad", "radian", "radians"}
 _NUM = re.compile(r"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 
 
@@ -77,7 +78,9 @@ def split_column_name(text: str) -> tuple[str, str]:
         if t.endswith(close) and open_ in t:
             k = t.rfind(open_)
             name, unit = t[:k].strip(), t[k + 1 : -1].strip()
-            if name and (_is_unit(unit) or not unit):
+            # text in [] or {} is a unit as written; in () only when it reads as one
+            # ("Excitation (Trigger)" is a name)
+            if name and (open_ != "(" or _is_unit(unit) or unit.lower() in _ANGLE or not unit):
                 return name, unit
     if " / " in t:
         name, unit = t.rsplit(" / ", 1)
@@ -91,7 +94,8 @@ def split_column_name(text: str) -> tuple[str, str]:
 
 def _delimiter(lines: Sequence[str]) -> tuple[str, bool]:
     """``(delimiter, decimal_comma)`` that splits the last lines into equal numeric rows."""
-    sample = [ln for ln in lines if ln.strip()][-20:]
+    rows = [ln for ln in lines if ln.strip()]
+    sample = rows[-21:-1] if len(rows) > 3 else rows  # the last row may be cut short
     for delim in ("\t", ";", ","):
         for dec_comma in (False, True) if delim != "," else (False,):
             widths = set()
@@ -306,6 +310,10 @@ def _read_frf(
             h = table[:, k] + 1j * table[:, k + 1]
         else:
             deg = unit2.strip().lower() not in ("rad", "radian", "radians")
+            if unit2.strip() and unit2.strip().lower() not in _ANGLE:
+                raise FileFormatError(
+                    f"{p}: column {cols[k + 1]!r}: phase unit {unit2!r} is not deg or rad"
+                )
             ph = np.deg2rad(table[:, k + 1]) if deg else table[:, k + 1]
             h = table[:, k] * np.exp(1j * ph)
         spec = specs.get(j)
@@ -335,7 +343,11 @@ def _read_frf(
     if len(kinds) > 1:
         raise FileFormatError(f"{p}: FRFs of different kinds in one file: {sorted(kinds)}")
     outs = [Channel(node=i + 1, direction=3, name=n) for i, n in enumerate(names)]
-    cmat = np.array(coh) if len(coh) == len(hs) else None
+    if coh and len(coh) != len(hs):
+        raise FileFormatError(
+            f"{p}: expected {len(hs)} coherence columns (one per FRF) or none, got {len(coh)}"
+        )
+    cmat = np.array(coh) if coh else None
     try:
         return FRF(
             f,
