@@ -86,7 +86,7 @@ def test_plain_csv_problems(tmp_path: Path) -> None:
     with pytest.raises(FileFormatError, match="time column is not evenly spaced"):
         read_timedata(_write(tmp_path / "b.csv", ["time_s,F_N,acc_g", *uneven]))
     notime = [f"{x[0, k]},{x[1, k]}" for k in range(8)]
-    with pytest.raises(FileFormatError, match="is not a time .* or a frequency"):
+    with pytest.raises(FileFormatError, match=r"is not a time .* or a frequency"):
         read_timedata(_write(tmp_path / "c.csv", ["F_N,acc_g", *notime]))
     # a last row cut short by an interrupted export is left out, and said so
     cut = _write(tmp_path / "d.csv", ["time_s,F_N,acc_g", *rows, "0.08,1.0"])
