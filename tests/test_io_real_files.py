@@ -226,3 +226,20 @@ def test_cli_output_only_and_bad_maps(tmp_path: Path, capsys: pytest.CaptureFixt
     # check quality reads output-only data and says so
     assert main(["check", "quality", str(UFF / "time-history-not-all-columns-filled.uff")]) == 0
     assert "output-only data" in capsys.readouterr().out
+
+
+def test_uff_time_data_takes_a_channel_map() -> None:
+    import pyuff
+
+    path = UFF / "time-history-not-all-columns-filled.uff"
+    stored = np.asarray(pyuff.UFF(str(path)).read_sets(0)["data"], dtype=float)
+    plain = read_timedata(path)
+    assert_array_equal(plain.data[0], stored)  # m/s² as labelled: SI already
+    # the map overrides the label (here: the sensor was in g) and sets the point
+    td = read_timedata(path, ChannelMap.parse(["1=acceleration:g@4-Y"]))
+    assert_allclose(td.data[0], stored * 9.80665, rtol=1e-15)  # g to m/s^2
+    assert (td.channels[0].node, td.channels[0].direction) == (4, -2)
+    mic = read_timedata(UFF / "Sample_UFF58b_bin.uff", ChannelMap.parse(["Mic 01=pressure:Pa"]))
+    assert mic.channels[0].name == "Mic 01"
+    with pytest.raises(InputError, match=r"'Pa' means pressure, but the channel map names it force"):
+        read_timedata(UFF / "Sample_UFF58b_bin.uff", ChannelMap.parse(["Mic 01=force"]))

@@ -10,7 +10,7 @@ from numpy.testing import assert_array_equal
 
 from tyredamp import FileFormatError, InputError
 from tyredamp.cli import main
-from tyredamp.io import read_frf, read_timedata
+from tyredamp.io import ChannelMap, read_frf, read_timedata
 from tyredamp.io.mdf import read_mdf
 from tyredamp.io.tdms import read_tdms
 
@@ -155,3 +155,39 @@ def test_tdms_unequal_sampling(tmp_path: Path) -> None:
         )
     with pytest.raises(FileFormatError, match="sample intervals"):
         read_tdms(path)
+
+
+def test_mdf_several_rates_text_and_value_table_channels(tmp_path: Path) -> None:
+    x, y, _ = signals()
+    t = np.arange(x.size) / FS
+    slow = np.arange(0, x.size, 64) / FS
+    m = asammdf.MDF(version="4.10")
+    m.append([asammdf.Signal(x, t, name="F", unit="N"), asammdf.Signal(y, t, name="a", unit="g")])
+    m.append(
+        [
+            asammdf.Signal(np.full(slow.size, 21.5), slow, name="temp", unit="degC"),
+            asammdf.Signal(np.array([b"run"] * slow.size), slow, name="state", encoding="utf-8"),
+            asammdf.Signal(np.ones(slow.size), slow, name="x1", unit="m/s^2"),
+            asammdf.Signal(np.ones(slow.size), slow, name="x2", unit="m/s^2"),
+            asammdf.Signal(np.ones(slow.size), slow, name="x3", unit="m/s^2"),
+        ]
+    )
+    # a value-table channel on the fast rate: strings after conversion
+    vt = {"val_0": 0, "text_0": b"off", "val_1": 1, "text_1": b"on", "default": b""}
+    m.append([asammdf.Signal(np.zeros(x.size, dtype=np.uint8), t, name="gear", conversion=vt)])
+    path = tmp_path / "logger.mf4"
+    m.save(str(path), overwrite=True)
+    m.close()
+    # the slow group has the most channels of vibration units: the map chooses the fast one
+    td = read_mdf(path, channel_map=ChannelMap.parse(["F=force"]))
+    assert [c.name for c in td.channels] == ["F", "a"]
+    assert_array_equal(td.data[0], x)
+    assert td.sample_rate == FS
+    note = td.meta["read_notes"][0]
+    for name in ("temp (another time base)", "state (not numeric", "gear (not numeric"):
+        assert name in note
+    slow_td = read_mdf(path)  # without a map: the rate of the most vibration channels
+    assert [c.name for c in slow_td.channels] == ["x1", "x2", "x3"]
+    assert "temp (unit 'degC' is not a vibration quantity)" in slow_td.meta["read_notes"][0]
+    with pytest.raises(InputError, match="different time bases"):
+        read_mdf(path, channel_map=ChannelMap.parse(["F=force", "x1=acceleration"]))

@@ -58,7 +58,7 @@ def _choose_group(
     if named:
         group_of = {groups[k] for k in named}
         if len(group_of) > 1:
-            raise FileFormatError(
+            raise InputError(
                 f"{p}: the channels named ({', '.join(names[k] for k in named)}) are on "
                 "different time bases; name channels of one rate"
             )
