@@ -241,5 +241,7 @@ def test_uff_time_data_takes_a_channel_map() -> None:
     assert (td.channels[0].node, td.channels[0].direction) == (4, -2)
     mic = read_timedata(UFF / "Sample_UFF58b_bin.uff", ChannelMap.parse(["Mic 01=pressure:Pa"]))
     assert mic.channels[0].name == "Mic 01"
-    with pytest.raises(InputError, match=r"'Pa' means pressure, but the channel map names it force"):
+    with pytest.raises(
+        InputError, match=r"'Pa' means pressure, but the channel map names it force"
+    ):
         read_timedata(UFF / "Sample_UFF58b_bin.uff", ChannelMap.parse(["Mic 01=force"]))
