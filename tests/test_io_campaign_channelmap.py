@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from tyredamp import InputError
 from tyredamp.campaign import steps
 from tyredamp.campaign.spec import CampaignFileError, load_campaign
 
@@ -56,3 +57,13 @@ def test_campaign_bad_channel_map(tmp_path: Path) -> None:
         load_campaign(_campaign(tmp_path, 'channel_map = "none.toml"\n'))
     with pytest.raises(CampaignFileError, match=r"tests\[0\].channel_map.*role 'forse'"):
         load_campaign(_campaign(tmp_path, 'channel_map = { channels = { F = "forse:N" } }\n'))
+
+
+def test_campaign_modal_step_on_output_only_data(tmp_path: Path) -> None:
+    mps = REAL / "ladisk_pyuff" / "data" / "MPSTD#Set001_2024_10_08_10_27_07.uff"
+    if not mps.is_file():
+        pytest.skip("real-data gallery not found")
+    with pytest.raises(InputError, match=r"MPSTD.*output-only data \(no force channel\)") as info:
+        steps.process_radial_test(mps)
+    assert "operational modal analysis is not available" in str(info.value)
+    assert "\n" not in str(info.value)

@@ -355,12 +355,19 @@ class TimeData:
         """True when no channel is a force: an operational (output-only) recording."""
         return not self.force_indices
 
-    def require_force(self, what: str = "an FRF") -> None:
+    def require_force(self, what: str = "an FRF", where: object = None) -> None:
         """Raise :class:`InputError` in one line when there is no force channel.
 
         The message says that this is output-only data, names the channels and
         says what to do: name a force channel (``--channel NAME=force:N``) or
         use output-only identification, which tyredamp does not offer yet.
+
+        Parameters
+        ----------
+        what : str
+            What needs the force (``"an FRF"``), for the message.
+        where : path-like, optional
+            The file the data came from, named first in the message.
         """
         if self.force_indices:
             return
@@ -369,10 +376,12 @@ class TimeData:
             for c, q in zip(self.channels, self.quantities, strict=True)
         )
         raise InputError(
-            f"output-only data (no force channel): channels {names}; {what} needs a measured "
-            "force: name the force channel with --channel NAME=force:N (Python: a ChannelMap), "
-            "or identify modes from output-only data with another tool (operational modal "
-            "analysis is not available in tyredamp yet)"
+            ("" if where is None else f"{where}: ")
+            + f"output-only data (no force channel): channels {names}; {what} needs a "
+            "measured force: name the force channel with --channel NAME=force:N (a "
+            "campaign's channel_map, Python's ChannelMap), or identify modes from output-only "
+            "data with another tool (operational modal analysis is not available in tyredamp "
+            "yet)"
         )
 
     def __repr__(self) -> str:

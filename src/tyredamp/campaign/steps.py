@@ -399,6 +399,8 @@ def _radial_modal(
 
     fs, cs, ms = settings["frf"], settings["checks"], settings["modal"]
     obj = read(path, ChannelMap.from_dict((conditions or {}).get("channel_map") or {}))
+    if not isinstance(obj, FRF):  # output-only data: said in one line, with what to do
+        obj.require_force("the modal step (an FRF from time data)", path.name)
     if isinstance(obj, FRF):
         frf = obj
         source_kind = "frf"
