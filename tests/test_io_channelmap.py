@@ -195,3 +195,13 @@ def test_voltage_and_pressure_channels_are_kept_but_not_responses() -> None:
     assert td.response_indices == [3]  # type: ignore[attr-defined]
     assert td.other_indices == [1, 2]  # type: ignore[attr-defined]
     assert td.units == ("N", "Pa", "V", "m/s^2")  # type: ignore[attr-defined]
+
+
+def test_a_step_that_needs_a_response_says_which_channels_it_has() -> None:
+    td = _build(ChannelMap(), ["N", "Pa", "V"], ["hammer", "mic", "acc"])
+    with pytest.raises(InputError, match=r"f.dat: no response channel") as info:
+        td.require_response("an FRF", "f.dat")  # type: ignore[attr-defined]
+    msg = str(info.value)
+    assert "mic (pressure, Pa), acc (voltage, V)" in msg
+    assert "--sensitivity 'acc=100 mV/g'" in msg
+    td.require_force()  # type: ignore[attr-defined]  # has a force: no error

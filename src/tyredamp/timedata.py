@@ -384,6 +384,35 @@ class TimeData:
             "yet)"
         )
 
+    def require_response(self, what: str = "an FRF", where: object = None) -> None:
+        """Raise :class:`InputError` in one line when no channel is a structural response.
+
+        Pressure and voltage channels are named with what to supply (a
+        sensitivity that makes a voltage an acceleration, a velocity ...).
+        """
+        if self.response_indices:
+            return
+        others = [
+            f"{self.channels[i].name or self.channels[i].label} "
+            f"({self.quantities[i]}, {QUANTITY_UNITS[self.quantities[i]]})"
+            for i in self.other_indices
+        ]
+        hint = ""
+        volts = [i for i in self.other_indices if self.quantities[i] == "voltage"]
+        if volts:
+            c = self.channels[volts[0]]
+            hint = (
+                f"; give a voltage channel's sensitivity, for example --sensitivity "
+                f"'{c.name or c.label}=100 mV/g'"
+            )
+        raise InputError(
+            ("" if where is None else f"{where}: ")
+            + f"no response channel (displacement, velocity or acceleration): {what} needs "
+            + "one"
+            + (f"; the other channels are {', '.join(others)}" if others else "")
+            + hint
+        )
+
     def __repr__(self) -> str:
         return (
             f"TimeData(n_channels={self.n_channels}, n_samples={self.n_samples}, "

@@ -176,6 +176,7 @@ def frf_command(
     td = read_timedata(time_file, channel_map())
     echo_read_notes(td)
     td.require_force("an FRF", time_file)
+    td.require_response("an FRF", time_file)
     if not references and len(td.force_indices) > 1:
         _refuse_dependent_forces(td)
     frf = frf_from_time(
