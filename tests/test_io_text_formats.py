@@ -95,6 +95,17 @@ def test_plain_csv_problems(tmp_path: Path) -> None:
     assert "last row is incomplete" in td.meta["read_notes"][0]
 
 
+def test_plain_csv_with_a_units_row(tmp_path: Path) -> None:
+    x = _signals(8)
+    xs = x.tolist()
+    rows = [f"{k / 100};{xs[0][k]!r};{xs[1][k]!r}".replace(".", ",") for k in range(8)]
+    p = _write(tmp_path / "u.csv", ["Messung 7", "Zeit;Kraft;Beschl.", "[s];[kN];[g]", *rows])
+    td = read_timedata(p)
+    assert [c.name for c in td.channels] == ["Kraft", "Beschl."]
+    assert_allclose(td.data, [x[0] * 1e3, x[1] * G], rtol=1e-15)  # kN and g to SI
+    assert td.meta["preamble"] == ["Messung 7"]
+
+
 def test_plain_csv_frf(tmp_path: Path) -> None:
     f = np.arange(1, 33) * 2.0
     h = (1 + 1j * f) / (100 - f**2 + 2j * f)

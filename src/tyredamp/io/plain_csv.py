@@ -16,7 +16,8 @@ Read rules (detected from the file itself):
   numbers of numbers); a decimal comma is read with ``;`` or tab delimiters;
 * lines before the header row (comments, a title, ``key: value`` lines) are
   kept in ``meta["preamble"]``; lines starting with ``#`` are comments;
-* the header row is the last line before the first row of numbers; each
+* the header row is the last line before the first row of numbers (or the
+  two last lines: a row of names and a row of units such as ``s,N,g``); each
   column name may carry its unit as ``name [unit]``, ``name (unit)``,
   ``name / unit`` or ``name_unit`` (``acc1_m/s2``, ``time_s``), read by
   :mod:`.units`;
@@ -166,6 +167,16 @@ def read_plain_csv(
     except FileFormatError as exc:
         raise FileFormatError(f"{p}: {exc}") from None
     cols = _cells(head[-1], delim)
+    unit_row: list[str] | None = None
+    if len(head) > 1:
+        above = _cells(head[-2], delim)
+        if len(above) == len(cols) and all(
+            not c or _is_unit(c.strip("[]() ")) or c.strip("[]() ").lower() in _ANGLE
+            for c in cols
+        ):  # a row of names, then a row of units (as many DAQ programs export)
+            unit_row = [c.strip("[]() ") for c in cols]
+            cols = above
+            head = head[:-1]
     rows = []
     for k, ln in enumerate(body):
         cells = _cells(ln, delim)
@@ -186,6 +197,8 @@ def read_plain_csv(
     if table.shape[0] < 2:
         raise FileFormatError(f"{p}: fewer than 2 data rows")
     split = [split_column_name(c) for c in cols]
+    if unit_row is not None:
+        split = [(n, u or v) for (n, v), u in zip(split, unit_row, strict=True)]
     meta: dict[str, Any] = {} if encoding == "utf-8" else {"text_encoding": encoding}
     if len(head) > 1:
         meta["preamble"] = [ln.strip() for ln in head[:-1]][:50]
