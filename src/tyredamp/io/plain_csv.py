@@ -171,8 +171,7 @@ def read_plain_csv(
     if len(head) > 1:
         above = _cells(head[-2], delim)
         if len(above) == len(cols) and all(
-            not c or _is_unit(c.strip("[]() ")) or c.strip("[]() ").lower() in _ANGLE
-            for c in cols
+            not c or _is_unit(c.strip("[]() ")) or c.strip("[]() ").lower() in _ANGLE for c in cols
         ):  # a row of names, then a row of units (as many DAQ programs export)
             unit_row = [c.strip("[]() ") for c in cols]
             cols = above
