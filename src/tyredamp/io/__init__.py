@@ -1,4 +1,4 @@
-"""Measurement file formats: UFF 58/58b (pyuff), CSV and NPZ for FRFs and time data.
+"""Measurement file formats: FRFs and time data in UFF, CSV, NPZ, TDMS, MDF4, LVM, MAT, WAV.
 
 One module per format, one line per format in :data:`FILE_FORMATS`: its name,
 the extensions it owns and its reader and writer (the module is imported when
