@@ -15,7 +15,7 @@ from tyredamp.io.plain_csv import split_column_name
 from tyredamp.timedata import TimeData
 
 from .test_io_roundtrip import sample_timedata
-from .test_io_uff import write_foreign
+from .test_io_uff import foreign_frf_sets, write_foreign
 
 G = 9.80665
 
@@ -251,3 +251,19 @@ def test_wav(tmp_path: Path) -> None:
     assert td.quantities == ("force", "acceleration")
     assert_allclose(td.data[0], x / 32768.0 / 10e-3, rtol=1e-15)
     assert not isinstance(td, FRF)
+
+
+@pytest.mark.parametrize("binary", [0, 1])
+def test_vendor_frf_label_in_cp1252(tmp_path: Path, binary: int) -> None:
+    sets, truth = foreign_frf_sets(binary, ("(1/N)*(m/s²)", "NONE"))
+    p = tmp_path / "vendor_frf.uff"
+    write_foreign(p, sets)
+    raw = p.read_bytes()
+    assert "m/s²".encode() in raw
+    # as the vendor's Windows software writes it: one byte 0xB2 (padded to keep the columns)
+    p.write_bytes(raw.replace("m/s²".encode(), "m/s²".encode("cp1252") + b" "))
+    frf = read_frf(p)
+    assert frf.kind == "accelerance"
+    assert frf.meta["text_encoding"] == "cp1252"
+    assert_allclose(frf.frequency, truth["f"], rtol=1e-5)  # record 7 keeps 6 digits
+    assert_allclose(frf.H[0, 0], truth["H"][11], rtol=1e-11)  # ASCII: 12 digits; binary exact

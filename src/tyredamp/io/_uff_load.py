@@ -144,23 +144,22 @@ def _redecode_strings(raw: bytes, sets: list[dict[str, Any]]) -> None:
     the file around the intact parts and decoded as cp1252 (Latin-1 for the
     bytes cp1252 leaves undefined); the set's ``_encoding`` records it.
     """
-    cache: dict[str, str | None] = {}
+    cache: dict[str, tuple[str, str] | None] = {}
     for s in sets:
         for key, value in list(s.items()):
             if not isinstance(value, str) or "\ufffd" not in value:
                 continue
             if value not in cache:
+                if len(value.replace("\ufffd", "")) < 2:  # too little to find it by
+                    cache[value] = None
+                    continue
                 parts = [re.escape(x.encode("utf-8")) for x in value.split("\ufffd")]
                 m = re.search(b"(?:.{1,3}?)".join(parts), raw, flags=re.DOTALL)
-                text = None
-                if m is not None:
-                    text, _ = decode_text(m.group(0))
-                    if "\ufffd" in text:
-                        text = None
-                cache[value] = text
-            if cache[value] is not None:
-                s[key] = cache[value]
-                s["_encoding"] = "cp1252"
+                found = None if m is None else decode_text(m.group(0))
+                cache[value] = None if found is None or "\ufffd" in found[0] else found
+            hit = cache[value]
+            if hit is not None:
+                s[key], s["_encoding"] = hit
 
 
 def read_coherence(

@@ -671,8 +671,9 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
     coh = read_coherence(sets, list(outs), list(ins), n)
     var = read_variance(sets, list(outs), list(ins), n, h.shape)
     meta = _meta(first, tok)
-    if any("_encoding" in s for s in frf_sets):
-        meta["text_encoding"] = "cp1252"
+    encodings = sorted({s["_encoding"] for s in frf_sets if "_encoding" in s})
+    if encodings:
+        meta["text_encoding"] = ", ".join(encodings)
     return FRF(
         x,
         h,
@@ -717,8 +718,9 @@ def _read_time(
                 "channels must have equal length"
             )
     meta = _meta(first, tok)
-    if any("_encoding" in s for s in ts):
-        meta["text_encoding"] = "cp1252"
+    encodings = sorted({s["_encoding"] for s in ts if "_encoding" in s})
+    if encodings:
+        meta["text_encoding"] = ", ".join(encodings)
     fs = _sample_rate(p, ts, tok)
     if channel_map:
         points, names, aliases, labels, hints = [], [], [], [], []
