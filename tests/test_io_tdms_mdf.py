@@ -191,3 +191,26 @@ def test_mdf_several_rates_text_and_value_table_channels(tmp_path: Path) -> None
     assert "temp (unit 'degC' is not a vibration quantity)" in slow_td.meta["read_notes"][0]
     with pytest.raises(InputError, match="different time bases"):
         read_mdf(path, channel_map=ChannelMap.parse(["F=force", "x1=acceleration"]))
+
+
+def test_tdms_time_channel_instead_of_wf_increment(tmp_path: Path) -> None:
+    x, y, _ = signals()
+    path = tmp_path / "script.tdms"
+    t = np.arange(x.size) / FS
+    with nptdms.TdmsWriter(str(path)) as w:
+        w.write_segment(
+            [
+                nptdms.ChannelObject("g", "Time", t),
+                nptdms.ChannelObject("g", "F", x, properties={"unit_string": "N"}),
+                nptdms.ChannelObject("g", "A", y),
+            ]
+        )
+    td = read_tdms(path, channel_map=ChannelMap.parse(["g/A=acceleration:g"]))
+    assert [c.name for c in td.channels] == ["F", "A"]
+    assert td.sample_rate == FS  # 1 / mean step of the time channel, snapped
+    assert_array_equal(td.data[0], x)
+    assert "time channel 'Time'" in td.meta["read_notes"][0]
+    with nptdms.TdmsWriter(str(path)) as w:
+        w.write_segment([nptdms.ChannelObject("g", "F", x, properties={"unit_string": "N"})])
+    with pytest.raises(FileFormatError, match=r"no wf_increment .* no evenly spaced time channel"):
+        read_tdms(path)

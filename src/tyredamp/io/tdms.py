@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -47,6 +48,10 @@ def read_tdms(
     channel_map : ChannelMap, optional
         Roles, units and sensitivities of channels (:mod:`.channelmap`);
         channels answer to their name and to ``group/name``.
+
+    Channels without ``wf_increment`` (files written by scripts) take the
+    interval of an evenly spaced time channel of the group (``Time``, ``t``
+    ...), which is then not read as data.
 
     Raises
     ------
@@ -81,21 +86,29 @@ def read_tdms(
         ]
         if named:
             groups = named
-    chans = groups[0].channels()
+    chans = list(groups[0].channels())
+    time_dt, time_name = _time_channel(chans)
+    notes = []
+    if time_name is not None:
+        notes.append(f"sample interval from the time channel {time_name!r}")
+        chans = [c for c in chans if c.name != time_name]
     names, units, arrays, steps = [], [], [], []
     for c in chans:
         props = c.properties
-        if "wf_increment" not in props:
+        if "wf_increment" not in props and time_dt is None:
             raise FileFormatError(
-                f"{p}: channel {c.name!r} has no wf_increment (sample interval) property"
+                f"{p}: channel {c.name!r} has no wf_increment (sample interval) property and "
+                "the group has no evenly spaced time channel (Time, t, ...)"
             )
         try:
-            steps.append(float(props["wf_increment"]))
+            steps.append(float(props.get("wf_increment", time_dt)))
             arrays.append(np.asarray(c[:], dtype=float))
         except (TypeError, ValueError) as exc:
             raise FileFormatError(f"{p}: channel {c.name!r}: {exc}") from None
         names.append(str(c.name))
         units.append(str(props.get("unit_string", "") or ""))
+    if not names:
+        raise FileFormatError(f"{p}: no data channels besides the time channel")
     dt = steps[0]
     if not np.isfinite(dt) or dt <= 0 or any(abs(s - dt) > 1e-12 * dt for s in steps):
         raise FileFormatError(f"{p}: channels have different or invalid sample intervals {steps}")
@@ -109,4 +122,28 @@ def read_tdms(
         quantities,
         channel_map,
         aliases=[[f"{gname}/{n}"] for n in names],
+        notes=notes,
     )
+
+
+_TIME_NAMES = {"time", "t", "zeit", "time_s", "timestamp", "x_value", "relative time"}
+
+
+def _time_channel(chans: list[Any]) -> tuple[float | None, str | None]:
+    """``(interval in s, name)`` of an evenly spaced time channel when a channel lacks
+    ``wf_increment`` (files written by scripts rather than LabVIEW waveforms)."""
+    if all("wf_increment" in c.properties for c in chans):
+        return None, None
+    for c in chans:
+        if str(c.name).strip().lower() not in _TIME_NAMES:
+            continue
+        try:
+            t = np.asarray(c[:], dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if t.size < 2:
+            continue
+        dt = float(t[-1] - t[0]) / (t.size - 1)
+        if dt > 0 and np.max(np.abs(np.diff(t) - dt)) <= 1e-6 * dt:
+            return dt, str(c.name)
+    return None, None
