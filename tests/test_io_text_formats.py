@@ -227,6 +227,12 @@ def test_mat_variants(tmp_path: Path) -> None:
     td = read_timedata(q, ChannelMap.parse(["F=force:kN", "a=velocity:mm/s"]))
     assert td.sample_rate == 50.0
     assert_allclose(td.data, [x[0] * 1e3, x[1] * 1e-3], rtol=1e-15)
+    s = tmp_path / "s.mat"
+    savemat(s, {"test": {"time": np.arange(100) / 20.0, "F": x[0], "acc": x[1], "id": "A"}})
+    td = read_timedata(s, ChannelMap.parse(["F=force:N", "acc=acceleration:g"]))
+    assert [c.name for c in td.channels] == ["test.F", "test.acc"]
+    assert td.sample_rate == 20.0
+    assert_allclose(td.data[1], x[1] * G, rtol=1e-15)  # g to m/s^2
     r = tmp_path / "c.mat"
     savemat(r, {"F": x[0], "a": x[1]})
     with pytest.raises(FileFormatError, match="no time base"):

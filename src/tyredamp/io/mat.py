@@ -22,7 +22,9 @@ FRF
     an FRF relates is named with the channel map (``--channel
     "Hf_chan_2=acceleration:g/N"``) or ``kind=``.
 
-Variables left out (other lengths, structures, text) are listed in
+Fields of structures are read as ``name.field`` (``test.time``,
+``test.acc1``) and match the rules above by their field name. Variables left
+out (other lengths, structure arrays, text) are listed in
 ``meta["read_notes"]``. MATLAB v7.3 files are HDF5 and are not read.
 """
 
@@ -63,7 +65,26 @@ def _load(p: Any) -> dict[str, np.ndarray]:
         ) from None
     except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError ... on garbage
         raise FileFormatError(f"{p}: not a readable MATLAB file ({exc})") from None
-    return {k: v for k, v in raw.items() if not k.startswith("__")}
+    out: dict[str, Any] = {}
+    for k, v in raw.items():
+        if not k.startswith("__"):
+            _flatten(k, v, out, 0)
+    return out
+
+
+def _flatten(name: str, v: Any, out: dict[str, Any], depth: int) -> None:
+    """Fields of a 1x1 struct as ``name.field`` (three levels), other values as they are."""
+    if isinstance(v, np.ndarray) and v.dtype.names is not None and v.size == 1 and depth < 3:
+        rec = v.ravel()[0]
+        for field in v.dtype.names:
+            _flatten(f"{name}.{field}", rec[field], out, depth + 1)
+    else:
+        out[name] = v
+
+
+def _leaf(name: str) -> str:
+    """The field name of ``struct.field`` (the name itself otherwise)."""
+    return name.rsplit(".", 1)[-1]
 
 
 def _vector(v: Any) -> np.ndarray | None:
@@ -137,7 +158,7 @@ def _time_base(vars_: dict[str, Any]) -> tuple[float | None, str | None, int | N
     n = None
     for name, v in vars_.items():
         vec = _vector(v)
-        if _TIME.match(name) and vec is not None and vec.dtype.kind in "iuf":
+        if _TIME.match(_leaf(name)) and vec is not None and vec.dtype.kind in "iuf":
             t = vec.astype(float)
             dt = np.diff(t)
             if np.all(dt > 0):
@@ -150,10 +171,10 @@ def _time_base(vars_: dict[str, Any]) -> tuple[float | None, str | None, int | N
         x = _scalar(v)
         if x is None:
             continue
-        if _RATE.search(name):
+        if _RATE.search(_leaf(name)):
             fs = x
             break
-        if _STEP.match(name):
+        if _STEP.match(_leaf(name)):
             fs = 1.0 / x
             break
     return fs, tname, n
@@ -198,7 +219,10 @@ def _read_time(p: Any, vars_: dict[str, Any], channel_map: ChannelMap | None) ->
         snap_rate(fs),
         None,
         channel_map,
-        aliases=[[c.split("(")[0]] if "(" in c else [] for c, _ in keep],
+        aliases=[
+            [a for a in dict.fromkeys([c.split("(")[0], _leaf(c.split("(")[0])]) if a != c]
+            for c, _ in keep
+        ],
         notes=notes,
     )
 
@@ -221,7 +245,12 @@ def _read_frf(
     freq = None
     for name, v in vars_.items():
         vec = _vector(v)
-        if vec is not None and vec.size == n and vec.dtype.kind in "iuf" and _FREQ.match(name):
+        if (
+            vec is not None
+            and vec.size == n
+            and vec.dtype.kind in "iuf"
+            and _FREQ.match(_leaf(name))
+        ):
             f = vec.astype(float)
             if np.all(np.diff(f) > 0):
                 freq = f
@@ -230,7 +259,7 @@ def _read_frf(
         df = None
         for name, v in vars_.items():
             x = _scalar(v)
-            if x is not None and re.search(r"(delta_?f|^df$)", name, re.I):
+            if x is not None and re.search(r"(delta_?f|^df$)", _leaf(name), re.I):
                 df = x
         if df is None:
             raise FileFormatError(
