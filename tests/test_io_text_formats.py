@@ -106,6 +106,21 @@ def test_plain_csv_with_a_units_row(tmp_path: Path) -> None:
     assert td.meta["preamble"] == ["Messung 7"]
 
 
+@pytest.mark.parametrize(
+    ("line", "fs"),
+    [("Sample rate: 1024 Hz", 1024.0), ("Abtastrate;2,56;kHz", 2560.0), ("dt = 0.5 ms", 2000.0)],
+)
+def test_plain_csv_without_time_column_but_a_stated_rate(
+    tmp_path: Path, line: str, fs: float
+) -> None:
+    x = _signals(8).tolist()
+    rows = [f"{x[0][k]!r};{x[1][k]!r}" for k in range(8)]
+    td = read_timedata(_write(tmp_path / "r.csv", [line, "F [N];a [g]", *rows]))
+    assert td.sample_rate == fs
+    assert_array_equal(td.data[0], x[0])
+    assert any("sample rate" in n for n in td.meta["read_notes"])
+
+
 def test_plain_csv_frf(tmp_path: Path) -> None:
     f = np.arange(1, 33) * 2.0
     h = (1 + 1j * f) / (100 - f**2 + 2j * f)

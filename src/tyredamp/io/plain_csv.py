@@ -210,27 +210,62 @@ def read_plain_csv(
     t_scale = _TIME_UNITS.get(first_unit.strip().lower())
     if t_scale is None and first_name.strip().lower() in _TIME_NAMES and not first_unit:
         t_scale = 1.0
+    first = 1
     if t_scale is None:
-        raise FileFormatError(
-            f"{p}: the first column {cols[0]!r} is not a time (named time/t or in s) or a "
-            "frequency (named freq... or in Hz) column; plain CSV needs one"
-        )
-    if what == "frf":
-        raise FileFormatError(f"{p}: holds time data (column {cols[0]!r}), not an FRF")
-    t = table[:, 0] * t_scale
-    fs = _rate(p, t, [ln.split(delim)[0] for ln in body[: len(rows)]], t_scale)
+        stated = _stated_rate(head[:-1])
+        if stated is None:
+            raise FileFormatError(
+                f"{p}: the first column {cols[0]!r} is not a time (named time/t or in s) or a "
+                "frequency (named freq... or in Hz) column, and no line above the header "
+                "states a sample rate (Sample rate: 1024 Hz); plain CSV needs one of them"
+            )
+        fs, first = stated, 0
+        notes.append(f"sample rate {fs:g} Hz from the lines above the header")
+    else:
+        t = table[:, 0] * t_scale
+        fs = _rate(p, t, [ln.split(delim)[0] for ln in body[: len(rows)]], t_scale)
     return timedata_from_channels(
         p,
-        [n for n, _ in split[1:]],
-        [u for _, u in split[1:]],
-        list(table[:, 1:].T),
+        [n for n, _ in split[first:]],
+        [u for _, u in split[first:]],
+        list(table[:, first:].T),
         fs,
         None,
         channel_map,
-        aliases=[[c.strip()] for c in cols[1:]],
+        aliases=[[c.strip()] for c in cols[first:]],
         meta=meta,
         notes=notes,
     )
+
+
+_RATE_LINE = re.compile(
+    r"(sampl\w*\s*rate|sampling\s*freq\w*|abtastrate|abtastfrequenz|\bfs\b|\bsr\b)"
+    r"\s*(\[hz\])?\s*[:=,;\t]?\s*\"?([-+]?\d+(?:[.,]\d*)?(?:[eE][-+]?\d+)?)[\s;,]*(k?hz)?",
+    re.IGNORECASE,
+)
+_STEP_LINE = re.compile(
+    r"(delta[_ ]?[tx]|\bdt\b|sample\s*interval|time\s*increment|increment)"
+    r"\s*(\[s\])?\s*[:=,;\t]?\s*\"?([-+]?\d+(?:[.,]\d*)?(?:[eE][-+]?\d+)?)\s*(s|ms)?\b",
+    re.IGNORECASE,
+)
+
+
+def _stated_rate(lines: Sequence[str]) -> float | None:
+    """A sample rate (Hz) stated in lines such as ``Sample rate: 1024 Hz`` or ``dt = 0.001``."""
+    for ln in lines:
+        m = _RATE_LINE.search(ln)
+        if m:
+            v = float(m.group(3).replace(",", "."))
+            v *= 1e3 if (m.group(4) or "").lower() == "khz" else 1.0
+            if v > 0:
+                return snap_rate(v)
+        m = _STEP_LINE.search(ln)
+        if m:
+            v = float(m.group(3).replace(",", "."))
+            v *= 1e-3 if (m.group(4) or "").lower() == "ms" else 1.0
+            if v > 0:
+                return snap_rate(1.0 / v)
+    return None
 
 
 def _rate(p: Path, t: np.ndarray, texts: Sequence[str], scale: float) -> float:
