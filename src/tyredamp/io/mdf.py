@@ -110,17 +110,26 @@ def read_mdf(
     p = check_input_file(path)
     cmap = ChannelMap.from_quantities(quantities).merged(channel_map)
     try:
-        with MDF(str(p)) as mdf:
-            sigs = list(mdf.iter_channels())
-            groups = [int(getattr(s, "group_index", 0)) for s in sigs]
-    except FileFormatError:
-        raise
+        mdf = MDF(str(p))
     except Exception as exc:  # asammdf raises MdfException, ValueError ... on garbage
         raise FileFormatError(f"{p}: not a readable MDF file ({exc})") from None
+    skipped: list[str] = []
+    sigs, groups = [], []
+    with mdf:
+        masters = getattr(mdf, "masters_db", {})
+        groups_: list[Any] = list(mdf.groups)
+        for gi, grp in enumerate(groups_):
+            for ci, ch in enumerate(grp.channels):
+                if masters.get(gi) == ci:
+                    continue
+                try:  # one channel asammdf cannot read (a bus frame ...) is left out
+                    sigs.append(mdf.get(group=gi, index=ci))
+                    groups.append(gi)
+                except Exception as exc:
+                    skipped.append(f"{ch.name} (not readable: {type(exc).__name__})")
     if not sigs:
         raise FileFormatError(f"{p}: no data channels in the MDF file")
     names = [str(s.name) for s in sigs]
-    skipped: list[str] = []
     numeric = []
     for k, s in enumerate(sigs):
         a = np.asarray(s.samples)
