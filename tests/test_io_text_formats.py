@@ -74,6 +74,14 @@ def test_plain_csv_layouts(tmp_path: Path, delim: str, dec: str, encoding: str) 
         assert "text_encoding" not in td.meta
 
 
+def test_aligned_text_table(tmp_path: Path) -> None:
+    x = _signals(8).tolist()
+    rows = [f"  {k / 100:10.4f}  {x[0][k]!r:>24}  {x[1][k]!r:>24}" for k in range(8)]
+    td = read_timedata(_write(tmp_path / "t.txt", ["   t [s]     F [N]    a [m/s^2]", *rows]))
+    assert td.sample_rate == 100.0
+    assert_array_equal(td.data, [x[0], x[1]])
+
+
 def test_plain_csv_problems(tmp_path: Path) -> None:
     x = _signals(8)
     rows = [f"{k / 100},{x[0, k]},{x[1, k]}" for k in range(8)]

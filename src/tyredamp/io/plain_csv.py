@@ -12,8 +12,9 @@ Read rules (detected from the file itself):
 
 * text encoding: UTF-8, else cp1252/Latin-1 (then named in
   ``meta["text_encoding"]``);
-* delimiter: comma, semicolon or tab (whichever splits the rows into equal
-  numbers of numbers); a decimal comma is read with ``;`` or tab delimiters;
+* delimiter: comma, semicolon, tab or blanks (an aligned text table),
+  whichever splits the rows into equal numbers of numbers; a decimal comma
+  is read with the other delimiters than the comma;
 * lines before the header row (comments, a title, ``key: value`` lines) are
   kept in ``meta["preamble"]``; lines starting with ``#`` are comments;
 * the header row is the last line before the first row of numbers (or the
@@ -97,14 +98,12 @@ def _delimiter(lines: Sequence[str]) -> tuple[str, bool]:
     """``(delimiter, decimal_comma)`` that splits the last lines into equal numeric rows."""
     rows = [ln for ln in lines if ln.strip()]
     sample = rows[-21:-1] if len(rows) > 3 else rows  # the last row may be cut short
-    for delim in ("\t", ";", ","):
+    for delim in ("\t", ";", ",", " "):
         for dec_comma in (False, True) if delim != "," else (False,):
             widths = set()
             ok = True
             for ln in sample:
-                cells = [c.strip() for c in ln.split(delim)]
-                while cells and cells[-1] == "":
-                    cells.pop()
+                cells = _cells(ln, delim)
                 if len(cells) < 2 or not all(
                     _NUM.match(c) and ("," not in c or dec_comma) for c in cells
                 ):
@@ -113,10 +112,25 @@ def _delimiter(lines: Sequence[str]) -> tuple[str, bool]:
                 widths.add(len(cells))
             if ok and len(widths) == 1:
                 return delim, dec_comma
-    raise FileFormatError("no delimiter (comma, semicolon or tab) splits the rows into numbers")
+    raise FileFormatError(
+        "no delimiter (comma, semicolon, tab or spaces) splits the rows into numbers"
+    )
+
+
+def _header_cells(line: str, delim: str, n: int) -> list[str]:
+    """Column names of a header line; in an aligned table (blanks) names may hold single
+    blanks (``F [N]``): columns are then split at runs of two or more blanks."""
+    if delim == " ":
+        wide = [c for c in re.split(r"\s{2,}|\t", line.strip()) if c]
+        if len(wide) == n:
+            return wide
+    return _cells(line, delim)
 
 
 def _cells(line: str, delim: str) -> list[str]:
+    """The cells of a row (``delim`` ``" "``: runs of blanks, as in aligned text tables)."""
+    if delim == " ":
+        return line.split()
     cells = [c.strip() for c in line.split(delim)]
     while cells and cells[-1] == "":
         cells.pop()
@@ -146,6 +160,8 @@ def read_plain_csv(
         if not ln.strip() or ln.lstrip().startswith("#"):
             continue
         cells = [c for c in re.split(r"[,;\t]", ln) if c.strip()]
+        if not all(_NUM.match(c.strip()) for c in cells):
+            cells = ln.split()  # an aligned table: columns separated by blanks
         if cells and all(_NUM.match(c.strip()) for c in cells):
             body_start = k if body_start is None else body_start
             numeric += 1
@@ -166,10 +182,10 @@ def read_plain_csv(
         delim, dec_comma = _delimiter(body)
     except FileFormatError as exc:
         raise FileFormatError(f"{p}: {exc}") from None
-    cols = _cells(head[-1], delim)
+    cols = _header_cells(head[-1], delim, len(_cells(body[0], delim)))
     unit_row: list[str] | None = None
     if len(head) > 1:
-        above = _cells(head[-2], delim)
+        above = _header_cells(head[-2], delim, len(cols))
         if len(above) == len(cols) and all(
             not c or _is_unit(c.strip("[]() ")) or c.strip("[]() ").lower() in _ANGLE for c in cols
         ):  # a row of names, then a row of units (as many DAQ programs export)
@@ -223,7 +239,7 @@ def read_plain_csv(
         notes.append(f"sample rate {fs:g} Hz from the lines above the header")
     else:
         t = table[:, 0] * t_scale
-        fs = _rate(p, t, [ln.split(delim)[0] for ln in body[: len(rows)]], t_scale)
+        fs = _rate(p, t, [_cells(ln, delim)[0] for ln in body[: len(rows)]], t_scale)
     return timedata_from_channels(
         p,
         [n for n, _ in split[first:]],
