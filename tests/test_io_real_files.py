@@ -228,6 +228,17 @@ def test_cli_output_only_and_bad_maps(tmp_path: Path, capsys: pytest.CaptureFixt
     assert "output-only data" in capsys.readouterr().out
 
 
+def test_uff_frf_refuses_a_channel_map(tmp_path: Path) -> None:
+    out = tmp_path / "frf.uff"
+    assert main(["frf", str(IMPACT.with_suffix(".csv")), *_opts(IMPACT_MAP), "-o", str(out)]) == 0
+    with pytest.raises(InputError, match=r"holds FRFs.*applies to time data"):
+        read(out, ChannelMap.parse(["1=force"]))
+
+
+def _opts(chans: list[str]) -> list[str]:
+    return [x for c in chans for x in ("--channel", c)]
+
+
 def test_uff_time_data_takes_a_channel_map() -> None:
     import pyuff
 

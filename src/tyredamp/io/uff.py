@@ -565,6 +565,11 @@ def read_uff(
         if 4 in types:
             raise FileFormatError(f"{p}: holds FRFs (function type 4), not time data")
         raise not_frf_or_time(p, types)
+    if what == "frf" and channel_map:
+        raise InputError(
+            f"{p}: holds FRFs, whose units and channels the file states; a channel map "
+            "(--channel, --sensitivity) applies to time data"
+        )
     with wrap_errors(p):
         if what == "frf":
             return _read_frf(p, sets, kind)
