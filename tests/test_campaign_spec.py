@@ -177,4 +177,4 @@ def test_schema_and_reader_know_the_same_settings() -> None:
     from tyredamp.campaign.spec import CONDITIONS
 
     test_props = SCHEMA["properties"]["tests"]["items"]["properties"]
-    assert set(test_props) == {"files", "study", *CONDITIONS}
+    assert set(test_props) == {"files", "study", "channel_map", *CONDITIONS}

@@ -10,7 +10,7 @@ from numpy.testing import assert_array_equal
 
 from tyredamp import FileFormatError, InputError
 from tyredamp.cli import main
-from tyredamp.io import read_frf, read_timedata
+from tyredamp.io import ChannelMap, read_frf, read_timedata
 from tyredamp.io.mdf import read_mdf
 from tyredamp.io.tdms import read_tdms
 
@@ -94,11 +94,11 @@ def test_force_named_by_quantities_when_units_are_blank(tmp_path: Path) -> None:
     x, y, _ = signals()
     path = tmp_path / "blank.tdms"
     write_tdms(path, [("ch0", x, ""), ("ch1", y, "")])
-    with pytest.raises(FileFormatError, match=r"ch0.*quantities"):
+    with pytest.raises(FileFormatError, match=r"'ch0', 'ch1' measure.*--channel 'ch0=force:N'"):
         read_tdms(path)
     td = read_tdms(path, quantities={"ch0": "force", "ch1": "velocity"})
     assert td.quantities == ("force", "velocity")
-    with pytest.raises(InputError, match="no channel named 'nope'"):
+    with pytest.raises(InputError, match="names channel 'nope', which the file does not have"):
         read_tdms(path, quantities={"nope": "force"})
     mpath = tmp_path / "blank.mf4"
     write_mdf(mpath, [("ch0", x, ""), ("ch1", y, "")])
@@ -118,12 +118,19 @@ def test_bad_files(tmp_path: Path, ext: str) -> None:
         read_timedata(empty)
     noforce = tmp_path / f"noforce{ext}"
     WRITERS[ext](noforce, [("a", x, "m/s^2"), ("b", y, "m/s^2")])
-    with pytest.raises(FileFormatError, match="no force channel"):
-        read_timedata(noforce)
+    td = read_timedata(noforce)  # output-only data reads; the steps needing a force refuse it
+    assert td.output_only
+    with pytest.raises(InputError, match=r"output-only data \(no force channel\): channels a"):
+        td.require_force()
     badunit = tmp_path / f"badunit{ext}"
     WRITERS[ext](badunit, [("F", x, "N"), ("b", y, "furlong")])
-    with pytest.raises(FileFormatError, match="units label 'furlong'"):
-        read_timedata(badunit)
+    if ext == ".mf4":  # a logger's other channels (degC, rpm ...) are left out, and said so
+        td = read_timedata(badunit)
+        assert td.n_channels == 1
+        assert "b (unit 'furlong' is not a vibration quantity)" in td.meta["read_notes"][0]
+    else:
+        with pytest.raises(FileFormatError, match="units label 'furlong'"):
+            read_timedata(badunit)
     nan = tmp_path / f"nan{ext}"
     WRITERS[ext](nan, [("F", np.where(np.arange(x.size) == 5, np.nan, x), "N"), ("b", y, "g")])
     with pytest.raises(FileFormatError, match="finite"):
@@ -147,4 +154,63 @@ def test_tdms_unequal_sampling(tmp_path: Path) -> None:
             ]
         )
     with pytest.raises(FileFormatError, match="sample intervals"):
+        read_tdms(path)
+
+
+def test_mdf_several_rates_text_and_value_table_channels(tmp_path: Path) -> None:
+    x, y, _ = signals()
+    t = np.arange(x.size) / FS
+    slow = np.arange(0, x.size, 64) / FS
+    m = asammdf.MDF(version="4.10")
+    m.append([asammdf.Signal(x, t, name="F", unit="N"), asammdf.Signal(y, t, name="a", unit="g")])
+    m.append(
+        [
+            asammdf.Signal(np.full(slow.size, 21.5), slow, name="temp", unit="degC"),
+            asammdf.Signal(np.array([b"run"] * slow.size), slow, name="state", encoding="utf-8"),
+            asammdf.Signal(np.ones(slow.size), slow, name="x1", unit="m/s^2"),
+            asammdf.Signal(np.ones(slow.size), slow, name="x2", unit="m/s^2"),
+            asammdf.Signal(np.ones(slow.size), slow, name="x3", unit="m/s^2"),
+        ]
+    )
+    # a value-table channel on the fast rate: strings after conversion
+    vt = {"val_0": 0, "text_0": b"off", "val_1": 1, "text_1": b"on", "default": b""}
+    m.append([asammdf.Signal(np.zeros(x.size, dtype=np.uint8), t, name="gear", conversion=vt)])
+    path = tmp_path / "logger.mf4"
+    m.save(str(path), overwrite=True)
+    m.close()
+    # the slow group has the most channels of vibration units: the map chooses the fast one
+    td = read_mdf(path, channel_map=ChannelMap.parse(["F=force"]))
+    assert [c.name for c in td.channels] == ["F", "a"]
+    assert_array_equal(td.data[0], x)
+    assert td.sample_rate == FS
+    note = td.meta["read_notes"][0]
+    for name in ("temp (another time base)", "state (not numeric", "gear (not numeric"):
+        assert name in note
+    slow_td = read_mdf(path)  # without a map: the rate of the most vibration channels
+    assert [c.name for c in slow_td.channels] == ["x1", "x2", "x3"]
+    assert "temp (unit 'degC' is not a vibration quantity)" in slow_td.meta["read_notes"][0]
+    with pytest.raises(InputError, match="different time bases"):
+        read_mdf(path, channel_map=ChannelMap.parse(["F=force", "x1=acceleration"]))
+
+
+def test_tdms_time_channel_instead_of_wf_increment(tmp_path: Path) -> None:
+    x, y, _ = signals()
+    path = tmp_path / "script.tdms"
+    t = np.arange(x.size) / FS
+    with nptdms.TdmsWriter(str(path)) as w:
+        w.write_segment(
+            [
+                nptdms.ChannelObject("g", "Time", t),
+                nptdms.ChannelObject("g", "F", x, properties={"unit_string": "N"}),
+                nptdms.ChannelObject("g", "A", y),
+            ]
+        )
+    td = read_tdms(path, channel_map=ChannelMap.parse(["g/A=acceleration:g"]))
+    assert [c.name for c in td.channels] == ["F", "A"]
+    assert td.sample_rate == FS  # 1 / mean step of the time channel, snapped
+    assert_array_equal(td.data[0], x)
+    assert "time channel 'Time'" in td.meta["read_notes"][0]
+    with nptdms.TdmsWriter(str(path)) as w:
+        w.write_segment([nptdms.ChannelObject("g", "F", x, properties={"unit_string": "N"})])
+    with pytest.raises(FileFormatError, match=r"no wf_increment .* no evenly spaced time channel"):
         read_tdms(path)

@@ -16,16 +16,27 @@ from ._validate import as_finite, check_positive
 from .exceptions import InputError, ShapeError
 from .frf import Channel
 
-__all__ = ["ACQUISITION_KEYS", "QUANTITY_UNITS", "Acquisition", "Quantity", "TimeData"]
+__all__ = [
+    "ACQUISITION_KEYS",
+    "MOTION_QUANTITIES",
+    "QUANTITY_UNITS",
+    "Acquisition",
+    "Quantity",
+    "TimeData",
+]
 
-Quantity = Literal["force", "displacement", "velocity", "acceleration"]
+Quantity = Literal["force", "displacement", "velocity", "acceleration", "pressure", "voltage"]
 #: SI unit of each measured quantity.
 QUANTITY_UNITS: dict[str, str] = {
     "force": "N",
     "displacement": "m",
     "velocity": "m/s",
     "acceleration": "m/s^2",
+    "pressure": "Pa",
+    "voltage": "V",
 }
+#: The quantities of structural responses (what an FRF relates to a force).
+MOTION_QUANTITIES: tuple[str, ...] = ("displacement", "velocity", "acceleration")
 
 
 def _count(v: Any, name: str, minimum: int) -> int:
@@ -226,14 +237,17 @@ class TimeData:
     Parameters
     ----------
     data : array_like, shape (n_channels, n_samples)
-        Samples in SI units (N, m, m/s, m/s^2 by quantity).
+        Samples in SI units (N, m, m/s, m/s^2, Pa, V by quantity).
     sample_rate : float
         Samples per second (Hz).
     channels : sequence of Channel
         Point and direction of each channel.
     quantities : sequence of str
-        ``"force"``, ``"displacement"``, ``"velocity"`` or ``"acceleration"``
-        per channel.
+        ``"force"``, ``"displacement"``, ``"velocity"``, ``"acceleration"``,
+        ``"pressure"`` (a microphone, Pa) or ``"voltage"`` (a sensor whose
+        sensitivity was not given, V) per channel. Pressure and voltage
+        channels are kept and shown but are neither forces nor structural
+        responses: FRF estimation leaves them out.
     meta : dict, optional
         Free notes (test description, operator ...); never read by the
         estimators. Legacy acquisition keys (``"period_samples"``,
@@ -328,8 +342,76 @@ class TimeData:
 
     @property
     def response_indices(self) -> list[int]:
-        """Positions of the response (non-force) channels."""
-        return [i for i, q in enumerate(self.quantities) if q != "force"]
+        """Positions of the structural response channels (displacement, velocity, acceleration)."""
+        return [i for i, q in enumerate(self.quantities) if q in MOTION_QUANTITIES]
+
+    @property
+    def other_indices(self) -> list[int]:
+        """Positions of the channels that are neither force nor motion (pressure, voltage)."""
+        return [i for i, q in enumerate(self.quantities) if q not in (*MOTION_QUANTITIES, "force")]
+
+    @property
+    def output_only(self) -> bool:
+        """True when no channel is a force: an operational (output-only) recording."""
+        return not self.force_indices
+
+    def require_force(self, what: str = "an FRF", where: object = None) -> None:
+        """Raise :class:`InputError` in one line when there is no force channel.
+
+        The message says that this is output-only data, names the channels and
+        says what to do: name a force channel (``--channel NAME=force:N``) or
+        use output-only identification, which tyredamp does not offer yet.
+
+        Parameters
+        ----------
+        what : str
+            What needs the force (``"an FRF"``), for the message.
+        where : path-like, optional
+            The file the data came from, named first in the message.
+        """
+        if self.force_indices:
+            return
+        names = ", ".join(
+            f"{c.name or c.label} ({q})"
+            for c, q in zip(self.channels, self.quantities, strict=True)
+        )
+        raise InputError(
+            ("" if where is None else f"{where}: ")
+            + f"output-only data (no force channel): channels {names}; {what} needs a "
+            "measured force: name the force channel with --channel NAME=force:N (a "
+            "campaign's channel_map, Python's ChannelMap), or identify modes from output-only "
+            "data with another tool (operational modal analysis is not available in tyredamp "
+            "yet)"
+        )
+
+    def require_response(self, what: str = "an FRF", where: object = None) -> None:
+        """Raise :class:`InputError` in one line when no channel is a structural response.
+
+        Pressure and voltage channels are named with what to supply (a
+        sensitivity that makes a voltage an acceleration, a velocity ...).
+        """
+        if self.response_indices:
+            return
+        others = [
+            f"{self.channels[i].name or self.channels[i].label} "
+            f"({self.quantities[i]}, {QUANTITY_UNITS[self.quantities[i]]})"
+            for i in self.other_indices
+        ]
+        hint = ""
+        volts = [i for i in self.other_indices if self.quantities[i] == "voltage"]
+        if volts:
+            c = self.channels[volts[0]]
+            hint = (
+                f"; give a voltage channel's sensitivity, for example --sensitivity "
+                f"'{c.name or c.label}=100 mV/g'"
+            )
+        raise InputError(
+            ("" if where is None else f"{where}: ")
+            + f"no response channel (displacement, velocity or acceleration): {what} needs "
+            + "one"
+            + (f"; the other channels are {', '.join(others)}" if others else "")
+            + hint
+        )
 
     def __repr__(self) -> str:
         return (

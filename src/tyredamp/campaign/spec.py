@@ -19,6 +19,8 @@ by the JSON schema ``tyredamp/schemas/campaign.schema.json`` and in
 
     [[tests]]
     files = "data/A_*bar.uff"      # a path or glob (or a list), relative to this file
+    channel_map = "channels.toml"  # optional (also in [defaults]): roles, units and
+                                   # sensitivities of the channels (docs/file-formats.md)
     tyre = "A"
     pressure_bar = 7.5
     load_n = 20000.0
@@ -62,7 +64,7 @@ CONDITIONS: dict[str, tuple[str, str]] = {
 NUMERIC_CONDITIONS: tuple[str, ...] = ("pressure_bar", "load_n", "speed_kmh", "temperature_c")
 
 _TOP_KEYS = ("name", "output", "defaults", "settings", "tracking", "tests")
-_TEST_KEYS = ("files", "study", *CONDITIONS)
+_TEST_KEYS = ("files", "study", "channel_map", *CONDITIONS)
 _TRACKING = {"model": ("complex", "real")}
 _GLOB = re.compile(r"[*?\[]")
 
@@ -147,6 +149,31 @@ def _condition(src: Path, key: str, name: str, value: Any) -> Any:
     if kind == "temperature" and v <= -273.15:
         raise _err(src, key, f"expected a temperature above -273.15 degC, got {v:g}")
     return v
+
+
+def _channel_map(src: Path, base: Path, key: str, value: Any) -> dict[str, Any]:
+    """A test's channel map: a TOML/JSON file (relative to the campaign file) or a table.
+
+    Returned as its document (``ChannelMap.to_dict``), which travels with the
+    test's conditions to the workers and into the step's cache key.
+    """
+    from ..io.channelmap import ChannelMap
+
+    try:
+        if isinstance(value, str):
+            full = Path(value) if Path(value).is_absolute() else base / value
+            if not full.is_file():
+                raise _err(src, key, f"channel-map file not found: {value}")
+            cmap = ChannelMap.from_file(full)
+        elif isinstance(value, dict):
+            cmap = ChannelMap.from_dict(value, key)
+        else:
+            raise _err(src, key, f"expected a channel-map file or a table, got {value!r}")
+    except CampaignFileError:
+        raise
+    except InputError as exc:
+        raise _err(src, key, str(exc)) from None
+    return cmap.to_dict()
 
 
 def _safe_id(text: str) -> str:
@@ -235,10 +262,12 @@ def parse_campaign(doc: Any, src: Path) -> Campaign:
     defaults = doc.get("defaults", {})
     if not isinstance(defaults, dict):
         raise _err(src, "defaults", f"expected a table, got {defaults!r}")
-    bad = sorted(set(defaults) - {"study", *CONDITIONS})
+    bad = sorted(set(defaults) - {"study", "channel_map", *CONDITIONS})
     if bad:
         raise _err(
-            src, f"defaults.{bad[0]}", f"unknown key; expected study or one of {list(CONDITIONS)}"
+            src,
+            f"defaults.{bad[0]}",
+            f"unknown key; expected study, channel_map or one of {list(CONDITIONS)}",
         )
 
     entries = doc.get("tests")
@@ -267,6 +296,9 @@ def parse_campaign(doc: Any, src: Path) -> Campaign:
             v = merged.get(c)
             k = f"{where}.{c}" if c in entry else f"defaults.{c}"
             conditions[c] = None if v is None else _condition(src, k, c, v)
+        if merged.get("channel_map") is not None:
+            k = f"{where}.channel_map" if "channel_map" in entry else "defaults.channel_map"
+            conditions["channel_map"] = _channel_map(src, base, k, merged["channel_map"])
         for path in _expand(src, base, f"{where}.files", merged["files"]):
             rp = path.resolve()
             if (study, rp) in seen:

@@ -176,6 +176,7 @@ STUDIES: dict[str, StudySteps] = {
         ("modal", "damping"),
         {"modal": ("frf", "checks", "modal"), "damping": ("damping",)},
         frozenset({"damping"}),
+        conditions_of={"modal": ("channel_map",)},  # the test's channel map (time data)
     ),
     "lateral": StudySteps(
         "lateral", ("fit",), {"fit": ("fit",)}, conditions_of={"fit": ("speed_kmh",)}
@@ -423,13 +424,15 @@ def _radial_modal(
     """``tyredamp frf`` (time data only), ``check quality`` and ``tyredamp modal``."""
     from ..documents.modes import modes_document
     from ..frf import FRF
-    from ..io import read
+    from ..io import ChannelMap, read
     from ..signal.checks import dependent_forces
     from ..studies.radial import check_quality, frf_from_time, label_wave_numbers, modes_from_frf
     from ..studies.verdicts import modal_verdicts
 
     fs, cs, ms = settings["frf"], settings["checks"], settings["modal"]
-    obj = read(path)
+    obj = read(path, ChannelMap.from_dict((conditions or {}).get("channel_map") or {}))
+    if not isinstance(obj, FRF):  # output-only data: said in one line, with what to do
+        obj.require_force("the modal step (an FRF from time data)", path.name)
     if isinstance(obj, FRF):
         frf = obj
         source_kind = "frf"

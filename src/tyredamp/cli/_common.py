@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -19,6 +20,9 @@ __all__ = [
     "EXIT_SIGTERM",
     "Interrupted",
     "OutPath",
+    "channel_map",
+    "channel_map_options",
+    "echo_read_notes",
     "fail",
     "out_file_option",
     "parse_drive_points",
@@ -96,3 +100,77 @@ def parse_drive_points(values: tuple[str, ...]) -> tuple[int, ...]:
                     f"--drive-points: expected point numbers like 1,5, got {v!r}"
                 ) from None
     return tuple(out) or (1,)
+
+
+_MAP_KEY = "tyredamp.channel_map"
+
+
+def channel_map_options(fn: F) -> F:
+    """``--channel``, ``--sensitivity`` and ``--channel-map`` for a command that reads data.
+
+    The three options are parsed into one :class:`~tyredamp.io.ChannelMap`
+    before the command runs (a bad string is a one-line error); the command
+    gets it with :func:`channel_map` and passes it to the reader.
+    """
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        from ..io.channelmap import ChannelMap
+
+        cmap = ChannelMap.parse(
+            kwargs.pop("channel_specs", ()),
+            kwargs.pop("sensitivity_specs", ()),
+            kwargs.pop("channel_map_file", None),
+        )
+        click.get_current_context().meta[_MAP_KEY] = cmap
+        return fn(*args, **kwargs)
+
+    options = [
+        click.option(
+            "--channel",
+            "channel_specs",
+            multiple=True,
+            metavar="NAME=ROLE[:UNIT][@POINT]",
+            help="What a channel of the file is, when the file does not say (or says it "
+            "wrongly): 'Kanal 3=force:N', '1=force' (by position), 'm_1=acceleration:g@2+Z', "
+            "'Trigger=ignore'. Roles: force, acceleration, velocity, displacement, pressure, "
+            "voltage, ignore. Repeatable.",
+        ),
+        click.option(
+            "--sensitivity",
+            "sensitivity_specs",
+            multiple=True,
+            metavar="NAME=VALUE UNIT",
+            help="Sensitivity of a channel stored in volts: 'Kanal 3=2.25 mV/N', "
+            "'2=100 mV/g' (or a calibration factor such as '444.8 N/V'). Repeatable.",
+        ),
+        click.option(
+            "--channel-map",
+            "channel_map_file",
+            type=click.Path(dir_okay=False, path_type=Path),
+            help="TOML or JSON file of channel roles, units and sensitivities "
+            "(docs/file-formats.md); --channel and --sensitivity override it.",
+        ),
+    ]
+    out: Any = wrapper
+    for opt in reversed(options):
+        out = opt(out)
+    return out
+
+
+def channel_map() -> Any:
+    """The :class:`~tyredamp.io.ChannelMap` of the running command (empty when none given)."""
+    from ..io.channelmap import ChannelMap
+
+    ctx = click.get_current_context(silent=True)
+    cmap = None if ctx is None else ctx.meta.get(_MAP_KEY)
+    return cmap if cmap is not None else ChannelMap()
+
+
+def echo_read_notes(obj: Any) -> None:
+    """Print what a reader assumed or left out (``meta["read_notes"]``), one ``note:`` line each."""
+    meta = getattr(obj, "meta", {}) or {}
+    for note in meta.get("read_notes", []) or []:
+        click.echo(f"note: {note}")
+    if meta.get("text_encoding"):
+        click.echo(f"note: header text read as {meta['text_encoding']} (not UTF-8)")

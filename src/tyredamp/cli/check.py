@@ -16,6 +16,7 @@ from ..exceptions import InputError
 from ..io import read, read_frf
 from ..signal.checks import CheckResult
 from ..studies.radial import check_linearity, check_quality, check_reciprocity
+from ._common import channel_map, channel_map_options, echo_read_notes
 
 __all__ = ["check_group"]
 
@@ -138,6 +139,7 @@ def reciprocity_cmd(
 )
 @_band
 @_strict
+@channel_map_options
 @click.pass_context
 def quality_cmd(
     ctx: click.Context,
@@ -156,7 +158,13 @@ def quality_cmd(
     Example:
       tyredamp check quality tyre_test.uff --coherence-min 0.9 --band 30 200 --strict
     """
-    obj = read(data_file)
+    obj = read(data_file, channel_map())
+    echo_read_notes(obj)
+    if getattr(obj, "output_only", False):
+        click.echo(
+            "note: output-only data (no force channel): clipping and dead channels are "
+            "checked; coherence and passivity need a force (name it with --channel NAME=force:N)"
+        )
     result = check_quality(
         obj,
         coherence_min=coherence_min,

@@ -15,7 +15,7 @@ from ..signal.checks import dependent_forces
 from ..signal.estimators import ESTIMATORS
 from ..studies.radial import frf_from_time
 from ..timedata import TimeData
-from ._common import out_file_option
+from ._common import channel_map, channel_map_options, echo_read_notes, out_file_option
 
 __all__ = ["frf_command", "frf_summary", "samples"]
 
@@ -138,6 +138,7 @@ def _refuse_dependent_forces(td: TimeData) -> None:
     type=click.Choice(FORMATS),
     help="Output format; default from the extension (.uff/.unv: binary UFF 58b).",
 )
+@channel_map_options
 def frf_command(
     time_file: Path,
     out: Path,
@@ -153,7 +154,9 @@ def frf_command(
     """Estimate FRFs (with coherence) from TIME_FILE and write them to --out.
 
     TIME_FILE holds force and response channels (UFF 58 function type 1,
-    tyredamp CSV/NPZ, NI TDMS or ASAM MDF4). The FRF kind follows the
+    tyredamp or plain CSV, NPZ, NI TDMS, ASAM MDF4, LabVIEW LVM, MATLAB
+    .mat, WAV); channels the file does not name are given with --channel,
+    --sensitivity or --channel-map. The FRF kind follows the
     response channels (acceleration gives accelerance). Without a stated
     period or record length the excitation is detected from the force
     (periodic: cyclic averaging over whole periods after any start
@@ -166,10 +169,14 @@ def frf_command(
       tyredamp frf tyre_test.uff --out tyre_frf.uff --estimator H1
       tyredamp frf rig.npz --out frf.csv --reference 1+Z --method welch --segment 4096
       tyredamp frf daq.unv --out frf.nc --period 0.5s --settle 2s
+      tyredamp frf impact.tdms -o frf.uff --channel F=force:N --channel 2=acceleration:m/s^2
     """
     check_output_file(out, [time_file])
     out_format = format_of(out, fmt)
-    td = read_timedata(time_file)
+    td = read_timedata(time_file, channel_map())
+    echo_read_notes(td)
+    td.require_force("an FRF", time_file)
+    td.require_response("an FRF", time_file)
     if not references and len(td.force_indices) > 1:
         _refuse_dependent_forces(td)
     frf = frf_from_time(

@@ -17,7 +17,7 @@ from ..modal.model import ModalModel
 from ..modal.quality import rejected_summary
 from ..studies.radial import label_wave_numbers, modes_from_frf
 from ..studies.verdicts import modal_verdicts
-from ._common import out_file_option
+from ._common import channel_map, channel_map_options, out_file_option
 
 __all__ = ["modal_command", "modes_table"]
 
@@ -175,6 +175,7 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
     help="UFF geometry (nodes 15/2411, trace lines 82, systems 18/2420): every channel's node "
     "must be in it; points on a circle get their angles from it (ring views).",
 )
+@channel_map_options
 def modal_command(
     frf_file: Path,
     out: Path,
@@ -206,7 +207,7 @@ def modal_command(
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
     check_output_file(out, [frf_file])
-    frf = read_frf(frf_file)
+    frf = read_frf(frf_file, channel_map=channel_map())
     if geometry_file is not None:
         frf = _with_geometry(frf, geometry_file)
     try:

@@ -1,4 +1,4 @@
-"""Measurement file formats: UFF 58/58b (pyuff), CSV and NPZ for FRFs and time data.
+"""Measurement file formats: FRFs and time data in UFF, CSV, NPZ, TDMS, MDF4, LVM, MAT, WAV.
 
 One module per format, one line per format in :data:`FILE_FORMATS`: its name,
 the extensions it owns and its reader and writer (the module is imported when
@@ -14,7 +14,15 @@ extension                 format
 ``.nc``                   FRF as netCDF with named dimensions (:mod:`.netcdf`, xarray)
 ``.tdms``                 NI TDMS time data, read only (:mod:`.tdms`, npTDMS)
 ``.mf4``, ``.mdf``        ASAM MDF time data, read only (:mod:`.mdf`, asammdf)
+``.csv``, ``.txt``        also plain CSV exports with a header row (:mod:`.csv_format`)
+``.lvm``                  LabVIEW Measurement time data, read only (:mod:`.lvm`)
+``.mat``                  MATLAB v5 time data or FRFs, read only (:mod:`.mat`, scipy)
+``.wav``                  WAV recordings, read only (:mod:`.wav`, scipy)
 ========================  ============================================
+
+Channels whose role, unit or sensitivity the file does not state are named
+with a :class:`ChannelMap` (``channel_map=``; on the command line
+``--channel``, ``--sensitivity``, ``--channel-map``).
 
 Writing takes ``format`` (``"uff58b"`` binary UFF, ``"uff58"`` ASCII UFF,
 ``"csv"``, ``"npz"``) or, by default, the extension (``.uff``/``.unv``: binary
@@ -37,10 +45,13 @@ from typing import Any, Literal
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, FRFKind
 from ..timedata import TimeData
+from .channelmap import ChannelMap, ChannelSpec
 
 __all__ = [
     "FILE_FORMATS",
     "FORMATS",
+    "ChannelMap",
+    "ChannelSpec",
     "FileFormat",
     "format_of",
     "read",
@@ -51,7 +62,7 @@ __all__ = [
     "write_timedata",
 ]
 
-Format = Literal["uff58b", "uff58", "csv", "npz", "netcdf", "tdms", "mdf"]
+Format = Literal["uff58b", "uff58", "csv", "npz", "netcdf", "tdms", "mdf", "lvm", "mat", "wav"]
 
 
 @dataclass(frozen=True)
@@ -82,6 +93,9 @@ class FileFormat:
         What the format can hold: FRFs and time data, or only one of them
         (reading the other kind from it, or writing it, is an error before
         any I/O).
+    maps : bool
+        The reader takes ``channel_map=`` (a :class:`ChannelMap`): formats
+        whose channels may lack roles, units or sensitivities.
     """
 
     name: str
@@ -92,23 +106,36 @@ class FileFormat:
     selects: bool = False
     write_options: Mapping[str, Any] = field(default_factory=dict)
     holds: Literal["any", "frf", "timedata"] = "any"
+    maps: bool = False
 
     def _function(self, name: str) -> Callable[..., Any]:
         fn: Callable[..., Any] = getattr(importlib.import_module(self.module, __name__), name)
         return fn
 
     def read(
-        self, path: str | os.PathLike[str], what: str | None = None, kind: FRFKind | None = None
+        self,
+        path: str | os.PathLike[str],
+        what: str | None = None,
+        kind: FRFKind | None = None,
+        channel_map: ChannelMap | None = None,
     ) -> FRF | TimeData:
         """Read ``path`` in this format (``what``/``kind`` only where the reader selects)."""
         if what is not None and self.holds not in ("any", what):
             held = "an FRF" if self.holds == "frf" else "time data"
             asked = "an FRF" if what == "frf" else "time data"
             raise FileFormatError(f"{path}: {self.name} files hold {held}, not {asked}")
+        kw: dict[str, Any] = {}
+        if channel_map:
+            if not self.maps:
+                raise InputError(
+                    f"{path}: {self.name} files state what each channel is; a channel map "
+                    "(--channel, --sensitivity, --channel-map) is not used for them"
+                )
+            kw["channel_map"] = channel_map
         if self.selects:
-            obj: FRF | TimeData = self._function(self.reader)(path, what, kind)
+            obj: FRF | TimeData = self._function(self.reader)(path, what, kind, **kw)
         else:
-            obj = self._function(self.reader)(path)
+            obj = self._function(self.reader)(path, **kw)
         return obj
 
     def write(self, obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
@@ -136,13 +163,19 @@ FILE_FORMATS: dict[str, FileFormat] = {
             "write_uff",
             True,
             {"binary": True},
+            maps=True,
         ),
-        FileFormat("uff58", (), ".uff", "read_uff", "write_uff", True, {"binary": False}),
-        FileFormat("csv", (".csv",), ".csv_format", "read_csv", "write_csv"),
+        FileFormat(
+            "uff58", (), ".uff", "read_uff", "write_uff", True, {"binary": False}, maps=True
+        ),
+        FileFormat("csv", (".csv", ".txt"), ".csv_format", "read_csv", "write_csv", maps=True),
         FileFormat("npz", (".npz",), ".npz", "read_npz", "write_npz"),
         FileFormat("netcdf", (".nc",), ".netcdf", "read_netcdf", "write_netcdf", holds="frf"),
-        FileFormat("tdms", (".tdms",), ".tdms", "read_tdms", None, holds="timedata"),
-        FileFormat("mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None, holds="timedata"),
+        FileFormat("tdms", (".tdms",), ".tdms", "read_tdms", None, holds="timedata", maps=True),
+        FileFormat("mdf", (".mf4", ".mdf"), ".mdf", "read_mdf", None, holds="timedata", maps=True),
+        FileFormat("lvm", (".lvm",), ".lvm", "read_lvm", None, holds="timedata", maps=True),
+        FileFormat("mat", (".mat",), ".mat", "read_mat", None, True, maps=True),
+        FileFormat("wav", (".wav",), ".wav", "read_wav", None, holds="timedata", maps=True),
     )
 }
 #: The built-in formats that can be written (choices of the command line).
@@ -181,40 +214,62 @@ def _read_format(path: str | os.PathLike[str]) -> FileFormat:
     return FILE_FORMATS[exts[ext]]
 
 
-def read(path: str | os.PathLike[str]) -> FRF | TimeData:
-    """Read whatever the file holds: an FRF or time data."""
-    return _read_format(path).read(path)
+def read(path: str | os.PathLike[str], channel_map: ChannelMap | None = None) -> FRF | TimeData:
+    """Read whatever the file holds: an FRF or time data.
+
+    Parameters
+    ----------
+    path : path-like
+    channel_map : ChannelMap, optional
+        Roles, units and sensitivities of channels the file does not state
+        (:mod:`tyredamp.io.channelmap`); for the acquisition formats (UFF time
+        data, plain CSV, TDMS, MDF, LVM, MAT, WAV).
+    """
+    return _read_format(path).read(path, channel_map=channel_map)
 
 
-def read_frf(path: str | os.PathLike[str], kind: FRFKind | None = None) -> FRF:
-    """Read an FRF matrix from a UFF, CSV, NPZ or netCDF file.
+def read_frf(
+    path: str | os.PathLike[str],
+    kind: FRFKind | None = None,
+    channel_map: ChannelMap | None = None,
+) -> FRF:
+    """Read an FRF matrix from a UFF, CSV, NPZ, netCDF or MATLAB file.
 
     Parameters
     ----------
     path : path-like
     kind : {"receptance", "mobility", "accelerance"}, optional
-        UFF only: the FRF kind when the file does not state it.
+        UFF and MATLAB: the FRF kind when the file does not state it.
+    channel_map : ChannelMap, optional
+        MATLAB and plain CSV: what an FRF relates (``"Hf_chan_2=acceleration:g/N"``).
 
     Raises
     ------
     FileFormatError
         The file is empty, truncated, corrupt, or holds time data.
     """
-    obj = _read_format(path).read(path, "frf", kind)
+    obj = _read_format(path).read(path, "frf", kind, channel_map)
     if not isinstance(obj, FRF):
         raise FileFormatError(f"{path}: holds time data, not an FRF")
     return obj
 
 
-def read_timedata(path: str | os.PathLike[str]) -> TimeData:
-    """Read time data from a UFF, CSV, NPZ, TDMS or MDF file.
+def read_timedata(path: str | os.PathLike[str], channel_map: ChannelMap | None = None) -> TimeData:
+    """Read time data from a UFF, CSV, NPZ, TDMS, MDF, LVM, MATLAB or WAV file.
+
+    Parameters
+    ----------
+    path : path-like
+    channel_map : ChannelMap, optional
+        Roles, units and sensitivities of channels the file does not state
+        (:mod:`tyredamp.io.channelmap`).
 
     Raises
     ------
     FileFormatError
         The file is empty, truncated, corrupt, or holds an FRF.
     """
-    obj = _read_format(path).read(path, "timedata")
+    obj = _read_format(path).read(path, "timedata", channel_map=channel_map)
     if not isinstance(obj, TimeData):
         raise FileFormatError(f"{path}: holds an FRF, not time data")
     return obj

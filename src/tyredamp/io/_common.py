@@ -148,6 +148,8 @@ def wrap_errors(path: Path) -> Iterator[None]:
     except FileFormatError:
         raise
     except TyredampError as exc:
+        if str(exc).startswith(f"{path}:"):
+            raise  # names the file already (a channel map that disagrees with it)
         raise FileFormatError(f"{path}: {exc}") from exc
     except (TypeError, ValueError, KeyError, IndexError, AttributeError, OverflowError) as exc:
         # content of the wrong type somewhere in the file: still the file's fault

@@ -1,5 +1,8 @@
 """CSV files: a documented text layout for FRFs and time data.
 
+Other CSV exports (a header row of column names and a time or frequency
+column) are read by :mod:`.plain_csv`.
+
 The file is UTF-8 text. It starts with comment lines (``#``) holding the
 metadata, then one line of column names, then one line per frequency line or
 sample, values separated by commas. Numbers are written with 17 significant
@@ -72,6 +75,8 @@ from ._common import (
     meta_to_json,
     wrap_errors,
 )
+from ._text import decode_text
+from .channelmap import ChannelMap
 
 __all__ = ["read_csv", "write_csv"]
 
@@ -132,11 +137,7 @@ def write_csv(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         np.savetxt(fh, table, fmt=_FMT, delimiter=",")
 
 
-def _parse(p: Path) -> tuple[dict[str, list[str]], list[str], np.ndarray]:
-    try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise FileFormatError(f"{p}: not a UTF-8 text file ({exc.reason})") from None
+def _parse(p: Path, text: str) -> tuple[dict[str, list[str]], list[str], np.ndarray]:
     lines = text.splitlines()
     if not lines or lines[0].strip() != _MAGIC:
         raise FileFormatError(
@@ -176,8 +177,12 @@ def _one(fields: dict[str, list[str]], key: str, p: Path) -> str:
     return vals[0]
 
 
-def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
-    """Read a CSV file in the layout of the module docstring.
+def read_csv(path: str | os.PathLike[str], channel_map: ChannelMap | None = None) -> FRF | TimeData:
+    """Read a CSV file: the layout of the module docstring, or a plain export.
+
+    A file that does not start with ``# tyredamp csv 1`` is read as a plain
+    CSV export with a header row (:mod:`.plain_csv`), where ``channel_map``
+    names the channels' roles, units and sensitivities.
 
     Raises
     ------
@@ -186,7 +191,16 @@ def read_csv(path: str | os.PathLike[str]) -> FRF | TimeData:
         numbers, NaN, a frequency axis that is not increasing, ...
     """
     p = check_input_file(path)
-    fields, cols, table = _parse(p)
+    text, encoding = decode_text(p.read_bytes())
+    if text.lstrip("\ufeff").split("\n", 1)[0].strip() != _MAGIC:
+        from .plain_csv import read_plain_csv
+
+        return read_plain_csv(p, text, encoding, None, channel_map)
+    if channel_map:
+        raise InputError(
+            f"{p}: a tyredamp CSV file states what each channel is; a channel map is not used"
+        )
+    fields, cols, table = _parse(p, text)
     typ = _one(fields, "type", p)
     meta = meta_from_json(fields["meta"][0], f"{p}: meta") if "meta" in fields else {}
     with wrap_errors(p):

@@ -1,11 +1,12 @@
 """NI TDMS time data (LabVIEW) through npTDMS.
 
-All channels of one group (the first group holding data, or ``group``) are
-read. The sample rate comes from the channels' ``wf_increment`` property
-(seconds per sample, the LabVIEW waveform attribute; all equal), the units
+All channels of one group (the first group holding data, the group of the
+channels a channel map names, or ``group``) are read. The sample rate comes
+from the channels' ``wf_increment`` property (seconds per sample, the
+LabVIEW waveform attribute; all equal), the units
 from ``unit_string`` (read by :mod:`.units` and converted to SI), the channel
-names from the TDMS channel names. The force is the channel with a force
-unit (or the one named ``"force"`` in ``quantities``); see :mod:`._channels`.
+names from the TDMS channel names. Channels without a ``unit_string`` (or
+with one that is wrong) are named with a channel map; see :mod:`._channels`.
 Channels are numbered as nodes 1..n in file order (direction +Z), named as
 in the file.
 """
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -21,6 +23,7 @@ from ..exceptions import FileFormatError
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
+from .channelmap import ChannelMap
 
 __all__ = ["read_tdms"]
 
@@ -29,6 +32,7 @@ def read_tdms(
     path: str | os.PathLike[str],
     quantities: Mapping[str, str] | None = None,
     group: str | None = None,
+    channel_map: ChannelMap | None = None,
 ) -> TimeData:
     """Read time data from a TDMS file.
 
@@ -39,7 +43,15 @@ def read_tdms(
         ``"force"``, ``"displacement"``, ``"velocity"`` or ``"acceleration"``
         for channels whose ``unit_string`` is blank (or to override it).
     group : str, optional
-        Group to read; default the first group with channels.
+        Group to read; default the group of the channels the channel map
+        names, else the first group with channels.
+    channel_map : ChannelMap, optional
+        Roles, units and sensitivities of channels (:mod:`.channelmap`);
+        channels answer to their name and to ``group/name``.
+
+    Channels without ``wf_increment`` (files written by scripts) take the
+    interval of an evenly spaced time channel of the group (``Time``, ``t``
+    ...), which is then not read as data.
 
     Raises
     ------
@@ -65,22 +77,73 @@ def read_tdms(
             raise FileFormatError(f"{p}: no group {group!r} with channels")
     if not groups:
         raise FileFormatError(f"{p}: no channels in the TDMS file")
-    chans = groups[0].channels()
+    if group is None and channel_map:
+        keys = set(channel_map.keys)
+        named = [
+            g
+            for g in groups
+            if any(c.name in keys or f"{g.name}/{c.name}" in keys for c in g.channels())
+        ]
+        if named:
+            groups = named
+    chans = list(groups[0].channels())
+    time_dt, time_name = _time_channel(chans)
+    notes = []
+    if time_name is not None:
+        notes.append(f"sample interval from the time channel {time_name!r}")
+        chans = [c for c in chans if c.name != time_name]
     names, units, arrays, steps = [], [], [], []
     for c in chans:
         props = c.properties
-        if "wf_increment" not in props:
+        if "wf_increment" not in props and time_dt is None:
             raise FileFormatError(
-                f"{p}: channel {c.name!r} has no wf_increment (sample interval) property"
+                f"{p}: channel {c.name!r} has no wf_increment (sample interval) property and "
+                "the group has no evenly spaced time channel (Time, t, ...)"
             )
         try:
-            steps.append(float(props["wf_increment"]))
+            steps.append(float(props.get("wf_increment", time_dt)))
             arrays.append(np.asarray(c[:], dtype=float))
         except (TypeError, ValueError) as exc:
             raise FileFormatError(f"{p}: channel {c.name!r}: {exc}") from None
         names.append(str(c.name))
         units.append(str(props.get("unit_string", "") or ""))
+    if not names:
+        raise FileFormatError(f"{p}: no data channels besides the time channel")
     dt = steps[0]
     if not np.isfinite(dt) or dt <= 0 or any(abs(s - dt) > 1e-12 * dt for s in steps):
         raise FileFormatError(f"{p}: channels have different or invalid sample intervals {steps}")
-    return timedata_from_channels(p, names, units, arrays, snap_rate(1.0 / dt), quantities)
+    gname = str(groups[0].name)
+    return timedata_from_channels(
+        p,
+        names,
+        units,
+        arrays,
+        snap_rate(1.0 / dt),
+        quantities,
+        channel_map,
+        aliases=[[f"{gname}/{n}"] for n in names],
+        notes=notes,
+    )
+
+
+_TIME_NAMES = {"time", "t", "zeit", "time_s", "timestamp", "x_value", "relative time"}
+
+
+def _time_channel(chans: list[Any]) -> tuple[float | None, str | None]:
+    """``(interval in s, name)`` of an evenly spaced time channel when a channel lacks
+    ``wf_increment`` (files written by scripts rather than LabVIEW waveforms)."""
+    if all("wf_increment" in c.properties for c in chans):
+        return None, None
+    for c in chans:
+        if str(c.name).strip().lower() not in _TIME_NAMES:
+            continue
+        try:
+            t = np.asarray(c[:], dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if t.size < 2:
+            continue
+        dt = float(t[-1] - t[0]) / (t.size - 1)
+        if dt > 0 and np.max(np.abs(np.diff(t) - dt)) <= 1e-6 * dt:
+            return dt, str(c.name)
+    return None, None

@@ -80,32 +80,65 @@ from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
 from ._atomic import atomic_path
+from ._channels import timedata_from_channels
 from ._common import check_input_file, meta_to_json, wrap_errors
-from ._uff_meta import meta_record, read_meta_record
+from ._uff_load import VARIANCE_ID, load_sets, not_frf_or_time, read_coherence, read_variance
+from ._uff_meta import meta_record
+from .channelmap import ChannelMap
 from .units import frf_units, quantity_units
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
 
 _MARK = "tyredamp1"
-#: ID line 1 of the extra data sets (function type 0) holding FRF.variance.
-_VARIANCE_ID = "tyredamp FRF variance"
-_SDT = {"displacement": 8, "velocity": 11, "acceleration": 12, "force": 13}
-_SDT_QUANTITY = {8: "displacement", 11: "velocity", 12: "acceleration", 13: "force", 9: "force"}
+# specific data types (record 8): 15 pressure, 21 sound pressure, 1 general (volts)
+_SDT = {
+    "displacement": 8,
+    "velocity": 11,
+    "acceleration": 12,
+    "force": 13,
+    "pressure": 15,
+    "voltage": 1,
+}
+_SDT_QUANTITY = {
+    8: "displacement",
+    11: "velocity",
+    12: "acceleration",
+    13: "force",
+    9: "force",
+    15: "pressure",
+    21: "pressure",
+}
 _KIND_QUANTITY = {
     "receptance": "displacement",
     "mobility": "velocity",
     "accelerance": "acceleration",
 }
 _QUANTITY_KIND: dict[str, FRFKind] = {v: k for k, v in _KIND_QUANTITY.items()}  # type: ignore[misc]
-_SI_LABEL = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2", "force": "N"}
+_SI_LABEL = {
+    "displacement": "m",
+    "velocity": "m/s",
+    "acceleration": "m/s^2",
+    "force": "N",
+    "pressure": "Pa",
+    "voltage": "V",
+}
 _AXIS_LABEL = {
     "displacement": "Displacement",
     "velocity": "Velocity",
     "acceleration": "Acceleration",
     "force": "Force",
+    "pressure": "Pressure",
+    "voltage": "Voltage",
 }
 # (length exponent, force exponent) of each quantity in SI
-_EXP = {"displacement": (1, 0), "velocity": (1, 0), "acceleration": (1, 0), "force": (0, 1)}
+_EXP = {
+    "displacement": (1, 0),
+    "velocity": (1, 0),
+    "acceleration": (1, 0),
+    "force": (0, 1),
+    "pressure": (-2, 1),
+    "voltage": (0, 0),
+}
 
 
 # ------------------------------------------------------------------ writing
@@ -349,7 +382,7 @@ def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
         for o, co in enumerate(obj.outputs):
             for i, ci in enumerate(obj.inputs):
                 fid += 1
-                d = _base_set(binary, q, _VARIANCE_ID, id2, id3)
+                d = _base_set(binary, q, VARIANCE_ID, id2, id3)
                 d.update(
                     func_type=0,
                     func_id=fid,
@@ -418,61 +451,6 @@ def _abscissa(
 
 
 # ------------------------------------------------------------------ reading
-def _markers(raw: bytes) -> int:
-    """Count data-set delimiters as pyuff does (``    -1`` ending a record)."""
-    count, i, n = 0, -1, len(raw)
-    while True:
-        i = raw.find(b"    -1", i + 1)
-        if i == -1:
-            return count
-        if (
-            i + 6 == n
-            or (i + 6 < n and raw[i + 6] in (10, 13))
-            or (i + 80 < n and raw[i + 6 : i + 80] == b" " * 74)
-        ):
-            count += 1
-
-
-def _load_sets(p: Path) -> list[dict[str, Any]]:
-    raw = p.read_bytes()
-    n_marks = _markers(raw)
-    if n_marks == 0:
-        raise FileFormatError(f"{p}: no UFF data set found (no '    -1' delimiters)")
-    if n_marks % 2:
-        raise FileFormatError(
-            f"{p}: truncated UFF file: the last data set has no closing '    -1' delimiter"
-        )
-    try:
-        uff = pyuff.UFF(str(p))
-        types = list(uff.get_set_types())
-        idx = [k for k, t in enumerate(types) if t == 58]
-        if not idx:
-            raise FileFormatError(
-                f"{p}: no data set 58 (function at nodal DOF); found types {sorted(set(types))}"
-            )
-        sets = uff.read_sets(idx)
-        record = read_meta_record(p, uff, types)
-    except FileFormatError:
-        raise
-    except Exception as exc:  # pyuff raises bare Exception, and others on garbage
-        raise FileFormatError(f"{p}: corrupt UFF data set 58 ({exc})") from None
-    if isinstance(sets, dict):
-        sets = [sets]
-    for k, s in zip(idx, sets, strict=True):
-        data = s.get("data")
-        if data is None or "num_pts" not in s or len(data) != int(s["num_pts"]):
-            got = "no" if data is None else len(data)
-            raise FileFormatError(
-                f"{p}: data set #{k + 1} is corrupt or truncated: header says "
-                f"{s.get('num_pts')} values, found {got}"
-            )
-        s["_index"] = k + 1
-    if record is not None:
-        for s in sets:
-            s["_meta"] = record
-    return sets
-
-
 def _tokens(s: dict[str, Any]) -> dict[str, str] | None:
     parts = str(s.get("id2", "")).split()
     if not parts or parts[0] != _MARK:
@@ -537,19 +515,19 @@ def _quantity(s: dict[str, Any], where: str) -> tuple[str | None, float]:
 def uff_contents(path: str | os.PathLike[str]) -> str:
     """``"frf"`` or ``"timedata"``: what the UFF file at ``path`` holds."""
     p = check_input_file(path)
-    types = {int(s.get("func_type", -1)) for s in _load_sets(p)}
+    types = {int(s.get("func_type", -1)) for s in load_sets(p)}
     if 4 in types:
         return "frf"
     if 1 in types:
         return "timedata"
-    raise FileFormatError(
-        f"{p}: no FRF (function type 4) or time response (type 1) in data sets 58; found "
-        f"function types {sorted(types)}"
-    )
+    raise not_frf_or_time(p, types)
 
 
 def read_uff(
-    path: str | os.PathLike[str], what: str | None = None, kind: FRFKind | None = None
+    path: str | os.PathLike[str],
+    what: str | None = None,
+    kind: FRFKind | None = None,
+    channel_map: ChannelMap | None = None,
 ) -> FRF | TimeData:
     """Read FRFs (function type 4) or time data (type 1) from a UFF file.
 
@@ -561,6 +539,10 @@ def read_uff(
     kind : {"receptance", "mobility", "accelerance"}, optional
         FRF kind when the file does not tell it (ordinate data type and units
         label missing); when given it overrides the file.
+    channel_map : ChannelMap, optional
+        Time data: roles, units and sensitivities of channels (keys: the
+        response entity name, ID line 1 or the point label such as ``1+Z``,
+        or the position 1, 2 ...).
 
     Raises
     ------
@@ -569,20 +551,30 @@ def read_uff(
         of different length or sampling; unknown units.
     """
     p = check_input_file(path)
-    sets = _load_sets(p)
+    sets = load_sets(p)
+    types = {int(s.get("func_type", -1)) for s in sets}
     if what is None:
-        types = {int(s.get("func_type", -1)) for s in sets}
         what = "frf" if 4 in types else "timedata" if 1 in types else ""
         if not what:
-            raise FileFormatError(
-                f"{p}: no FRF (function type 4) or time response (type 1) in data sets 58; "
-                f"found function types {sorted(types)}"
-            )
+            raise not_frf_or_time(p, types)
+    if what == "frf" and 4 not in types:
+        if 1 in types:
+            raise FileFormatError(f"{p}: holds time data (function type 1), not an FRF")
+        raise not_frf_or_time(p, types)
+    if what == "timedata" and 1 not in types:
+        if 4 in types:
+            raise FileFormatError(f"{p}: holds FRFs (function type 4), not time data")
+        raise not_frf_or_time(p, types)
+    if what == "frf" and channel_map:
+        raise InputError(
+            f"{p}: holds FRFs, whose units and channels the file states; a channel map "
+            "(--channel, --sensitivity) applies to time data"
+        )
     with wrap_errors(p):
         if what == "frf":
             return _read_frf(p, sets, kind)
         if what == "timedata":
-            return _read_time(p, sets)
+            return _read_time(p, sets, channel_map)
     raise InputError(f"what: expected 'frf' or 'timedata', got {what!r}")
 
 
@@ -681,8 +673,12 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
                     f"{ko[1]} and reference node {ki[0]} dir {ki[1]}"
                 )
             h[a, b] = cells[(ko, ki)]
-    coh = _read_coherence(sets, list(outs), list(ins), n)
-    var = _read_variance(sets, list(outs), list(ins), n, h.shape)
+    coh = read_coherence(sets, list(outs), list(ins), n)
+    var = read_variance(sets, list(outs), list(ins), n, h.shape)
+    meta = _meta(first, tok)
+    encodings = sorted({s["_encoding"] for s in frf_sets if "_encoding" in s})
+    if encodings:
+        meta["text_encoding"] = ", ".join(encodings)
     return FRF(
         x,
         h,
@@ -690,50 +686,24 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
         outputs=list(outs.values()),
         inputs=list(ins.values()),
         coherence=coh,
-        meta=_meta(first, tok),
+        meta=meta,
         variance=var,
     )
 
 
-def _read_coherence(
-    sets: list[dict[str, Any]], outs: list[tuple[int, int]], ins: list[tuple[int, int]], n: int
-) -> np.ndarray | None:
-    want = ins[0] if len(ins) == 1 else (0, 0)
-    found: dict[tuple[int, int], np.ndarray] = {}
-    for s in sets:
-        if int(s["func_type"]) not in (6, 26) or len(s["data"]) != n:
-            continue
-        if (int(s["ref_node"]), int(s["ref_dir"])) != want:
-            continue
-        found[(int(s["rsp_node"]), int(s["rsp_dir"]))] = np.real(np.asarray(s["data"]))
-    if not all(o in found for o in outs):
-        return None
-    return np.array([found[o] for o in outs])
+def _uff_name(s: dict[str, Any], tok: dict[str, str] | None) -> str:
+    """The name a data set's channel goes by: tyredamp's, the response entity, ID line 1."""
+    name = str(_extras(s.get("id4")).get("name", "")) if tok else ""
+    for key in ("rsp_ent_name", "id1"):
+        if not name:
+            v = str(s.get(key, "") or "").strip()
+            name = "" if v.upper() in ("", "NONE") else v
+    return name
 
 
-def _read_variance(
-    sets: list[dict[str, Any]],
-    outs: list[tuple[int, int]],
-    ins: list[tuple[int, int]],
-    n: int,
-    shape: tuple[int, ...],
-) -> np.ndarray | None:
-    """FRF.variance from tyredamp's extra type-0 data sets, when every pair has one."""
-    found: dict[tuple[tuple[int, int], tuple[int, int]], np.ndarray] = {}
-    for s in sets:
-        if int(s["func_type"]) != 0 or str(s.get("id1", "")).strip() != _VARIANCE_ID:
-            continue
-        if len(s["data"]) != n:
-            continue
-        ko = (int(s["rsp_node"]), int(s["rsp_dir"]))
-        ki = (int(s["ref_node"]), int(s["ref_dir"]))
-        found[(ko, ki)] = np.real(np.asarray(s["data"], dtype=float))
-    if not all((o, i) in found for o in outs for i in ins):
-        return None
-    return np.array([[found[(o, i)] for i in ins] for o in outs]).reshape(shape)
-
-
-def _read_time(p: Path, sets: list[dict[str, Any]]) -> TimeData:
+def _read_time(
+    p: Path, sets: list[dict[str, Any]], channel_map: ChannelMap | None = None
+) -> TimeData:
     ts = [s for s in sets if int(s["func_type"]) == 1]
     if not ts:
         raise FileFormatError(f"{p}: no time response (function type 1) data set")
@@ -752,19 +722,50 @@ def _read_time(p: Path, sets: list[dict[str, Any]]) -> TimeData:
                 f"{where}: {len(s['data'])} samples, but data set #{first['_index']} has {n}; "
                 "channels must have equal length"
             )
+    meta = _meta(first, tok)
+    encodings = sorted({s["_encoding"] for s in ts if "_encoding" in s})
+    if encodings:
+        meta["text_encoding"] = ", ".join(encodings)
+    fs = _sample_rate(p, ts, tok)
+    if channel_map:
+        points, names, aliases, labels, hints = [], [], [], [], []
+        for k, s in enumerate(ts):
+            ch = _channel(s["rsp_node"], s["rsp_dir"], {}, f"{p}: data set #{s['_index']}")
+            name = _uff_name(s, tok) or f"{ch.label}"
+            names.append(name)
+            aliases.append([ch.label, str(s.get("id1", "")).strip(), f"#{k + 1}"])
+            points.append((ch.node, ch.direction))
+            labels.append(str(s.get("ordinate_axis_units_lab", "") or ""))
+            hints.append(_SDT_QUANTITY.get(int(s.get("ordinate_spec_data_type", 0) or 0)))
+        return timedata_from_channels(
+            p,
+            names,
+            labels,
+            [np.asarray(s["data"], dtype=float) for s in ts],
+            fs,
+            None,
+            channel_map,
+            aliases=aliases,
+            hints=hints,
+            points=points,
+            meta=meta,
+        )
+    for s in ts:
+        where = f"{p}: data set #{s['_index']}"
         q, scale = _quantity(s, where)
         if q is None:
+            name = _uff_name(s, tok) or str(s["rsp_node"])
             raise FileFormatError(
                 f"{where}: cannot tell the measured quantity (ordinate data type "
-                f"{s.get('ordinate_spec_data_type')}, no units label)"
+                f"{s.get('ordinate_spec_data_type')}, no units label); name it, for example "
+                f"--channel '{name}=acceleration:m/s^2'"
             )
         rows.append(np.asarray(s["data"], dtype=float) * scale)
         chans.append(
             _channel(s["rsp_node"], s["rsp_dir"], _extras(s.get("id4")) if tok else {}, where)
         )
         quants.append(q)
-    fs = _sample_rate(p, ts, tok)
-    return TimeData(np.array(rows), fs, chans, quants, meta=_meta(first, tok))
+    return TimeData(np.array(rows), fs, chans, quants, meta=meta)
 
 
 def _sample_rate(p: Path, ts: list[dict[str, Any]], tok: dict[str, str] | None) -> float:

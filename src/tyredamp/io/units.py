@@ -33,14 +33,23 @@ from typing import Literal
 
 from ..exceptions import InputError
 
-__all__ = ["QUANTITY_DIMENSIONS", "Unit", "frf_units", "parse_unit", "quantity_units"]
+__all__ = [
+    "MOTION",
+    "QUANTITY_DIMENSIONS",
+    "Sensitivity",
+    "Unit",
+    "frf_units",
+    "parse_sensitivity",
+    "parse_unit",
+    "quantity_units",
+]
 
 _G = 9.80665
 _LBF = 4.4482216152605
 _IN = 0.0254
 
-# symbol -> (factor to SI, (length, time, force) exponents)
-_ATOMS: dict[str, tuple[float, tuple[int, int, int]]] = {
+# symbol -> (factor to SI, (length, time, force[, voltage]) exponents)
+_ATOMS3: dict[str, tuple[float, tuple[int, ...]]] = {
     "m": (1.0, (1, 0, 0)),
     "mm": (1e-3, (1, 0, 0)),
     "cm": (1e-2, (1, 0, 0)),
@@ -71,6 +80,37 @@ _ATOMS: dict[str, tuple[float, tuple[int, int, int]]] = {
     "g": (_G, (1, -2, 0)),
     "gn": (_G, (1, -2, 0)),
     "ips": (_IN, (1, -1, 0)),
+    "newtons": (1.0, (0, 0, 1)),
+    "lbs": (_LBF, (0, 0, 1)),
+    # pressure: N/m^2
+    "Pa": (1.0, (-2, 0, 1)),
+    "hPa": (1e2, (-2, 0, 1)),
+    "kPa": (1e3, (-2, 0, 1)),
+    "MPa": (1e6, (-2, 0, 1)),
+    "mPa": (1e-3, (-2, 0, 1)),
+    "uPa": (1e-6, (-2, 0, 1)),
+    "µPa": (1e-6, (-2, 0, 1)),
+    "μPa": (1e-6, (-2, 0, 1)),
+    "pascal": (1.0, (-2, 0, 1)),
+    "bar": (1e5, (-2, 0, 1)),
+    "mbar": (1e2, (-2, 0, 1)),
+    "psi": (_LBF / _IN**2, (-2, 0, 1)),
+    # frequency (PSD labels such as g^2/Hz)
+    "Hz": (1.0, (0, -1, 0)),
+    "kHz": (1e3, (0, -1, 0)),
+    # electric potential: its own dimension (a sensor's output before its sensitivity)
+    "V": (1.0, (0, 0, 0, 1)),
+    "mV": (1e-3, (0, 0, 0, 1)),
+    "uV": (1e-6, (0, 0, 0, 1)),
+    "µV": (1e-6, (0, 0, 0, 1)),
+    "μV": (1e-6, (0, 0, 0, 1)),
+    "kV": (1e3, (0, 0, 0, 1)),
+    "volt": (1.0, (0, 0, 0, 1)),
+    "volts": (1.0, (0, 0, 0, 1)),
+}
+Dims = tuple[int, int, int, int]
+_ATOMS: dict[str, tuple[float, Dims]] = {
+    k: (f, (d[0], d[1], d[2], d[3] if len(d) > 3 else 0)) for k, (f, d) in _ATOMS3.items()
 }
 # case-insensitive look-up where unambiguous (MN, mN clash: neither taken from upper case)
 _LOWER: dict[str, str] = {}
@@ -79,6 +119,12 @@ for _k in _ATOMS:
 _LOWER["n"] = "N"
 _LOWER["kn"] = "kN"
 _LOWER.pop("mn", None)
+for _k in ("pa", "kpa", "hpa", "mpa", "upa", "µpa", "μpa", "v", "mv", "uv", "µv", "μv", "kv"):
+    _LOWER.pop(_k, None)
+# upper/lower case as DAQ software writes them (mPa/MPa and mV/MV clash: only the
+# spellings below are taken case-insensitively)
+_LOWER.update({"pa": "Pa", "kpa": "kPa", "hpa": "hPa", "v": "V", "mv": "mV", "uv": "uV"})
+_LOWER.update({"µv": "µV", "μv": "μV", "hz": "Hz", "khz": "kHz"})
 
 _SUPERSCRIPT = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻⁺", "0123456789-+")
 _TOKEN = re.compile(
@@ -86,14 +132,17 @@ _TOKEN = re.compile(
     r"|(?P<word>[A-Za-zµμ]+)|(?P<op>\*\*|[/*·×^().\-+]))"
 )
 
-Quantity = Literal["displacement", "velocity", "acceleration", "force"]
-#: (length, time, force) exponents of each measured quantity.
+Quantity = Literal["displacement", "velocity", "acceleration", "force", "pressure", "voltage"]
+#: (length, time, force) exponents of each measured quantity (no voltage).
 QUANTITY_DIMENSIONS: dict[str, tuple[int, int, int]] = {
     "displacement": (1, 0, 0),
     "velocity": (1, -1, 0),
     "acceleration": (1, -2, 0),
     "force": (0, 0, 1),
+    "pressure": (-2, 0, 1),
 }
+#: The quantities that make an FRF (a motion per force).
+MOTION = ("displacement", "velocity", "acceleration")
 _KIND = {"displacement": "receptance", "velocity": "mobility", "acceleration": "accelerance"}
 
 
@@ -106,18 +155,27 @@ class Unit:
     label : str
         The label as written.
     factor : float
-        Multiply values in this unit by ``factor`` to get SI (m, s, N).
+        Multiply values in this unit by ``factor`` to get SI (m, s, N, V).
     dimensions : (int, int, int)
         Exponents of length, time and force.
+    voltage : int
+        Exponent of the volt (1 for ``V``, ``mV``; -1 for a calibration in
+        ``N/V``; 0 for physical units).
     """
 
     label: str
     factor: float
     dimensions: tuple[int, int, int]
+    voltage: int = 0
 
     @property
     def quantity(self) -> str | None:
-        """``"displacement"``, ``"velocity"``, ``"acceleration"``, ``"force"`` or None."""
+        """``"displacement"``, ``"velocity"``, ``"acceleration"``, ``"force"``,
+        ``"pressure"``, ``"voltage"`` or None."""
+        if self.voltage == 1 and self.dimensions == (0, 0, 0):
+            return "voltage"
+        if self.voltage != 0:
+            return None
         for q, d in QUANTITY_DIMENSIONS.items():
             if d == self.dimensions:
                 return q
@@ -126,9 +184,11 @@ class Unit:
     @property
     def frf_kind(self) -> str | None:
         """``"receptance"``, ``"mobility"`` or ``"accelerance"`` for a response per force."""
+        if self.voltage != 0:
+            return None
         le, t, f = self.dimensions
-        for q, d in QUANTITY_DIMENSIONS.items():
-            if q != "force" and d == (le, t, f + 1):
+        for q in MOTION:
+            if QUANTITY_DIMENSIONS[q] == (le, t, f + 1):
                 return _KIND[q]
         return None
 
@@ -161,7 +221,7 @@ class _Parser:
         self.i += 1
         return tok
 
-    def parse(self) -> tuple[float, tuple[int, int, int]]:
+    def parse(self) -> tuple[float, Dims]:
         if not self.toks:
             raise self.error("empty")
         out = self.product()
@@ -169,7 +229,7 @@ class _Parser:
             raise self.error(f"unexpected {self.peek()[1]!r}")  # type: ignore[index]
         return out
 
-    def product(self) -> tuple[float, tuple[int, int, int]]:
+    def product(self) -> tuple[float, Dims]:
         fac, dim = self.power()
         while True:
             tok = self.peek()
@@ -186,7 +246,7 @@ class _Parser:
             fac = fac * f2 if sign > 0 else fac / f2
             dim = tuple(a + sign * b for a, b in zip(dim, d2, strict=True))  # type: ignore[assignment]
 
-    def power(self) -> tuple[float, tuple[int, int, int]]:
+    def power(self) -> tuple[float, Dims]:
         fac, dim, is_number = self.atom()
         n = None if is_number else self.exponent()
         if n is None:
@@ -230,12 +290,12 @@ class _Parser:
         except ValueError:
             raise self.error(f"exponent {text!r} is not an integer") from None
 
-    def atom(self) -> tuple[float, tuple[int, int, int], bool]:
+    def atom(self) -> tuple[float, Dims, bool]:
         if self.peek() is None:
             raise self.error("ends where a unit was expected")
         kind, text = self.take()
         if kind == "num":
-            return float(text), (0, 0, 0), True
+            return float(text), (0, 0, 0, 0), True
         if text == "(":
             fac, dim = self.product()
             tok = self.peek()
@@ -247,7 +307,7 @@ class _Parser:
             return (*self.word(text), False)
         raise self.error(f"unexpected {text!r}")
 
-    def word(self, text: str) -> tuple[float, tuple[int, int, int]]:
+    def word(self, text: str) -> tuple[float, Dims]:
         key = text if text in _ATOMS else _LOWER.get(text.lower())
         if key is None and text.lower() == "ms":
             # metre times second ("ms^-2", "ms-1"), never the millisecond: the
@@ -256,8 +316,8 @@ class _Parser:
             return _ATOMS["m"]
         if key is None:
             raise self.error(
-                f"unknown unit {text!r}; known: m, mm, cm, um, nm, in, ft, mil, s, N, kN, lbf, "
-                "kgf, kg, g (gravity), ips"
+                f"unknown unit {text!r}; known: m, mm, cm, um, nm, in, ft, mil, s, Hz, N, kN, "
+                "lbf, kgf, kg, g (gravity), ips, Pa, kPa, bar, mbar, psi, V, mV"
             )
         return _ATOMS[key]
 
@@ -267,7 +327,7 @@ def parse_unit(label: str) -> Unit:
     if not isinstance(label, str):
         raise InputError(f"units label: expected text, got {type(label).__name__}")
     fac, dim = _Parser(label).parse()
-    return Unit(label=label, factor=float(fac), dimensions=dim)
+    return Unit(label=label, factor=float(fac), dimensions=dim[:3], voltage=dim[3])
 
 
 def _blank(label: object) -> bool:
@@ -289,10 +349,77 @@ def quantity_units(label: object) -> tuple[str, float] | None:
     q = u.quantity
     if q is None:
         raise InputError(
-            f"units label {label!r}: dimension m^{u.dimensions[0]} s^{u.dimensions[1]} "
-            f"N^{u.dimensions[2]} is not a displacement, velocity, acceleration or force"
+            f"units label {label!r}: dimension {_dimension(u)} is not a displacement, "
+            "velocity, acceleration, force, pressure or voltage"
         )
     return q, u.factor
+
+
+def _dimension(u: Unit) -> str:
+    """``m^1 s^-2 N^0`` (and ``V^n`` when the volt appears) of a parsed label."""
+    le, t, f = u.dimensions
+    return f"m^{le} s^{t} N^{f}" + (f" V^{u.voltage}" if u.voltage else "")
+
+
+@dataclass(frozen=True)
+class Sensitivity:
+    """A transducer sensitivity such as ``2.25 mV/N`` or ``100 mV/g``.
+
+    Attributes
+    ----------
+    text : str
+        As written.
+    quantity : str
+        The physical quantity the transducer measures (``"force"``,
+        ``"acceleration"``, ``"pressure"`` ...).
+    volts_per_si : float
+        Volts per SI unit of ``quantity`` (V/N, V/(m/s^2), V/Pa ...): a
+        channel in volts divided by it is in SI units.
+    """
+
+    text: str
+    quantity: str
+    volts_per_si: float
+
+
+def parse_sensitivity(text: object) -> Sensitivity:
+    """Read a sensitivity: a number and a units label of volts per physical unit.
+
+    ``"2.25 mV/N"``, ``"100 mV/g"``, ``"10.2mV/(m/s^2)"``, ``"50 mV/Pa"``;
+    the inverse, a calibration factor in physical units per volt (``"444.8
+    N/V"``, ``"9.81 m/s^2/V"``), is accepted too.
+
+    Raises
+    ------
+    InputError
+        Not a positive number followed by such a label.
+    """
+    raw = str(text).strip()
+    m = re.match(r"^([-+]?\d+(?:[.,]\d*)?(?:[eE][-+]?\d+)?)\s*(.*)$", raw)
+    if m is None or not m.group(2).strip():
+        raise InputError(
+            f"sensitivity {raw!r}: expected a number and a unit, such as '2.25 mV/N', "
+            "'100 mV/g' or '444.8 N/V'"
+        )
+    value = float(m.group(1).replace(",", "."))
+    if not value > 0 or value == float("inf"):
+        raise InputError(f"sensitivity {raw!r}: expected a positive number")
+    u = parse_unit(m.group(2).strip())
+    phys = Unit(u.label, 1.0, u.dimensions, 0)
+    if u.voltage == 1:
+        phys = Unit(u.label, 1.0, tuple(-d for d in u.dimensions), 0)  # type: ignore[arg-type]
+        per = value * u.factor
+    elif u.voltage == -1:
+        per = 1.0 / (value * u.factor)
+    else:
+        per = 0.0
+    q = phys.quantity
+    if per == 0.0 or q is None or q == "voltage":
+        raise InputError(
+            f"sensitivity {raw!r}: expected volts per physical unit (mV/N, mV/g, V/Pa) or "
+            f"physical unit per volt (N/V), got dimension {_dimension(u)}"
+        )
+    return Sensitivity(raw, q, per)
 
 
 def frf_units(label: object, denominator: object = None) -> tuple[str | None, float] | None:
@@ -322,16 +449,16 @@ def frf_units(label: object, denominator: object = None) -> tuple[str | None, fl
         return None, 1.0 / d_factor
     u = parse_unit(str(label))
     dims = (u.dimensions[0], u.dimensions[1], u.dimensions[2] - d_force)
-    ratio = Unit(u.label, u.factor / d_factor, dims)
+    ratio = Unit(u.label, u.factor / d_factor, dims, u.voltage)
     kind = ratio.frf_kind
     if kind is not None:
         return kind, ratio.factor
     q = ratio.quantity
-    if q is not None and q != "force" and d_force == 0:
+    if q in MOTION and d_force == 0:
         return _KIND[q], ratio.factor  # response only: per newton
     raise InputError(
         f"units label {label!r}"
         + (f" over {denominator!r}" if d_force else "")
-        + f": dimension m^{dims[0]} s^{dims[1]} N^{dims[2]} is not a displacement, velocity "
+        + f": dimension {_dimension(ratio)} is not a displacement, velocity "
         "or acceleration per force"
     )
