@@ -352,7 +352,7 @@ MALFORMED: dict[str, tuple[str, bytes | None, str]] = {
     "truncated-npz": ("x.npz", b"", "x.npz"),  # filled from the library (half the bytes)
     "garbage-uff": ("x.uff", b"    -1\n    58\nthis is not a data set\n    -1\n", "x.uff"),
     "garbage-csv": ("x.csv", b"a,b,c\n1,2\nx,y,z\n", "x.csv"),
-    "unknown-ext": ("x.txt", b"1 2 3\n", "extension"),
+    "unknown-ext": ("x.xyz", b"1 2 3\n", "extension"),
     "binary-uff": ("x.uff", bytes(range(256)) * 8, "x.uff"),
 }
 

@@ -117,7 +117,7 @@ def test_timedata() -> None:
     with pytest.raises(ShapeError, match="channels"):
         TimeData(np.zeros((3, 100)), 1000.0, [1, 2], ["force"] * 3)
     with pytest.raises(InputError, match="quantities"):
-        TimeData(np.zeros((1, 100)), 1000.0, [1], ["pressure"])
+        TimeData(np.zeros((1, 100)), 1000.0, [1], ["strain"])
     with pytest.raises(InputError, match="finite"):
         TimeData(np.full((1, 10), np.nan), 1000.0, [1], ["force"])
     with pytest.raises(InputError, match="sample_rate"):

@@ -251,6 +251,14 @@ def goodness(
     )
 
 
+def _unresolved(poles: NDArray[np.complex128], f: NDArray[np.float64]) -> list[str]:
+    """The statements of the modes whose damping the lines ``f`` (Hz) do not resolve."""
+    df = float(f[1] - f[0]) if f.size > 1 else 0.0
+    fn, zeta = pole_quantities(poles)
+    out = (unresolved_damping(float(a), float(b), df) for a, b in zip(fn, zeta, strict=True))
+    return [w for w in out if w]
+
+
 @dataclasses.dataclass(frozen=True)
 class ModelContext:
     """What :func:`to_model` needs besides the fit."""
@@ -442,13 +450,7 @@ def to_model(
         n_evaluations=res.n_iter,
         thresholds=thr,
     )
-    df = float(pr.frequency[1] - pr.frequency[0]) if n_f > 1 else 0.0
-    fn_z = pole_quantities(poles)
-    unresolved = [
-        w
-        for w in (unresolved_damping(float(a), float(b), df) for a, b in zip(*fn_z, strict=True))
-        if w
-    ]
+    unresolved = _unresolved(poles, pr.frequency)
     meta = {
         "band_hz": [pr.band[0], pr.band[1]],
         "frf_kind": data.kind,
