@@ -12,7 +12,7 @@ tested virtual tyre itself. Beside the result it keeps the tyre's own values:
   Kelvin-Voigt time constant);
 * the rigid-ring parameters computed by the same formulas from the exact
   modes of each tested tyre (``TyreTruth.modal_model("visible")``): the
-  issue's reference for the rigid ring;
+  reference for the rigid ring;
 * the same ring fit on those exact modes (``exact_ring``): the virtual tyre
   is a finite-difference ring (64 nodes), whose discretisation lowers the
   higher modes a little; the continuous ring model reads that as about 3 %
