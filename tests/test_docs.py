@@ -172,3 +172,12 @@ def test_examples_run(page: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatc
             _run_python(block, namespace)
         else:
             _run_bash(block, tmp_path)
+
+
+def test_every_page_in_the_site_navigation() -> None:
+    """Each page under docs/ is reachable from the site's navigation (mkdocs.yml)."""
+    config = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    listed = set(re.findall(r":\s*([\w./-]+\.md)\s*$", config, flags=re.MULTILINE))
+    pages = {str(p.relative_to(ROOT / "docs")) for p in (ROOT / "docs").rglob("*.md")}
+    assert pages - listed == set(), "pages missing from nav in mkdocs.yml"
+    assert listed - pages == set(), "nav entries without a page"
