@@ -1,7 +1,7 @@
 """The ``>>>`` examples in the docstrings of the key public functions run.
 
 These are the examples the API reference shows (``identify_modes``, ``FRF``,
-``read_frf``, ``estimate_frf``, the virtual tyre); each module's examples run
+``read_frf``, the virtual tyre); each module's examples run
 under :mod:`doctest` as written.
 """
 
@@ -17,7 +17,6 @@ MODULES = [
     "tyredamp.frf",
     "tyredamp.io",
     "tyredamp.modal.identify",
-    "tyredamp.signal.estimators",
     "tyredamp.virtual",
 ]
 

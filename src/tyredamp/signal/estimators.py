@@ -580,20 +580,6 @@ def estimate_frf(
     InputError
         Unknown options, no force channel, a force channel of zeros, mixed
         response quantities, fully correlated inputs (MIMO), too few samples.
-
-    Examples
-    --------
-    The virtual modal test of the truck tyre: a periodic chirp, 8 periods;
-    the periodicity is detected, so the FRF is averaged over whole periods.
-
-    >>> from tyredamp.signal import estimate_frf
-    >>> from tyredamp.virtual import run_modal_test
-    >>> test = run_modal_test(seed=1)
-    >>> frf = estimate_frf(test.data)
-    >>> frf.H.shape, frf.kind
-    ((16, 1, 801), 'accelerance')
-    >>> frf.meta["method"], frf.meta["n_averages"]
-    ('cyclic', 8)
     """
     ref_idx, out_idx, kind = _resolve_io(timedata, estimator, reference, outputs)
     choice = choose_method(

@@ -219,7 +219,7 @@ def _compare(value: float, stderr: float, true: float | None) -> dict[str, Any]:
 
 
 def tyre_model_section(study: TyreModelStudy) -> dict[str, Any]:
-    """The ``radial.tyre_model`` section of results.json (layout in the README).
+    """The ``radial.tyre_model`` section of results.json (layout in docs/reference/results-json.md).
 
     ``status`` ``"ok"`` or ``"failed"`` (then ``error`` says why and the
     other lists are empty); the ring's parameters with standard errors,
