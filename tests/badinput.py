@@ -1,7 +1,7 @@
 """The bad-input corpus generator (issue 15): inputs, hostile files and a runner.
 
 Every case runs ``tyredamp.cli.main`` in-process in its own directory and checks
-the promises of the README's "Safety" section:
+the promises of docs/reference/safety.md:
 
 * the exit code;
 * stderr is exactly one line ``tyredamp: error: ...`` naming the problem (no

@@ -1012,12 +1012,12 @@ def test_interrupted(
     assert snapshot(tmp_path) == before
 
 
-def test_readme_states_the_exit_codes() -> None:
-    """The README's exit-code table is the one cli.main uses."""
+def test_docs_state_the_exit_codes() -> None:
+    """The exit-code table of docs/reference/safety.md is the one cli.main uses."""
     from tyredamp.cli import _common as c
 
-    text = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
-    section = text.split("## Safety", 1)[1].split("\n## ", 1)[0]
+    page = Path(__file__).parents[1] / "docs" / "reference" / "safety.md"
+    section = page.read_text(encoding="utf-8")
     codes = {
         int(x)
         for row in section.splitlines()

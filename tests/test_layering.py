@@ -1,4 +1,4 @@
-"""The package's import layering (README "Package layout", /shared/DESIGN.md).
+"""The package's import layering (developer guide "Package layout", /shared/DESIGN.md).
 
 The import graph is parsed from the source with :mod:`ast` (nothing is
 imported), counting every import: at module level, inside functions (lazy)

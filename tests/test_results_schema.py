@@ -1,4 +1,4 @@
-"""results.json against its schema (``tyredamp/schemas/results.schema.json``) and the README."""
+"""results.json against its schema (``tyredamp/schemas/results.schema.json``) and its docs page."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from tyredamp.studies.document import build_results
 
 from .test_studies_demo import quick_demo
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+REFERENCE = Path(__file__).resolve().parents[1] / "docs" / "reference" / "results-json.md"
 
 
 @pytest.fixture(scope="module")
@@ -108,11 +108,12 @@ def _schema_keys(node: Any, out: set[str]) -> None:
                 _schema_keys(node[key], out)
 
 
-def test_readme_documents_every_key() -> None:
-    """Every property name of the schema appears in a code span of the README's results.json
-    section (as ``radial.rmsd_real`` or in a list such as ``{"passed", ...}``)."""
-    text = README.read_text(encoding="utf-8")
-    start = text.index("## results.json")
+def test_reference_documents_every_key() -> None:
+    """Every property name of the schema appears in a code span of the results.json section
+    of docs/reference/results-json.md (as ``radial.rmsd_real`` or in a list such as
+    ``{"passed", ...}``)."""
+    text = REFERENCE.read_text(encoding="utf-8")
+    start = text.index("# results.json")
     end = text.find("\n## ", start + 5)
     section = text[start : end if end > 0 else None]
     keys: set[str] = set()
@@ -121,4 +122,4 @@ def test_readme_documents_every_key() -> None:
     for span in re.findall(r"`([^`]+)`", section):
         words |= set(re.findall(r"\w+", span))
     missing = sorted(keys - words)
-    assert not missing, f"README results.json section does not mention {missing}"
+    assert not missing, f"the results.json reference does not mention {missing}"

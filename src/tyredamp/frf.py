@@ -126,6 +126,23 @@ class FRF:
         Variance ``E|H_est - H|^2`` of each estimate of ``H`` (real, >= 0, in
         the unit of ``H`` squared), as estimated from the measurement noise
         by the FRF estimator; the weights of a maximum-likelihood fit.
+
+    Examples
+    --------
+    The receptance of a mass of 1 kg on a spring of 1000 N/m with 1 % damping:
+
+    >>> import numpy as np
+    >>> from tyredamp import FRF
+    >>> f = np.linspace(0.0, 20.0, 401)  # Hz
+    >>> w = 2 * np.pi * f
+    >>> frf = FRF(f, 1 / (1000 - w**2 + 2j * 0.01 * np.sqrt(1000) * w), kind="receptance")
+    >>> frf.H.shape  # always (outputs, inputs, lines)
+    (1, 1, 401)
+    >>> frf.band(4.0, 6.0).n_freq  # a new FRF of the lines from 4 to 6 Hz
+    41
+    >>> acc = frf.accelerance()  # -omega^2 H, in (m/s^2)/N
+    >>> acc.kind
+    'accelerance'
     """
 
     frequency: NDArray[np.float64]

@@ -195,7 +195,7 @@ def main(argv: list[str] | None = None) -> None:
     """Entry point of the console script.
 
     Every failure ends in one line ``tyredamp: error: ...`` on stderr and an exit
-    code (see the README's "Safety" section): 2 bad input or output path, 3 a
+    code (see docs/reference/safety.md): 2 bad input or output path, 3 a
     numerical method failed on valid input, 70 an internal error (a bug),
     130/143 interrupted by SIGINT/SIGTERM (temporaries removed). ``--debug``
     prints the traceback as well; the exit code stays the same. Warnings are

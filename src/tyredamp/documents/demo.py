@@ -2,7 +2,7 @@
 
 The document is assembled from a demo run by
 :func:`tyredamp.studies.document.build_results`; its layout is described key
-by key in the README ("results.json") and formally in
+by key in ``docs/reference/results-json.md`` and formally in
 ``tyredamp/schemas/results.schema.json`` (JSON Schema draft 2020-12), which
 :func:`validate_results` applies. jsonschema is needed only for validation (a
 test dependency), never to write the file.

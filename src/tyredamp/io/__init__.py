@@ -247,6 +247,23 @@ def read_frf(
     ------
     FileFormatError
         The file is empty, truncated, corrupt, or holds time data.
+
+    Examples
+    --------
+    Write an FRF of the virtual tyre as UFF 58b and read it back:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from tyredamp.io import read_frf, write_frf
+    >>> from tyredamp.virtual import RingTyre
+    >>> frf = RingTyre().truth().frf(np.arange(0.0, 200.25, 0.25))  # exact accelerances
+    >>> path = write_frf(frf, Path(tempfile.mkdtemp()) / "tyre_frf.uff")
+    >>> back = read_frf(path)
+    >>> back.H.shape, back.kind
+    ((16, 1, 801), 'accelerance')
+    >>> bool(np.allclose(back.H, frf.H, rtol=1e-6))  # 58b keeps double precision
+    True
     """
     obj = _read_format(path).read(path, "frf", kind, channel_map)
     if not isinstance(obj, FRF):

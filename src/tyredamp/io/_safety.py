@@ -1,6 +1,6 @@
 """The one output-safety layer: every file and directory tyredamp writes goes through here.
 
-The promises (stated in the README's "Safety" section and tested by
+The promises (stated in docs/reference/safety.md and tested by
 ``tests/test_badinput.py``):
 
 * An output appears whole or not at all: it is written to a temporary beside

@@ -45,7 +45,7 @@ same quantities come from a Householder QR of ``[Phi | E]`` with ``Q^T``
 applied to ``Y`` (:func:`~tyredamp.modal._linalg._vp_solve`). The refinement
 is a bounded Levenberg-Marquardt iteration on these normal equations.
 
-Memory (issue 15): the Gram blocks, the QR and the fitted FRFs are summed
+Memory: the Gram blocks, the QR and the fitted FRFs are summed
 over blocks of lines of a fixed size (:func:`~tyredamp.modal._basis.blocks`,
 about 1 MB); the basis of all lines, the weighted data ``Y`` and the
 residual are never held, so a fit costs the data plus a constant. The data
@@ -58,9 +58,9 @@ MB), the fitter forms them and the line factors once and keeps them (no
 more than the one block of a blocked fit), a basis is formed once per
 evaluation for both routes, and an ill-conditioned basis is orthogonalised
 by CholeskyQR2 (:func:`~tyredamp.modal._linalg._cholqr2`) rather than by
-Householder. A fitter keeps nothing between calls (issue 14: a stateless
-fitter): what one call can reuse from another is passed explicitly -- the
-fixed part of ``fit_added`` (:meth:`ModalFitter.fixed_part`, an immutable
+Householder. A fitter keeps nothing between calls: what one call can reuse
+from another is passed explicitly -- the fixed part of ``fit_added``
+(:meth:`ModalFitter.fixed_part`, an immutable
 :class:`~tyredamp.modal._added.FixedPart` formed once per fixed mode set) and
 a previous intermediate fit at rest (``fit(..., start=res)``).
 

@@ -262,6 +262,26 @@ def identify_modes(
     ModalIdentification
         Raises :class:`InputError` on bad arguments, a band without lines, a
         non-uniform axis, more modes than the data support, or no mode found.
+
+    Examples
+    --------
+    The virtual modal test of the truck tyre (40 dB noise, 8 averages): the
+    complex modes found, against the tyre's exact ones.
+
+    >>> import numpy as np
+    >>> from tyredamp.modal import identify_modes
+    >>> from tyredamp.signal import estimate_frf
+    >>> from tyredamp.virtual import run_modal_test
+    >>> test = run_modal_test(seed=1)
+    >>> result = identify_modes(estimate_frf(test.data), band=(30, 200))
+    >>> modes = result.models["complex"]
+    >>> modes.n_modes
+    6
+    >>> exact = [row["frequency_hz"] for row in test.truth.table("visible")]
+    >>> bool(np.allclose(modes.frequency_hz, exact, atol=0.1))  # Hz
+    True
+    >>> modes.quality.passed  # the residual is within the noise
+    True
     """
 
     def run(v: ArrayLike | None, note: str = "") -> ModalIdentification:

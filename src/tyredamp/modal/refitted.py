@@ -8,8 +8,9 @@ move without the mode. Beside a much stronger mode they do: a second pole
 half a half-width from a strong one shifts the strong one's estimate, and
 removing the second with the strong pole held at the shifted value leaves the
 strong mode's misfit in the residual, a rise many times the threshold (150
-systems of the issue-16 corpus at 40 dB, seeds 200-799: ``T`` 129 held against
-41 refitted, threshold 59; 3700 held against 350 refitted). The likelihood
+systems of the corpus of ``benchmarks/modal_statistics.py`` at 40 dB, seeds
+200-799: ``T`` 129 held against 41 refitted, threshold 59; 3700 held against
+350 refitted). The likelihood
 ratio of Wilks' theorem, the test's own law, maximises both models (Seber & Wild 1989, *Nonlinear
 Regression*, sec. 5.9.1).
 

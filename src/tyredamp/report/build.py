@@ -684,7 +684,8 @@ def build_demo_report(
     rep.heading(SECTIONS[5])
     listed = doc.get("files", []) if files is None else files
     rep.paragraph(
-        "Written beside this report: results.json (all numbers; schema in the README), the "
+        "Written beside this report: results.json (all numbers; described in the "
+        "documentation's results.json reference), the "
         "figures as PNG, the generated data as UFF 58 (binary 58b: time data function type 1, "
         "FRFs type 4), the modes and damping JSON files, which the other commands read "
         "(tyredamp damping, tyredamp report), and the tyre model of all pressures "

@@ -2,7 +2,7 @@
 
 :func:`save_demo` writes what :func:`tyredamp.studies.demo.run_demo`
 returned: ``report.html`` (self-contained), ``results.json`` (schema
-``tyredamp/schemas/results.schema.json``, described in the README), the
+``tyredamp/schemas/results.schema.json``, described in ``docs/reference/results-json.md``), the
 figures as PNG, the generated data as UFF 58 (binary 58b), the modes and
 damping JSON files of the main pressure and the tyre model of all pressures
 (``tyre_model/``: ``ring.json``, ``rigid_ring.json``, ``.tir`` subsets; none

@@ -1,4 +1,4 @@
-"""The "Tyre model" section of the demo report (issue 18).
+"""The "Tyre model" section of the demo report.
 
 The updated flexible ring and the rigid ring beside the virtual tyre's own
 values, the parameters the modes cannot identify, the figure of identified
@@ -107,7 +107,7 @@ def tyre_model_report(
     rep.heading(heading)
     ps = ", ".join(f"{p:g}" for p in tm["pressures_bar"])
     rep.paragraph(
-        f"The modes identified at {ps} bar go to tyredamp tyre-model (issue 18): every mode "
+        f"The modes identified at {ps} bar go to tyredamp tyre-model: every mode "
         "is labelled with its wave number, the flexible ring (EI, tension law T0 = p b R + T_c, "
         "foundation k_r, k_t linear in pressure, mass per length, dampers c_r, c_t and band "
         "loss) is fitted to all pressures at once with the modal standard errors as weights, "

@@ -9,7 +9,7 @@ virtual tyre's values), and the lateral
 study (ranking per condition and overall, corner frequencies, the vehicle
 model and the time test). SI units unless a key says otherwise (``_hz``,
 ``_bar``, ``_kmh``, ``_pct``); non-finite numbers are written as ``null``.
-The layout is described key by key in the README ("results.json") and
+The layout is described key by key in ``docs/reference/results-json.md`` and
 formally in ``tyredamp/schemas/results.schema.json`` (JSON Schema draft
 2020-12), which :func:`tyredamp.documents.demo.validate_results` applies;
 reading and writing the file is :mod:`tyredamp.documents.demo`.
@@ -459,7 +459,9 @@ def _lateral_section(result: DemoResult, fnd: DemoFindings) -> dict[str, Any]:
 
 
 def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dict[str, Any]:
-    """The results.json document of a demo run (strict JSON types; layout in the README).
+    """The results.json document of a demo run (strict JSON types).
+
+    Its layout, key by key, is in ``docs/reference/results-json.md``.
 
     Parameters
     ----------

@@ -12,7 +12,7 @@ tested virtual tyre itself. Beside the result it keeps the tyre's own values:
   Kelvin-Voigt time constant);
 * the rigid-ring parameters computed by the same formulas from the exact
   modes of each tested tyre (``TyreTruth.modal_model("visible")``): the
-  issue's reference for the rigid ring;
+  reference for the rigid ring;
 * the same ring fit on those exact modes (``exact_ring``): the virtual tyre
   is a finite-difference ring (64 nodes), whose discretisation lowers the
   higher modes a little; the continuous ring model reads that as about 3 %
@@ -219,7 +219,7 @@ def _compare(value: float, stderr: float, true: float | None) -> dict[str, Any]:
 
 
 def tyre_model_section(study: TyreModelStudy) -> dict[str, Any]:
-    """The ``radial.tyre_model`` section of results.json (layout in the README).
+    """The ``radial.tyre_model`` section of results.json (layout in docs/reference/results-json.md).
 
     ``status`` ``"ok"`` or ``"failed"`` (then ``error`` says why and the
     other lists are empty); the ring's parameters with standard errors,

@@ -1,4 +1,4 @@
-"""From the modal test to the tyre models that vehicle simulation uses (issue 18).
+"""From the modal test to the tyre models that vehicle simulation uses.
 
 * :mod:`.wavenumber` -- circumferential wave number of every identified mode
   from its shape (spatial Fourier fit over the measured angles), cos/sin
