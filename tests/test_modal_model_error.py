@@ -54,7 +54,9 @@ def _beam(k: int) -> FRF:
 
 
 @pytest.mark.skipif(not BEAM.is_dir(), reason="the real-data gallery is not beside the repository")
-@pytest.mark.parametrize(("k", "band"), [(1, None), (1, (5.0, 995.0)), (1, (3.0, 980.0))])
+@pytest.mark.parametrize(
+    ("k", "band"), [(1, None), (1, (5.0, 995.0)), (1, (20.0, 980.0)), (2, (1.0, 990.0))]
+)
 def test_measured_beam_modes_are_not_split(k: int, band: tuple[float, float] | None) -> None:
     r = identify_modes(_beam(k), band=band, model="complex")
     fn = r.models["complex"].frequency_hz

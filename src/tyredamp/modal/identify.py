@@ -93,7 +93,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._blas import blas_threads as blas_limit
 from .._validate import as_finite
 from ..exceptions import InputError
-from ..frf import FRF
+from ..frf import FRF, FRFKind
 from ..mechanics.modal_sum import kind_factor, pole_from_frequency_damping
 from .compress import _compress, combine_outputs
 from .estimators import PoleEstimator
@@ -327,46 +327,33 @@ def _with_model_error(
     if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
         return first
     problem = build_problem(frf, first.band_hz, variance=variance)
-    floor = noise_floor(
-        frf,
-        problem,
-        None if variance is None else np.asarray(variance, float),
-        q.noise_rms_per_output,
-    )
     lines = problem.lines
     H = np.asarray(frf.H)[:, :, lines]
+    m1 = first.models[kind]
+    floor = noise_floor(frf, problem, _model_band(m1, problem, frf.kind) - H)
     V = floor.variance[:, :, lines]
 
     def eps_of(res: ModalIdentification) -> float:
         m = res.models[kind]
-        Hm = m.receptance(problem.frequency) * kind_factor(2 * np.pi * problem.frequency, frf.kind)
         dof = m.quality.dof if m.quality is not None else 0
-        return relative_model_error(H, Hm, V, dof)
+        return relative_model_error(H, _model_band(m, problem, frf.kind), V, dof)
 
-    eps = eps_of(first)
-    # each pass decides the modes against the eps of the previous fit; the result is
-    # the pass whose fit gives back the eps it was decided with (the fixed point of
-    # eq. (2)), or the closest to it when the passes do not settle
-    best: tuple[float, float, ModalIdentification] | None = None
+    eps, res = eps_of(first), first
+    # each pass decides the modes against the eps of the fits before it; a pass
+    # whose fit gives back a larger eps (it merged a split, so the model error
+    # shows) is followed by one against that eps: the sequence only rises, to the
+    # largest eps the fits of the data give back (the fixed point of eq. (2) that
+    # holds the fewest modes; a split fit reproduces its own smaller eps too)
     for _ in range(MODEL_ERROR_PASSES):
         if eps <= 0.0:
-            break
+            return first
         v = floor.variance.copy()
         v[:, :, lines] += eps**2 * np.abs(H) ** 2
         res = run(v, f"{floor.what} plus a model error of {eps:.2%} of the response")
-        if not _fewer_modes(res.models[kind].poles, first.models[kind].poles):
-            break  # a larger noise may only take modes away: an inconsistent pass is not used
         again = eps_of(res)
-        gap = abs(math.log(again / eps)) if again > 0.0 else math.inf
-        if best is None or gap < best[0]:
-            best = (gap, eps, res)
-        if gap < math.log1p(EPS_TOLERANCE):
+        if again <= eps * (1.0 + EPS_TOLERANCE):
             break
         eps = again
-    if best is None or best[2].models[kind].n_modes == first.models[kind].n_modes:
-        return first  # the same modes: the first fit's own values and errors stand
-    _, eps, res = best
-
     res.warnings.append(
         f"the fit left structure beyond {floor.what} that no modal sum explains (leakage, "
         "a window, a non-linearity, ...): modes were decided and their uncertainty stated "
@@ -447,9 +434,11 @@ def _identify(
     )
 
 
-def _fewer_modes(poles: NDArray[np.complex128], before: NDArray[np.complex128]) -> bool:
-    """Whether every pole of ``poles`` is one of ``before`` (within 1 % of ``|p|``)."""
-    return all(before.size and np.min(np.abs(before - p)) <= 0.01 * abs(p) for p in poles)
+def _model_band(m: ModalModel, problem: FitProblem, kind: FRFKind) -> NDArray[np.complex128]:
+    """The model ``m`` synthesised on the band's lines of ``problem``, in the FRF ``kind``."""
+    f = problem.frequency
+    h: NDArray[np.complex128] = m.receptance(f) * kind_factor(2 * np.pi * f, kind)
+    return h
 
 
 def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:

@@ -25,28 +25,27 @@ whose level follows the signal)::
 
     Var H_jkf = V_jkf + eps^2 |H_jkf|^2                                 (1)
 
-``V`` the noise the first fit used (estimated from its residual and the
-second differences of adjacent lines), ``H`` the data (its magnitude, not the
-model's, so that a mode the model lacks is not taken for noise-free lines),
-``H^`` the fitted model and ``eps`` the relative model error, estimated from the data by the moment
+``V`` a robust noise level per output (:func:`noise_floor`: the larger of the
+median of the first fit's residual and the noise floor from second differences
+of adjacent lines; a median leaves out the few lines near sharp peaks where the
+model errs), ``H`` the data (its magnitude, not the model's, so that a mode
+the model lacks is not taken for lines without error), ``H^`` the fitted model
+and ``eps`` the relative model error, estimated from the data by the moment
 equation of the weighted cost (its expectation for a correct noise model)::
 
     sum 2 |H^ - H|^2 / (V + eps^2 |H|^2) = n_obs - n_par                (2)
 
 whose left side falls monotonically in ``eps``: (2) has one root when the
 cost at ``eps = 0`` exceeds ``n_obs - n_par`` (the fit leaves structure) and
-none otherwise (``eps = 0``: the measured noise explains the residual, and
-nothing changes). The identification is repeated with (1) as the per-line
-variance (the mode count decided again against it, standard errors widened by
-it) and ``eps`` re-estimated from the new fit, until it changes by less than
-:data:`EPS_TOLERANCE` (at most :data:`PASSES` repetitions). Eq. (1) is
-never below the noise the first identification used, so a repetition can
-only take modes away; one that finds a mode the first did not (a noise
-model inconsistent with the data: a floor from second differences below the
-noise of some lines) is not used, and the first result stands. So does the first result when the
-repetition keeps as many modes: eq. (1) is there to decide which peaks the
-data prove to be modes, and a fit whose modes it confirms keeps its values
-and the errors of its own noise.
+none otherwise (``eps = 0``: the noise explains the residual, and nothing
+changes). The identification is repeated with (1) as the per-line variance
+(the mode count decided again against it, standard errors widened by it) and
+``eps`` re-estimated from the new fit. A fit that split a peak into two poles
+leaves a small residual, and gives back a small ``eps``: eq. (2) can hold for
+a split fit and for the merged one alike. The repetitions therefore only raise
+``eps``: a pass whose fit gives back a larger ``eps`` than it was decided with
+(by more than :data:`EPS_TOLERANCE`) is followed by one against that larger
+value (at most :data:`PASSES` passes), and the last pass is the result.
 """
 
 from __future__ import annotations
@@ -59,7 +58,7 @@ from numpy.typing import NDArray
 from scipy import optimize
 
 from ..frf import FRF
-from .problem import FitProblem, line_variance
+from .problem import FitProblem
 from .stats import difference_noise
 
 __all__ = [
@@ -93,32 +92,24 @@ class NoiseFloor:
 
 
 def noise_floor(
-    frf: FRF,
-    problem: FitProblem,
-    variance: NDArray[np.float64] | None,
-    sigma_out: NDArray[np.float64] | None = None,
+    frf: FRF, problem: FitProblem, residual: NDArray[np.complex128] | None = None
 ) -> NoiseFloor:
-    """``V`` of eq. (1) on the whole axis of ``frf``: the variance the fit of
-    ``problem`` used (given, carried by the FRF or from the coherence), or, for
-    a fit whose noise was estimated from its residual, per output the larger of
-    that estimate ``sigma_out`` (RMS, units of ``H``) and the noise floor from
-    second differences of the band's lines
-    (:func:`~tyredamp.modal.stats.difference_noise`). ``V`` is never below the
-    noise the first fit decided its modes with, so eq. (1) can only raise it:
-    the repeated identification does not find modes in noise the first one
-    did not call noise."""
-    n = frf.frequency.size
-    source, v = line_variance(frf, np.arange(n), np.asarray(frf.H), variance)
-    if v is not None and source == "variance":
-        return NoiseFloor(np.asarray(v, dtype=float), "the per-line variance")
-    if v is not None:
-        return NoiseFloor(np.asarray(v, dtype=float), "the noise from the coherence")
+    """``V`` of eq. (1) on the whole axis of ``frf``, for a fit whose noise was
+    estimated from its residual: per output the larger of two robust estimates, the
+    noise floor from second differences of the band's lines
+    (:func:`~tyredamp.modal.stats.difference_noise`) and the median of the fit's own
+    ``residual`` (shape (n_out, n_in, n_band), units of ``H``; ``|r|^2`` of complex
+    Gaussian noise is exponential with median ``s^2 ln 2``). A median leaves out the
+    few lines near sharp peaks where the model errs; the residual's median also holds
+    noise that adjacent lines share (a window's leakage), which second differences
+    cancel."""
     full = np.empty(frf.H.shape)
     s2 = difference_noise(problem.H) * problem.scale**2
-    if sigma_out is not None and np.all(np.isfinite(sigma_out)):
-        s2 = np.fmax(s2, np.asarray(sigma_out, dtype=float) ** 2)
+    if residual is not None and residual.size:
+        r2 = (residual.real**2 + residual.imag**2).reshape(residual.shape[0], -1)
+        s2 = np.fmax(s2, np.median(r2, axis=1) / math.log(2.0))
     full[:] = s2[:, None, None]
-    return NoiseFloor(full, "the noise estimated from the residual")
+    return NoiseFloor(full, "the noise of the fit's residual (a median over lines)")
 
 
 def relative_model_error(

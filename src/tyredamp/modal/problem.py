@@ -58,7 +58,6 @@ __all__ = [
     "NoiseSource",
     "build_problem",
     "line_factor_dof",
-    "line_variance",
     "max_modes",
 ]
 
@@ -200,7 +199,7 @@ def check_uniform(f: NDArray[np.float64]) -> None:
         )
 
 
-def line_variance(
+def _line_variance(
     frf: FRF, lines: NDArray[np.intp], H: NDArray[np.complex128], variance: ArrayLike | None
 ) -> tuple[NoiseSource, NDArray[np.float64] | None]:
     """Variance of each line of ``lines`` (data units ``H``) and where it comes from.
@@ -330,7 +329,7 @@ def build_problem(
     rms = float(np.sqrt(np.vdot(Hn, Hn).real / Hn.size))
     Hn /= rms  # in place: one copy of the band's data
     scale = peak * rms
-    source, v = line_variance(frf, lines, Hb, variance)
+    source, v = _line_variance(frf, lines, Hb, variance)
     nu = variance_dof(frf, source, variance is not None)
     n_avg = _meta_number(frf, "n_averages")
     sig = lw = vn = None
