@@ -58,6 +58,17 @@ _ANGLE = {"deg", "°", "degree", "degrees", "rad", "radian", "radians"}
 _NUM = re.compile(r"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 
 
+_COMPLEX = re.compile(
+    r"^\(?\s*[-+]?[0-9.]+(e[-+]?[0-9]+)?\s*[-+]\s*[0-9.]+(e[-+]?[0-9]+)?j\s*\)?$", re.I
+)
+
+
+def _complex_column(lines: list[str]) -> bool:
+    """Whether the non-blank lines are complex numbers (``(1.2+3.4j)``), one per line."""
+    rows = [ln.strip() for ln in lines if ln.strip() and not ln.lstrip().startswith("#")]
+    return len(rows) >= 3 and all(_COMPLEX.match(r) for r in rows[:50])
+
+
 def _is_unit(text: str) -> bool:
     """Whether ``text`` reads as a units label with a dimension (not a bare number)."""
     t = text.strip()
@@ -170,6 +181,12 @@ def read_plain_csv(
         else:
             body_start, numeric = None, 0
     if body_start is None:
+        if _complex_column(lines):
+            raise FileFormatError(
+                f"{p}: holds complex numbers, one per line, without a frequency column: an FRF "
+                "needs its frequency axis; write the file with a header row and a frequency "
+                "column, for example 'freq_Hz,H.re [m/s^2/N],H.im [m/s^2/N]'"
+            )
         raise FileFormatError(f"{p}: no rows of numbers found (not a CSV export of data?)")
     head = [ln for ln in lines[:body_start] if ln.strip() and not ln.lstrip().startswith("#")]
     if not head:
