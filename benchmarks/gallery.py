@@ -672,8 +672,6 @@ def _rows() -> list[Row]:
             ladisk,
             "catalogue: truncated (10 samples), good only for parsing",
             row_short_lvm,
-            xfail="frf estimates a 2-line FRF from the 10 samples instead of refusing a record too "
-            "short for one",
         ),
         Row(
             "case1-frf-modal",
