@@ -302,7 +302,7 @@ def row_lvm_refused(ctx: Context) -> Check:
 
 def row_lvm_check(ctx: Context) -> Check:
     """``check quality`` with the hammer named: impacts read, coherence judged."""
-    run = ctx.cli("check", "quality", ctx.path(LVM_LONG), *IMPACT_MAP, "--band", "100", "500")
+    run = ctx.cli("check", "quality", ctx.path(LVM_LONG), *IMPACT_MAP)
     succeeded(run)
     verdict = _first(run.out)
     # physics: two clean hits and an accelerometer response: no clipping, no dead channel
@@ -754,7 +754,7 @@ def _rows() -> list[Row]:
             "shaker-controller PSD (UFF 58, function type 9)",
             pyuff,
             "catalogue: a PSD, not time data or an FRF",
-            row_refused(UFF + "sample_dataset58_psd.uff", "PSD"),
+            row_refused(UFF + "sample_dataset58_psd.uff", "PSD", "function type 1"),
         ),
     ]
     for name, sets in (
@@ -782,6 +782,14 @@ def _rows() -> list[Row]:
             row_uff55,
             subprocess=True,
             needs_references=True,
+        ),
+        Row(
+            "uff55-as-data",
+            UFF + "uff55 sample_test record10.uff",
+            "one UFF 55 complex mode, given where data is read",
+            pyuff,
+            "catalogue: modes (data set 55), not time data or an FRF",
+            row_refused(UFF + "uff55 sample_test record10.uff", "mode shapes", "tyredamp damping"),
         ),
         Row(
             "poma-tower",

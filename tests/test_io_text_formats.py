@@ -309,3 +309,12 @@ def test_a_column_of_complex_numbers_asks_for_its_frequency_axis(tmp_path: Path)
     p.write_text("1.0\n2.0\nabc\n", encoding="utf-8")
     with pytest.raises(FileFormatError, match="no rows of numbers"):
         read(p)
+
+
+def test_unnamed_channels_beside_a_force_are_suggested_as_responses(tmp_path: Path) -> None:
+    p = tmp_path / "hammer.csv"
+    rows = "\n".join(f"{k / 100:.2f},{k % 3},{k % 5},{k % 7}" for k in range(20))
+    p.write_text("time_s,F [N],a1,a2\n" + rows + "\n", encoding="utf-8")
+    # the force is named by its unit: the example does not call a1 a force too
+    with pytest.raises(FileFormatError, match=r"for example --channel 'a1=acceleration:m/s\^2'"):
+        read_timedata(p)

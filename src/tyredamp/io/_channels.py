@@ -265,9 +265,11 @@ def timedata_from_channels(
     if unnamed:
         listed = ", ".join(repr(n) for n, _ in unnamed)
         first = unnamed[0][0]
+        # the example names a force only when no channel read so far is one
+        role = "acceleration:m/s^2" if "force" in quants else "force:N"
         raise FileFormatError(
             f"{path}: no units label tells what channels {listed} measure; name them, for "
-            f"example {_opt(first, 'force:N')} {_opt(unnamed[1][0], 'acceleration:m/s^2')} "
+            f"example {_opt(first, role)} {_opt(unnamed[1][0], 'acceleration:m/s^2')} "
             "(or a --channel-map file)"
         )
     if skipped:
