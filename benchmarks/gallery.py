@@ -206,7 +206,8 @@ def _first(text: str) -> str:
 
 def _strip_paths(text: str) -> str:
     """An error message without the absolute folder of its file."""
-    return re.sub(r"(/[^\s:]+/)+", "", text)
+    # an absolute path (not "m/s^2/N"): a slash at the start of a word, two folders or more
+    return re.sub(r"(?<![\w\[\]^])/(?:[^\s:/]+/){2,}", "", text)
 
 
 def succeeded(run: Run) -> None:
