@@ -26,7 +26,7 @@ from tyredamp.damping.modeset import (
     shape_side,
 )
 from tyredamp.documents.modes import modes_document, read_modes, write_modes_json
-from tyredamp.exceptions import InputError, ShapeError
+from tyredamp.exceptions import FileFormatError, InputError, ShapeError
 from tyredamp.frf import FRF, Channel
 from tyredamp.geometry import Geometry
 from tyredamp.io.uff55 import read_uff55
@@ -556,3 +556,10 @@ def test_roving_hammer_report_and_cli(
     doc = json.loads(out.read_text())
     assert [p["node"] for p in doc["points"]] == [1, 2, 3]
     assert read_modes(js)["complex"].n_modes == len(BEAM_MODES_HZ)
+
+
+def test_a_file_that_is_not_modes_says_what_modes_come_from(tmp_path: Path) -> None:
+    tir = tmp_path / "tyre.tir"
+    tir.write_text("[VERTICAL]\nFNOMIN = 4000\n", encoding="utf-8")
+    with pytest.raises(FileFormatError, match=r"tyre\.tir: not valid JSON.*modes JSON.*'\.tir'"):
+        read_modes(tir)

@@ -154,7 +154,9 @@ def test_uff_gallery_reads_or_says_what_the_file_is() -> None:
     hbm = read_timedata(UFF / "time-history-not-all-columns-filled.uff")
     assert hbm.quantities == ("acceleration",)
     lines = {
-        "sample_dataset58_psd.uff": r"holds a PSD \(function type 9\), not time data or an FRF",
+        "sample_dataset58_psd.uff": (
+            r"holds a PSD \(function type 9\), not time data or an FRF; export the time data"
+        ),
         "dataset_milestone_in_header.uff": r"header declares 2508876 values, the file stores 42",
         "TestLab 161 164 18 15 82.uff": r"holds geometry only",
         "mesh_Oros-modal_uff15_uff2412.uff": r"holds geometry only",

@@ -296,3 +296,25 @@ def test_vendor_frf_label_in_cp1252(tmp_path: Path, binary: int) -> None:
     assert frf.meta["text_encoding"] == "cp1252"
     assert_allclose(frf.frequency, truth["f"], rtol=1e-5)  # record 7 keeps 6 digits
     assert_allclose(frf.H[0, 0], truth["H"][11], rtol=1e-11)  # ASCII: 12 digits; binary exact
+
+
+def test_a_column_of_complex_numbers_asks_for_its_frequency_axis(tmp_path: Path) -> None:
+    # one Python complex per line, as numpy or a script writes an FRF without its axis
+    p = tmp_path / "frf.txt"
+    p.write_text("(-0.07+2.6e-08j)\n(-0.17-0.12j)\n(0.09+0.02j)\n", encoding="utf-8")
+    with pytest.raises(
+        FileFormatError, match=r"complex numbers.*without a frequency column.*freq_Hz"
+    ):
+        read(p)
+    p.write_text("1.0\n2.0\nabc\n", encoding="utf-8")
+    with pytest.raises(FileFormatError, match="no rows of numbers"):
+        read(p)
+
+
+def test_unnamed_channels_beside_a_force_are_suggested_as_responses(tmp_path: Path) -> None:
+    p = tmp_path / "hammer.csv"
+    rows = "\n".join(f"{k / 100:.2f},{k % 3},{k % 5},{k % 7}" for k in range(20))
+    p.write_text("time_s,F [N],a1,a2\n" + rows + "\n", encoding="utf-8")
+    # the force is named by its unit: the example does not call a1 a force too
+    with pytest.raises(FileFormatError, match=r"for example --channel 'a1=acceleration:m/s\^2'"):
+        read_timedata(p)

@@ -184,6 +184,17 @@ def test_welch_matches_scipy_csd_siso(rng) -> None:
     assert frf.meta["n_averages"] == 31
 
 
+def test_welch_refuses_a_record_too_short_for_its_default_segments(rng) -> None:
+    x = rng.normal(size=(2, 100))  # 100 samples: default segments of 12 samples
+    td = TimeData(x, 100.0, [Channel(1), Channel(2)], ["force", "velocity"])
+    with pytest.raises(InputError, match=r"100 samples per channel are too few.*--segment"):
+        estimate_frf(td, method="welch")
+    frf = estimate_frf(td, method="welch", segment_samples=32)  # a stated segment is used
+    assert frf.meta["segment_samples"] == 32
+    td = TimeData(rng.normal(size=(2, 128)), 100.0, [Channel(1), Channel(2)], ["force", "velocity"])
+    assert estimate_frf(td, method="welch").meta["segment_samples"] == 16  # the shortest default
+
+
 def _band_limited_noise(g: np.random.Generator, n: int, fs: float, f_hi: float) -> np.ndarray:
     spec = np.zeros(n // 2 + 1, dtype=complex)
     k = np.arange(1, int(f_hi * n / fs))

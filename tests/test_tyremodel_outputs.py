@@ -165,6 +165,18 @@ def test_tir_parser_reads_comments_and_refuses_bad_lines() -> None:
         parse_tir("$ only a comment\n")
 
 
+def test_tir_parser_reads_table_sections() -> None:
+    # a [SHAPE] section as ADAMS/MF-Tyre files write it: column names, then rows of numbers
+    doc = parse_tir(
+        "[DIMENSION]\nWIDTH = 0.335\n[SHAPE]\n{radial width}\n 1.00  0.00\n 0.90  1.00 $ c\n"
+        "[VERTICAL]\nFNOMIN = 16929\n"
+    )
+    assert doc["SHAPE"] == {"_columns": ["radial", "width"], "_rows": [[1.0, 0.0], [0.9, 1.0]]}
+    assert doc["VERTICAL"] == {"FNOMIN": 16929.0}
+    with pytest.raises(FileFormatError, match="line 2"):
+        parse_tir("[SHAPE]\n1.0 abc\n")  # a row that is not numbers is still refused
+
+
 # ------------------------------------------------------------------------ lateral bridge
 def test_lateral_carcass_from_fit_and_dict() -> None:
     true = HystereticModel(K=1.2e5, h=1.5e4, C_r=8.0e3)

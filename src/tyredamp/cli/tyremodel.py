@@ -27,7 +27,7 @@ from typing import Any
 import click
 
 from ..documents.jsonfile import json_text
-from ..documents.modes import read_modes, read_modes_json
+from ..documents.modes import read_modes
 from ..exceptions import FileFormatError, InputError
 from ..io._safety import atomic_dir, check_output_dir, private_matplotlib_config
 from ..modal.model import ModalModel
@@ -261,7 +261,7 @@ def _read_tyre_modes(path: Path, model_kind: str, geometry_file: Path | None) ->
     from ..io import FILE_FORMATS
 
     uff = path.suffix.lower() in FILE_FORMATS["uff58b"].extensions
-    models = read_modes(path) if uff else read_modes_json(path)
+    models = read_modes(path)  # a UFF file of data sets 55 or a modes JSON
     if model_kind == "auto":
         mdl = models.get("complex") or models["real"]
     elif model_kind not in models:

@@ -167,7 +167,15 @@ def read_modes(path: str | os.PathLike[str]) -> dict[str, ModalModel]:
 
         model = read_uff55(p)
         return {model.mode_kind: model}
-    return read_modes_json(p)
+    if p.suffix.lower() in ("", ".json"):
+        return read_modes_json(p)
+    try:
+        return read_modes_json(p)
+    except FileFormatError as exc:  # say what a modes file is (a .tir, a .csv given by mistake)
+        raise FileFormatError(
+            f"{exc}; modes come from a modes JSON (tyredamp modal --out) or a UFF file of "
+            f"data sets 55, not a '{p.suffix}' file"
+        ) from None
 
 
 def models_from_document(doc: dict[str, Any]) -> dict[str, ModalModel]:

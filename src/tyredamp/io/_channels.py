@@ -163,6 +163,21 @@ def channel_values(
     )
 
 
+def _refuse_unnamed(path: Any, unnamed: Sequence[tuple[str, Exception]], has_force: bool) -> None:
+    """One error for the channels no units label names, with an example channel map."""
+    if len(unnamed) == 1:
+        raise unnamed[0][1]
+    if unnamed:
+        listed = ", ".join(repr(n) for n, _ in unnamed)
+        # the example names a force only when no channel read so far is one
+        role = "acceleration:m/s^2" if has_force else "force:N"
+        raise FileFormatError(
+            f"{path}: no units label tells what channels {listed} measure; name them, for "
+            f"example {_opt(unnamed[0][0], role)} {_opt(unnamed[1][0], 'acceleration:m/s^2')} "
+            "(or a --channel-map file)"
+        )
+
+
 def timedata_from_channels(
     path: Path,
     names: Sequence[str],
@@ -260,16 +275,7 @@ def timedata_from_channels(
         if spec is not None and spec.direction is not None:
             direction = spec.direction
         chans.append(Channel(node=node, direction=direction, name=str(name)))
-    if len(unnamed) == 1:
-        raise unnamed[0][1]
-    if unnamed:
-        listed = ", ".join(repr(n) for n, _ in unnamed)
-        first = unnamed[0][0]
-        raise FileFormatError(
-            f"{path}: no units label tells what channels {listed} measure; name them, for "
-            f"example {_opt(first, 'force:N')} {_opt(unnamed[1][0], 'acceleration:m/s^2')} "
-            "(or a --channel-map file)"
-        )
+    _refuse_unnamed(path, unnamed, "force" in quants)
     if skipped:
         read_notes.append(f"left out as the channel map asks: {', '.join(skipped)}")
     if not rows:

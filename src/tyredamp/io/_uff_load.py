@@ -122,7 +122,10 @@ def _what_instead(types: list[int]) -> str:
             "--geometry)"
         )
     if 55 in found:
-        return f"holds mode shapes (data sets {listed}), not time data or an FRF"
+        return (
+            f"holds mode shapes (data sets {listed}), not time data or an FRF; use it where "
+            "modes are read (tyredamp damping, tyredamp tyre-model)"
+        )
     return f"no data set 58 (time data or FRF); found data sets {listed}"
 
 
@@ -132,7 +135,10 @@ def _function_name(t: int) -> str:
 
 def not_frf_or_time(p: Path, types: set[int]) -> FileFormatError:
     kinds = ", ".join(f"{_function_name(t)} (function type {t})" for t in sorted(types))
-    return FileFormatError(f"{p}: holds {kinds}, not time data or an FRF")
+    return FileFormatError(
+        f"{p}: holds {kinds}, not time data or an FRF; export the time data it was computed "
+        "from (function type 1), or FRFs (function type 4)"
+    )
 
 
 def _redecode_strings(raw: bytes, sets: list[dict[str, Any]]) -> None:

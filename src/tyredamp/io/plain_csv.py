@@ -58,6 +58,22 @@ _ANGLE = {"deg", "°", "degree", "degrees", "rad", "radian", "radians"}
 _NUM = re.compile(r"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 
 
+_COMPLEX = re.compile(
+    r"^\(?\s*[-+]?[0-9.]+(e[-+]?[0-9]+)?\s*[-+]\s*[0-9.]+(e[-+]?[0-9]+)?j\s*\)?$", re.I
+)
+
+
+def _refuse_complex_column(p: Path, lines: list[str]) -> None:
+    """Refuse lines of complex numbers (``(1.2+3.4j)``, one per line): no frequency axis."""
+    rows = [ln.strip() for ln in lines if ln.strip() and not ln.lstrip().startswith("#")]
+    if len(rows) >= 3 and all(_COMPLEX.match(r) for r in rows[:50]):
+        raise FileFormatError(
+            f"{p}: holds complex numbers, one per line, without a frequency column: an FRF "
+            "needs its frequency axis; write the file with a header row and a frequency "
+            "column, for example 'freq_Hz,H.re [m/s^2/N],H.im [m/s^2/N]'"
+        )
+
+
 def _is_unit(text: str) -> bool:
     """Whether ``text`` reads as a units label with a dimension (not a bare number)."""
     t = text.strip()
@@ -170,6 +186,7 @@ def read_plain_csv(
         else:
             body_start, numeric = None, 0
     if body_start is None:
+        _refuse_complex_column(p, lines)
         raise FileFormatError(f"{p}: no rows of numbers found (not a CSV export of data?)")
     head = [ln for ln in lines[:body_start] if ln.strip() and not ln.lstrip().startswith("#")]
     if not head:

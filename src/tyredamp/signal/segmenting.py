@@ -186,6 +186,10 @@ class SegmentPlan:
     info: dict[str, Any] = field(default_factory=dict)
 
 
+#: Shortest default Welch segment (samples): 8 frequency lines above DC.
+_MIN_DEFAULT_SEGMENT = 16
+
+
 def _cyclic_plan(period: int | None, window: Any, overlap: Any) -> SegmentPlan:
     if period is None:
         raise InputError(
@@ -201,7 +205,15 @@ def _cyclic_plan(period: int | None, window: Any, overlap: Any) -> SegmentPlan:
 
 
 def _welch_plan(n: int, segment: int | None, window: Any, overlap: float | None) -> SegmentPlan:
-    seg = as_count(segment if segment is not None else max(n // 8, 2), "segment_samples", 2)
+    if segment is None and n // 8 < _MIN_DEFAULT_SEGMENT:
+        raise InputError(
+            f"timedata: {n} samples per channel are too few for an FRF: the default segments "
+            f"(an eighth of the record, for 8 averages) would hold {n // 8} sample(s), and a "
+            f"spectrum needs at least {_MIN_DEFAULT_SEGMENT} ({_MIN_DEFAULT_SEGMENT // 2} lines); "
+            f"record at least {8 * _MIN_DEFAULT_SEGMENT} samples, or give the segment length "
+            "(tyredamp frf --segment)"
+        )
+    seg = as_count(segment if segment is not None else n // 8, "segment_samples", 2)
     ov = 0.5 if overlap is None else float(overlap)
     if not 0.0 <= ov < 1.0:
         raise InputError(f"overlap: expected a fraction in [0, 1), got {overlap!r}")

@@ -138,17 +138,31 @@ def _value(raw: str, lineno: int) -> Any:
         return s
 
 
+def _table_row(line: str) -> list[float] | None:
+    """A row of numbers (a list), a ``{column names}`` line (empty list), else None."""
+    if line.startswith("{") and line.endswith("}"):
+        return []
+    try:
+        return [float(x) for x in line.split()] or None
+    except ValueError:
+        return None
+
+
 def parse_tir(text: str) -> dict[str, dict[str, Any]]:
     """Read ``.tir`` text into ``{section: {key: value}}`` (numbers as float).
 
     Comments (``$`` anywhere outside a quoted string, lines starting with
-    ``!``) and blank lines are skipped; keys are kept as written.
+    ``!``) and blank lines are skipped; keys are kept as written. A table
+    section (``[SHAPE]``: a ``{radial width}`` line, then rows of numbers)
+    gives its rows as ``"_rows"`` (lists of floats) and its column names as
+    ``"_columns"``.
 
     Raises
     ------
     FileFormatError
         A key before the first section, a line that is neither a section,
-        a ``KEY = value`` line nor a comment, a key repeated in a section.
+        a ``KEY = value`` line, a table row nor a comment, a key repeated in
+        a section.
     """
     out: dict[str, dict[str, Any]] = {}
     current: str | None = None
@@ -162,6 +176,14 @@ def parse_tir(text: str) -> dict[str, dict[str, Any]]:
             out.setdefault(current, {})
             continue
         k = _KEY.match(line)
+        table = _table_row(line.split("$", 1)[0].strip())
+        if not k and current is not None and table is not None:
+            # a table section ([SHAPE]: "{radial width}" then rows of numbers)
+            if table:
+                out[current].setdefault("_rows", []).append(table)
+            else:
+                out[current]["_columns"] = line.strip("{} ").split()
+            continue
         if not k:
             raise FileFormatError(
                 f".tir line {lineno}: expected [SECTION] or KEY = value, got {line!r}"
