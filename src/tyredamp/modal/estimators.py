@@ -35,7 +35,13 @@ from numpy.typing import NDArray
 from ..exceptions import InputError
 from .lscf import PoleSet, plscf
 
-__all__ = ["DEFAULT_ESTIMATOR", "ESTIMATORS", "PoleEstimator", "get_estimator", "register_estimator"]
+__all__ = [
+    "DEFAULT_ESTIMATOR",
+    "ESTIMATORS",
+    "PoleEstimator",
+    "get_estimator",
+    "register_estimator",
+]
 
 
 class PoleEstimator(Protocol):

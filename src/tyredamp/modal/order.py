@@ -178,7 +178,9 @@ def settle_order(
     full = order_limit(n_in, problem.shape[2])
     limit = full
     if automatic:
-        limit = min(limit, order_cap(n_in, problem.shape[2], p_start, modes_shown(problem, false_alarm)))
+        limit = min(
+            limit, order_cap(n_in, problem.shape[2], p_start, modes_shown(problem, false_alarm))
+        )
     cur = diagram(problem, estimator, p_start, rules)
     trial: Diagram | None = None  # the diagram before a trial raise
     while automatic:

@@ -209,7 +209,11 @@ class Band(Check):
     def __call__(self, value: Any, where: str) -> Any:
         if value is None:
             return None
-        if not isinstance(value, list | tuple) or len(value) != 2 or not all(map(_is_number, value)):
+        if (
+            not isinstance(value, list | tuple)
+            or len(value) != 2
+            or not all(map(_is_number, value))
+        ):
             raise InputError(f"{where}: expected [f_lo, f_hi] in Hz, got {_show(value)}")
         lo, hi = float(value[0]), float(value[1])
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
@@ -355,7 +359,9 @@ def samples(text: Any, sample_rate: float, where: str, *, whole: bool = True) ->
     try:
         value = float(t[:-1]) * sample_rate if seconds else float(int(t))
     except ValueError:
-        raise InputError(f"{where}: expected samples (4096) or seconds (0.5s), got {text!r}") from None
+        raise InputError(
+            f"{where}: expected samples (4096) or seconds (0.5s), got {text!r}"
+        ) from None
     n = round(value) if math.isfinite(value) else -1
     if whole and seconds and (n < 0 or abs(value - n) > 1e-6 * max(1.0, abs(value))):
         raise InputError(

@@ -43,12 +43,6 @@ class LateralFitSettings(StepSettings):
     models: tuple[str, ...] | None = knob(
         None, _models_text(), Names(_model_name, "model names"), "--models", metavar="NAMES"
     )
-    force: str | None = knob(
-        None,
-        "Force the FRF refers to (default from the file's meta, else ground).",
-        Choice(("ground", "axle"), optional=True),
-        "--force",
-    )
     wheel_mass_kg: float | None = knob(
         None,
         "Wheel mass for axle-force FRFs, kg (default from the file's meta, else 0).",
@@ -56,6 +50,12 @@ class LateralFitSettings(StepSettings):
         "--wheel-mass",
         unit="kg",
         metavar="KG",
+    )
+    force: str | None = knob(
+        None,
+        "Force the FRF refers to (default from the file's meta, else ground).",
+        Choice(("ground", "axle"), optional=True),
+        "--force",
     )
     band: tuple[float, float] | None = knob(
         None, "Fit only lines in this band (Hz).", Band(), "--band", unit="Hz", metavar="F_LO F_HI"
@@ -93,6 +93,8 @@ class LateralFitStep:
 
     name: ClassVar[str] = "fit"
     Settings: ClassVar[type[LateralFitSettings]] = LateralFitSettings
+    #: in a campaign: the test's speed
+    conditions: ClassVar[tuple[str, ...]] = ("speed_kmh",)
 
     @staticmethod
     def run(

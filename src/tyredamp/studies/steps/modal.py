@@ -16,8 +16,17 @@ from ...frf import FRF
 from ...modal.estimators import DEFAULT_ESTIMATOR, ESTIMATORS
 from ...modal.identify import ModalIdentification
 from ...modal.stats import FALSE_ALARM
-from ._settings import Band, Boolean, Choice, Integer, Number, Positives, Registered, StepSettings
-from ._settings import knob
+from ._settings import (
+    Band,
+    Boolean,
+    Choice,
+    Integer,
+    Number,
+    Positives,
+    Registered,
+    StepSettings,
+    knob,
+)
 
 __all__ = ["MODAL_MODELS", "ModalSettings", "ModalStep"]
 
@@ -89,6 +98,10 @@ class ModalStep:
 
     name: ClassVar[str] = "modal"
     Settings: ClassVar[type[ModalSettings]] = ModalSettings
+    #: in a campaign: the FRF of time data and the quality check come first
+    sections: ClassVar[tuple[str, ...]] = ("frf", "checks", "modal")
+    #: in a campaign: the test's channel map reads its time data
+    conditions: ClassVar[tuple[str, ...]] = ("channel_map",)
 
     @staticmethod
     def run(frf: FRF, settings: ModalSettings) -> tuple[ModalIdentification, dict[str, Any]]:

@@ -33,7 +33,12 @@ class QualitySettings(StepSettings):
         "--max-low-fraction",
     )
     band: tuple[float, float] | None = knob(
-        None, "Check only lines in this band (Hz).", Band(), "--band", unit="Hz", metavar="F_LO F_HI"
+        None,
+        "Check only lines in this band (Hz).",
+        Band(),
+        "--band",
+        unit="Hz",
+        metavar="F_LO F_HI",
     )
 
 
