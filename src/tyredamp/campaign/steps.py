@@ -8,28 +8,30 @@ step names, settings dictionaries and documents, never the processing
 itself, so pointing this module at :mod:`tyredamp.studies` changes nothing
 else.
 
-The steps are those of :mod:`tyredamp.studies`, called with the same
-arguments and defaults as the single-test commands, and their documents are
-those of :mod:`tyredamp.documents` (the files the commands write):
+The steps are those of :data:`tyredamp.studies.registry.STEPS`, run with
+their typed settings (:mod:`tyredamp.studies.steps`), the very ``run`` the
+single-test commands call, and their documents are those of
+:mod:`tyredamp.documents` (the files the commands write); the chain of each
+study is :data:`tyredamp.studies.registry.STUDIES`:
 
 * radial ``modal``: :func:`tyredamp.io.read` (time data or FRFs); for time
-  data :func:`tyredamp.studies.radial.frf_from_time` as ``tyredamp frf``;
-  :func:`tyredamp.studies.radial.check_quality` as ``tyredamp check
-  quality``; :func:`tyredamp.studies.radial.modes_from_frf`,
-  :func:`tyredamp.studies.radial.label_wave_numbers` and
-  :func:`tyredamp.studies.verdicts.modal_verdicts` as ``tyredamp modal``;
-  the document is :func:`tyredamp.documents.modes.modes_document` (the modes
-  JSON, ``docs/modes-json.md``) with a ``"campaign"`` entry holding the FRF
-  summary and the quality check;
-* radial ``damping``: :func:`tyredamp.studies.radial.damping_from_modes` on
-  the models of that modes document
+  data :class:`~tyredamp.studies.steps.FrfStep` as ``tyredamp frf``;
+  :class:`~tyredamp.studies.steps.QualityStep` as ``tyredamp check
+  quality``; :class:`~tyredamp.studies.steps.ModalStep` (modes, wave
+  numbers, verdicts) as ``tyredamp modal``; the document is its modes
+  document (``docs/modes-json.md``) with a ``"campaign"`` entry holding the
+  FRF summary and the quality check;
+* radial ``damping``: :class:`~tyredamp.studies.steps.DampingStep` on the
+  models of that modes document
   (:func:`tyredamp.documents.modes.models_from_document`), as ``tyredamp
   damping``; the document is
   :func:`tyredamp.documents.damping.damping_document` (``docs/damping-json.md``);
-* lateral ``fit``: :func:`tyredamp.studies.lateral.lateral_data` and
-  :func:`tyredamp.studies.lateral.fit_models` as ``tyredamp lateral fit``
-  (a test where no model fits fails with the reasons); the document is
-  :func:`tyredamp.documents.lateral.lateral_fit_document`.
+* lateral ``fit``: :class:`~tyredamp.studies.steps.LateralFitStep` as
+  ``tyredamp lateral fit`` (a test where no model fits fails with the
+  reasons); the document is
+  :func:`tyredamp.documents.lateral.lateral_fit_document`;
+* any other registered step of a chain: its ``run_file(path, upstream,
+  settings, conditions)``.
 
 Skipped steps
 -------------
@@ -52,10 +54,14 @@ check or fit verdict failed has its document like any other. The radial
 
 Settings
 --------
-Each study's settings are a nested dictionary ``{step: {key: value}}`` with
-the defaults of :data:`DEFAULTS` (the single-test commands' defaults); see
+Each study's settings are a nested dictionary ``{section: {key: value}}``,
+one section per step of its chain (the modal step also reads the ``frf`` and
+``checks`` sections): the fields of the step's settings class with their
+defaults (the single-test commands' defaults), plus the step's switch
+(``damping.enabled``, ``checks.quality``) when it has one; see
 ``docs/campaign.md``. :func:`validate_settings` checks a campaign file's
-table against them.
+table against the classes (unknown keys refused); :func:`settings_schema`
+gives the ``settings`` part of the campaign file's JSON schema.
 """
 
 from __future__ import annotations
