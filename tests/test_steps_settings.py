@@ -69,7 +69,7 @@ def _command(step: str) -> click.Command:
     return cmd  # type: ignore[no-any-return]
 
 
-def _other_value(name: str, check: Any, default: Any) -> tuple[list[str], Any, Any]:
+def _other_value(name: str, check: Any, default: Any, option: str) -> tuple[list[str], Any, Any]:
     """(CLI words, campaign value, expected typed value) of a value that is not the default."""
     if isinstance(check, Boolean):
         return [], not default, not default
@@ -96,7 +96,9 @@ def _other_value(name: str, check: Any, default: Any) -> tuple[list[str], Any, A
         return ["0.5s"], "0.5s", "0.5s"
     if isinstance(check, Names):
         v = NAMES[name]
-        return [",".join(v)], v, tuple(v)
+        if check.split:  # comma-separated
+            return [",".join(v)], v, tuple(v)
+        return [v[0], option, v[1]], v, tuple(v)  # the option repeated
     raise AssertionError(f"{name}: no example value for {type(check).__name__}")
 
 
@@ -125,7 +127,7 @@ def test_every_setting_reaches_every_path(step: str, name: str) -> None:
     cls = STEPS[step].Settings
     k = knobs(cls)[name]
     default = {f.name: f.default for f in dataclasses.fields(cls)}[name]
-    words, campaign_value, expected = _other_value(name, k.check, default)
+    words, campaign_value, expected = _other_value(name, k.check, default, k.option)
     assert expected != default  # the test would not see a knob that went nowhere
     # the command line: the option as the user types it
     got = _cli_settings(step, cls, [k.option, *words])
@@ -218,3 +220,29 @@ def test_settings_are_frozen_and_checked_when_built() -> None:
     with pytest.raises(InputError, match=r"^false_alarm: expected a number in \(0, 1\)"):
         ModalSettings(false_alarm=1.0)
     assert s.replace(order_step=4).order_step == 4
+
+
+def test_false_alarm_reaches_the_automatic_order(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``--false-alarm`` / ``false_alarm`` also sets the count of resonances the data show,
+    which caps the automatic order (it used to stay at the default rate there)."""
+    import numpy as np
+
+    from tyredamp.modal import order
+    from tyredamp.studies.steps import ModalSettings, ModalStep
+
+    from .helpers import chain_system
+
+    seen: list[float] = []
+    shown = order.modes_shown
+
+    def spy(problem: Any, false_alarm: float = 0.01) -> int:
+        seen.append(false_alarm)
+        return shown(problem, false_alarm)
+
+    monkeypatch.setattr(order, "modes_shown", spy)
+    frf = chain_system().frf(np.linspace(0.5, 40.0, 200), kind="accelerance", inputs=[0])
+    rng = np.random.default_rng(2)
+    frf = frf.with_H(frf.H * (1 + 1e-3 * rng.normal(size=frf.H.shape)))
+    ModalStep.run(frf, ModalSettings(false_alarm=0.001, search=False, model="complex"))
+    assert seen
+    assert set(seen) == {0.001}

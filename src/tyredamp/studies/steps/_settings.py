@@ -304,12 +304,17 @@ class Names(Check):
 
     each: Callable[[str, str], Any] | None = None
     what: str = "names"
+    #: text is split at commas (false: each repetition of the option is one name)
+    split: bool = True
     cli: ClassVar[str] = "multiple"
 
     def __call__(self, value: Any, where: str) -> Any:
         if value is None or value == ():
             return None
-        value = _split(value)
+        if self.split:
+            value = _split(value)
+        elif isinstance(value, tuple | str):
+            value = [value] if isinstance(value, str) else list(value)
         if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
             raise InputError(f"{where}: expected a non-empty list of {self.what}, got {value!r}")
         if self.each is None:

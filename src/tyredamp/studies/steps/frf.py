@@ -33,7 +33,7 @@ class FrfSettings(StepSettings):
         None,
         "Force channel to use as input (label like 1+Z, channel name or node number); "
         "repeat for MIMO. Default: every force channel.",
-        Names(what="force channels"),
+        Names(what="force channels", split=False),
         "--reference",
         metavar="CHANNEL",
     )
