@@ -154,7 +154,7 @@ def test_no_stable_mode_at_the_cap_raises_the_order_up_to_escalate_times_it(
 
     pr = build_problem(_six_modes(2001), (20.0, 190.0))
     w = 2 * np.pi * FN
-    monkeypatch.setattr(order, "modes_shown", lambda problem: 0)
+    monkeypatch.setattr(order, "modes_shown", lambda problem, false_alarm=0.01: 0)
     cap = order.order_cap(1, pr.shape[2], 20, 0)
     assert cap < 50
     assert order.ESCALATE * cap < order.order_limit(1, pr.shape[2])

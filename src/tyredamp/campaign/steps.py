@@ -8,28 +8,30 @@ step names, settings dictionaries and documents, never the processing
 itself, so pointing this module at :mod:`tyredamp.studies` changes nothing
 else.
 
-The steps are those of :mod:`tyredamp.studies`, called with the same
-arguments and defaults as the single-test commands, and their documents are
-those of :mod:`tyredamp.documents` (the files the commands write):
+The steps are those of :data:`tyredamp.studies.registry.STEPS`, run with
+their typed settings (:mod:`tyredamp.studies.steps`), the very ``run`` the
+single-test commands call, and their documents are those of
+:mod:`tyredamp.documents` (the files the commands write); the chain of each
+study is :data:`tyredamp.studies.registry.STUDIES`:
 
 * radial ``modal``: :func:`tyredamp.io.read` (time data or FRFs); for time
-  data :func:`tyredamp.studies.radial.frf_from_time` as ``tyredamp frf``;
-  :func:`tyredamp.studies.radial.check_quality` as ``tyredamp check
-  quality``; :func:`tyredamp.studies.radial.modes_from_frf`,
-  :func:`tyredamp.studies.radial.label_wave_numbers` and
-  :func:`tyredamp.studies.verdicts.modal_verdicts` as ``tyredamp modal``;
-  the document is :func:`tyredamp.documents.modes.modes_document` (the modes
-  JSON, ``docs/modes-json.md``) with a ``"campaign"`` entry holding the FRF
-  summary and the quality check;
-* radial ``damping``: :func:`tyredamp.studies.radial.damping_from_modes` on
-  the models of that modes document
+  data :class:`~tyredamp.studies.steps.FrfStep` as ``tyredamp frf``;
+  :class:`~tyredamp.studies.steps.QualityStep` as ``tyredamp check
+  quality``; :class:`~tyredamp.studies.steps.ModalStep` (modes, wave
+  numbers, verdicts) as ``tyredamp modal``; the document is its modes
+  document (``docs/modes-json.md``) with a ``"campaign"`` entry holding the
+  FRF summary and the quality check;
+* radial ``damping``: :class:`~tyredamp.studies.steps.DampingStep` on the
+  models of that modes document
   (:func:`tyredamp.documents.modes.models_from_document`), as ``tyredamp
   damping``; the document is
   :func:`tyredamp.documents.damping.damping_document` (``docs/damping-json.md``);
-* lateral ``fit``: :func:`tyredamp.studies.lateral.lateral_data` and
-  :func:`tyredamp.studies.lateral.fit_models` as ``tyredamp lateral fit``
-  (a test where no model fits fails with the reasons); the document is
-  :func:`tyredamp.documents.lateral.lateral_fit_document`.
+* lateral ``fit``: :class:`~tyredamp.studies.steps.LateralFitStep` as
+  ``tyredamp lateral fit`` (a test where no model fits fails with the
+  reasons); the document is
+  :func:`tyredamp.documents.lateral.lateral_fit_document`;
+* any other registered step of a chain: its ``run_file(path, upstream,
+  settings, conditions)``.
 
 Skipped steps
 -------------
@@ -52,16 +54,19 @@ check or fit verdict failed has its document like any other. The radial
 
 Settings
 --------
-Each study's settings are a nested dictionary ``{step: {key: value}}`` with
-the defaults of :data:`DEFAULTS` (the single-test commands' defaults); see
+Each study's settings are a nested dictionary ``{section: {key: value}}``,
+one section per step of its chain (the modal step also reads the ``frf`` and
+``checks`` sections): the fields of the step's settings class with their
+defaults (the single-test commands' defaults), plus the step's switch
+(``damping.enabled``, ``checks.quality``) when it has one; see
 ``docs/campaign.md``. :func:`validate_settings` checks a campaign file's
-table against them.
+table against the classes (unknown keys refused); :func:`settings_schema`
+gives the ``settings`` part of the campaign file's JSON schema.
 """
 
 from __future__ import annotations
 
 import json
-import math
 import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -71,6 +76,8 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import InputError
+from ..studies import registry as _registry
+from ..studies.steps import knobs
 from .skips import (
     SKIP_KIND,
     StepSkipped,
@@ -98,232 +105,35 @@ __all__ = [
     "validate_settings",
 ]
 
-_ESTIMATORS = ("H1", "H2", "Hv")
-_FRF_METHODS = ("auto", "cyclic", "welch", "transient", "lrm", "lpm")
-_MODAL_MODELS = ("both", "real", "complex")
-_DAMPING_METHODS = ("first", "improved", "refined")
-_WEIGHTS = ("auto", "relative", "coherence", "uniform")
-
-#: Default settings of each study (the defaults of the single-test commands).
-DEFAULTS: dict[str, dict[str, dict[str, Any]]] = {
-    "radial": {
-        "frf": {"estimator": "H1", "method": "auto", "segment": None, "band": None},
-        "checks": {"quality": True, "coherence_min": 0.9, "max_low_fraction": 0.1},
-        "modal": {
-            "band": None,
-            "model": "both",
-            "n_modes": None,
-            "frequencies": None,
-            "max_order": None,
-            "order_step": 2,
-            "residuals": True,
-        },
-        "damping": {
-            "enabled": True,
-            "method": "improved",
-            "model": "complex",
-            "samples": 200,
-            "seed": 0,
-            "normalise": True,
-        },
-    },
-    "lateral": {
-        "fit": {
-            "models": None,
-            "force": None,
-            "wheel_mass_kg": None,
-            "band": None,
-            "weights": "auto",
-            "criterion": "bic",
-            "channel": None,
-        },
-    },
-}
+#: The studies a campaign test can belong to, and their chains of steps (the registry's).
+STUDIES = _registry.STUDIES
+#: Kept for readers of the old name: a study's chain of steps.
+StudySteps = _registry.Study
 
 
-@dataclass(frozen=True)
-class StudySteps:
-    """The chain of steps of one study.
-
-    Attributes
-    ----------
-    name : str
-        ``"radial"`` or ``"lateral"``.
-    steps : tuple of str
-        Step names in order; a step's cache key includes the keys of the steps
-        before it.
-    settings_of : dict of str to tuple of str
-        For each step, the settings sections (keys of the study's settings)
-        its result depends on.
-    optional : frozenset of str
-        Steps that are skipped when their ``enabled`` setting is false.
-    conditions_of : dict of str to tuple of str
-        For each step, the test conditions its result depends on (part of its
-        cache key; the lateral fit uses the speed).
-    """
-
-    name: str
-    steps: tuple[str, ...]
-    settings_of: dict[str, tuple[str, ...]]
-    optional: frozenset[str] = field(default_factory=frozenset)
-    conditions_of: dict[str, tuple[str, ...]] = field(default_factory=dict)
+def _section_defaults(section: str) -> dict[str, Any]:
+    step = _registry.STEPS[section]
+    switch = getattr(step, "switch", None)
+    table = {switch: True} if switch else {}
+    return {**table, **_registry.settings_class(section).defaults()}
 
 
-#: The studies a campaign test can belong to.
-STUDIES: dict[str, StudySteps] = {
-    "radial": StudySteps(
-        "radial",
-        ("modal", "damping"),
-        {"modal": ("frf", "checks", "modal"), "damping": ("damping",)},
-        frozenset({"damping"}),
-        conditions_of={"modal": ("channel_map",)},  # the test's channel map (time data)
-    ),
-    "lateral": StudySteps(
-        "lateral", ("fit",), {"fit": ("fit",)}, conditions_of={"fit": ("speed_kmh",)}
-    ),
-}
+def defaults(study: str) -> dict[str, dict[str, Any]]:
+    """The default settings of ``study``, ``{section: {key: value}}`` (from the step classes)."""
+    return {sec: _section_defaults(sec) for sec in STUDIES[study].sections}
 
 
-# ------------------------------------------------------------------ settings
-def _band(value: Any, where: str) -> list[float] | None:
-    if value is None:
-        return None
-    if (
-        not isinstance(value, list | tuple)
-        or len(value) != 2
-        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
-    ):
-        raise InputError(f"{where}: expected [f_lo, f_hi] in Hz, got {value!r}")
-    lo, hi = float(value[0]), float(value[1])
-    if not (math.isfinite(lo) and math.isfinite(hi) and 0 <= lo < hi):
-        raise InputError(f"{where}: expected 0 <= f_lo < f_hi, got {value!r}")
-    return [lo, hi]
-
-
-def _choice(options: Sequence[str]) -> Callable[[Any, str], Any]:
-    def check(value: Any, where: str) -> Any:
-        if value not in options:
-            raise InputError(f"{where}: expected one of {list(options)}, got {value!r}")
-        return value
-
-    return check
-
-
-def _boolean(value: Any, where: str) -> bool:
-    if not isinstance(value, bool):
-        raise InputError(f"{where}: expected true or false, got {value!r}")
-    return value
-
-
-def _int_min(lo: int, optional: bool = True) -> Callable[[Any, str], Any]:
-    def check(value: Any, where: str) -> Any:
-        if value is None and optional:
-            return None
-        if not isinstance(value, int) or isinstance(value, bool) or value < lo:
-            raise InputError(f"{where}: expected an integer >= {lo}, got {value!r}")
-        return value
-
-    return check
-
-
-def _fraction(value: Any, where: str) -> float:
-    if not isinstance(value, int | float) or isinstance(value, bool) or not 0 <= value <= 1:
-        raise InputError(f"{where}: expected a number in [0, 1], got {value!r}")
-    return float(value)
-
-
-def _positive_list(value: Any, where: str) -> list[float] | None:
-    if value is None:
-        return None
-    ok = isinstance(value, list) and len(value) > 0
-    ok = ok and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
-    if not ok or not all(math.isfinite(v) and v > 0 for v in value):
-        raise InputError(f"{where}: expected a non-empty list of frequencies > 0 Hz, got {value!r}")
-    return [float(v) for v in value]
-
-
-def _models(value: Any, where: str) -> list[str] | None:
-    if value is None:
-        return None
-    from ..lateral.models import get_model_class
-
-    if not isinstance(value, list) or not value or not all(isinstance(v, str) for v in value):
-        raise InputError(f"{where}: expected a non-empty list of model names, got {value!r}")
-    try:
-        return [get_model_class(v).name for v in value]
-    except (InputError, KeyError, ValueError) as exc:
-        raise InputError(f"{where}: {exc}") from None
-
-
-def _nonneg_or_none(value: Any, where: str) -> float | None:
-    if value is None:
-        return None
-    if not isinstance(value, int | float) or isinstance(value, bool) or not value >= 0:
-        raise InputError(f"{where}: expected a number >= 0, got {value!r}")
-    return float(value)
-
-
-def _channel(value: Any, where: str) -> list[int] | None:
-    if value is None:
-        return None
-    if (
-        not isinstance(value, list)
-        or len(value) != 2
-        or not all(isinstance(v, int) and not isinstance(v, bool) and v >= 1 for v in value)
-    ):
-        raise InputError(
-            f"{where}: expected [output, input] counted from 1 (as --channel), got {value!r}"
-        )
-    return [int(v) for v in value]
-
-
-_CHECKS: dict[str, dict[str, dict[str, Callable[[Any, str], Any]]]] = {
-    "radial": {
-        "frf": {
-            "estimator": _choice(_ESTIMATORS),
-            "method": _choice(_FRF_METHODS),
-            "segment": _int_min(2),
-            "band": _band,
-        },
-        "checks": {
-            "quality": _boolean,
-            "coherence_min": _fraction,
-            "max_low_fraction": _fraction,
-        },
-        "modal": {
-            "band": _band,
-            "model": _choice(_MODAL_MODELS),
-            "n_modes": _int_min(1),
-            "frequencies": _positive_list,
-            "max_order": _int_min(2),
-            "order_step": _int_min(1, optional=False),
-            "residuals": _boolean,
-        },
-        "damping": {
-            "enabled": _boolean,
-            "method": _choice(_DAMPING_METHODS),
-            "model": _choice(("complex", "real")),
-            "samples": _int_min(0, optional=False),
-            "seed": _int_min(0, optional=False),
-            "normalise": _boolean,
-        },
-    },
-    "lateral": {
-        "fit": {
-            "models": _models,
-            "force": _choice(("ground", "axle", None)),  # type: ignore[arg-type]
-            "wheel_mass_kg": _nonneg_or_none,
-            "band": _band,
-            "weights": _choice(_WEIGHTS),
-            "criterion": _choice(("bic", "aic")),
-            "channel": _channel,
-        },
-    },
-}
+#: Default settings of each study (the defaults of the single-test commands), from the
+#: settings classes of :mod:`tyredamp.studies.steps` when this module was imported.
+DEFAULTS: dict[str, dict[str, dict[str, Any]]] = {s: defaults(s) for s in STUDIES}
 
 
 def validate_settings(study: str, table: Any, where: str) -> dict[str, dict[str, Any]]:
     """Check one study's settings table and fill in the defaults.
+
+    Each section is the settings class of its step
+    (:func:`tyredamp.studies.registry.settings_class`; unknown keys refused),
+    plus the step's switch (``enabled``, ``quality``) when it has one.
 
     Parameters
     ----------
@@ -331,46 +141,89 @@ def validate_settings(study: str, table: Any, where: str) -> dict[str, dict[str,
         ``"radial"`` or ``"lateral"``.
     table : dict or None
         ``{section: {key: value}}`` from the campaign file (missing sections
-        and keys take the defaults of :data:`DEFAULTS`).
+        and keys take the defaults).
     where : str
         Prefix for error messages (file and key path).
 
     Returns
     -------
     dict
-        The complete settings, ``{section: {key: value}}``.
+        The complete settings, ``{section: {key: value}}`` (JSON-ready).
 
     Raises
     ------
     InputError
         Unknown study, section or key, or a bad value (the message names it).
     """
-    if study not in DEFAULTS:
-        raise InputError(f"{where}: unknown study {study!r}; expected one of {sorted(DEFAULTS)}")
+    if study not in STUDIES:
+        raise InputError(f"{where}: unknown study {study!r}; expected one of {sorted(STUDIES)}")
     table = {} if table is None else table
     if not isinstance(table, dict):
         raise InputError(f"{where}: expected a table of sections, got {table!r}")
+    sections = STUDIES[study].sections
+    unknown = sorted(set(table) - set(sections))
+    if unknown:
+        raise InputError(
+            f"{where}: unknown section {unknown[0]!r}; expected one of {sorted(sections)}"
+        )
     out: dict[str, dict[str, Any]] = {}
-    for section, defaults in DEFAULTS[study].items():
+    for section in sections:
         given = table.get(section, {})
         if not isinstance(given, dict):
             raise InputError(f"{where}.{section}: expected a table, got {given!r}")
-        unknown = sorted(set(given) - set(defaults))
+        given = dict(given)
+        switch = getattr(_registry.STEPS[section], "switch", None)
+        head: dict[str, Any] = {}
+        if switch:
+            on = given.pop(switch, True)
+            if not isinstance(on, bool):
+                raise InputError(f"{where}.{section}.{switch}: expected true or false, got {on!r}")
+            head[switch] = on
+        cls = _registry.settings_class(section)
+        unknown = sorted(set(given) - set(knobs(cls)))
         if unknown:
             raise InputError(
-                f"{where}.{section}: unknown key {unknown[0]!r}; expected one of {sorted(defaults)}"
+                f"{where}.{section}: unknown key {unknown[0]!r}; "
+                f"expected one of {sorted([*head, *knobs(cls)])}"
             )
-        sec: dict[str, Any] = {}
-        for key, default in defaults.items():
-            value = given.get(key, default)
-            sec[key] = _CHECKS[study][section][key](value, f"{where}.{section}.{key}")
-        out[section] = sec
-    unknown = sorted(set(table) - set(DEFAULTS[study]))
-    if unknown:
-        raise InputError(
-            f"{where}: unknown section {unknown[0]!r}; expected one of {sorted(DEFAULTS[study])}"
-        )
+        settings = cls.from_mapping(given, f"{where}.{section}")
+        out[section] = {**head, **settings.to_dict()}
     return out
+
+
+def settings_schema() -> dict[str, Any]:
+    """The ``settings`` part of the campaign file's JSON schema, from the step classes.
+
+    ``tyredamp/schemas/campaign.schema.json`` holds it as written by this
+    function (a test compares them).
+    """
+    import inspect
+
+    studies: dict[str, Any] = {}
+    for study, chain in STUDIES.items():
+        props: dict[str, Any] = {}
+        for section in chain.sections:
+            cls = _registry.settings_class(section)
+            sec = cls.schema()
+            switch = getattr(_registry.STEPS[section], "switch", None)
+            if switch:
+                on = {
+                    "type": "boolean",
+                    "default": True,
+                    "description": f"false: the campaign does not run the {section} step.",
+                }
+                sec["properties"] = {switch: on, **sec["properties"]}
+            text = " ".join((inspect.getdoc(cls) or "").split("\n\n")[0].split())
+            props[section] = {"description": text, **sec}
+        studies[study] = {"type": "object", "additionalProperties": False, "properties": props}
+    return {"type": "object", "additionalProperties": False, "properties": studies}
+
+
+def section_settings(section: str, table: Mapping[str, Any]) -> Any:
+    """The typed settings of one validated section (its switch left out)."""
+    switch = getattr(_registry.STEPS[section], "switch", None)
+    cls = _registry.settings_class(section)
+    return cls.from_mapping({k: v for k, v in table.items() if k != switch})
 
 
 def step_settings(study: str, step: str, settings: Mapping[str, Any]) -> dict[str, Any]:
@@ -385,9 +238,10 @@ def step_conditions(study: str, step: str, conditions: Mapping[str, Any]) -> dic
 
 def step_enabled(study: str, step: str, settings: Mapping[str, Any]) -> bool:
     """False when an optional step is switched off in ``settings``."""
-    if step not in STUDIES[study].optional:
+    switch = getattr(_registry.STEPS[step], "switch", None)
+    if not switch:
         return True
-    return bool(settings[step].get("enabled", True))
+    return bool(settings[step].get(switch, True))
 
 
 # ------------------------------------------------------------------ steps
@@ -422,14 +276,11 @@ def _radial_modal(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
     """``tyredamp frf`` (time data only), ``check quality`` and ``tyredamp modal``."""
-    from ..documents.modes import modes_document
     from ..frf import FRF
     from ..io import ChannelMap, read
     from ..signal.checks import dependent_forces
-    from ..studies.radial import check_quality, frf_from_time, label_wave_numbers, modes_from_frf
-    from ..studies.verdicts import modal_verdicts
+    from ..studies.steps import FrfStep, ModalStep, QualityStep
 
-    fs, cs, ms = settings["frf"], settings["checks"], settings["modal"]
     obj = read(path, ChannelMap.from_dict((conditions or {}).get("channel_map") or {}))
     if not isinstance(obj, FRF):  # output-only data: said in one line, with what to do
         obj.require_force("the modal step (an FRF from time data)", path.name)
@@ -437,7 +288,8 @@ def _radial_modal(
         frf = obj
         source_kind = "frf"
     else:
-        dep = dependent_forces(obj) if len(obj.force_indices) > 1 else []
+        fs = section_settings("frf", settings["frf"])
+        dep = dependent_forces(obj) if len(obj.force_indices) > 1 and not fs.reference else []
         if dep:  # every force channel is an input: refused as 'tyredamp frf' does
             k, r2, uses = dep[0]
             lab = obj.channels
@@ -447,34 +299,13 @@ def _radial_modal(
                 "independent excitations (one is a reaction); give the FRFs, or time data "
                 "with the excitation forces only"
             )
-        frf = frf_from_time(
-            obj,
-            fs["estimator"],
-            method=None if fs["method"] == "auto" else fs["method"],
-            segment_samples=fs["segment"],
-            band=None if fs["band"] is None else (fs["band"][0], fs["band"][1]),
-        )
+        frf, _ = FrfStep.run(obj, fs, "settings.radial.frf.")
         source_kind = "time"
     quality = None
-    if cs["quality"]:
-        quality = check_quality(
-            obj, coherence_min=cs["coherence_min"], max_low_fraction=cs["max_low_fraction"]
-        )
-    res = modes_from_frf(
-        frf,
-        band=None if ms["band"] is None else (ms["band"][0], ms["band"][1]),
-        model=ms["model"],
-        n_modes=ms["n_modes"],
-        frequencies=ms["frequencies"],
-        max_order=ms["max_order"],
-        order_step=ms["order_step"],
-        residuals=ms["residuals"],
-    )
-    for mdl in res.models.values():
-        label_wave_numbers(mdl)
-    for name, v in modal_verdicts(frf, res).items():  # meta.verdict, as 'tyredamp modal'
-        res.models[name].meta["verdict"] = v.to_dict()
-    doc = modes_document(res.models, source=path.name, band_hz=res.band_hz, frf_kind=res.frf_kind)
+    if step_enabled("radial", "checks", settings):
+        quality, _ = QualityStep.run(obj, section_settings("checks", settings["checks"]))
+    res, verdicts = ModalStep.run(frf, section_settings("modal", settings["modal"]))
+    doc = ModalStep.document(res, verdicts, source=path.name)
     doc["campaign"] = {
         "input": source_kind,
         "n_out": frf.n_out,
@@ -490,88 +321,55 @@ def _radial_damping(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
     """``tyredamp damping`` on the modes document of the modal step."""
-    from ..documents.damping import damping_document
     from ..documents.modes import models_from_document
-    from ..studies.radial import damping_from_modes
+    from ..studies.steps import DampingStep
 
-    ds = settings["damping"]
-    skip = damping_skip_reason(upstream["modal"], ds["model"])
+    ds = section_settings("damping", settings["damping"])
+    skip = damping_skip_reason(upstream["modal"], ds.model)
     if skip is not None:
         raise skip
     models = models_from_document(dict(upstream["modal"]))
-    if ds["model"] not in models:
+    if ds.model not in models:
         raise InputError(
             f"settings.radial.damping.model: the modes hold models {sorted(models)}, "
-            f"not {ds['model']!r}"
+            f"not {ds.model!r}"
         )
-    dm = damping_from_modes(
-        models,
-        model=ds["model"],
-        method=ds["method"],
-        normalise=ds["normalise"],
-        n_samples=ds["samples"],
-        seed=ds["seed"],
-        meta={"source": path.name, "model": ds["model"]},
-    )
-    return damping_document(dm)
+    dm, _ = DampingStep.run(models, ds, meta={"source": path.name, "model": ds.model})
+    return DampingStep.document(dm)
 
 
 def _lateral_fit(
     path: Path, upstream: Mapping[str, Any], settings: Mapping[str, Any], conditions: Any
 ) -> dict[str, Any]:
     """``tyredamp lateral fit`` with the test's speed."""
-    from ..documents.lateral import lateral_fit_document
     from ..io import read_frf
-    from ..lateral import DEFAULT_MODELS
-    from ..lateral.models import get_model_class
-    from ..studies.lateral import fit_models, lateral_data
+    from ..studies.steps import LateralFitStep
 
-    s = settings["fit"]
     frf = read_frf(path)
-    channel = s["channel"]
-    where = "settings.lateral.fit"
-    if channel is not None and (channel[0] > frf.n_out or channel[1] > frf.n_in):
-        raise InputError(
-            f"{where}.channel: expected an output 1..{frf.n_out} and an input 1..{frf.n_in} "
-            f"of {path.name}, got {channel}"
-        )
-    if channel is None and frf.n_out * frf.n_in != 1:
-        raise InputError(
-            f"{where}.channel: {path.name} holds {frf.n_out}x{frf.n_in} FRFs and a lateral "
-            "fit takes one; choose it with channel = [OUT, IN] (counted from 1)"
-        )
     speed_kmh = None if conditions is None else conditions.get("speed_kmh")
-    data = lateral_data(
+    result, _ = LateralFitStep.run(
         frf,
+        section_settings("fit", settings["fit"]),
         speed_kmh=None if speed_kmh is None else float(speed_kmh),
-        force=s["force"],
-        wheel_mass=s["wheel_mass_kg"],
+        source=path.name,
     )
-    names = s["models"] or list(DEFAULT_MODELS)
-    if data.speed is None:
-        need = [n for n in names if "speed" in get_model_class(n).condition_names]
-        if need:
-            raise InputError(
-                f"speed_kmh: the {', '.join(need)} model(s) need the travel speed and "
-                f"{path.name} does not store it; give the test's speed_kmh"
-            )
-    ranking = fit_models(
-        data,
-        names,
-        criterion=s["criterion"],
-        band=None if s["band"] is None else (s["band"][0], s["band"][1]),
-        weights=s["weights"],
-        channel=None if channel is None else (channel[0] - 1, channel[1] - 1),
-    )
-    ranking.check()  # no model fits: the test fails with the reasons, as the command does
-    return lateral_fit_document(ranking, data, source=path.name, frf_kind=frf.kind)
+    return LateralFitStep.document(result, source=path.name, frf_kind=frf.kind)
 
 
-_STEP_FUNCTIONS: dict[tuple[str, str], Callable[..., dict[str, Any]]] = {
-    ("radial", "modal"): _radial_modal,
-    ("radial", "damping"): _radial_damping,
-    ("lateral", "fit"): _lateral_fit,
+#: The campaign's own recipes of the built-in steps (a registered step that is not
+#: here runs with its ``run_file``).
+_STEP_FUNCTIONS: dict[str, Callable[..., dict[str, Any]]] = {
+    "modal": _radial_modal,
+    "damping": _radial_damping,
+    "fit": _lateral_fit,
 }
+
+
+def _step_function(step: str) -> Callable[..., dict[str, Any]]:
+    fn = _STEP_FUNCTIONS.get(step)
+    if fn is None:
+        fn = _registry.STEPS[step].run_file
+    return fn
 
 
 def run_step(
@@ -606,7 +404,7 @@ def run_step(
     skip = upstream_skip(STUDIES[study].steps, step, upstream)
     if skip is not None:
         raise skip
-    fn = _STEP_FUNCTIONS[(study, step)]
+    fn = _step_function(step)
     return fn(Path(path), upstream, settings, conditions)
 
 

@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Any
 
 import click
 
 from ..exceptions import InputError
 from ..io import read, read_frf
 from ..signal.checks import CheckResult
-from ..studies.radial import check_linearity, check_quality, check_reciprocity
+from ..studies.radial import check_linearity, check_reciprocity
+from ..studies.steps import QualitySettings, QualityStep
 from ._common import channel_map, channel_map_options, echo_read_notes
+from ._settings import settings_from_options, settings_options
 
 __all__ = ["check_group"]
 
@@ -123,32 +126,11 @@ def reciprocity_cmd(
 
 @check_group.command("quality")
 @click.argument("data_file", type=_FILE)
-@click.option(
-    "--coherence-min",
-    type=click.FloatRange(0, 1),
-    default=0.9,
-    show_default=True,
-    help="Lines with multiple coherence below this count as low.",
-)
-@click.option(
-    "--max-low-fraction",
-    type=click.FloatRange(0, 1),
-    default=0.1,
-    show_default=True,
-    help="Largest accepted fraction of low-coherence lines.",
-)
-@_band
+@settings_options(QualitySettings)
 @_strict
 @channel_map_options
 @click.pass_context
-def quality_cmd(
-    ctx: click.Context,
-    data_file: Path,
-    coherence_min: float,
-    max_low_fraction: float,
-    band: tuple[float, float] | None,
-    strict: bool,
-) -> None:
+def quality_cmd(ctx: click.Context, data_file: Path, strict: bool, **options: Any) -> None:
     """Clipping, dead channels, low-coherence bands and drive-point passivity.
 
     DATA_FILE holds time data (all checks; the FRF is estimated with H1 and
@@ -158,6 +140,7 @@ def quality_cmd(
     Example:
       tyredamp check quality tyre_test.uff --coherence-min 0.9 --band 30 200 --strict
     """
+    settings = settings_from_options(QualitySettings, options)
     obj = read(data_file, channel_map())
     echo_read_notes(obj)
     if getattr(obj, "output_only", False):
@@ -165,10 +148,5 @@ def quality_cmd(
             "note: output-only data (no force channel): clipping and dead channels are "
             "checked; coherence and passivity need a force (name it with --channel NAME=force:N)"
         )
-    result = check_quality(
-        obj,
-        coherence_min=coherence_min,
-        max_low_fraction=max_low_fraction,
-        band=band or None,
-    )
+    result, _ = QualityStep.run(obj, settings)
     _finish(ctx, result, strict)

@@ -14,15 +14,15 @@ from typing import Any
 import click
 import numpy as np
 
-from ..damping import METHODS, DampingModel, no_std_note
-from ..damping.modeset import parse_mode_numbers
+from ..damping import DampingModel, no_std_note
 from ..documents.damping import write_damping_json
 from ..documents.modes import read_modes
 from ..exceptions import InputError
 from ..io._common import check_input_file
 from ..io._safety import check_output_file
-from ..studies.radial import damping_from_modes
-from ._common import out_file_option, seed_option
+from ..studies.steps import DampingSettings, DampingStep
+from ._common import out_file_option
+from ._settings import settings_from_options, settings_options
 
 __all__ = ["damping_command", "damping_summary"]
 
@@ -77,58 +77,8 @@ def _ranges(nums: list[int]) -> str:
 @click.command("damping")
 @click.argument("modes_json", type=click.Path(dir_okay=False, path_type=Path))
 @out_file_option("Damping JSON file to write.")
-@click.option(
-    "--method",
-    type=click.Choice(METHODS),
-    default="improved",
-    show_default=True,
-    help="first: eq. [16]; improved: eq. [18]; refined: bias-corrected (exact for "
-    "consistent modes).",
-)
-@click.option(
-    "--model",
-    "model_name",
-    default="complex",
-    show_default=True,
-    help="Which model of the modes file to use (complex modes carry the coupling).",
-)
-@click.option(
-    "--samples",
-    type=click.IntRange(min=0),
-    default=200,
-    show_default=True,
-    help="Monte Carlo samples for the standard errors (0 to skip).",
-)
-@seed_option("Monte Carlo seed.")
-@click.option(
-    "--modes",
-    "mode_numbers",
-    metavar="LIST",
-    help="Modes to use, numbered from 1 in order of frequency: e.g. 1,2,5-7 (default all).",
-)
-@click.option(
-    "--band",
-    type=(float, float),
-    default=None,
-    metavar="F1 F2",
-    help="Use only the modes with natural frequency in F1..F2 Hz.",
-)
-@click.option(
-    "--no-normalise",
-    is_flag=True,
-    help="Skip the alpha_n^(n) = 1 phase normalisation of the complex shapes.",
-)
-def damping_command(
-    modes_json: Path,
-    out: Path,
-    method: str,
-    model_name: str,
-    samples: int,
-    seed: int,
-    mode_numbers: str | None,
-    band: tuple[float, float] | None,
-    no_normalise: bool,
-) -> None:
+@settings_options(DampingSettings)
+def damping_command(modes_json: Path, out: Path, **options: Any) -> None:
     """Identify the viscous damping matrix from the complex modes in MODES_JSON.
 
     MODES_JSON is a modes JSON file (tyredamp modal) or a UFF file (.uff,
@@ -155,28 +105,15 @@ def damping_command(
       tyredamp damping beam_modes.uff -o beam_damping.json --modes 1-3,5
     """
     check_output_file(out, [modes_json])
+    settings = settings_from_options(DampingSettings, options)
     models = read_modes(check_input_file(modes_json))
-    if model_name not in models:
-        raise InputError(f"--model: {modes_json} holds models {sorted(models)}, not {model_name!r}")
-    meta: dict[str, Any] = {"source": str(modes_json), "model": model_name}
-    try:
-        numbers = None if mode_numbers is None else parse_mode_numbers(mode_numbers)
-    except InputError as exc:
-        raise InputError(f"--{exc}") from None
-    if band is not None and not band[0] < band[1]:
-        raise InputError(f"--band: expected F1 < F2 in Hz, got {band[0]:g} {band[1]:g}")
-    try:
-        dm = damping_from_modes(
-            models,
-            model=model_name,
-            method=method,  # type: ignore[arg-type]
-            normalise=not no_normalise,
-            n_samples=samples,
-            seed=seed,
-            meta=meta,
-            modes=numbers,
-            band=band,
+    if settings.model not in models:
+        raise InputError(
+            f"--model: {modes_json} holds models {sorted(models)}, not {settings.model!r}"
         )
+    meta: dict[str, Any] = {"source": str(modes_json), "model": settings.model}
+    try:
+        dm, _ = DampingStep.run(models, settings, meta)
     except InputError as exc:  # the option's name, as the user typed it
         if str(exc).startswith(("modes:", "band:")):
             raise InputError(f"--{exc}") from None

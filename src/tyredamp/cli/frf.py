@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 import numpy as np
@@ -12,38 +13,12 @@ from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
 from ..io._safety import check_output_file
 from ..signal.checks import dependent_forces
-from ..signal.estimators import ESTIMATORS
-from ..studies.radial import frf_from_time
+from ..studies.steps import FrfSettings, FrfStep, samples
 from ..timedata import TimeData
 from ._common import channel_map, channel_map_options, echo_read_notes, out_file_option
+from ._settings import settings_from_options, settings_options
 
 __all__ = ["frf_command", "frf_summary", "samples"]
-
-
-def samples(text: str, sample_rate: float, option: str) -> int:
-    """A length given as samples (``"4096"``) or seconds (``"0.5s"``) in whole samples.
-
-    Seconds must be a whole number of samples at ``sample_rate`` (to 1e-6 of
-    a sample); otherwise, and for text that is neither, :class:`InputError`
-    names the option.
-    """
-    t = str(text).strip().lower()
-    seconds = t.endswith("s")
-    try:
-        value = float(t[:-1]) * sample_rate if seconds else float(int(t))
-    except ValueError:
-        raise InputError(
-            f"{option}: expected samples (4096) or seconds (0.5s), got {text!r}"
-        ) from None
-    n = round(value) if np.isfinite(value) else -1
-    if seconds and (n < 0 or abs(value - n) > 1e-6 * max(1.0, abs(value))):
-        raise InputError(
-            f"{option}: {text!r} is {value:.6g} samples at {sample_rate:g} Hz, not a whole "
-            "non-negative number; give samples"
-        )
-    if n < 0:
-        raise InputError(f"{option}: expected a non-negative length, got {text!r}")
-    return int(n)
 
 
 def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
@@ -92,46 +67,7 @@ def _refuse_dependent_forces(td: TimeData) -> None:
 @click.command("frf")
 @click.argument("time_file", type=click.Path(dir_okay=False, path_type=Path))
 @out_file_option("FRF file to write (.uff, .unv, .csv, .npz or .nc).")
-@click.option(
-    "--estimator",
-    type=click.Choice(ESTIMATORS),
-    default="H1",
-    show_default=True,
-    help="H1 (noise on outputs), H2 (noise on inputs) or Hv (total least squares).",
-)
-@click.option(
-    "--reference",
-    "references",
-    multiple=True,
-    metavar="CHANNEL",
-    help="Force channel to use as input (label like 1+Z, channel name or node number); "
-    "repeat for MIMO. Default: every force channel.",
-)
-@click.option(
-    "--method",
-    type=click.Choice(["auto", "cyclic", "welch", "transient", "lrm", "lpm"]),
-    default="auto",
-    show_default=True,
-    help="auto: cyclic when the file states a period, transient when it states a record "
-    "length, else decided from the data (periodic: cyclic; impact: transient; random: Welch). "
-    "lrm/lpm: local rational/polynomial method on the whole record (random excitation).",
-)
-@click.option("--segment", type=click.IntRange(min=2), help="Welch/transient segment in samples.")
-@click.option(
-    "--period",
-    metavar="SAMPLES|SECONDS",
-    help="Period of a periodic excitation: samples (4096) or seconds (0.5s); it must be a "
-    "whole number of samples. Default: from the file, else detected from the force.",
-)
-@click.option(
-    "--settle",
-    metavar="SAMPLES|SECONDS",
-    help="Samples (or seconds, 2s) to drop at the start (transient). Default: from the "
-    "file, else detected for periodic data.",
-)
-@click.option(
-    "--band", nargs=2, type=float, metavar="F_LO F_HI", help="Keep lines in this band (Hz)."
-)
+@settings_options(FrfSettings)
 @click.option(
     "--format",
     "fmt",
@@ -139,18 +75,7 @@ def _refuse_dependent_forces(td: TimeData) -> None:
     help="Output format; default from the extension (.uff/.unv: binary UFF 58b).",
 )
 @channel_map_options
-def frf_command(
-    time_file: Path,
-    out: Path,
-    estimator: str,
-    references: tuple[str, ...],
-    method: str,
-    segment: int | None,
-    period: str | None,
-    settle: str | None,
-    band: tuple[float, float] | None,
-    fmt: str | None,
-) -> None:
+def frf_command(time_file: Path, out: Path, fmt: str | None, **options: Any) -> None:
     """Estimate FRFs (with coherence) from TIME_FILE and write them to --out.
 
     TIME_FILE holds force and response channels (UFF 58 function type 1,
@@ -173,22 +98,14 @@ def frf_command(
     """
     check_output_file(out, [time_file])
     out_format = format_of(out, fmt)
+    settings = settings_from_options(FrfSettings, options)
     td = read_timedata(time_file, channel_map())
     echo_read_notes(td)
     td.require_force("an FRF", time_file)
     td.require_response("an FRF", time_file)
-    if not references and len(td.force_indices) > 1:
+    if not settings.reference and len(td.force_indices) > 1:
         _refuse_dependent_forces(td)
-    frf = frf_from_time(
-        td,
-        estimator,  # type: ignore[arg-type]
-        reference=list(references) or None,
-        method=None if method == "auto" else method,  # type: ignore[arg-type]
-        segment_samples=segment,
-        period_samples=None if period is None else samples(period, td.sample_rate, "--period"),
-        settle_samples=None if settle is None else samples(settle, td.sample_rate, "--settle"),
-        band=band or None,
-    )
+    frf, _ = FrfStep.run(td, settings, "--")
     write_frf(frf, out, out_format)
     for row in frf_summary(frf):
         click.echo(row)

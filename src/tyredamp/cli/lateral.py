@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -23,22 +24,21 @@ from ..documents.lateral import write_lateral_fit
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, read_frf, write_frf
 from ..io._safety import check_output_file
-from ..lateral.fit import DEFAULT_MODELS
-from ..lateral.models import MODELS, get_model_class
-from ..studies.lateral import fit_models, lateral_data
+from ..studies.steps import LateralFitSettings, LateralFitStep
 from ..virtual.lateral_rig import KMH, VirtualLateralRig
 from ._common import out_file_option, seed_option
+from ._settings import settings_from_options, settings_options
 
 __all__ = ["lateral_group"]
 
 
-def _model_list(values: tuple[str, ...]) -> list[str]:
-    names: list[str] = []
-    for v in values:
-        names += [s.strip() for s in v.split(",") if s.strip()]
-    if not names:
-        return list(DEFAULT_MODELS)
-    return [get_model_class(n).name for n in names]
+#: How the command line names the channel and the speed in messages.
+_LABELS = {
+    "channel": "--channel",
+    "channel_form": "--channel OUT IN",
+    "speed": "--speed",
+    "speed_form": "give --speed KMH",
+}
 
 
 def _with_unit(name: str, value: float, unit: str) -> str:
@@ -60,14 +60,8 @@ def lateral_group() -> None:
 @lateral_group.command("fit")
 @click.argument("frf_file", type=click.Path(dir_okay=False, path_type=Path))
 @out_file_option("JSON file to write (layout in the module docs).")
-@click.option(
-    "--models",
-    "models",
-    multiple=True,
-    metavar="NAMES",
-    help=f"Models to compare, comma-separated or repeated; from {sorted(MODELS)} "
-    "or aliases (proposed, lines ...). Default: classic, maxwell, viscoplastic, "
-    "hysteretic.",
+@settings_options(
+    LateralFitSettings, skip=("force", "wheel_mass_kg", "band", "weights", "criterion", "channel")
 )
 @click.option(
     "--speed",
@@ -76,56 +70,8 @@ def lateral_group() -> None:
     help="Travel speed in km/h (default from the file's meta). Needed by the "
     "relaxation and string models.",
 )
-@click.option(
-    "--wheel-mass",
-    "wheel_mass",
-    type=float,
-    metavar="KG",
-    help="Wheel mass for axle-force FRFs, kg (default from the file's meta, else 0).",
-)
-@click.option(
-    "--force",
-    type=click.Choice(["ground", "axle"]),
-    help="Force the FRF refers to (default from the file's meta, else ground).",
-)
-@click.option(
-    "--band", nargs=2, type=float, metavar="F_LO F_HI", help="Fit only lines in this band (Hz)."
-)
-@click.option(
-    "--weights",
-    type=click.Choice(["auto", "relative", "coherence", "uniform"]),
-    default="auto",
-    show_default=True,
-    help="Residual weights: auto = coherence if the FRF has it, else relative.",
-)
-@click.option(
-    "--criterion",
-    type=click.Choice(["bic", "aic"]),
-    default="bic",
-    show_default=True,
-    help="Information criterion used for the ranking.",
-)
-@click.option(
-    "--channel",
-    nargs=2,
-    type=click.IntRange(min=1),
-    default=None,
-    metavar="OUT IN",
-    help="Output and input of the FRF to fit, counted from 1 like every other option "
-    "(needed when the file holds more than one FRF).",
-)
-def fit_command(
-    frf_file: Path,
-    out: Path,
-    models: tuple[str, ...],
-    speed: float | None,
-    wheel_mass: float | None,
-    force: str | None,
-    band: tuple[float, float] | None,
-    weights: str,
-    criterion: str,
-    channel: tuple[int, int] | None,
-) -> None:
+@settings_options(LateralFitSettings, skip=("models",))
+def fit_command(frf_file: Path, out: Path, speed: float | None, **options: Any) -> None:
     """Fit lateral tyre models to a measured FRF and rank them.
 
     FRF_FILE holds lateral acceleration (or displacement/velocity) per lateral
@@ -137,52 +83,22 @@ def fit_command(
           --speed 5 --force axle --wheel-mass 100
     """
     check_output_file(out, [frf_file])
+    settings = settings_from_options(LateralFitSettings, options)
     frf = read_frf(frf_file)
-    names = _model_list(models)
     if speed is not None and not (math.isfinite(speed) and speed > 0):
         raise InputError(f"--speed: expected a speed > 0 km/h, got {speed}")
-    if channel is not None and (channel[0] > frf.n_out or channel[1] > frf.n_in):
-        raise InputError(
-            f"--channel: expected an output 1..{frf.n_out} and an input 1..{frf.n_in} of "
-            f"{frf_file}, got {channel[0]} {channel[1]}"
-        )
-    if channel is None and frf.n_out * frf.n_in != 1:
-        raise InputError(
-            f"--channel: {frf_file} holds {frf.n_out}x{frf.n_in} FRFs and a lateral fit takes "
-            "one; choose it with --channel OUT IN (counted from 1)"
-        )
-    data = lateral_data(
-        frf,
-        speed_kmh=speed,
-        force=force,  # type: ignore[arg-type]
-        wheel_mass=wheel_mass,
+    (ranking, data), _ = LateralFitStep.run(
+        frf, settings, speed_kmh=speed, source=str(frf_file), labels=_LABELS
     )
-    if data.speed is None:
-        need = [n for n in names if "speed" in get_model_class(n).condition_names]
-        if need:
-            raise InputError(
-                f"--speed: the {', '.join(need)} model{'s' if len(need) > 1 else ''} "
-                f"need{'' if len(need) > 1 else 's'} the travel speed and {frf_file} does not "
-                "store it; give --speed KMH"
-            )
-    ranking = fit_models(
-        data,
-        names,
-        criterion=criterion,  # type: ignore[arg-type]
-        band=band,
-        weights=weights,
-        channel=None if channel is None else (channel[0] - 1, channel[1] - 1),
-    )
-    ranking.check()  # no model fits: exit 3 with the reasons, nothing written
     best = ranking.best
     write_lateral_fit(out, ranking, data, source=str(frf_file), frf_kind=frf.kind)
     assumed = []
-    if force is None and "force" not in frf.meta:
+    if settings.force is None and "force" not in frf.meta:
         assumed.append(
             "the file does not say which force the FRF refers to: ground assumed "
             "(give --force axle for an axle-force FRF)"
         )
-    if wheel_mass is None and "wheel_mass_kg" not in frf.meta and data.force == "axle":
+    if settings.wheel_mass_kg is None and "wheel_mass_kg" not in frf.meta and data.force == "axle":
         assumed.append("the file gives no wheel mass: 0 kg assumed (give --wheel-mass KG)")
     for a in assumed:
         click.echo(f"note: {a}", err=True)

@@ -3,21 +3,21 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 import numpy as np
 
-from ..documents.modes import write_modes_json
+from ..documents.jsonfile import write_json
 from ..exceptions import InputError
 from ..frf import FRF, Channel
 from ..io import read_frf
 from ..io._safety import check_output_file
-from ..modal.identify import ModalIdentification
 from ..modal.model import ModalModel
 from ..modal.quality import rejected_summary
-from ..studies.radial import label_wave_numbers, modes_from_frf
-from ..studies.verdicts import modal_verdicts
+from ..studies.steps import ModalSettings, ModalStep
 from ._common import channel_map, channel_map_options, out_file_option
+from ._settings import settings_from_options, settings_options
 
 __all__ = ["modal_command", "modes_table"]
 
@@ -92,20 +92,6 @@ def _likelihood_rows(model: ModalModel) -> list[str]:
     ]
 
 
-def _parse_frequencies(text: str | None) -> list[float] | None:
-    if text is None:
-        return None
-    try:
-        vals = [float(x) for x in text.replace(";", ",").split(",") if x.strip()]
-    except ValueError:
-        raise InputError(
-            f"--frequencies: expected numbers separated by commas, got {text!r}"
-        ) from None
-    if not vals:
-        raise InputError("--frequencies: expected at least one frequency")
-    return vals
-
-
 def _with_geometry(frf: FRF, path: Path) -> FRF:
     """The FRF with channel angles from the geometry when its points lie on a circle."""
     from dataclasses import replace
@@ -130,44 +116,7 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
 @click.command("modal")
 @click.argument("frf_file", type=click.Path(dir_okay=False, path_type=Path))
 @out_file_option("Modes JSON file to write (schema: docs/modes-json.md).")
-@click.option(
-    "--band", nargs=2, type=float, metavar="F_LO F_HI", help="Analysis band in Hz (default all)."
-)
-@click.option(
-    "--model",
-    type=click.Choice(["both", "real", "complex"]),
-    default="both",
-    show_default=True,
-    help="Real modes (proportional damping, eq. 2/3), complex modes (eq. 10) or both.",
-)
-@click.option("--modes", "n_modes", type=click.IntRange(min=1), help="Number of modes to keep.")
-@click.option(
-    "--frequencies",
-    metavar="F1,F2,...",
-    help="Approximate natural frequencies (Hz) of the wanted modes; overrides --modes.",
-)
-@click.option(
-    "--max-order",
-    type=click.IntRange(min=2),
-    help="Highest pLSCF model order (default 60 / number of inputs).",
-)
-@click.option(
-    "--order-step",
-    type=click.IntRange(min=1),
-    default=2,
-    show_default=True,
-    help="Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
-)
-@click.option("--no-residuals", is_flag=True, help="Fit without lower/upper residual terms.")
-@click.option(
-    "--false-alarm",
-    type=click.FloatRange(min=0.0, max=1.0, min_open=True, max_open=True),
-    default=0.01,
-    show_default=True,
-    help="False-alarm rate of the mode test: probability that a fit of pure noise keeps a "
-    "noise mode (also the level of the goodness-of-fit test).",
-)
-@click.option("--no-search", is_flag=True, help="Skip the residual-driven search for missed modes.")
+@settings_options(ModalSettings, skip=("estimator",))
 @click.option(
     "--geometry",
     "geometry_file",
@@ -175,21 +124,9 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
     help="UFF geometry (nodes 15/2411, trace lines 82, systems 18/2420): every channel's node "
     "must be in it; points on a circle get their angles from it (ring views).",
 )
+@settings_options(ModalSettings, only=("estimator",))
 @channel_map_options
-def modal_command(
-    frf_file: Path,
-    out: Path,
-    band: tuple[float, float] | None,
-    model: str,
-    n_modes: int | None,
-    frequencies: str | None,
-    max_order: int | None,
-    order_step: int,
-    no_residuals: bool,
-    geometry_file: Path | None,
-    false_alarm: float,
-    no_search: bool,
-) -> None:
+def modal_command(frf_file: Path, out: Path, geometry_file: Path | None, **options: Any) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
 
     Poles come from a poly-reference LSCF stabilisation diagram with automatic
@@ -206,37 +143,20 @@ def modal_command(
       tyredamp modal tyre_frf.uff --out modes.json --band 0 200
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
+    settings = settings_from_options(ModalSettings, options)
     check_output_file(out, [frf_file])
     frf = read_frf(frf_file, channel_map=channel_map())
     if geometry_file is not None:
         frf = _with_geometry(frf, geometry_file)
     try:
-        res: ModalIdentification = modes_from_frf(
-            frf,
-            band=None if band is None else (float(band[0]), float(band[1])),
-            model=model,  # type: ignore[arg-type]
-            n_modes=n_modes,
-            frequencies=_parse_frequencies(frequencies),
-            max_order=max_order,
-            order_step=order_step,
-            residuals=not no_residuals,
-            false_alarm=false_alarm,
-            search=not no_search,
-        )
+        res, verdicts = ModalStep.run(frf, settings)
     except InputError as e:  # the limits of the data, named by the option that set them
         msg = str(e)
         for arg, opt in (("n_modes:", "--modes:"), ("frequencies:", "--frequencies:")):
             if msg.startswith(arg):
                 raise InputError(opt + msg[len(arg) :]) from None
         raise
-    for mdl in res.models.values():
-        label_wave_numbers(mdl)
-    verdicts = modal_verdicts(frf, res)
-    for name, v in verdicts.items():  # stored with the model: meta.verdict of the modes JSON
-        res.models[name].meta["verdict"] = v.to_dict()
-    write_modes_json(
-        out, res.models, source=frf_file.name, band_hz=res.band_hz, frf_kind=res.frf_kind
-    )
+    write_json(ModalStep.document(res, verdicts, source=frf_file.name), out)
     click.echo(
         f"FRF {frf_file.name}: {frf.n_out} output(s) x {frf.n_in} input(s), {res.frf_kind}, "
         f"band {res.band_hz[0]:g}-{res.band_hz[1]:g} Hz, {res.frequency.size} lines"

@@ -13,6 +13,11 @@ known poles)::
 
     identify_modes(frf, estimator=my_estimator)
 
+A named estimator is one line of :data:`ESTIMATORS` (:func:`register_estimator`):
+the command line (``tyredamp modal --estimator NAME``), a campaign file
+(``[settings.radial.modal] estimator = "NAME"``) and Python
+(``identify_modes(frf, estimator="NAME")``) then all select it by that name.
+
 The identification calls it with the normalised data of the band (unit RMS,
 :class:`~tyredamp.modal.problem.FitProblem`) and reads, per pole, its order
 (stability is judged between consecutive computed orders) and its
@@ -27,9 +32,16 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from .lscf import PoleSet
+from ..exceptions import InputError
+from .lscf import PoleSet, plscf
 
-__all__ = ["PoleEstimator"]
+__all__ = [
+    "DEFAULT_ESTIMATOR",
+    "ESTIMATORS",
+    "PoleEstimator",
+    "get_estimator",
+    "register_estimator",
+]
 
 
 class PoleEstimator(Protocol):
@@ -66,3 +78,30 @@ class PoleEstimator(Protocol):
         band: tuple[float, float],
         order_step: int,
     ) -> PoleSet: ...
+
+
+#: The pole estimators selectable by name (``--estimator``, a campaign's ``estimator``).
+ESTIMATORS: dict[str, PoleEstimator] = {"plscf": plscf}
+#: The estimator used when none is named.
+DEFAULT_ESTIMATOR = "plscf"
+
+
+def register_estimator(name: str, estimator: PoleEstimator) -> None:
+    """Make ``estimator`` selectable by ``name`` everywhere (replaces one of that name)."""
+    if not isinstance(name, str) or not name.strip() or not callable(estimator):
+        raise InputError(f"estimator: expected a name and a callable, got {name!r}")
+    ESTIMATORS[name] = estimator
+
+
+def get_estimator(estimator: str | PoleEstimator | None) -> PoleEstimator:
+    """The estimator of a name of :data:`ESTIMATORS` (a callable is returned as it is;
+    None gives the default)."""
+    if estimator is None:
+        return ESTIMATORS[DEFAULT_ESTIMATOR]
+    if callable(estimator):
+        return estimator
+    if estimator not in ESTIMATORS:
+        raise InputError(
+            f"estimator: expected a pole estimator of {sorted(ESTIMATORS)}, got {estimator!r}"
+        )
+    return ESTIMATORS[estimator]

@@ -96,7 +96,7 @@ from ..exceptions import InputError
 from ..frf import FRF, FRFKind
 from ..mechanics.modal_sum import kind_factor, pole_from_frequency_damping
 from .compress import _compress, combine_outputs
-from .estimators import PoleEstimator
+from .estimators import PoleEstimator, get_estimator
 from .final import ModelContext, final_complex, fit_real, to_model
 from .fit import FitResult, ModalFitter
 from .lscf import PoleSet, plscf
@@ -202,7 +202,7 @@ def identify_modes(
     min_contribution: float = 0.0,
     max_helpers: int = 4,
     variance: ArrayLike | None = None,
-    estimator: PoleEstimator | None = None,
+    estimator: PoleEstimator | str | None = None,
     search: bool = True,
     blas_threads: int | None = 1,
 ) -> ModalIdentification:
@@ -247,9 +247,10 @@ def identify_modes(
         Variance of each line of ``frf.H``; default ``frf.variance`` when
         present, else from the coherence and ``meta["n_averages"]``, else
         estimated from the residual (:mod:`tyredamp.modal.problem`).
-    estimator : PoleEstimator, optional
-        Pole estimator (default :func:`~tyredamp.modal.lscf.plscf`; protocol
-        in :mod:`tyredamp.modal.estimators`).
+    estimator : PoleEstimator or str, optional
+        Pole estimator, or its name in :data:`~tyredamp.modal.estimators.ESTIMATORS`
+        (default ``"plscf"``, :func:`~tyredamp.modal.lscf.plscf`; protocol in
+        :mod:`tyredamp.modal.estimators`).
     search : bool
         Residual-driven search for missed modes (default True; automatic count).
     blas_threads : int or None
@@ -283,6 +284,7 @@ def identify_modes(
     >>> modes.quality.passed  # the residual is within the noise
     True
     """
+    est = get_estimator(estimator)
 
     def run(v: ArrayLike | None, note: str = "") -> ModalIdentification:
         return _identify(
@@ -302,7 +304,7 @@ def identify_modes(
             min_contribution=min_contribution,
             max_helpers=max_helpers,
             variance=v,
-            estimator=estimator,
+            estimator=est,
             search=search,
             noise_note=note,
         )
@@ -396,7 +398,7 @@ def _identify(
     rules = SelectionRules(order_step, max_damping, cluster_distance, min_fraction)
     est: PoleEstimator = plscf if estimator is None else estimator
     p_start = default_order(n_in, n_f, nm_hint) if max_order is None else int(max_order)
-    dg = settle_order(problem, est, p_start, rules, automatic=max_order is None)
+    dg = settle_order(problem, est, p_start, rules, max_order is None, false_alarm)
     auto = fr is None and n_modes is None
     warnings: list[str] = []
     modes, rej = _start_modes(problem, dg, fr, n_modes, min_fraction, warnings)

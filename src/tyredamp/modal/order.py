@@ -168,16 +168,19 @@ def settle_order(
     p_start: int,
     rules: SelectionRules,
     automatic: bool,
+    false_alarm: float = FALSE_ALARM,
 ) -> Diagram:
     """Diagram of the automatic order (sizing rule and trial raises, up to
-    :func:`order_cap` of the modes the data show, or up to ``ESCALATE`` times
-    that cap and :func:`order_limit` when no mode is stable at the cap), or of
-    ``p_start``."""
+    :func:`order_cap` of the modes the data show at ``false_alarm``, or up to
+    ``ESCALATE`` times that cap and :func:`order_limit` when no mode is stable at
+    the cap), or of ``p_start``."""
     n_in = problem.shape[1]
     full = order_limit(n_in, problem.shape[2])
     limit = full
     if automatic:
-        limit = min(limit, order_cap(n_in, problem.shape[2], p_start, modes_shown(problem)))
+        limit = min(
+            limit, order_cap(n_in, problem.shape[2], p_start, modes_shown(problem, false_alarm))
+        )
     cur = diagram(problem, estimator, p_start, rules)
     trial: Diagram | None = None  # the diagram before a trial raise
     while automatic:

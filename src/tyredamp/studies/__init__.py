@@ -4,6 +4,10 @@
   complex modes -> damping matrix.
 * :mod:`.lateral` -- paper 001: lateral FRFs -> model fits and ranking ->
   corner frequency, vehicle, time response.
+* :mod:`.steps` -- one module per step (frf, checks, modal, damping, lateral
+  fit): its typed settings, each knob declared once, and its ``run``;
+  :mod:`.registry` lists them (``STEPS``) and the chains a campaign runs
+  (``STUDIES``).
 * :mod:`.demo` -- both studies on the built-in virtual tyres
   (:func:`~tyredamp.studies.demo.run_demo`); the result types are in
   :mod:`.results`; saving the demo output is :func:`tyredamp.report.demo.save_demo`.

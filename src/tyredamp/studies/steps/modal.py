@@ -1,0 +1,149 @@
+"""The ``modal`` step: real and complex modes of FRFs, their verdicts and the modes document.
+
+The whole recipe of ``tyredamp modal``, of a campaign's modal step and of
+Python is :meth:`ModalStep.run` (modes, then the wave numbers of ring
+outputs, then the verdict of each fit), and :meth:`ModalStep.document` puts
+the verdicts into the modes document (``meta.verdict`` of each model,
+``docs/modes-json.md``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from ...frf import FRF
+from ...modal.estimators import DEFAULT_ESTIMATOR, ESTIMATORS
+from ...modal.identify import ModalIdentification
+from ...modal.stats import FALSE_ALARM
+from ._settings import (
+    Band,
+    Boolean,
+    Choice,
+    Integer,
+    Number,
+    Positives,
+    Registered,
+    StepSettings,
+    knob,
+)
+
+__all__ = ["MODAL_MODELS", "ModalSettings", "ModalStep"]
+
+#: The modal models a fit can give.
+MODAL_MODELS: tuple[str, ...] = ("both", "real", "complex")
+
+
+@dataclass(frozen=True)
+class ModalSettings(StepSettings):
+    """How modes are identified from FRFs (``tyredamp modal``; a campaign's
+    ``[settings.radial.modal]``; :func:`~tyredamp.modal.identify_modes`)."""
+
+    section: ClassVar[str] = "modal"
+
+    band: tuple[float, float] | None = knob(
+        None, "Analysis band in Hz (default all).", Band(), "--band", unit="Hz", metavar="F_LO F_HI"
+    )
+    model: str = knob(
+        "both",
+        "Real modes (proportional damping, eq. 2/3), complex modes (eq. 10) or both.",
+        Choice(MODAL_MODELS),
+        "--model",
+    )
+    n_modes: int | None = knob(None, "Number of modes to keep.", Integer(1), "--modes")
+    frequencies: tuple[float, ...] | None = knob(
+        None,
+        "Approximate natural frequencies (Hz) of the wanted modes; overrides --modes.",
+        Positives(),
+        "--frequencies",
+        unit="Hz",
+        metavar="F1,F2,...",
+    )
+    max_order: int | None = knob(
+        None,
+        "Highest pLSCF model order (default 60 / number of inputs).",
+        Integer(2),
+        "--max-order",
+    )
+    order_step: int = knob(
+        2,
+        "Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
+        Integer(1, optional=False),
+        "--order-step",
+    )
+    residuals: bool = knob(
+        True, "Fit without lower/upper residual terms.", Boolean(), "--no-residuals"
+    )
+    false_alarm: float = knob(
+        FALSE_ALARM,
+        "False-alarm rate of the mode test: probability that a fit of pure noise keeps a "
+        "noise mode (also the level of the goodness-of-fit test).",
+        Number(0.0, 1.0, open=True, optional=False),
+        "--false-alarm",
+    )
+    search: bool = knob(
+        True, "Skip the residual-driven search for missed modes.", Boolean(), "--no-search"
+    )
+    estimator: str = knob(
+        DEFAULT_ESTIMATOR,
+        "Pole estimator of the stabilisation diagram, by name (plscf: poly-reference LSCF).",
+        Registered(lambda: ESTIMATORS, "pole estimator"),
+        "--estimator",
+    )
+
+
+class ModalStep:
+    """FRF -> modes (:class:`~tyredamp.modal.identify.ModalIdentification`) and the
+    verdict of each fitted model."""
+
+    name: ClassVar[str] = "modal"
+    Settings: ClassVar[type[ModalSettings]] = ModalSettings
+    #: in a campaign: the FRF of time data and the quality check come first
+    sections: ClassVar[tuple[str, ...]] = ("frf", "checks", "modal")
+    #: in a campaign: the test's channel map reads its time data
+    conditions: ClassVar[tuple[str, ...]] = ("channel_map",)
+
+    @staticmethod
+    def run(frf: FRF, settings: ModalSettings) -> tuple[ModalIdentification, dict[str, Any]]:
+        """Identify the modes of ``frf``; returns them and ``{model: FitVerdict}``.
+
+        Each model gets the wave numbers of its modes when the outputs carry
+        their angles on the ring
+        (:func:`~tyredamp.studies.radial.label_wave_numbers`); the verdicts are
+        returned, not stored in the models (:meth:`document` stores them).
+        """
+        from ..radial import label_wave_numbers, modes_from_frf
+        from ..verdicts import modal_verdicts
+
+        s = settings
+        res = modes_from_frf(
+            frf,
+            band=s.band,
+            model=s.model,  # type: ignore[arg-type]
+            n_modes=s.n_modes,
+            frequencies=s.frequencies,
+            max_order=s.max_order,
+            order_step=s.order_step,
+            residuals=s.residuals,
+            false_alarm=s.false_alarm,
+            search=s.search,
+            estimator=ESTIMATORS[s.estimator],
+        )
+        for mdl in res.models.values():
+            label_wave_numbers(mdl)
+        return res, dict(modal_verdicts(frf, res))
+
+    @staticmethod
+    def document(
+        result: ModalIdentification, verdicts: dict[str, Any], *, source: str = ""
+    ) -> dict[str, Any]:
+        """The modes document (``docs/modes-json.md``) with each model's verdict
+        in its ``meta.verdict``."""
+        from ...documents.modes import modes_document
+
+        doc = modes_document(
+            result.models, source=source, band_hz=result.band_hz, frf_kind=result.frf_kind
+        )
+        for name, v in verdicts.items():
+            doc["models"][name].setdefault("meta", {})["verdict"] = v.to_dict()
+        return doc
