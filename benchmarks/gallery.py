@@ -828,7 +828,7 @@ def _rows() -> list[Row]:
                 row_beam_point(k),
                 subprocess=(k == 1),
                 needs_references=True,
-                xfail=BEAM_GAP if k > 1 else "",
+                xfail=BEAM_GAP if k == 3 else "",
             )
         )
     rows += [

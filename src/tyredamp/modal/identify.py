@@ -82,8 +82,6 @@ fit is tested against the noise (``ModalModel.quality``).
 from __future__ import annotations
 
 import dataclasses
-import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -93,16 +91,15 @@ from numpy.typing import ArrayLike, NDArray
 from .._blas import blas_threads as blas_limit
 from .._validate import as_finite
 from ..exceptions import InputError
-from ..frf import FRF, FRFKind
-from ..mechanics.modal_sum import kind_factor, pole_from_frequency_damping
+from ..frf import FRF
+from ..mechanics.modal_sum import pole_from_frequency_damping
 from .compress import _compress, combine_outputs
 from .estimators import PoleEstimator, get_estimator
 from .final import ModelContext, final_complex, fit_real, to_model
 from .fit import FitResult, ModalFitter
 from .lscf import PoleSet, plscf
 from .model import ModalModel
-from .model_error import EPS_TOLERANCE, noise_floor, relative_model_error
-from .model_error import PASSES as MODEL_ERROR_PASSES
+from .model_error import with_model_error
 from .order import Diagram, SelectionRules, default_order, modes_shown, settle_order
 from .out_of_band import search_helpers
 from .problem import FitProblem, build_problem, max_modes
@@ -182,6 +179,29 @@ class ModalIdentification:
     warnings: list[str] = field(default_factory=list)
     noise_source: str = "residual"
     model_error: float = 0.0
+
+
+@dataclass(frozen=True)
+class IdentifyOptions:
+    """The settings of :func:`identify_modes`, one object (its parameters, in its
+    order, but the data ``frf``, ``band``, ``variance`` and ``blas_threads``;
+    ``estimator`` resolved to a function). Documented there."""
+
+    model: ModelChoice = "both"
+    n_modes: int | None = None
+    frequencies: ArrayLike | None = None
+    max_order: int | None = None
+    order_step: int = 2
+    residuals: bool = True
+    refine: bool = True
+    max_damping: float = 0.2
+    cluster_distance: float = 0.01
+    min_fraction: float = 0.3
+    false_alarm: float = FALSE_ALARM
+    min_contribution: float = 0.0
+    max_helpers: int = 4
+    estimator: PoleEstimator | None = None
+    search: bool = True
 
 
 def identify_modes(
@@ -284,142 +304,60 @@ def identify_modes(
     >>> modes.quality.passed  # the residual is within the noise
     True
     """
-    est = get_estimator(estimator)
-
-    def run(v: ArrayLike | None, note: str = "") -> ModalIdentification:
-        return _identify(
-            frf,
-            band,
-            model,
-            n_modes=n_modes,
-            frequencies=frequencies,
-            max_order=max_order,
-            order_step=order_step,
-            residuals=residuals,
-            refine=refine,
-            max_damping=max_damping,
-            cluster_distance=cluster_distance,
-            min_fraction=min_fraction,
-            false_alarm=false_alarm,
-            min_contribution=min_contribution,
-            max_helpers=max_helpers,
-            variance=v,
-            estimator=est,
-            search=search,
-            noise_note=note,
-        )
-
+    o = IdentifyOptions(
+        model, n_modes, frequencies, max_order, order_step, residuals, refine, max_damping,
+        cluster_distance, min_fraction, false_alarm, min_contribution, max_helpers,
+        get_estimator(estimator), search,
+    )  # fmt: skip
     with blas_limit(blas_threads):
-        first = run(variance)
-        return _with_model_error(frf, variance, first, run)
-
-
-def _with_model_error(
-    frf: FRF,
-    variance: ArrayLike | None,
-    first: ModalIdentification,
-    run: Callable[[ArrayLike | None, str], ModalIdentification],
-) -> ModalIdentification:
-    """``first`` again with a noise level that includes the model error, when its fit
-    leaves structure beyond the measured noise (:mod:`tyredamp.modal.model_error`)."""
-    kind = "complex" if "complex" in first.models else "real"
-    q = first.models[kind].quality
-    if first.noise_source != "residual":
-        return first  # a measured noise: a fit that misses it has failed, and says so
-    if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
-        return first
-    problem = build_problem(frf, first.band_hz, variance=variance)
-    lines = problem.lines
-    H = np.asarray(frf.H)[:, :, lines]
-    m1 = first.models[kind]
-    floor = noise_floor(frf, problem, _model_band(m1, problem, frf.kind) - H)
-    V = floor.variance[:, :, lines]
-
-    def eps_of(res: ModalIdentification) -> float:
-        m = res.models[kind]
-        dof = m.quality.dof if m.quality is not None else 0
-        return relative_model_error(H, _model_band(m, problem, frf.kind), V, dof)
-
-    eps, res = eps_of(first), first
-    # each pass decides the modes against the eps of the fits before it; a pass
-    # whose fit gives back a larger eps (it merged a split, so the model error
-    # shows) is followed by one against that eps: the sequence only rises, to the
-    # largest eps the fits of the data give back (the fixed point of eq. (2) that
-    # holds the fewest modes; a split fit reproduces its own smaller eps too)
-    for _ in range(MODEL_ERROR_PASSES):
-        if eps <= 0.0:
-            return first
-        v = floor.variance.copy()
-        v[:, :, lines] += eps**2 * np.abs(H) ** 2
-        res = run(v, f"{floor.what} plus a model error of {eps:.2%} of the response")
-        again = eps_of(res)
-        if again <= eps * (1.0 + EPS_TOLERANCE):
-            break
-        eps = again
-    res.warnings.append(
-        f"the fit left structure beyond {floor.what} that no modal sum explains (leakage, "
-        "a window, a non-linearity, ...): modes were decided and their uncertainty stated "
-        f"against a noise that includes a model error of {eps:.2%} of the response"
-    )
-    return dataclasses.replace(res, model_error=eps)
+        first = _identify(frf, band, o, variance)
+        res, eps = with_model_error(
+            frf, variance, first, lambda v, note: _identify(frf, band, o, v, note)
+        )
+    return res if eps == 0.0 else dataclasses.replace(res, model_error=eps)
 
 
 def _identify(
     frf: FRF,
     band: tuple[float, float] | None,
-    model: ModelChoice,
-    *,
-    n_modes: int | None,
-    frequencies: ArrayLike | None,
-    max_order: int | None,
-    order_step: int,
-    residuals: bool,
-    refine: bool,
-    max_damping: float,
-    cluster_distance: float,
-    min_fraction: float,
-    false_alarm: float,
-    min_contribution: float,
-    max_helpers: int,
+    o: IdentifyOptions,
     variance: ArrayLike | None,
-    estimator: PoleEstimator | None,
-    search: bool,
     noise_note: str = "",
 ) -> ModalIdentification:
-    """The body of :func:`identify_modes` (its parameters but ``blas_threads``;
-    ``noise_note`` says what a given ``variance`` is)."""
-    if model not in ("both", "complex", "real"):
-        raise InputError(f"model: expected 'both', 'complex' or 'real', got {model!r}")
+    """The body of :func:`identify_modes` (``noise_note`` says what a given
+    ``variance`` is, :attr:`~tyredamp.modal.problem.FitProblem.noise_note`)."""
+    if o.model not in ("both", "complex", "real"):
+        raise InputError(f"model: expected 'both', 'complex' or 'real', got {o.model!r}")
     problem = build_problem(frf, band, variance=variance, noise_note=noise_note)
     _, n_in, n_f = problem.shape
     lo, hi = problem.band
-    fr = _check_counts(problem, n_modes, frequencies)
-    nm_hint = int(n_modes) if n_modes is not None else (None if fr is None else fr.size)
-    rules = SelectionRules(order_step, max_damping, cluster_distance, min_fraction)
-    est: PoleEstimator = plscf if estimator is None else estimator
-    p_start = default_order(n_in, n_f, nm_hint) if max_order is None else int(max_order)
-    dg = settle_order(problem, est, p_start, rules, max_order is None, false_alarm)
-    auto = fr is None and n_modes is None
+    fr = _check_counts(problem, o.n_modes, o.frequencies)
+    nm_hint = int(o.n_modes) if o.n_modes is not None else (None if fr is None else fr.size)
+    rules = SelectionRules(o.order_step, o.max_damping, o.cluster_distance, o.min_fraction)
+    est: PoleEstimator = plscf if o.estimator is None else o.estimator
+    p_start = default_order(n_in, n_f, nm_hint) if o.max_order is None else int(o.max_order)
+    dg = settle_order(problem, est, p_start, rules, o.max_order is None, o.false_alarm)
+    auto = fr is None and o.n_modes is None
     warnings: list[str] = []
-    modes, rej = _start_modes(problem, dg, fr, n_modes, min_fraction, warnings)
-    fitters = _Fitters.build(problem, residuals, modes, max_helpers)
-    thr, test = _threshold(problem, "complex", false_alarm), _mode_test(problem, false_alarm)
-    opts = (auto, refine, max_helpers, min_contribution, search, (lo, hi))
+    modes, rej = _start_modes(problem, dg, fr, o.n_modes, o.min_fraction, warnings)
+    fitters = _Fitters.build(problem, o.residuals, modes, o.max_helpers)
+    thr, test = _threshold(problem, "complex", o.false_alarm), _mode_test(problem, o.false_alarm)
+    opts = (auto, o.refine, o.max_helpers, o.min_contribution, o.search, (lo, hi))
     last, modes, more = _select(fitters, modes, dg, rej, (thr, test), *opts)
     rej = merge_rejected(rej + more)
-    sigma0 = _noise_per_output(problem, fitters, modes, last, refine)
+    sigma0 = _noise_per_output(problem, fitters, modes, last, o.refine)
     ctx = {
         "problem": problem,
         "max_order": dg.order,
-        "order_step": order_step,
+        "order_step": o.order_step,
         "threshold": thr,
         "test": test,
-        "false_alarm": false_alarm,
+        "false_alarm": o.false_alarm,
         "kept": None if auto else tuple(_asked(fr) for _ in range(modes.m)),
         "method": _METHOD.format(est=getattr(est, "__name__", type(est).__name__)),
     }
     models, disc = _final_models(
-        problem, fitters, modes, sigma0, refine, residuals, model, ctx, rej
+        problem, fitters, modes, sigma0, o.refine, o.residuals, o.model, ctx, rej
     )
     return ModalIdentification(
         models=models,
@@ -434,13 +372,6 @@ def _identify(
         warnings=warnings,
         noise_source=problem.noise_source,
     )
-
-
-def _model_band(m: ModalModel, problem: FitProblem, kind: FRFKind) -> NDArray[np.complex128]:
-    """The model ``m`` synthesised on the band's lines of ``problem``, in the FRF ``kind``."""
-    f = problem.frequency
-    h: NDArray[np.complex128] = m.receptance(f) * kind_factor(2 * np.pi * f, kind)
-    return h
 
 
 def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:

@@ -51,22 +51,28 @@ value (at most :data:`PASSES` passes), and the last pass is the result.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol, TypeVar
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
-from ..frf import FRF
-from .problem import FitProblem
+from ..frf import FRF, FRFKind
+from ..mechanics.modal_sum import kind_factor
+from .model import ModalModel
+from .problem import FitProblem, build_problem
 from .stats import difference_noise
 
 __all__ = [
     "EPS_TOLERANCE",
     "PASSES",
+    "Identification",
     "NoiseFloor",
     "noise_floor",
     "relative_model_error",
+    "with_model_error",
 ]
 
 #: most repetitions of the identification with a re-estimated model error
@@ -157,3 +163,94 @@ def relative_model_error(
     if excess(lo) <= 0:
         return math.exp(lo)
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-3))
+
+
+class Identification(Protocol):
+    """What :func:`with_model_error` reads of an identification
+    (:class:`~tyredamp.modal.identify.ModalIdentification`)."""
+
+    @property
+    def models(self) -> dict[str, ModalModel]: ...
+    @property
+    def band_hz(self) -> tuple[float, float]: ...
+    @property
+    def noise_source(self) -> str: ...
+    @property
+    def warnings(self) -> list[str]: ...
+
+
+R = TypeVar("R", bound=Identification)
+
+
+def with_model_error(
+    frf: FRF,
+    variance: ArrayLike | None,
+    first: R,
+    run: Callable[[ArrayLike | None, str], R],
+) -> tuple[R, float]:
+    """``first`` decided again against eq. (1), when its fit leaves structure beyond
+    a noise estimated from its residual (module docstring).
+
+    Parameters
+    ----------
+    frf : FRF
+        The data ``first`` was identified from; ``variance`` the variance it was given.
+    first : identification
+        The identification against the noise alone.
+    run : callable
+        ``run(variance, note)`` identifies ``frf`` again with a per-line
+        ``variance`` (shape of ``frf.H``, units of ``H`` squared) that ``note``
+        describes.
+
+    Returns
+    -------
+    identification, float
+        The last pass (a warning added) and its ``eps``; ``(first, 0.0)`` where
+        the noise was measured, the fit passed, or eq. (2) has no root.
+    """
+    kind = "complex" if "complex" in first.models else "real"
+    q = first.models[kind].quality
+    if first.noise_source != "residual":
+        return first, 0.0  # a measured noise: a fit that misses it has failed, and says so
+    if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
+        return first, 0.0
+    problem = build_problem(frf, first.band_hz, variance=variance)
+    lines = problem.lines
+    H = np.asarray(frf.H)[:, :, lines]
+    floor = noise_floor(frf, problem, _model_band(first.models[kind], problem, frf.kind) - H)
+    V = floor.variance[:, :, lines]
+
+    def eps_of(res: R) -> float:
+        m = res.models[kind]
+        dof = m.quality.dof if m.quality is not None else 0
+        return relative_model_error(H, _model_band(m, problem, frf.kind), V, dof)
+
+    eps, res = eps_of(first), first
+    # each pass decides the modes against the eps of the fits before it; a pass
+    # whose fit gives back a larger eps (it merged a split, so the model error
+    # shows) is followed by one against that eps: the sequence only rises, to the
+    # largest eps the fits of the data give back (the fixed point of eq. (2) that
+    # holds the fewest modes; a split fit reproduces its own smaller eps too)
+    for _ in range(PASSES):
+        if eps <= 0.0:
+            return first, 0.0
+        v = floor.variance.copy()
+        v[:, :, lines] += eps**2 * np.abs(H) ** 2
+        res = run(v, f"{floor.what} plus a model error of {eps:.2%} of the response")
+        again = eps_of(res)
+        if again <= eps * (1.0 + EPS_TOLERANCE):
+            break
+        eps = again
+    res.warnings.append(
+        f"the fit left structure beyond {floor.what} that no modal sum explains (leakage, "
+        "a window, a non-linearity, ...): modes were decided and their uncertainty stated "
+        f"against a noise that includes a model error of {eps:.2%} of the response"
+    )
+    return res, eps
+
+
+def _model_band(m: ModalModel, problem: FitProblem, kind: FRFKind) -> NDArray[np.complex128]:
+    """The model ``m`` synthesised on the band's lines of ``problem``, in the FRF ``kind``."""
+    f = problem.frequency
+    h: NDArray[np.complex128] = m.receptance(f) * kind_factor(2 * np.pi * f, kind)
+    return h
