@@ -292,7 +292,10 @@ class TimeData:
             raise ShapeError(f"quantities: expected {d.shape[0]} entries, got {len(q)}")
         for qi in q:
             if qi not in QUANTITY_UNITS:
-                raise InputError(f"quantities: expected one of {tuple(QUANTITY_UNITS)}, got {qi!r}")
+                raise InputError(
+                    f"channel quantity (--channel NAME=ROLE): expected one of "
+                    f"{', '.join(QUANTITY_UNITS)}, got {qi!r}"
+                )
         d = d.copy()
         d.setflags(write=False)
         object.__setattr__(self, "data", d)

@@ -620,7 +620,7 @@ def _resolve_io(
     chans = timedata.channels
     forces = timedata.force_indices
     if not forces:
-        raise InputError("timedata: no force channel; an FRF needs a measured force")
+        timedata.require_force("an FRF")
     if reference is None:
         ref_idx = list(forces)
     else:
