@@ -678,6 +678,16 @@ def modal_fit_verdict(
                 f"{fn[k] + half:.4g} Hz) crosses the band edge; its damping is poorly "
                 "determined: widen the band"
             )
+    held = getattr(model, "residual_modes", None)
+    if held is not None and int(getattr(held, "n_modes", 0)) > 0:
+        inside = [x for x in np.asarray(held.frequency_hz, float) if band[0] <= x <= band[1]]
+        if inside:
+            at = ", ".join(f"{x:.4g}" for x in inside)
+            cautions.append(
+                f"the fit holds {len(inside)} resonance(s) inside the band at {at} Hz with "
+                "residual terms, not listed as modes: their frequency and damping are not "
+                "identified"
+            )
     mpc = model.meta.get("mpc")
     if mpc is not None and model.mode_kind == "complex":
         for k, v in enumerate(np.asarray(mpc, dtype=float)):
@@ -715,6 +725,13 @@ def modal_fit_verdict(
                 "data themselves (differences of adjacent lines, a running median) and the "
                 "structure of the residual across lines",
             )
+            if status == "failed":
+                cautions.insert(
+                    1,
+                    "that floor takes the noise as uncorrelated across lines; a window (an "
+                    "exponential or force window) correlates it and lowers the floor, so a "
+                    "residual a few times the floor may be that: a measured coherence decides",
+                )
         if model_error > 0 and status == "ok":
             cautions.append(
                 f"the identification stated its modes against a noise that includes a model "
