@@ -391,3 +391,20 @@ def test_a_fallback_of_the_refinement_is_named() -> None:
     v = modal_fit_verdict(one, meas)
     assert v.status == "failed"
     assert any("fell back to the complex-mode poles" in r for r in v.reasons)
+
+
+def test_a_resonance_held_by_residual_terms_is_said() -> None:
+    """A mode held as a residual mode inside the band: the fit may be within the noise,
+    but the verdict says that resonance is not identified as a mode."""
+    m = two_modes()
+    held = ModalModel(m.poles[1:], m.psi_out[:, 1:], m.psi_in[:, 1:])
+    one = ModalModel(
+        m.poles[:1],
+        m.psi_out[:, :1],
+        m.psi_in[:, :1],
+        residual_modes=held,
+        meta={"band_hz": [5.0, 100.0]},
+    )
+    v = modal_fit_verdict(one, measured(m, 8, 300.0, 0))
+    assert v.status == "ok", v.summary()
+    assert any("resonance(s) inside the band at 80 Hz" in c for c in v.cautions)
