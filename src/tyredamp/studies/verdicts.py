@@ -591,15 +591,22 @@ def modal_fit_verdict(
     test = None
     form = False
     missing = False
+    excess: NDArray[np.float64] | None = None
     if noise is not None:
         test = noise_test(f, measured.H, synth, noise[0], noise[1], alpha)
+        excess = np.abs(synth - measured.H) ** 2 - noise[0]
     elif f.size >= _MIN_LINES:
-        # no coherence: the noise floor of the data themselves (module docstring)
-        var = adjacent_line_variance(measured.H)
-        test = noise_test(f, measured.H, synth, var, _FLOOR_DOF, alpha)
-        r, z = residual_correlation(synth - measured.H, var)
+        # no coherence: the noise floor of the data themselves (module docstring), on
+        # the data scaled to their largest value (the test is scale-free; no overflow)
+        big = float(np.max(np.abs(measured.H)))
+        scale = big if math.isfinite(big) and big > 0 else 1.0
+        h, e = measured.H / scale, (synth - measured.H) / scale
+        var = adjacent_line_variance(h)
+        test = noise_test(f, h, h + e, var, _FLOOR_DOF, alpha)
+        excess = np.abs(e) ** 2 - var
+        r, z = residual_correlation(e, var)
         test = replace(test, noise_from="adjacent lines", correlation=r, correlation_z=z)
-        spikes = _outlying_lines(f, synth - measured.H, var, alpha)
+        spikes = _outlying_lines(f, e, var, alpha)
         if spikes and not test.structured:
             # a mode sharper than the line spacing leaves a spike, not a correlation
             test = replace(test, correlation_z=math.inf)
@@ -652,8 +659,7 @@ def modal_fit_verdict(
             reasons.append(edge)
         elif test.misfit_hz is not None:
             reasons.append(f"the misfit lies at {test.misfit_hz[0]:.4g}-{test.misfit_hz[1]:.4g} Hz")
-        excess = np.abs(synth - measured.H) ** 2 - _var_of(noise, test, measured.H)
-        there = _rejected_in(model, f, excess)
+        there = "" if excess is None else _rejected_in(model, f, excess)
         if there and not form:
             reasons.append(there)
         if any(
@@ -758,17 +764,6 @@ def _outlying_lines(
     k = 2.0 * _FLOOR_DOF * _FLOOR_LINES
     limit = float(stats.f.isf(alpha / u2.size, 2, k))
     return [float(x) for x in f[np.any(u2 > limit, axis=0)]]
-
-
-def _var_of(
-    noise: tuple[NDArray[np.float64], float] | None,
-    test: NoiseTest,
-    H: NDArray[np.complex128],
-) -> NDArray[np.float64]:
-    """The noise variance the test used (coherence, or the adjacent-line floor)."""
-    if noise is not None and test.noise_from == "coherence":
-        return noise[0]
-    return adjacent_line_variance(H)
 
 
 def _rejected_in(model: Any, f: NDArray[np.float64], excess: NDArray[np.float64]) -> str:
