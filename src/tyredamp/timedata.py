@@ -293,8 +293,8 @@ class TimeData:
         for qi in q:
             if qi not in QUANTITY_UNITS:
                 raise InputError(
-                    f"channel quantity (--channel NAME=ROLE): expected one of "
-                    f"{', '.join(QUANTITY_UNITS)}, got {qi!r}"
+                    f"channel quantity {qi!r}: expected one of {', '.join(QUANTITY_UNITS)} "
+                    "(a channel's role on the command line: --channel NAME=ROLE)"
                 )
         d = d.copy()
         d.setflags(write=False)
