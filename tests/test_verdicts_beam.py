@@ -84,7 +84,7 @@ def test_rejected_summary_gives_each_its_reason() -> None:
         ),
     ]
     text = rejected_summary(rej)
-    assert text.startswith("5 candidate(s) rejected, the strongest first: ")
+    assert text.startswith("5 candidate(s) rejected, largest mode statistic T first: ")
     assert "closest to the threshold" not in text
     # 278.67 (largest T) first, once, with its reason; then 31.2 with its T and threshold
     assert text.index("278.67 Hz: half-power band below the line spacing") < text.index(

@@ -169,7 +169,9 @@ def rejected_summary(rejected: Sequence[RejectedMode], n: int = 3) -> str:
     if not shown:
         return row
     parts = [f"{k}: {', '.join(w)}" for k, w in shown.items()]
-    first = "the strongest first" if any(np.isfinite(r.statistic) for r in rejected) else ""
+    first = (
+        "largest mode statistic T first" if any(np.isfinite(r.statistic) for r in rejected) else ""
+    )
     rest = sum(f"{r.frequency_hz:.2f} Hz" not in shown for r in rejected)
     more = f"; {rest} more" if rest > 0 else ""
     return f"{row}" + (f", {first}" if first else "") + ": " + "; ".join(parts) + more
