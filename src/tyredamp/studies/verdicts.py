@@ -620,8 +620,8 @@ def modal_fit_verdict(
             cautions.append(
                 f"the residual is {math.sqrt(test.ratio):.3g}x the noise floor of adjacent "
                 f"lines but white across lines (correlation of adjacent lines {r:.2f}, "
-                f"{z:.2g} standard deviations of white noise): the noise is larger than "
-                "that floor, not a misfit; judged within the noise"
+                f"{z:.2g} standard deviations of white noise) and on no few lines: noise "
+                "larger than that floor rather than a misfit; judged within the noise"
             )
             test = replace(test, threshold=max(test.threshold, test.ratio))
     if test is not None and not test.passed:
