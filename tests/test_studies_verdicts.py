@@ -408,3 +408,27 @@ def test_a_resonance_held_by_residual_terms_is_said() -> None:
     v = modal_fit_verdict(one, measured(m, 8, 300.0, 0))
     assert v.status == "ok", v.summary()
     assert any("resonance(s) inside the band at 80 Hz" in c for c in v.cautions)
+
+
+def test_lateral_verdict_without_coherence_is_judged() -> None:
+    """The rig's FRF without its coherence: the lateral fit is judged against the noise
+    floor of adjacent lines, which is the noise the coherence gives."""
+    from tyredamp.lateral import fit_model
+    from tyredamp.virtual import VirtualLateralRig
+
+    rig = VirtualLateralRig()
+    data = rig.measure(5.0, 1.7, "ground", 0)
+    fit = fit_model(data, "hysteretic")
+    frf = data.frf
+    bare = FRF(frf.frequency, frf.H, frf.kind, frf.outputs, frf.inputs)
+    v = lateral_fit_verdict(fit, bare)
+    assert v.test is not None
+    assert v.test.noise_from == "adjacent lines"
+    assert v.status in ("ok", "failed")
+    assert v.cautions[0].startswith("no coherence: judged against the noise floor")
+    with_coherence = lateral_fit_verdict(fit, frf)
+    assert with_coherence.test is not None
+    # the floor of 176 lines is the coherence's noise to within 20 % in variance (a
+    # median over 21 lines, about 5 degrees of freedom each: the ratio of the two
+    # statistics is 0.82-1.23 over seeds 0-5, 0.94 for this seed)
+    assert v.test.ratio == pytest.approx(with_coherence.test.ratio, rel=0.2)

@@ -115,12 +115,15 @@ __all__ = [
     "CAUSE_OUTSIDE_FAMILY",
     "FitVerdict",
     "NoiseTest",
+    "adjacent_line_variance",
+    "floor_test",
     "frf_noise_variance",
     "lateral_family_verdicts",
     "lateral_fit_verdict",
     "modal_fit_verdict",
     "modal_verdicts",
     "noise_test",
+    "residual_correlation",
 ]
 
 #: Significance level of the test against the noise.
@@ -514,6 +517,69 @@ def residual_correlation(
     return r, r * math.sqrt(2.0 * u.shape[0] * (u.shape[-1] - 1))
 
 
+def floor_test(
+    frequency: NDArray[np.float64],
+    measured: NDArray[np.complex128],
+    fitted: NDArray[np.complex128],
+    alpha: float = ALPHA,
+) -> tuple[NoiseTest, NDArray[np.float64], list[str]]:
+    """Test a fit without coherence against the noise floor of adjacent lines.
+
+    The residual against :func:`adjacent_line_variance`, its correlation
+    across lines (:func:`residual_correlation`) and its outlying lines
+    (module docstring), on the data scaled to their largest value (the test
+    is scale-free).
+
+    Parameters
+    ----------
+    frequency : ndarray, shape (n_freq,)
+        Hz, adjacent lines.
+    measured, fitted : ndarray, complex, shape (..., n_freq)
+    alpha : float
+        Significance level.
+
+    Returns
+    -------
+    test : NoiseTest
+        ``noise_from="adjacent lines"``; a white residual above the floor on no
+        few lines passes (its threshold raised to its ratio) with a caution.
+    excess : ndarray, shape of ``measured``
+        ``|e|^2 - var`` of the scaled data.
+    cautions : list of str
+    """
+    f = np.asarray(frequency, dtype=float)
+    h0: NDArray[np.complex128] = np.asarray(measured, dtype=complex)
+    big = float(np.max(np.abs(h0)))
+    scale = big if math.isfinite(big) and big > 0 else 1.0
+    h: NDArray[np.complex128] = h0 / scale
+    e: NDArray[np.complex128] = (np.asarray(fitted, dtype=complex) - h0) / scale
+    var = adjacent_line_variance(h)
+    test = noise_test(f, h, h + e, var, _FLOOR_DOF, alpha)
+    excess = np.abs(e) ** 2 - var
+    r, z = residual_correlation(e, var)
+    test = replace(test, noise_from="adjacent lines", correlation=r, correlation_z=z)
+    cautions: list[str] = []
+    spikes = _outlying_lines(f, e, var, alpha)
+    if spikes and not test.structured:
+        # a mode sharper than the line spacing leaves a spike, not a correlation
+        test = replace(test, correlation_z=math.inf)
+        cautions.append(
+            "the residual stands out of the noise floor at "
+            + ", ".join(f"{x:.6g}" for x in spikes[:5])
+            + " Hz"
+            + (f" and {len(spikes) - 5} more line(s)" if len(spikes) > 5 else "")
+        )
+    if not test.passed and not test.structured:
+        cautions.append(
+            f"the residual is {math.sqrt(test.ratio):.3g}x the noise floor of adjacent "
+            f"lines but white across lines (correlation of adjacent lines {r:.2f}, "
+            f"{z:.2g} standard deviations of white noise) and on no few lines: noise "
+            "larger than that floor rather than a misfit; judged within the noise"
+        )
+        test = replace(test, threshold=max(test.threshold, test.ratio))
+    return test, excess, cautions
+
+
 def _p(p: float) -> str:
     return "p < 1e-300" if p <= 0 else f"p = {p:.2g}"
 
@@ -596,34 +662,8 @@ def modal_fit_verdict(
         test = noise_test(f, measured.H, synth, noise[0], noise[1], alpha)
         excess = np.abs(synth - measured.H) ** 2 - noise[0]
     elif f.size >= _MIN_LINES:
-        # no coherence: the noise floor of the data themselves (module docstring), on
-        # the data scaled to their largest value (the test is scale-free; no overflow)
-        big = float(np.max(np.abs(measured.H)))
-        scale = big if math.isfinite(big) and big > 0 else 1.0
-        h, e = measured.H / scale, (synth - measured.H) / scale
-        var = adjacent_line_variance(h)
-        test = noise_test(f, h, h + e, var, _FLOOR_DOF, alpha)
-        excess = np.abs(e) ** 2 - var
-        r, z = residual_correlation(e, var)
-        test = replace(test, noise_from="adjacent lines", correlation=r, correlation_z=z)
-        spikes = _outlying_lines(f, e, var, alpha)
-        if spikes and not test.structured:
-            # a mode sharper than the line spacing leaves a spike, not a correlation
-            test = replace(test, correlation_z=math.inf)
-            cautions.append(
-                "the residual stands out of the noise floor at "
-                + ", ".join(f"{x:.6g}" for x in spikes[:5])
-                + " Hz"
-                + (f" and {len(spikes) - 5} more line(s)" if len(spikes) > 5 else "")
-            )
-        if not test.passed and not test.structured:
-            cautions.append(
-                f"the residual is {math.sqrt(test.ratio):.3g}x the noise floor of adjacent "
-                f"lines but white across lines (correlation of adjacent lines {r:.2f}, "
-                f"{z:.2g} standard deviations of white noise) and on no few lines: noise "
-                "larger than that floor rather than a misfit; judged within the noise"
-            )
-            test = replace(test, threshold=max(test.threshold, test.ratio))
+        test, excess, notes = floor_test(f, measured.H, synth, alpha)
+        cautions += notes
     if test is not None and not test.passed:
         source = (
             "from the coherence"
@@ -824,25 +864,43 @@ def lateral_fit_verdict(
         Its ``frequency``, ``measured`` and ``fitted`` (accelerance at the
         data's force) are tested.
     frf : FRF
-        The measured FRF the fit was made on (1x1, with coherence).
+        The measured FRF the fit was made on (1x1; without coherence the fit is
+        judged against the noise floor of adjacent lines, :func:`floor_test`).
     """
     name = subject or f"{fit.name} fit"
     noise = frf_noise_variance(frf)
+    cautions: list[str] = []
     if noise is None:
-        return FitVerdict(
-            name, "not judged", cautions=("no coherence: not judged against the noise",)
+        if np.size(fit.frequency) < _MIN_LINES:
+            return FitVerdict(
+                name,
+                "not judged",
+                cautions=(
+                    f"no coherence and only {np.size(fit.frequency)} line(s): too few to "
+                    "judge against the noise",
+                ),
+            )
+        # no coherence: the noise floor of adjacent lines (module docstring)
+        test, _, cautions = floor_test(fit.frequency, fit.measured, fit.fitted, alpha)
+        cautions.insert(
+            0,
+            "no coherence: judged against the noise floor of the data themselves "
+            "(differences of adjacent lines) and the structure of the residual across lines",
         )
-    keep = np.flatnonzero(np.isin(frf.frequency, fit.frequency))
-    if keep.size != fit.frequency.size:
-        raise InputError("frf: does not hold every line of the fit")
-    acc = frf.to("accelerance").H[0, 0, keep]
-    rel_var = noise[0][0, 0, keep] / np.abs(frf.H[0, 0, keep]) ** 2
-    var = rel_var * np.abs(acc) ** 2
-    test = noise_test(fit.frequency, fit.measured, fit.fitted, var, noise[1], alpha)
+    else:
+        keep = np.flatnonzero(np.isin(frf.frequency, fit.frequency))
+        if keep.size != fit.frequency.size:
+            raise InputError("frf: does not hold every line of the fit")
+        acc = frf.to("accelerance").H[0, 0, keep]
+        rel_var = noise[0][0, 0, keep] / np.abs(frf.H[0, 0, keep]) ** 2
+        var = rel_var * np.abs(acc) ** 2
+        test = noise_test(fit.frequency, fit.measured, fit.fitted, var, noise[1], alpha)
     reasons: list[str] = []
     if not test.passed:
+        floor = "" if test.noise_from == "coherence" else " floor of adjacent lines"
         reasons.append(
-            f"the residual is {math.sqrt(test.ratio):.3g}x the noise level ({_p(test.p_value)})"
+            f"the residual is {math.sqrt(test.ratio):.3g}x the noise{floor} level "
+            f"({_p(test.p_value)})"
         )
         where = (
             ""
@@ -852,7 +910,9 @@ def lateral_fit_verdict(
         reasons.append(
             f"the model form misses the measured tyre{where} (noise does not explain it)"
         )
-    return FitVerdict(name, "ok" if not reasons else "failed", tuple(reasons), (), test)
+    return FitVerdict(
+        name, "ok" if not reasons else "failed", tuple(reasons), tuple(cautions), test
+    )
 
 
 def _converged(fit: Any) -> bool:
