@@ -605,7 +605,7 @@ def hostile_cases() -> list[Case]:
                 },
                 {"data": data},
             ),
-            "quantities",
+            "channel quantity 'heat'",
         ),
         "nan-sample": (npz_bytes(td_head, {"data": np.where(data > 2, np.nan, data)}), "finite"),
         "one-sample": (npz_bytes(td_head, {"data": data[:, :1]}), "samples"),

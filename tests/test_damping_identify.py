@@ -266,7 +266,7 @@ def test_input_validation() -> None:
     shp = model.second_order_shapes()
     with pytest.raises(InputError, match="method"):
         modal_damping_from_modes(model.poles, shp, "second")  # type: ignore[arg-type]
-    with pytest.raises(ShapeError, match="at least as many points as modes"):
+    with pytest.raises(ShapeError, match="at least as many measured points as modes"):
         modal_damping_from_modes(model.poles, shp[:4], "first")
     with pytest.raises(ShapeError, match="columns"):
         modal_damping_from_modes(model.poles[:5], shp, "first")

@@ -233,7 +233,7 @@ def test_identify_validation() -> None:
         identify_damping(exact_model(s), "exact")  # type: ignore[arg-type]
     cm = s.complex_modes()
     few_points = ModalModel(cm.poles, cm.psi[:3], cm.psi[:1])
-    with pytest.raises(ShapeError, match="at least as many points"):
+    with pytest.raises(ShapeError, match="at least as many measured points as modes"):
         identify_damping(few_points)
     with pytest.raises(InputError, match="n_samples"):
         identify_damping(exact_model(s), n_samples=-1)

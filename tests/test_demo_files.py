@@ -350,20 +350,20 @@ def test_files_report_shows_the_demo_verdicts_and_warnings(
 
 
 def test_report_summarises_the_rejected_candidates(demo: tuple[DemoResult, Path]) -> None:
-    """The report gives the count of rejected candidates and those closest to the
-    threshold; every reason is in the modes JSON it names."""
+    """The report gives the count of rejected candidates and the strongest, each with
+    its own short reason; every reason is in the modes JSON it names."""
     import html
 
-    from tyredamp.modal.quality import RejectedMode, closest_rejected
+    from tyredamp.modal.quality import RejectedMode, short_reason, strongest_rejected
 
     result, out = demo
     ident = result.radial.main.identification
     assert ident.rejected
     page = _sections((out / "report.html").read_text(encoding="utf-8"))["radial"]
     assert f"{len(ident.rejected)} candidate(s) rejected" in page
-    near = closest_rejected([RejectedMode.from_dict(x) for x in ident.rejected])
-    assert near
-    assert html.escape(f"{near[0].frequency_hz:.2f} Hz (T = {near[0].statistic:.3g}") in page
+    top = strongest_rejected([RejectedMode.from_dict(x) for x in ident.rejected])[0]
+    assert html.escape(f"{top.frequency_hz:.2f} Hz: {short_reason(top)}") in page
+    assert "closest to the threshold" not in page
     name = f"modes_{result.radial.main.pressure_bar:g}bar.json"
     assert name in page
     doc = json.loads((out / name).read_text(encoding="utf-8"))

@@ -116,7 +116,7 @@ def test_timedata() -> None:
     assert_allclose(td.time[-1], 0.099)
     with pytest.raises(ShapeError, match="channels"):
         TimeData(np.zeros((3, 100)), 1000.0, [1, 2], ["force"] * 3)
-    with pytest.raises(InputError, match="quantities"):
+    with pytest.raises(InputError, match="channel quantity 'strain': expected one of force"):
         TimeData(np.zeros((1, 100)), 1000.0, [1], ["strain"])
     with pytest.raises(InputError, match="finite"):
         TimeData(np.full((1, 10), np.nan), 1000.0, [1], ["force"])

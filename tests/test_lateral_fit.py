@@ -164,7 +164,7 @@ def test_input_errors() -> None:
     d = _data(TRUTHS[3], "ground")
     with pytest.raises(InputError, match="speed"):
         fit_model(LateralData(d.frf), "relaxation")
-    with pytest.raises(InputError, match="at least 4 lines"):
+    with pytest.raises(InputError, match="the lateral fit needs at least 4"):
         fit_model(d, "maxwell", band=(1.0, 1.1))
     with pytest.raises(InputError, match="coherence"):
         fit_model(d, "maxwell", weights="coherence")

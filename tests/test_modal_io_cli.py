@@ -14,6 +14,7 @@ from tyredamp.documents.modes import modes_document, read_modes_json, write_mode
 from tyredamp.exceptions import FileFormatError, InputError
 from tyredamp.io import write_frf
 from tyredamp.modal.model import ModalModel
+from tyredamp.modal.quality import short_reason, strongest_rejected
 
 from .helpers import chain_system
 
@@ -113,13 +114,14 @@ def test_cli_modal_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     q = models["complex"].quality
     assert q is not None
     assert np.all(q.statistic > q.threshold)
-    # the rejected candidates in one line: their number and those closest to passing
+    # the rejected candidates in one line: their number, the strongest first, each with
+    # its own short reason, and where every reason is
     assert q.rejected
-    assert f"{len(q.rejected)} candidate(s) rejected; closest to the threshold" in text
+    assert f"{len(q.rejected)} candidate(s) rejected" in text
+    assert "closest to the threshold" not in text
     assert "(every reason in the modes JSON)" in text
-    tested = [r for r in q.rejected if np.isfinite(r.statistic)]
-    top = max(tested, key=lambda r: r.statistic / r.threshold)
-    assert f"closest to the threshold: {top.frequency_hz:.2f} Hz (T = {top.statistic:.3g}" in text
+    top = strongest_rejected(q.rejected)[0]
+    assert f": {top.frequency_hz:.2f} Hz: {short_reason(top)}" in text
     doc = json.loads(out.read_text())
     mode0 = doc["models"]["complex"]["modes"][0]
     assert mode0["test"]["statistic"] > mode0["test"]["threshold"]

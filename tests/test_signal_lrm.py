@@ -93,7 +93,7 @@ def test_lrm_bad_input() -> None:
         local_frf(x, x, 1.0, order=-1)
     with pytest.raises(InputError, match="inputs, outputs"):
         local_frf(x, x[:100], 1.0)
-    with pytest.raises(InputError, match="fewer than a window"):
+    with pytest.raises(InputError, match="fewer than the local method's window"):
         local_frf(x[:8], x[:8], 1.0)
     td = TimeData(np.vstack([x, x]), 1.0, [1, 2], ["force", "displacement"])
     with pytest.raises(InputError, match="least-squares"):

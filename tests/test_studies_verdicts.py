@@ -172,13 +172,77 @@ def test_band_edge_and_complex_shape_cautions() -> None:
     assert any("MPC 0.30" in c for c in modal_fit_verdict(bad, meas).cautions)
 
 
-def test_without_coherence_not_judged() -> None:
+def bare_frf(model: ModalModel, snr: float, seed: int, f: np.ndarray = F) -> FRF:
+    """The model's FRF with white complex noise on the response and no coherence."""
+    rng = np.random.default_rng(seed)
+    h = model.frf(f, "receptance").H
+    sd = np.abs(h).max() / snr
+    noise = sd * (rng.standard_normal(h.shape) + 1j * rng.standard_normal(h.shape)) / np.sqrt(2)
+    return FRF(f, h + noise, "receptance", [Channel(1, 3)], [Channel(1, 3)])
+
+
+def test_without_coherence_judged_from_the_data() -> None:
+    """No coherence: the fit is judged against the noise floor of adjacent lines."""
     m = two_modes()
-    meas = measured(m, 4, 300.0, 0)
-    bare = FRF(meas.frequency, meas.H, meas.kind, meas.outputs, meas.inputs)
-    assert frf_noise_variance(bare) is None
+    ratios = []
+    for seed in range(5):
+        bare = bare_frf(m, 300.0, seed)
+        assert frf_noise_variance(bare) is None
+        v = modal_fit_verdict(m, bare)
+        assert v.status == "ok", v.summary()
+        assert v.test is not None
+        assert v.test.noise_from == "adjacent lines"
+        assert "noise floor of adjacent lines" in v.summary()
+        assert "differences of adjacent lines" in v.cautions[0]
+        ratios.append(v.test.ratio)
+    # the floor from the data is the noise: the residual of the true model is about it
+    # (1 +- 0.3: five runs of 400 lines, a median-based floor)
+    assert 0.7 < float(np.mean(ratios)) < 1.3
+
+
+def test_without_coherence_a_missed_mode_fails() -> None:
+    """A model without the 80 Hz mode misses the bare FRF: FAILED, structured, where."""
+    m = two_modes()
+    one = ModalModel(m.poles[:1], m.psi_out[:, :1], m.psi_in[:, :1], meta={"band_hz": [5.0, 100.0]})
+    v = modal_fit_verdict(one, bare_frf(m, 300.0, 0))
+    assert v.status == "failed"
+    assert v.outcome == "failed"
+    assert v.test is not None
+    assert v.test.structured
+    assert "from the noise floor of adjacent lines (no coherence)" in v.reasons[0]
+    assert "structured across lines" in v.reasons[0]
+    assert v.test.misfit_hz is not None
+    assert v.test.misfit_hz[0] <= 80.0 <= v.test.misfit_hz[1]
+
+
+def test_without_coherence_a_sharp_missed_mode_fails() -> None:
+    """A mode sharper than the line spacing leaves a spike, not a correlation: FAILED."""
+    f = np.arange(5.0, 100.0, 1.0)
+    m = two_modes(f2=80.3)
+    sharp = ModalModel(
+        np.array([m.poles[0], -0.0002 * 2 * np.pi * 80.3 + 2j * np.pi * 80.3]),
+        m.psi_out,
+        m.psi_in,
+        meta={"band_hz": [5.0, 100.0]},
+    )
+    one = ModalModel(m.poles[:1], m.psi_out[:, :1], m.psi_in[:, :1], meta={"band_hz": [5.0, 100.0]})
+    v = modal_fit_verdict(one, bare_frf(sharp, 1000.0, 0, f))
+    assert v.status == "failed", v.summary()
+    assert v.test is not None
+    assert v.test.misfit_hz is not None
+    assert v.test.misfit_hz[0] <= 80.3 <= v.test.misfit_hz[1] + 1.0
+
+
+def test_without_coherence_too_few_lines_not_judged() -> None:
+    m = two_modes()
+    f = np.linspace(20.0, 40.0, 5)
+    bare = bare_frf(m, 300.0, 0, f)
     v = modal_fit_verdict(m, bare)
     assert v.status == "not judged"
+    assert v.outcome == "not judged"
+    assert "too few to judge" in v.cautions[0]
+    assert v.brief().startswith("not judged")
+    meas = measured(m, 4, 300.0, 0)
     one_avg = FRF(
         meas.frequency,
         meas.H,
@@ -189,6 +253,16 @@ def test_without_coherence_not_judged() -> None:
         {"n_averages": 1},
     )
     assert frf_noise_variance(one_avg) is None
+
+
+def test_model_error_is_said() -> None:
+    """A fit outside the floor whose identification widened its noise says so."""
+    m = two_modes()
+    one = ModalModel(m.poles[:1], m.psi_out[:, :1], m.psi_in[:, :1], meta={"band_hz": [5.0, 100.0]})
+    v = modal_fit_verdict(one, bare_frf(m, 300.0, 0), model_error=0.05)
+    assert v.status == "failed"
+    assert any("model error of 5 % of the response" in r for r in v.reasons)
+    assert "within the noise" not in v.summary()
 
 
 def test_noise_test_chi_square_level() -> None:
@@ -317,3 +391,44 @@ def test_a_fallback_of_the_refinement_is_named() -> None:
     v = modal_fit_verdict(one, meas)
     assert v.status == "failed"
     assert any("fell back to the complex-mode poles" in r for r in v.reasons)
+
+
+def test_a_resonance_held_by_residual_terms_is_said() -> None:
+    """A mode held as a residual mode inside the band: the fit may be within the noise,
+    but the verdict says that resonance is not identified as a mode."""
+    m = two_modes()
+    held = ModalModel(m.poles[1:], m.psi_out[:, 1:], m.psi_in[:, 1:])
+    one = ModalModel(
+        m.poles[:1],
+        m.psi_out[:, :1],
+        m.psi_in[:, :1],
+        residual_modes=held,
+        meta={"band_hz": [5.0, 100.0]},
+    )
+    v = modal_fit_verdict(one, measured(m, 8, 300.0, 0))
+    assert v.status == "ok", v.summary()
+    assert any("resonance(s) inside the band at 80 Hz" in c for c in v.cautions)
+
+
+def test_lateral_verdict_without_coherence_is_judged() -> None:
+    """The rig's FRF without its coherence: the lateral fit is judged against the noise
+    floor of adjacent lines, which is the noise the coherence gives."""
+    from tyredamp.lateral import fit_model
+    from tyredamp.virtual import VirtualLateralRig
+
+    rig = VirtualLateralRig()
+    data = rig.measure(5.0, 1.7, "ground", 0)
+    fit = fit_model(data, "hysteretic")
+    frf = data.frf
+    bare = FRF(frf.frequency, frf.H, frf.kind, frf.outputs, frf.inputs)
+    v = lateral_fit_verdict(fit, bare)
+    assert v.test is not None
+    assert v.test.noise_from == "adjacent lines"
+    assert v.status in ("ok", "failed")
+    assert v.cautions[0].startswith("no coherence: judged against the noise floor")
+    with_coherence = lateral_fit_verdict(fit, frf)
+    assert with_coherence.test is not None
+    # the floor of 176 lines is the coherence's noise to within 20 % in variance (a
+    # median over 21 lines, about 5 degrees of freedom each: the ratio of the two
+    # statistics is 0.82-1.23 over seeds 0-5, 0.94 for this seed)
+    assert v.test.ratio == pytest.approx(with_coherence.test.ratio, rel=0.2)

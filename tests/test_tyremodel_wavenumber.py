@@ -200,7 +200,7 @@ def test_missing_angles_refused() -> None:
     # the angles may be given instead
     wa = wave_number_analysis(bare, angles_deg=np.arange(16) * 22.5)
     assert_allclose(wa.n, tr.wave_number[tr.select("visible")])
-    with pytest.raises(InputError, match="one angle per output"):
+    with pytest.raises(InputError, match="one per response point"):
         wave_number_analysis(bare, angles_deg=[0.0, 10.0])
 
 

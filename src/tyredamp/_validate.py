@@ -72,6 +72,8 @@ def as_band(band: Any, name: str = "band", *, positive: bool = False) -> tuple[f
         ``positive``) or ``f_hi <= f_lo``; the message names ``name``.
     """
     rule = "0 < f_lo < f_hi" if positive else "0 <= f_lo < f_hi"
+    # the command-line option of the same name, for a message a CLI user reads
+    name = "band (--band)" if name == "band" else name
     try:
         if isinstance(band, str) or len(band) != 2:
             raise TypeError

@@ -291,7 +291,9 @@ class FRF:
             if at_zero != "drop":
                 raise InputError(f"at_zero: expected 'drop' or 'raise', got {at_zero!r}")
             if self.n_freq == 1:
-                raise InputError("to: the only frequency line is 0 Hz, nothing left to convert")
+                raise InputError(
+                    "the FRF's only frequency line is 0 Hz: nothing left to convert to another kind"
+                )
             frf = self.select_lines(slice(1, None))
         factor = (1j * frf.omega) ** k
         var = None if frf.variance is None else frf.variance * np.abs(factor) ** 2

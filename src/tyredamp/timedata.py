@@ -292,7 +292,10 @@ class TimeData:
             raise ShapeError(f"quantities: expected {d.shape[0]} entries, got {len(q)}")
         for qi in q:
             if qi not in QUANTITY_UNITS:
-                raise InputError(f"quantities: expected one of {tuple(QUANTITY_UNITS)}, got {qi!r}")
+                raise InputError(
+                    f"channel quantity {qi!r}: expected one of {', '.join(QUANTITY_UNITS)} "
+                    "(a channel's role on the command line: --channel NAME=ROLE)"
+                )
         d = d.copy()
         d.setflags(write=False)
         object.__setattr__(self, "data", d)

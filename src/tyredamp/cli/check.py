@@ -87,7 +87,10 @@ def linearity_cmd(
       tyredamp check linearity frf_10N.uff frf_20N.uff frf_40N.uff --threshold 0.05
     """
     if len(frf_files) < 2:
-        raise InputError(f"linearity: expected two or more FRF files, got {len(frf_files)}")
+        raise InputError(
+            f"check linearity: expected two or more FRF files (one per force level), got "
+            f"{len(frf_files)}"
+        )
     frfs = [read_frf(p) for p in frf_files]
     _finish(ctx, check_linearity(frfs, threshold, band or None), strict)
 
@@ -119,7 +122,7 @@ def reciprocity_cmd(
       tyredamp check reciprocity frf_shaker_at_1.uff frf_shaker_at_5.uff
     """
     if not frf_files:
-        raise InputError("reciprocity: expected one or more FRF files")
+        raise InputError("check reciprocity: expected one or more FRF files, got none")
     frfs = [read_frf(p) for p in frf_files]
     _finish(ctx, check_reciprocity(frfs, threshold, band or None), strict)
 

@@ -159,8 +159,9 @@ def _check_inputs(
         raise PhysicsError("poles: expected Re p < 0 (damped, stable modes)")
     if s.shape[0] < p.size:
         raise ShapeError(
-            f"shapes: need at least as many points as modes to invert Re Psi^, got "
-            f"{s.shape[0]} points for {p.size} modes"
+            f"the damping matrix needs at least as many measured points as modes "
+            f"({s.shape[0]} points, {p.size} modes): choose fewer modes with --modes or "
+            "--band (Python: fewer columns of shapes)"
         )
     # C, M and K at the points involve omega^2 and 1/|shape|^2: both must stay finite
     big = float(np.max(np.abs(p)))
@@ -172,7 +173,10 @@ def _check_inputs(
     amax = np.max(np.abs(s.real), axis=0)  # no squares: no overflow or underflow
     if np.any(amax == 0):
         k = int(np.argmin(amax))
-        raise PhysicsError(f"shapes: mode {k + 1} has a zero real part at every point")
+        raise PhysicsError(
+            f"the shape of mode {k + 1} has a zero real part at every measured point: its "
+            "damping cannot be identified; leave that mode out (--modes or --band)"
+        )
     if np.any(amax < 1 / _MAX_SCALE) or np.any(amax > _MAX_SCALE):
         raise InputError(
             f"shapes: largest entries from {amax.min():.3g} to {amax.max():.3g} 1/sqrt(kg) "
@@ -182,8 +186,8 @@ def _check_inputs(
     sv = np.linalg.svd(s.real / amax, compute_uv=False)
     if sv[-1] <= _RANK_RTOL * sv[0]:
         raise PhysicsError(
-            f"shapes: the real parts of the {p.size} mode shapes are linearly dependent at the "
-            f"{s.shape[0]} points (condition number {sv[0] / max(sv[-1], 1e-300):.3g}); "
+            f"the real parts of the {p.size} mode shapes are linearly dependent at the "
+            f"{s.shape[0]} measured points (condition number {sv[0] / max(sv[-1], 1e-300):.3g}); "
             "spatial aliasing or a repeated mode: measure more points or drop a mode"
         )
     return p, s

@@ -275,7 +275,9 @@ def _prepare(
     sl = _lines(frf, band)
     n = sl.stop - sl.start
     if n < 4:
-        raise InputError(f"frf: expected at least 4 lines above 0 Hz in the band, got {n}")
+        raise InputError(
+            f"the FRF has {n} line(s) above 0 Hz in the band; the lateral fit needs at least 4"
+        )
     f = frf.frequency[sl]
     acc = frf.H[i, j, sl]
     k = KIND_POWER["accelerance"] - KIND_POWER[frf.kind]
@@ -283,7 +285,9 @@ def _prepare(
         acc = acc * (1j * (2.0 * np.pi * f)) ** k
     mag = np.abs(acc)
     if np.any(mag == 0):
-        raise InputError("frf: some lines are exactly 0; drop them (relative weights undefined)")
+        raise InputError(
+            "the FRF is exactly 0 at some lines; drop them (relative weights undefined)"
+        )
     coh = None  # multiple coherence refers to all inputs (FRF.select)
     if frf.coherence is not None and frf.n_in == 1:
         coh = frf.coherence[i, sl]

@@ -172,9 +172,15 @@ def plscf(
     check_uniform(f)
     n_out, n_in, n_f = h.shape
     if n_f * 2 <= (p_max + 1) * (n_in + 1):
+        top = math.ceil(2 * n_f / (n_in + 1)) - 2  # highest order the lines allow
         raise InputError(
-            f"max_order: {p_max} is too high for {n_f} lines in the band "
-            f"(need 2 * n_freq > (max_order + 1) * (n_in + 1))"
+            f"max_order (--max-order): {p_max} is too high for the {n_f} lines in the band "
+            f"with {n_in} input(s)"
+            + (
+                f": at most {top}; lower --max-order or widen the band (--band)"
+                if top >= 2
+                else ": too few lines for a stabilisation diagram; widen the band (--band)"
+            )
         )
     if output_weights is None:
         ms = np.einsum("okf,okf->o", h.real, h.real) + np.einsum("okf,okf->o", h.imag, h.imag)

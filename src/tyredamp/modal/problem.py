@@ -314,7 +314,7 @@ def build_problem(
         i0 += 1  # 0 Hz lines are skipped
     if i1 <= i0:
         raise InputError(
-            f"band: no line above 0 Hz in [{lo:g}, {hi:g}] Hz; data cover "
+            f"band (--band): no line above 0 Hz in [{lo:g}, {hi:g}] Hz; the data cover "
             f"[{fa[0]:g}, {fa[-1]:g}] Hz"
         )
     lines = np.arange(i0, i1)

@@ -11,7 +11,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import InputError
 
-__all__ = ["FitQuality", "RejectedMode", "threshold_text"]
+__all__ = [
+    "FitQuality",
+    "RejectedMode",
+    "rejected_summary",
+    "short_reason",
+    "strongest_rejected",
+    "threshold_text",
+]
 
 
 def _ro(x: ArrayLike, dtype: type = float) -> NDArray[Any]:
@@ -105,17 +112,69 @@ def closest_rejected(rejected: Sequence[RejectedMode], n: int = 3) -> list[Rejec
     return tested[:n]
 
 
+def short_reason(r: RejectedMode) -> str:
+    """A few words on why the candidate ``r`` was not kept, from its last (deciding)
+    reason: ``"half-power band below the line spacing"``, ``"not significant, T = 12
+    <= 28"``, ``"represented by the mode at 51.52 Hz"``, ...; the full reason stays
+    in ``r.reason``."""
+    import re
+
+    last = r.reason.split("; ")[-1]
+    tested = np.isfinite(r.statistic) and np.isfinite(r.threshold)
+    if "below the line spacing" in last:
+        return "half-power band below the line spacing"
+    if "not significant" in last:
+        if tested:
+            return f"not significant, T = {r.statistic:.3g} <= {r.threshold:.3g}"
+        return "not significant"
+    if "stands for it" in last:
+        m = re.search(r"the mode at ([0-9.eE+-]+) Hz", last)
+        return f"represented by the mode at {float(m.group(1)):.2f} Hz" if m else last
+    if "merge distance" in last:
+        return "the same candidate as one tried before"
+    if "merged with" in last:
+        return "merged with another mode in the refit"
+    if "band edge" in last or "outside the band" in last or "left the band" in last:
+        return "outside the band"
+    if "did not converge" in last:
+        return "its trial did not converge"
+    m = re.fullmatch(r"present in (\d+%) of orders < (\d+%)", last)
+    if m:
+        return f"unstable in the stabilisation diagram ({m.group(1)} of the orders)"
+    return last if len(last) <= 80 else last[:77].rstrip() + "..."
+
+
+def strongest_rejected(rejected: Sequence[RejectedMode]) -> list[RejectedMode]:
+    """The rejected candidates, those with the largest mode-test statistic first (the
+    ones that most changed the fit when tried), untested ones after them in order."""
+    tested = [r for r in rejected if np.isfinite(r.statistic)]
+    rest = [r for r in rejected if not np.isfinite(r.statistic)]
+    return sorted(tested, key=lambda r: r.statistic, reverse=True) + rest
+
+
 def rejected_summary(rejected: Sequence[RejectedMode], n: int = 3) -> str:
-    """One line on the rejected candidates: how many, and the ``n`` closest to the
-    threshold with their statistic (:func:`closest_rejected`)."""
+    """One line on the rejected candidates: how many, and the ``n`` most relevant
+    (:func:`strongest_rejected`; records shown at the same frequency counted as one)
+    each with its short reason (:func:`short_reason`)."""
     row = f"{len(rejected)} candidate(s) rejected"
-    near = closest_rejected(rejected, n)
-    if not near:
+    shown: dict[str, list[str]] = {}
+    for r in strongest_rejected(rejected):
+        key = f"{r.frequency_hz:.2f} Hz"
+        if key not in shown and len(shown) == n:
+            continue
+        shown.setdefault(key, [])
+        why = short_reason(r)
+        if why not in shown[key]:
+            shown[key].append(why)
+    if not shown:
         return row
-    return f"{row}; closest to the threshold: " + ", ".join(
-        f"{r.frequency_hz:.2f} Hz (T = {r.statistic:.3g}, threshold {r.threshold:.3g})"
-        for r in near
+    parts = [f"{k}: {', '.join(w)}" for k, w in shown.items()]
+    first = (
+        "largest mode statistic T first" if any(np.isfinite(r.statistic) for r in rejected) else ""
     )
+    rest = sum(f"{r.frequency_hz:.2f} Hz" not in shown for r in rejected)
+    more = f"; {rest} more" if rest > 0 else ""
+    return f"{row}" + (f", {first}" if first else "") + ": " + "; ".join(parts) + more
 
 
 def threshold_text(thr: float, base: float) -> str:

@@ -620,7 +620,7 @@ def _resolve_io(
     chans = timedata.channels
     forces = timedata.force_indices
     if not forces:
-        raise InputError("timedata: no force channel; an FRF needs a measured force")
+        timedata.require_force("an FRF")
     if reference is None:
         ref_idx = list(forces)
     else:
@@ -634,7 +634,8 @@ def _resolve_io(
     else:
         out_idx = resolve_channels(chans, list(outputs), "outputs", candidates=responses)
     if not out_idx:
-        raise InputError("timedata: no response channel to relate to the force")
+        timedata.require_response("an FRF")
+        raise InputError("no response channel to relate to the force")
     quantities = {timedata.quantities[i] for i in out_idx}
     if len(quantities) > 1:
         raise InputError(
@@ -722,9 +723,11 @@ def _band_lines(
         lines = lines[(f[lines] >= lo) & (f[lines] <= hi)]
     if lines.size == 0:
         raise InputError(
-            "timedata: no excited frequency line"
-            + (f" in band {band!r} Hz" if band is not None else "")
-            + f" (input power above {min_relative_power:g} of its maximum)"
+            "no excited frequency line"
+            + (f" in the band {lo:g}-{hi:g} Hz (--band)" if band is not None else "")
+            + f": the force's power is nowhere above {min_relative_power:g} of its maximum"
+            + (" there" if band is not None else "")
+            + "; check the force channel and the band"
         )
     return spectra.select_lines(lines)
 

@@ -449,5 +449,7 @@ def _length(v: Any, name: str, minimum: int = 2) -> int:
 def _band(band: tuple[float, float], fs: float) -> tuple[float, float]:
     lo, hi = as_band(band)
     if hi > fs / 2:
-        raise InputError(f"band: upper edge {hi:g} Hz is above the Nyquist frequency {fs / 2:g} Hz")
+        raise InputError(
+            f"band (--band): upper edge {hi:g} Hz is above the Nyquist frequency {fs / 2:g} Hz"
+        )
     return lo, hi

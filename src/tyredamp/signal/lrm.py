@@ -141,7 +141,10 @@ def local_frf(
     n_f = n // 2 + 1
     w = 2 * half + 1
     if n_f < w:
-        raise InputError(f"inputs: {n} samples give {n_f} lines, fewer than a window of {w}")
+        raise InputError(
+            f"the record's {n} samples give {n_f} lines, fewer than the local method's window of "
+            f"{w} lines: use a longer record or another method (--method)"
+        )
     u_f = scipy.fft.rfft(x, axis=1).T  # (f, in)
     y_f = scipy.fft.rfft(y, axis=1).T  # (f, out)
     idx = _windows(n_f, half)  # (f, w)
@@ -192,11 +195,14 @@ def _local_lines(
     if band is not None:
         lo, hi = float(band[0]), float(band[1])
         if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
-            raise InputError(f"band: expected f_lo < f_hi in Hz, got {band!r}")
+            raise InputError(f"band (--band): expected F_LO < F_HI in Hz, got {band!r}")
         keep &= (f >= lo) & (f <= hi)
     lines = np.flatnonzero(keep)
     if lines.size == 0:
-        raise InputError("timedata: no excited frequency line for the local method")
+        raise InputError(
+            "no frequency line is excited by the force (in the band, --band) for the local "
+            "method: check the force channel and the band"
+        )
     return lines
 
 

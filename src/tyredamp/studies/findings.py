@@ -390,7 +390,7 @@ def outcome_groups(doc: dict[str, Any]) -> list[OutcomeGroup]:
         elif out == "ok":
             detail = "within noise" + (f" ({span} the noise level)" if span else "")
         else:
-            detail = "not judged (no coherence)"
+            detail = "not judged (no noise to judge against, or too few lines)"
         rest.append(
             OutcomeGroup(out, title, detail, tuple(e[3] for e in es), tuple(labels), span, cause)
         )

@@ -256,7 +256,10 @@ def damping_from_modes(
     )
 
     if model not in models:
-        raise InputError(f"model: the modes hold models {sorted(models)}, not {model!r}")
+        raise InputError(
+            f"model (--model): the modes file holds the {' and '.join(sorted(models))} model(s), "
+            f"not {model!r}"
+        )
     full = at_shape_points(models[model])
     why = scaling_problem(full)
     if why:

@@ -46,10 +46,32 @@ The verdict judges a fit from the data alone:
   caller knows them, for example the truth of a virtual tyre) that are not
   identified.
 
+* **without coherence** (an impact-test FRF exported alone): the noise is
+  estimated from the data themselves, from differences of adjacent lines
+  (as :func:`tyredamp.modal.stats.difference_noise`, but fourth differences
+  ``d_f = H_{f-2} - 4 H_{f-1} + 6 H_f - 4 H_{f+1} + H_{f+2}``, which cancel a
+  cubic trend, with ``E|d|^2 = 70 s^2`` for white noise of variance ``s^2``),
+  as a running median over 21 lines of each FRF (``median |d|^2 = 70 s^2
+  ln 2``), so noise that varies along the band is followed and the few lines
+  where a sharp peak curves the FRF are ignored. The residual is
+  tested against that floor as above (F quantile, with the floor's own
+  degrees of freedom taken as ``ln(2)^2 / 4`` of the residual's: a median
+  of correlated differences), and its structure is measured by the correlation
+  of adjacent lines of the residual (``r``, about 0 with ``sd 1/sqrt(2 N)``
+  for white noise over ``N`` pairs), or by lines that stand out of the floor
+  (a mode sharper than the line spacing). The floor is an upper bound where the
+  FRF curves at most lines and a lower one when the noise is itself
+  correlated across lines (a window): a residual above the floor *and*
+  structured is a failed fit, with where it misses and the rejected
+  candidates there; above the floor but white, it is judged within the
+  noise with a caution. When the modal fit widened its noise by a model
+  error (``ModalIdentification.model_error``: it left structure beyond the
+  floor), the verdict tests against the floor alone and says so.
+
 A verdict's ``status`` is ``"ok"`` (within the noise), ``"failed"`` (with
-the reasons and likely causes) or ``"not judged"`` (no coherence to judge
-against). Its ``outcome`` says what a miss means, from the verdict's own
-cause:
+the reasons and likely causes) or ``"not judged"`` (too few lines, or no
+noise that the data or their coherence give). Its ``outcome`` says what a miss
+means, from the verdict's own cause:
 
 * ``"expected"``: the miss is an identification result, not a failure of the
   fit, because another model of the same data shows where it comes from.
@@ -93,12 +115,15 @@ __all__ = [
     "CAUSE_OUTSIDE_FAMILY",
     "FitVerdict",
     "NoiseTest",
+    "adjacent_line_variance",
+    "floor_test",
     "frf_noise_variance",
     "lateral_family_verdicts",
     "lateral_fit_verdict",
     "modal_fit_verdict",
     "modal_verdicts",
     "noise_test",
+    "residual_correlation",
 ]
 
 #: Significance level of the test against the noise.
@@ -149,7 +174,20 @@ class NoiseTest:
     misfit_hz : (float, float) or None
         Lines holding the central 80 % of the excess residual, Hz; None when
         there is no excess.
+    noise_from : str
+        ``"coherence"`` (the FRF's coherence) or ``"adjacent lines"`` (the
+        noise floor from second differences of adjacent lines, module
+        docstring).
+    correlation, correlation_z : float
+        Correlation of the residual between adjacent lines and its ratio to
+        the standard deviation white noise gives (NaN when not measured).
     """
+
+    @property
+    def structured(self) -> bool:
+        """True when the residual is correlated across lines beyond what white noise
+        gives (one-sided at the level ``ALPHA``): a misfit rather than noise."""
+        return bool(self.correlation_z > stats.norm.isf(ALPHA))
 
     ratio: float
     threshold: float
@@ -158,6 +196,9 @@ class NoiseTest:
     noise_relative_error: float
     dof: float
     misfit_hz: tuple[float, float] | None
+    noise_from: str = "coherence"
+    correlation: float = math.nan
+    correlation_z: float = math.nan
 
     @property
     def passed(self) -> bool:
@@ -238,8 +279,13 @@ class FitVerdict:
         if self.reasons:
             return f"{self.subject}: {head}: " + "; ".join(self.reasons)
         if t is not None:
+            what = (
+                "the noise"
+                if t.noise_from == "coherence"
+                else "the noise floor of adjacent lines (no coherence)"
+            )
             return (
-                f"{self.subject}: {head}: within the noise (residual {math.sqrt(t.ratio):.3g}x "
+                f"{self.subject}: {head}: within {what} (residual {math.sqrt(t.ratio):.3g}x "
                 f"the noise level; relative error {100 * t.relative_error:.3g} % against "
                 f"{100 * t.noise_relative_error:.3g} % from noise alone)"
             )
@@ -252,7 +298,7 @@ class FitVerdict:
         if self.status == "ok":
             return "within noise"
         if self.status == "not judged":
-            return "not judged (no coherence)"
+            return "not judged" + (f" ({self.cautions[0]})" if self.cautions else "")
         size = "" if t is None else f" (residual {math.sqrt(t.ratio):.3g}x the noise)"
         if self.outcome == "expected":
             return f"expected{size}: {self.expected_cause}"
@@ -279,6 +325,8 @@ class FitVerdict:
             "relative_error": None if t is None else t.relative_error,
             "noise_relative_error": None if t is None else t.noise_relative_error,
             "misfit_hz": None if t is None or t.misfit_hz is None else list(t.misfit_hz),
+            "noise_from": None if t is None else t.noise_from,
+            "residual_correlation": None if t is None else _num(t.correlation),
         }
 
 
@@ -384,6 +432,154 @@ def noise_test(
     )
 
 
+#: Lines of the running median of the adjacent-line noise floor (odd).
+_FLOOR_LINES = 21
+#: Differences of the noise floor: fourth differences (binomial weights), which
+#: cancel a cubic trend of the FRF over five lines, so that a smooth FRF between
+#: few lines per half-power band adds little (the second differences of
+#: :func:`tyredamp.modal.stats.difference_noise` cancel only a straight line)
+_DIFF = np.array([1.0, -4.0, 6.0, -4.0, 1.0])
+#: Fewest lines a fit is judged on without coherence.
+_MIN_LINES = 8
+#: Degrees of freedom of the adjacent-line floor per real residual degree of freedom:
+#: a median of exponential variables has the efficiency ln(2)^2 of their mean, and
+#: adjacent fourth differences are correlated (about a quarter as many independent)
+_FLOOR_DOF = math.log(2.0) ** 2 / 4.0
+
+
+def _num(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def adjacent_line_variance(H: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """Noise variance of each FRF value from differences of adjacent lines.
+
+    The running median over ``_FLOOR_LINES`` lines of ``|d|^2 / (70 ln 2)``,
+    ``d`` the fourth difference of adjacent lines (second differences with fewer
+    than 6 lines), for each FRF (module docstring): it follows noise that varies
+    along the band and ignores the few lines where a sharp peak curves the FRF.
+
+    Parameters
+    ----------
+    H : ndarray, complex, shape (..., n_freq)
+        The FRFs, ``n_freq >= 3``.
+
+    Returns
+    -------
+    ndarray, shape of ``H``
+        Variance of each value (``H``'s unit squared); the end lines take that of
+        their neighbours.
+    """
+    from scipy.ndimage import median_filter
+
+    h = np.asarray(H, dtype=complex)
+    n = h.shape[-1]
+    c = _DIFF if n > len(_DIFF) else np.array([1.0, -2.0, 1.0])
+    k = c.size
+    if n < k:
+        raise ShapeError(f"the FRF has {n} line(s): the noise floor needs at least 3")
+    d = sum(c[j] * h[..., j : n - k + 1 + j] for j in range(k))
+    a2 = (d.real**2 + d.imag**2) / (float(np.sum(c**2)) * math.log(2.0))
+    size = [1] * (a2.ndim - 1) + [min(_FLOOR_LINES, a2.shape[-1])]
+    med = median_filter(a2, size=size, mode="nearest")
+    lo = (k - 1) // 2
+    out = np.concatenate(
+        [np.repeat(med[..., :1], lo, -1), med, np.repeat(med[..., -1:], k - 1 - lo, -1)], axis=-1
+    )
+    # a noise-free FRF (a simulation): the rounding of its values is the floor
+    tiny = (1e-12 * np.sqrt(np.mean(np.abs(h) ** 2, axis=-1, keepdims=True))) ** 2
+    return np.asarray(np.maximum(out, tiny + np.finfo(float).tiny))
+
+
+def residual_correlation(
+    residual: NDArray[np.complex128], variance: NDArray[np.float64]
+) -> tuple[float, float]:
+    """Correlation of a residual between adjacent lines, and its size against white noise.
+
+    ``r = Re sum_f u_f conj(u_{f+1}) / sum_f |u_f|^2`` of the residual scaled by its
+    noise, ``u = e / sqrt(var)``, over every FRF; white noise gives ``r`` about 0 with
+    standard deviation ``1 / sqrt(2 N)`` over ``N`` pairs of lines.
+
+    Returns
+    -------
+    (float, float)
+        ``r`` and ``z = r sqrt(2 N)`` (NaN with fewer than 2 lines).
+    """
+    u = np.asarray(residual, dtype=complex) / np.sqrt(np.asarray(variance, dtype=float))
+    u = u.reshape(-1, u.shape[-1])
+    if u.shape[-1] < 2:
+        return math.nan, math.nan
+    num = float(np.sum((u[:, 1:] * np.conj(u[:, :-1])).real))
+    den = float(np.sum(np.abs(u) ** 2))
+    if not den > 0:
+        return math.nan, math.nan
+    r = num / den
+    return r, r * math.sqrt(2.0 * u.shape[0] * (u.shape[-1] - 1))
+
+
+def floor_test(
+    frequency: NDArray[np.float64],
+    measured: NDArray[np.complex128],
+    fitted: NDArray[np.complex128],
+    alpha: float = ALPHA,
+) -> tuple[NoiseTest, NDArray[np.float64], list[str]]:
+    """Test a fit without coherence against the noise floor of adjacent lines.
+
+    The residual against :func:`adjacent_line_variance`, its correlation
+    across lines (:func:`residual_correlation`) and its outlying lines
+    (module docstring), on the data scaled to their largest value (the test
+    is scale-free).
+
+    Parameters
+    ----------
+    frequency : ndarray, shape (n_freq,)
+        Hz, adjacent lines.
+    measured, fitted : ndarray, complex, shape (..., n_freq)
+    alpha : float
+        Significance level.
+
+    Returns
+    -------
+    test : NoiseTest
+        ``noise_from="adjacent lines"``; a white residual above the floor on no
+        few lines passes (its threshold raised to its ratio) with a caution.
+    excess : ndarray, shape of ``measured``
+        ``|e|^2 - var`` of the scaled data.
+    cautions : list of str
+    """
+    f = np.asarray(frequency, dtype=float)
+    h0: NDArray[np.complex128] = np.asarray(measured, dtype=complex)
+    big = float(np.max(np.abs(h0)))
+    scale = big if math.isfinite(big) and big > 0 else 1.0
+    h: NDArray[np.complex128] = h0 / scale
+    e: NDArray[np.complex128] = (np.asarray(fitted, dtype=complex) - h0) / scale
+    var = adjacent_line_variance(h)
+    test = noise_test(f, h, h + e, var, _FLOOR_DOF, alpha)
+    excess = np.abs(e) ** 2 - var
+    r, z = residual_correlation(e, var)
+    test = replace(test, noise_from="adjacent lines", correlation=r, correlation_z=z)
+    cautions: list[str] = []
+    spikes = _outlying_lines(f, e, var, alpha)
+    if spikes and not test.structured:
+        # a mode sharper than the line spacing leaves a spike, not a correlation
+        test = replace(test, correlation_z=math.inf)
+        cautions.append(
+            "the residual stands out of the noise floor at "
+            + ", ".join(f"{x:.6g}" for x in spikes[:5])
+            + " Hz"
+            + (f" and {len(spikes) - 5} more line(s)" if len(spikes) > 5 else "")
+        )
+    if not test.passed and not test.structured:
+        cautions.append(
+            f"the residual is {math.sqrt(test.ratio):.3g}x the noise floor of adjacent "
+            f"lines but white across lines (correlation of adjacent lines {r:.2f}, "
+            f"{z:.2g} standard deviations of white noise) and on no few lines: noise "
+            "larger than that floor rather than a misfit; judged within the noise"
+        )
+        test = replace(test, threshold=max(test.threshold, test.ratio))
+    return test, excess, cautions
+
+
 def _p(p: float) -> str:
     return "p < 1e-300" if p <= 0 else f"p = {p:.2g}"
 
@@ -418,6 +614,7 @@ def modal_fit_verdict(
     expected_hz: Sequence[float] | None = None,
     better: FitVerdict | None = None,
     alpha: float = ALPHA,
+    model_error: float = 0.0,
 ) -> FitVerdict:
     """Verdict on a modal model fitted to ``measured`` (module docstring).
 
@@ -441,6 +638,10 @@ def modal_fit_verdict(
         misfit at a band edge is not put down to a mode missing there.
     alpha : float
         Significance level of the test against the noise.
+    model_error : float
+        Relative model error the identification included in its noise
+        (``ModalIdentification.model_error``; 0: none): said in the verdict,
+        which tests against the noise without it.
     """
     f = measured.frequency
     band_meta = model.meta.get("band_hz")
@@ -456,37 +657,63 @@ def modal_fit_verdict(
     test = None
     form = False
     missing = False
+    excess: NDArray[np.float64] | None = None
     if noise is not None:
         test = noise_test(f, measured.H, synth, noise[0], noise[1], alpha)
-        if not test.passed:
-            reasons.append(
-                f"the residual is {math.sqrt(test.ratio):.3g}x the noise level (relative error "
-                f"{100 * test.relative_error:.3g} % against {100 * test.noise_relative_error:.3g}"
-                f" % from the coherence; {_p(test.p_value)})"
+        excess = np.abs(synth - measured.H) ** 2 - noise[0]
+    elif f.size >= _MIN_LINES:
+        test, excess, notes = floor_test(f, measured.H, synth, alpha)
+        cautions += notes
+    if test is not None and not test.passed:
+        source = (
+            "from the coherence"
+            if test.noise_from == "coherence"
+            else "from the noise floor of adjacent lines (no coherence)"
+        )
+        shape = ""
+        if test.structured and math.isinf(test.correlation_z):
+            shape = ", concentrated on a few lines"
+        elif test.structured:
+            shape = (
+                f", structured across lines (correlation of adjacent lines "
+                f"{test.correlation:.2f}, {test.correlation_z:.3g} standard deviations "
+                "of white noise)"
             )
-            # another model of the same band within the noise refutes a missing mode
-            # at an edge: the misfit is this model's form
-            form = better is not None and better.passed
-            edge = None if form else _edge_reason(test, band)
-            if edge:
-                reasons.append(edge)
-            elif test.misfit_hz is not None:
-                reasons.append(
-                    f"the misfit lies at {test.misfit_hz[0]:.4g}-{test.misfit_hz[1]:.4g} Hz"
-                )
-            if any(
-                str(w).startswith("real-mode refinement not acceptable")
-                for w in model.meta.get("warnings", [])
-            ):
-                reasons.append(
-                    "its refinement fell back to the complex-mode poles (only the residues "
-                    "are fitted)"
-                )
-            if form and better is not None:
-                reasons.append(
-                    f"the {better.subject} is within the noise: the model form misses (real "
-                    "modes cannot hold damping that couples the modes)"
-                )
+        reasons.append(
+            f"the residual is {math.sqrt(test.ratio):.3g}x the noise level (relative error "
+            f"{100 * test.relative_error:.3g} % against {100 * test.noise_relative_error:.3g}"
+            f" % {source}; {_p(test.p_value)}){shape}"
+        )
+        if model_error > 0:
+            reasons.append(
+                f"the identification widened its noise by a model error of "
+                f"{100 * model_error:.3g} % of the response because the fit left this "
+                "structure (leakage, a window, a non-linearity, or a mode it did not "
+                "keep); its modes and their errors are stated against that wider noise"
+            )
+        # another model of the same band within the noise refutes a missing mode
+        # at an edge: the misfit is this model's form
+        form = better is not None and better.passed
+        edge = None if form else _edge_reason(test, band)
+        if edge:
+            reasons.append(edge)
+        elif test.misfit_hz is not None:
+            reasons.append(f"the misfit lies at {test.misfit_hz[0]:.4g}-{test.misfit_hz[1]:.4g} Hz")
+        there = "" if excess is None else _rejected_in(model, f, excess)
+        if there and not form:
+            reasons.append(there)
+        if any(
+            str(w).startswith("real-mode refinement not acceptable")
+            for w in model.meta.get("warnings", [])
+        ):
+            reasons.append(
+                "its refinement fell back to the complex-mode poles (only the residues are fitted)"
+            )
+        if form and better is not None:
+            reasons.append(
+                f"the {better.subject} is within the noise: the model form misses (real "
+                "modes cannot hold damping that couples the modes)"
+            )
     fn = np.asarray(model.frequency_hz, dtype=float)
     zeta = np.asarray(model.damping_ratio, dtype=float)
     for k in range(fn.size):
@@ -496,6 +723,16 @@ def modal_fit_verdict(
                 f"mode at {fn[k]:.4g} Hz: its half-power band ({fn[k] - half:.4g}-"
                 f"{fn[k] + half:.4g} Hz) crosses the band edge; its damping is poorly "
                 "determined: widen the band"
+            )
+    held = getattr(model, "residual_modes", None)
+    if held is not None and int(getattr(held, "n_modes", 0)) > 0:
+        inside = [x for x in np.asarray(held.frequency_hz, float) if band[0] <= x <= band[1]]
+        if inside:
+            at = ", ".join(f"{x:.4g}" for x in inside)
+            cautions.append(
+                f"the fit holds {len(inside)} resonance(s) inside the band at {at} Hz with "
+                "residual terms, not listed as modes: their frequency and damping are not "
+                "identified"
             )
     mpc = model.meta.get("mpc")
     if mpc is not None and model.mode_kind == "complex":
@@ -520,14 +757,86 @@ def modal_fit_verdict(
     if test is None:
         status: Status = "failed" if reasons else "not judged"
         if not reasons:
-            cautions.insert(0, "no coherence (or a single average): not judged against the noise")
+            cautions.insert(
+                0,
+                f"no coherence (or a single average) and only {f.size} line(s): too few to "
+                "judge against the noise",
+            )
     else:
         status = "ok" if not reasons else "failed"
+        if test.noise_from != "coherence":
+            cautions.insert(
+                0,
+                "no coherence (or a single average): judged against the noise floor of the "
+                "data themselves (differences of adjacent lines, a running median) and the "
+                "structure of the residual across lines",
+            )
+            if status == "failed":
+                cautions.insert(
+                    1,
+                    "that floor takes the noise as uncorrelated across lines; a window (an "
+                    "exponential or force window) correlates it and lowers the floor, so a "
+                    "residual a few times the floor may be that: a measured coherence decides",
+                )
+        if model_error > 0 and status == "ok":
+            cautions.append(
+                f"the identification stated its modes against a noise that includes a model "
+                f"error of {100 * model_error:.3g} % of the response; this verdict judged "
+                "the fit against the noise without it"
+            )
     cause = why = ""
     # a miss that only the model form explains (no expected mode lost) is a result
     if status == "failed" and form and better is not None and not missing:
         cause, why = _form_cause(model, better)
     return FitVerdict(subject, status, tuple(reasons), tuple(cautions), test, cause, why)
+
+
+def _outlying_lines(
+    f: NDArray[np.float64],
+    residual: NDArray[np.complex128],
+    variance: NDArray[np.float64],
+    alpha: float,
+) -> list[float]:
+    """Lines (Hz) where the residual stands out of the adjacent-line noise floor: its
+    scaled power ``|e|^2 / var`` beyond the ``1 - alpha / N`` quantile of ``F(2, k)``
+    over ``N`` values, ``k`` the floor's degrees of freedom over its running median."""
+    u2 = (np.abs(residual) ** 2 / variance).reshape(-1, f.size)
+    k = 2.0 * _FLOOR_DOF * _FLOOR_LINES
+    limit = float(stats.f.isf(alpha / u2.size, 2, k))
+    return [float(x) for x in f[np.any(u2 > limit, axis=0)]]
+
+
+def _rejected_in(model: Any, f: NDArray[np.float64], excess: NDArray[np.float64]) -> str:
+    """The candidates the identification rejected where the excess residual
+    ``|e|^2 - var`` (shape (..., n_freq)) concentrates: at least a fifth of it within
+    two half-power bandwidths (at least 1.5 line spacings, at most a twentieth of the
+    band) of the candidate. The likely cause of the miss, with why each was
+    rejected."""
+    q = getattr(model, "quality", None)
+    if q is None or not q.rejected or f.size < 2:
+        return ""
+    from ..modal.quality import short_reason, strongest_rejected
+
+    ex = np.clip(excess, 0.0, None).reshape(-1, f.size).sum(axis=0)
+    total = float(ex.sum())
+    if not total > 0:
+        return ""
+    df = float(np.median(np.diff(f)))
+    seen: dict[str, tuple[float, str]] = {}
+    for r in strongest_rejected(q.rejected):
+        w = max(4.0 * r.damping_ratio * r.frequency_hz, 1.5 * df)
+        if 2.0 * w > 0.1 * (f[-1] - f[0]):
+            continue  # too broad to place a misfit
+        share = float(ex[np.abs(f - r.frequency_hz) <= w].sum()) / total
+        key = f"{r.frequency_hz:.2f} Hz"
+        if share >= 0.2 and key not in seen:
+            seen[key] = (share, short_reason(r))
+    if not seen:
+        return ""
+    items = sorted(seen.items(), key=lambda kv: -kv[1][0])[:3]
+    return "the identification rejected a candidate where the misfit lies: " + "; ".join(
+        f"{k} ({w}; {100 * sh:.0f} % of the excess residual)" for k, (sh, w) in items
+    )
 
 
 def _form_cause(model: Any, better: FitVerdict) -> tuple[str, str]:
@@ -555,25 +864,43 @@ def lateral_fit_verdict(
         Its ``frequency``, ``measured`` and ``fitted`` (accelerance at the
         data's force) are tested.
     frf : FRF
-        The measured FRF the fit was made on (1x1, with coherence).
+        The measured FRF the fit was made on (1x1; without coherence the fit is
+        judged against the noise floor of adjacent lines, :func:`floor_test`).
     """
     name = subject or f"{fit.name} fit"
     noise = frf_noise_variance(frf)
+    cautions: list[str] = []
     if noise is None:
-        return FitVerdict(
-            name, "not judged", cautions=("no coherence: not judged against the noise",)
+        if np.size(fit.frequency) < _MIN_LINES:
+            return FitVerdict(
+                name,
+                "not judged",
+                cautions=(
+                    f"no coherence and only {np.size(fit.frequency)} line(s): too few to "
+                    "judge against the noise",
+                ),
+            )
+        # no coherence: the noise floor of adjacent lines (module docstring)
+        test, _, cautions = floor_test(fit.frequency, fit.measured, fit.fitted, alpha)
+        cautions.insert(
+            0,
+            "no coherence: judged against the noise floor of the data themselves "
+            "(differences of adjacent lines) and the structure of the residual across lines",
         )
-    keep = np.flatnonzero(np.isin(frf.frequency, fit.frequency))
-    if keep.size != fit.frequency.size:
-        raise InputError("frf: does not hold every line of the fit")
-    acc = frf.to("accelerance").H[0, 0, keep]
-    rel_var = noise[0][0, 0, keep] / np.abs(frf.H[0, 0, keep]) ** 2
-    var = rel_var * np.abs(acc) ** 2
-    test = noise_test(fit.frequency, fit.measured, fit.fitted, var, noise[1], alpha)
+    else:
+        keep = np.flatnonzero(np.isin(frf.frequency, fit.frequency))
+        if keep.size != fit.frequency.size:
+            raise InputError("frf: does not hold every line of the fit")
+        acc = frf.to("accelerance").H[0, 0, keep]
+        rel_var = noise[0][0, 0, keep] / np.abs(frf.H[0, 0, keep]) ** 2
+        var = rel_var * np.abs(acc) ** 2
+        test = noise_test(fit.frequency, fit.measured, fit.fitted, var, noise[1], alpha)
     reasons: list[str] = []
     if not test.passed:
+        floor = "" if test.noise_from == "coherence" else " floor of adjacent lines"
         reasons.append(
-            f"the residual is {math.sqrt(test.ratio):.3g}x the noise level ({_p(test.p_value)})"
+            f"the residual is {math.sqrt(test.ratio):.3g}x the noise{floor} level "
+            f"({_p(test.p_value)})"
         )
         where = (
             ""
@@ -583,7 +910,9 @@ def lateral_fit_verdict(
         reasons.append(
             f"the model form misses the measured tyre{where} (noise does not explain it)"
         )
-    return FitVerdict(name, "ok" if not reasons else "failed", tuple(reasons), (), test)
+    return FitVerdict(
+        name, "ok" if not reasons else "failed", tuple(reasons), tuple(cautions), test
+    )
 
 
 def _converged(fit: Any) -> bool:
@@ -671,10 +1000,17 @@ def modal_verdicts(frf: FRF, res: ModalIdentification) -> dict[str, FitVerdict]:
     keep = np.flatnonzero(np.isin(frf.frequency, res.frequency))
     meas = frf.select_lines(keep).to(res.frf_kind)  # type: ignore[arg-type]
     out: dict[str, FitVerdict] = {}
+    eps = float(getattr(res, "model_error", 0.0))
     if "complex" in res.models:
-        out["complex"] = modal_fit_verdict(res.models["complex"], meas, subject="complex-mode fit")
+        out["complex"] = modal_fit_verdict(
+            res.models["complex"], meas, subject="complex-mode fit", model_error=eps
+        )
     if "real" in res.models:
         out["real"] = modal_fit_verdict(
-            res.models["real"], meas, subject="real-mode fit", better=out.get("complex")
+            res.models["real"],
+            meas,
+            subject="real-mode fit",
+            better=out.get("complex"),
+            model_error=eps,
         )
     return out

@@ -56,13 +56,18 @@ def _projector(a: NDArray[np.float64]) -> NDArray[np.float64]:
 def as_angles(angles_deg: ArrayLike) -> NDArray[np.float64]:
     a = as_finite(angles_deg, "angles_deg", ndim=1)
     if a.size < 3:
-        raise InputError(f"angles_deg: expected at least 3 measured angles, got {a.size}")
+        raise InputError(
+            f"the points' angles around the tyre: expected at least 3 measured points, got {a.size}"
+        )
     wrapped = np.mod(a, 360.0)
     d = np.abs(wrapped[:, None] - wrapped[None, :])
     d = np.minimum(d, 360.0 - d)
     np.fill_diagonal(d, np.inf)
     if np.any(d < 1e-9):
-        raise InputError("angles_deg: two outputs are at the same angle; expected distinct points")
+        raise InputError(
+            "the points' angles around the tyre: two response points are at the same angle; "
+            "expected distinct points"
+        )
     return np.deg2rad(a)
 
 

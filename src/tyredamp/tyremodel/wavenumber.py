@@ -251,7 +251,8 @@ def _output_angles(
             return a[rows]
         if a.size != rows.size:
             raise ShapeError(
-                f"angles_deg: expected one angle per output ({len(model.outputs)}), got {a.size}"
+                f"the points' angles (angles_deg): expected one per response point "
+                f"({len(model.outputs)}), got {a.size}"
             )
         return a
     chans = [model.outputs[int(r)] for r in rows]

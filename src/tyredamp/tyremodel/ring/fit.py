@@ -246,7 +246,10 @@ def _stiffness_problem(
     """
     fit_mass = rho_fixed is None
     if fit_mass and not np.any(x.use_a):
-        raise InputError("data: no mode amplitude to fix rho A; give mass_per_length")
+        raise InputError(
+            "no mode amplitude to fix the ring's mass per length (rho A): give it "
+            "(--mass-per-length, mass_per_length in Python)"
+        )
     sf_list = [o.frequency_std for o in obs]
     sa_list = [o.amplitude_std for o in obs]
     have_std = all(s is not None and s > 0 for s in sf_list) and (
@@ -351,7 +354,9 @@ def _fit_stiffness(problem: _StiffnessProblem, theta0: _Array) -> _StiffnessFit:
     u0 = theta0 / scales
     res = least_squares(residual, u0, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
     if res.status <= 0 or not np.all(np.isfinite(res.x)):
-        raise ConvergenceError(f"fit_ring: the least-squares fit did not converge ({res.message})")
+        raise ConvergenceError(
+            f"the ring model's least-squares fit did not converge ({res.message})"
+        )
     u = np.asarray(res.x, dtype=float)
     rvec = residual(u)
     rss = float(rvec @ rvec)

@@ -196,7 +196,10 @@ def gather_observations(
         obs += o
         skipped += s
     if not obs:
-        raise InputError("data: no mode usable by the ring model (see the wave-number analysis)")
+        raise InputError(
+            "no mode of the modes file(s) is usable by the ring model: each needs a resolved "
+            "wave number (see the wave-number analysis)"
+        )
     for i, ob in enumerate(obs):
         vals = (ob.pressure, ob.frequency_hz, ob.amplitude, ob.damping_ratio, ob.drive_phi2)
         if not all(math.isfinite(v) for v in vals):
