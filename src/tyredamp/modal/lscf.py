@@ -98,6 +98,21 @@ class PoleSet:
         return np.flatnonzero(self.order == order)
 
 
+def _order_too_high(p_max: int, n_f: int, n_in: int) -> InputError:
+    """The error for an order above what ``n_f`` lines and ``n_in`` inputs allow
+    (``2 n_f > (p + 1)(n_in + 1)``), with the highest order they allow."""
+    top = math.ceil(2 * n_f / (n_in + 1)) - 2
+    return InputError(
+        f"max_order (--max-order): {p_max} is too high for the {n_f} lines in the band "
+        f"with {n_in} input(s)"
+        + (
+            f": at most {top}; lower --max-order or widen the band (--band)"
+            if top >= 2
+            else ": too few lines for a stabilisation diagram; widen the band (--band)"
+        )
+    )
+
+
 def plscf(
     frequency: ArrayLike,
     H: ArrayLike,
@@ -172,16 +187,7 @@ def plscf(
     check_uniform(f)
     n_out, n_in, n_f = h.shape
     if n_f * 2 <= (p_max + 1) * (n_in + 1):
-        top = math.ceil(2 * n_f / (n_in + 1)) - 2  # highest order the lines allow
-        raise InputError(
-            f"max_order (--max-order): {p_max} is too high for the {n_f} lines in the band "
-            f"with {n_in} input(s)"
-            + (
-                f": at most {top}; lower --max-order or widen the band (--band)"
-                if top >= 2
-                else ": too few lines for a stabilisation diagram; widen the band (--band)"
-            )
-        )
+        raise _order_too_high(p_max, n_f, n_in)
     if output_weights is None:
         ms = np.einsum("okf,okf->o", h.real, h.real) + np.einsum("okf,okf->o", h.imag, h.imag)
         rms = np.sqrt(ms / (n_in * n_f))
