@@ -11,6 +11,7 @@ from numpy.testing import assert_allclose
 from tyredamp.frf import FRF, Channel
 from tyredamp.modal import identify_modes
 from tyredamp.modal.model_error import relative_model_error
+from tyredamp.modal.search import unresolved_damping
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "real-data"
 BEAM = REAL / "ladisk_pyuff" / "data"
@@ -38,6 +39,29 @@ def test_no_model_error_when_the_noise_explains_the_residual() -> None:
     r = 0.5 * np.ones(H.shape)  # 2 |r|^2 / V = 0.5 per term: cost below dof
     assert relative_model_error(H, H + r, V, H.size) == 0.0
     assert relative_model_error(H, H + r, V, 0) == 0.0
+
+
+def test_a_residual_on_a_line_without_noise_needs_a_model_error() -> None:
+    # V = 0 on one line: a residual there is explained only by eps > 0; with no
+    # residual there the other lines decide (here they are at the noise: eps = 0)
+    H = np.ones((1, 1, 4), complex)
+    V = np.array([[[0.0, 1.0, 1.0, 1.0]]])
+    r = np.array([[[0.1, 0.5, 0.5, 0.5]]])
+    # closed form: 2 * 0.01 / (eps^2 * 1) + 3 * 2 * 0.25 / (1 + eps^2) = 4 terms
+    eps = relative_model_error(H, H + r, V, 4)
+    assert_allclose(2 * 0.01 / eps**2 + 1.5 / (1 + eps**2), 4.0, rtol=1e-2)  # brentq xtol
+    r[..., 0] = 0.0
+    assert relative_model_error(H, H + r, V, 4) == 0.0
+
+
+def test_unresolved_damping_states_the_bound() -> None:
+    # half-power bandwidth 2 zeta f = 2 * 1e-4 * 500 = 0.1 Hz below 1 Hz lines:
+    # the bound is df / (2 f) = 0.1 %
+    text = unresolved_damping(500.0, 1e-4, 1.0)
+    assert "zeta < 0.10%" in text
+    assert "500 Hz" in text
+    assert unresolved_damping(500.0, 2e-3, 1.0) == ""  # 2 Hz wide: resolved
+    assert unresolved_damping(500.0, 1e-4, 0.0) == ""  # no line spacing
 
 
 def _beam(k: int) -> FRF:

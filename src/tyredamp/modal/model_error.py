@@ -154,12 +154,12 @@ def relative_model_error(
 
     lo, hi = math.log(1e-9), math.log(1e3)
     pos = V > 0
-    if not np.all(pos):  # lines without noise: the cost is infinite at eps = 0
-        start = np.inf if np.any(r2[~pos] > 0) else excess(-math.inf)
-    else:
-        start = float(np.sum(2.0 * r2 / V)) - dof
-    if not start > 0 or excess(hi) > 0:
-        return 0.0 if not start > 0 else math.exp(hi)
+    # the cost at eps = 0; a residual on a line without noise makes it infinite
+    at_zero = math.inf if np.any(r2[~pos] > 0) else float(np.sum(2.0 * r2[pos] / V[pos]))
+    if not at_zero > dof:
+        return 0.0
+    if excess(hi) > 0:
+        return math.exp(hi)
     if excess(lo) <= 0:
         return math.exp(lo)
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-3))
@@ -226,14 +226,14 @@ def with_model_error(
         return relative_model_error(H, _model_band(m, problem, frf.kind), V, dof)
 
     eps, res = eps_of(first), first
+    if eps <= 0.0:
+        return first, 0.0
     # each pass decides the modes against the eps of the fits before it; a pass
     # whose fit gives back a larger eps (it merged a split, so the model error
     # shows) is followed by one against that eps: the sequence only rises, to the
     # largest eps the fits of the data give back (the fixed point of eq. (2) that
     # holds the fewest modes; a split fit reproduces its own smaller eps too)
     for _ in range(PASSES):
-        if eps <= 0.0:
-            return first, 0.0
         v = floor.variance.copy()
         v[:, :, lines] += eps**2 * np.abs(H) ** 2
         res = run(v, f"{floor.what} plus a model error of {eps:.2%} of the response")

@@ -53,13 +53,7 @@ from .._validate import as_band
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, KIND_POWER
 
-__all__ = [
-    "FitProblem",
-    "NoiseSource",
-    "build_problem",
-    "line_factor_dof",
-    "max_modes",
-]
+__all__ = ["FitProblem", "NoiseSource", "build_problem", "line_factor_dof", "max_modes"]
 
 NoiseSource = Literal["variance", "coherence", "residual"]
 #: relative spread of the line spacing accepted as uniform (float32 axes of
