@@ -88,6 +88,12 @@ def test_virtual_campaign_end_to_end(virtual: Path, serial: dict[str, Any]) -> N
     for fam, by_tyre in check["families"].items():
         waves = set().union(*by_tyre.values())
         assert len(waves) == 1, (fam, by_tyre)  # the same mode for both tyres
+    # every family is named by the true wave number of its modes (the cos member: one shaker)
+    names = {f["family"]: f for f in results.summary["families"]}
+    for fam, by_tyre in check["families"].items():
+        (true_n,) = set().union(*by_tyre.values())
+        assert names[fam]["wave_number"] == true_n, (fam, names[fam])
+        assert names[fam]["label"] == f"n={true_n} cos"
     # every family seen at all three pressures of both tyres is tracked through all six tests
     n_tests = {f["family"]: f["n_tests"] for f in results.summary["families"]}
     assert sum(v == 6 for v in n_tests.values()) >= 4

@@ -332,5 +332,9 @@ def test_excitation_layout_of_a_ring_test_with_two_shakers() -> None:
     # 16 points: wave numbers up to 8; shakers 90 deg apart miss every even n
     ex = excitation_layout(run([0.0, 90.0]))
     assert ex == {"angles_deg": [0.0, 90.0], "single_member": [2, 4, 6, 8]}
-    assert excitation_layout(run([0.0])) is None  # one shaker: the usual case, no note
+    # one shaker drives only the cos member of every n: the report advises a second one
+    assert excitation_layout(run([0.0])) == {
+        "angles_deg": [0.0],
+        "single_member": list(range(1, 9)),
+    }
     assert excitation_layout(run([0.0, None])) is None  # an angle unknown: nothing said

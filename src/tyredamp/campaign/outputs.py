@@ -56,6 +56,7 @@ from ..documents.jsonfile import write_json
 from ..exceptions import InputError
 from ..io._safety import atomic_path, check_output_dir
 from . import steps
+from .families import FamilyName, ModeWave, family_names, mode_wave
 from .runner import TestRun
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign
 from .status import STEP_COLUMNS, quality_checks, step_rows, summary_entry
@@ -69,6 +70,7 @@ __all__ = [
     "check_campaign_output",
     "lateral_rows",
     "mode_rows",
+    "row_family_names",
     "trend_rows",
     "write_outputs",
 ]
@@ -84,7 +86,11 @@ MODE_COLUMNS: dict[str, str] = {
     "model": "string",
     "mode": "int",
     "family": "string",
+    "family_label": "string",
     "slot": "string",
+    "wave_number": "int",
+    "wave_fraction": "float",
+    "member": "string",
     "match": "string",
     "match_mac": "float",
     "match_z": "float",
@@ -292,14 +298,20 @@ def mode_rows(
     for r in runs:
         for m in steps.mode_records(r.spec.study, r.documents, model):
             q = (r.spec.test_id, m["mode"] - 1)
+            wave = mode_wave(m["angles_deg"], m["shape"], m["reference_deg"])
+            fam = tracking.family.get(q)
             row: dict[str, Any] = {"test_id": r.spec.test_id, "file": r.spec.rel}
             row.update({c: r.spec.conditions.get(c) for c in CONDITIONS})
             row.update(
                 {
                     "model": m["model"],
                     "mode": m["mode"],
-                    "family": tracking.family.get(q),
+                    "family": fam,
+                    "family_label": None,
                     "slot": tracking.slot.get(q, ""),
+                    "wave_number": None if wave is None else wave.n,
+                    "wave_fraction": math.nan if wave is None else wave.fraction,
+                    "member": None if wave is None else wave.member,
                     "match": tracking.method.get(q, ""),
                     "match_mac": tracking.mac.get(q),
                     "match_z": tracking.distance.get(q),
@@ -316,7 +328,30 @@ def mode_rows(
             ):
                 row[k] = _float(m[k])
             rows.append(row)
+    names = row_family_names(rows)
+    for row in rows:
+        if row["family"] is not None:
+            row["family_label"] = names[row["family"]].label
     return rows
+
+
+def row_family_names(rows: Sequence[dict[str, Any]]) -> dict[str, FamilyName]:
+    """The name of every family of the mode table (:func:`.families.family_names`)."""
+    waves: dict[str, list[ModeWave | None]] = {}
+    for r in sorted(rows, key=lambda r: _family_number(r["family"] or "F0")):
+        if r["family"] is None:
+            continue
+        n = r["wave_number"]
+        waves.setdefault(r["family"], []).append(
+            None if n is None else ModeWave(int(n), float(r["wave_fraction"]), r["member"])
+        )
+    pairs = {r["family"] for r in rows if r["family"] is not None and r["slot"]}
+    return family_names(waves, sorted(pairs))
+
+
+def _family_number(name: str) -> int:
+    """``F12`` -> 12 (the tracking's names, in order of frequency)."""
+    return int(name[1:]) if name[1:].isdigit() else 0
 
 
 def damping_rows(runs: Sequence[TestRun], modes: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -608,6 +643,7 @@ def write_outputs(
             test_docs[step] = rel
         mine = [x for x in srows if x["test_id"] == r.spec.test_id]
         tests.append(summary_entry(r, mine, test_docs, model))
+    names = row_family_names(rows)
     families: dict[str, dict[str, Any]] = {}
     for row in rows:
         if row["family"] is None:
@@ -621,6 +657,7 @@ def write_outputs(
     fam_list = [
         {
             "family": k,
+            **names[k].to_dict(),
             "n_modes": v["n_modes"],
             "n_tests": len(v["tests"]),
             "pair": bool(v["slots"] - {""}),
@@ -628,7 +665,7 @@ def write_outputs(
                 np.median([r["frequency_hz"] for r in rows if r["family"] == k])
             ),
         }
-        for k, v in sorted(families.items(), key=lambda kv: int(kv[0][1:]))
+        for k, v in sorted(families.items(), key=lambda kv: _family_number(kv[0]))
     ]
     summary = {
         "kind": KIND,

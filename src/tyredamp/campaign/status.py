@@ -126,10 +126,10 @@ def quality_checks(run: TestRun, model: str = "complex") -> dict[str, Any]:
 
 
 def excitation_layout(run: TestRun, model: str = "complex") -> dict[str, Any] | None:
-    """Shaker angles of a ring test with several shakers, and the pairs they cannot split.
+    """Shaker angles of a ring test, and the doubled pairs of which they drive one member.
 
-    From the channels of the test's modes document: when at least two
-    inputs and three outputs carry an angular position, returns
+    From the channels of the test's modes document: when every input and at
+    least three outputs carry an angular position, returns
     ``angles_deg`` (the inputs) and ``single_member`` (the wave numbers up to
     the outputs' spatial Nyquist limit of which only one member of the
     doubled pair is driven, :func:`~.tracking.single_member_wave_numbers`);
@@ -144,7 +144,9 @@ def excitation_layout(run: TestRun, model: str = "complex") -> dict[str, Any] | 
         return None
     ins = [c.get("angle_deg") for c in m.get("inputs") or []]
     outs = [c.get("angle_deg") for c in m.get("outputs") or []]
-    if len(ins) < 2 or any(a is None for a in ins) or sum(a is not None for a in outs) < 3:
+    if m.get("shapes_at") == "inputs":
+        return None  # a roving hammer: the excitation moves over the points
+    if not ins or any(a is None for a in ins) or sum(a is not None for a in outs) < 3:
         return None
     n_max = len({round(float(a) % 360.0, 6) for a in outs if a is not None}) // 2
     angles = [float(a) for a in ins]

@@ -517,8 +517,11 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
     ``modal_damping`` and ``modal_damping_std`` (the diagonal ``C'_nn`` in 1/s
     and its standard error, from the damping step when there is one),
     ``points`` (output labels; input labels when the shapes are at the
-    inputs, a roving-hammer test) and ``shape`` (complex, one per point). A
-    lateral test has no modes (empty list).
+    inputs, a roving-hammer test), ``angles_deg`` (the points' angular
+    positions in deg, None where a channel has none), ``reference_deg`` (the
+    first excitation's angle, 0 when unknown; the fixed response's angle for
+    a roving-hammer test, the same point by reciprocity) and ``shape``
+    (complex, one per point). A lateral test has no modes (empty list).
     """
     if study != "radial" or "modal" not in documents or is_skip(documents["modal"]):
         return []
@@ -531,6 +534,11 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
         str(o.get("name") or f"{o.get('node')}{o.get('direction', '')}")
         for o in m["inputs" if at_inputs else "outputs"]
     ]
+    at = m["inputs" if at_inputs else "outputs"]
+    angles = [None if o.get("angle_deg") is None else float(o["angle_deg"]) for o in at]
+    fixed = m.get("outputs" if at_inputs else "inputs") or []
+    refs = [float(c["angle_deg"]) for c in fixed if c.get("angle_deg") is not None]
+    reference = refs[0] if refs else 0.0
     damp = documents.get("damping")
     if is_skip(damp):
         damp = None
@@ -559,6 +567,8 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
                 "modal_damping": None if cdiag is None else cdiag[i],
                 "modal_damping_std": None if cstd is None else cstd[i],
                 "points": points,
+                "angles_deg": angles,
+                "reference_deg": reference,
                 "shape": _complex_vec(md["participation" if at_inputs else "shape"]),
             }
         )

@@ -43,7 +43,7 @@ def _family_order(name: str) -> tuple[int, str]:
     return (int(name[1:]), "") if name[:1] == "F" and name[1:].isdigit() else (10**9, name)
 
 
-def _trend_figures(rep: HtmlReport, fits: list[Any]) -> None:
+def _trend_figures(rep: HtmlReport, fits: list[Any], labels: dict[str, str]) -> None:
     from matplotlib.figure import Figure
 
     from ..plot.campaign import plot_trend
@@ -83,7 +83,8 @@ def _trend_figures(rep: HtmlReport, fits: list[Any]) -> None:
         n_series = sum(it[0]["quantity"] == quantities[0] for it in items)
         if n_series <= 12:
             axes[0].legend(fontsize=6)
-        name = fam + (slot and f" ({slot})")
+        name = fam + (f", {labels[fam]}" if labels.get(fam, fam) != fam else "")
+        name += slot and f" ({slot})"
         rep.figure(
             fig,
             f"{name}: against {_LABELS.get(cond, cond)}; line: fitted trend "
@@ -185,11 +186,13 @@ def _family_figures(rep: HtmlReport, modes: list[dict[str, Any]]) -> None:
             for ax in axes:
                 ax.set_xlabel(_LABELS[cond])
         med = float(np.median([r["frequency_hz"] for r in rows]))
+        label = rows[0].get("family_label")
+        name = f"{fam}, {label}" if label and label != fam else fam
         n_tests = len({r["test_id"] for r in rows})
         against = f"against {_LABELS[cond]}" if cond else "test by test"
         rep.figure(
             fig,
-            f"{fam} (median {med:.4g} Hz, {n_tests} test{'s' if n_tests != 1 else ''}): "
+            f"{name} (median {med:.4g} Hz, {n_tests} test{'s' if n_tests != 1 else ''}): "
             f"natural frequency and damping ratio {against}, +- 1 standard error",
             dpi=80,
         )
@@ -206,8 +209,20 @@ def _excitation_note(rep: HtmlReport, s: dict[str, Any]) -> None:
     for (angles, waves), ids in layouts.items():
         where = ", ".join(f"{a:g}" for a in angles)
         ns = ", ".join(str(n) for n in waves)
+        tests = f"{len(ids)} test{'s' if len(ids) != 1 else ''}"
+        if len(angles) == 1:
+            rep.paragraph(
+                f"One shaker at {where} deg ({tests}) drives only the member of each doubled "
+                f"mode whose antinode is at the shaker (cos) for wave numbers n = {ns}: the "
+                "other member (sin) has a node there and cannot appear in these FRFs, so each "
+                "family holds one member, not the pair, and the pair's splitting is not "
+                "measured. Two shakers see both members of wave number n when n times their "
+                "angular spacing is not a multiple of 180 deg (0 and 45 deg: n = 1, 2, 3).",
+                "note",
+            )
+            continue
         rep.paragraph(
-            f"Shakers at {where} deg ({len(ids)} test{'s' if len(ids) != 1 else ''}) drive "
+            f"Shakers at {where} deg ({tests}) drive "
             f"only one member of the doubled modes of wave number n = {ns}: for these n every "
             "shaker lies on a nodal line of the same member (n times the angle between the "
             "shakers is a multiple of 180 deg), so the second member cannot appear in these "
@@ -390,11 +405,19 @@ def campaign_report(results: Any) -> str:
                 f"{100 * float(tr.get('scatter_ln_damping_ratio') or 0):.3g} % in damping ratio)"
             )
         rep.paragraph(text + ".")
+    rep.paragraph(
+        "Each family is named by the circumferential wave number n of its shapes (the "
+        "single harmonic a cos n theta + b sin n theta that explains most of a shape at the "
+        "points' angles, counted when it explains at least 80 % of it; the family takes the "
+        "wave number most of its modes carry) and, for a single member of a doubled mode, by "
+        "the member: cos (antinode at the first shaker) or sin (node there)."
+    )
     rep.table(
-        ["family", "median f [Hz]", "modes", "tests", "pair"],
+        ["family", "name", "median f [Hz]", "modes", "tests", "pair"],
         [
             [
                 f["family"],
+                f.get("label") or "",
                 f["median_frequency_hz"],
                 f["n_modes"],
                 f["n_tests"],
@@ -408,7 +431,8 @@ def campaign_report(results: Any) -> str:
         _family_figures(rep, results.modes)
     if results.fits:
         rep.heading("Trends")
-        _trend_figures(rep, results.fits)
+        labels = {f["family"]: f.get("label") or f["family"] for f in s["families"]}
+        _trend_figures(rep, results.fits, labels)
     if results.damping:
         rep.heading("Damping matrix across conditions")
         if not _damping_figures(rep, results.damping):
