@@ -261,3 +261,28 @@ def test_dependent_forces_finds_a_reaction_force_not_a_second_shaker() -> None:
     assert dependent_forces(td([body, resp, other])) == []
     with pytest.raises(InputError, match="min_r2"):
         dependent_forces(td([body, acc, ground]), min_r2=1.5)
+
+
+def test_quality_judges_coherence_where_the_response_is_strong(chain: MCKSystem) -> None:
+    f = np.linspace(0.5, 40, 400)
+    frf = chain.frf(f, "accelerance", outputs=[0, 2, 4], inputs=[0])
+    power = np.abs(frf.H[:, 0, :]) ** 2
+    # white output noise: gamma^2 = S / (S + N) (Bendat & Piersol, Random Data, output noise,
+    # no input noise), N set so that the dips (antiresonances, nodal lines) fall below 0.9
+    noise = 0.5 * np.quantile(power, 0.2, axis=1, keepdims=True)
+    coh = power / (power + noise)
+    base = FRF(f, frf.H, "accelerance", frf.outputs, frf.inputs, coherence=coh)
+    weak_only = quality_check(base)
+    assert weak_only.figures["low_coherence_fraction_all_lines"] > 0.1
+    assert weak_only.passed, weak_only.report()
+    assert weak_only.figure == 0.0
+    assert any("response is weak" in n for n in weak_only.notes)
+    # the same low coherence moved to the strongest lines (leakage or a non-linearity at
+    # the resonances): the data fail
+    strong = power >= np.quantile(power, 0.8, axis=1, keepdims=True)
+    coh_bad = np.where(strong, 0.5, 1.0)
+    bad = quality_check(FRF(f, frf.H, "accelerance", frf.outputs, frf.inputs, coherence=coh_bad))
+    assert not bad.passed
+    # 20 % of all lines are the top 40 % of the strong half: the verdict figure is 0.4
+    assert bad.figure == pytest.approx(0.4, abs=0.01)
+    assert "strong response" in bad.summary

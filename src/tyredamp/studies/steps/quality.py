@@ -28,7 +28,7 @@ class QualitySettings(StepSettings):
     )
     max_low_fraction: float = knob(
         0.1,
-        "Largest accepted fraction of low-coherence lines.",
+        "Largest accepted fraction of low-coherence lines where the response is strong.",
         Number(0.0, 1.0, optional=False),
         "--max-low-fraction",
     )
