@@ -187,9 +187,14 @@ def rotating_ring_roots(
     for i in range(nn.size):
         coeffs = [m**2, 0.0, -(m * (q11[i] + q22[i]) + g**2), 2 * g * q12[i]]
         coeffs.append(q11[i] * q22[i] - q12[i] ** 2)
-        r = np.roots(np.array(coeffs) / m**2)
+        poly = np.array(coeffs) / m**2
+        r = np.roots(poly)
         tol = 1e-7 * np.max(np.abs(r))
-        out[i] = np.sort(np.where(np.abs(r.imag) <= tol, r.real, np.nan))
+        real = np.where(np.abs(r.imag) <= tol, r.real, np.nan)
+        deriv = np.polyder(poly)
+        for _ in range(3):  # Newton polish of the companion-matrix roots
+            real = real - np.polyval(poly, real) / np.polyval(deriv, real)
+        out[i] = np.sort(real)
     return out
 
 
