@@ -97,29 +97,46 @@ class PointContact:
         return trig_interpolation(np.deg2rad(self.angle_deg) - turned, n_ring)
 
 
+def _harmonics(x: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """Weighted harmonics ``c_k X_k / N`` of nodal fields (columns), shape (N/2 + 1, L).
+
+    The trigonometric interpolant (:func:`trig_interpolation`) of the field is
+    then ``Re sum_k H_k e^{i k theta}``.
+    """
+    n = x.shape[0]
+    h = np.fft.rfft(x, axis=0) / n
+    h[1:] *= 2.0
+    if n % 2 == 0:
+        h[-1] /= 2.0
+    return h
+
+
 def _sensor_signal(
-    w: tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
+    h: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]],
     theta: NDArray[np.float64],
     omega: float,
     quantity: str,
     fixed: bool,
 ) -> NDArray[np.float64]:
-    """Signal of one sensor over a chunk: ``w`` = (x, x', x'') of the radial nodes, (N, L)."""
-    n = w[0].shape[0]
-    w0 = trig_interpolation(theta, n)
-    x, xd, xdd = w
+    """One sensor over a chunk from the harmonics ``h`` of (x, x', x'') of the radial nodes.
+
+    A fixed sensor (material angle ``theta(t) = phi - Omega t``) adds the convected
+    terms ``-Omega d/dtheta`` of the time derivative; an in-tyre one does not.
+    """
+    k = np.arange(h[0].shape[0])[:, None]
+    ik = 1j * k
+    om = omega if fixed else 0.0
     if quantity == "displacement":
-        return np.einsum("ln,nl->l", w0, x)
-    w1 = trig_interpolation(theta, n, derivative=1) if fixed else None
-    if quantity == "velocity":
-        out = np.einsum("ln,nl->l", w0, xd)
-        return out - omega * np.einsum("ln,nl->l", w1, x) if w1 is not None else out
-    out = np.einsum("ln,nl->l", w0, xdd)
-    if w1 is not None:
-        w2 = trig_interpolation(theta, n, derivative=2)
-        out = out - 2 * omega * np.einsum("ln,nl->l", w1, xd)
-        out = out + omega**2 * np.einsum("ln,nl->l", w2, x)
-    return out
+        coef = h[0]
+    elif quantity == "velocity":
+        coef = h[1] - om * ik * h[0]
+    else:
+        coef = h[2] - 2 * om * ik * h[1] + om**2 * ik**2 * h[0]
+    z = np.exp(1j * theta)
+    acc = coef[-1].copy()
+    for row in coef[-2::-1]:  # Horner: sum_k coef_k z^k
+        acc = acc * z + row
+    return np.asarray(np.real(acc), dtype=np.float64)
 
 
 def rolling_response(
@@ -198,14 +215,12 @@ def rolling_response(
         x = 2 * np.real(cm.displacement[:n] @ qc)
         xd = 2 * np.real(cm.velocity[:n] @ qc)
         xdd = 2 * np.real(cm.velocity[:n] @ (cm.poles[:, None] * qc)) + inv_mass[:, None] * nodal.T
+        hx = (_harmonics(x), _harmonics(xd), _harmonics(xdd))
         for i, a in enumerate(phi_f):
-            out[i, start:stop] = _sensor_signal(
-                (x, xd, xdd), a - turned, ring.omega, quantity, True
-            )
+            out[i, start:stop] = _sensor_signal(hx, a - turned, ring.omega, quantity, True)
         for i, a in enumerate(th_r):
             theta = np.full(stop - start, a)
-            row = phi_f.size + i
-            out[row, start:stop] = _sensor_signal((x, xd, xdd), theta, 0.0, quantity, False)
+            out[phi_f.size + i, start:stop] = _sensor_signal(hx, theta, 0.0, quantity, False)
     return out
 
 
