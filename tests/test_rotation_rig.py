@@ -142,3 +142,37 @@ def test_rolling_test_recording() -> None:
 def test_rolling_test_refuses_bad_options(kwargs: dict, match: str) -> None:
     with pytest.raises(InputError, match=match):
         rolling_test(duration=0.05, settle=0.0, **kwargs)
+
+
+def test_harmonic_road_force_gives_the_fixed_frame_modal_sum() -> None:
+    # heavily damped 32-node ring: the transient is gone after 0.3 s
+    p = RingTyreParameters(radial_damping=3000.0, tangential_damping=3000.0)
+    layout = MeasurementLayout(attachment_mass=0.0, attachment_damping=0.0)
+    ring = RotatingRing(RingTyre(p, layout, n_ring=32, nonproportionality=1.0), SPEED)
+    modes = ring.system.state_modes()
+    n = ring.n_ring
+    k, _ = signed_wave_numbers(modes.displacement[:n], modes.displacement[n:])
+    theta = 2 * np.pi * np.arange(n) / n
+    # each mode is a pure harmonic: shape c e^{ik theta}, input row u e^{-ik theta}
+    c = np.array(
+        [np.mean(modes.displacement[:n, j] * np.exp(-1j * kk * theta)) for j, kk in enumerate(k)]
+    )
+    u = np.array([np.mean(modes.input[j, :n] * np.exp(1j * kk * theta)) for j, kk in enumerate(k)])
+    c[np.abs(k) == n // 2] = 0.0  # the grid's standing Nyquist pattern is neither loaded nor read
+    fs, nu = 8192.0, 2 * np.pi * 100.0
+    t = np.arange(int(0.6 * fs)) / fs
+    phi, phi_c = np.deg2rad(45.0), np.deg2rad(10.0)
+    out = rolling_response(
+        ring, np.cos(nu * t), fs, fixed_deg=[45.0], contact=PointContact(10.0),
+        quantity="displacement", modes=modes,
+    )[0]  # fmt: skip
+    # load at phi_c - Omega t, read at phi - Omega t: in the fixed frame each mode answers
+    # e^{+-i nu t} with the pole moved by -i k Omega (time-invariant, Doppler-shifted)
+    a = c * u * np.exp(1j * k * (phi - phi_c)) / 2
+    up = np.exp(1j * nu * t)[None, :] / (1j * (nu + k * ring.omega) - modes.poles)[:, None]
+    down = np.exp(-1j * nu * t)[None, :] / (1j * (k * ring.omega - nu) - modes.poles)[:, None]
+    want = 2 * np.real(np.sum(a[:, None] * (up + down), axis=0))
+    steady = t >= 0.3
+    # 5e-4 of the amplitude: the first-order hold of the moving load, (nu h)^2 / 12 = 2e-4
+    scale = np.max(np.abs(want[steady]))
+    assert_allclose(out[steady], want[steady], atol=5e-4 * scale)

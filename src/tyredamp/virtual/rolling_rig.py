@@ -107,7 +107,7 @@ def _harmonics(x: NDArray[np.float64]) -> NDArray[np.complex128]:
     h = np.fft.rfft(x, axis=0) / n
     h[1:] *= 2.0
     if n % 2 == 0:
-        h[-1] /= 2.0
+        h[-1] = 0.0  # the grid's standing Nyquist pattern (see trig_interpolation)
     return h
 
 

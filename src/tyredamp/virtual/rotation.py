@@ -304,16 +304,25 @@ def critical_speed_kmh(params: RingTyreParameters) -> float:
 
 
 def trig_interpolation(
-    angles: ArrayLike, n_nodes: int, offset: float = 0.0, derivative: int = 0
+    angles: ArrayLike,
+    n_nodes: int,
+    offset: float = 0.0,
+    derivative: int = 0,
+    *,
+    nyquist: bool = False,
 ) -> NDArray[np.float64]:
     """Weights of the trigonometric (Fourier) interpolant on ``n_nodes`` equally spaced angles.
 
     For samples ``f_j`` at ``theta_j = (j + offset) h``, ``h = 2 pi /
     n_nodes``, the interpolant is ``f(theta) = (1/N) sum_{k=0}^{N/2} c_k
-    sum_j f_j cos(k (theta - theta_j))`` (``c_0 = 1``, ``c_k = 2``, and ``c =
-    1`` for ``k = N/2`` of an even ``N``; Trefethen, *Spectral Methods in
-    MATLAB*, SIAM 2000, ch. 3). It reproduces every harmonic below ``N/2``
-    exactly, which is the ring's own discrete representation.
+    sum_j f_j cos(k (theta - theta_j))`` (``c_0 = 1``, ``c_k = 2``; Trefethen,
+    *Spectral Methods in MATLAB*, SIAM 2000, ch. 3). It reproduces every
+    harmonic below ``N/2`` exactly, which is the ring's own discrete
+    representation. The harmonic ``k = N/2`` of an even ``N`` (``c = 1``
+    with ``nyquist=True``) is left out by default: on the grid it is a
+    standing pattern ``cos(N theta / 2)`` that cannot travel, so a moving
+    load or sensor would couple it to itself at ``+- N Omega`` (a grid
+    artefact, not a wave of the ring).
 
     Parameters
     ----------
@@ -325,6 +334,9 @@ def trig_interpolation(
         Grid offset in steps (0 for the ring nodes, 0.5 for the mid-points).
     derivative : {0, 1, 2}
         Derivative order in ``theta`` of the interpolant.
+    nyquist : bool
+        Keep the harmonic ``N/2`` (the classical interpolant through the
+        samples); default False.
 
     Returns
     -------
@@ -337,7 +349,7 @@ def trig_interpolation(
     c = np.full(k.size, 2.0)
     c[0] = 1.0
     if n % 2 == 0:
-        c[-1] = 1.0
+        c[-1] = 1.0 if nyquist else 0.0
     theta = (np.arange(n) + offset) * (2 * np.pi / n)
     e = np.exp(1j * a[:, None] * k[None, :]) * (c * (1j * k) ** derivative)[None, :]
     basis = np.exp(-1j * k[:, None] * theta[None, :])
