@@ -281,7 +281,10 @@ def _known_force(
 
 
 def _check_speed(speed_kmh: float, tyre: RingTyre) -> float:
-    ring_speed = float(speed_kmh) if isinstance(speed_kmh, int | float) else np.nan
+    try:
+        ring_speed = float(speed_kmh)
+    except (TypeError, ValueError):
+        ring_speed = np.nan
     if not np.isfinite(ring_speed) or ring_speed < 0:
         raise InputError(f"speed: expected a finite speed >= 0 km/h, got {speed_kmh!r}")
     v_c = critical_speed_kmh(tyre.params)
