@@ -45,9 +45,10 @@ the quartic reduces to
 / (n^2 + 1)^2)``
 
 (:func:`inextensible_rotating_frequencies`), ``omega_0`` the static
-inextensible frequency; for the free ring this is Bryan's result (G. H.
-Bryan, Proc. Cambridge Phil. Soc. 7, 1890, 101-111): the pattern lags the
-ring at ``2 Omega / (n^2 + 1)``, and with ``omega_0 = 0`` the backward wave
+inextensible frequency (derived here). Its term linear in ``Omega`` is
+Bryan's effect (G. H. Bryan, Proc. Cambridge Phil. Soc. 7, 1890, 101-111):
+the vibration pattern lags the ring at ``2 Omega / (n^2 + 1)``; and with
+``omega_0 = 0`` (a free ring with no bending stiffness) the backward wave
 stands still in space.
 
 Fixed frame (Doppler)
@@ -256,8 +257,9 @@ def inextensible_rotating_frequencies(
     ``omega_{f,b} = -+ 2 n Omega/(n^2 + 1) + sqrt(omega_0^2 + Omega^2 n^2
     (n^2 - 1)^2/(n^2 + 1)^2)`` with ``omega_0`` from
     :func:`~tyredamp.virtual.analytic_ring_frequencies` (the quartic of
-    :func:`rotating_ring_roots` with ``v' = -w``; for the free ring, Bryan
-    1890). The limit of :func:`rotating_ring_dispersion` as ``EA -> inf``.
+    :func:`rotating_ring_roots` with ``v' = -w``, derived here; its linear
+    term in ``Omega`` is Bryan's effect, Proc. Cambridge Phil. Soc. 7, 1890).
+    The limit of :func:`rotating_ring_dispersion` as ``EA -> inf``.
 
     Returns
     -------
