@@ -377,7 +377,12 @@ class RotatingRing:
       centrifugal softening of every mass.
 
     The axisymmetric ring's discrete waves follow :func:`rotating_ring_roots`
-    with ``n`` replaced by ``s(n)`` (``n_ring=``), to rounding.
+    with ``n`` replaced by ``s(n)`` (``n_ring=``), to rounding. Masses of
+    :class:`~tyredamp.virtual.Imperfection` spin with the ring: they enter
+    ``G`` and ``-Omega^2 M`` through ``M`` (for a point mass the Coriolis
+    coupling is then the mean of its radial and tangential lumped shares, an
+    approximation). Anything fixed in space (the road, a contact patch) must
+    not be part of ``tyre``: it acts through the load of the rolling rig.
 
     Parameters
     ----------
