@@ -7,7 +7,9 @@ type 4); ``--truth`` also writes the exact modes as a modes JSON file.
 ``simulate lateral`` is the rolling-tyre rig; it is the same command as
 ``tyredamp lateral simulate`` (same options, same output). ``simulate
 campaign`` (:mod:`.simulate_campaign`) writes a whole virtual test campaign
-and its campaign file for ``tyredamp campaign``.
+and its campaign file for ``tyredamp campaign``. ``simulate rolling``
+(:mod:`.simulate_rolling`) records the rolling radial tyre with fixed and
+in-tyre sensors.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from ..io._safety import atomic_paths, check_distinct, check_output_file
 from ._common import OutPath, out_file_option, parse_drive_points, seed_option
 from .lateral import lateral_group
 from .simulate_campaign import simulate_campaign_command
+from .simulate_rolling import simulate_rolling_command
 
 __all__ = ["simulate_group"]
 
@@ -40,6 +43,7 @@ def simulate_group() -> None:
       tyredamp simulate radial --out tyre_test.uff --pressure 7.5 --seed 1
       tyredamp simulate radial --out tyre_frf.uff --frf --truth truth.json
       tyredamp simulate lateral --out rig.npz --speed 5 --pressure 1.7
+      tyredamp simulate rolling --out rolling.uff --speed 40
       tyredamp simulate campaign --out virtual
     """
 
@@ -219,3 +223,4 @@ simulate_group.add_command(
     )
 )
 simulate_group.add_command(simulate_campaign_command)
+simulate_group.add_command(simulate_rolling_command)

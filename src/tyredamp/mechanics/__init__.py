@@ -6,6 +6,7 @@ damped system ``M x'' + C x' + K x = f``.
 
 from __future__ import annotations
 
+from .gyroscopic import GyroscopicSystem, StateModes
 from .modal_sum import (
     kind_factor,
     modal_sum_receptance,
@@ -31,9 +32,11 @@ from .system import ComplexModes, MCKSystem, UndampedModes, normalisation_consta
 
 __all__ = [
     "ComplexModes",
+    "GyroscopicSystem",
     "MCKSystem",
     "SmallDampingError",
     "SmallDampingModes",
+    "StateModes",
     "TimeResponse",
     "UndampedModes",
     "alpha_coefficients",

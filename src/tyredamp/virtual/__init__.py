@@ -13,6 +13,11 @@ test rig (paper 000), the rolling-tyre lateral rig (paper 001).
   truth at the points (:class:`TyreTruth`).
 * :func:`run_modal_test`: the virtual test rig (periodic chirp, noise,
   multi-reference), returning :class:`VirtualModalTest` (``TimeData`` + truth).
+* :class:`RotatingRing` (:mod:`.rotation`): the ring spinning at a rolling
+  speed (Coriolis, centrifugal, centrifugal tension), its closed-form
+  dispersion :func:`rotating_ring_dispersion`; :func:`rolling_test`
+  (:mod:`.rolling_rig`): fixed and in-tyre sensors under a road force, with
+  the forward/backward waves in both frames (:class:`RollingTruth`).
 * :class:`VirtualLateralRig` (:mod:`.lateral_rig`): the rolling-tyre rig of
   paper 001 with its exact tyre (:class:`ViscoelasticStringTyre`,
   :class:`AgriculturalTyre`), FRFs and time tests.
@@ -42,27 +47,47 @@ from .ring import (
     ring_dispersion,
     staggered_weights,
 )
+from .rolling_rig import ContactLoad, PointContact, RollingTest, rolling_response, rolling_test
+from .rolling_truth import RollingTruth
+from .rotation import (
+    RotatingRing,
+    critical_speed_kmh,
+    inextensible_rotating_frequencies,
+    rotating_ring_dispersion,
+    rotating_ring_roots,
+)
 from .truth import TyreTruth, modal_phase_collinearity, wave_numbers
 
 __all__ = [
     "KMH",
     "AgriculturalTyre",
+    "ContactLoad",
     "Imperfection",
     "MeasurementLayout",
+    "PointContact",
     "RingConvergence",
     "RingTyre",
     "RingTyreParameters",
+    "RollingTest",
+    "RollingTruth",
+    "RotatingRing",
     "TyreTruth",
     "VirtualLateralRig",
     "VirtualModalTest",
     "ViscoelasticStringTyre",
     "analytic_ring_frequencies",
+    "critical_speed_kmh",
     "difference_symbol",
     "hadamard_drive_matrix",
+    "inextensible_rotating_frequencies",
     "modal_phase_collinearity",
     "periodic_initial_state",
     "ring_convergence",
     "ring_dispersion",
+    "rolling_response",
+    "rolling_test",
+    "rotating_ring_dispersion",
+    "rotating_ring_roots",
     "run_modal_test",
     "schroeder_multisine",
     "staggered_weights",
