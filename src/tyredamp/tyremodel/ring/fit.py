@@ -30,6 +30,7 @@ from ..._validate import check_positive
 from ...exceptions import ConvergenceError, InputError, PhysicsError
 from ...modal.model import ModalModel
 from .identifiability import (
+    admit_model_error,
     central_jacobian,
     chi2_scaling,
     collinearity,
@@ -385,7 +386,12 @@ def _fit_stiffness(problem: _StiffnessProblem, theta0: _Array) -> _StiffnessFit:
         stderr=se,
         correlation=corr,
         singular_values=sv,
-        verdicts=verdicts(names, se / vscale, corr, jac),
+        verdicts=admit_model_error(
+            verdicts(names, se / vscale, corr, jac),
+            theta,
+            se,
+            rss / dof if problem.have_std and dof > 0 else None,
+        ),
         fitted_frequency_hz=fm,
         fitted_amplitude=am,
         chi2=rss,
@@ -443,7 +449,12 @@ def _fit_damping(
         units=("N s/m^2", "N s/m^2", "s", "N s/m")[: dmat.shape[1]],
         values=np.asarray(dsol, dtype=float),
         stderr=dse,
-        verdicts=verdicts(names, dse / dscale, correlation(dcov), dw),
+        verdicts=admit_model_error(
+            verdicts(names, dse / dscale, correlation(dcov), dw),
+            dsol,
+            dse,
+            drss / ddof if have_zstd else None,
+        ),
         fitted_damping_ratio=(dmat @ dsol + (c_known or 0.0) * phi2) / (2 * omega),
     )
 

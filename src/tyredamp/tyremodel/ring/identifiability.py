@@ -31,7 +31,9 @@ __all__ = [
     "COLLINEARITY",
     "CORRELATED",
     "IDENTIFIED",
+    "MODEL_LIMITED",
     "POORLY",
+    "admit_model_error",
     "central_jacobian",
     "chi2_scaling",
     "collinearity",
@@ -52,6 +54,10 @@ CORRELATED = 0.95
 #: undetermined. Brun et al. call 10-15 critical for percent-level environmental data; modal
 #: frequencies are more precise, and the standard-error verdict covers the noise itself.
 COLLINEARITY = 100.0
+#: Reduced chi-square above which the misfit is model error, not noise: the covariance scaled
+#: by it describes a random scatter the residuals do not have (systematic misfit moves every
+#: parameter together), so no parameter is called identified.
+MODEL_LIMITED = 4.0
 #: Chi-square upper-tail probability below which the covariance is scaled by ``RSS/dof``.
 _SIGNIFICANT = 0.01
 
@@ -169,3 +175,47 @@ def verdicts(
             label = f"not separately identifiable (confounded with {others})"
         out[nm] = {"verdict": label, "relative_se": rel, "correlated_with": partners}
     return out
+
+
+def admit_model_error(
+    out: dict[str, dict[str, Any]],
+    theta: NDArray[np.float64],
+    se: NDArray[np.float64],
+    chi2_per_dof: float | None,
+) -> dict[str, dict[str, Any]]:
+    """Verdicts that admit a model discrepancy and parameters consistent with zero.
+
+    With weights from the measurement standard errors the reduced chi-square
+    ``RSS/dof`` estimates ``1 + s_model^2 / s_noise^2`` (the model
+    discrepancy's variance against the noise's, Kennedy & O'Hagan, J. R.
+    Stat. Soc. B 63(3), 2001, eq. (5) with a constant discrepancy variance);
+    above :data:`MODEL_LIMITED` the covariance (already scaled by it) still
+    treats the misfit as random, so a parameter judged identified or poorly
+    identified becomes ``model-limited``. A parameter within two standard
+    errors of zero is flagged ``consistent_with_zero`` (a 95 % interval
+    that contains 0).
+
+    Parameters
+    ----------
+    out : dict
+        From :func:`verdicts` (changed copies are returned).
+    theta, se : ndarray, shape (P,)
+        Values and (scaled) standard errors in the order of ``out``.
+    chi2_per_dof : float or None
+        ``RSS/dof`` with measurement weights, None without standard errors.
+    """
+    res: dict[str, dict[str, Any]] = {}
+    limited = chi2_per_dof is not None and chi2_per_dof > MODEL_LIMITED
+    for i, (name, v) in enumerate(out.items()):
+        w = dict(v)
+        w["consistent_with_zero"] = bool(abs(float(theta[i])) <= 2 * float(se[i]))
+        w["model_limited"] = bool(limited and w["verdict"] in ("identified", "poorly identified"))
+        if w["model_limited"]:
+            w["verdict"] = (
+                f"model-limited (chi2/dof {chi2_per_dof:.3g}: the ring does not describe these "
+                "modes to their precision)"
+            )
+        elif w["consistent_with_zero"] and w["verdict"] == "identified":
+            w["verdict"] = "consistent with zero"
+        res[name] = w
+    return res

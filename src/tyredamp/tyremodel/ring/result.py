@@ -287,6 +287,26 @@ class RingFit:
             band_loss_frequency=self.band_loss_frequency,
         )
 
+    def model_discrepancy(self) -> dict[str, Any]:
+        """The misfit beyond the noise: reduced chi-square and relative frequency scatter.
+
+        ``chi2_per_dof`` (None without measurement standard errors), whether
+        it makes the parameters model-limited (above
+        :data:`~tyredamp.tyremodel.ring.identifiability.MODEL_LIMITED`), and
+        the RMS of ``(f_model - f_measured) / f_measured``: the accuracy to
+        which the ring describes the modes, whatever their noise.
+        """
+        from .identifiability import MODEL_LIMITED
+
+        f = np.array([o.frequency_hz for o in self.observations], dtype=float)
+        rel = (self.fitted_frequency_hz - f) / f
+        c = self.chi2 / self.dof if self.p_value is not None and self.dof > 0 else None
+        return {
+            "chi2_per_dof": c,
+            "model_limited": bool(c is not None and c > MODEL_LIMITED),
+            "frequency_rms_relative": float(np.sqrt(np.mean(rel**2))) if rel.size else 0.0,
+        }
+
     # ------------------------------------------------------------ output
     def table(self) -> list[dict[str, Any]]:
         """One row per parameter: name, unit, value, stderr, verdict, correlated_with."""
@@ -365,6 +385,7 @@ class RingFit:
             "dof": self.dof,
             "p_value": self.p_value,
             "scaled_covariance": self.scaled_covariance,
+            "model_discrepancy": self.model_discrepancy(),
             "weights": self.weights,
             "observations": [
                 {
