@@ -238,6 +238,29 @@ def _choose_test(res: Any, doc: dict[str, dict[str, Any]], name: str, force: boo
     return k
 
 
+def _same_tyre(doc: dict[str, dict[str, Any]], radius: float, name: str, force: bool) -> str:
+    """Refuse (unless ``force``) a base whose radii cannot hold the tested belt; a warning or "".
+
+    The belt (tread-band centre line) radius of the test lies between the
+    base's ``RIM_RADIUS`` and its ``UNLOADED_RADIUS`` (5 % allowed above it
+    for the radius's own uncertainty) when both describe the same tyre.
+    """
+    dim = doc.get("DIMENSION", {})
+    r0, rr = dim.get("UNLOADED_RADIUS"), dim.get("RIM_RADIUS")
+    r0 = r0 if isinstance(r0, float) and r0 > 0 else None
+    rr = rr if isinstance(rr, float) and rr > 0 else None
+    if (r0 is None or radius <= 1.05 * r0) and (rr is None or radius > rr):
+        return ""
+    msg = (
+        f"{name}: a tyre of unloaded radius {r0 if r0 is not None else '?'} m and rim radius "
+        f"{rr if rr is not None else '?'} m cannot have the tested belt radius {radius:g} m: "
+        "another tyre"
+    )
+    if not force:
+        raise InputError(msg + "; merge into the tested tyre's file, or give --force")
+    return msg + " (merged with --force)"
+
+
 def merged_text(res: Any, base_text: str, name: str, *, force: bool = False) -> str:
     """A tyre-model result merged into a base ``.tir`` (module docstring).
 
@@ -265,6 +288,7 @@ def merged_text(res: Any, base_text: str, name: str, *, force: bool = False) -> 
     except FileFormatError as exc:
         raise FileFormatError(f"{name}: {exc}") from None
     k = _choose_test(res, doc, name, force)
+    other_tyre = _same_tyre(doc, float(res.ring.radius), name, force)
     p, rigid, budget = res.pressures[k], res.rigid[k], res.budgets[k]
     pb = base_pressure(doc)
     test = f"{res.sources[k]} at {p / _BAR:g} bar"
@@ -308,6 +332,8 @@ def merged_text(res: Any, base_text: str, name: str, *, force: bool = False) -> 
             f"WARNING: the test ({p / _BAR:g} bar) and the base ({pb / _BAR:.3g} bar) differ in "
             "pressure (merged with --force)"
         )
+    if other_tyre:
+        header.append(f"WARNING: {other_tyre}")
     disc = res.ring.model_discrepancy()
     if disc["model_limited"]:
         header.append(
