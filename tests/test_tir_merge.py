@@ -1,4 +1,4 @@
-"""Merging identified values into a complete ``.tir`` (:func:`tyredamp.tyremodel.tirmerge.merge_tir`).
+"""Identified values merged into a complete ``.tir`` (``tyremodel.tirmerge.merge_tir``).
 
 Bases: the public files of ``../shared/real-data`` (CATALOGUE.md sections 8, 9; see
 test_tir_reader.py). The merged text must keep every base line but the identified ones,
@@ -21,10 +21,8 @@ from .tir_readers import mfeval_required, mfeval_style_read, tyredyn_problems
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "real-data"
 BASES = {
-    "chrono40": REAL
-    / "projectchrono_chrono/data/vehicle/feda/tires/335_65R22_5_G275MSA_40psi.tir",
-    "chrono95": REAL
-    / "projectchrono_chrono/data/vehicle/feda/tires/335_65R22_5_G275MSA_95psi.tir",
+    "chrono40": REAL / "projectchrono_chrono/data/vehicle/feda/tires/335_65R22_5_G275MSA_40psi.tir",
+    "chrono95": REAL / "projectchrono_chrono/data/vehicle/feda/tires/335_65R22_5_G275MSA_95psi.tir",
     "mf62": REAL / "matheusft_MFeval_julia/test/fixtures/MagicFormula62_Parameters.tir",
 }
 VALUES = [
@@ -127,7 +125,7 @@ def test_merge_refusals() -> None:
         merge_tir("[A]\nX = 1\n", [TirValue("A", "Y", float("nan"))], header=[])
     with pytest.raises(InputError, match="twice"):
         merge_tir("[A]\nX = 1\n", [VALUES[0], VALUES[0]], header=[])
-    with pytest.raises(FileFormatError, match="b.tir: .tir line 2"):
+    with pytest.raises(FileFormatError, match=r"b\.tir: \.tir line 2"):
         merge_tir("[A]\nnot a line\n", VALUES, header=[], name="b.tir")
 
 

@@ -53,6 +53,13 @@ def _float_list(text: str | None, name: str, top: float) -> list[float] | None:
     return vals
 
 
+def _finite(options: dict[str, float | None]) -> None:
+    """Refuse a numeric option given as nan (click's ranges let it through)."""
+    for name, v in options.items():
+        if v is not None and not math.isfinite(v):
+            raise InputError(f"{name}: expected a finite number, got {v}")
+
+
 @dataclass(frozen=True)
 class _Options:
     """Uncertainty assumptions, base files ``{output name: (base name, text)}``, --force."""
@@ -335,6 +342,19 @@ def tyre_model_command(
     """
     from ..tyremodel.budget import Assumptions
 
+    _finite(
+        {
+            "--radius": radius,
+            "--attachment-mass": attachment_mass,
+            "--attachment-damping": attachment_damping,
+            "--mass-per-length": mass_per_length,
+            "--lateral-pressure": lateral_pressure,
+            "--force-sensitivity-error": force_sensitivity_error,
+            "--acceleration-sensitivity-error": acceleration_sensitivity_error,
+            "--attachment-mass-error": attachment_mass_error,
+            "--attachment-damping-error": attachment_damping_error,
+        }
+    )
     check_out_dir(out)
     opts = _Options(
         Assumptions(

@@ -52,9 +52,9 @@ def check_modes(items: Sequence[tuple[float, ModalModel, str]]) -> None:
         if bad.size:
             k = int(bad[0])
             raise InputError(
-                f"{src}: mode {k + 1} at {f[k]:.4g} Hz has damping ratio {z[k]:.3g} (an unstable "
-                "or undamped pole); a passive tyre's modes are damped: re-identify the modes "
-                "(a tyre model from them would have negative dampers)"
+                f"{src}: mode {k + 1} at {f[k]:.4g} Hz has damping ratio {z[k] + 0.0:.3g} (an "
+                "unstable or undamped pole); a passive tyre's modes are damped: re-identify "
+                "the modes (a tyre model from them would have negative dampers)"
             )
     for i, (p_i, m_i, s_i) in enumerate(items):
         for p_j, m_j, s_j in items[:i]:
