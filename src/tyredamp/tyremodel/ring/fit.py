@@ -391,6 +391,7 @@ def _fit_stiffness(problem: _StiffnessProblem, theta0: _Array) -> _StiffnessFit:
             theta,
             se,
             rss / dof if problem.have_std and dof > 0 else None,
+            int(dof),
         ),
         fitted_frequency_hz=fm,
         fitted_amplitude=am,
@@ -454,6 +455,7 @@ def _fit_damping(
             dsol,
             dse,
             drss / ddof if have_zstd else None,
+            int(ddof),
         ),
         fitted_damping_ratio=(dmat @ dsol + (c_known or 0.0) * phi2) / (2 * omega),
     )

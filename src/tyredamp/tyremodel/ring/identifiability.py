@@ -182,18 +182,27 @@ def admit_model_error(
     theta: NDArray[np.float64],
     se: NDArray[np.float64],
     chi2_per_dof: float | None,
+    dof: int = 1,
 ) -> dict[str, dict[str, Any]]:
     """Verdicts that admit a model discrepancy and parameters consistent with zero.
 
     With weights from the measurement standard errors the reduced chi-square
-    ``RSS/dof`` estimates ``1 + s_model^2 / s_noise^2`` (the model
-    discrepancy's variance against the noise's, Kennedy & O'Hagan, J. R.
-    Stat. Soc. B 63(3), 2001, eq. (5) with a constant discrepancy variance);
-    above :data:`MODEL_LIMITED` the covariance (already scaled by it) still
-    treats the misfit as random, so a parameter judged identified or poorly
-    identified becomes ``model-limited``. A parameter within two standard
-    errors of zero is flagged ``consistent_with_zero`` (a 95 % interval
-    that contains 0).
+    ``RSS/dof`` estimates ``1 + s_d^2 / s_noise^2`` (a model discrepancy of
+    constant variance ``s_d^2`` beside the noise, Kennedy & O'Hagan, J. R.
+    Stat. Soc. B 63(3), 2001, eq. (5)). Above :data:`MODEL_LIMITED` the misfit
+    is systematic and the covariance, even scaled by ``RSS/dof``, treats it
+    as random. A systematic discrepancy ``d`` (weighted) moves parameter
+    ``k`` by ``e_k^T (J^T J)^-1 J^T d``, at most ``sqrt(C_kk) ||P_J d||``
+    (Cauchy-Schwarz; ``C = (J^T J)^-1``, ``P_J`` the projection on the
+    model's sensitivities). The part of ``d`` the model absorbs cannot be
+    seen; taking it no larger than the part it leaves (``||P_J d||^2 <=
+    RSS``) gives the bound ``b_k = sqrt(C_kk RSS) = se_k sqrt(dof)`` with
+    ``se_k`` the scaled standard error. A parameter whose bound, against its
+    verdict scale, exceeds :data:`IDENTIFIED` is not distinguishable from the
+    discrepancy: it becomes ``model-limited`` (``model_error_bound`` is
+    reported as a fraction of the verdict scale for every parameter). A
+    parameter within two standard errors of zero is flagged
+    ``consistent_with_zero`` (a 95 % interval that contains 0).
 
     Parameters
     ----------
@@ -203,17 +212,23 @@ def admit_model_error(
         Values and (scaled) standard errors in the order of ``out``.
     chi2_per_dof : float or None
         ``RSS/dof`` with measurement weights, None without standard errors.
+    dof : int
+        Degrees of freedom of the fit.
     """
     res: dict[str, dict[str, Any]] = {}
     limited = chi2_per_dof is not None and chi2_per_dof > MODEL_LIMITED
     for i, (name, v) in enumerate(out.items()):
         w = dict(v)
         w["consistent_with_zero"] = bool(abs(float(theta[i])) <= 2 * float(se[i]))
-        w["model_limited"] = bool(limited and w["verdict"] in ("identified", "poorly identified"))
+        bound = float(w["relative_se"]) * math.sqrt(max(dof, 1)) if limited else 0.0
+        w["model_error_bound"] = bound
+        w["model_limited"] = bool(
+            limited and bound > IDENTIFIED and w["verdict"] in ("identified", "poorly identified")
+        )
         if w["model_limited"]:
             w["verdict"] = (
-                f"model-limited (chi2/dof {chi2_per_dof:.3g}: the ring does not describe these "
-                "modes to their precision)"
+                f"model-limited (chi2/dof {chi2_per_dof:.3g}: the ring's misfit could move it "
+                f"by {100 * bound:.2g} %)"
             )
         elif w["consistent_with_zero"] and w["verdict"] == "identified":
             w["verdict"] = "consistent with zero"

@@ -319,6 +319,7 @@ class RingFit:
                     "unit": self.units[i],
                     "value": float(self.values[i]),
                     "stderr": float(self.stderr[i]),
+                    "model_error": _model_error(float(self.stderr[i]), v),
                     **v,
                 }
             )
@@ -330,6 +331,7 @@ class RingFit:
                     "unit": self.damping_units[i],
                     "value": float(self.damping_values[i]),
                     "stderr": float(self.damping_stderr[i]),
+                    "model_error": _model_error(float(self.damping_stderr[i]), v),
                     **v,
                 }
             )
@@ -399,3 +401,12 @@ class RingFit:
             "skipped": list(self.skipped),
             "fit_time_s": self.fit_time_s,
         }
+
+
+def _model_error(stderr: float, verdict: dict[str, Any]) -> float:
+    """The model-discrepancy bound ``se sqrt(dof)`` in the parameter's unit (0 when none).
+
+    See :func:`~tyredamp.tyremodel.ring.identifiability.admit_model_error`.
+    """
+    rel, bound = float(verdict.get("relative_se", 0.0)), verdict.get("model_error_bound", 0.0)
+    return stderr * float(bound) / rel if rel > 0 and bound else 0.0
