@@ -105,6 +105,7 @@ class RingFit:
     fit_time_s: float = 0.0
     band_loss_frequency: float = 200.0
     foundation_law: FoundationLaw = "linear"
+    discrepancy_chi2: float | None = None
 
     # ------------------------------------------------------------ parameters
     def param(self, name: str) -> tuple[float, float]:
@@ -290,7 +291,8 @@ class RingFit:
     def model_discrepancy(self) -> dict[str, Any]:
         """The misfit beyond the noise: reduced chi-square and relative frequency scatter.
 
-        ``chi2_per_dof`` (None without measurement standard errors), whether
+        ``chi2_per_dof`` (the larger of the whole fit's and the frequencies'
+        own reduced chi-square; None without measurement standard errors), whether
         it makes the parameters model-limited (above
         :data:`~tyredamp.tyremodel.ring.identifiability.MODEL_LIMITED`), and
         the RMS of ``(f_model - f_measured) / f_measured``: the accuracy to
@@ -300,7 +302,7 @@ class RingFit:
 
         f = np.array([o.frequency_hz for o in self.observations], dtype=float)
         rel = (self.fitted_frequency_hz - f) / f
-        c = self.chi2 / self.dof if self.p_value is not None and self.dof > 0 else None
+        c = self.discrepancy_chi2
         return {
             "chi2_per_dof": c,
             "model_limited": bool(c is not None and c > MODEL_LIMITED),
