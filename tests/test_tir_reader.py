@@ -116,7 +116,9 @@ def test_public_excerpts() -> None:
     assert bus["UNITS"]["PRESSURE"] == "pascal"
     assert base_pressure(bus) == 800000.0  # IP_NOM
     bus_doc = parse_tir(MICROBUS)
-    assert bus_doc == {"MDI_HEADER": {"FILE_TYPE": "tir", "FILE_VERSION": 3.0, "FILE_FORMAT": "ASCII"}}
+    assert bus_doc == {
+        "MDI_HEADER": {"FILE_TYPE": "tir", "FILE_VERSION": 3.0, "FILE_FORMAT": "ASCII"}
+    }
 
 
 def test_format_corner_cases() -> None:
