@@ -20,7 +20,8 @@ from tyredamp.tyremodel import (
     ring_amplitude,
     wave_number_analysis,
 )
-from tyredamp.tyremodel.budget import Assumptions, rigid_ring_budget
+from tyredamp.tyremodel.budget import Assumptions, UncertaintyBudget, rigid_ring_budget
+from tyredamp.tyremodel.rigid import RigidRingParameters
 from tyredamp.tyremodel.checks import check_lateral, check_modes, check_ring
 from tyredamp.tyremodel.ring.identifiability import MODEL_LIMITED, admit_model_error
 from tyredamp.virtual import RingTyre, RingTyreParameters, analytic_ring_frequencies
@@ -36,7 +37,9 @@ def modes() -> ModalModel:
     )
 
 
-def budget_of(m_a: float, c_a: float, a: Assumptions) -> tuple:  # type: ignore[type-arg]
+def budget_of(
+    m_a: float, c_a: float, a: Assumptions
+) -> tuple[RigidRingParameters, UncertaintyBudget]:
     wa = wave_number_analysis(modes())
     rr = rigid_ring_from_modes(modes(), analysis=wa, attachment_mass=m_a, attachment_damping=c_a)
     b = rigid_ring_budget(
@@ -80,7 +83,8 @@ def test_attachment_terms_and_total() -> None:
     # with the default 1 % + 1 % calibration BELT_MASS is known to about 1.4 %, far above its
     # statistical error (none here: exact modes)
     assert 0.013 < b.total["BELT_MASS"] / rr.belt_mass < 0.02
-    assert "+- " in b.comment("BELT_MASS") and "assumes" in b.comment("BELT_MASS")
+    assert "+- " in b.comment("BELT_MASS")
+    assert "assumes" in b.comment("BELT_MASS")
 
 
 @pytest.mark.parametrize(
@@ -105,12 +109,15 @@ def test_admit_model_error_rules() -> None:
     }
     theta, se = np.array([1.0, 0.01, 5.0]), np.array([0.01, 0.01, 10.0])
     ok = admit_model_error(base, theta, se, 1.2)
-    assert ok["a"]["verdict"] == "identified" and not ok["a"]["model_limited"]
+    assert ok["a"]["verdict"] == "identified"
+    assert not ok["a"]["model_limited"]
     assert ok["b"]["verdict"] == "consistent with zero"  # 0.01 +- 0.01
-    assert ok["c"]["consistent_with_zero"] and ok["c"]["verdict"].startswith("not identifiable")
+    assert ok["c"]["consistent_with_zero"]
+    assert ok["c"]["verdict"].startswith("not identifiable")
     # the discrepancy bound se sqrt(dof), against the verdict scale: 0.01 sqrt(400) = 0.2
     bad = admit_model_error(base, theta, se, 140.0, dof=400)
-    assert bad["a"]["model_limited"] and bad["a"]["verdict"].startswith("model-limited")
+    assert bad["a"]["model_limited"]
+    assert bad["a"]["verdict"].startswith("model-limited")
     assert bad["a"]["model_error_bound"] == pytest.approx(0.2, rel=1e-12)  # closed form
     assert not bad["c"]["model_limited"]  # already not identifiable
     # ... 0.01 sqrt(16) = 0.04 < 0.1: still identified, its bound reported
@@ -155,12 +162,14 @@ def test_ring_fit_admits_model_error() -> None:
     rng = np.random.default_rng(5)
     good = fit_ring(analytic_observations(rng, 0.0), radius=0.5, attachment_damping=0.0)
     disc = good.model_discrepancy()
-    assert disc["chi2_per_dof"] < MODEL_LIMITED and not disc["model_limited"]
+    assert disc["chi2_per_dof"] < MODEL_LIMITED
+    assert not disc["model_limited"]
     assert good.verdicts["EI"]["verdict"] == "identified"
     # a 2 % alternating misfit against 0.1 % noise: chi2/dof in the hundreds
     bad = fit_ring(analytic_observations(rng, 0.02), radius=0.5, attachment_damping=0.0)
     disc = bad.model_discrepancy()
-    assert disc["model_limited"] and disc["chi2_per_dof"] > 50
+    assert disc["model_limited"]
+    assert disc["chi2_per_dof"] > 50
     assert 0.005 < disc["frequency_rms_relative"] < 0.03  # the misfit's size, about 2 %
     assert not [k for k, v in bad.verdicts.items() if v["verdict"] == "identified"]
     assert bad.to_dict()["model_discrepancy"]["model_limited"]
@@ -202,5 +211,6 @@ def test_check_lateral_pressure() -> None:
     assert check_lateral([carcass(7.2)], [7.5 * BAR], force=False) == []  # within 10 %
     (w,) = check_lateral([carcass(None)], [7.5 * BAR], force=False)
     assert "not recorded" in w
-    assert carcass(7.5, 0.2).model_limited and "MODEL-LIMITED" in carcass(7.5, 0.2).comment()
+    assert carcass(7.5, 0.2).model_limited
+    assert "MODEL-LIMITED" in carcass(7.5, 0.2).comment()
     assert not carcass(7.5, 0.01).model_limited
