@@ -21,8 +21,8 @@ from tyredamp.tyremodel import (
     wave_number_analysis,
 )
 from tyredamp.tyremodel.budget import Assumptions, UncertaintyBudget, rigid_ring_budget
-from tyredamp.tyremodel.rigid import RigidRingParameters
 from tyredamp.tyremodel.checks import check_lateral, check_modes, check_ring
+from tyredamp.tyremodel.rigid import RigidRingParameters
 from tyredamp.tyremodel.ring.identifiability import MODEL_LIMITED, admit_model_error
 from tyredamp.virtual import RingTyre, RingTyreParameters, analytic_ring_frequencies
 
