@@ -121,6 +121,13 @@ def test_admit_model_error_rules() -> None:
     assert bad["a"]["model_error_bound"] == pytest.approx(0.2, rel=1e-12)  # closed form
     assert not bad["c"]["model_limited"]  # already not identifiable
     # ... 0.01 sqrt(16) = 0.04 < 0.1: still identified, its bound reported
+    # c: 5 +- 10 was consistent with zero already; b (0.01 +- 0.01) stays so with the bound
+    assert bad["b"]["consistent_with_zero"]
+    # a value 3 se from zero is not consistent with zero by noise, but is with the bound
+    far = admit_model_error(base, np.array([1.0, 0.03, 5.0]), se, 1.2)
+    assert not far["b"]["consistent_with_zero"]
+    near = admit_model_error(base, np.array([1.0, 0.03, 5.0]), se, 140.0, dof=16)
+    assert near["b"]["consistent_with_zero"]  # 2 se sqrt(17) = 0.082 > 0.03
     small = admit_model_error(base, theta, se, 140.0, dof=16)
     assert small["a"]["verdict"] == "identified"
     assert small["a"]["model_error_bound"] == pytest.approx(0.04, rel=1e-12)

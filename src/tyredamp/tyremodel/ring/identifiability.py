@@ -201,8 +201,9 @@ def admit_model_error(
     verdict scale, exceeds :data:`IDENTIFIED` is not distinguishable from the
     discrepancy: it becomes ``model-limited`` (``model_error_bound`` is
     reported as a fraction of the verdict scale for every parameter). A
-    parameter within two standard errors of zero is flagged
-    ``consistent_with_zero`` (a 95 % interval that contains 0).
+    parameter within two standard uncertainties of zero (``sqrt(se^2 + b_k^2)``
+    with the bound in the parameter's unit) is flagged ``consistent_with_zero``
+    (a 95 % interval that contains 0).
 
     Parameters
     ----------
@@ -219,8 +220,10 @@ def admit_model_error(
     limited = chi2_per_dof is not None and chi2_per_dof > MODEL_LIMITED
     for i, (name, v) in enumerate(out.items()):
         w = dict(v)
-        w["consistent_with_zero"] = bool(abs(float(theta[i])) <= 2 * float(se[i]))
         bound = float(w["relative_se"]) * math.sqrt(max(dof, 1)) if limited else 0.0
+        # two standard uncertainties, the model-error bound included (se sqrt(1 + dof))
+        u = float(se[i]) * math.sqrt(1.0 + (max(dof, 1) if limited else 0.0))
+        w["consistent_with_zero"] = bool(abs(float(theta[i])) <= 2 * u)
         w["model_error_bound"] = bound
         w["model_limited"] = bool(
             limited and bound > IDENTIFIED and w["verdict"] in ("identified", "poorly identified")
