@@ -159,6 +159,7 @@ CASES: list[tuple[str, list[str], dict[str, Any], str]] = [
     ("attachment mass huge", [*TWO, "--attachment-mass", "1e9"], {}, "attachment-mass"),
     ("attachment mass negative", [*TWO, "--attachment-mass=-1"], {}, "attachment-mass"),
     ("attachment damping huge", [*TWO, "--attachment-damping", "1e300"], {}, "attachment-damping"),
+    ("attachment damper too large", [*TWO, "--attachment-damping", "1e5"], {}, "exceeds"),
     ("mass per length zero", [*TWO, "--mass-per-length", "0"], {}, "mass-per-length"),
     ("predict huge", [*TWO, "--predict", "1e300"], {}, "predict"),
     ("predict negative", [*TWO, "--predict=-3"], {}, "predict"),

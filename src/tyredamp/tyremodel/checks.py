@@ -9,6 +9,9 @@ would otherwise give a tyre model that looks identified but is not:
 * :func:`check_ring` -- a ring fit whose tension does not follow the
   pressure (``T0 = p R b + T_c`` with the belt width ``b`` not clearly
   positive, e.g. the same modes given at several pressures);
+* :func:`check_rigid` -- rigid-ring values a simulation cannot take: a
+  damping ratio at or below zero once the attachment damper is removed (the
+  given damper is larger than the measured losses);
 * :func:`check_lateral` -- lateral tests at a pressure other than the radial
   tests' (their relaxation length and stiffness do not belong to the same
   ``.tir`` file).
@@ -24,9 +27,10 @@ import numpy as np
 from ..exceptions import InputError
 from ..modal.model import ModalModel
 from .lateral import LateralCarcass
+from .rigid import RigidRingParameters
 from .ring import RingFit
 
-__all__ = ["check_lateral", "check_modes", "check_ring"]
+__all__ = ["check_lateral", "check_modes", "check_rigid", "check_ring"]
 
 _BAR = 1e5
 #: Relative pressure difference above which two tests are not "at the same pressure".
@@ -94,6 +98,30 @@ def check_ring(ring: RingFit) -> None:
             f"ring's do (belt width b = {b:.3g} +- {sb:.2g} m from the tension p R b); check "
             "that the files are tests at the pressures given"
         )
+
+
+def check_rigid(rigid: Sequence[RigidRingParameters], sources: Sequence[str]) -> None:
+    """Refuse rigid-ring values that are not a passive, massive belt (module docstring).
+
+    Raises
+    ------
+    InputError
+        ``DAMP_LONG <= 0`` (naming the attachment damping), ``BELT_MASS`` or
+        ``FREQ_LONG`` not positive and finite.
+    """
+    for r, src in zip(rigid, sources, strict=True):
+        if not (math.isfinite(r.belt_mass) and r.belt_mass > 0):
+            raise InputError(
+                f"{src}: belt mass {r.belt_mass:.3g} kg from the n = 1 mode; expected > 0"
+            )
+        if not (math.isfinite(r.freq_long) and r.freq_long > 0):
+            raise InputError(f"{src}: n = 1 frequency {r.freq_long:.3g} Hz; expected > 0")
+        if not (math.isfinite(r.damp_long) and r.damp_long > 0):
+            raise InputError(
+                f"{src}: the n = 1 damping ratio is {r.damp_long:.3g} once the attachment "
+                "damping is removed: the given --attachment-damping exceeds the measured "
+                "losses (a .tir with a negative damper would be unstable)"
+            )
 
 
 def check_lateral(

@@ -25,7 +25,7 @@ from .. import __version__
 from ..exceptions import InputError
 from ..modal.model import ModalModel
 from .budget import Assumptions, UncertaintyBudget, rigid_ring_budget
-from .checks import check_lateral, check_modes, check_ring
+from .checks import check_lateral, check_modes, check_rigid, check_ring
 from .lateral import LateralCarcass
 from .rigid import RigidRingParameters, rigid_ring_from_modes
 from .ring import FoundationLaw, RingFit, fit_ring, ring_observations
@@ -198,6 +198,7 @@ def build_tyre_model(
         )
         for (p, mdl, _), wa in zip(items, analyses, strict=True)
     )
+    check_rigid(rigid, [s for _, _, s in items])
     budgets = tuple(
         rigid_ring_budget(
             mdl,
