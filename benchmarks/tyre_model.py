@@ -9,7 +9,10 @@ Prints
    64 nodes) and (b) the modes identified from a virtual modal test at each
    pressure (``run_modal_test`` seed 1, H1, ``identify_modes``), with the
    predicted frequencies at the held-out pressures 6 and 8 bar;
-3. the coverage of the 1-sigma intervals over 200 noise seeds: modes generated
+3. the coverage of the 1-sigma intervals over 200 noise seeds (3b: on data
+   that are not the fit's own model, the 64-node ring's exact modes plus
+   noise, where a parameter must cover the truth with its model-error term or
+   be flagged model-limited): modes generated
    from the analytic ring (spec ``virtual-tyre.md``, via
    ``tyredamp.virtual.analytic_ring_frequencies``) at the true parameters, n =
    1..7 at 5, 7, 9 bar, the driven member with the 0.1 kg / 350 N s/m shaker
@@ -27,6 +30,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -204,6 +208,58 @@ def coverage(n_seeds: int) -> None:
         print(f"  {name:>14} {100 * np.mean(h):>11.1f}{flag}")
 
 
+def coverage_with_model_error(n_seeds: int, rel_f: float, n_ring: int = 64) -> None:
+    """Coverage when the data are not the fit's own model: the 64-node ring's exact modes.
+
+    The finite-difference ring differs from the analytic ring the fit uses by
+    about 1 % in EI: with 0.1 % frequency noise the fit's chi2/dof is far
+    above 1. Each parameter must either cover the truth at its stated level
+    (|error| <= sqrt(se^2 + model_error^2) in at least 68 % less two binomial
+    standard deviations of the seeds) or be flagged model-limited.
+    """
+    print(
+        f"\n3b. coverage on the {n_ring}-node ring's exact modes, frequency noise "
+        f"{100 * rel_f:g} % ({n_seeds} seeds)"
+    )
+    exact = [o for p, m in exact_data(n_ring) for o in ring_observations(m, p)[0]]
+    hits: dict[str, list[bool]] = {}
+    flagged: dict[str, list[bool]] = {}
+    c2 = []
+    for seed in range(n_seeds):
+        rng = np.random.default_rng(2000 + seed)
+        obs = []
+        for o in exact:
+            e = rng.standard_normal(3)
+            sf, sz, sa = rel_f * o.frequency_hz, 2e-2 * o.damping_ratio, 1e-2 * o.amplitude
+            obs.append(
+                replace(
+                    o,
+                    frequency_hz=o.frequency_hz + sf * e[0],
+                    frequency_std=sf,
+                    damping_ratio=o.damping_ratio + sz * e[1],
+                    damping_std=sz,
+                    amplitude=o.amplitude + sa * e[2],
+                    amplitude_std=sa,
+                )
+            )
+        fit = fit_ring(obs, radius=TRUE.radius, attachment_mass=M_A, attachment_damping=C_A)
+        c2.append(fit.model_discrepancy()["chi2_per_dof"])
+        rows = {r["name"]: r for r in fit.table()}
+        for name, tv, v, s in recovery_rows(fit):
+            if name not in rows:
+                continue
+            u = float(np.hypot(s, rows[name]["model_error"]))
+            hits.setdefault(name, []).append(abs(v - tv) <= u)
+            flagged.setdefault(name, []).append(bool(rows[name].get("model_limited")))
+    print(f"  chi2/dof (worst block): median {np.median(c2):.3g}")
+    floor = 100 * (0.6827 - 2 * np.sqrt(0.6827 * 0.3173 / n_seeds))
+    print(f"  {'parameter':>10} {'coverage %':>11} {'model-limited %':>16}  result")
+    for name in hits:
+        cov, fl = 100 * np.mean(hits[name]), 100 * np.mean(flagged[name])
+        ok = "covered" if cov >= floor else ("flagged" if fl >= 95 else "NEITHER")
+        print(f"  {name:>10} {cov:>11.1f} {fl:>16.1f}  {ok}")
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
     print("1. fit time, 3 pressures (exact modes of the 128-node ring, 0-200 Hz)")
@@ -259,6 +315,8 @@ def main() -> None:
             print(f"  {p / BAR:g} bar: {labels}")
 
     coverage(50 if quick else 200)
+    for n_ring, rel_f in ((64, 1e-3), (64, 1e-4), (128, 1e-4)):
+        coverage_with_model_error(30 if quick else 100, rel_f, n_ring)
 
     print("\n4b. aliased case: imperfect tyre at 5 bar, 0-260 Hz (n = 8, 9 in band)")
     tyre = RingTyre(

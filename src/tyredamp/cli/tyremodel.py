@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -36,19 +37,60 @@ from ._common import OutPath
 __all__ = ["tyre_model_command", "write_all_or_none"]
 
 _BAR = 1e5
+_MAX_BAR = 20.0  # above any road tyre's inflation pressure
 _FIGURE = "ring_frequencies.png"
 
 
-def _float_list(text: str | None, name: str) -> list[float] | None:
+def _float_list(text: str | None, name: str, top: float) -> list[float] | None:
     if text is None:
         return None
     try:
         vals = [float(x) for x in text.replace(";", ",").split(",") if x.strip()]
     except ValueError:
         raise InputError(f"{name}: expected numbers separated by commas, got {text!r}") from None
-    if not vals or not all(math.isfinite(v) and v >= 0 for v in vals):
-        raise InputError(f"{name}: expected finite values >= 0, got {text!r}")
+    if not vals or not all(math.isfinite(v) and 0 < v <= top for v in vals):
+        raise InputError(f"{name}: expected pressures above 0 and up to {top:g} bar, got {text!r}")
     return vals
+
+
+def _finite(options: dict[str, float | None]) -> None:
+    """Refuse a numeric option given as nan (click's ranges let it through)."""
+    for name, v in options.items():
+        if v is not None and not math.isfinite(v):
+            raise InputError(f"{name}: expected a finite number, got {v}")
+
+
+@dataclass(frozen=True)
+class _Options:
+    """Uncertainty assumptions, base files ``{output name: (base name, text)}``, --force."""
+
+    assumptions: Any
+    bases: dict[str, tuple[str, str]]
+    force: bool
+
+
+def _read_bases(paths: tuple[Path, ...]) -> dict[str, tuple[str, str]]:
+    """Read and check every --merge-into base before any work: ``{output name: (name, text)}``."""
+    from ..tyremodel.tir import decode_tir, parse_tir
+
+    out: dict[str, tuple[str, str]] = {}
+    for p in paths:
+        try:
+            data = p.read_bytes()
+        except OSError as exc:
+            raise InputError(f"--merge-into: cannot read {p} ({exc.strerror or exc})") from None
+        text = decode_tir(data, str(p))
+        try:
+            parse_tir(text)
+        except FileFormatError as exc:
+            raise FileFormatError(f"--merge-into: {p}: {exc}") from None
+        name = f"{p.stem}_tyredamp.tir"
+        k = 2
+        while name in out:
+            name = f"{p.stem}_tyredamp_{k}.tir"
+            k += 1
+        out[name] = (p.name, text)
+    return out
 
 
 def _meta_pressure_bar(path: Path, model: ModalModel) -> float | None:
@@ -58,10 +100,22 @@ def _meta_pressure_bar(path: Path, model: ModalModel) -> float | None:
     except (OSError, UnicodeDecodeError, json.JSONDecodeError):
         doc = {}
     for src in (doc if isinstance(doc, dict) else {}, model.meta):
-        if src.get("pressure_bar") is not None:
-            return float(src["pressure_bar"])
-        if src.get("pressure_pa") is not None:
-            return float(src["pressure_pa"]) / _BAR
+        for key, unit in (("pressure_bar", 1.0), ("pressure_pa", _BAR)):
+            v = src.get(key)
+            if v is None:
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float)):
+                raise InputError(
+                    f"{path}: the recorded pressure ({key}) is {json.dumps(v)[:40]}, not a "
+                    "number; give --pressure"
+                )
+            bar = float(v) / unit
+            if not (math.isfinite(bar) and 0 < bar <= _MAX_BAR):
+                raise InputError(
+                    f"{path}: the recorded pressure is {bar:g} bar; expected above 0 and up to "
+                    f"{_MAX_BAR:g} bar (give --pressure)"
+                )
+            return bar
     return None
 
 
@@ -121,10 +175,10 @@ def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]])
 )
 @click.option(
     "--radius",
-    type=click.FloatRange(min=0, min_open=True),
+    type=click.FloatRange(min=0, max=5, min_open=True),
     required=True,
     metavar="M",
-    help="Belt (tread-band centre line) radius in m.",
+    help="Belt (tread-band centre line) radius in m (up to 5).",
 )
 @click.option(
     "--pressure",
@@ -142,7 +196,7 @@ def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]])
 )
 @click.option(
     "--attachment-mass",
-    type=click.FloatRange(min=0),
+    type=click.FloatRange(min=0, max=100),
     default=0.0,
     show_default=True,
     metavar="KG",
@@ -150,13 +204,13 @@ def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]])
 )
 @click.option(
     "--attachment-damping",
-    type=click.FloatRange(min=0),
+    type=click.FloatRange(min=0, max=1e6),
     metavar="NS_PER_M",
     help="Known local radial damper at each drive point, N s/m (default: fitted).",
 )
 @click.option(
     "--mass-per-length",
-    type=click.FloatRange(min=0, min_open=True),
+    type=click.FloatRange(min=0, max=1000, min_open=True),
     metavar="KG_PER_M",
     help="Known belt mass per length (default: from the mass-normalised shapes).",
 )
@@ -182,7 +236,7 @@ def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]])
 )
 @click.option(
     "--lateral-pressure",
-    type=click.FloatRange(min=0),
+    type=click.FloatRange(min=0, max=_MAX_BAR, min_open=True),
     metavar="BAR",
     help="Pressure of the lateral tests when their files do not record it.",
 )
@@ -191,6 +245,52 @@ def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]])
     "geometry_file",
     type=click.Path(dir_okay=False, path_type=Path),
     help="UFF test geometry (data sets 15/2411) for UFF 55 modes files without their own.",
+)
+@click.option(
+    "--merge-into",
+    "merge_into",
+    multiple=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="A complete .tir property file to write the identified values into (kept as it is; "
+    "the merged copy goes into --out); repeatable.",
+)
+@click.option(
+    "--force-sensitivity-error",
+    type=click.FloatRange(min=0, max=50),
+    default=1.0,
+    show_default=True,
+    metavar="PCT",
+    help="1-sigma calibration uncertainty of the force transducer, %.",
+)
+@click.option(
+    "--acceleration-sensitivity-error",
+    type=click.FloatRange(min=0, max=50),
+    default=1.0,
+    show_default=True,
+    metavar="PCT",
+    help="1-sigma calibration uncertainty of the accelerometers, %.",
+)
+@click.option(
+    "--attachment-mass-error",
+    type=click.FloatRange(min=0, max=50),
+    default=10.0,
+    show_default=True,
+    metavar="PCT",
+    help="1-sigma uncertainty of --attachment-mass, %.",
+)
+@click.option(
+    "--attachment-damping-error",
+    type=click.FloatRange(min=0, max=100),
+    default=50.0,
+    show_default=True,
+    metavar="PCT",
+    help="1-sigma uncertainty of --attachment-damping, %.",
+)
+@click.option(
+    "--force",
+    is_flag=True,
+    help="Merge into a base of another pressure, keep lateral tests of another pressure "
+    "(both with a warning in the files).",
 )
 def tyre_model_command(
     modes_files: tuple[Path, ...],
@@ -206,6 +306,12 @@ def tyre_model_command(
     lateral_files: tuple[Path, ...],
     lateral_pressure: float | None,
     geometry_file: Path | None,
+    merge_into: tuple[Path, ...],
+    force_sensitivity_error: float,
+    acceleration_sensitivity_error: float,
+    attachment_mass_error: float,
+    attachment_damping_error: float,
+    force: bool,
 ) -> None:
     """Flexible-ring and rigid-ring tyre models from modes files at one or more pressures.
 
@@ -215,7 +321,14 @@ def tyre_model_command(
     once with the modal standard errors as weights; the in-plane rigid-ring
     parameters (BELT_MASS, FREQ_LONG, DAMP_LONG) come from the n = 1 modes.
     Fields a radial test cannot give (wind-up, lateral, yaw) are listed, not
-    invented.
+    invented. Each value carries its uncertainty budget (statistical,
+    calibration of the transducers, attachment mass and damping, rigid
+    translation) and the assumptions it rests on.
+
+    Without --merge-into the .tir files are fragments (no simulator loads
+    them alone); with --merge-into BASE.tir the values are written into a
+    copy of a complete property file of the same tyre at the test pressure
+    (every other line kept, old values in comments).
 
     A modes file may also be a UFF file of data sets 55 (modes from another
     program) whose nodes (data sets 15/2411 in the file, or --geometry) lie
@@ -227,7 +340,32 @@ def tyre_model_command(
       tyredamp tyre-model m5.json m7.json m9.json --pressure 5,7,9 \\
           --radius 0.5 --attachment-mass 0.1 --out tyre_model
     """
+    from ..tyremodel.budget import Assumptions
+
+    _finite(
+        {
+            "--radius": radius,
+            "--attachment-mass": attachment_mass,
+            "--attachment-damping": attachment_damping,
+            "--mass-per-length": mass_per_length,
+            "--lateral-pressure": lateral_pressure,
+            "--force-sensitivity-error": force_sensitivity_error,
+            "--acceleration-sensitivity-error": acceleration_sensitivity_error,
+            "--attachment-mass-error": attachment_mass_error,
+            "--attachment-damping-error": attachment_damping_error,
+        }
+    )
     check_out_dir(out)
+    opts = _Options(
+        Assumptions(
+            force_sensitivity_error / 100,
+            acceleration_sensitivity_error / 100,
+            attachment_mass_error / 100,
+            attachment_damping_error / 100,
+        ),
+        _read_bases(merge_into),
+        force,
+    )
     with private_matplotlib_config():
         _tyre_model(
             modes_files,
@@ -243,6 +381,7 @@ def tyre_model_command(
             lateral_files,
             lateral_pressure,
             geometry_file,
+            opts,
         )
 
 
@@ -314,6 +453,7 @@ def _tyre_model(
     lateral_files: tuple[Path, ...],
     lateral_pressure: float | None,
     geometry_file: Path | None = None,
+    opts: _Options | None = None,
 ) -> None:
     from matplotlib.figure import Figure
 
@@ -321,7 +461,7 @@ def _tyre_model(
     from ..tyremodel.lateral import read_lateral_carcass
     from ..tyremodel.pipeline import build_tyre_model
 
-    p_list = _float_list(pressures, "--pressure")
+    p_list = _float_list(pressures, "--pressure", _MAX_BAR)
     if p_list is not None and len(p_list) != len(modes_files):
         raise InputError(
             f"--pressure: expected one pressure per modes file ({len(modes_files)}), "
@@ -336,7 +476,7 @@ def _tyre_model(
                 f"{path}: the test pressure is not recorded in the file; give --pressure"
             )
         inputs.append((pb * _BAR, mdl, path.name))
-    preds = [p * _BAR for p in (_float_list(predict, "--predict") or [])]
+    preds = [p * _BAR for p in (_float_list(predict, "--predict", _MAX_BAR) or [])]
     lateral = []
     for lf in lateral_files:
         lateral += read_lateral_carcass(lf, pressure_bar=lateral_pressure)
@@ -349,10 +489,14 @@ def _tyre_model(
         foundation_law=foundation_law,  # type: ignore[arg-type]
         predict_pressures=preds,
         lateral=lateral,
+        assumptions=opts.assumptions if opts else None,
+        force=bool(opts and opts.force),
     )
     ring_text = json_text(res.ring_document(), indent=1)
     rigid_text = json_text(res.rigid_document(), indent=1)
     tirs = res.tir_files()
+    for name, (base_name, text) in (opts.bases if opts else {}).items():
+        tirs[name] = res.merged_tir(text, base_name, force=opts.force if opts else False)
     fig = Figure(figsize=(6.5, 4.0), layout="constrained")
     plot_ring_frequencies(res.ring, ax=fig.subplots())
 
@@ -393,13 +537,17 @@ def _echo_summary(res: Any) -> None:
     )
     for row in ring.format_table().splitlines():
         click.echo("  " + row)
-    for r in res.rigid:
+    for r, b in zip(res.rigid, res.budgets, strict=True):
         pb = "?" if r.pressure is None else f"{r.pressure / _BAR:g} bar"
+        t = b.total
         click.echo(
-            f"rigid ring ({pb}): BELT_MASS {r.belt_mass:.4g} +- {r.belt_mass_std:.2g} kg, "
-            f"FREQ_LONG {r.freq_long:.4g} +- {r.freq_long_std:.2g} Hz, DAMP_LONG "
-            f"{r.damp_long:.4g} +- {r.damp_long_std:.2g}; FREQ_WINDUP, DAMP_WINDUP, BELT_IYY "
-            "not given (wind-up needs tangential measurement)"
+            f"rigid ring ({pb}): BELT_MASS {r.belt_mass:.4g} +- {t['BELT_MASS']:.2g} kg, "
+            f"FREQ_LONG {r.freq_long:.4g} +- {t['FREQ_LONG']:.2g} Hz, DAMP_LONG "
+            f"{r.damp_long:.4g} +- {t['DAMP_LONG']:.2g} (1 sigma with calibration and "
+            "attachment; budgets in rigid_ring.json); FREQ_WINDUP, DAMP_WINDUP, BELT_IYY not "
+            "given (wind-up needs tangential measurement)"
         )
+    for w in res.warnings:
+        click.echo(f"warning: {w}")
     for c in res.lateral:
         click.echo(c.comment())

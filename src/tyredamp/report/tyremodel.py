@@ -2,7 +2,7 @@
 
 The updated flexible ring and the rigid ring beside the virtual tyre's own
 values, the parameters the modes cannot identify, the figure of identified
-against model frequencies and the in-plane ``.tir`` subset; or, when the fit
+against model frequencies and the in-plane ``.tir`` fragment; or, when the fit
 failed, the reason. Laid out from the ``radial.tyre_model`` section of
 results.json (:func:`tyredamp.studies.tyremodel.tyre_model_section`).
 """
@@ -102,7 +102,7 @@ def _tyre_model_rigid(rep: HtmlReport, tm: dict[str, Any], doc: dict[str, Any]) 
 def tyre_model_report(
     rep: HtmlReport, result: DemoResult, doc: dict[str, Any], images: Any, heading: str
 ) -> None:
-    """Updated flexible ring and rigid ring beside the virtual tyre, the .tir subset."""
+    """Updated flexible ring and rigid ring beside the virtual tyre, the .tir fragment."""
     tm = doc["radial"]["tyre_model"]
     rep.heading(heading)
     ps = ", ".join(f"{p:g}" for p in tm["pressures_bar"])
@@ -205,8 +205,10 @@ def tyre_model_report(
     if res is not None:
         name, text = next(iter(res.tir_files().items()))
         rep.paragraph(
-            f"The in-plane .tir subset at {tm['pressures_bar'][0]:g} bar ({name}; one "
-            "file per pressure in tyre_model/):"
+            f"The in-plane .tir fragment at {tm['pressures_bar'][0]:g} bar ({name}; one "
+            "file per pressure in tyre_model/), with each value's uncertainty budget and "
+            "assumptions; a simulation needs it merged into a complete property file of the "
+            "tyre (tyredamp tyre-model --merge-into BASE.tir):"
         )
         rep.raw(f"<pre>{html.escape(text)}</pre>")
     _warnings(rep, doc, "radial:tyre_model")

@@ -10,7 +10,13 @@
   identifiability verdicts; predictions of modes and FRFs.
 * :mod:`.rigid` -- in-plane rigid-ring (MF-Swift) parameters from the n = 1
   modes, with what a radial test cannot give stated.
-* :mod:`.tir` -- the in-plane ``.tir`` subset: writer and reader.
+* :mod:`.tir` -- the in-plane ``.tir`` fragment (writer) and a reader of
+  every public ``.tir`` property file; :mod:`.tirmerge` -- identified
+  values merged into a complete base ``.tir``.
+* :mod:`.budget` -- the uncertainty budget of the written values
+  (calibration, attachment, rigid translation); :mod:`.checks` -- what is
+  refused (unstable modes, repeated files or pressures, a ring whose tension
+  does not follow the pressure, lateral tests at another pressure).
 * :mod:`.lateral` -- lateral carcass stiffness and relaxation length from the
   lateral fits of paper 001.
 * :mod:`.pipeline` -- all of it in one call (:func:`build_tyre_model`), as

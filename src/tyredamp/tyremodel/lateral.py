@@ -37,6 +37,9 @@ from ..lateral.fit import LateralFit
 __all__ = ["LateralCarcass", "lateral_carcass", "read_lateral_carcass"]
 
 # model name -> (stiffness parameter, road damper parameter)
+#: Mean relative amplitude misfit above which the lateral quantities are model-limited.
+MODEL_LIMITED = 0.05
+
 _PAIRS = {
     "hysteretic": ("K", "C_r"),
     "maxwell": ("k", "c"),
@@ -65,6 +68,11 @@ class LateralCarcass:
     correlation_used : bool
         Whether the standard errors include the fit's correlation.
     source : str
+    model_error : float or None
+        The fit's mean absolute relative amplitude error (a fraction; the
+        misfit of the model to the measured FRF, paper 001 Table 1), when known.
+        Above :data:`MODEL_LIMITED` the quantities are flagged model-limited:
+        their standard errors describe the noise, not the model's misfit.
     """
 
     model: str
@@ -78,6 +86,12 @@ class LateralCarcass:
     cornering_stiffness_std: float
     correlation_used: bool
     source: str = ""
+    model_error: float | None = None
+
+    @property
+    def model_limited(self) -> bool:
+        """Whether the model misses the measured FRF by more than :data:`MODEL_LIMITED`."""
+        return self.model_error is not None and self.model_error > MODEL_LIMITED
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary with units."""
@@ -105,6 +119,8 @@ class LateralCarcass:
             if self.correlation_used
             else "parameters taken as uncorrelated (the lateral-fit JSON has no correlations)",
             "source": self.source,
+            "model_error": self.model_error,
+            "model_limited": self.model_limited,
         }
 
     def comment(self) -> str:
@@ -115,6 +131,12 @@ class LateralCarcass:
             f"K = {self.lateral_stiffness:.5g} +- {self.lateral_stiffness_std:.2g} N/m, "
             f"relaxation length C_r V / K = {self.relaxation_length:.4g} +- "
             f"{self.relaxation_length_std:.2g} m"
+            + (
+                f"; MODEL-LIMITED: the fit misses the FRF by {100 * self.model_error:.2g} % on "
+                "average, more than its standard errors say"
+                if self.model_limited and self.model_error is not None
+                else ""
+            )
         )
 
 
@@ -178,6 +200,15 @@ def _from_parts(
     )
 
 
+def _with_error(err: Any, c: LateralCarcass) -> LateralCarcass:
+    """``c`` with the fit's relative amplitude misfit, when it is a finite number."""
+    from dataclasses import replace
+
+    if isinstance(err, (int, float)) and not isinstance(err, bool) and math.isfinite(err):
+        return replace(c, model_error=float(err))
+    return c
+
+
 def lateral_carcass(
     fit: LateralFit | Mapping[str, Any],
     *,
@@ -200,29 +231,35 @@ def lateral_carcass(
     """
     if isinstance(fit, LateralFit):
         names = fit.model.param_names
-        return _from_parts(
-            fit.model.name,
-            fit.params,
-            fit.stderr,
-            fit.model.derived(),
-            fit.speed if fit.speed is not None else speed,
-            fit.correlation,
-            names,
-            pressure_bar,
-            source,
+        return _with_error(
+            fit.amplitude_error,
+            _from_parts(
+                fit.model.name,
+                fit.params,
+                fit.stderr,
+                fit.model.derived(),
+                fit.speed if fit.speed is not None else speed,
+                fit.correlation,
+                names,
+                pressure_bar,
+                source,
+            ),
         )
     try:
         sp = fit.get("speed_m_s")
-        return _from_parts(
-            str(fit["model"]),
-            fit["params"],
-            fit["stderr"],
-            fit.get("derived", {}),
-            float(sp) if sp is not None else speed,
-            None,
-            None,
-            pressure_bar,
-            source,
+        return _with_error(
+            fit.get("amplitude_error"),
+            _from_parts(
+                str(fit["model"]),
+                fit["params"],
+                fit["stderr"],
+                fit.get("derived", {}),
+                float(sp) if sp is not None else speed,
+                None,
+                None,
+                pressure_bar,
+                source,
+            ),
         )
     except (KeyError, TypeError, ValueError) as exc:
         if isinstance(exc, InputError):

@@ -154,6 +154,7 @@ def rigid_ring_from_modes(
     attachment_mass: float = 0.0,
     attachment_damping: float = 0.0,
     radius: float | None = None,
+    shape_scale: float = 1.0,
 ) -> RigidRingParameters:
     """In-plane rigid-ring parameters from the ``n = 1`` modes of ``model``.
 
@@ -173,6 +174,11 @@ def rigid_ring_from_modes(
         the damping: ``2 zeta omega - c_a phi_d^2``, default 0 = kept).
     radius : float, optional
         Belt radius in m, for the thin-ring ``m_b R^2`` reported as an assumption.
+    shape_scale : float
+        Factor on the squared mass-normalised shapes (the drive-point residue),
+        as a calibration error of the response over the force transducer
+        ``(1 + e_a) / (1 + e_f)`` would give; 1 = as measured (used by
+        :mod:`~tyredamp.tyremodel.budget`).
 
     Raises
     ------
@@ -182,7 +188,7 @@ def rigid_ring_from_modes(
     m_a = check_positive(attachment_mass, "attachment_mass", allow_zero=True)
     c_a = check_positive(attachment_damping, "attachment_damping", allow_zero=True)
     wa = analysis if analysis is not None else wave_number_analysis(model)
-    rows = _n1_members(model, wa, m_a, c_a)
+    rows = _n1_members(model, wa, m_a, c_a, check_positive(shape_scale, "shape_scale"))
     if not rows:
         raise InputError(
             "model: no n = 1 mode (belt translation) among the identified modes; the rigid-ring "
@@ -224,7 +230,7 @@ def rigid_ring_from_modes(
 
 
 def _n1_members(
-    model: ModalModel, wa: WaveNumberAnalysis, m_a: float, c_a: float
+    model: ModalModel, wa: WaveNumberAnalysis, m_a: float, c_a: float, scale: float = 1.0
 ) -> list[dict[str, Any]]:
     """The usable ``n = 1`` modes as bare-belt quantities (module docstring).
 
@@ -236,7 +242,7 @@ def _n1_members(
     sf = model.std.get("frequency_hz")
     sz = model.std.get("damping_ratio")
     omega_d = model.poles.imag
-    phi_d2 = np.sum(np.abs(model.psi_in) ** 2, axis=0) * 2.0 * omega_d
+    phi_d2 = scale * np.sum(np.abs(model.psi_in) ** 2, axis=0) * 2.0 * omega_d
     rows: list[dict[str, Any]] = []
     for m in wa.modes:
         if m.n != 1 or m.aliased or not m.single_harmonic:
@@ -247,7 +253,7 @@ def _n1_members(
             raise PhysicsError(
                 "attachment_mass: exceeds the modal mass of the n = 1 mode (check the mass)"
             )
-        a = m.amplitude
+        a = m.amplitude * math.sqrt(scale)
         if not a > 0:
             continue
         mass = share / a**2

@@ -1,4 +1,4 @@
-"""The in-plane subset of an MF-Swift ``.tir`` property file: writer and reader.
+"""The in-plane fragment of an MF-Swift ``.tir`` property file (writer) and a ``.tir`` reader.
 
 A ``.tir`` file (MSC ADAMS tyre property file, used by MF-Tyre/MF-Swift) is
 INI-like: ``[SECTION]`` headers, ``KEY = value`` lines, strings in single
@@ -20,17 +20,16 @@ dictionaries.
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from .. import __version__
 from ..exceptions import FileFormatError
+from .budget import UncertaintyBudget
 from .rigid import RigidRingParameters
 
-__all__ = ["parse_tir", "tir_text"]
-
-_SECTION = re.compile(r"^\[([A-Za-z0-9_]+)\]$")
-_KEY = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*=\s*(.*)$")
+__all__ = ["TirLine", "decode_tir", "parse_tir", "scan_tir", "tir_text"]
 
 
 def _fmt(x: float) -> str:
@@ -42,8 +41,14 @@ def tir_text(
     *,
     source: str = "",
     extra_comments: Sequence[str] = (),
+    budget: UncertaintyBudget | None = None,
 ) -> str:
-    """The in-plane ``.tir`` subset of one pressure as text.
+    """The in-plane ``.tir`` fragment of one pressure as text.
+
+    Headed as a fragment: no simulator can load it alone (it lacks
+    ``[MODEL]``, ``[DIMENSION]``, ``[VERTICAL]``, ``NOMPRES``...); merge it
+    into a complete file with :func:`~tyredamp.tyremodel.tirmerge.merge_tir`
+    (``tyredamp tyre-model --merge-into BASE.tir``).
 
     Parameters
     ----------
@@ -53,6 +58,9 @@ def tir_text(
         Where the modes came from (a comment).
     extra_comments : sequence of str
         More comment lines (for example the lateral carcass quantities).
+    budget : UncertaintyBudget, optional
+        The values' uncertainty budgets and assumptions (written beside
+        them); without it the statistical standard errors only.
 
     Returns
     -------
@@ -64,7 +72,11 @@ def tir_text(
         "FILE_TYPE = 'tir'",
         "FILE_VERSION = 3.0",
         "FILE_FORMAT = 'ASCII'",
-        f"$ In-plane subset written by tyredamp {__version__} from a radial modal test.",
+        "$ FRAGMENT -- not a complete tyre property file: it lacks [MODEL], [DIMENSION],",
+        "$ [VERTICAL], NOMPRES and the Magic Formula coefficients, so a simulator would fill",
+        "$ them with defaults. Merge it into a complete file: tyredamp tyre-model ... "
+        "--merge-into BASE.tir",
+        f"$ In-plane values written by tyredamp {__version__} from a radial modal test.",
     ]
     if source:
         lines.append(f"$ source: {source}")
@@ -83,10 +95,14 @@ def tir_text(
             f"INFLPRES = {_fmt(rigid.pressure)}  $ inflation pressure of the test (Pa)",
         ]
     ng = rigid.not_given
+
+    def why(key: str, default: str) -> str:
+        return budget.comment(key) if budget is not None else default
+
     lines += [
         "[INERTIA]",
-        f"BELT_MASS = {_fmt(rigid.belt_mass)}  $ belt mass from the n = 1 mode shape "
-        f"(+- {rigid.belt_mass_std:.3g} kg)",
+        f"BELT_MASS = {_fmt(rigid.belt_mass)}  $ belt mass from the n = 1 mode shape, "
+        + why("BELT_MASS", f"+- {rigid.belt_mass_std:.3g} kg (statistical only)"),
     ]
     for key in ("MASS", "IXX", "IYY", "BELT_IXX", "BELT_IYY"):
         lines.append(f"$ {key}: not given by this test ({ng.get(key, 'not measured')})")
@@ -96,9 +112,10 @@ def tir_text(
         )
     lines += [
         "[STRUCTURAL]",
-        f"FREQ_LONG = {_fmt(rigid.freq_long)}  $ n = 1 belt translation, Hz "
-        f"(+- {rigid.freq_long_std:.3g})",
-        f"DAMP_LONG = {_fmt(rigid.damp_long)}  $ its damping ratio (+- {rigid.damp_long_std:.3g})",
+        f"FREQ_LONG = {_fmt(rigid.freq_long)}  $ n = 1 belt translation, Hz, "
+        + why("FREQ_LONG", f"+- {rigid.freq_long_std:.3g} (statistical only)"),
+        f"DAMP_LONG = {_fmt(rigid.damp_long)}  $ its damping ratio, "
+        + why("DAMP_LONG", f"+- {rigid.damp_long_std:.3g} (statistical only)"),
     ]
     for key in (
         "FREQ_WINDUP",
@@ -122,78 +139,167 @@ def tir_text(
     return "\n".join(lines) + "\n"
 
 
+_SECTION = re.compile(r"^\[\s*([A-Za-z0-9_ \-]+?)\s*\]$")
+_KEY = re.compile(r"^([A-Za-z_][A-Za-z0-9_.]*)\s*=\s*(.*)$")
+_FORTRAN_EXP = re.compile(r"(?<=[0-9.])[dD](?=[+-]?[0-9])")
+
+
+def _code(line: str) -> str:
+    """The part of ``line`` before a comment (``$`` or ``!`` outside a quoted string)."""
+    quote = ""
+    for i, ch in enumerate(line):
+        if quote:
+            if ch == quote:
+                quote = ""
+        elif ch in "'\"":
+            quote = ch
+        elif ch in "$!":
+            return line[:i].strip()
+    return line.strip()
+
+
+def _number(s: str) -> float | None:
+    try:
+        return float(_FORTRAN_EXP.sub("e", s))
+    except ValueError:
+        return None
+
+
 def _value(raw: str, lineno: int) -> Any:
+    """A value: a quoted string (its text), a number (float) or a bare word (str)."""
     s = raw.strip()
-    if s.startswith("'"):
-        end = s.find("'", 1)
+    if s[:1] in ("'", '"'):
+        end = s.find(s[0], 1)
         if end < 0:
             raise FileFormatError(f".tir line {lineno}: unterminated string {s!r}")
         return s[1:end]
-    s = s.split("$", 1)[0].strip()
     if not s:
-        raise FileFormatError(f".tir line {lineno}: missing value")
-    try:
-        return float(s)
-    except ValueError:
-        return s
+        raise FileFormatError(f".tir line {lineno}: a key without a value")
+    x = _number(s)
+    return s if x is None else x
 
 
-def _table_row(line: str) -> list[float] | None:
-    """A row of numbers (a list), a ``{column names}`` line (empty list), else None."""
-    if line.startswith("{") and line.endswith("}"):
-        return []
-    try:
-        return [float(x) for x in line.split()] or None
-    except ValueError:
-        return None
+@dataclass(frozen=True)
+class TirLine:
+    """One meaningful line of a ``.tir`` file (see :func:`scan_tir`).
+
+    Attributes
+    ----------
+    lineno : int
+        1-based line number.
+    section : str or None
+        The section the line is in (None before the first section).
+    kind : {"section", "key", "columns", "row"}
+    key : str
+        The key (``kind == "key"``), the section name (``"section"``), else "".
+    value : object
+        The value (float, str), the row (list of float), the column names
+        (list of str) or None.
+    """
+
+    lineno: int
+    section: str | None
+    kind: str
+    key: str
+    value: Any
+
+
+def scan_tir(text: str) -> Iterator[TirLine]:
+    """The meaningful lines of ``.tir`` text, in order (comments and blank lines skipped).
+
+    Accepts what public property files contain (MF 5.2, PAC2002, MF 6.1/6.2,
+    MF-Swift; ADAMS/MDI tyre property file format): ``[SECTION]`` headers (any
+    order, repeated), ``KEY = value`` lines (quoted strings in ``'`` or
+    ``"``, numbers also with a Fortran ``D`` exponent, bare words), comments
+    from ``$`` or ``!`` outside a quoted string to the end of the line, and
+    table sections: a ``{column names}`` line (``[SHAPE]``,
+    ``[BOTTOMING_CURVE]``, ``[DEFLECTION_LOAD_CURVE]``...) and rows of numbers.
+
+    Raises
+    ------
+    FileFormatError
+        A line that is none of these (the message gives its number and text),
+        a key or row before the first section.
+    """
+    section: str | None = None
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = _code(raw.replace("\ufeff", ""))
+        if not line:
+            continue
+        m = _SECTION.match(line)
+        if m:
+            section = m.group(1).strip().upper().replace(" ", "_")
+            yield TirLine(lineno, section, "section", section, None)
+            continue
+        k = _KEY.match(line)
+        if k:
+            if section is None:
+                raise FileFormatError(
+                    f".tir line {lineno}: key {k.group(1)!r} before any [SECTION]"
+                )
+            yield TirLine(lineno, section, "key", k.group(1), _value(k.group(2), lineno))
+            continue
+        if line.startswith("{") and line.endswith("}") and section is not None:
+            yield TirLine(lineno, section, "columns", "", line.strip("{} ").split())
+            continue
+        row = [_number(x) for x in line.replace(",", " ").split()]
+        if section is not None and row and all(x is not None for x in row):
+            yield TirLine(lineno, section, "row", "", row)
+            continue
+        raise FileFormatError(
+            f".tir line {lineno}: expected [SECTION], KEY = value or a row of numbers, "
+            f"got {raw.strip()[:60]!r}"
+        )
 
 
 def parse_tir(text: str) -> dict[str, dict[str, Any]]:
     """Read ``.tir`` text into ``{section: {key: value}}`` (numbers as float).
 
-    Comments (``$`` anywhere outside a quoted string, lines starting with
-    ``!``) and blank lines are skipped; keys are kept as written. A table
-    section (``[SHAPE]``: a ``{radial width}`` line, then rows of numbers)
-    gives its rows as ``"_rows"`` (lists of floats) and its column names as
-    ``"_columns"``.
+    Lines as :func:`scan_tir` reads them. Section names are upper-cased, keys
+    kept as written. A section given twice is read as one (its keys
+    together); a key given twice with the same value is read once. A table
+    section gives its rows as ``"_rows"`` (lists of floats) and its column
+    names as ``"_columns"``.
 
     Raises
     ------
     FileFormatError
-        A key before the first section, a line that is neither a section,
-        a ``KEY = value`` line, a table row nor a comment, a key repeated in
-        a section.
+        As :func:`scan_tir`; a key given twice in a section with different
+        values (which one a simulator takes is not defined); no section.
     """
     out: dict[str, dict[str, Any]] = {}
-    current: str | None = None
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = raw.strip()
-        if not line or line.startswith("$") or line.startswith("!"):
-            continue
-        m = _SECTION.match(line.split("$", 1)[0].strip())
-        if m:
-            current = m.group(1)
-            out.setdefault(current, {})
-            continue
-        k = _KEY.match(line)
-        table = _table_row(line.split("$", 1)[0].strip())
-        if not k and current is not None and table is not None:
-            # a table section ([SHAPE]: "{radial width}" then rows of numbers)
-            if table:
-                out[current].setdefault("_rows", []).append(table)
-            else:
-                out[current]["_columns"] = line.strip("{} ").split()
-            continue
-        if not k:
-            raise FileFormatError(
-                f".tir line {lineno}: expected [SECTION] or KEY = value, got {line!r}"
-            )
-        if current is None:
-            raise FileFormatError(f".tir line {lineno}: key {k.group(1)!r} before any [SECTION]")
-        key = k.group(1)
-        if key in out[current]:
-            raise FileFormatError(f".tir line {lineno}: key {key!r} repeated in [{current}]")
-        out[current][key] = _value(k.group(2), lineno)
+    where: dict[tuple[str, str], int] = {}
+    for ln in scan_tir(text):
+        assert ln.section is not None
+        sec = out.setdefault(ln.section, {})
+        if ln.kind == "row":
+            sec.setdefault("_rows", []).append(ln.value)
+        elif ln.kind == "columns":
+            sec["_columns"] = ln.value
+        elif ln.kind == "key":
+            first = where.setdefault((ln.section, ln.key), ln.lineno)
+            if ln.key in sec and sec[ln.key] != ln.value:
+                raise FileFormatError(
+                    f".tir line {ln.lineno}: key {ln.key!r} repeated in [{ln.section}] with a "
+                    f"different value ({sec[ln.key]!r} on line {first}, {ln.value!r} here)"
+                )
+            sec[ln.key] = ln.value
     if not out:
         raise FileFormatError(".tir: no [SECTION] found")
     return out
+
+
+def decode_tir(data: bytes, name: str = ".tir") -> str:
+    """``.tir`` bytes as text: UTF-8 (a byte-order mark dropped), else Latin-1.
+
+    Raises
+    ------
+    FileFormatError
+        NUL bytes (not a text file).
+    """
+    if b"\x00" in data:
+        raise FileFormatError(f"{name}: not a text file (NUL bytes); expected a .tir property file")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")

@@ -30,6 +30,8 @@ from ..._validate import check_positive
 from ...exceptions import ConvergenceError, InputError, PhysicsError
 from ...modal.model import ModalModel
 from .identifiability import (
+    MODEL_LIMITED,
+    admit_model_error,
     central_jacobian,
     chi2_scaling,
     collinearity,
@@ -115,6 +117,7 @@ class _StiffnessFit:
     dof: int
     p_value: float | None
     scaled: bool
+    discrepancy: float | None = None
 
 
 @dataclass(frozen=True)
@@ -365,7 +368,15 @@ def _fit_stiffness(problem: _StiffnessProblem, theta0: _Array) -> _StiffnessFit:
     sv, _ = collinearity(jac)
     cov_u = np.linalg.pinv(jac.T @ jac, rcond=1e-12)
     pval, scaled = chi2_scaling(rss, dof, problem.have_std)
-    if scaled:
+    # the frequencies' own reduced chi-square: a systematic frequency misfit hides in the
+    # global one when the many amplitudes carry larger noise
+    nf = problem.x.f.size
+    dof_f = max(nf - (u.size - (1 if problem.rho_fixed is None else 0)), 1)
+    disc = max(rss / dof, float(rvec[:nf] @ rvec[:nf]) / dof_f) if problem.have_std else None
+    if disc is not None and disc > MODEL_LIMITED:
+        cov_u = cov_u * disc  # Birge ratio of the worst block
+        scaled = True
+    elif scaled:
         cov_u = cov_u * (rss / dof)
     theta = u * scales
     cov = np.asarray(cov_u * np.outer(scales, scales), dtype=np.float64)
@@ -385,13 +396,20 @@ def _fit_stiffness(problem: _StiffnessProblem, theta0: _Array) -> _StiffnessFit:
         stderr=se,
         correlation=corr,
         singular_values=sv,
-        verdicts=verdicts(names, se / vscale, corr, jac),
+        verdicts=admit_model_error(
+            verdicts(names, se / vscale, corr, jac),
+            theta,
+            se,
+            disc,
+            int(dof_f),
+        ),
         fitted_frequency_hz=fm,
         fitted_amplitude=am,
         chi2=rss,
         dof=int(dof),
         p_value=pval,
         scaled=scaled,
+        discrepancy=disc,
     )
 
 
@@ -443,7 +461,13 @@ def _fit_damping(
         units=("N s/m^2", "N s/m^2", "s", "N s/m")[: dmat.shape[1]],
         values=np.asarray(dsol, dtype=float),
         stderr=dse,
-        verdicts=verdicts(names, dse / dscale, correlation(dcov), dw),
+        verdicts=admit_model_error(
+            verdicts(names, dse / dscale, correlation(dcov), dw),
+            dsol,
+            dse,
+            drss / ddof if have_zstd else None,
+            int(ddof),
+        ),
         fitted_damping_ratio=(dmat @ dsol + (c_known or 0.0) * phi2) / (2 * omega),
     )
 
@@ -488,6 +512,7 @@ def _result(
         fitted_amplitude=stiff.fitted_amplitude,
         fitted_damping_ratio=damp.fitted_damping_ratio,
         chi2=stiff.chi2,
+        discrepancy_chi2=stiff.discrepancy,
         dof=stiff.dof,
         p_value=stiff.p_value,
         scaled_covariance=stiff.scaled,

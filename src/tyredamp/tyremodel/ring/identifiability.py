@@ -31,7 +31,9 @@ __all__ = [
     "COLLINEARITY",
     "CORRELATED",
     "IDENTIFIED",
+    "MODEL_LIMITED",
     "POORLY",
+    "admit_model_error",
     "central_jacobian",
     "chi2_scaling",
     "collinearity",
@@ -52,6 +54,10 @@ CORRELATED = 0.95
 #: undetermined. Brun et al. call 10-15 critical for percent-level environmental data; modal
 #: frequencies are more precise, and the standard-error verdict covers the noise itself.
 COLLINEARITY = 100.0
+#: Reduced chi-square above which the misfit is model error, not noise: the covariance scaled
+#: by it describes a random scatter the residuals do not have (systematic misfit moves every
+#: parameter together), so no parameter is called identified.
+MODEL_LIMITED = 4.0
 #: Chi-square upper-tail probability below which the covariance is scaled by ``RSS/dof``.
 _SIGNIFICANT = 0.01
 
@@ -169,3 +175,65 @@ def verdicts(
             label = f"not separately identifiable (confounded with {others})"
         out[nm] = {"verdict": label, "relative_se": rel, "correlated_with": partners}
     return out
+
+
+def admit_model_error(
+    out: dict[str, dict[str, Any]],
+    theta: NDArray[np.float64],
+    se: NDArray[np.float64],
+    chi2_per_dof: float | None,
+    dof: int = 1,
+) -> dict[str, dict[str, Any]]:
+    """Verdicts that admit a model discrepancy and parameters consistent with zero.
+
+    With weights from the measurement standard errors the reduced chi-square
+    ``RSS/dof`` estimates ``1 + s_d^2 / s_noise^2`` (a model discrepancy of
+    constant variance ``s_d^2`` beside the noise, Kennedy & O'Hagan, J. R.
+    Stat. Soc. B 63(3), 2001, eq. (5)). Above :data:`MODEL_LIMITED` the misfit
+    is systematic and the covariance, even scaled by ``RSS/dof``, treats it
+    as random. A systematic discrepancy ``d`` (weighted) moves parameter
+    ``k`` by ``e_k^T (J^T J)^-1 J^T d``, at most ``sqrt(C_kk) ||P_J d||``
+    (Cauchy-Schwarz; ``C = (J^T J)^-1``, ``P_J`` the projection on the
+    model's sensitivities). The part of ``d`` the model absorbs cannot be
+    seen; taking it no larger than the part it leaves (``||P_J d||^2 <=
+    RSS``) gives the bound ``b_k = sqrt(C_kk RSS) = se_k sqrt(dof)`` with
+    ``se_k`` the scaled standard error. A parameter whose bound, against its
+    verdict scale, exceeds :data:`IDENTIFIED` is not distinguishable from the
+    discrepancy: it becomes ``model-limited`` (``model_error_bound`` is
+    reported as a fraction of the verdict scale for every parameter). A
+    parameter within two standard uncertainties of zero (``sqrt(se^2 + b_k^2)``
+    with the bound in the parameter's unit) is flagged ``consistent_with_zero``
+    (a 95 % interval that contains 0).
+
+    Parameters
+    ----------
+    out : dict
+        From :func:`verdicts` (changed copies are returned).
+    theta, se : ndarray, shape (P,)
+        Values and (scaled) standard errors in the order of ``out``.
+    chi2_per_dof : float or None
+        ``RSS/dof`` with measurement weights, None without standard errors.
+    dof : int
+        Degrees of freedom of the fit.
+    """
+    res: dict[str, dict[str, Any]] = {}
+    limited = chi2_per_dof is not None and chi2_per_dof > MODEL_LIMITED
+    for i, (name, v) in enumerate(out.items()):
+        w = dict(v)
+        bound = float(w["relative_se"]) * math.sqrt(max(dof, 1)) if limited else 0.0
+        # two standard uncertainties, the model-error bound included (se sqrt(1 + dof))
+        u = float(se[i]) * math.sqrt(1.0 + (max(dof, 1) if limited else 0.0))
+        w["consistent_with_zero"] = bool(abs(float(theta[i])) <= 2 * u)
+        w["model_error_bound"] = bound
+        w["model_limited"] = bool(
+            limited and bound > IDENTIFIED and w["verdict"] in ("identified", "poorly identified")
+        )
+        if w["model_limited"]:
+            w["verdict"] = (
+                f"model-limited (chi2/dof {chi2_per_dof:.3g}: the ring's misfit could move it "
+                f"by {100 * bound:.2g} %)"
+            )
+        elif w["consistent_with_zero"] and w["verdict"] == "identified":
+            w["verdict"] = "consistent with zero"
+        res[name] = w
+    return res

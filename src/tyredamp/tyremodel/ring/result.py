@@ -105,6 +105,7 @@ class RingFit:
     fit_time_s: float = 0.0
     band_loss_frequency: float = 200.0
     foundation_law: FoundationLaw = "linear"
+    discrepancy_chi2: float | None = None
 
     # ------------------------------------------------------------ parameters
     def param(self, name: str) -> tuple[float, float]:
@@ -287,6 +288,27 @@ class RingFit:
             band_loss_frequency=self.band_loss_frequency,
         )
 
+    def model_discrepancy(self) -> dict[str, Any]:
+        """The misfit beyond the noise: reduced chi-square and relative frequency scatter.
+
+        ``chi2_per_dof`` (the larger of the whole fit's and the frequencies'
+        own reduced chi-square; None without measurement standard errors), whether
+        it makes the parameters model-limited (above
+        :data:`~tyredamp.tyremodel.ring.identifiability.MODEL_LIMITED`), and
+        the RMS of ``(f_model - f_measured) / f_measured``: the accuracy to
+        which the ring describes the modes, whatever their noise.
+        """
+        from .identifiability import MODEL_LIMITED
+
+        f = np.array([o.frequency_hz for o in self.observations], dtype=float)
+        rel = (self.fitted_frequency_hz - f) / f
+        c = self.discrepancy_chi2
+        return {
+            "chi2_per_dof": c,
+            "model_limited": bool(c is not None and c > MODEL_LIMITED),
+            "frequency_rms_relative": float(np.sqrt(np.mean(rel**2))) if rel.size else 0.0,
+        }
+
     # ------------------------------------------------------------ output
     def table(self) -> list[dict[str, Any]]:
         """One row per parameter: name, unit, value, stderr, verdict, correlated_with."""
@@ -299,6 +321,7 @@ class RingFit:
                     "unit": self.units[i],
                     "value": float(self.values[i]),
                     "stderr": float(self.stderr[i]),
+                    "model_error": _model_error(float(self.stderr[i]), v),
                     **v,
                 }
             )
@@ -310,6 +333,7 @@ class RingFit:
                     "unit": self.damping_units[i],
                     "value": float(self.damping_values[i]),
                     "stderr": float(self.damping_stderr[i]),
+                    "model_error": _model_error(float(self.damping_stderr[i]), v),
                     **v,
                 }
             )
@@ -365,6 +389,7 @@ class RingFit:
             "dof": self.dof,
             "p_value": self.p_value,
             "scaled_covariance": self.scaled_covariance,
+            "model_discrepancy": self.model_discrepancy(),
             "weights": self.weights,
             "observations": [
                 {
@@ -378,3 +403,12 @@ class RingFit:
             "skipped": list(self.skipped),
             "fit_time_s": self.fit_time_s,
         }
+
+
+def _model_error(stderr: float, verdict: dict[str, Any]) -> float:
+    """The model-discrepancy bound ``se sqrt(dof)`` in the parameter's unit (0 when none).
+
+    See :func:`~tyredamp.tyremodel.ring.identifiability.admit_model_error`.
+    """
+    rel, bound = float(verdict.get("relative_se", 0.0)), verdict.get("model_error_bound", 0.0)
+    return stderr * float(bound) / rel if rel > 0 and bound else 0.0
