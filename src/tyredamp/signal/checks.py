@@ -538,37 +538,11 @@ def quality_check(
 
     if frf is not None and band is not None:
         frf = frf.band(*band)
-    low_frac = 0.0
+    low_frac = all_frac = 0.0
     per_line = freq = None
-    all_frac = 0.0
     if frf is not None and frf.coherence is not None:
-        coh = frf.coherence
-        low = coh < cmin
-        strong = _strong_response(frf)
-        all_frac = float(np.mean(low))
-        low_frac = float(np.mean(low[strong]))
-        figures["low_coherence_fraction"] = low_frac
-        figures["low_coherence_fraction_all_lines"] = all_frac
-        figures["min_coherence"] = float(coh.min())
-        figures["mean_coherence"] = float(coh.mean())
-        freq, per_line = frf.frequency.copy(), coh.min(axis=0)
-        bands = _low_bands(frf.frequency, np.mean(low, axis=0) >= 0.5)
-        if bands:
-            notes.append(f"coherence below {cmin:g} on most outputs in: {', '.join(bands)}")
-        weak_low = float(np.mean(low[~strong])) if np.any(~strong) else 0.0
-        if weak_low > thr and low_frac <= thr:
-            notes.append(
-                f"coherence below {cmin:g} on {100 * weak_low:.3g} % of the lines where the "
-                "response is weak (antiresonances, nodal points): the output noise there, "
-                "expected at any finite signal-to-noise ratio"
-            )
-        if low_frac > thr:
-            problems.append(
-                f"{100 * low_frac:.3g} % of the lines with a strong response have coherence "
-                f"< {cmin:g}"
-            )
-        if frf.meta.get("n_averages") == 1:
-            notes.append("one average only: the coherence is 1 by construction")
+        low_frac, all_frac = _coherence(frf, frf.coherence, cmin, thr, figures, notes, problems)
+        freq, per_line = frf.frequency.copy(), frf.coherence.min(axis=0)
     elif frf is not None:
         notes.append("no coherence available: coherence check skipped")
 
@@ -586,6 +560,45 @@ def quality_check(
     return CheckResult(
         "quality", passed, low_frac, thr, figures, summary, freq, per_line, tuple(notes)
     )
+
+
+def _coherence(
+    frf: FRF,
+    coh: NDArray[np.float64],
+    cmin: float,
+    thr: float,
+    figures: dict[str, float],
+    notes: list[str],
+    problems: list[str],
+) -> tuple[float, float]:
+    """The coherence part of :func:`quality_check`: low-coherence fractions where the
+    response is strong (the verdict figure) and over all lines; adds figures, notes
+    and problems."""
+    low = coh < cmin
+    strong = _strong_response(frf)
+    all_frac = float(np.mean(low))
+    low_frac = float(np.mean(low[strong]))
+    figures["low_coherence_fraction"] = low_frac
+    figures["low_coherence_fraction_all_lines"] = all_frac
+    figures["min_coherence"] = float(coh.min())
+    figures["mean_coherence"] = float(coh.mean())
+    bands = _low_bands(frf.frequency, np.mean(low, axis=0) >= 0.5)
+    if bands:
+        notes.append(f"coherence below {cmin:g} on most outputs in: {', '.join(bands)}")
+    weak_low = float(np.mean(low[~strong])) if np.any(~strong) else 0.0
+    if weak_low > thr and low_frac <= thr:
+        notes.append(
+            f"coherence below {cmin:g} on {100 * weak_low:.3g} % of the lines where the "
+            "response is weak (antiresonances, nodal points): the output noise there, "
+            "expected at any finite signal-to-noise ratio"
+        )
+    if low_frac > thr:
+        problems.append(
+            f"{100 * low_frac:.3g} % of the lines with a strong response have coherence < {cmin:g}"
+        )
+    if frf.meta.get("n_averages") == 1:
+        notes.append("one average only: the coherence is 1 by construction")
+    return low_frac, all_frac
 
 
 def _strong_response(frf: FRF) -> NDArray[np.bool_]:
