@@ -63,7 +63,10 @@ from .._validate import as_finite
 from ..exceptions import InputError, PhysicsError
 from ..frf import Channel
 from ..mechanics import MCKSystem, proportional_part
+from .cavity import Cavity, CavityBlocks, cavity_blocks
+from .contact import ContactPatch, contact_blocks, patch_intrusion, solve_patch
 from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
+from .sources import Splice, splice_weights
 from .truth import TyreTruth, wave_numbers
 
 __all__ = [
@@ -349,8 +352,11 @@ class RingTyre:
         *,
         n_ring: int = 64,
         fd_order: int = 4,
-        nonproportionality: float = 0.5,
+        nonproportionality: float = 1.0,
         imperfections: Sequence[Imperfection] = (),
+        splice: Splice | None = None,
+        cavity: Cavity | None = None,
+        contact: ContactPatch | None = None,
     ) -> None:
         self.params = params if params is not None else RingTyreParameters()
         self.layout = layout if layout is not None else MeasurementLayout()
@@ -396,44 +402,34 @@ class RingTyre:
         self.fd_order = int(fd_order)
         self.nonproportionality = nu
         self.imperfections = imps
+        for name, obj, cls in (
+            ("splice", splice, Splice),
+            ("cavity", cavity, Cavity),
+            ("contact", contact, ContactPatch),
+        ):
+            if obj is not None and not isinstance(obj, cls):
+                raise InputError(f"{name}: expected {cls.__name__} or None, got {type(obj).__name__}")
+        self.splice = splice
+        self.cavity = cavity
+        self.contact = contact
+        self.cavity_basis: NDArray[np.float64] | None = None
         self._build()
 
     # ------------------------------------------------------------ assembly
     def _build(self) -> None:
         p = self.params
         n = self.n_ring
-        ops = _operators(n, self.fd_order)
-        d, h = ops.D, ops.h
-        g = -d.T
-        r = p.radius
-        eye = np.eye(n)
-        zero = np.zeros((n, n))
-        e_op = np.hstack([eye, d])  # R * membrane strain at nodes
-        b_op = np.hstack([-d @ g, d])  # R^2 * curvature change at nodes
-        gw_op = np.hstack([g, zero])  # w' at mid-points
-        w_sel = np.hstack([eye, zero])
-        v_sel = np.hstack([zero, eye])
-        arc = r * h
-        ete = e_op.T @ e_op
-        k_bend = arc * p.bending_stiffness / r**4 * (b_op.T @ b_op)
-        k = (
-            arc * p.membrane_stiffness / r**2 * ete
-            + k_bend
-            + arc * p.hoop_tension / r**2 * (ete - w_sel.T @ w_sel + gw_op.T @ gw_op)
-            + arc * p.radial_stiffness * (w_sel.T @ w_sel)
-            + arc * p.tangential_stiffness * (v_sel.T @ v_sel)
-        )
-        m = p.mass_per_length * arc * np.eye(2 * n)
-        c = arc * (p.radial_damping * (w_sel.T @ w_sel) + p.tangential_damping * (v_sel.T @ v_sel))
-        if p.band_loss_factor > 0:
-            c = c + p.band_loss_factor / (2 * np.pi * p.band_loss_frequency) * k_bend
+        d = _operators(n, self.fd_order).D
+        k, k_bend, m, sources = _ring_blocks(p, d, self.splice)
         step = n // self.layout.n_points
         self._point_nodes = np.arange(self.layout.n_points) * step
         self._drive_nodes = np.array([(dp - 1) * step for dp in self.layout.drive_points])
+        c_att = np.zeros_like(k)
         for node in self._drive_nodes:
             m[node, node] += self.layout.attachment_mass
-            c[node, node] += self.layout.attachment_damping
+            c_att[node, node] += self.layout.attachment_damping
         self._imperfection_nodes = []
+        c_imp = np.zeros_like(k)
         for imp in self.imperfections:
             node = int(np.round(imp.angle_deg / 360.0 * n)) % n
             self._imperfection_nodes.append(node)
@@ -441,10 +437,29 @@ class RingTyre:
             m[n + node, n + node] += imp.mass / 2  # mid-point i + 1/2
             m[n + (node - 1) % n, n + (node - 1) % n] += imp.mass / 2  # mid-point i - 1/2
             k[node, node] += imp.stiffness
-            c[node, node] += imp.damping
+            c_imp[node, node] += imp.damping
+        sources["attachment"] = c_att
+        sources["imperfections"] = c_imp
         k = 0.5 * (k + k.T)
+        self.patch = None
+        area_change = None
+        if self.contact is not None:
+            self.patch = solve_patch(k, self.contact, p.radius)
+            k_c, c_c = contact_blocks(self.patch, self.contact)
+            k = k + k_c
+            sources["contact"] = c_c
+            area_change = -p.width * patch_intrusion(self.patch, self.contact, p.radius, n)
+        if self.cavity is not None:
+            blk = cavity_blocks(
+                self.cavity, d, pressure=p.pressure, band_width=p.width, area_change=area_change
+            )
+            self.cavity_basis = blk.basis
+            m, k, sources = _with_cavity(m, k, sources, blk)
+        sources = {name: c for name, c in sources.items() if np.any(c)}
+        self.damping_sources: dict[str, NDArray[np.float64]] = sources
         self.K_bend = k_bend
-        self.physical_system = MCKSystem(m, c, k)
+        c = sum(sources.values(), np.zeros_like(k))
+        self.physical_system = MCKSystem(m, 0.5 * (c + c.T), k)
         nu = self.nonproportionality
         if nu == 1.0:
             self.system = self.physical_system
@@ -456,8 +471,13 @@ class RingTyre:
     # ------------------------------------------------------------ geometry
     @property
     def n_dof(self) -> int:
-        """Number of DOFs, ``2 n_ring``."""
-        return 2 * self.n_ring
+        """Number of DOFs: ``2 n_ring``, plus ``n_ring - 1`` air DOFs with a cavity."""
+        return int(self.physical_system.M.shape[0])
+
+    @property
+    def cavity_dofs(self) -> NDArray[np.intp]:
+        """DOF indices of the reduced air coordinates (empty without a cavity)."""
+        return np.arange(2 * self.n_ring, self.n_dof, dtype=np.intp)
 
     @property
     def M(self) -> NDArray[np.float64]:
@@ -548,7 +568,7 @@ class RingTyre:
             In the order of ``system.undamped_modes()`` (ascending frequency).
         """
         phi = self.system.undamped_modes().phi
-        return wave_numbers(phi[: self.n_ring], phi[self.n_ring :])
+        return wave_numbers(phi[: self.n_ring], phi[self.n_ring : 2 * self.n_ring])
 
     def ring_frequencies(self, n_max: int = 6) -> NDArray[np.float64]:
         """Undamped frequencies of the two flexural modes of each wave number 1..n_max.
@@ -593,6 +613,80 @@ class RingTyre:
     def truth(self, band: tuple[float, float] = (0.0, 200.0)) -> TyreTruth:
         """The exact modal truth of this tyre in ``band`` (Hz); see :class:`TyreTruth`."""
         return TyreTruth.from_tyre(self, band)
+
+
+
+def _ring_blocks(
+    p: RingTyreParameters, d: NDArray[np.float64], splice: Splice | None
+) -> tuple[
+    NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], dict[str, NDArray[np.float64]]
+]:
+    """Stiffness, bending stiffness, mass and named damping blocks of the bare ring.
+
+    Returns ``K``, ``K_bend`` (N/m), ``M`` (kg), each ``(2N, 2N)``, and the
+    damping of each source (N s/m): the sidewall dashpots ``c_r``, ``c_t``,
+    the band's Kelvin-Voigt losses on bending and membrane strain and the
+    splice (:class:`~tyredamp.virtual.sources.Splice`).
+    """
+    n = d.shape[0]
+    h = 2 * np.pi / n
+    g = -d.T
+    r = p.radius
+    eye = np.eye(n)
+    zero = np.zeros((n, n))
+    e_op = np.hstack([eye, d])  # R * membrane strain at nodes
+    b_op = np.hstack([-d @ g, d])  # R^2 * curvature change at nodes
+    gw_op = np.hstack([g, zero])  # w' at mid-points
+    w_sel = np.hstack([eye, zero])
+    v_sel = np.hstack([zero, eye])
+    arc = r * h
+    ete = e_op.T @ e_op
+    k_bend = arc * p.bending_stiffness / r**4 * (b_op.T @ b_op)
+    k_mem = arc * p.membrane_stiffness / r**2 * ete
+    k = (
+        k_mem
+        + k_bend
+        + arc * p.hoop_tension / r**2 * (ete - w_sel.T @ w_sel + gw_op.T @ gw_op)
+        + arc * p.radial_stiffness * (w_sel.T @ w_sel)
+        + arc * p.tangential_stiffness * (v_sel.T @ v_sel)
+    )
+    m = p.mass_per_length * arc * np.eye(2 * n)
+    omega_ref = 2 * np.pi * p.band_loss_frequency
+    sources = {
+        "sidewall radial": arc * p.radial_damping * (w_sel.T @ w_sel),
+        "sidewall tangential": arc * p.tangential_damping * (v_sel.T @ v_sel),
+        "band bending": p.band_loss_factor / omega_ref * k_bend,
+        "band membrane": p.membrane_loss_factor / omega_ref * k_mem,
+    }
+    if splice is not None:
+        nodes, mids = splice_weights(splice, r, n)
+        k_sp = arc * p.bending_stiffness / r**4 * splice.stiffness_fraction * (
+            b_op.T @ (nodes[:, None] * b_op)
+        )
+        k = k + k_sp
+        k_bend = k_bend + k_sp
+        m = m + p.mass_per_length * arc * splice.mass_fraction * np.diag(
+            np.concatenate([nodes, mids])
+        )
+        sources["splice"] = (p.band_loss_factor + splice.loss_factor) / omega_ref * k_sp
+    return k, k_bend, m, sources
+
+
+def _with_cavity(
+    m: NDArray[np.float64],
+    k: NDArray[np.float64],
+    sources: dict[str, NDArray[np.float64]],
+    blk: CavityBlocks,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, NDArray[np.float64]]]:
+    """Append the reduced air DOFs of ``blk`` to the ring's ``M``, ``K`` and damping sources."""
+    na = blk.m_air.shape[0]
+    nr = m.shape[0]
+    za = np.zeros((nr, na))
+    m2 = np.block([[m, za], [za.T, blk.m_air]])
+    k2 = np.block([[k + blk.k_ring, blk.k_cross], [blk.k_cross.T, blk.k_air]])
+    out = {name: np.block([[c, za], [za.T, np.zeros((na, na))]]) for name, c in sources.items()}
+    out["cavity"] = np.block([[blk.c_ring, blk.c_cross], [blk.c_cross.T, blk.c_air]])
+    return m2, 0.5 * (k2 + k2.T), out
 
 
 @dataclass(frozen=True)
