@@ -127,7 +127,9 @@ class PatchState:
     tangential_springs: NDArray[np.float64]
 
 
-def _cell_overlap(centres: NDArray[np.float64], h: float, lo: float, hi: float) -> NDArray[np.float64]:
+def _cell_overlap(
+    centres: NDArray[np.floating], h: float, lo: float, hi: float
+) -> NDArray[np.float64]:
     """Angle (rad) of each cell ``[c - h/2, c + h/2]`` inside ``[lo, hi]``, periodic."""
     out = np.zeros(centres.size)
     for shift in (-2 * np.pi, 0.0, 2 * np.pi):
@@ -197,9 +199,7 @@ def hub_stiffness(
     return float(e @ f - f @ x)
 
 
-def solve_patch(
-    k_ring: NDArray[np.float64], patch: ContactPatch, radius: float
-) -> PatchState:
+def solve_patch(k_ring: NDArray[np.float64], patch: ContactPatch, radius: float) -> PatchState:
     """Patch half-length and hub stiffness consistent with the load (module docstring).
 
     Bisection on ``a`` of ``g(a) = sqrt(2 R d(a) - d(a)^2) - a`` with
@@ -219,7 +219,8 @@ def solve_patch(
         return kh, d, math.sqrt(max(2 * radius * d - d * d, 0.0))
 
     lo, hi = 1e-6 * radius, 0.99 * radius
-    if state(hi)[2] > hi:
+    _, d_hi, a_hi = state(hi)
+    if d_hi >= radius or a_hi > hi:
         raise PhysicsError(
             f"ContactPatch.load: {patch.load:g} N flattens the tyre by more than its radius; "
             "expected a load the sidewalls can carry"

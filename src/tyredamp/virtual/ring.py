@@ -63,10 +63,10 @@ from .._validate import as_finite
 from ..exceptions import InputError, PhysicsError
 from ..frf import Channel
 from ..mechanics import MCKSystem, proportional_part
-from .cavity import Cavity, CavityBlocks, cavity_blocks
+from .assembly import Splice, ring_blocks, with_cavity
+from .cavity import Cavity, cavity_blocks
 from .contact import ContactPatch, contact_blocks, patch_intrusion, solve_patch
 from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
-from .sources import Splice, splice_weights
 from .truth import TyreTruth, wave_numbers
 
 __all__ = [
@@ -408,7 +408,9 @@ class RingTyre:
             ("contact", contact, ContactPatch),
         ):
             if obj is not None and not isinstance(obj, cls):
-                raise InputError(f"{name}: expected {cls.__name__} or None, got {type(obj).__name__}")
+                raise InputError(
+                    f"{name}: expected {cls.__name__} or None, got {type(obj).__name__}"
+                )
         self.splice = splice
         self.cavity = cavity
         self.contact = contact
@@ -420,7 +422,7 @@ class RingTyre:
         p = self.params
         n = self.n_ring
         d = _operators(n, self.fd_order).D
-        k, k_bend, m, sources = _ring_blocks(p, d, self.splice)
+        k, k_bend, m, sources = ring_blocks(p, d, self.splice)
         step = n // self.layout.n_points
         self._point_nodes = np.arange(self.layout.n_points) * step
         self._drive_nodes = np.array([(dp - 1) * step for dp in self.layout.drive_points])
@@ -454,7 +456,7 @@ class RingTyre:
                 self.cavity, d, pressure=p.pressure, band_width=p.width, area_change=area_change
             )
             self.cavity_basis = blk.basis
-            m, k, sources = _with_cavity(m, k, sources, blk)
+            m, k, sources = with_cavity(m, k, sources, blk)
         sources = {name: c for name, c in sources.items() if np.any(c)}
         self.damping_sources: dict[str, NDArray[np.float64]] = sources
         self.K_bend = k_bend
@@ -613,80 +615,6 @@ class RingTyre:
     def truth(self, band: tuple[float, float] = (0.0, 200.0)) -> TyreTruth:
         """The exact modal truth of this tyre in ``band`` (Hz); see :class:`TyreTruth`."""
         return TyreTruth.from_tyre(self, band)
-
-
-
-def _ring_blocks(
-    p: RingTyreParameters, d: NDArray[np.float64], splice: Splice | None
-) -> tuple[
-    NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], dict[str, NDArray[np.float64]]
-]:
-    """Stiffness, bending stiffness, mass and named damping blocks of the bare ring.
-
-    Returns ``K``, ``K_bend`` (N/m), ``M`` (kg), each ``(2N, 2N)``, and the
-    damping of each source (N s/m): the sidewall dashpots ``c_r``, ``c_t``,
-    the band's Kelvin-Voigt losses on bending and membrane strain and the
-    splice (:class:`~tyredamp.virtual.sources.Splice`).
-    """
-    n = d.shape[0]
-    h = 2 * np.pi / n
-    g = -d.T
-    r = p.radius
-    eye = np.eye(n)
-    zero = np.zeros((n, n))
-    e_op = np.hstack([eye, d])  # R * membrane strain at nodes
-    b_op = np.hstack([-d @ g, d])  # R^2 * curvature change at nodes
-    gw_op = np.hstack([g, zero])  # w' at mid-points
-    w_sel = np.hstack([eye, zero])
-    v_sel = np.hstack([zero, eye])
-    arc = r * h
-    ete = e_op.T @ e_op
-    k_bend = arc * p.bending_stiffness / r**4 * (b_op.T @ b_op)
-    k_mem = arc * p.membrane_stiffness / r**2 * ete
-    k = (
-        k_mem
-        + k_bend
-        + arc * p.hoop_tension / r**2 * (ete - w_sel.T @ w_sel + gw_op.T @ gw_op)
-        + arc * p.radial_stiffness * (w_sel.T @ w_sel)
-        + arc * p.tangential_stiffness * (v_sel.T @ v_sel)
-    )
-    m = p.mass_per_length * arc * np.eye(2 * n)
-    omega_ref = 2 * np.pi * p.band_loss_frequency
-    sources = {
-        "sidewall radial": arc * p.radial_damping * (w_sel.T @ w_sel),
-        "sidewall tangential": arc * p.tangential_damping * (v_sel.T @ v_sel),
-        "band bending": p.band_loss_factor / omega_ref * k_bend,
-        "band membrane": p.membrane_loss_factor / omega_ref * k_mem,
-    }
-    if splice is not None:
-        nodes, mids = splice_weights(splice, r, n)
-        k_sp = arc * p.bending_stiffness / r**4 * splice.stiffness_fraction * (
-            b_op.T @ (nodes[:, None] * b_op)
-        )
-        k = k + k_sp
-        k_bend = k_bend + k_sp
-        m = m + p.mass_per_length * arc * splice.mass_fraction * np.diag(
-            np.concatenate([nodes, mids])
-        )
-        sources["splice"] = (p.band_loss_factor + splice.loss_factor) / omega_ref * k_sp
-    return k, k_bend, m, sources
-
-
-def _with_cavity(
-    m: NDArray[np.float64],
-    k: NDArray[np.float64],
-    sources: dict[str, NDArray[np.float64]],
-    blk: CavityBlocks,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], dict[str, NDArray[np.float64]]]:
-    """Append the reduced air DOFs of ``blk`` to the ring's ``M``, ``K`` and damping sources."""
-    na = blk.m_air.shape[0]
-    nr = m.shape[0]
-    za = np.zeros((nr, na))
-    m2 = np.block([[m, za], [za.T, blk.m_air]])
-    k2 = np.block([[k + blk.k_ring, blk.k_cross], [blk.k_cross.T, blk.k_air]])
-    out = {name: np.block([[c, za], [za.T, np.zeros((na, na))]]) for name, c in sources.items()}
-    out["cavity"] = np.block([[blk.c_ring, blk.c_cross], [blk.c_cross.T, blk.c_air]])
-    return m2, 0.5 * (k2 + k2.T), out
 
 
 @dataclass(frozen=True)

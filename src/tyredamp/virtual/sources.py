@@ -31,80 +31,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import InputError
-from .parameters import _check_field
 
 if TYPE_CHECKING:
     from .ring import RingTyre
 
-__all__ = ["DampingDecomposition", "Splice", "damping_decomposition", "splice_weights"]
-
-
-@dataclass(frozen=True)
-class Splice:
-    """A tread/belt splice: more mass, stiffness and loss over a short arc of the band.
-
-    Parameters
-    ----------
-    angle_deg : float
-        Centre of the splice in deg (0 deg is measurement point 1). Default
-        100 (not on a measured point or a symmetry line of the layout).
-    arc_length : float
-        Length of the splice along the band in m, > 0. Default 0.04 (tread
-        and belt-ply overlaps of a few cm).
-    mass_fraction : float
-        Added band mass over the arc, relative to ``rho A``, >= 0. Default
-        0.3 (overlapping tread and ply: about 0.13 kg in all).
-    stiffness_fraction : float
-        Added bending stiffness over the arc, relative to ``EI``, >= 0.
-        Default 0.5.
-    loss_factor : float
-        Loss factor of the splice joint on its own bending stiffness
-        (overlap rubber and cord ends), >= 0. Default 0.3 (a joint works
-        its rubber in shear; tread compounds 0.1-0.3).
-    """
-
-    angle_deg: float = 100.0
-    arc_length: float = 0.04
-    mass_fraction: float = 0.3
-    stiffness_fraction: float = 0.5
-    loss_factor: float = 0.3
-
-    def __post_init__(self) -> None:
-        try:
-            a = float(self.angle_deg)
-        except (TypeError, ValueError):
-            raise InputError(f"Splice.angle_deg: expected a number, got {self.angle_deg!r}") from None
-        if not math.isfinite(a):
-            raise InputError(f"Splice.angle_deg: expected a finite angle, got {a}")
-        object.__setattr__(self, "angle_deg", a)
-        _check_field(self, "arc_length", allow_zero=False)
-        for name in ("mass_fraction", "stiffness_fraction", "loss_factor"):
-            _check_field(self, name, allow_zero=True)
-        for name in ("arc_length", "mass_fraction", "stiffness_fraction", "loss_factor"):
-            object.__setattr__(self, name, float(getattr(self, name)))
-
-
-def splice_weights(
-    splice: Splice, radius: float, n_ring: int
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Share of each node cell and mid-point cell covered by the splice, in [0, 1].
-
-    Returns
-    -------
-    nodes, mids : ndarray, shape (n_ring,)
-        Covered fraction of the cell ``[theta - h/2, theta + h/2]`` around each
-        node and each mid-point.
-    """
-    from .contact import _cell_overlap
-
-    h = 2 * np.pi / n_ring
-    c = math.radians(splice.angle_deg) % (2 * np.pi)
-    half = 0.5 * splice.arc_length / radius
-    th = np.arange(n_ring) * h
-    return (
-        _cell_overlap(th, h, c - half, c + half) / h,
-        _cell_overlap(th + h / 2, h, c - half, c + half) / h,
-    )
+__all__ = ["DampingDecomposition", "damping_decomposition"]
 
 
 @dataclass(frozen=True)
