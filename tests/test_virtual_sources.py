@@ -17,7 +17,8 @@ N = 32
 
 
 def test_sources_sum_to_the_damping_matrix() -> None:
-    tyre = RingTyre(n_ring=N, splice=Splice(), cavity=Cavity(), contact=ContactPatch(25e3))
+    p = RingTyreParameters(membrane_loss_factor=0.02)
+    tyre = RingTyre(p, n_ring=N, splice=Splice(), cavity=Cavity(), contact=ContactPatch(25e3))
     total = sum(tyre.damping_sources.values())
     assert_allclose(tyre.physical_system.C, total, atol=1e-12 * np.abs(total).max())  # symmetric
     assert set(tyre.damping_sources) == {

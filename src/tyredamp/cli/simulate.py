@@ -116,7 +116,7 @@ def simulate_group() -> None:
 )
 @click.option(
     "--splice/--no-splice",
-    default=True,
+    default=False,
     show_default=True,
     help="Include a tread splice (a 4 cm arc of extra mass, stiffness and loss).",
 )
@@ -161,7 +161,7 @@ def radial_command(
       tyredamp simulate radial --out tyre_test.uff
       tyredamp simulate radial --out tyre_frf.uff --frf --pressure 9 --snr 30 --seed 2
       tyredamp simulate radial --out mimo.uff --drive-points 1,5 --periods 4
-      tyredamp simulate radial --out loaded.uff --load 25 --no-splice
+      tyredamp simulate radial --out loaded.uff --load 25 --splice
     """
     from ..studies.demo import single_threaded_blas
     from ..studies.radial import frf_from_time, virtual_tyre

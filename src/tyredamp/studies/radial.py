@@ -352,14 +352,15 @@ def virtual_tyre(
     *,
     load_n: float = 0.0,
     cavity: bool = True,
-    splice: bool = True,
+    splice: bool = False,
     attachment_damping: float = 30.0,
 ) -> RingTyre:
     """The virtual truck tyre at ``pressure_bar`` with shakers at ``drive_points`` (1-based).
 
     The tyre of paper 000: free on a rigid wheel (no load), with its air
-    cavity and a tread splice as physical sources of non-proportional
-    damping (docs ``virtual-tyre.md``). ``load_n`` > 0 (N) presses it on a
+    cavity (docs ``virtual-tyre.md``). ``splice=True`` adds a tread splice,
+    which splits each double by 0.06-0.7 Hz but adds almost nothing to the
+    non-proportional damping. ``load_n`` > 0 (N) presses it on a
     flat road at 180 deg (:class:`~tyredamp.virtual.ContactPatch`);
     ``attachment_damping`` (N s/m) is the tread loss under each shaker tip.
     """
