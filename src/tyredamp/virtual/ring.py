@@ -299,10 +299,14 @@ class RingTyre:
     diagonal of ``C'`` (the same modal damping ratios to first order, eq.
     [15]); only the off-diagonal terms, which make the modes complex (eq.
     [16]), scale with ``nu``. ``nu = 0`` is exactly proportional (real modes),
-    ``nu = 1`` is the physical distribution, whose in-band non-proportionality
-    comes mostly from the local dampers: an axisymmetric distributed damping
-    only couples modes of the same wave number (flexural with the kHz
-    extensional branch).
+    ``nu = 1`` (the default) is the physical distribution. An axisymmetric
+    distributed damping only couples modes of the same wave number (flexural
+    with the kHz extensional branch); the in-band non-proportionality comes
+    from what breaks the symmetry or mixes losses in one mode: the
+    drive-point tip, the air cavity, a splice, the tread in a loaded contact
+    patch. ``damping_sources`` holds the damping of each source and
+    :func:`~tyredamp.virtual.damping_decomposition` splits ``C'_off`` among
+    them.
 
     Parameters
     ----------
@@ -316,24 +320,35 @@ class RingTyre:
     fd_order : {2, 4, 6}
         Order of the staggered differences (default 4).
     nonproportionality : float
-        The knob ``nu`` in [0, 1]. Default 0.5: nearly proportional (MPC
-        0.992-0.997 for the visible modes of the default tyre) yet measurably
-        complex (a complex-mode fit of a 40 dB virtual test is several times
-        closer than a real-mode fit, ``benchmarks/tyre_virtual_test.py``).
-        ``nu = 1`` gives MPC down to 0.97 on the perfect ring; the coupling of
-        well separated modes is bounded by the damping (eq. [16]), so strongly
-        complex modes (MPC 0.2-0.8) need close modes: add an imperfection that
+        The knob ``nu`` in [0, 1]. Default 1 (the physical distribution).
+        The bare ring with its 30 N s/m drive-point tip is nearly
+        proportional (MPC above 0.999); the coupling of well separated modes
+        is bounded by the damping (eq. [16]), so strongly complex modes need
+        close modes: a loaded ``contact``, an imperfection or ``splice`` that
         splits the doubles, or several drive points.
     imperfections : sequence of Imperfection, optional
         Local masses, springs or dampers that split the double modes.
+    splice : Splice, optional
+        A tread splice (:mod:`tyredamp.virtual.assembly`). Default none.
+    cavity : Cavity, optional
+        The air cavity (:mod:`tyredamp.virtual.cavity`), adding ``n_ring - 1``
+        air DOFs after the ring's (``cavity_dofs``). Default none.
+    contact : ContactPatch, optional
+        A static load on a flat road (:mod:`tyredamp.virtual.contact`); the
+        solved patch is in ``patch``. Default none (free tyre).
 
     Attributes
     ----------
     system : MCKSystem
         ``M`` (kg), ``C`` (N s/m, after the knob) and ``K`` (N/m) of the full
-        discretisation, shape (2 n_ring, 2 n_ring) each.
+        discretisation, shape (n_dof, n_dof) each (``n_dof = 2 n_ring``, plus
+        ``n_ring - 1`` with a cavity).
     physical_system : MCKSystem
         The same with the physical damping ``C_phys`` (``nu = 1``).
+    damping_sources : dict of str to ndarray, shape (n_dof, n_dof)
+        ``C_phys`` split by physical source (N s/m); they sum to ``C_phys``.
+    patch : PatchState or None
+        The solved contact patch (half-length, deflection, hub stiffness).
     K_bend : ndarray, shape (2 n_ring, 2 n_ring)
         The bending part of ``K`` (N/m), which carries the band loss.
 
