@@ -15,7 +15,7 @@ Prints
    be flagged model-limited): modes generated
    from the analytic ring (spec ``virtual-tyre.md``, via
    ``tyredamp.virtual.analytic_ring_frequencies``) at the true parameters, n =
-   1..7 at 5, 7, 9 bar, the driven member with the 0.1 kg / 350 N s/m shaker
+   1..7 at 5, 7, 9 bar, the driven member with the 0.1 kg / 30 N s/m shaker
    attachment, plus Gaussian noise (frequency 0.1 %, shape amplitude 1 %,
    damping ratio 2 %) given to the fit as the modal standard errors;
 4. wave numbers of the identified modes and the aliased case (5 bar,
@@ -48,6 +48,7 @@ from tyredamp.tyremodel import (
 )
 from tyredamp.virtual import (
     Imperfection,
+    MeasurementLayout,
     RingTyre,
     RingTyreParameters,
     analytic_ring_frequencies,
@@ -58,7 +59,7 @@ BAR = 1e5
 TRUE = RingTyreParameters()
 PRESSURES = (5.0, 7.0, 9.0)
 HELD_OUT = (6.0, 8.0)
-M_A, C_A = 0.1, 350.0  # the virtual shaker attachment (MeasurementLayout defaults)
+M_A, C_A = MeasurementLayout().attachment_mass, MeasurementLayout().attachment_damping
 ETA_B = TRUE.band_loss_factor / (2 * np.pi * TRUE.band_loss_frequency)
 TRUE_VALUES = {
     "EI": TRUE.bending_stiffness,

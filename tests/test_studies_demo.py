@@ -145,17 +145,22 @@ def test_results_validate_and_agree_with_truth(demo: tuple[DemoResult, Path]) ->
     doc = json.loads((out / "results.json").read_text())
     validate_results(doc)
     rad = doc["radial"]
-    # complex modes fit the non-proportionally damped tyre better (paper: about 2x)
-    assert rad["rmsd_complex"] < rad["rmsd_real"] / 2
+    # complex modes fit the non-proportionally damped tyre better; by how much follows the
+    # SNR (sqrt(1 + (B/noise)^2): 1.2 at 30 dB, 2.2 at 40 dB, benchmarks/tyre_physics.py)
+    assert rad["rmsd_complex"] < rad["rmsd_real"] / 1.3
+    assert set(rad["tyre"]["nonproportional_sources"]) >= {"attachment", "cavity"}
     matched = [m for m in rad["modes"] if m["true"] and m["complex"]]
     assert len(matched) >= 5
     for m in matched:
         # 40 dB SNR, 4 averages: natural frequencies within 0.05 %, damping ratios within 2 %
         assert_allclose(m["complex"]["frequency_hz"], m["true"]["frequency_hz"], rtol=5e-4)
         assert_allclose(m["complex"]["damping_ratio"], m["true"]["damping_ratio"], rtol=0.02)
-    # the symmetric part of C' is within 4 % of the truth (leakage makes the raw C' ~9 %,
-    # tests/test_damping_tyre.py); the checks pass on a linear, reciprocal tyre
-    assert rad["damping"]["modal_error_symmetric"] < 0.04
+    # the diagonal of C' is within 1 % of the truth. Its off-diagonal terms are not: the
+    # n = 1 band mode and the n = 1 cavity mode have the same shape at the 16 radial points,
+    # so the off-diagonal terms between them are ill-conditioned (a finding the document
+    # reports as an indefinite C'); the checks pass on a linear, reciprocal tyre
+    assert rad["damping"]["diagonal_error"] < 0.01
+    assert rad["tyre"]["cavity"]
     assert rad["checks"]["linearity"]["passed"]
     assert rad["checks"]["reciprocity"]["passed"]
     lat = doc["lateral"]
@@ -209,7 +214,9 @@ def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> No
     for pp, p in zip(tm["per_pressure"], pressures, strict=True):
         tp = true.with_pressure(p * 1e5)
         assert_allclose(pp["T0"]["value"], tp.hoop_tension, rtol=0.02)
-        assert_allclose(pp["k_r"]["value"], tp.radial_stiffness, rtol=0.02)
+        # the fitted ring has no air cavity, whose coupling lowers n = 1 by 4 %: its k_r
+        # reads about 3 % low
+        assert_allclose(pp["k_r"]["value"], tp.radial_stiffness, rtol=0.05)
         assert_allclose(pp["k_r"]["true"], tp.radial_stiffness, rtol=1e-12)
     # what two pressures cannot separate is reported as such, with its verdict. Since
     # stop 29 the 9 bar fit reaches its noise (a residual mode above the band holds the
@@ -222,7 +229,9 @@ def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> No
     main = tm["rigid_ring"][0]
     for key in ("BELT_MASS", "FREQ_LONG", "DAMP_LONG"):
         assert abs(main[key]["relative_gap"]) < 0.02, key
-    assert_allclose(main["BELT_MASS"]["value"], true.band_mass, rtol=0.02)
+    # the n = 1 mode moves the cavity's air too (46.1 Hz against 47.9 Hz without it): the
+    # rigid ring reads the band plus about 3 kg of air-coupled mass
+    assert_allclose(main["BELT_MASS"]["value"], true.band_mass, rtol=0.12)
     # the report: figure, table against the truth, non-identifiable parameters, .tir text
     html = (out / "report.html").read_text(encoding="utf-8")
     start = html.index(f">{SECTIONS[3]}</h2>")
@@ -249,7 +258,7 @@ def test_tyre_model_single_pressure(demo: tuple[DemoResult, Path]) -> None:
     tp = RingTyreParameters(pressure=main.pressure_bar * 1e5)
     assert_allclose(par["T0"]["true"], tp.hoop_tension, rtol=1e-12)
     assert_allclose(par["T0"]["value"], tp.hoop_tension, rtol=0.02)
-    assert_allclose(par["k_r"]["value"], tp.radial_stiffness, rtol=0.02)
+    assert_allclose(par["k_r"]["value"], tp.radial_stiffness, rtol=0.05)  # no cavity in the ring
     assert_allclose(par["EI"]["value"], tp.bending_stiffness, rtol=0.05)
 
 

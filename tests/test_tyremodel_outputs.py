@@ -28,7 +28,13 @@ from tyredamp.tyremodel import (
     rigid_ring_from_modes,
     tir_text,
 )
-from tyredamp.virtual import Imperfection, RingTyre, RingTyreParameters, TyreTruth
+from tyredamp.virtual import (
+    Imperfection,
+    MeasurementLayout,
+    RingTyre,
+    RingTyreParameters,
+    TyreTruth,
+)
 
 BAR = 1e5
 
@@ -80,7 +86,9 @@ def test_rigid_ring_equals_exact_modes(imperfect: bool) -> None:
 def test_rigid_ring_known_attachment_damper() -> None:
     tr = truth(7.5)
     rr = rigid_ring_from_modes(
-        tr.modal_model("visible"), attachment_mass=0.1, attachment_damping=350.0
+        tr.modal_model("visible"),
+        attachment_mass=MeasurementLayout().attachment_mass,
+        attachment_damping=MeasurementLayout().attachment_damping,
     )
     # without the shaker's damper, the member with a node at the drive point (not excited,
     # not attached) has the bare belt's damping

@@ -144,7 +144,7 @@ def test_held_out_pressure_predicted() -> None:
 
 
 def test_damping_with_known_attachment_damper() -> None:
-    fit = fit3(350.0)
+    fit = fit3(MeasurementLayout().attachment_damping)
     # with the shaker's local damper known, the ring's own damping is recovered
     assert_allclose(fit.param("c_r")[0], TRUE.radial_damping, rtol=0.05)
     assert_allclose(fit.param("c_t")[0], TRUE.tangential_damping, rtol=0.05)

@@ -179,16 +179,19 @@ def test_knob_zero_is_proportional() -> None:
 
 def test_knob_scales_only_off_diagonal() -> None:
     c = {}
+    lay = MeasurementLayout(attachment_damping=350.0)  # a strong local damper: large C'_off
     for nu in (0.0, 0.5, 1.0):
-        t = RingTyre(n_ring=32, nonproportionality=nu)
+        t = RingTyre(layout=lay, n_ring=32, nonproportionality=nu)
         um = t.physical_system.undamped_modes()  # same M, K for every nu
         c[nu] = um.phi.T @ t.C @ um.phi
     scale = np.max(np.abs(c[1.0]))
     # diagonal of C' independent of nu; off-diagonal linear in nu (rounding 1e-10)
     assert_allclose(np.diag(c[0.0]), np.diag(c[1.0]), atol=1e-10 * scale)
     assert_allclose(c[0.5], 0.5 * (c[0.0] + c[1.0]), atol=1e-10 * scale)
-    off = c[1.0] - np.diag(np.diag(c[1.0]))
-    assert np.max(np.abs(off)) > 1e-2 * scale
+    band = np.flatnonzero(um.frequency_hz < 200.0)  # the in-band modes
+    cb = c[1.0][np.ix_(band, band)]
+    off = cb - np.diag(np.diag(cb))
+    assert np.max(np.abs(off)) > 1e-2 * np.max(np.abs(cb))
 
 
 def test_default_modes_in_band_with_realistic_damping(default_tyre: RingTyre) -> None:
@@ -197,13 +200,13 @@ def test_default_modes_in_band_with_realistic_damping(default_tyre: RingTyre) ->
     f, z = tr.frequency_hz[vis], tr.damping_ratio[vis]
     assert np.all((f > 0) & (f < 200))
     assert np.all((z > 0.01) & (z < 0.05))
-    # nearly proportional (Re and Im nearly collinear) yet measurably complex
-    assert np.all(tr.mpc[vis] > 0.97)
-    assert np.all(tr.mpc[vis] < 0.999)
-    # more non-proportional at nu = 1, same damping ratios within 1 %
-    tr1 = RingTyre(nonproportionality=1.0).truth()
+    # the bare ring with a realistic 30 N s/m tip loss: nearly real modes, yet complex
+    assert np.all(tr.mpc[vis] > 0.999)
+    assert np.all(tr.mpc[vis] < 1.0 - 1e-6)
+    # less non-proportional at nu = 0.5, same damping ratios within 5 %
+    tr1 = RingTyre(nonproportionality=0.5).truth()
     vis1 = tr1.select("visible")
-    assert np.all(tr1.mpc[vis1] < tr.mpc[vis])
+    assert np.all(tr1.mpc[vis1] > tr.mpc[vis])
     assert_allclose(tr1.damping_ratio[vis1], z, rtol=0.05)  # second-order shift, eq. [15]
 
 

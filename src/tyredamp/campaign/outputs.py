@@ -145,6 +145,7 @@ LATERAL_COLUMNS: dict[str, str] = {
     "value": "float",
     "stderr": "float",
     "unit": "string",
+    "at_bound": "int",
 }
 _QUANTITIES = (
     ("frequency_hz", "frequency_std_hz"),
@@ -405,6 +406,7 @@ def lateral_rows(runs: Sequence[TestRun]) -> list[dict[str, Any]]:
                 row.update({c: r.spec.conditions.get(c) for c in CONDITIONS})
                 row.update(
                     {
+                        "at_bound": int(p in rec.get("at_bound", ())),
                         "model": rec["model"],
                         "rank": rec["rank"],
                         "aic": _float(rec["aic"]),
@@ -542,7 +544,9 @@ def lateral_trend_rows(lrows: Sequence[dict[str, Any]]) -> tuple[list[dict[str, 
                 **{c: r.get(c) for c in CONDITIONS},
             },
         )
-        row[r["parameter"]] = r["value"]
+        # a parameter the fit left on the bound of its search is not an estimate:
+        # it is kept out of the trends (its row in lateral.csv stays)
+        row[r["parameter"]] = None if r.get("at_bound") else r["value"]
         row[f"{r['parameter']}_std"] = r["stderr"]
         if r["parameter"] not in params:
             params.append(r["parameter"])

@@ -594,6 +594,7 @@ def lateral_records(documents: Mapping[str, Any]) -> list[dict[str, Any]]:
                 "params": dict(f.get("params", {})),
                 "stderr": dict(f.get("stderr", {})),
                 "units": dict(f.get("units", {})),
+                "at_bound": list(f.get("at_bound", [])),
             }
         )
     return out

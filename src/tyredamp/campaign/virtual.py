@@ -164,9 +164,11 @@ def _tyre(
     drive_points: tuple[int, ...] = (1,),
 ) -> RingTyre:
     p = params.with_pressure(pressure_bar * BAR)
-    return RingTyre(
-        p, MeasurementLayout(drive_points=drive_points), imperfections=contact_patch(p, load_n)
-    )
+    # the campaign's tyre as it was before the physical sources (virtual/contact.py,
+    # cavity.py): a 350 N s/m tip damper at half its off-diagonal C'; moving it to
+    # ContactPatch and the 30 N s/m tip changes the campaign's truth (its owner's call)
+    layout = MeasurementLayout(drive_points=drive_points, attachment_damping=350.0)
+    return RingTyre(p, layout, nonproportionality=0.5, imperfections=contact_patch(p, load_n))
 
 
 def tyre_truth(

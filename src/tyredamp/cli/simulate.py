@@ -103,6 +103,37 @@ def simulate_group() -> None:
     help="Also write the exact modes of the tyre as a modes JSON (for tyredamp report).",
 )
 @click.option(
+    "--load",
+    "load_kn",
+    type=click.FloatRange(min=0, max=100),
+    default=0.0,
+    show_default=True,
+    metavar="KN",
+    help="Vertical load pressing the tyre on a flat road opposite point 1, kN "
+    "(0: the free tyre on a rigid wheel, as in paper 000).",
+)
+@click.option(
+    "--cavity/--no-cavity",
+    default=True,
+    show_default=True,
+    help="Couple the air cavity (first mode near 140 Hz) to the tread band.",
+)
+@click.option(
+    "--splice/--no-splice",
+    default=False,
+    show_default=True,
+    help="Include a tread splice (a 4 cm arc of extra mass, stiffness and loss).",
+)
+@click.option(
+    "--attachment-damping",
+    "attachment_damping",
+    type=click.FloatRange(min=0),
+    default=30.0,
+    show_default=True,
+    metavar="NS_M",
+    help="Local tread loss under each shaker tip, N s/m.",
+)
+@click.option(
     "--format", "fmt", type=click.Choice(FORMATS), help="File format (default from the extension)."
 )
 def radial_command(
@@ -115,6 +146,10 @@ def radial_command(
     periods: int,
     force_rms: float,
     truth_out: Path | None,
+    load_kn: float,
+    cavity: bool,
+    splice: bool,
+    attachment_damping: float,
     fmt: str | None,
 ) -> None:
     """Run the virtual modal test of the truck tyre and write time data or FRFs.
@@ -130,6 +165,7 @@ def radial_command(
       tyredamp simulate radial --out tyre_test.uff
       tyredamp simulate radial --out tyre_frf.uff --frf --pressure 9 --snr 30 --seed 2
       tyredamp simulate radial --out mimo.uff --drive-points 1,5 --periods 4
+      tyredamp simulate radial --out loaded.uff --load 25 --splice
     """
     from ..studies.demo import single_threaded_blas
     from ..studies.radial import frf_from_time, virtual_tyre
@@ -141,7 +177,14 @@ def radial_command(
         check_distinct([("--out", out), ("--truth", truth_out)])
     out_format = format_of(out, fmt)
     points = parse_drive_points(drive_points)
-    tyre = virtual_tyre(pressure, points)
+    tyre = virtual_tyre(
+        pressure,
+        points,
+        load_n=1e3 * load_kn,
+        cavity=cavity,
+        splice=splice,
+        attachment_damping=attachment_damping,
+    )
     with single_threaded_blas():
         test = run_modal_test(tyre, n_periods=periods, force_rms=force_rms, snr_db=snr, seed=seed)
     truth_text = None if truth_out is None else _truth_text(test, pressure)
@@ -164,6 +207,7 @@ def radial_command(
         f"SNR {snr:g} dB, seed {seed}"
     )
     click.echo(_true_modes_line(test))
+    click.echo(_sources_line(tyre))
     click.echo(f"wrote {out} ({out_format}, {what})")
     if truth_out is not None:
         click.echo(f"wrote {truth_out} (exact modes, modes JSON)")
@@ -180,6 +224,28 @@ def _truth_text(test: Any, pressure: float) -> str:
         frf_kind="receptance",
     )
     return json_text(doc)
+
+
+def _sources_line(tyre: Any) -> str:
+    """``non-proportional damping ...``: the off-diagonal share of C' and its sources."""
+    from ..virtual import damping_decomposition
+
+    dd = damping_decomposition(tyre)
+    parts = sorted(dd.as_dict().items(), key=lambda kv: -abs(kv[1]))
+    load = (
+        ""
+        if tyre.patch is None
+        else (
+            f"; hub stiffness {tyre.patch.hub_stiffness / 1e6:.2f} MN/m, "
+            f"patch {2e3 * tyre.patch.half_length:.0f} mm"
+        )
+    )
+    return (
+        f"non-proportional damping: {100 * dd.offdiagonal_share:.1f} % of the in-band modal "
+        "damping is off-diagonal; from "
+        + ", ".join(f"{name} {100 * v:.0f} %" for name, v in parts if abs(v) >= 0.005)
+        + load
+    )
 
 
 def _true_modes_line(test: Any) -> str:

@@ -19,7 +19,7 @@ numbers as ``null``; files written before the ``"kind"`` key carry only
                 "units": {name: unit}, "conditions": {...}, "derived": {...},
                 "n_params", "n_lines", "rss", "residual_rms", "aic", "bic",
                 "amplitude_error", "amplitude_bias", "weights", "force",
-                "wheel_mass_kg", "speed_m_s", "message"}, ...],
+                "wheel_mass_kg", "speed_m_s", "message", "at_bound"}, ...],
       "problems": {model name: [one sentence per problem of that fit]}
     }
 

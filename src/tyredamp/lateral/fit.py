@@ -448,6 +448,7 @@ class LateralFit:
             "wheel_mass_kg": self.wheel_mass,
             "speed_m_s": self.speed,
             "message": self.message,
+            "at_bound": list(self.at_bound),
         }
 
     def plot(self, **kwargs: Any) -> Any:

@@ -44,6 +44,28 @@ SECTIONS = (
 )
 
 
+def _physics_note(rad: dict[str, Any]) -> str:
+    """Why the ratio is what it is: the noise, and the sources of non-proportional damping."""
+    tyre = rad.get("tyre", {})
+    text = (
+        "The ratio measures the real modes' model error against the noise: the complex fit "
+        "reaches the noise, the real fit adds its model error B, so the ratio is about "
+        "sqrt(1 + (B/noise)^2) and grows with the SNR (on this virtual tyre 1.02, 1.19, 2.25 "
+        "and 6.4 at 20, 30, 40 and 50 dB)."
+    )
+    src = tyre.get("nonproportional_sources")
+    if src:
+        parts = sorted(src.items(), key=lambda kv: -abs(kv[1]))
+        text += (
+            f" {100 * tyre['offdiagonal_share']:.0f} % of the tyre's in-band modal damping is "
+            "off-diagonal; it comes from "
+            + ", ".join(f"{k} ({100 * v:.0f} %)" for k, v in parts if abs(v) >= 0.01)
+            + ". The shaker tip adds only the tread loss under it: with the force gauge at the "
+            "tyre surface (ISO 7626-2) the shaker's own damping is outside the measured FRF."
+        )
+    return text
+
+
 def _pct(v: Any, digits: str = ".3g") -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "-"
@@ -323,6 +345,7 @@ def _radial(
         "proportional damping), yet the complex description fits better because the damping "
         "couples the modes (off-diagonal C')."
     )
+    rep.paragraph(_physics_note(rad))
     for name in ("fig02_real_fit", "fig03_complex_fit", "fig04_discrepancy", "residual_zoom"):
         _image(rep, images, name)
     rep.heading("Mode shapes", 3)

@@ -44,6 +44,20 @@ __all__ = [
 ]
 
 
+def _tyre_physics(tyre: Any) -> dict[str, Any]:
+    """Cavity, load, tip loss and the sources of the tyre's non-proportional damping."""
+    from ..virtual import damping_decomposition
+
+    dd = damping_decomposition(tyre)
+    return {
+        "cavity": tyre.cavity is not None,
+        "load_n": 0.0 if tyre.contact is None else tyre.contact.load,
+        "attachment_damping_ns_m": tyre.layout.attachment_damping,
+        "offdiagonal_share": dd.offdiagonal_share,
+        "nonproportional_sources": dd.as_dict(),
+    }
+
+
 def _matrix(a: Any) -> list[list[float]]:
     return [[float(x) for x in row] for row in np.asarray(a, dtype=float)]
 
@@ -345,6 +359,7 @@ def _radial_section(result: DemoResult, fnd: DemoFindings) -> dict[str, Any]:
             "drive_points": list(tyre.layout.drive_points),
             "n_dof": int(tyre.n_dof),
             "nonproportionality": tyre.nonproportionality,
+            **_tyre_physics(tyre),
         },
         **_fit_quality(main),
         "verdict": {k: v.to_dict() for k, v in fnd.radial[radial_key(main)].items()},

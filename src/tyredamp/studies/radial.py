@@ -35,7 +35,15 @@ from ..signal.checks import merge_inputs
 from ..signal.estimators import Estimator, estimate_frf
 from ..signal.estimators import Method as FRFMethod
 from ..timedata import TimeData
-from ..virtual import MeasurementLayout, RingTyre, RingTyreParameters, run_modal_test
+from ..virtual import (
+    Cavity,
+    ContactPatch,
+    MeasurementLayout,
+    RingTyre,
+    RingTyreParameters,
+    Splice,
+    run_modal_test,
+)
 from .results import DampingComparison, ModeMatch, PressureRun, RadialStudy
 from .settings import BAR, DemoSettings
 from .tyremodel import tyre_model_from_runs
@@ -338,11 +346,30 @@ def match_modes(
     return ModeMatch(tuple(sorted(pairs, key=key)))
 
 
-def virtual_tyre(pressure_bar: float, drive_points: tuple[int, ...] = (1,)) -> RingTyre:
-    """The virtual truck tyre at ``pressure_bar`` with shakers at ``drive_points`` (1-based)."""
+def virtual_tyre(
+    pressure_bar: float,
+    drive_points: tuple[int, ...] = (1,),
+    *,
+    load_n: float = 0.0,
+    cavity: bool = True,
+    splice: bool = False,
+    attachment_damping: float = 30.0,
+) -> RingTyre:
+    """The virtual truck tyre at ``pressure_bar`` with shakers at ``drive_points`` (1-based).
+
+    The tyre of paper 000: free on a rigid wheel (no load), with its air
+    cavity (docs ``virtual-tyre.md``). ``splice=True`` adds a tread splice,
+    which splits each double by 0.06-0.7 Hz but adds almost nothing to the
+    non-proportional damping. ``load_n`` > 0 (N) presses it on a
+    flat road at 180 deg (:class:`~tyredamp.virtual.ContactPatch`);
+    ``attachment_damping`` (N s/m) is the tread loss under each shaker tip.
+    """
     return RingTyre(
         RingTyreParameters(pressure=pressure_bar * BAR),
-        MeasurementLayout(drive_points=drive_points),
+        MeasurementLayout(drive_points=drive_points, attachment_damping=attachment_damping),
+        cavity=Cavity() if cavity else None,
+        splice=Splice() if splice else None,
+        contact=ContactPatch(load_n) if load_n > 0 else None,
     )
 
 

@@ -11,6 +11,11 @@ test rig (paper 000), the rolling-tyre lateral rig (paper 001).
   ``K`` (:class:`~tyredamp.mechanics.MCKSystem`), index maps and the
   ``nonproportionality`` knob; :meth:`RingTyre.truth` gives the exact modal
   truth at the points (:class:`TyreTruth`).
+* Physical additions to the ring (:class:`RingTyre` keywords): :class:`Splice`
+  (:mod:`.assembly`), the air cavity :class:`Cavity` (:mod:`.cavity`), a
+  loaded :class:`ContactPatch` with its hub stiffness (:mod:`.contact`);
+  :func:`damping_decomposition` (:mod:`.sources`) splits the non-proportional
+  damping by physical source.
 * :func:`run_modal_test`: the virtual test rig (periodic chirp, noise,
   multi-reference), returning :class:`VirtualModalTest` (``TimeData`` + truth).
 * :class:`RotatingRing` (:mod:`.rotation`): the ring spinning at a rolling
@@ -29,11 +34,14 @@ Examples
 >>> test.data
 TimeData(n_channels=17, n_samples=32768, sample_rate=1024 Hz, forces=1)
 >>> round(test.truth.table("visible")[0]["frequency_hz"], 2)  # the n = 1 mode, Hz
-47.9
+47.88
 """
 
 from __future__ import annotations
 
+from .assembly import Splice
+from .cavity import Cavity
+from .contact import ContactPatch
 from .excitation import hadamard_drive_matrix, schroeder_multisine
 from .lateral_rig import KMH, AgriculturalTyre, VirtualLateralRig, ViscoelasticStringTyre
 from .modal_rig import VirtualModalTest, periodic_initial_state, run_modal_test
@@ -56,12 +64,16 @@ from .rotation import (
     rotating_ring_dispersion,
     rotating_ring_roots,
 )
+from .sources import DampingDecomposition, damping_decomposition
 from .truth import TyreTruth, modal_phase_collinearity, wave_numbers
 
 __all__ = [
     "KMH",
     "AgriculturalTyre",
+    "Cavity",
     "ContactLoad",
+    "ContactPatch",
+    "DampingDecomposition",
     "Imperfection",
     "MeasurementLayout",
     "PointContact",
@@ -71,12 +83,14 @@ __all__ = [
     "RollingTest",
     "RollingTruth",
     "RotatingRing",
+    "Splice",
     "TyreTruth",
     "VirtualLateralRig",
     "VirtualModalTest",
     "ViscoelasticStringTyre",
     "analytic_ring_frequencies",
     "critical_speed_kmh",
+    "damping_decomposition",
     "difference_symbol",
     "hadamard_drive_matrix",
     "inextensible_rotating_frequencies",

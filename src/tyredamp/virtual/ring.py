@@ -63,6 +63,9 @@ from .._validate import as_finite
 from ..exceptions import InputError, PhysicsError
 from ..frf import Channel
 from ..mechanics import MCKSystem, proportional_part
+from .assembly import Splice, ring_blocks, with_cavity
+from .cavity import Cavity, cavity_blocks
+from .contact import ContactPatch, contact_blocks, patch_intrusion, solve_patch
 from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
 from .truth import TyreTruth, wave_numbers
 
@@ -296,10 +299,14 @@ class RingTyre:
     diagonal of ``C'`` (the same modal damping ratios to first order, eq.
     [15]); only the off-diagonal terms, which make the modes complex (eq.
     [16]), scale with ``nu``. ``nu = 0`` is exactly proportional (real modes),
-    ``nu = 1`` is the physical distribution, whose in-band non-proportionality
-    comes mostly from the local dampers: an axisymmetric distributed damping
-    only couples modes of the same wave number (flexural with the kHz
-    extensional branch).
+    ``nu = 1`` (the default) is the physical distribution. An axisymmetric
+    distributed damping only couples modes of the same wave number (flexural
+    with the kHz extensional branch); the in-band non-proportionality comes
+    from what breaks the symmetry or mixes losses in one mode: the
+    drive-point tip, the air cavity, a splice, the tread in a loaded contact
+    patch. ``damping_sources`` holds the damping of each source and
+    :func:`~tyredamp.virtual.damping_decomposition` splits ``C'_off`` among
+    them.
 
     Parameters
     ----------
@@ -313,24 +320,35 @@ class RingTyre:
     fd_order : {2, 4, 6}
         Order of the staggered differences (default 4).
     nonproportionality : float
-        The knob ``nu`` in [0, 1]. Default 0.5: nearly proportional (MPC
-        0.992-0.997 for the visible modes of the default tyre) yet measurably
-        complex (a complex-mode fit of a 40 dB virtual test is several times
-        closer than a real-mode fit, ``benchmarks/tyre_virtual_test.py``).
-        ``nu = 1`` gives MPC down to 0.97 on the perfect ring; the coupling of
-        well separated modes is bounded by the damping (eq. [16]), so strongly
-        complex modes (MPC 0.2-0.8) need close modes: add an imperfection that
+        The knob ``nu`` in [0, 1]. Default 1 (the physical distribution).
+        The bare ring with its 30 N s/m drive-point tip is nearly
+        proportional (MPC above 0.999); the coupling of well separated modes
+        is bounded by the damping (eq. [16]), so strongly complex modes need
+        close modes: a loaded ``contact``, an imperfection or ``splice`` that
         splits the doubles, or several drive points.
     imperfections : sequence of Imperfection, optional
         Local masses, springs or dampers that split the double modes.
+    splice : Splice, optional
+        A tread splice (:mod:`tyredamp.virtual.assembly`). Default none.
+    cavity : Cavity, optional
+        The air cavity (:mod:`tyredamp.virtual.cavity`), adding ``n_ring - 1``
+        air DOFs after the ring's (``cavity_dofs``). Default none.
+    contact : ContactPatch, optional
+        A static load on a flat road (:mod:`tyredamp.virtual.contact`); the
+        solved patch is in ``patch``. Default none (free tyre).
 
     Attributes
     ----------
     system : MCKSystem
         ``M`` (kg), ``C`` (N s/m, after the knob) and ``K`` (N/m) of the full
-        discretisation, shape (2 n_ring, 2 n_ring) each.
+        discretisation, shape (n_dof, n_dof) each (``n_dof = 2 n_ring``, plus
+        ``n_ring - 1`` with a cavity).
     physical_system : MCKSystem
         The same with the physical damping ``C_phys`` (``nu = 1``).
+    damping_sources : dict of str to ndarray, shape (n_dof, n_dof)
+        ``C_phys`` split by physical source (N s/m); they sum to ``C_phys``.
+    patch : PatchState or None
+        The solved contact patch (half-length, deflection, hub stiffness).
     K_bend : ndarray, shape (2 n_ring, 2 n_ring)
         The bending part of ``K`` (N/m), which carries the band loss.
 
@@ -349,8 +367,11 @@ class RingTyre:
         *,
         n_ring: int = 64,
         fd_order: int = 4,
-        nonproportionality: float = 0.5,
+        nonproportionality: float = 1.0,
         imperfections: Sequence[Imperfection] = (),
+        splice: Splice | None = None,
+        cavity: Cavity | None = None,
+        contact: ContactPatch | None = None,
     ) -> None:
         self.params = params if params is not None else RingTyreParameters()
         self.layout = layout if layout is not None else MeasurementLayout()
@@ -396,44 +417,36 @@ class RingTyre:
         self.fd_order = int(fd_order)
         self.nonproportionality = nu
         self.imperfections = imps
+        for name, obj, cls in (
+            ("splice", splice, Splice),
+            ("cavity", cavity, Cavity),
+            ("contact", contact, ContactPatch),
+        ):
+            if obj is not None and not isinstance(obj, cls):
+                raise InputError(
+                    f"{name}: expected {cls.__name__} or None, got {type(obj).__name__}"
+                )
+        self.splice = splice
+        self.cavity = cavity
+        self.contact = contact
+        self.cavity_basis: NDArray[np.float64] | None = None
         self._build()
 
     # ------------------------------------------------------------ assembly
     def _build(self) -> None:
         p = self.params
         n = self.n_ring
-        ops = _operators(n, self.fd_order)
-        d, h = ops.D, ops.h
-        g = -d.T
-        r = p.radius
-        eye = np.eye(n)
-        zero = np.zeros((n, n))
-        e_op = np.hstack([eye, d])  # R * membrane strain at nodes
-        b_op = np.hstack([-d @ g, d])  # R^2 * curvature change at nodes
-        gw_op = np.hstack([g, zero])  # w' at mid-points
-        w_sel = np.hstack([eye, zero])
-        v_sel = np.hstack([zero, eye])
-        arc = r * h
-        ete = e_op.T @ e_op
-        k_bend = arc * p.bending_stiffness / r**4 * (b_op.T @ b_op)
-        k = (
-            arc * p.membrane_stiffness / r**2 * ete
-            + k_bend
-            + arc * p.hoop_tension / r**2 * (ete - w_sel.T @ w_sel + gw_op.T @ gw_op)
-            + arc * p.radial_stiffness * (w_sel.T @ w_sel)
-            + arc * p.tangential_stiffness * (v_sel.T @ v_sel)
-        )
-        m = p.mass_per_length * arc * np.eye(2 * n)
-        c = arc * (p.radial_damping * (w_sel.T @ w_sel) + p.tangential_damping * (v_sel.T @ v_sel))
-        if p.band_loss_factor > 0:
-            c = c + p.band_loss_factor / (2 * np.pi * p.band_loss_frequency) * k_bend
+        d = _operators(n, self.fd_order).D
+        k, k_bend, m, sources = ring_blocks(p, d, self.splice)
         step = n // self.layout.n_points
         self._point_nodes = np.arange(self.layout.n_points) * step
         self._drive_nodes = np.array([(dp - 1) * step for dp in self.layout.drive_points])
+        c_att = np.zeros_like(k)
         for node in self._drive_nodes:
             m[node, node] += self.layout.attachment_mass
-            c[node, node] += self.layout.attachment_damping
+            c_att[node, node] += self.layout.attachment_damping
         self._imperfection_nodes = []
+        c_imp = np.zeros_like(k)
         for imp in self.imperfections:
             node = int(np.round(imp.angle_deg / 360.0 * n)) % n
             self._imperfection_nodes.append(node)
@@ -441,10 +454,29 @@ class RingTyre:
             m[n + node, n + node] += imp.mass / 2  # mid-point i + 1/2
             m[n + (node - 1) % n, n + (node - 1) % n] += imp.mass / 2  # mid-point i - 1/2
             k[node, node] += imp.stiffness
-            c[node, node] += imp.damping
+            c_imp[node, node] += imp.damping
+        sources["attachment"] = c_att
+        sources["imperfections"] = c_imp
         k = 0.5 * (k + k.T)
+        self.patch = None
+        area_change = None
+        if self.contact is not None:
+            self.patch = solve_patch(k, self.contact, p.radius)
+            k_c, c_c = contact_blocks(self.patch, self.contact)
+            k = k + k_c
+            sources["contact"] = c_c
+            area_change = -p.width * patch_intrusion(self.patch, self.contact, p.radius, n)
+        if self.cavity is not None:
+            blk = cavity_blocks(
+                self.cavity, d, pressure=p.pressure, band_width=p.width, area_change=area_change
+            )
+            self.cavity_basis = blk.basis
+            m, k, sources = with_cavity(m, k, sources, blk)
+        sources = {name: c for name, c in sources.items() if np.any(c)}
+        self.damping_sources: dict[str, NDArray[np.float64]] = sources
         self.K_bend = k_bend
-        self.physical_system = MCKSystem(m, c, k)
+        c = sum(sources.values(), np.zeros_like(k))
+        self.physical_system = MCKSystem(m, 0.5 * (c + c.T), k)
         nu = self.nonproportionality
         if nu == 1.0:
             self.system = self.physical_system
@@ -456,8 +488,13 @@ class RingTyre:
     # ------------------------------------------------------------ geometry
     @property
     def n_dof(self) -> int:
-        """Number of DOFs, ``2 n_ring``."""
-        return 2 * self.n_ring
+        """Number of DOFs: ``2 n_ring``, plus ``n_ring - 1`` air DOFs with a cavity."""
+        return int(self.physical_system.M.shape[0])
+
+    @property
+    def cavity_dofs(self) -> NDArray[np.intp]:
+        """DOF indices of the reduced air coordinates (empty without a cavity)."""
+        return np.arange(2 * self.n_ring, self.n_dof, dtype=np.intp)
 
     @property
     def M(self) -> NDArray[np.float64]:
@@ -548,7 +585,7 @@ class RingTyre:
             In the order of ``system.undamped_modes()`` (ascending frequency).
         """
         phi = self.system.undamped_modes().phi
-        return wave_numbers(phi[: self.n_ring], phi[self.n_ring :])
+        return wave_numbers(phi[: self.n_ring], phi[self.n_ring : 2 * self.n_ring])
 
     def ring_frequencies(self, n_max: int = 6) -> NDArray[np.float64]:
         """Undamped frequencies of the two flexural modes of each wave number 1..n_max.

@@ -250,9 +250,9 @@ class TyreTruth:
         sel = np.flatnonzero((f >= b[0]) & (f <= b[1]))
         n = tyre.n_ring
         big_psi = cm.Psi[:, sel]
-        wn, purity = wave_numbers(big_psi[:n], big_psi[n:])
+        wn, purity = wave_numbers(big_psi[:n], big_psi[n : 2 * n])
         pw = np.sum(np.abs(big_psi[:n]) ** 2, axis=0)
-        pv = np.sum(np.abs(big_psi[n:]) ** 2, axis=0)
+        pv = np.sum(np.abs(big_psi[n : 2 * n]) ** 2, axis=0)
         radial_fraction = pw / (pw + pv)
         psi = cm.psi[:, sel]
         pts, drv = tyre.point_dofs, tyre.drive_dofs
