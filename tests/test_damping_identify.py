@@ -278,3 +278,19 @@ def test_input_validation() -> None:
         modal_damping_from_modes(np.abs(model.poles.real) + 1j * model.poles.imag, shp)
     with pytest.raises(InputError, match="finite"):
         modal_damping_from_modes(model.poles, shp * np.nan)
+
+
+def test_modes_the_points_cannot_tell_apart_are_named() -> None:
+    from tyredamp.damping.diagnostics import COLLINEAR_MAC, collinear_pairs
+
+    th = np.radians(22.5 * np.arange(16))
+    a = np.cos(th)
+    b = np.cos(2 * th)
+    near = a + 0.2 * np.sin(3 * th)  # MAC with a: 1 / (1 + 0.04) = 0.9615
+    basis = np.column_stack([a, b, near])
+    pairs = collinear_pairs(basis)
+    assert [(i, j) for i, j, _ in pairs] == [(0, 2)]
+    # orthogonal harmonics on equal points: cos th . sin 3 th = 0, |sin 3 th|^2 = |cos th|^2
+    assert pairs[0][2] == pytest.approx(1 / 1.04, rel=1e-12)
+    assert pairs[0][2] > COLLINEAR_MAC
+    assert collinear_pairs(np.column_stack([a, b])) == ()

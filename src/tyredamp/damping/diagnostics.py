@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["DampingDiagnostics", "definiteness", "findings"]
+__all__ = ["COLLINEAR_MAC", "DampingDiagnostics", "collinear_pairs", "definiteness", "findings"]
 
 #: Relative asymmetry below which C' counts as symmetric (measured data).
 SYMMETRY_OK = 0.05
@@ -32,6 +32,8 @@ SYMMETRY_OK = 0.05
 SYMMETRY_BAD = 0.2
 #: ||Im Psi^|| / ||Re Psi^|| below which the modes count as real.
 REAL_MODES = 1e-10
+#: MAC of two modes' real shapes at the points above which the points cannot tell them apart.
+COLLINEAR_MAC = 0.9
 
 
 @dataclass(frozen=True)
@@ -84,6 +86,12 @@ class DampingDiagnostics:
         ``||C - C_Lancaster||_F / ||C_Lancaster||_F`` when ``m == N``.
     max_damping_ratio : float
         Largest identified ``zeta_n``.
+    collinear_pairs : tuple of (int, int, float)
+        Pairs of modes (0-based) whose real shapes at the points have a MAC
+        above :data:`COLLINEAR_MAC`, with that MAC: the points barely tell them
+        apart (e.g. a structural mode and an air-cavity mode of the same wave
+        number seen by radial sensors only), so the ``C'`` terms coupling them
+        rest on the small difference between two nearly equal shapes.
     """
 
     n_modes: int
@@ -105,12 +113,15 @@ class DampingDiagnostics:
     theory_change: float | None
     lancaster_difference: float | None
     max_damping_ratio: float
+    collinear_pairs: tuple[tuple[int, int, float], ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary of the fields (arrays as lists)."""
         out: dict[str, Any] = {}
         for fl in fields(self):
             v = getattr(self, fl.name)
+            if fl.name == "collinear_pairs":
+                v = [list(p) for p in v]
             out[fl.name] = v.tolist() if isinstance(v, np.ndarray) else v
         return out
 
@@ -119,6 +130,11 @@ class DampingDiagnostics:
         """Inverse of :meth:`to_dict`."""
         kw: dict[str, Any] = {}
         for fl in fields(cls):
+            if fl.name == "collinear_pairs":  # absent from documents of older versions
+                kw[fl.name] = tuple(
+                    (int(i), int(j), float(mac)) for i, j, mac in d.get(fl.name, ())
+                )
+                continue
             v = d[fl.name]
             kw[fl.name] = np.asarray(v, dtype=float) if fl.name.startswith("eigenvalues") else v
         return cls(**kw)
@@ -203,7 +219,27 @@ def compute_diagnostics(
         theory_change=theory_change,
         lancaster_difference=lancaster_difference,
         max_damping_ratio=float(np.max(damping_ratio)),
+        collinear_pairs=collinear_pairs(basis),
     )
+
+
+def collinear_pairs(basis: NDArray[np.float64]) -> tuple[tuple[int, int, float], ...]:
+    """Pairs of columns of ``basis`` (N x m real shapes) with a MAC above :data:`COLLINEAR_MAC`.
+
+    ``MAC_ij = (phi_i^T phi_j)^2 / (phi_i^T phi_i phi_j^T phi_j)`` (Allemang &
+    Brown 1982); 1 for shapes that are multiples of each other at the points.
+    """
+    b = np.asarray(basis, dtype=float)
+    gram = b.T @ b
+    d = np.diag(gram)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mac = np.where(np.outer(d, d) > 0, gram**2 / np.outer(d, d), 0.0)
+    out = []
+    for i in range(b.shape[1]):
+        for j in range(i + 1, b.shape[1]):
+            if mac[i, j] > COLLINEAR_MAC:
+                out.append((i, j, float(mac[i, j])))
+    return tuple(out)
 
 
 def findings(
@@ -234,6 +270,7 @@ def findings(
             "construction: non-proportional damping cannot be identified from real modes. "
             "Use the complex-mode fit to identify damping coupling between modes."
         )
+    out += _collinear_findings(d)
     out += _symmetry_findings(d, real)
     out += _definiteness_findings(d)
     out += _proportionality_findings(d, real, proportional)
@@ -242,6 +279,23 @@ def findings(
     if std_modal is not None and c_modal is not None and d.n_modes > 1:
         out += _uncertainty_findings(d, std_modal, c_modal)
     return out
+
+
+def _collinear_findings(d: DampingDiagnostics) -> list[str]:
+    """Modes the points cannot tell apart: their coupling terms are not determined."""
+    if not d.collinear_pairs:
+        return []
+    pairs = ", ".join(f"{i + 1} and {j + 1} (MAC {mac:.3f})" for i, j, mac in d.collinear_pairs)
+    return [
+        f"Modes {pairs} have nearly the same shape at the {d.n_points} measured points: "
+        "the points cannot tell them apart, so the terms of C' that couple them (and with "
+        "them the definiteness of C' and the physical matrix) rest on the small difference "
+        "between two nearly equal shapes and are not determined by these data; their "
+        "standard errors say how far. Measure where the modes differ (for an air-cavity "
+        "mode beside a structural mode of the same wave number: a microphone in the "
+        "cavity, or tangential responses) or leave one of them out of the damping "
+        "identification."
+    ]
 
 
 def _symmetry_findings(d: DampingDiagnostics, real: bool) -> list[str]:
