@@ -45,8 +45,15 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
         (
             "damping C' vs truth",
             f"{100 * rad['damping']['modal_error']:.3g} % (symmetric part "
-            f"{100 * rad['damping']['modal_error_symmetric']:.3g} %), "
-            f"{rad['damping']['definiteness_modal']}",
+            f"{100 * rad['damping']['modal_error_symmetric']:.3g} %"
+            + (
+                f"; {100 * rad['damping']['modal_error_determined']:.3g} % without the "
+                "modes the points cannot tell apart"
+                if rad["damping"].get("undetermined_pairs")
+                and rad["damping"].get("modal_error_determined") is not None
+                else ""
+            )
+            + f"), {rad['damping']['definiteness_modal']}",
         ),
         ("tyre model", _tyre_model_row(rad["tyre_model"])),
         (

@@ -365,6 +365,18 @@ def _radial_damping(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
             ["method", f"{dmp['method']} ({dmp['n_modes']} modes at {dmp['n_points']} points)"],
             ["C' against the true C' (matched modes)", _pct(dmp["modal_error"])],
             ["its symmetric part against the truth", _pct(dmp["modal_error_symmetric"])],
+            *(
+                [
+                    [
+                        "C' against the truth without the terms of modes "
+                        + ", ".join(f"{i} and {j}" for i, j in dmp["undetermined_pairs"])
+                        + " (shapes the points cannot tell apart)",
+                        _pct(dmp["modal_error_determined"]),
+                    ]
+                ]
+                if dmp.get("undetermined_pairs")
+                else []
+            ),
             ["diagonal of C' against the truth", _pct(dmp["diagonal_error"])],
             ["symmetric C at the points against the true reduced C", _pct(dmp["physical_error"])],
             ["asymmetry of C'", _pct(dmp["symmetry_modal"])],

@@ -33,7 +33,7 @@ from .tyremodel import tyre_model_section
 
 if TYPE_CHECKING:
     from ..lateral.fit import LateralFit
-    from .results import DemoResult, LateralCondition, PressureRun
+    from .results import DampingComparison, DemoResult, LateralCondition, PressureRun
 
 __all__ = [
     "build_results",
@@ -335,6 +335,23 @@ def lateral_overall_ranking(conditions: Sequence[LateralCondition]) -> list[dict
     return out
 
 
+def _determined_error(
+    dc: DampingComparison, pairs: Sequence[tuple[int, int, float]]
+) -> float | None:
+    """``||C'_id - C'_true||_F / ||C'_true||_F`` without the rows and columns of the modes
+    the points cannot tell apart (:func:`tyredamp.damping.diagnostics.collinear_pairs`:
+    their modal coordinates are mixed, so every term of theirs is); None when nothing
+    is left."""
+    mi = [int(k) for k in dc.model_index]
+    out = {int(k) for i, j, _ in pairs for k in (i, j)}
+    rows = np.array([k not in out for k in mi], dtype=bool)
+    keep = np.outer(rows, rows)
+    ref = float(np.linalg.norm(dc.modal_true[keep]))
+    if ref == 0 or not np.any(keep):
+        return None
+    return float(np.linalg.norm((dc.modal - dc.modal_true)[keep])) / ref
+
+
 def _radial_section(result: DemoResult, fnd: DemoFindings) -> dict[str, Any]:
     """``radial``: the main pressure, its checks, modes and damping, and every pressure."""
     s = result.settings
@@ -377,6 +394,8 @@ def _radial_section(result: DemoResult, fnd: DemoFindings) -> dict[str, Any]:
             "modal_true": _matrix(dc.modal_true),
             "modal_error": dc.modal_error,
             "modal_error_symmetric": dc.modal_error_symmetric,
+            "modal_error_determined": _determined_error(dc, d.collinear_pairs),
+            "undetermined_pairs": [[i + 1, j + 1] for i, j, _ in d.collinear_pairs],
             "diagonal_error": dc.diagonal_error,
             "physical_error": dc.physical_error,
             "symmetry_modal": d.symmetry_modal,
