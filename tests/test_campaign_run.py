@@ -295,7 +295,7 @@ def test_without_the_campaign_extra_the_command_says_what_to_install(
     from tyredamp.cli import main
 
     with pytest.raises(SystemExit) as exc:
-        main(["campaign", str(virtual / "campaign.toml"), "--out", str(tmp_path / "o")])
+        main(["campaign", str(virtual / "campaign.toml"), "--out", str(tmp_path / "o"), "--dask"])
     assert exc.value.code == 2
     assert not (tmp_path / "o").exists()
 
