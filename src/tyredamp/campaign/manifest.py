@@ -78,7 +78,9 @@ def _manifest(root: Path) -> dict[str, Any] | None:
     return doc
 
 
-def check_edits(root: str | os.PathLike[str], option: str = "--out") -> None:
+def check_edits(
+    root: str | os.PathLike[str], option: str = "--out", shown: str | None = None
+) -> None:
     """Refuse to go on when a file the campaign wrote in ``root`` was changed since.
 
     Raises
@@ -95,7 +97,7 @@ def check_edits(root: str | os.PathLike[str], option: str = "--out") -> None:
     if changed:
         few = ", ".join(changed[:3]) + (f" and {len(changed) - 3} more" if len(changed) > 3 else "")
         raise InputError(
-            f"{option}: {os.fspath(root)}: {few} changed since the campaign wrote it; "
+            f"{option}: {shown or os.fspath(root)}: {few} changed since the campaign wrote it; "
             "not replaced: move the changed files elsewhere (or choose another output folder) "
             "and run again"
         )

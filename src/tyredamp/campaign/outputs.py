@@ -182,11 +182,11 @@ def check_campaign_output(
                 f"--out: {text} is or holds the input file {os.fspath(inp)}; "
                 "choose another directory"
             )
-    real = check_output_dir(out, campaign_files, what="campaign output", manifest=False)
     from .manifest import check_edits  # the files it lists must be as the campaign wrote them
 
-    check_edits(real)
-    return real
+    if text and os.path.isdir(real):
+        check_edits(real, shown=text)
+    return check_output_dir(out, campaign_files, what="campaign output", manifest=False)
 
 
 def _listed(doc: dict[str, Any]) -> list[str]:

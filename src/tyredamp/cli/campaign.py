@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import math
 import sys
 import time
 from pathlib import Path
@@ -177,6 +178,12 @@ def campaign_command(
     """
     from ..campaign.spec import load_campaign
 
+    for name, value in (
+        ("--connect-timeout", connect_timeout),
+        ("--worker-timeout", worker_timeout),
+    ):
+        if not math.isfinite(value):
+            raise InputError(f"{name}: expected a number of seconds, got {value}")
     mode = _mode(serial, use_dask, scheduler, workers, (tls_ca, tls_cert, tls_key))
     _need(["pyarrow"] if mode in ("serial", "local") else ["pyarrow", "dask", "distributed"])
     client = None
