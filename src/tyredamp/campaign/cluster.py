@@ -323,16 +323,24 @@ def connect_scheduler(
 def local_dask_cluster(workers: int) -> tuple[Any, Any]:
     """A new ``LocalCluster`` on 127.0.0.1 only, without dashboard, and its client.
 
-    ``workers`` processes with one thread each; the workers' statistical
-    profiler is off (it samples every thread every 10 ms and costs the tasks
-    CPU on busy cores).
+    ``workers`` processes with one thread each. The scheduler, the workers,
+    their nannies and the HTTP servers Dask always starts listen on 127.0.0.1
+    only, and those HTTP servers answer nothing but their health check (no
+    dashboard, no worker list). The workers' statistical profiler is off (it
+    samples every thread every 10 ms and costs the tasks CPU on busy cores).
     """
     import logging
 
     import dask
     from distributed import Client, LocalCluster
 
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
+    quiet = {
+        "distributed.worker.profile.enabled": False,
+        # the HTTP servers Dask always starts serve nothing but their health check
+        "distributed.scheduler.http.routes": ["distributed.http.health"],
+        "distributed.worker.http.routes": ["distributed.http.health"],
+    }
+    with dask.config.set(quiet):
         cluster = LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
@@ -340,6 +348,7 @@ def local_dask_cluster(workers: int) -> tuple[Any, Any]:
             host="127.0.0.1",
             dashboard_address=None,
             worker_dashboard_address=None,
+            scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
             silence_logs=logging.ERROR,
         )
     return Client(cluster, set_as_default=False), cluster
