@@ -43,8 +43,8 @@ from tyredamp.campaign.virtual import VirtualCampaign, write_virtual_campaign
 def _command(args: list[str]) -> float:
     t0 = time.perf_counter()
     subprocess.run(
-        [sys.executable, "-m", "tyredamp.cli", "campaign", *args],
-        check=False,
+        [sys.executable, "-c", "from tyredamp.cli import main; main()", "campaign", *args],
+        check=True,
         stdout=subprocess.DEVNULL,
     )
     return time.perf_counter() - t0

@@ -306,12 +306,12 @@ def connect_scheduler(
             deserializers=["msgpack"],
             set_as_default=False,
         )
-    except (OSError, TimeoutError) as exc:
-        reason = " ".join(str(exc).split()) or type(exc).__name__
+    except Exception as exc:  # any failure of the handshake is a failure to connect
+        reason = " ".join(str(exc).split())[:300] or type(exc).__name__
         raise InputError(f"--scheduler: cannot connect to {address.url} ({reason})") from None
     try:
         client.wait_for_workers(1, timeout=worker_timeout)
-    except (TimeoutError, OSError):
+    except Exception:  # TimeoutError, or the scheduler went away while we waited
         client.close()
         raise InputError(
             f"--scheduler: the cluster at {address.url} has no worker after {worker_timeout:g} s "
