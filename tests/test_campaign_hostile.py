@@ -400,6 +400,23 @@ def test_an_edited_output_is_never_replaced(
     assert tree(tiny) == inputs
 
 
+def test_a_rerun_with_nothing_changed_keeps_the_outputs(
+    tiny: Path, done: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    shutil.copytree(done, out)
+    stamps = {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()}
+    camp = str(tiny / "data" / "campaign.toml")
+    main(["campaign", camp, "--out", str(out)])
+    assert "nothing changed since the last run" in capsys.readouterr().out
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == stamps
+    # without the report the outputs are not those of the last run: written again
+    main(["campaign", camp, "--out", str(out), "--no-report"])
+    assert "wrote " in capsys.readouterr().out
+    assert (out / "modes.csv").stat().st_mtime_ns != stamps[out / "modes.csv"]
+    assert (out / "modes.csv").read_bytes() == (done / "modes.csv").read_bytes()
+
+
 def test_the_corpus_has_at_least_fifty_cases() -> None:
     n = len(SCHEDULER_TEXT) + len(SERVER_CASES) + len(OPTION_CASES) + len(SETTINGS_CASES)
     assert n + len(FILE_CASES) + len(EDIT_CASES) >= 50

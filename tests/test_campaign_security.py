@@ -21,6 +21,7 @@ import psutil
 import pytest
 
 from tyredamp.campaign import load_campaign
+from tyredamp.campaign.outputs import write_outputs
 from tyredamp.campaign.runner import TestRun, run_tests
 from tyredamp.cli import main
 
@@ -64,7 +65,7 @@ def reference(tiny: Path, tmp_path_factory: pytest.TempPathFactory) -> bytes:
     return (out / "modes.csv").read_bytes()
 
 
-def test_the_local_pool_opens_no_port(tiny: Path, tmp_path: Path) -> None:
+def test_the_local_pool_opens_no_port(tiny: Path, reference: bytes, tmp_path: Path) -> None:
     before = {(c.laddr.ip, c.laddr.port) for c in _listening()}
     seen: list[set[tuple[str, int]]] = []
 
@@ -77,6 +78,9 @@ def test_the_local_pool_opens_no_port(tiny: Path, tmp_path: Path) -> None:
     assert all(r.ok for r in runs)
     assert len(seen) == 2
     assert all(s <= before for s in seen)  # no new listening socket while the pool ran
+    # and the pool gives the serial results, bit for bit
+    write_outputs(load_campaign(tiny), runs, tmp_path / "out", report=False)
+    assert (tmp_path / "out" / "modes.csv").read_bytes() == reference
 
 
 def test_a_local_dask_cluster_listens_on_loopback_only() -> None:
