@@ -6,8 +6,9 @@ The processes are forked where the platform allows it and no other thread
 runs (no imports to repeat, no port opened); otherwise started by a fork
 server. A worker process that dies (the system's out-of-memory killer, a
 crash in a native library) breaks the pool: the tests still unfinished are
-run again in a new pool, and after :data:`RESTARTS` broken pools the tests
-still unfinished fail with the reason, so the others complete.
+run again in a new pool; after :data:`RESTARTS` broken pools each test still
+unfinished runs alone in a pool of its own, so that only the test whose
+process dies fails (with the reason) and the others complete.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from __future__ import annotations
 import multiprocessing
 import sys
 import threading
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
@@ -23,7 +24,7 @@ from typing import Any, TypeVar
 __all__ = ["RESTARTS", "run_in_pool"]
 
 #: How many times a broken pool is replaced before its unfinished tests fail.
-RESTARTS = 2
+RESTARTS = 1
 
 T = TypeVar("T")
 R = TypeVar("R")
@@ -56,32 +57,42 @@ def run_in_pool(
         Processes (>= 1).
     on_broken : callable
         ``on_broken(item)`` gives the result of an item whose process died
-        in every one of ``RESTARTS + 1`` pools.
+        in a pool of its own (after ``RESTARTS`` broken pools).
     """
     todo = list(items)
     for attempt in range(RESTARTS + 1):
         if not todo:
             return
-        broken: list[T] = []
-        ex = ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=_context())
-        clean = False
-        try:
-            futures: dict[Future[R], T] = {ex.submit(fn, it): it for it in todo}
-            pending = set(futures)
-            while pending:
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for fut in finished:
-                    try:
-                        result = fut.result()
-                    except BrokenProcessPool:
-                        broken.append(futures[fut])
-                        continue
-                    yield futures[fut], result
-            clean = True
-        finally:
-            # an interruption (or a consumer that stops) does not wait for the queued tests
-            ex.shutdown(wait=clean, cancel_futures=not clean)
-        todo = broken
-        if attempt == RESTARTS:
-            for it in todo:
+        if attempt < RESTARTS:
+            todo = yield from _round(fn, todo, workers)
+            continue
+        for it in todo:  # the last round: each alone, so only the culprit fails
+            left = yield from _round(fn, [it], 1)
+            if left:
                 yield it, on_broken(it)
+
+
+def _round(
+    fn: Callable[[T], R], todo: list[T], workers: int
+) -> Generator[tuple[T, R], None, list[T]]:
+    """One pool over ``todo``; yields what finished and returns what a broken pool lost."""
+    broken: list[T] = []
+    ex = ProcessPoolExecutor(max_workers=min(workers, len(todo)), mp_context=_context())
+    clean = False
+    try:
+        futures: dict[Future[R], T] = {ex.submit(fn, it): it for it in todo}
+        pending = set(futures)
+        while pending:
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                try:
+                    result = fut.result()
+                except BrokenProcessPool:
+                    broken.append(futures[fut])
+                    continue
+                yield futures[fut], result
+        clean = True
+    finally:
+        # an interruption (or a consumer that stops) does not wait for the queued tests
+        ex.shutdown(wait=clean, cancel_futures=not clean)
+    return broken
