@@ -3,8 +3,8 @@
 Run: ``python benchmarks/campaign_virtual.py [--data DIR] [--out DIR] [--quick] [--workers N]``.
 
 Writes the virtual campaign (``tyredamp simulate campaign``; or reuses
-``--data``), runs it (serially by default, ``--workers N`` on a local Dask
-cluster; ``--out`` keeps the results and their cache), and prints: per
+``--data``), runs it (serially by default, ``--workers N`` on local worker
+processes; ``--out`` keeps the results and their cache), and prints: per
 family the true wave number of its modes for every tyre (one number each
 means no swap), the identified modes with no true mode, and the relative
 error of the frequency-against-pressure trends at the held-out pressures
@@ -34,7 +34,7 @@ def main() -> None:
     ap.add_argument("--data", type=Path, help="folder of an existing virtual campaign")
     ap.add_argument("--out", type=Path, help="results folder (default: temporary)")
     ap.add_argument("--quick", action="store_true", help="the small campaign of the tests")
-    ap.add_argument("--workers", type=int, help="local Dask workers (default: serial)")
+    ap.add_argument("--workers", type=int, help="local worker processes (default: serial)")
     ap.add_argument(
         "--pairs",
         action="store_true",

@@ -64,7 +64,12 @@ def cluster() -> Iterator[Any]:
     from distributed import LocalCluster
 
     with LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
     ) as c:
         yield c
 
@@ -301,7 +306,7 @@ def test_without_the_campaign_extra_the_command_says_what_to_install(
     from tyredamp.cli import main
 
     with pytest.raises(SystemExit) as exc:
-        main(["campaign", str(virtual / "campaign.toml"), "--out", str(tmp_path / "o")])
+        main(["campaign", str(virtual / "campaign.toml"), "--out", str(tmp_path / "o"), "--dask"])
     assert exc.value.code == 2
     assert not (tmp_path / "o").exists()
 

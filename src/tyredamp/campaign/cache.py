@@ -14,6 +14,12 @@ A finished step is on disk as soon as the campaign receives it, so a crash,
 a kill or Ctrl-C loses nothing that finished, and a changed setting renews
 only the steps that depend on it. Entries that cannot be read (for example a
 disk that filled up) count as missing and are computed again.
+
+Each entry carries the SHA-256 of its document's exact JSON text
+(``"sha256"``, written before the document). An entry whose text no longer
+matches it (edited, truncated, damaged on disk), or that is not an entry of
+its key, is not trusted: it is computed again and named in
+:attr:`ResultCache.damaged` (the campaign reports it as a warning).
 """
 
 from __future__ import annotations
@@ -31,7 +37,7 @@ from ..io._safety import atomic_path
 __all__ = ["CACHE_FORMAT", "ResultCache", "file_digest", "step_key"]
 
 #: Version of the cache entry layout (part of every key).
-CACHE_FORMAT = 1
+CACHE_FORMAT = 2
 
 
 def file_digest(path: str | os.PathLike[str]) -> str:
@@ -67,32 +73,62 @@ def step_key(
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
+_KIND = "tyredamp-campaign-cache"
+_DOC = b',"document":'
+
+
 class ResultCache:
-    """Step documents on disk under ``root`` (``DIR/cache``), one JSON file per key."""
+    """Step documents on disk under ``root`` (``DIR/cache``), one JSON file per key.
+
+    Attributes
+    ----------
+    damaged : list of str
+        One line for each entry found damaged by :meth:`get` (then recomputed).
+    """
 
     def __init__(self, root: str | os.PathLike[str]) -> None:
         self.root = Path(root)
+        self.damaged: list[str] = []
 
     def path(self, key: str) -> Path:
         """The file of ``key``."""
         return self.root / f"{key}.json"
 
     def get(self, key: str) -> dict[str, Any] | None:
-        """The stored document of ``key``, or None when absent or unreadable."""
+        """The stored document of ``key``; None when absent, unreadable or damaged."""
         p = self.path(key)
         try:
-            entry = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, ValueError):
+            raw = p.read_bytes()
+        except FileNotFoundError:
             return None
-        if not isinstance(entry, dict) or entry.get("key") != key:
+        except OSError as exc:
+            self._bad(key, f"cannot be read ({exc.strerror})")
             return None
-        doc = entry.get("document")
-        return doc if isinstance(doc, dict) else None
+        try:
+            entry = json.loads(raw)
+        except (UnicodeDecodeError, ValueError, RecursionError):
+            self._bad(key, "is not valid JSON")
+            return None
+        if not isinstance(entry, dict) or entry.get("kind") != _KIND or entry.get("key") != key:
+            self._bad(key, "is not the cache entry of its name")
+            return None
+        doc, start = entry.get("document"), raw.find(_DOC)
+        text = raw[start + len(_DOC) : raw.rstrip().rfind(b"}")] if start > 0 else b""
+        if not isinstance(doc, dict) or hashlib.sha256(text).hexdigest() != entry.get("sha256"):
+            self._bad(key, "does not match its checksum")
+            return None
+        return doc
+
+    def _bad(self, key: str, why: str) -> None:
+        self.damaged.append(f"{self.path(key)}: the cache entry {why}; not trusted, computed again")
 
     def put(self, key: str, document: dict[str, Any], about: dict[str, Any]) -> Path:
-        """Store ``document`` under ``key`` atomically, with ``about`` (test, step) beside it."""
-        entry = {"kind": "tyredamp-campaign-cache", "key": key, **about, "document": document}
-        text = json_text(entry, indent=0)
+        """Store ``document`` under ``key`` atomically, with ``about`` (test, step) and checksum."""
+        text = json_text(document, indent=0).encode("utf-8")
+        head = json.dumps(
+            {"kind": _KIND, "key": key, **about, "sha256": hashlib.sha256(text).hexdigest()},
+            allow_nan=False,
+        ).encode("utf-8")
         with atomic_path(self.path(key)) as tmp:
-            tmp.write_text(text, encoding="utf-8")
+            tmp.write_bytes(head[:-1] + _DOC + text + b"}\n")
         return self.path(key)

@@ -164,9 +164,11 @@ def check_campaign_output(
     nothing but what earlier campaign runs wrote there (:func:`campaign_files`:
     the files its ``campaign.json`` lists, cache entries, and temporaries of
     our own pattern left by a killed run). A folder that is, or holds, one
-    of the ``inputs`` (the campaign file, the test files) is refused. The
-    rest of the rules (not the current directory, a writable parent, links
-    followed) are those of :func:`tyredamp.io._safety.check_output_dir`.
+    of the ``inputs`` (the campaign file, the test files) is refused, and so
+    is one where a file the campaign wrote was changed since
+    (:func:`.manifest.check_edits`). The rest of the rules (not the current
+    directory, a writable parent, links followed) are those of
+    :func:`tyredamp.io._safety.check_output_dir`.
 
     Returns
     -------
@@ -187,6 +189,10 @@ def check_campaign_output(
                 f"--out: {text} is or holds the input file {os.fspath(inp)}; "
                 "choose another directory"
             )
+    from .manifest import check_edits  # the files it lists must be as the campaign wrote them
+
+    if text and os.path.isdir(real):
+        check_edits(real, shown=text)
     return check_output_dir(out, campaign_files, what="campaign output", manifest=False)
 
 

@@ -1,4 +1,4 @@
-"""Running every test of a campaign: in-process, or on Dask (a local or an existing cluster).
+"""Running every test of a campaign: in-process, a local process pool, or Dask.
 
 The runner plans each test from the cache (:mod:`.cache`): the steps whose
 keys are stored are read back, the others are sent as one task per test to
@@ -11,7 +11,21 @@ reads the skip from the cache instead of trying again; failures are not
 cached. Results are stored in the cache as they
 arrive, so an interruption loses nothing that finished. With Dask a task
 whose worker dies is run again on another worker (the scheduler's
-``allowed-failures``, and ``retries`` on the task).
+``allowed-failures``, and ``retries`` on the task); in the local pool a test
+whose process dies is run again in a new pool (:mod:`.pool`).
+
+Where the work runs (``mode``): ``"serial"`` in this process; ``"local"``
+(the default) a pool of local processes (:mod:`.pool`) that starts in a
+fraction of a second, or this process when one test or one worker is
+left; ``"dask"`` a new local Dask cluster on 127.0.0.1 only
+(:func:`.cluster.local_dask_cluster`); ``"scheduler"`` an existing, trusted
+Dask cluster (:func:`.cluster.connect_scheduler`). On Dask every task
+returns its outcome as JSON bytes, decoded and checked here
+(:func:`outcome_from_json`).
+
+A test file larger than ``max_file_bytes`` (default :data:`MAX_FILE_BYTES`)
+fails that test before it is read; a test that runs out of memory fails
+alone too.
 
 Serial and parallel runs give identical results bit for bit: every task runs
 the same function on the same bytes with one BLAS thread, and every document
@@ -21,6 +35,8 @@ is read back through the same strict-JSON round trip.
 from __future__ import annotations
 
 import hashlib
+import json
+import os
 import socket
 import time
 from collections.abc import Callable, Iterable
@@ -33,9 +49,24 @@ from . import steps
 from .cache import ResultCache, file_digest, step_key
 from .spec import Campaign, TestSpec
 
-__all__ = ["Outcome", "Task", "TestRun", "execute", "plan_tests", "run_tests"]
+__all__ = [
+    "MAX_FILE_BYTES",
+    "Outcome",
+    "Task",
+    "TestRun",
+    "execute",
+    "execute_json",
+    "outcome_from_json",
+    "plan_tests",
+    "run_tests",
+]
 
-Mode = Literal["serial", "local", "scheduler"]
+Mode = Literal["serial", "local", "dask", "scheduler"]
+
+#: The largest test file a campaign reads (bytes): a larger one fails its test alone.
+#: Each task holds the file's bytes and a copy on disk; the largest measured files the
+#: readers take are well under 1 GiB.
+MAX_FILE_BYTES = 2 << 30
 
 
 @dataclass(frozen=True)
@@ -56,6 +87,7 @@ class Task:
     settings: dict[str, Any]
     conditions: dict[str, Any]
     step_keys: tuple[str, ...] = ()
+    max_bytes: int = MAX_FILE_BYTES
 
     @property
     def key(self) -> str:
@@ -140,49 +172,125 @@ class TestRun:
             self.documents[step] = doc
 
 
+def _size_text(n: float) -> str:
+    for unit in ("bytes", "KiB", "MiB", "GiB"):
+        if n < 1024 or unit == "GiB":
+            return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n:.1f} GiB"  # pragma: no cover
+
+
+def _too_large(rel: str, size: int, limit: int) -> str:
+    return (
+        f"{rel}: the file is {_size_text(size)}, larger than the {_size_text(limit)} "
+        "a campaign reads per test file"
+    )
+
+
 def execute(task: Task) -> Outcome:
     """Run the missing steps of one test (on a worker or in-process); never raises for a bad test.
 
     BLAS is limited to one thread inside the task (threadpoolctl): the
     matrices are small and several threads per worker on shared cores slow
-    everything down (:mod:`tyredamp._blas`).
+    everything down (:mod:`tyredamp._blas`). A file larger than the task's
+    limit, or one whose processing runs out of memory, fails this test only.
     """
     from .._blas import single_threaded_blas
+    from .scratch import sweep_once
 
+    sweep_once()
     t0, c0 = time.perf_counter(), time.process_time()
+    first = task.steps[0]
     try:
+        size = os.stat(task.path).st_size
+        if size > task.max_bytes:
+            return Outcome(task.test_id, {}, first, _too_large(task.rel, size, task.max_bytes))
         data = Path(task.path).read_bytes()
+    except MemoryError:
+        return Outcome(task.test_id, {}, first, f"{task.rel}: not enough memory to read the file")
     except OSError as exc:
         where = socket.gethostname()
         return Outcome(
             task.test_id,
             {},
-            task.steps[0],
+            first,
             f"{task.rel}: cannot read on {where} ({exc.strerror}; a cluster needs the test "
             "files at the same path on every worker, e.g. a shared file system)",
         )
     if hashlib.sha256(data).hexdigest() != task.digest:
-        return Outcome(
-            task.test_id, {}, task.steps[0], f"{task.rel}: the file changed during the campaign"
-        )
-    with single_threaded_blas():
-        docs, failure = steps.run_steps_from_bytes(
-            task.study,
-            task.rel,
-            data,
-            task.steps,
-            task.upstream,
-            task.settings,
-            task.conditions,
-        )
+        return Outcome(task.test_id, {}, first, f"{task.rel}: the file changed during the campaign")
+    try:
+        with single_threaded_blas():
+            docs, failure = steps.run_steps_from_bytes(
+                task.study,
+                task.rel,
+                data,
+                task.steps,
+                task.upstream,
+                task.settings,
+                task.conditions,
+            )
+    except MemoryError:
+        del data
+        return Outcome(task.test_id, {}, first, f"{task.rel}: ran out of memory")
     dt, dc = time.perf_counter() - t0, time.process_time() - c0
     if failure is not None:
         return Outcome(task.test_id, docs, failure[0], failure[1], dt, dc)
     return Outcome(task.test_id, docs, None, None, dt, dc)
 
 
-def plan_tests(campaign: Campaign, cache: ResultCache) -> tuple[list[TestRun], list[Task]]:
-    """Key every step of every test, read what the cache holds, list the tasks still to run."""
+def execute_json(task: Task) -> bytes:
+    """:func:`execute` with the outcome as strict JSON bytes (what a Dask worker sends back)."""
+    from ..documents.jsonfile import json_text
+
+    out = execute(task)
+    doc = {
+        "test_id": out.test_id,
+        "documents": out.documents,
+        "failed_step": out.failed_step,
+        "reason": out.reason,
+        "seconds": out.seconds,
+        "cpu_seconds": out.cpu_seconds,
+    }
+    return json_text(doc, indent=0).encode("utf-8")
+
+
+def outcome_from_json(data: Any, task: Task) -> Outcome:
+    """The :class:`Outcome` in the JSON bytes a worker sent for ``task``, checked.
+
+    Only plain JSON is decoded (:func:`json.loads`); an answer that is not
+    bytes, not JSON, for another test, or with documents of steps the task
+    did not ask for becomes a failure of that test.
+    """
+    bad = Outcome(task.test_id, {}, task.steps[0], "the worker sent a malformed result")
+    if not isinstance(data, bytes | bytearray):
+        return bad
+    try:
+        doc = json.loads(data)
+    except (ValueError, RecursionError):
+        return bad
+    if not isinstance(doc, dict) or doc.get("test_id") != task.test_id:
+        return bad
+    docs = doc.get("documents")
+    failed, reason = doc.get("failed_step"), doc.get("reason")
+    secs = [doc.get("seconds"), doc.get("cpu_seconds")]
+    if not isinstance(docs, dict) or not set(docs) <= set(task.steps):
+        return bad
+    ok = all(isinstance(v, dict) for v in docs.values())
+    ok = ok and (failed is None or (failed in task.steps and isinstance(reason, str)))
+    times = [float(x) for x in secs if isinstance(x, int | float) and not isinstance(x, bool)]
+    if not ok or len(times) != 2:
+        return bad
+    return Outcome(task.test_id, docs, failed, reason, times[0], times[1])
+
+
+def plan_tests(
+    campaign: Campaign, cache: ResultCache, max_bytes: int = MAX_FILE_BYTES
+) -> tuple[list[TestRun], list[Task]]:
+    """Key every step of every test, read what the cache holds, list the tasks still to run.
+
+    A test whose file cannot be read or is larger than ``max_bytes`` fails here.
+    """
     runs: list[TestRun] = []
     tasks: list[Task] = []
     for spec in campaign.tests:
@@ -190,6 +298,11 @@ def plan_tests(campaign: Campaign, cache: ResultCache) -> tuple[list[TestRun], l
         runs.append(run)
         settings = campaign.settings[spec.study]
         try:
+            size = os.stat(spec.path).st_size
+            if size > max_bytes:
+                run.failed_step = steps.STUDIES[spec.study].steps[0]
+                run.reason = _too_large(spec.rel, size, max_bytes)
+                continue
             run.digest = file_digest(spec.path)
         except OSError as exc:
             run.failed_step = steps.STUDIES[spec.study].steps[0]
@@ -229,6 +342,7 @@ def plan_tests(campaign: Campaign, cache: ResultCache) -> tuple[list[TestRun], l
                     settings,
                     dict(spec.conditions),
                     tuple(run.keys[s] for s in todo),
+                    max_bytes,
                 )
             )
     return runs, tasks
@@ -250,71 +364,59 @@ def _serial(tasks: Iterable[Task]) -> Iterable[Outcome]:
         yield execute(task)
 
 
+def _broken(task: Task) -> Outcome:
+    return Outcome(
+        task.test_id,
+        {},
+        task.steps[0],
+        f"{task.rel}: the worker process died on this test (out of memory?)",
+    )
+
+
+def _pool(tasks: list[Task], workers: int) -> Iterable[Outcome]:
+    from .pool import run_in_pool
+
+    for _task, out in run_in_pool(execute, tasks, workers, _broken):
+        yield out
+
+
 def _dask(tasks: list[Task], client: Any) -> Iterable[Outcome]:
     from distributed import as_completed
 
-    futures = {client.submit(execute, t, key=t.key, retries=2): t for t in tasks}
-    for fut in as_completed(list(futures)):
+    futures = {client.submit(execute_json, t, key=t.key, retries=2): t for t in tasks}
+    for fut in as_completed(list(futures), loop=client.loop):
         task = futures[fut]
         try:
-            yield fut.result()
+            data = fut.result()
         except Exception as exc:  # KilledWorker after the allowed failures, lost scheduler ...
             reason = " ".join(str(exc).split()) or type(exc).__name__
             yield Outcome(task.test_id, {}, task.steps[0], f"worker failed: {reason}")
+            continue
+        yield outcome_from_json(data, task)
 
 
-def dask_client(
-    mode: Mode, workers: int | None = None, scheduler: str | None = None
-) -> tuple[Any, Any]:
-    """A ``distributed.Client`` for ``mode`` (and the ``LocalCluster`` it owns, or None).
-
-    ``"local"``: a new ``LocalCluster`` of ``workers`` processes (default the
-    machine's cores) with one thread each; ``"scheduler"``: connect to the
-    existing cluster at ``scheduler`` (``tcp://host:port``).
-    """
-    try:
-        from distributed import Client, LocalCluster
-    except ImportError:
-        raise InputError(
-            "the campaign on Dask needs dask and distributed: pip install 'tyredamp[campaign]' "
-            "(or run with --serial)"
-        ) from None
-    import logging
-    import os
-
-    if mode == "scheduler":
-        if not scheduler:
-            raise InputError("--scheduler: expected an address like tcp://host:8786")
+def local_workers(workers: int | None, n_tasks: int) -> int:
+    """Local processes for ``n_tasks`` tasks: ``workers`` (default the usable cores), <= n_tasks."""
+    if workers is None:
         try:
-            return Client(scheduler, timeout="20s"), None
-        except (OSError, TimeoutError) as exc:
-            raise InputError(f"--scheduler: cannot connect to {scheduler} ({exc})") from None
-    n = workers if workers is not None else (os.cpu_count() or 1)
-    import dask
-
-    # the workers' statistical profiler samples every thread every 10 ms; nobody looks
-    # at it in a batch run, and on busy cores it costs the tasks CPU
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
-        cluster = LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # the HTTP server always starts; any free port
-            silence_logs=logging.ERROR,
-        )
-    return Client(cluster), cluster
+            workers = len(os.sched_getaffinity(0))
+        except (AttributeError, OSError):  # pragma: no cover - not Linux
+            workers = os.cpu_count() or 1
+    return max(1, min(workers, n_tasks))
 
 
 def run_tests(
     campaign: Campaign,
     out_dir: str | Path,
     *,
-    mode: Mode = "serial",
+    mode: Mode = "local",
     workers: int | None = None,
     scheduler: str | None = None,
     client: Any = None,
+    max_file_bytes: int = MAX_FILE_BYTES,
     on_start: Callable[[int], None] | None = None,
     on_outcome: Callable[[TestRun, int, int, int], None] | None = None,
+    on_warning: Callable[[str], None] | None = None,
 ) -> list[TestRun]:
     """Run (or read from the cache) every step of every test of ``campaign``.
 
@@ -324,26 +426,40 @@ def run_tests(
         The parsed campaign file.
     out_dir : path
         Output folder; the cache is ``out_dir/cache``.
-    mode : {"serial", "local", "scheduler"}
-        In-process without Dask, a new local cluster, or an existing one.
+    mode : {"local", "serial", "dask", "scheduler"}
+        A local process pool (this process when one test or one worker is
+        left), in-process, a new local Dask cluster, or an existing one
+        (module docstring).
     workers : int, optional
-        Local workers (processes) for ``mode="local"`` (default: the cores).
+        Local processes for ``"local"`` and ``"dask"`` (default: the usable cores).
     scheduler : str, optional
-        Scheduler address for ``mode="scheduler"``.
+        Scheduler address for ``mode="scheduler"`` (``tcp://`` only; a
+        ``tls://`` cluster needs ``client`` made by
+        :func:`.cluster.connect_scheduler` with its security).
     client : distributed.Client, optional
-        Use this client instead (any mode but serial).
+        Use this client instead (modes ``"dask"`` and ``"scheduler"``).
+    max_file_bytes : int
+        Largest test file read (bytes); a larger one fails its test.
     on_start : callable, optional
         ``on_start(total)`` with the number of tests to run (after the cache lookup).
     on_outcome : callable, optional
         ``on_outcome(run, done, failed, total)`` after each test that ran.
+    on_warning : callable, optional
+        ``on_warning(text)`` for each damaged cache entry (recomputed).
 
     Returns
     -------
     list of TestRun
         In campaign order; failed tests carry their reason.
     """
+    from .scratch import sweep_scratch
+
+    sweep_scratch()
     cache = ResultCache(Path(out_dir) / "cache")
-    runs, tasks = plan_tests(campaign, cache)
+    runs, tasks = plan_tests(campaign, cache, max_file_bytes)
+    if on_warning is not None:
+        for text in cache.damaged:
+            on_warning(text)
     by_id = {r.spec.test_id: r for r in runs}
     total = len(tasks)
     done = failed = 0
@@ -352,11 +468,14 @@ def run_tests(
     if not tasks:
         return runs
     own: tuple[Any, Any] = (None, None)
-    if mode == "serial":
+    n_local = local_workers(workers, total)
+    if mode == "serial" or (mode == "local" and n_local == 1):
         outcomes: Iterable[Outcome] = _serial(tasks)
+    elif mode == "local":
+        outcomes = _pool(tasks, n_local)
     else:
         if client is None:
-            own = dask_client(mode, workers, scheduler)
+            own = _own_client(mode, n_local, scheduler)
             client = own[0]
         outcomes = _dask(tasks, client)
     try:
@@ -373,3 +492,32 @@ def run_tests(
         if own[1] is not None:
             own[1].close()
     return runs
+
+
+def _own_client(mode: Mode, workers: int, scheduler: str | None) -> tuple[Any, Any]:
+    try:
+        import distributed  # noqa: F401
+    except ImportError:
+        raise InputError(
+            "the campaign on Dask needs dask and distributed: pip install 'tyredamp[campaign]' "
+            "(or run without --dask and --scheduler)"
+        ) from None
+    from .cluster import connect_scheduler, local_dask_cluster, parse_scheduler
+
+    if mode == "scheduler":
+        return connect_scheduler(parse_scheduler(scheduler or "")), None
+    return local_dask_cluster(workers)
+
+
+def dask_client(
+    mode: Mode, workers: int | None = None, scheduler: str | None = None
+) -> tuple[Any, Any]:
+    """A ``distributed.Client`` for ``mode`` (and the ``LocalCluster`` it owns, or None).
+
+    ``"local"`` or ``"dask"``: a new loopback-only ``LocalCluster`` of
+    ``workers`` processes (default the cores) with one thread each;
+    ``"scheduler"``: the existing trusted cluster at ``scheduler``
+    (``tcp://host:port``), checked first (:mod:`.cluster`).
+    """
+    n = workers if workers is not None else (os.cpu_count() or 1)
+    return _own_client("dask" if mode == "local" else mode, n, scheduler)

@@ -319,6 +319,10 @@ def parse_campaign(doc: Any, src: Path) -> Campaign:
     return Campaign(src, name, tuple(tests), settings, tracking, out_path)
 
 
+#: The largest campaign file read (bytes).
+MAX_CAMPAIGN_BYTES = 16 << 20
+
+
 def load_campaign(path: str | Path) -> Campaign:
     """Read and validate a campaign file (TOML).
 
@@ -332,9 +336,18 @@ def load_campaign(path: str | Path) -> Campaign:
     if not src.is_file():
         raise CampaignFileError(f"{src}: campaign file not found")
     try:
+        if src.stat().st_size > MAX_CAMPAIGN_BYTES:
+            raise CampaignFileError(
+                f"{src}: {src.stat().st_size} bytes; a campaign file is at most "
+                f"{MAX_CAMPAIGN_BYTES >> 20} MiB (globs list many test files in one line)"
+            )
         doc = tomllib.loads(src.read_text(encoding="utf-8"))
     except UnicodeDecodeError:
         raise CampaignFileError(f"{src}: not a text (TOML) file") from None
     except tomllib.TOMLDecodeError as exc:
         raise CampaignFileError(f"{src}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise CampaignFileError(f"{src}: not valid TOML (nested too deeply)") from None
+    except OSError as exc:
+        raise CampaignFileError(f"{src}: cannot read ({exc.strerror})") from None
     return parse_campaign(doc, src)

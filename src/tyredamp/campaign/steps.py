@@ -67,7 +67,6 @@ gives the ``settings`` part of the campaign file's JSON schema.
 from __future__ import annotations
 
 import json
-import tempfile
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -470,7 +469,7 @@ def run_steps_from_bytes(
     settings: Mapping[str, Any],
     conditions: Mapping[str, Any] | None,
 ) -> tuple[dict[str, dict[str, Any]], tuple[str, str] | None]:
-    """Run ``steps`` on a test given as its bytes (written to a private temporary file).
+    """Run ``steps`` on a test given as its bytes (written to a private scratch copy).
 
     The file gets its original base name ``name`` so that readers which
     dispatch on the extension, and documents that record the source name,
@@ -486,8 +485,11 @@ def run_steps_from_bytes(
     """
     docs: dict[str, dict[str, Any]] = dict(upstream)
     new: dict[str, dict[str, Any]] = {}
-    with tempfile.TemporaryDirectory(prefix="tyredamp-campaign-") as tmp:
-        path = Path(tmp) / Path(name).name
+    from .scratch import scratch_dir
+
+    with scratch_dir() as scratch:
+        tmp = str(scratch)
+        path = scratch / Path(name).name
         path.write_bytes(data)
         for step in steps:
             try:

@@ -140,10 +140,11 @@ class Boolean(Check):
 
 @dataclass(frozen=True)
 class Integer(Check):
-    """An integer ``>= minimum``."""
+    """An integer ``>= minimum`` (and ``<= maximum`` when given: the most the method can use)."""
 
     minimum: int
     optional: bool = True
+    maximum: int | None = None
     cli_type: ClassVar[str] = "integer"
 
     def __call__(self, value: Any, where: str) -> Any:
@@ -151,10 +152,15 @@ class Integer(Check):
             return None
         if not isinstance(value, int) or isinstance(value, bool) or value < self.minimum:
             raise InputError(f"{where}: expected an integer >= {self.minimum}, got {value!r}")
+        if self.maximum is not None and value > self.maximum:
+            raise InputError(f"{where}: expected an integer <= {self.maximum}, got {value!r}")
         return value
 
     def schema(self) -> dict[str, Any]:
-        return {"type": "integer", "minimum": self.minimum}
+        out: dict[str, Any] = {"type": "integer", "minimum": self.minimum}
+        if self.maximum is not None:
+            out["maximum"] = self.maximum
+        return out
 
 
 @dataclass(frozen=True)
@@ -268,9 +274,10 @@ def _split(value: Any) -> Any:
 
 @dataclass(frozen=True)
 class Positives(Check):
-    """A non-empty list of numbers > 0 (text ``"F1,F2"`` on the command line)."""
+    """A non-empty list of at most ``max_items`` numbers > 0 (``"F1,F2"`` on the command line)."""
 
     what: str = "frequencies > 0 Hz"
+    max_items: int = 1000
 
     def __call__(self, value: Any, where: str) -> Any:
         if value is None:
@@ -287,12 +294,15 @@ class Positives(Check):
         ok = isinstance(value, list) and len(value) > 0 and all(map(_is_number, value))
         if not ok or not all(math.isfinite(v) and v > 0 for v in value):
             raise InputError(f"{where}: expected a non-empty list of {self.what}, got {raw!r}")
+        if len(value) > self.max_items:
+            raise InputError(f"{where}: expected at most {self.max_items} values, got {len(value)}")
         return tuple(float(v) for v in value)
 
     def schema(self) -> dict[str, Any]:
         return {
             "type": "array",
             "minItems": 1,
+            "maxItems": self.max_items,
             "items": {"type": "number", "exclusiveMinimum": 0},
         }
 

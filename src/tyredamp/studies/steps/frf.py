@@ -47,7 +47,11 @@ class FrfSettings(StepSettings):
         "--method",
     )
     segment: int | None = knob(
-        None, "Welch/transient segment in samples.", Integer(2), "--segment", unit="samples"
+        None,
+        "Welch/transient segment in samples (at most 2^26).",
+        Integer(2, maximum=1 << 26),
+        "--segment",
+        unit="samples",
     )
     period: int | str | None = knob(
         None,

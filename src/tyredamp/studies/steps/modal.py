@@ -50,7 +50,9 @@ class ModalSettings(StepSettings):
         Choice(MODAL_MODELS),
         "--model",
     )
-    n_modes: int | None = knob(None, "Number of modes to keep.", Integer(1), "--modes")
+    n_modes: int | None = knob(
+        None, "Number of modes to keep (at most 1000).", Integer(1, maximum=1000), "--modes"
+    )
     frequencies: tuple[float, ...] | None = knob(
         None,
         "Approximate natural frequencies (Hz) of the wanted modes; overrides --modes.",
@@ -61,14 +63,14 @@ class ModalSettings(StepSettings):
     )
     max_order: int | None = knob(
         None,
-        "Highest pLSCF model order (default 60 / number of inputs).",
-        Integer(2),
+        "Highest pLSCF model order (default 60 / number of inputs; at most 1000).",
+        Integer(2, maximum=1000),
         "--max-order",
     )
     order_step: int = knob(
         2,
         "Stabilisation diagram: every N-th order from the highest down to a quarter of it.",
-        Integer(1, optional=False),
+        Integer(1, optional=False, maximum=1000),
         "--order-step",
     )
     residuals: bool = knob(
