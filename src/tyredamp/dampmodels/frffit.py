@@ -132,7 +132,7 @@ class ModelFit:
         if self.model == "hysteretic":
             return Hysteretic(c)
         if self.model == "exponential":
-            return Exponential(c, [self.extra["mu"]])
+            return Exponential(c, np.array([self.extra["mu"]]))
         return Fractional(c, self.extra["alpha"])
 
     def receptance(self, frequency: ArrayLike, inputs: ArrayLike) -> NDArray[np.complex128]:
@@ -146,11 +146,11 @@ def _g(model: str, w: NDArray[np.float64], extra: float) -> NDArray[np.complex12
     """The scalar ``g(i w)`` of each law (module docstring)."""
     s = 1j * w
     if model in ("proportional", "viscous"):
-        return s
+        return np.asarray(s, dtype=complex)
     if model == "hysteretic":
         return np.full(w.shape, 1j)
     if model == "exponential":
-        return s * extra / (s + extra)
+        return np.asarray(s * extra / (s + extra), dtype=complex)
     return np.asarray(s**extra, dtype=complex)
 
 

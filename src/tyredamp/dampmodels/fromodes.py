@@ -21,7 +21,8 @@ symmetric gives, with ``t = theta^2``, one linear equation per pair ``k < j``:
 solved by least squares for ``t``; then ``C' = sym(C1 diag(1 + omega^2 t))``.
 The A-W viscous-consistency test asks whether ``t`` differs from 0 beyond
 the scatter of the pair equations (a one-sided t-test on the least-squares
-``t``) and the kernel removes most of the asymmetry; ``gamma = theta / T_min`` with ``T_min = 2 pi/omega_max`` is the
+``t``) and the kernel removes most of the asymmetry; ``gamma = theta / T_min``
+with ``T_min = 2 pi/omega_max`` is the
 non-dimensional relaxation time of A-W part 2 (their figures use ``gamma =
 0.02`` for a nearly viscous and ``gamma = 0.5`` for a strongly non-viscous case).
 """
@@ -134,7 +135,7 @@ class RelaxationEstimate:
 
 
 def _asym(c: NDArray[np.float64]) -> float:
-    return float(np.linalg.norm(c - c.T) / max(np.linalg.norm(c + c.T), 1e-300))
+    return float(np.linalg.norm(c - c.T)) / max(float(np.linalg.norm(c + c.T)), 1e-300)
 
 
 def exponential_from_modes(poles: ArrayLike, shapes: ArrayLike) -> RelaxationEstimate:
