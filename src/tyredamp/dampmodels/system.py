@@ -34,12 +34,12 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._validate import as_frequency
 from ..exceptions import ConvergenceError, ShapeError
-from .laws import DampingLaw, Exponential, Fractional, Hysteretic, Viscous
+from .laws import DampingLaw, Exponential, Hysteretic, Viscous
 
 __all__ = ["DampedSystem", "ExactModes", "newton_mode"]
 
 #: Relative step of Newton's method at which a root counts as converged.
-_NEWTON_TOL = 1e-13
+_NEWTON_TOL = 1e-10
 
 
 @dataclass(frozen=True)
@@ -143,41 +143,65 @@ class DampedSystem:
             out[:, :, i] = np.linalg.inv(self.dynamic_stiffness(2j * np.pi * fi))
         return out
 
-    def modes(self) -> ExactModes:
-        """The exact modes (module docstring for the method of each law)."""
+    def modes(self, max_hz: float | None = None) -> ExactModes:
+        """The exact modes (module docstring for the method of each law).
+
+        Parameters
+        ----------
+        max_hz : float, optional
+            Only the elastic modes whose undamped frequency is below this (Hz),
+            by Newton's method from each undamped mode (any causal law; the
+            relaxation modes are then not computed). Default: all modes, by
+            the state space where there is one.
+        """
         law = self.law
-        if isinstance(law, Viscous | Exponential):
-            return self._state_space_modes()
         if isinstance(law, Hysteretic):
             lam, X = sla.eig(self.K + 1j * law.D, self.M)
             p = 1j * np.sqrt(lam.astype(complex))
             modes = self._finish(p, X, np.zeros(0), np.zeros((self.n_dof, 0)))
+            keep = modes.frequency_hz <= (np.inf if max_hz is None else max_hz * 1.5)
             return ExactModes(
-                modes.poles,
-                modes.shapes,
+                modes.poles[keep],
+                modes.shapes[:, keep],
                 modes.relaxation_poles,
                 modes.relaxation_shapes,
                 partner="negative",
             )
-        if isinstance(law, Fractional):
-            w2, phi = sla.eigh(self.K, self.M)
-            roots = [
-                newton_mode(self, 1j * np.sqrt(max(w, 0.0)), phi[:, j]) for j, w in enumerate(w2)
-            ]
-            p = np.array([r[0] for r in roots])
-            X = np.column_stack([r[1] for r in roots])
-            return self._finish(p, X, np.zeros(0), np.zeros((self.n_dof, 0)))
-        raise ShapeError(f"law: no exact eigensolver for {type(law).__name__}")
+        if max_hz is None and isinstance(law, Viscous | Exponential):
+            return self._state_space_modes()
+        if not law.causal:
+            raise ShapeError(f"law: no exact eigensolver for the non-causal {type(law).__name__}")
+        w2, phi = sla.eigh(self.K, self.M)
+        w = np.sqrt(np.clip(w2, 0.0, None))
+        if max_hz is not None:
+            w, phi = w[w <= 2 * np.pi * max_hz], phi[:, w <= 2 * np.pi * max_hz]
+        roots = [
+            newton_mode(self, _scalar_start(self, wj, phi[:, j]), phi[:, j])
+            for j, wj in enumerate(w)
+        ]
+        p = np.array([r[0] for r in roots], dtype=complex)
+        X = np.zeros((self.n_dof, len(roots)), dtype=complex)
+        for j, r in enumerate(roots):
+            X[:, j] = r[1]
+        return self._finish(p, X, np.zeros(0), np.zeros((self.n_dof, 0)))
 
-    def _state_space_modes(self) -> ExactModes:
-        """Eigenvalues of the augmented state space (Wagner & Adhikari 2003, eq. (13))."""
+    def state_matrix(self) -> NDArray[np.float64]:
+        """First-order matrix ``A`` of the (augmented) state ``[x, v, z_1 .. z_K]``.
+
+        ``x' = v``, ``M v' = -K x - C v - sum_k C_k z_k + f``,
+        ``z_k' = mu_k (v - z_k)`` (Wagner & Adhikari 2003, eq. (13)); the force
+        enters ``v'`` through ``M^-1``. Viscous and exponential laws only.
+        """
         n = self.n_dof
         law = self.law
         if isinstance(law, Viscous):
             C0, Cs, mus = law.C, np.zeros((0, n, n)), np.zeros(0)
-        else:
-            assert isinstance(law, Exponential)
+        elif isinstance(law, Exponential):
             C0, Cs, mus = np.zeros((n, n)), law.C, law.mu
+        else:
+            raise ShapeError(
+                f"law: the {law.name} law has no finite state space (viscous or exponential only)"
+            )
         nk = mus.size
         Minv = np.linalg.inv(self.M)
         A = np.zeros(((2 + nk) * n, (2 + nk) * n))
@@ -189,6 +213,54 @@ class DampedSystem:
             A[n : 2 * n, rows] = -Minv @ Cs[k]
             A[rows, n : 2 * n] = mus[k] * np.eye(n)
             A[rows, rows] = -mus[k] * np.eye(n)
+        return A
+
+    def time_response(self, force: ArrayLike, dt: float) -> NDArray[np.float64]:
+        """Displacements under ``force`` from rest, exact for a force held over each step.
+
+        Parameters
+        ----------
+        force : array_like, shape (n_t, n)
+            Force at each degree of freedom, N, held constant over each step
+            (zero-order hold).
+        dt : float
+            Time step, s.
+
+        Returns
+        -------
+        ndarray, shape (n_t, n)
+            Displacement at the start of each step, m.
+
+        Notes
+        -----
+        The state space is discretised exactly, ``Phi = e^{A dt}`` and
+        ``Gamma = int_0^dt e^{A t} dt B`` from the block matrix exponential
+        (Van Loan, IEEE Trans. Autom. Control 23(3) (1978) 395-404, eq. (1.3)).
+        The hysteretic law has no time response (not causal; frequency domain only).
+        """
+        A = self.state_matrix()
+        n, N = self.n_dof, A.shape[0]
+        f = np.asarray(force, dtype=float)
+        if f.ndim != 2 or f.shape[1] != n:
+            raise ShapeError(f"force: expected shape (n_t, {n}), got {f.shape}")
+        B = np.zeros((N, n))
+        B[n : 2 * n] = np.linalg.inv(self.M)
+        big = np.zeros((N + n, N + n))
+        big[:N, :N] = A * dt
+        big[:N, N:] = B * dt
+        E = sla.expm(big)
+        Phi, Gam = E[:N, :N], E[:N, N:]
+        q = np.zeros(N)
+        out = np.empty_like(f)
+        for i in range(f.shape[0]):
+            out[i] = q[:n]
+            q = Phi @ q + Gam @ f[i]
+        return out
+
+    def _state_space_modes(self) -> ExactModes:
+        """Eigenvalues of the augmented state space (Wagner & Adhikari 2003, eq. (13))."""
+        n = self.n_dof
+        A = self.state_matrix()
         lam, V = np.linalg.eig(A)
         X = V[:n]
         keep = np.linalg.norm(X, axis=0) > 1e-9 * np.linalg.norm(V, axis=0)
@@ -225,6 +297,23 @@ class DampedSystem:
         return ExactModes(
             p.astype(complex), X, np.asarray(rp, dtype=float), np.asarray(R, dtype=float)
         )
+
+
+def _scalar_start(system: DampedSystem, w: float, phi: NDArray[np.float64]) -> complex:
+    """Root of the one-mode equation ``s^2 + w^2 + phi^T Z(s) phi = 0`` near ``i w`` (Newton).
+
+    ``phi`` is mass-normalised; this projected root is the start of the full
+    Newton iteration (it holds the damping's first-order shift of the pole).
+    """
+    s = complex(1j * max(w, 1e-6))
+    for _ in range(50):
+        f = complex(s * s + w * w + phi @ system.law.term(s) @ phi)
+        df = complex(2 * s + phi @ system.law.dterm(s) @ phi)
+        step = -f / df
+        s += step
+        if abs(step) <= 1e-12 * abs(s):
+            break
+    return s
 
 
 def newton_mode(

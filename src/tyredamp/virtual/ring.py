@@ -444,6 +444,11 @@ class RingTyre:
             c[node, node] += imp.damping
         k = 0.5 * (k + k.T)
         self.K_bend = k_bend
+        # the rubber parts (virtual.rubber): sidewall foundation and band (membrane + bending)
+        self.K_sidewall = arc * (
+            p.radial_stiffness * (w_sel.T @ w_sel) + p.tangential_stiffness * (v_sel.T @ v_sel)
+        )
+        self.K_band = arc * p.membrane_stiffness / r**2 * ete + k_bend
         self.physical_system = MCKSystem(m, c, k)
         nu = self.nonproportionality
         if nu == 1.0:
