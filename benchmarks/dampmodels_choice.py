@@ -107,8 +107,10 @@ def main(n_draws: int) -> None:
                 lr[other].append(cmp.fits[other].chi2 - fit.chi2)
         dt = time.perf_counter() - t0
         print(
-            f"\ntruth {truth:<12} chosen {100 * best / n_draws:5.1f} %  tied {100 * tied / n_draws:5.1f} %"
-            f"  95 % coverage {100 * inside / total:5.1f} % ({total} intervals)  {dt / n_draws:.2f} s/draw"
+            f"\ntruth {truth:<12} chosen {100 * best / n_draws:5.1f} %"
+            f"  tied {100 * tied / n_draws:5.1f} %"
+            f"  95 % coverage {100 * inside / total:5.1f} % ({total} intervals)"
+            f"  {dt / n_draws:.2f} s/draw"
         )
         for other, vals in lr.items():
             v = np.array(vals)
@@ -116,7 +118,8 @@ def main(n_draws: int) -> None:
                 cmp.fits[truth].n_data
             )
             print(
-                f"   {other:<12} chi2 - chi2_true: median {np.median(v):10.1f}, min {v.min():10.1f};"
+                f"   {other:<12} chi2 - chi2_true: median {np.median(v):10.1f},"
+                f" min {v.min():10.1f};"
                 f" BIC gap median {np.median(v) + dk:10.1f}"
             )
 
