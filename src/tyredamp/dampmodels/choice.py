@@ -244,7 +244,10 @@ def compare_models(
         raise InputError(
             f"models: expected names among {', '.join(MODELS)}, got {', '.join(bad) or 'none'}"
         )
-    fits = {m: fit_model(m, frequency, H, noise_std, inputs, start) for m in names}
+    fits: dict[str, ModelFit] = {}
+    for m in sorted(names, key=lambda m: m != "viscous"):  # viscous first: the warm start
+        fits[m] = fit_model(m, frequency, H, noise_std, inputs, start, warm=fits.get("viscous"))
+    fits = {m: fits[m] for m in names}
     bic = {m: f.bic for m, f in fits.items()}
     ranking = tuple(sorted(bic, key=lambda m: (bic[m], fits[m].n_params)))
     delta = {m: bic[m] - bic[ranking[0]] for m in ranking}

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import least_squares
+from scipy.special import expit
 
 from .._validate import as_finite, as_frequency
 from ..damping import modal_damping_from_modes
@@ -43,6 +44,8 @@ __all__ = ["MODELS", "ModelFit", "fit_model", "start_from_modes"]
 MODELS: tuple[str, ...] = ("proportional", "viscous", "hysteretic", "exponential", "fractional")
 #: Starting relaxation parameters, as multiples of the largest natural frequency.
 _MU_STARTS = (0.1, 0.3, 1.0, 3.0, 30.0)
+#: Bound on ``|ln mu|`` (mu in 1/s): beyond it the kernel is viscous (or a stiffness) to rounding.
+_LN_MU_MAX = 60.0
 #: Starting derivative orders of the fractional model.
 _ALPHA_STARTS = (0.3, 0.6, 1.0, 1.4)
 
@@ -238,7 +241,7 @@ def _unpack(
     c = c + np.triu(c, 1).T
     extra = 0.0
     if model == "exponential":
-        extra = float(np.exp(x[-1]))
+        extra = float(np.exp(np.clip(x[-1], -_LN_MU_MAX, _LN_MU_MAX)))
     elif model == "fractional":
         extra = _alpha(float(x[-1]))
     return omega, phi, c, extra
@@ -246,7 +249,7 @@ def _unpack(
 
 def _alpha(u: float) -> float:
     """Derivative order ``alpha = 2 / (1 + e^-u)`` in (0, 2) from the free parameter ``u``."""
-    return 2.0 / (1.0 + np.exp(-u))
+    return 2.0 * float(expit(u))
 
 
 def _alpha_u(alpha: float) -> float:
@@ -285,6 +288,18 @@ def _starts(model: str, start: ModalStart) -> list[NDArray[np.float64]]:
     return out
 
 
+def _warm_start(model: str, warm: ModelFit) -> NDArray[np.float64]:
+    """Start vector at a fitted viscous model (``mu = 1000 omega_max``, ``alpha = 1``)."""
+    om, c = warm.omega, warm.c_modal
+    iu = np.triu_indices(om.size)
+    head = np.concatenate([om, warm.shapes.ravel()])
+    if model == "hysteretic":
+        return np.concatenate([head, (c * np.sqrt(np.outer(om, om)))[iu]])
+    if model == "exponential":
+        return np.concatenate([head, c[iu], [np.log(1e3 * om.max())]])
+    return np.concatenate([head, c[iu], [_alpha_u(1.0)]])
+
+
 def fit_model(
     model: str,
     frequency: ArrayLike,
@@ -292,6 +307,7 @@ def fit_model(
     noise_std: ArrayLike,
     inputs: ArrayLike,
     start: ModalStart,
+    warm: ModelFit | None = None,
 ) -> ModelFit:
     """Fit one damping model's FRF to measured receptances (module docstring).
 
@@ -310,6 +326,10 @@ def fit_model(
         Row of the response at each input's point (drive points).
     start : ModalStart
         Start values (:func:`start_from_modes`).
+    warm : ModelFit, optional
+        A fitted viscous model: one more start at its solution (``mu`` far
+        above the band, ``alpha = 1``), so that a model nesting the viscous one
+        fits at least as well.
 
     Returns
     -------
@@ -340,7 +360,10 @@ def fit_model(
         return np.concatenate([d.real, d.imag])
 
     best = None
-    for x0 in _starts(model, start):
+    starts = _starts(model, start)
+    if warm is not None and warm.model == "viscous" and model not in ("proportional", "viscous"):
+        starts.append(_warm_start(model, warm))
+    for x0 in starts:
         sol = least_squares(resid, x0, jac=jac, method="lm", x_scale="jac", max_nfev=200)
         if best is None or sol.cost < best.cost:
             best = sol
