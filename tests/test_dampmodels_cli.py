@@ -26,7 +26,7 @@ def _files(tmp_path: Path) -> tuple[Path, Path]:
     md = sys.modes()
     mm = ModalModel(md.poles, md.shapes, md.shapes[:1], outputs=[0, 1, 2], inputs=[0])
     src = modes_file(tmp_path / "modes.json", {"complex": mm})
-    f = np.linspace(2.0, 40.0, 200)
+    f = np.linspace(2.0, 40.0, 120)
     H = sys.receptance(f)[:, :1, :]
     var = (0.01 * np.abs(H)) ** 2  # 40 dB
     rng = np.random.default_rng(4)
