@@ -33,6 +33,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("signal",),
     ("modal", "lateral"),
     ("damping",),
+    ("dampmodels",),
     ("virtual",),
     ("tyremodel",),
     ("io",),

@@ -74,11 +74,58 @@ def _ranges(nums: list[int]) -> str:
     return ", ".join(out)
 
 
+def _with_models(
+    dm: DampingModel, mm: Any, models_text: str, frf_path: Path | None
+) -> tuple[DampingModel, list[str]]:
+    """The damping-model comparison (``--models``) added to ``dm.meta["damping_models"]``."""
+    from dataclasses import replace
+
+    from ..dampmodels.study import models_report, parse_models
+    from ..io import read_frf
+
+    try:
+        names = parse_models(models_text)
+    except InputError as exc:
+        raise InputError(f"--{exc}") from None
+    frf = read_frf(check_input_file(frf_path)) if frf_path is not None else None
+    used = dm.meta.get("modes_used")
+    doc, rows = models_report(
+        mm,
+        names,
+        modes=used if isinstance(used, list) else None,
+        at_inputs=dm.meta.get("shape_points") == "inputs",
+        frf=frf,
+    )
+    return replace(dm, meta={**dm.meta, "damping_models": doc}), ["damping models:", *rows]
+
+
 @click.command("damping")
 @click.argument("modes_json", type=click.Path(dir_okay=False, path_type=Path))
 @out_file_option("Damping JSON file to write.")
 @settings_options(DampingSettings)
-def damping_command(modes_json: Path, out: Path, **options: Any) -> None:
+@click.option(
+    "--models",
+    "models_text",
+    default=None,
+    metavar="LIST",
+    help="Compare damping models, e.g. viscous,hysteretic,exponential,fractional "
+    "(also proportional): the Adhikari-Woodhouse part 2 test from the modes and, "
+    "with --frf, a likelihood ranking on the FRFs.",
+)
+@click.option(
+    "--frf",
+    "frf_path",
+    default=None,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="The FRF file the modes came from, with the variance of each value (for --models).",
+)
+def damping_command(
+    modes_json: Path,
+    out: Path,
+    models_text: str | None = None,
+    frf_path: Path | None = None,
+    **options: Any,
+) -> None:
     """Identify the viscous damping matrix from the complex modes in MODES_JSON.
 
     MODES_JSON is a modes JSON file (tyredamp modal) or a UFF file (.uff,
@@ -118,8 +165,13 @@ def damping_command(modes_json: Path, out: Path, **options: Any) -> None:
         if str(exc).startswith(("modes:", "band:")):
             raise InputError(f"--{exc}") from None
         raise
+    extra_rows: list[str] = []
+    if models_text is not None:
+        dm, extra_rows = _with_models(dm, models[settings.model], models_text, frf_path)
+    elif frf_path is not None:
+        raise InputError("--frf: only used with --models")
     write_damping_json(out, dm)
-    for row in damping_summary(dm):
+    for row in damping_summary(dm) + extra_rows:
         click.echo(row)
     click.echo(f"wrote {out}")
     gap = no_std_note("")[: no_std_note("").index("for ")]

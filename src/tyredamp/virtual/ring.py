@@ -274,6 +274,29 @@ def _operators(n_ring: int, order: int) -> _Operators:
     return _Operators(D=d, h=h)
 
 
+def _rubber_parts(
+    p: RingTyreParameters, d: NDArray[np.float64], k_bend: NDArray[np.float64], n_dof: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The sidewall foundation's and the band's stiffness (N/m), padded to ``n_dof``.
+
+    The same terms as the ring's stiffness (module docstring): ``k_r w^2 + k_t v^2``
+    of the sidewall and the band's membrane ``EA eps^2`` plus bending ``EI kappa^2``;
+    :mod:`tyredamp.virtual.rubber` gives them a viscoelastic modulus. Extra DOFs (the
+    air cavity's) get zero rows.
+    """
+    n = d.shape[0]
+    arc = p.radius * 2.0 * math.pi / n
+    eye = np.eye(n)
+    e_op = np.hstack([eye, d])  # R * membrane strain at nodes
+    side = np.zeros((n_dof, n_dof))
+    idx = np.arange(n)
+    side[idx, idx] = arc * p.radial_stiffness
+    side[n + idx, n + idx] = arc * p.tangential_stiffness
+    band = np.zeros((n_dof, n_dof))
+    band[: 2 * n, : 2 * n] = arc * p.membrane_stiffness / p.radius**2 * (e_op.T @ e_op) + k_bend
+    return side, band
+
+
 class RingTyre:
     """The discretised in-plane ring tyre with its measurement layout (the virtual tyre).
 
@@ -475,6 +498,8 @@ class RingTyre:
         sources = {name: c for name, c in sources.items() if np.any(c)}
         self.damping_sources: dict[str, NDArray[np.float64]] = sources
         self.K_bend = k_bend
+        # the rubber parts (virtual.rubber): sidewall foundation and band (membrane + bending)
+        self.K_sidewall, self.K_band = _rubber_parts(p, d, k_bend, k.shape[0])
         c = sum(sources.values(), np.zeros_like(k))
         self.physical_system = MCKSystem(m, 0.5 * (c + c.T), k)
         nu = self.nonproportionality
