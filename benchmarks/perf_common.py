@@ -376,7 +376,10 @@ def _timed_names(module: ModuleType, names: Sequence[str], acc: list[float]) -> 
             setattr(module, n, fn)
 
 
-POLE_STAGE = ("plscf", "stability_flags", "cluster_poles", "_pick_frequencies")
+#: the pole stage as :mod:`tyredamp.modal.identify` calls it: the automatic order
+#: and its diagram (:func:`~tyredamp.modal.order.settle_order`: pLSCF, the flags,
+#: the clusters) and the picking of given frequencies
+POLE_STAGE = ("settle_order", "plscf", "stability_flags", "cluster_poles", "_pick_frequencies")
 
 
 def run_tyredamp(case: Case, max_order: int | None = None, **options: Any) -> RunResult:
