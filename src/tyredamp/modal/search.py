@@ -530,10 +530,8 @@ def residual_search(
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
     A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
-    of the diagram) is not a mode: it is rejected whatever its statistic (a
-    trial's decay rate is bounded there, :func:`sigma_bound` at its window's
-    upper frequency, so that such a trial stops at the bound instead of running
-    on: half the evaluations on a 60 dB case, the same modes). Nor
+    of the diagram) is not a mode: it is rejected whatever its statistic (a trial
+    stops at that bound, :func:`sigma_bound`, rather than running on). Nor
     is a trial whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
     narrower than the line spacing: such a pole fits single lines (an outlier,
     the tail of an impact test's low-frequency end) as well as a resonance.
