@@ -1,5 +1,5 @@
-"""The real-mode basis built for every mode at once (modal._basis.basis_real) and
-the line factors (i w)^p: against finite differences and complex powers."""
+"""The real-mode basis (modal._basis.basis_real): its derivative columns against
+finite differences."""
 
 from __future__ import annotations
 
@@ -9,13 +9,6 @@ from numpy.testing import assert_allclose
 
 from tyredamp.modal import _basis
 from tyredamp.modal.fit import ModalFitter
-
-
-@pytest.mark.parametrize("p", [-2, -1, 0, 1, 2, 3])
-def test_i_power_matches_the_complex_power(p: int) -> None:
-    w = np.linspace(0.5, 2e3, 101)
-    # i^p exact, w^p one real power: round-off only
-    assert_allclose(_basis._i_power(w, p), (1j * w) ** p, rtol=1e-14)
 
 
 @pytest.mark.parametrize("n_in", [1, 3])

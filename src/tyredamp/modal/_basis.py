@@ -139,20 +139,14 @@ def factors(
     f = fitter.f if lines is None else fitter.f[lines]
     w = 2 * np.pi * f
     s = 1j * w
-    kappa = _i_power(w, fitter.power)
-    kappa_low = _i_power(w, fitter.power - 2)
+    kappa = (1j * w) ** fitter.power
+    kappa_low = (1j * w) ** (fitter.power - 2)
     lw = fitter.line_weights
     if lw is not None:
         lw = lw if lines is None else lw[lines]
         kappa = kappa * lw
         kappa_low = kappa_low * lw
     return s, kappa, kappa_low
-
-
-def _i_power(w: NDArray[np.float64], p: int) -> NDArray[np.complex128]:
-    """``(i w)^p`` of an integer ``p`` as ``i^p w^p`` (``i^p`` exact: 1, i, -1, -i): a
-    real power and one complex scaling instead of a complex power of every line."""
-    return np.asarray((1, 1j, -1, -1j)[p % 4] * w ** float(p), dtype=np.complex128)
 
 
 def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
@@ -405,21 +399,26 @@ def basis_real(
     m = poles.size
     q = fitter.n_cols(m)
     cols = np.zeros((q, nin, nf), complex)
-    sig, om = (-poles.real)[:, None], poles.imag[:, None]  # (m, 1)
-    den = s**2 + 2 * sig * s + sig**2 + om**2  # (m, nf), every mode at once
-    base = kap / den
-    lr = part.real[:, :, None]  # (m, nin, 1)
-    cols[:m] = lr * base[:, None, :]
-    # per mode: d/dx1 and d/dx2 of its column, then one column per free input
-    npm = 2 + (nin - 1)
-    dl = np.zeros((m, npm, nin, nf), complex) if derivatives else None
-    if dl is not None:
-        r2 = kap / den**2
-        dl[:, 0] = lr * (-(2 * s + 2 * sig) * r2 * sig)[:, None, :]
-        dl[:, 1] = lr * (-(2 * om) * r2 * fitter.w_ref)[:, None, :]
-        for n in range(m):
-            for j, k in enumerate(k for k in range(nin) if k != ref[n]):
-                dl[n, 2 + j, k] = base[n]
+    dl: list[NDArray[np.complex128]] = []
+    for n in range(m):
+        p = poles[n]
+        sig, om = -p.real, p.imag
+        L = part[n]
+        den = s**2 + 2 * sig * s + sig**2 + om**2
+        base = kap / den
+        cols[n] = L.real[:, None] * base[None, :]
+        if not derivatives:
+            continue
+        d_sig = -kap * (2 * s + 2 * sig) / den**2
+        d_om = -kap * (2 * om) / den**2
+        dl += [L.real[:, None] * (d_sig * sig)[None, :]]
+        dl += [L.real[:, None] * (d_om * fitter.w_ref)[None, :]]
+        for k in range(nin):
+            if k == ref[n]:
+                continue
+            a_ = np.zeros((nin, nf), complex)
+            a_[k] = base
+            dl.append(a_)
     c0 = m
     if fitter.use_upper:
         for k in range(nin):
@@ -430,9 +429,9 @@ def basis_real(
             cols[c0, k] = kap_low
             c0 += 1
     phi = cols.reshape(q, nin * nf).view(np.float64).T
-    if dl is None or not dl.size:
+    if not derivatives or not dl:
         return phi, np.zeros((phi.shape[0], 0))
-    return phi, dl.reshape(m * npm, nin * nf).view(np.float64).T
+    return phi, np.stack(dl).reshape(len(dl), nin * nf).view(np.float64).T
 
 
 # ---------------------------------------------------- variable projection
