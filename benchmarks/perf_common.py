@@ -298,6 +298,39 @@ def synthetic_case(
     )
 
 
+def mimo_case(
+    n_out: int, n_in: int, n_lines: int, n_modes: int, snr_db: float = 40.0, seed: int = 0
+) -> Case:
+    """:func:`synthetic_case` with ``n_in`` inputs: the drive points are outputs
+    ``1 .. n_in`` (each excites every mode), the participation their shapes."""
+    rng = np.random.default_rng(seed)
+    f_n = np.linspace(10.0, 190.0, n_modes) * (1 + 0.01 * rng.uniform(-1, 1, n_modes))
+    f_n = np.sort(np.concatenate([f_n, [215.0, 240.0]]))
+    p = pole_from_frequency_damping(f_n, rng.uniform(0.005, 0.03, f_n.size))
+    psi = (rng.normal(size=(n_out, f_n.size)) + 0.3j * rng.normal(size=(n_out, f_n.size))) * 1e-2
+    psi[:n_in] = (np.abs(psi[:n_in].real) + 0.5e-2) + 0.3j * psi[:n_in].imag
+    model = ModalModel(
+        p,
+        psi,
+        psi[:n_in],
+        mode_kind="complex",
+        outputs=range(1, n_out + 1),
+        inputs=range(1, n_in + 1),
+    )
+    df = 200.0 / n_lines
+    f = df * np.arange(1, n_lines + 2)
+    ex = model.frf(f, kind="accelerance")
+    return Case(
+        name=f"{n_out} out x {n_in} in, {n_lines} lines, {n_modes} modes, {snr_db:g} dB",
+        frf=ex.with_H(add_noise(np.asarray(ex.H), snr_db, seed + 1)),
+        exact=np.asarray(ex.H),
+        band=(float(f[0]), float(f[-2])),
+        poles=p[:n_modes],
+        psi=psi[:, :n_modes],
+        noise=f"complex Gaussian on the FRF, SNR {snr_db:g} dB per FRF, seed {seed + 1}",
+    )
+
+
 # ------------------------------------------------------------------ the runs
 
 
@@ -343,7 +376,10 @@ def _timed_names(module: ModuleType, names: Sequence[str], acc: list[float]) -> 
             setattr(module, n, fn)
 
 
-POLE_STAGE = ("plscf", "stability_flags", "cluster_poles", "_pick_frequencies")
+#: the pole stage as :mod:`tyredamp.modal.identify` calls it: the automatic order
+#: and its diagram (:func:`~tyredamp.modal.order.settle_order`: pLSCF, the flags,
+#: the clusters) and the picking of given frequencies
+POLE_STAGE = ("settle_order", "plscf", "stability_flags", "cluster_poles", "_pick_frequencies")
 
 
 def run_tyredamp(case: Case, max_order: int | None = None, **options: Any) -> RunResult:

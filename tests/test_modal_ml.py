@@ -163,3 +163,29 @@ def test_full_weights_choice_and_helpers() -> None:
     rng = np.random.default_rng(0)
     g = rng.chisquare(24, 4000) / 24
     assert line_factor_dof(1 / np.sqrt(g)) == pytest.approx(24.0, rel=0.15)
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-9])
+def test_projection_matches_least_squares(scale: float) -> None:
+    # _projection on a well-conditioned basis (the Gram route) and on one whose last
+    # column nearly repeats the first (condition ~1e9, beyond the Gram limit: the QR
+    # route): fitted values as lstsq's, and Q^T of an orthonormal basis Q of the
+    # range: R = Q^T pw has R^T R = pw^T pw and R^T Q^T X = pw^T X
+    from tyredamp.modal.ml import _projection
+
+    rng = np.random.default_rng(3)
+    pw = rng.normal(size=(400, 6))
+    if scale < 1:
+        pw[:, 5] = pw[:, 0] + scale * pw[:, 5]
+    yw = rng.normal(size=400)
+    X = rng.normal(size=(400, 3))
+    c, qt = _projection(pw, yw)
+    ref = np.linalg.lstsq(pw, yw, rcond=None)[0]
+    # fitted values: the least-squares error of either route is ~eps times the
+    # condition (1e-9 relative of the data's norm is far above it for both)
+    assert_allclose(pw @ c, pw @ ref, atol=1e-9 * np.linalg.norm(yw))
+    R = qt(pw)
+    g = pw.T @ pw
+    # identities of an orthonormal Q: relative to the largest Gram entry, eps-sized
+    assert_allclose(R.T @ R, g, atol=1e-12 * np.abs(g).max())
+    assert_allclose(R.T @ qt(X), pw.T @ X, atol=1e-12 * np.abs(pw.T @ X).max() * 10)

@@ -3,21 +3,20 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
 
-from ..documents.jsonfile import write_json
 from ..exceptions import InputError
-from ..frf import FRF, Channel
-from ..io import read_frf
-from ..io._safety import check_output_file
-from ..modal.model import ModalModel
 from ..modal.quality import rejected_summary
 from ..studies.steps import ModalSettings, ModalStep
 from ._common import channel_map, channel_map_options, out_file_option
 from ._settings import settings_from_options, settings_options
+
+if TYPE_CHECKING:
+    from ..frf import FRF
+    from ..modal.model import ModalModel
 
 __all__ = ["modal_command", "modes_table"]
 
@@ -96,6 +95,7 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
     """The FRF with channel angles from the geometry when its points lie on a circle."""
     from dataclasses import replace
 
+    from ..frf import Channel
     from ..io.uff_geometry import read_uff_geometry
 
     geo = read_uff_geometry(path)
@@ -143,6 +143,10 @@ def modal_command(frf_file: Path, out: Path, geometry_file: Path | None, **optio
       tyredamp modal tyre_frf.uff --out modes.json --band 0 200
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
     """
+    from ..documents.jsonfile import write_json  # imported when the command runs
+    from ..io import read_frf
+    from ..io._safety import check_output_file
+
     settings = settings_from_options(ModalSettings, options)
     check_output_file(out, [frf_file])
     frf = read_frf(frf_file, channel_map=channel_map())

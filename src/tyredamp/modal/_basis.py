@@ -95,8 +95,12 @@ def coef(lay: Layout, poles: NDArray[np.complex128]) -> NDArray[np.float64]:
 #: bytes of one block of rows of the fits (basis, derivative and data columns):
 #: the Gram blocks, the QR route and the fitted FRFs are accumulated over blocks
 #: of lines of this size, so that no array of the fits grows with the lines
-#: beyond the data (:func:`blocks`)
-BLOCK_BYTES = 1_000_000
+#: beyond the data (:func:`blocks`). 8 MB: on 16 outputs x 2 inputs x 3000 lines
+#: one block instead of several made the residual search 2x faster with the same
+#: modes (``benchmarks/modal_blocks.py``); the cap is a constant, not per line
+BLOCK_BYTES = 8_000_000
+#: most bytes of data rows a fitter keeps for its life (:func:`one_block`)
+KEEP_BYTES = 1_000_000
 #: fewest lines of a block (fewer make the per-block overhead dominate)
 MIN_BLOCK_LINES = 256
 
@@ -117,9 +121,10 @@ def blocks(fitter: Any, n_col: int) -> list[slice]:
 
 
 def one_block(fitter: Any) -> bool:
-    """Do the data rows of every line fit in one block (:data:`BLOCK_BYTES`)? The
-    fitter then keeps them (no more memory than one block of a blocked fit)."""
-    return bool(16 * fitter.n_in * fitter.n_f * fitter.n_out <= BLOCK_BYTES)
+    """Do the data rows of every line fit in :data:`KEEP_BYTES` (and one block,
+    :data:`BLOCK_BYTES`)? The fitter then keeps them (no more memory than one block
+    of a blocked fit)."""
+    return bool(16 * fitter.n_in * fitter.n_f * fitter.n_out <= min(KEEP_BYTES, BLOCK_BYTES))
 
 
 def factors(

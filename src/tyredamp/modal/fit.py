@@ -568,6 +568,7 @@ class ModalFitter:
         max_nfev: int = 200,
         tol: float = 1e-6,
         fixed: _added.FixedPart | None = None,
+        sigma_max: float | None = None,
     ) -> tuple[complex, NDArray[np.complex128], NDArray[np.float64]]:
         """Refine one added mode with the modes ``poles`` (m,) held fixed.
 
@@ -584,8 +585,9 @@ class ModalFitter:
         blocks of lines; the QR route of :func:`_vp_solve` is taken when the
         subtraction would lose accuracy. ``omega_bounds`` (rad/s, lower < upper)
         limits the damped natural frequency ``Im p`` of the added mode; ``tol``
-        as in :meth:`fit`. ``fixed``: the :meth:`fixed_part` of ``poles`` and
-        ``part`` (formed by this call when None; another mode set's is refused).
+        as in :meth:`fit`; ``sigma_max`` (rad/s) bounds its decay rate ``-Re p``.
+        ``fixed``: the :meth:`fixed_part` of ``poles`` and ``part`` (formed by
+        this call when None; another mode set's is refused).
 
         Returns
         -------
@@ -612,9 +614,8 @@ class ModalFitter:
         w = self._w1
         th0 = one.pack(p1, l1, ref1)
         solve = _added.added_solver(self, one, fixed, ref1, lay1)
-        th, _, _, sol = self._refine(
-            th0, 1, ref1, w, max_nfev, solve=solve, omega_bounds=omega_bounds, tol=tol
-        )
+        box = None if omega_bounds is None else (*omega_bounds, sigma_max or np.inf)
+        th, _, _, sol = self._refine(th0, 1, ref1, w, max_nfev, solve, box, tol)
         p_out, l_out = one.unpack(th, 1, ref1)
         dof = self.n_rows - self.n_cols(m + 1)
         res_ss = np.maximum(sol["cost_out"], 0.0) / w**2
@@ -628,16 +629,16 @@ class ModalFitter:
         w: NDArray[np.float64],
         max_nfev: int,
         solve: Any = None,
-        omega_bounds: tuple[float, float] | None = None,
+        box: tuple[float, float, float] | None = None,
         tol: float = 1e-6,
     ) -> tuple[NDArray[np.float64], int, str, dict[str, Any]]:
         n_par = th0.size
         lb, ub = pole_bounds(m, n_par)
-        if omega_bounds is not None:
-            lb[1 : 2 * m : 2] = max(1e-6, omega_bounds[0] / self.w_ref)
-            ub[1 : 2 * m : 2] = min(20.0, omega_bounds[1] / self.w_ref)
+        if box is not None:  # Im p in [box[0], box[1]], -Re p below box[2] (rad/s)
+            lb[1 : 2 * m : 2] = max(1e-6, box[0] / self.w_ref)
+            ub[1 : 2 * m : 2] = min(20.0, box[1] / self.w_ref)
+            ub[0 : 2 * m : 2] = min(np.log(5.0), np.log(max(box[2] / self.w_ref, 1e-6)))
         th0 = np.minimum(np.maximum(th0, lb + 1e-9), ub - 1e-9)
-
         n_lin = self.n_cols(m) if solve is None else 2
         n_obs = self.n_rows * self.n_out
 

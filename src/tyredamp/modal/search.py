@@ -145,11 +145,15 @@ def _trial(
     part: NDArray[np.complex128],
     w_lim: tuple[float, float],
     strict: bool = True,
+    max_damping: float | None = None,
 ) -> tuple[complex, NDArray[np.complex128], float] | None:
     """Refine one added mode alone against ``modes`` (their fixed part from
     ``fixed``); its statistic ``T``. ``strict``: None when it stopped at a limit
     of ``w_lim`` (an out-of-band residual mode that runs into the band edge is
-    not there); otherwise the limit only localises the trial."""
+    not there); otherwise the limit only localises the trial. ``max_damping``:
+    the trial's decay rate is bounded by that damping ratio at the window's upper
+    limit (:func:`sigma_bound`), so that a trial that would be refused for its
+    damping stops at the bound instead of running on (None: no bound)."""
     p_all, l_all = modes.all()
     fx = fixed.of(p_all, l_all)
     if fx is None:
@@ -164,6 +168,7 @@ def _trial(
             tol=TRIAL_TOL,
             fixed=fx,
             max_nfev=TRIAL_NFEV,
+            sigma_max=None if max_damping is None else sigma_bound(max_damping, w_lim[1]),
         )
     except (np.linalg.LinAlgError, ValueError):
         return None
@@ -177,6 +182,14 @@ def _trial(
     s2b = np.maximum(res.sigma_out**2, s2a)
     t = float(np.sum((s2b * dof0 - s2a * dof1) / s2a))
     return p_t, l_t, t
+
+
+def sigma_bound(max_damping: float, omega: float) -> float:
+    """The decay rate ``sigma = -Re p`` (rad/s) of damping ratio ``max_damping`` at the
+    damped natural frequency ``omega`` (rad/s): ``zeta = sigma / |p|`` with ``|p|^2
+    = sigma^2 + omega^2`` gives ``sigma = zeta omega / sqrt(1 - zeta^2)``. A pole
+    with ``Im p <= omega`` and a larger decay rate has a larger damping ratio."""
+    return float(max_damping * omega / np.sqrt(1.0 - max_damping**2))
 
 
 def reject_by_test(
@@ -461,14 +474,15 @@ def _follow(
     start: tuple[complex, NDArray[np.complex128]],
     w_lim: tuple[float, float],
     band: tuple[float, float],
+    max_damping: float | None = None,
 ) -> tuple[tuple[complex, NDArray[np.complex128], float], tuple[float, float]] | None:
     """A trial (:func:`_trial`) that follows its pole out of its window: one that
     stopped at a limit inside the band runs toward structure beyond it, and is
     continued from there in a window centred on it (at most ``FOLLOW`` times,
     while its statistic grows), unless that window holds a current mode (the
     pole runs toward that mode's misfit or noise, not toward a missed one).
-    Returns the trial's last result and window."""
-    got = _trial(fitter, res, cur, fixed, start[0], start[1], w_lim, strict=False)
+    Returns the trial's last result and window (``max_damping`` as in :func:`_trial`)."""
+    got = _trial(fitter, res, cur, fixed, start[0], start[1], w_lim, False, max_damping)
     w_band = (2 * np.pi * band[0], 2 * np.pi * band[1])
     for _ in range(FOLLOW):
         if got is None:
@@ -484,7 +498,7 @@ def _follow(
         )
         if np.any((cur.poles.imag > w_new[0]) & (cur.poles.imag < w_new[1])):
             break  # runs toward a current mode (its misfit or its noise), not beyond
-        nxt = _trial(fitter, res, cur, fixed, p_t, l_t, w_new, strict=False)
+        nxt = _trial(fitter, res, cur, fixed, p_t, l_t, w_new, False, max_damping)
         if nxt is None or nxt[2] <= got[2]:
             break
         got, w_lim = nxt, w_new
@@ -516,7 +530,8 @@ def residual_search(
     """Add missed in-band modes that pass the mode test (module docstring, stage 3).
 
     A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
-    of the diagram) is not a mode: it is rejected whatever its statistic. Nor
+    of the diagram) is not a mode: it is rejected whatever its statistic (a trial
+    stops at that bound, :func:`sigma_bound`, rather than running on). Nor
     is a trial whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
     narrower than the line spacing: such a pole fits single lines (an outlier,
     the tail of an impact test's low-frequency end) as well as a resonance.
@@ -650,11 +665,13 @@ def _try_start(
     )
     if not w_lim[0] < w_lim[1]:
         return rejected(p0, "not tried: its window lies outside the band")
-    got = _follow(fitter, res, cur, fixed, (p0, l0), w_lim, band)
+    got = _follow(fitter, res, cur, fixed, (p0, l0), w_lim, band, max_damping)
     if got is None:
         return None
     (p_t, l_t, t), w_lim = got
     why = _inadmissible(p_t, df, max_damping)
+    if not why and -p_t.real >= (1 - 1e-9) * sigma_bound(max_damping, w_lim[1]):
+        why = f"damping above the admissible {max_damping:.0%}"  # stopped at the bound
     if not why and t <= threshold:
         why = f"not significant: T = {t:.3g} <= {threshold:.3g}"
     if why:

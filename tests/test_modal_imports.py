@@ -1,0 +1,62 @@
+"""What importing the command line and the modal package loads (start-up time).
+
+Each check runs in a fresh interpreter and lists ``sys.modules`` after the
+import: a heavy import added back at module level (SciPy's optimisers,
+plotting, the parallel and file-format back-ends) fails here, not only in
+``benchmarks/startup.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+#: top-level packages that no command may load before it runs
+HEAVY = ("matplotlib", "scipy", "distributed", "dask", "asammdf", "nptdms")
+
+
+def _loaded(statement: str) -> list[str]:
+    """Modules in ``sys.modules`` after ``statement`` in a fresh interpreter."""
+    code = f"import json, sys\n{statement}\nprint(json.dumps(sorted(sys.modules)))"
+    env = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    out = subprocess.run(
+        [sys.executable, "-c", code], check=True, capture_output=True, text=True, env=env
+    )
+    return list(json.loads(out.stdout.splitlines()[-1]))
+
+
+def _heavy(mods: list[str], names: tuple[str, ...] = HEAVY) -> list[str]:
+    return [m for m in mods if m.split(".")[0] in names]
+
+
+@pytest.mark.parametrize("statement", ["import tyredamp", "import tyredamp.cli"])
+def test_command_line_loads_no_heavy_package(statement: str) -> None:
+    assert _heavy(_loaded(statement)) == []
+
+
+def test_modal_package_is_lazy() -> None:
+    # the names of tyredamp.modal are loaded on first access (PEP 562)
+    mods = _loaded("import tyredamp.modal")
+    assert _heavy(mods) == []
+    assert [m for m in mods if m.startswith("tyredamp.modal.")] == []
+    mods = _loaded("from tyredamp.modal import ModalModel")
+    assert "scipy.optimize" not in mods
+    assert "tyredamp.modal.identify" not in mods
+    assert _heavy(mods, ("matplotlib", "distributed", "dask", "asammdf", "nptdms")) == []
+
+
+def test_modal_package_names_resolve() -> None:
+    import tyredamp.modal as modal
+
+    for name in modal.__all__:
+        assert getattr(modal, name) is not None, name
+    assert set(modal.__all__) <= set(dir(modal))
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        modal.nothing
