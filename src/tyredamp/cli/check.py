@@ -9,17 +9,18 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from ..exceptions import InputError
 from ..io import read, read_frf
-from ..signal.checks import CheckResult
-from ..studies.radial import check_linearity, check_reciprocity
 from ..studies.steps import QualitySettings, QualityStep
 from ._common import channel_map, channel_map_options, echo_read_notes
 from ._settings import settings_from_options, settings_options
+
+if TYPE_CHECKING:
+    from ..signal.checks import CheckResult
 
 __all__ = ["check_group"]
 
@@ -91,6 +92,8 @@ def linearity_cmd(
             f"check linearity: expected two or more FRF files (one per force level), got "
             f"{len(frf_files)}"
         )
+    from ..studies.radial import check_linearity
+
     frfs = [read_frf(p) for p in frf_files]
     _finish(ctx, check_linearity(frfs, threshold, band or None), strict)
 
@@ -123,6 +126,8 @@ def reciprocity_cmd(
     """
     if not frf_files:
         raise InputError("check reciprocity: expected one or more FRF files, got none")
+    from ..studies.radial import check_reciprocity
+
     frfs = [read_frf(p) for p in frf_files]
     _finish(ctx, check_reciprocity(frfs, threshold, band or None), strict)
 

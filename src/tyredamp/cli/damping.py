@@ -9,20 +9,20 @@ description in ``docs/damping-json.md``).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 import numpy as np
 
-from ..damping import DampingModel, no_std_note
-from ..documents.damping import write_damping_json
-from ..documents.modes import read_modes
 from ..exceptions import InputError
 from ..io._common import check_input_file
 from ..io._safety import check_output_file
 from ..studies.steps import DampingSettings, DampingStep
 from ._common import out_file_option
 from ._settings import settings_from_options, settings_options
+
+if TYPE_CHECKING:
+    from ..damping import DampingModel
 
 __all__ = ["damping_command", "damping_summary"]
 
@@ -153,6 +153,9 @@ def damping_command(
     """
     check_output_file(out, [modes_json])
     settings = settings_from_options(DampingSettings, options)
+    from ..documents.damping import write_damping_json
+    from ..documents.modes import read_modes
+
     models = read_modes(check_input_file(modes_json))
     if settings.model not in models:
         raise InputError(
@@ -174,6 +177,8 @@ def damping_command(
     for row in damping_summary(dm) + extra_rows:
         click.echo(row)
     click.echo(f"wrote {out}")
+    from ..damping import no_std_note
+
     gap = no_std_note("")[: no_std_note("").index("for ")]
     for note in dm.findings:  # the run goes on; the gap is said where scripts look
         if note.startswith(gap):

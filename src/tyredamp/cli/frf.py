@@ -12,7 +12,6 @@ from ..exceptions import InputError
 from ..frf import FRF
 from ..io import FORMATS, format_of, read_timedata, write_frf
 from ..io._safety import check_output_file
-from ..signal.checks import dependent_forces
 from ..studies.steps import FrfSettings, FrfStep, samples
 from ..timedata import TimeData
 from ._common import channel_map, channel_map_options, echo_read_notes, out_file_option
@@ -48,6 +47,8 @@ def frf_summary(frf: FRF, coherence_min: float = 0.9) -> list[str]:
 
 def _refuse_dependent_forces(td: TimeData) -> None:
     """Every force channel would be an input: refuse when one follows from the others."""
+    from ..signal.checks import dependent_forces
+
     dep = dependent_forces(td)
     if not dep:
         return

@@ -20,12 +20,10 @@ from typing import Any
 
 import click
 
-from ..documents.lateral import write_lateral_fit
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, read_frf, write_frf
 from ..io._safety import check_output_file
 from ..studies.steps import LateralFitSettings, LateralFitStep
-from ..virtual.lateral_rig import KMH, VirtualLateralRig
 from ._common import out_file_option, seed_option
 from ._settings import settings_from_options, settings_options
 
@@ -91,6 +89,8 @@ def fit_command(frf_file: Path, out: Path, speed: float | None, **options: Any) 
         frf, settings, speed_kmh=speed, source=str(frf_file), labels=_LABELS
     )
     best = ranking.best
+    from ..documents.lateral import write_lateral_fit
+
     write_lateral_fit(out, ranking, data, source=str(frf_file), frf_kind=frf.kind)
     assumed = []
     if settings.force is None and "force" not in frf.meta:
@@ -102,6 +102,8 @@ def fit_command(frf_file: Path, out: Path, speed: float | None, **options: Any) 
         assumed.append("the file gives no wheel mass: 0 kg assumed (give --wheel-mass KG)")
     for a in assumed:
         click.echo(f"note: {a}", err=True)
+    from ..virtual.lateral_rig import KMH
+
     sp = "?" if data.speed is None else f"{data.speed / KMH:g} km/h"
     click.echo(
         f"{frf_file}: {best.n_lines} lines {best.frequency[0]:.3g}-{best.frequency[-1]:.3g} Hz, "
@@ -177,6 +179,8 @@ def simulate_command(
     """
     check_output_file(out)
     fmt = format_of(out, fmt)
+    from ..virtual.lateral_rig import VirtualLateralRig
+
     rig = VirtualLateralRig() if noise is None else VirtualLateralRig(relative_noise=noise)
     data = rig.measure(speed, pressure, force, seed)  # type: ignore[arg-type]
     path = write_frf(data.frf, out, fmt)

@@ -23,16 +23,17 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
 from ..documents.jsonfile import json_text
-from ..documents.modes import read_modes
 from ..exceptions import FileFormatError, InputError
 from ..io._safety import atomic_dir, check_output_dir, private_matplotlib_config
-from ..modal.model import ModalModel
 from ._common import OutPath
+
+if TYPE_CHECKING:
+    from ..modal.model import ModalModel
 
 __all__ = ["tyre_model_command", "write_all_or_none"]
 
@@ -400,6 +401,8 @@ def _read_tyre_modes(path: Path, model_kind: str, geometry_file: Path | None) ->
     from ..io import FILE_FORMATS
 
     uff = path.suffix.lower() in FILE_FORMATS["uff58b"].extensions
+    from ..documents.modes import read_modes
+
     models = read_modes(path)  # a UFF file of data sets 55 or a modes JSON
     if model_kind == "auto":
         mdl = models.get("complex") or models["real"]

@@ -28,6 +28,7 @@ Example
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -35,16 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from ..exceptions import FileFormatError, InputError, TyredampError
-from .damping import DAMPING_KIND, DAMPING_VERSION, damping_document, damping_from_document
-from .demo import RESULTS_KIND, RESULTS_VERSION, results_from_document
 from .jsonfile import read_json, write_json
-from .lateral import (
-    LATERAL_FIT_KIND,
-    LATERAL_FIT_VERSION,
-    lateral_fit_document,
-    lateral_fit_from_document,
-)
-from .modes import MODES_KIND, MODES_VERSION, models_from_document, modes_document
 
 __all__ = [
     "DOCUMENTS",
@@ -77,22 +69,45 @@ class DocumentKind:
     from_document: Callable[[dict[str, Any]], Any]
 
 
-def _results_document(doc: dict[str, Any]) -> dict[str, Any]:
-    return results_from_document(doc)
-
-
-#: Every result document by kind; a new kind is one module and one line here.
-DOCUMENTS: dict[str, DocumentKind] = {
-    d.kind: d
-    for d in (
-        DocumentKind(MODES_KIND, MODES_VERSION, modes_document, models_from_document),
-        DocumentKind(DAMPING_KIND, DAMPING_VERSION, damping_document, damping_from_document),
-        DocumentKind(
-            LATERAL_FIT_KIND, LATERAL_FIT_VERSION, lateral_fit_document, lateral_fit_from_document
-        ),
-        DocumentKind(RESULTS_KIND, RESULTS_VERSION, _results_document, results_from_document),
+@functools.cache
+def _registry() -> dict[str, DocumentKind]:
+    """:data:`DOCUMENTS`, built on first use (the kinds' modules import the method packages,
+    which a command that only reads options or writes JSON does not need)."""
+    from .damping import DAMPING_KIND, DAMPING_VERSION, damping_document, damping_from_document
+    from .demo import RESULTS_KIND, RESULTS_VERSION, results_from_document
+    from .lateral import (
+        LATERAL_FIT_KIND,
+        LATERAL_FIT_VERSION,
+        lateral_fit_document,
+        lateral_fit_from_document,
     )
-}
+    from .modes import MODES_KIND, MODES_VERSION, models_from_document, modes_document
+
+    def results_document(doc: dict[str, Any]) -> dict[str, Any]:
+        return results_from_document(doc)
+
+    return {
+        d.kind: d
+        for d in (
+            DocumentKind(MODES_KIND, MODES_VERSION, modes_document, models_from_document),
+            DocumentKind(DAMPING_KIND, DAMPING_VERSION, damping_document, damping_from_document),
+            DocumentKind(
+                LATERAL_FIT_KIND,
+                LATERAL_FIT_VERSION,
+                lateral_fit_document,
+                lateral_fit_from_document,
+            ),
+            DocumentKind(RESULTS_KIND, RESULTS_VERSION, results_document, results_from_document),
+        )
+    }
+
+
+def __getattr__(name: str) -> Any:
+    #: Every result document by kind (:class:`DocumentKind`); a new kind is one module
+    #: and one line in :func:`_registry`.
+    if name == "DOCUMENTS":
+        return _registry()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def kind_of(doc: dict[str, Any]) -> str:
@@ -104,17 +119,18 @@ def kind_of(doc: dict[str, Any]) -> str:
         No known kind, or a version newer than this tyredamp reads.
     """
     kind = doc.get("kind", doc.get("tyredamp"))
-    if not isinstance(kind, str) or kind not in DOCUMENTS:
+    documents = _registry()
+    if not isinstance(kind, str) or kind not in documents:
         raise FileFormatError(
-            f"not a tyredamp result document (kind {kind!r}; expected one of {sorted(DOCUMENTS)})"
+            f"not a tyredamp result document (kind {kind!r}; expected one of {sorted(documents)})"
         )
     version = doc.get("version", 1)
     if not isinstance(version, int) or isinstance(version, bool) or version < 1:
         raise FileFormatError(f"{kind}: version: expected an integer >= 1, got {version!r}")
-    if version > DOCUMENTS[kind].version:
+    if version > documents[kind].version:
         raise FileFormatError(
             f"{kind}: version {version} is newer than this tyredamp reads "
-            f"({DOCUMENTS[kind].version}); update tyredamp"
+            f"({documents[kind].version}); update tyredamp"
         )
     return kind
 
@@ -132,7 +148,7 @@ def read_document(path: str | os.PathLike[str]) -> tuple[str, Any, dict[str, Any
     try:
         doc = read_json(p)
         kind = kind_of(doc)
-        return kind, DOCUMENTS[kind].from_document(doc), doc
+        return kind, _registry()[kind].from_document(doc), doc
     except FileFormatError as exc:
         msg = str(exc)
         raise FileFormatError(msg if msg.startswith(str(p)) else f"{p}: {msg}") from None
@@ -152,6 +168,7 @@ def write_document(path: str | os.PathLike[str], kind: str, obj: Any, **options:
     ``options`` go to the kind's ``to_document`` (for example ``source=`` of
     the modes document).
     """
-    if kind not in DOCUMENTS:
-        raise InputError(f"kind: expected one of {sorted(DOCUMENTS)}, got {kind!r}")
-    return write_json(DOCUMENTS[kind].to_document(obj, **options), path)
+    documents = _registry()
+    if kind not in documents:
+        raise InputError(f"kind: expected one of {sorted(documents)}, got {kind!r}")
+    return write_json(documents[kind].to_document(obj, **options), path)

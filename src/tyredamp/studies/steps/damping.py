@@ -4,12 +4,18 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
-from ...damping import METHODS, DampingModel
 from ...exceptions import InputError
-from ...modal.model import ModalModel
 from ._settings import Band, Boolean, Check, Choice, Integer, StepSettings, knob
+
+if TYPE_CHECKING:
+    from ...damping import DampingModel
+    from ...modal.model import ModalModel
+
+#: The estimators of :data:`tyredamp.damping.METHODS` (named here so that the settings
+#: load without the numerical packages; a test keeps the two equal).
+DAMPING_METHODS: tuple[str, ...] = ("first", "improved", "refined")
 
 __all__ = ["DampingSettings", "DampingStep", "ModeNumbers"]
 
@@ -66,7 +72,7 @@ class DampingSettings(StepSettings):
         "improved",
         "first: eq. [16]; improved: eq. [18]; refined: bias-corrected (exact for "
         "consistent modes).",
-        Choice(tuple(METHODS)),
+        Choice(DAMPING_METHODS),
         "--method",
     )
     model: str = knob(

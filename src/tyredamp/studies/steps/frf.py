@@ -6,12 +6,14 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ...frf import FRF
-from ...signal.estimators import ESTIMATORS
 from ...timedata import TimeData
 from ._settings import Band, Choice, Integer, Length, Names, StepSettings, knob, samples
 
 __all__ = ["FRF_METHODS", "FrfSettings", "FrfStep"]
 
+#: The FRF estimators of :data:`tyredamp.signal.estimators.ESTIMATORS` (named here so that
+#: the settings load without SciPy; a test keeps the two equal).
+FRF_ESTIMATORS: tuple[str, ...] = ("H1", "H2", "Hv")
 #: Averaging methods of the FRF estimation (``auto``: from the file, else from the data).
 FRF_METHODS: tuple[str, ...] = ("auto", "cyclic", "welch", "transient", "lrm", "lpm")
 
@@ -26,7 +28,7 @@ class FrfSettings(StepSettings):
     estimator: str = knob(
         "H1",
         "H1 (noise on outputs), H2 (noise on inputs) or Hv (total least squares).",
-        Choice(tuple(ESTIMATORS)),
+        Choice(FRF_ESTIMATORS),
         "--estimator",
     )
     reference: tuple[str, ...] | None = knob(

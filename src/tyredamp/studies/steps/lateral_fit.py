@@ -4,15 +4,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from ...exceptions import InputError
 from ...frf import FRF
-from ...lateral import DEFAULT_MODELS
-from ...lateral.ranking import Ranking
 from ._settings import Band, Choice, Names, Number, Pair, StepSettings, knob
 
-__all__ = ["LateralFitSettings", "LateralFitStep"]
+if TYPE_CHECKING:
+    from ...lateral.ranking import Ranking
+
+__all__ = ["LATERAL_MODELS", "LateralFitSettings", "LateralFitStep"]
 
 
 def _model_name(name: str, where: str) -> str:
@@ -24,12 +25,22 @@ def _model_name(name: str, where: str) -> str:
         raise InputError(f"{where}: {exc}") from None
 
 
-def _models_text() -> str:
-    from ...lateral.models import MODELS
+#: The lateral models of :data:`tyredamp.lateral.models.MODELS` (named here so that the
+#: settings load without SciPy; a test keeps the two equal).
+LATERAL_MODELS: tuple[str, ...] = (
+    "classic",
+    "hysteretic",
+    "maxwell",
+    "relaxation",
+    "string",
+    "viscoplastic",
+)
 
+
+def _models_text() -> str:
     return (
-        f"Models to compare, comma-separated or repeated; from {sorted(MODELS)} or aliases "
-        "(proposed, lines ...). Default: classic, maxwell, viscoplastic, hysteretic."
+        f"Models to compare, comma-separated or repeated; from {list(LATERAL_MODELS)} or "
+        "aliases (proposed, lines ...). Default: classic, maxwell, viscoplastic, hysteretic."
     )
 
 
@@ -129,6 +140,8 @@ class LateralFitStep:
             force=s.force,  # type: ignore[arg-type]
             wheel_mass=s.wheel_mass_kg,
         )
+        from ...lateral import DEFAULT_MODELS
+
         names = list(s.models or DEFAULT_MODELS)
         if data.speed is None:
             need = [n for n in names if "speed" in get_model_class(n).condition_names]

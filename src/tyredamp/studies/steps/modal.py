@@ -10,12 +10,9 @@ the verdicts into the modes document (``meta.verdict`` of each model,
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from ...frf import FRF
-from ...modal.estimators import DEFAULT_ESTIMATOR, ESTIMATORS
-from ...modal.identify import ModalIdentification
-from ...modal.stats import FALSE_ALARM
 from ._settings import (
     Band,
     Boolean,
@@ -28,7 +25,23 @@ from ._settings import (
     knob,
 )
 
+if TYPE_CHECKING:
+    from ...modal.identify import ModalIdentification
+
 __all__ = ["MODAL_MODELS", "ModalSettings", "ModalStep"]
+
+#: The default false-alarm rate of the mode test (:data:`tyredamp.modal.stats.FALSE_ALARM`)
+#: and pole estimator (:data:`tyredamp.modal.estimators.DEFAULT_ESTIMATOR`), named here so
+#: that the settings load without SciPy; a test keeps them equal.
+FALSE_ALARM = 0.01
+DEFAULT_ESTIMATOR = "plscf"
+
+
+def _estimators() -> Any:
+    from ...modal.estimators import ESTIMATORS
+
+    return ESTIMATORS
+
 
 #: The modal models a fit can give.
 MODAL_MODELS: tuple[str, ...] = ("both", "real", "complex")
@@ -89,7 +102,7 @@ class ModalSettings(StepSettings):
     estimator: str = knob(
         DEFAULT_ESTIMATOR,
         "Pole estimator of the stabilisation diagram, by name (plscf: poly-reference LSCF).",
-        Registered(lambda: ESTIMATORS, "pole estimator"),
+        Registered(_estimators, "pole estimator"),
         "--estimator",
     )
 
@@ -129,7 +142,7 @@ class ModalStep:
             residuals=s.residuals,
             false_alarm=s.false_alarm,
             search=s.search,
-            estimator=ESTIMATORS[s.estimator],
+            estimator=_estimators()[s.estimator],
         )
         for mdl in res.models.values():
             label_wave_numbers(mdl)

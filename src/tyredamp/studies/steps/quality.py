@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from ...frf import FRF
-from ...signal import CheckResult
 from ...timedata import TimeData
 from ._settings import Band, Number, StepSettings, knob
+
+if TYPE_CHECKING:
+    from ...signal import CheckResult
 
 __all__ = ["QualitySettings", "QualityStep"]
 

@@ -1,4 +1,4 @@
-"""What importing the command line and the modal package loads (start-up time).
+"""What importing the command line, its subcommands and the modal package loads (start-up).
 
 Each check runs in a fresh interpreter and lists ``sys.modules`` after the
 import: a heavy import added back at module level (SciPy's optimisers,
@@ -39,6 +39,43 @@ def _heavy(mods: list[str], names: tuple[str, ...] = HEAVY) -> list[str]:
 @pytest.mark.parametrize("statement", ["import tyredamp", "import tyredamp.cli"])
 def test_command_line_loads_no_heavy_package(statement: str) -> None:
     assert _heavy(_loaded(statement)) == []
+
+
+def _commands() -> list[str]:
+    cli = Path(SRC) / "tyredamp" / "cli"
+    return sorted(p.stem for p in cli.glob("*.py") if not p.stem.startswith("_"))
+
+
+@pytest.mark.parametrize("command", _commands())
+def test_every_command_module_loads_no_heavy_package(command: str) -> None:
+    # a subcommand's module is imported for its --help and before its inputs are
+    # checked: the numerical packages wait until the command runs
+    assert _heavy(_loaded(f"import tyredamp.cli.{command}")) == []
+
+
+def test_step_settings_name_what_the_registries_hold() -> None:
+    # the settings carry the registries' names so that they load without SciPy
+    from tyredamp.damping import METHODS
+    from tyredamp.lateral.models import MODELS
+    from tyredamp.modal.estimators import DEFAULT_ESTIMATOR
+    from tyredamp.modal.stats import FALSE_ALARM
+    from tyredamp.signal.estimators import ESTIMATORS
+    from tyredamp.studies.steps import damping, frf, lateral_fit, modal
+
+    assert damping.DAMPING_METHODS == tuple(METHODS)
+    assert frf.FRF_ESTIMATORS == tuple(ESTIMATORS)
+    assert lateral_fit.LATERAL_MODELS == tuple(sorted(MODELS))
+    assert modal.FALSE_ALARM == FALSE_ALARM
+    assert modal.DEFAULT_ESTIMATOR == DEFAULT_ESTIMATOR
+
+
+def test_documents_registry_is_built_on_first_use() -> None:
+    mods = _loaded("import tyredamp.documents.jsonfile")
+    assert _heavy(mods) == []
+    assert "tyredamp.documents.modes" not in mods
+    from tyredamp.documents import DOCUMENTS
+
+    assert sorted(DOCUMENTS) == ["damping", "lateral-fit", "modes", "tyredamp-demo-results"]
 
 
 def test_modal_package_is_lazy() -> None:
