@@ -62,9 +62,9 @@ def test_step_settings_name_what_the_registries_hold() -> None:
     from tyredamp.signal.estimators import ESTIMATORS
     from tyredamp.studies.steps import damping, frf, lateral_fit, modal
 
-    assert damping.DAMPING_METHODS == tuple(METHODS)
-    assert frf.FRF_ESTIMATORS == tuple(ESTIMATORS)
-    assert lateral_fit.LATERAL_MODELS == tuple(sorted(MODELS))
+    assert tuple(METHODS) == damping.DAMPING_METHODS
+    assert tuple(ESTIMATORS) == frf.FRF_ESTIMATORS
+    assert tuple(sorted(MODELS)) == lateral_fit.LATERAL_MODELS
     assert modal.FALSE_ALARM == FALSE_ALARM
     assert modal.DEFAULT_ESTIMATOR == DEFAULT_ESTIMATOR
 
