@@ -34,12 +34,12 @@ from __future__ import annotations
 import glob
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..exceptions import InputError
+from ..exceptions import FileFormatError, InputError
+from ..io._guard import load_toml
 from . import steps
 
 __all__ = [
@@ -332,9 +332,9 @@ def load_campaign(path: str | Path) -> Campaign:
     if not src.is_file():
         raise CampaignFileError(f"{src}: campaign file not found")
     try:
-        doc = tomllib.loads(src.read_text(encoding="utf-8"))
+        doc = load_toml(src.read_text(encoding="utf-8"), str(src))
     except UnicodeDecodeError:
         raise CampaignFileError(f"{src}: not a text (TOML) file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignFileError(f"{src}: not valid TOML ({exc})") from None
+    except FileFormatError as exc:
+        raise CampaignFileError(str(exc)) from None
     return parse_campaign(doc, src)

@@ -23,6 +23,7 @@ from ..exceptions import FileFormatError
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
+from ._guard import axis_scale
 from .channelmap import ChannelMap
 
 __all__ = ["read_tdms"]
@@ -87,7 +88,7 @@ def read_tdms(
         if named:
             groups = named
     chans = list(groups[0].channels())
-    time_dt, time_name = _time_channel(chans)
+    time_dt, time_name = _time_channel(p, chans)
     notes = []
     if time_name is not None:
         notes.append(f"sample interval from the time channel {time_name!r}")
@@ -101,9 +102,24 @@ def read_tdms(
                 "the group has no evenly spaced time channel (Time, t, ...)"
             )
         try:
-            steps.append(float(props.get("wf_increment", time_dt)))
-            arrays.append(np.asarray(c[:], dtype=float))
+            raw = np.asarray(c[:])
+            if raw.dtype.kind == "c":
+                raise FileFormatError(
+                    f"{p}: channel {c.name!r} holds complex values; time data are real "
+                    "(a spectrum or FRF stored in TDMS is not read as time data)"
+                )
+            scale, note = (1.0, None)
+            if "wf_increment" in props:  # in the waveform's x unit (s by default)
+                scale, note = axis_scale(
+                    props.get("wf_xunit_string"), "time", f"{p}: channel {c.name!r} wf_xunit_string"
+                )
+            if note and note not in notes:
+                notes.append(note)
+            steps.append(float(props.get("wf_increment", time_dt)) * scale)
+            arrays.append(np.asarray(raw, dtype=float))
         except (TypeError, ValueError) as exc:
+            if isinstance(exc, FileFormatError):
+                raise
             raise FileFormatError(f"{p}: channel {c.name!r}: {exc}") from None
         names.append(str(c.name))
         units.append(str(props.get("unit_string", "") or ""))
@@ -129,7 +145,7 @@ def read_tdms(
 _TIME_NAMES = {"time", "t", "zeit", "time_s", "timestamp", "x_value", "relative time"}
 
 
-def _time_channel(chans: list[Any]) -> tuple[float | None, str | None]:
+def _time_channel(p: Any, chans: list[Any]) -> tuple[float | None, str | None]:
     """``(interval in s, name)`` of an evenly spaced time channel when a channel lacks
     ``wf_increment`` (files written by scripts rather than LabVIEW waveforms)."""
     if all("wf_increment" in c.properties for c in chans):
@@ -143,7 +159,10 @@ def _time_channel(chans: list[Any]) -> tuple[float | None, str | None]:
             continue
         if t.size < 2:
             continue
-        dt = float(t[-1] - t[0]) / (t.size - 1)
-        if dt > 0 and np.max(np.abs(np.diff(t) - dt)) <= 1e-6 * dt:
+        scale, _ = axis_scale(
+            c.properties.get("unit_string"), "time", f"{p}: time channel {c.name!r} unit"
+        )
+        dt = float(t[-1] - t[0]) / (t.size - 1) * scale
+        if dt > 0 and np.max(np.abs(np.diff(t) * scale - dt)) <= 1e-6 * dt:
             return dt, str(c.name)
     return None, None
