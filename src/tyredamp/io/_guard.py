@@ -48,6 +48,7 @@ __all__ = [
     "axis_scale",
     "check_archive",
     "guarded_read",
+    "library_messages",
     "load_toml",
     "quiet_libraries",
     "toml_depth",
@@ -146,28 +147,64 @@ def _drop_unraisable(_unraisable: Any) -> None:
     """Drop what a destructor raises while a file is read (a half-opened file's cleanup)."""
 
 
-@contextlib.contextmanager
-def quiet_libraries() -> Iterator[None]:
-    """Silence the readers' libraries: their loggers and their destructors' complaints.
+#: Log records of the libraries, one list per read under way (innermost last).
+_RECORDS: list[list[logging.LogRecord]] = []
 
-    Loggers in :data:`LIBRARY_LOGGERS` are disabled and restored afterwards;
-    ``sys.unraisablehook`` drops what a destructor raises (asammdf's
-    ``__del__`` of a file it failed to open), and a garbage collection before
-    leaving runs those destructors while the hook is in place.
+
+class _Capture(logging.Handler):
+    def __init__(self, sink: list[logging.LogRecord]) -> None:
+        super().__init__(logging.DEBUG)
+        self.sink = sink
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.sink.append(record)
+
+
+def library_messages() -> list[str]:
+    """What the libraries logged during the read under way (for a reader that checks, e.g.
+    npTDMS's ``less data than expected`` of a truncated file)."""
+    return [r.getMessage() for r in _RECORDS[-1]] if _RECORDS else []
+
+
+def _library_loggers() -> list[logging.Logger]:
+    names = set(LIBRARY_LOGGERS)
+    for name in list(logging.root.manager.loggerDict):
+        if name.split(".")[0] in LIBRARY_LOGGERS:
+            names.add(name)
+    return [logging.getLogger(n) for n in sorted(names)]
+
+
+@contextlib.contextmanager
+def quiet_libraries() -> Iterator[list[logging.LogRecord]]:
+    """Keep the readers' libraries off stderr: their loggers and their destructors.
+
+    The loggers of :data:`LIBRARY_LOGGERS` and their children (npTDMS gives
+    each module its own console handler) send their records to a list instead
+    of stderr (yielded; :func:`library_messages` reads it), and are restored
+    afterwards; ``sys.unraisablehook`` drops what a destructor raises
+    (asammdf's ``__del__`` of a file it failed to open), and a garbage
+    collection before leaving runs those destructors while the hook is in place.
     """
+    records: list[logging.LogRecord] = []
+    capture = _Capture(records)
     saved = []
-    for name in LIBRARY_LOGGERS:
-        log = logging.getLogger(name)
-        saved.append((log, log.disabled))
-        log.disabled = True
+    for log in _library_loggers():
+        saved.append((log, list(log.handlers), log.propagate, log.disabled))
+        log.handlers = [capture]
+        log.propagate = False
+        log.disabled = False
     hook = sys.unraisablehook
     sys.unraisablehook = _drop_unraisable
+    _RECORDS.append(records)
     try:
-        yield
+        yield records
     finally:
         gc.collect()
+        _RECORDS.pop()
         sys.unraisablehook = hook
-        for log, disabled in saved:
+        for log, handlers, propagate, disabled in saved:
+            log.handlers = handlers
+            log.propagate = propagate
             log.disabled = disabled
 
 

@@ -29,7 +29,7 @@ from ..exceptions import FileFormatError, InputError
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
-from ._guard import axis_scale
+from ._guard import axis_scale, quiet_libraries
 from .channelmap import ChannelMap
 from .units import quantity_units
 
@@ -102,18 +102,9 @@ def read_mdf(
         Not an MDF file, no numeric channels, channels named on different
         time bases, uneven sampling, a channel whose quantity cannot be told.
     """
-    try:
-        from asammdf import MDF
-    except ImportError:  # pragma: no cover - optional dependency
-        raise FileFormatError(
-            f"{path}: reading MDF needs asammdf (pip install 'tyredamp[mdf]')"
-        ) from None
     p = check_input_file(path)
     cmap = ChannelMap.from_quantities(quantities).merged(channel_map)
-    try:
-        mdf = MDF(str(p))
-    except Exception as exc:  # asammdf raises MdfException, ValueError ... on garbage
-        raise FileFormatError(f"{p}: not a readable MDF file ({exc})") from None
+    mdf = _open(p)
     skipped: list[str] = []
     sigs, groups = [], []
     master_units: dict[int, str] = {}
@@ -196,6 +187,21 @@ def read_mdf(
         meta=meta,
         notes=notes,
     )
+
+
+def _open(p: Any) -> Any:
+    """The asammdf ``MDF`` object of ``p`` (its loggers quiet: they exist once imported)."""
+    try:
+        from asammdf import MDF
+    except ImportError:  # pragma: no cover - optional dependency
+        raise FileFormatError(
+            f"{p}: reading MDF needs asammdf (pip install 'tyredamp[mdf]')"
+        ) from None
+    try:
+        with quiet_libraries():
+            return MDF(str(p))
+    except Exception as exc:  # asammdf raises MdfException, ValueError ... on garbage
+        raise FileFormatError(f"{p}: not a readable MDF file ({exc})") from None
 
 
 def _only(cmap: ChannelMap, kept: list[str], p: Any, all_names: list[str]) -> ChannelMap:

@@ -23,7 +23,7 @@ from ..exceptions import FileFormatError
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
-from ._guard import axis_scale
+from ._guard import axis_scale, library_messages, quiet_libraries
 from .channelmap import ChannelMap
 
 __all__ = ["read_tdms"]
@@ -68,8 +68,17 @@ def read_tdms(
         ) from None
     p = check_input_file(path)
     try:
-        f = TdmsFile.read(str(p))
-        groups = [g for g in f.groups() if g.channels()]
+        with quiet_libraries():  # again: npTDMS's loggers exist once it is imported
+            f = TdmsFile.read(str(p))
+            groups = [g for g in f.groups() if g.channels()]
+            said = library_messages()
+        if any("less data than expected" in m for m in said):
+            raise FileFormatError(
+                f"{p}: truncated TDMS file: its last segment holds less data than its header "
+                "declares"
+            )
+    except FileFormatError:
+        raise
     except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on garbage
         raise FileFormatError(f"{p}: not a readable TDMS file ({exc})") from None
     if group is not None:
