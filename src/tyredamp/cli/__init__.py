@@ -258,9 +258,9 @@ def main(argv: list[str] | None = None) -> None:
         code = EXIT_INPUT
         text = exc.strerror or str(exc)
         message = f"{exc.filename}: {text}" if exc.filename else text
-    except ArithmeticError as exc:
-        # OverflowError, ZeroDivisionError, FloatingPointError: values of the input beyond
-        # what double precision computes with (|H| near 1e300 squared): the input's fault
+    except (OverflowError, FloatingPointError) as exc:
+        # values of the input beyond what double precision computes with (|H| near 1e300
+        # squared): the input's fault (a ZeroDivisionError stays a bug, exit 70)
         error = sys.exc_info()[1]
         code = EXIT_INPUT
         message = (
