@@ -34,12 +34,12 @@ from __future__ import annotations
 import glob
 import math
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..exceptions import InputError
+from ..exceptions import FileFormatError, InputError
+from ..io._guard import load_toml
 from . import steps
 
 __all__ = [
@@ -341,11 +341,11 @@ def load_campaign(path: str | Path) -> Campaign:
                 f"{src}: {src.stat().st_size} bytes; a campaign file is at most "
                 f"{MAX_CAMPAIGN_BYTES >> 20} MiB (globs list many test files in one line)"
             )
-        doc = tomllib.loads(src.read_text(encoding="utf-8"))
+        doc = load_toml(src.read_text(encoding="utf-8"), str(src))
     except UnicodeDecodeError:
         raise CampaignFileError(f"{src}: not a text (TOML) file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignFileError(f"{src}: not valid TOML ({exc})") from None
+    except FileFormatError as exc:
+        raise CampaignFileError(str(exc)) from None
     except RecursionError:
         raise CampaignFileError(f"{src}: not valid TOML (nested too deeply)") from None
     except OSError as exc:

@@ -29,6 +29,7 @@ from ._common import (
     EXIT_SIGTERM,
     Interrupted,
     fail,
+    quiet_run,
 )
 
 __all__ = ["COMMANDS", "LazyGroup", "cli", "main"]
@@ -219,7 +220,7 @@ def main(argv: list[str] | None = None) -> None:
                 # (imported here so that --help and --version start fast).
                 from .._blas import single_threaded_blas
 
-                with single_threaded_blas():
+                with single_threaded_blas(), quiet_run(debug):
                     rv = cli.main(args=args, prog_name="tyredamp", standalone_mode=False)
                 if isinstance(rv, int) and rv != 0:
                     # ctx.exit(n) hands its code back as the return value here
@@ -257,6 +258,15 @@ def main(argv: list[str] | None = None) -> None:
         code = EXIT_INPUT
         text = exc.strerror or str(exc)
         message = f"{exc.filename}: {text}" if exc.filename else text
+    except (OverflowError, FloatingPointError) as exc:
+        # values of the input beyond what double precision computes with (|H| near 1e300
+        # squared): the input's fault (a ZeroDivisionError stays a bug, exit 70)
+        error = sys.exc_info()[1]
+        code = EXIT_INPUT
+        message = (
+            f"numbers out of the range of double precision ({type(exc).__name__}: {exc}); "
+            "the input's values are too large or too small to compute with: check its units"
+        )
     except (MemoryError, RecursionError) as exc:
         error = sys.exc_info()[1]
         code = EXIT_INTERNAL

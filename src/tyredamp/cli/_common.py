@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import gc
+import logging
 import sys
-from collections.abc import Callable
+import warnings
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
@@ -26,6 +30,7 @@ __all__ = [
     "fail",
     "out_file_option",
     "parse_drive_points",
+    "quiet_run",
     "seed_option",
 ]
 
@@ -56,6 +61,41 @@ def fail(message: str, code: int = EXIT_INPUT) -> NoReturn:
     line = " ".join(str(message).split())
     click.echo(f"tyredamp: error: {line}", err=True)
     sys.exit(code)
+
+
+class _LogAsWarning(logging.Handler):
+    """Library log records (WARNING and above) as Python warnings: the command line
+    prints them as its own one-line ``tyredamp: warning:`` after a successful run."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        text = " ".join(record.getMessage().split())
+        warnings.warn(f"{record.name}: {text[:200]}", RuntimeWarning, stacklevel=2)
+
+
+@contextlib.contextmanager
+def quiet_run(debug: bool) -> Iterator[None]:
+    """Keep library output off stderr while a command runs (unless ``debug``).
+
+    Log records of the libraries (matplotlib's font cache, npTDMS, scipy ...)
+    become warnings, printed as one-line ``tyredamp: warning:`` lines after a
+    successful run and dropped after an error; what destructors raise (a
+    library's cleanup of a file it failed to open) is dropped, after a garbage
+    collection that runs them before the error line is printed.
+    """
+    if debug:
+        yield
+        return
+    root = logging.getLogger()
+    handler = _LogAsWarning(logging.WARNING)
+    root.addHandler(handler)
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda _unraisable: None
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = hook
+        root.removeHandler(handler)
 
 
 class OutPath(click.Path):

@@ -45,6 +45,7 @@ from typing import Any, Literal
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, FRFKind
 from ..timedata import TimeData
+from ._guard import guarded_read
 from .channelmap import ChannelMap, ChannelSpec
 
 __all__ = [
@@ -132,10 +133,11 @@ class FileFormat:
                     "(--channel, --sensitivity, --channel-map) is not used for them"
                 )
             kw["channel_map"] = channel_map
-        if self.selects:
-            obj: FRF | TimeData = self._function(self.reader)(path, what, kind, **kw)
-        else:
-            obj = self._function(self.reader)(path, **kw)
+        with guarded_read(path):
+            if self.selects:
+                obj: FRF | TimeData = self._function(self.reader)(path, what, kind, **kw)
+            else:
+                obj = self._function(self.reader)(path, **kw)
         return obj
 
     def write(self, obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:

@@ -447,14 +447,42 @@ def _usual_mode(p: Path, directory: bool = False) -> None:
 
 
 def _rename_error(exc: OSError, names: dict[str, str]) -> OSError:
-    """``exc`` with temporary names replaced by the user's names (same errno)."""
+    """``exc`` with temporary names replaced by the user's names (same errno).
+
+    An error without a file name (``No space left on device`` while writing)
+    gets the user's target, so that the one error line says which file failed.
+    """
     fn = exc.filename
     if isinstance(fn, str | os.PathLike):
         for tmp, user in names.items():
             if os.fspath(fn) == tmp or tmp in os.fspath(fn):
-                new = OSError(exc.errno, exc.strerror or str(exc), user)
-                return new
+                where = os.fspath(fn).replace(tmp, user)
+                return OSError(exc.errno, _user_text(exc.strerror or str(exc), names), where)
+        return exc
+    users = list(dict.fromkeys(names.values()))
+    if fn is None and users and exc.errno is not None:
+        return OSError(exc.errno, _user_text(exc.strerror or str(exc), names), ", ".join(users))
     return exc
+
+
+def _user_text(text: str, names: dict[str, str]) -> str:
+    """``text`` with every temporary name replaced by the user's name of its target."""
+    for tmp, user in names.items():
+        text = text.replace(tmp, user)
+    return text
+
+
+def _renamed(exc: BaseException, names: dict[str, str]) -> BaseException:
+    """A tyredamp error whose message names a temporary, re-made naming the target."""
+    from ..exceptions import TyredampError
+
+    text = str(exc)
+    if not isinstance(exc, TyredampError) or not any(t in text for t in names):
+        return exc
+    try:
+        return type(exc)(_user_text(text, names))
+    except Exception:  # pragma: no cover - an error class with another signature
+        return exc
 
 
 class _Target:
@@ -518,9 +546,12 @@ def atomic_paths(paths: Sequence[str | os.PathLike[str]]) -> Iterator[list[Path]
     except OSError as exc:
         _cleanup(targets)
         raise _rename_error(exc, names) from None
-    except BaseException:
+    except BaseException as exc:
         _cleanup(targets)
-        raise
+        new = _renamed(exc, names)
+        if new is exc:
+            raise
+        raise new from None
 
 
 def _commit(targets: list[_Target], names: dict[str, str]) -> None:
@@ -633,9 +664,12 @@ def atomic_dir(path: str | os.PathLike[str]) -> Iterator[Path]:
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
         raise _rename_error(exc, names) from None
-    except BaseException:
+    except BaseException as exc:
         shutil.rmtree(tmp, ignore_errors=True)
-        raise
+        new = _renamed(exc, names)
+        if new is exc:
+            raise
+        raise new from None
 
 
 # ----------------------------------------------------------------------------- matplotlib

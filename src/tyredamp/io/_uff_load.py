@@ -18,6 +18,7 @@ import numpy as np
 import pyuff
 
 from ..exceptions import FileFormatError
+from ._guard import axis_scale
 from ._text import decode_text
 from ._uff_meta import read_meta_record
 
@@ -40,8 +41,12 @@ def _markers(raw: bytes) -> int:
             count += 1
 
 
-def load_sets(p: Path) -> list[dict[str, Any]]:
-    raw = p.read_bytes()
+def check_delimiters(p: Path, raw: bytes) -> None:
+    """Refuse a UFF file without data sets or whose last data set is cut off.
+
+    Every UFF data set (58, 55, 15, 2411, ...) opens and closes with a ``    -1``
+    line; an odd count means the file ends inside a data set (a truncated copy).
+    """
     n_marks = _markers(raw)
     if n_marks == 0:
         raise FileFormatError(f"{p}: no UFF data set found (no '    -1' delimiters)")
@@ -49,6 +54,11 @@ def load_sets(p: Path) -> list[dict[str, Any]]:
         raise FileFormatError(
             f"{p}: truncated UFF file: the last data set has no closing '    -1' delimiter"
         )
+
+
+def load_sets(p: Path) -> list[dict[str, Any]]:
+    raw = p.read_bytes()
+    check_delimiters(p, raw)
     try:
         uff = pyuff.UFF(str(p))
         types = list(uff.get_set_types())
@@ -80,10 +90,40 @@ def load_sets(p: Path) -> list[dict[str, Any]]:
             )
         s["_index"] = k + 1
     _redecode_strings(raw, sets)
-    if record is not None:
+    notes = _abscissa_units(p, sets)
+    if record is not None or notes:
+        extra = {"read_notes": [*(record or {}).get("read_notes", []), *notes]} if notes else {}
         for s in sets:
-            s["_meta"] = record
+            s["_meta"] = {**(record or {}), **extra}
     return sets
+
+
+def _abscissa_units(p: Path, sets: list[dict[str, Any]]) -> list[str]:
+    """Convert each data set's abscissa to Hz or s from its units label (record 8).
+
+    A frequency axis (abscissa data type 18, or a non-time function) may be in
+    Hz, kHz, rad/s, cpm or rpm, a time axis (type 17, or function type 1) in
+    s, ms, us or min; the values are converted and a note says so. Any other
+    label is refused (:func:`._guard.axis_scale`).
+    """
+    notes: list[str] = []
+    for s in sets:
+        sdt = int(s.get("abscissa_spec_data_type", 0) or 0)
+        timelike = sdt == 17 or (sdt not in (17, 18) and int(s.get("func_type", 0) or 0) == 1)
+        factor, note = axis_scale(
+            s.get("abscissa_axis_units_lab"),
+            "time" if timelike else "frequency",
+            f"{p}: data set #{s['_index']} abscissa units",
+        )
+        if note is None:
+            continue
+        if note not in notes:
+            notes.append(note)
+        s["x"] = np.asarray(s["x"], dtype=float) * factor
+        for key in ("abscissa_inc", "abscissa_min"):
+            if key in s:
+                s[key] = float(s[key]) * factor
+    return notes
 
 
 #: UFF data-set types that hold geometry (nodes, coordinate systems, lines, elements, units).

@@ -41,13 +41,13 @@ from __future__ import annotations
 import json
 import os
 import re
-import tomllib
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..exceptions import FileFormatError, InputError
+from ._guard import guarded_read, load_toml
 from .units import Sensitivity, parse_sensitivity, parse_unit
 
 __all__ = ["ROLES", "ChannelMap", "ChannelSpec"]
@@ -275,11 +275,15 @@ class ChannelMap:
         from ._text import decode_text
 
         text, _ = decode_text(raw, p)
-        try:
-            doc = json.loads(text) if p.suffix.lower() == ".json" else tomllib.loads(text)
-        except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
-            kind = "JSON" if p.suffix.lower() == ".json" else "TOML"
-            raise FileFormatError(f"{p}: not a valid {kind} channel map ({exc})") from None
+        if p.suffix.lower() != ".json":
+            with guarded_read(p):
+                doc = load_toml(text, str(p), "a valid TOML channel map")
+            return cls.from_dict(doc, str(p))
+        with guarded_read(p):
+            try:
+                doc = json.loads(text)
+            except json.JSONDecodeError as exc:
+                raise FileFormatError(f"{p}: not a valid JSON channel map ({exc})") from None
         return cls.from_dict(doc, str(p))
 
     @classmethod

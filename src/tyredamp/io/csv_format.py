@@ -154,6 +154,11 @@ def _parse(p: Path, text: str) -> tuple[dict[str, list[str]], list[str], np.ndar
         k += 1
     if k >= len(lines):
         raise FileFormatError(f"{p}: no column-name line after the header (truncated file?)")
+    if not text.endswith(("\n", "\r")):
+        raise FileFormatError(
+            f"{p}: truncated file: the last row has no line end (tyredamp ends every row "
+            "with one; a copy cut short loses it)"
+        )
     cols = [c.strip() for c in lines[k].split(",")]
     body_text = "\n".join(lines[k + 1 :])
     if not body_text.strip():

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import os
 import re
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -41,15 +41,43 @@ from ..frf import FRF, Channel, FRFKind
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
+from ._guard import axis_scale
 from .channelmap import ChannelMap
 from .units import frf_units
 
 __all__ = ["read_mat"]
 
-_TIME = re.compile(r"^(t|time|times|zeit|time_?s|time_?domain|time_?axis|time_?vector)$", re.I)
+_TIME = re.compile(
+    r"^(t|time|times|zeit|time_?s|time_?domain|time_?axis|time_?vector)"
+    r"([_ ](s|sec|ms|us|min|h|hz|khz|deg|rad))?$",
+    re.I,
+)
 _RATE = re.compile(r"(^fs$|^sr$|samp.*rate|sample_?freq|rate$)", re.I)
 _STEP = re.compile(r"^(dt|delta_?t|ts|sample_?interval|time_?step|time_?increment)$", re.I)
-_FREQ = re.compile(r"^(f|freq.*|frequency.*|f_?hz|.*_?freq_?domain|.*freq.*)$", re.I)
+_FREQ = re.compile(
+    r"^(f|freq.*|frequency.*|f_?hz|.*_?freq_?domain|.*freq.*|omega.*|f_(k?hz|rad_?s|rpm|cpm))$",
+    re.I,
+)
+#: An axis unit at the end of a variable name: ``t_ms``, ``freq_kHz``, ``omega_rad_s``.
+_NAME_UNIT = re.compile(
+    r"[_ ](?P<unit>k?hz|rad_?s|rad_per_s|cpm|rpm|s|sec|ms|us|min|h|deg|rad)$", re.I
+)
+
+
+def _name_scale(p: Any, name: str, axis: Literal["frequency", "time"]) -> tuple[float, str | None]:
+    """``(factor to Hz or s, note)`` of the unit a variable's name ends with (none: Hz or s);
+    ``omega`` without a unit is taken as rad/s."""
+    leaf = _leaf(name)
+    m = _NAME_UNIT.search(leaf)
+    unit = "" if m is None else m.group("unit").lower()
+    if m is not None and leaf.lower() in ("time_s", "times"):
+        unit = "s"
+    unit = {"rad_s": "rad/s", "rads": "rad/s", "rad_per_s": "rad/s"}.get(unit, unit)
+    if not unit and leaf.lower().startswith("omega"):
+        unit = "rad/s"
+    return axis_scale(unit, axis, f"{p}: variable {name!r} (unit from its name)")
+
+
 _NOT_FRF = re.compile(r"(spec|cross|psd|corr|auto|coh|mag|lin_)", re.I)
 _ROLE_KIND = {"acceleration": "accelerance", "velocity": "mobility", "displacement": "receptance"}
 
@@ -144,7 +172,7 @@ def read_mat(
     p = check_input_file(path)
     vars_ = _load(p)
     if what is None:
-        what = "timedata" if _time_base(vars_)[0] is not None else "frf"
+        what = "timedata" if _time_base(vars_, p)[0] is not None else "frf"
     if what == "frf":
         return _read_frf(p, vars_, kind, channel_map)
     if what == "timedata":
@@ -152,14 +180,17 @@ def read_mat(
     raise InputError(f"what: expected 'frf' or 'timedata', got {what!r}")
 
 
-def _time_base(vars_: dict[str, Any]) -> tuple[float | None, str | None, int | None]:
-    """``(sample rate, time vector name, its length)`` from the variables."""
+def _time_base(
+    vars_: dict[str, Any], p: Any = "MATLAB file"
+) -> tuple[float | None, str | None, int | None]:
+    """``(sample rate, time vector name, its length)`` from the variables (a unit in the
+    time vector's name, ``t_ms``, converted)."""
     fs = tname = None
     n = None
     for name, v in vars_.items():
         vec = _vector(v)
         if _TIME.match(_leaf(name)) and vec is not None and vec.dtype.kind in "iuf":
-            t = vec.astype(float)
+            t = vec.astype(float) * _name_scale(p, name, "time")[0]
             dt = np.diff(t)
             if np.all(dt > 0):
                 tname, n = name, t.size
@@ -181,7 +212,7 @@ def _time_base(vars_: dict[str, Any]) -> tuple[float | None, str | None, int | N
 
 
 def _read_time(p: Any, vars_: dict[str, Any], channel_map: ChannelMap | None) -> TimeData:
-    fs, tname, n = _time_base(vars_)
+    fs, tname, n = _time_base(vars_, p)
     if fs is None:
         raise FileFormatError(
             f"{p}: no time base: expected an evenly spaced time vector (t, time ...) or a "
@@ -211,6 +242,8 @@ def _read_time(p: Any, vars_: dict[str, Any], channel_map: ChannelMap | None) ->
     if not keep:
         raise FileFormatError(f"{p}: no channel with the {n} samples of the time base {tname}")
     notes = [f"left out (not on the time base): {', '.join(left)}"] if left else []
+    t_note = None if tname is None else _name_scale(p, tname, "time")[1]
+    notes += [t_note] if t_note else []
     return timedata_from_channels(
         p,
         [c for c, _ in keep],
@@ -242,7 +275,8 @@ def _read_frf(
         )
     n = next(iter(frfs.values())).size
     frfs = {k: v for k, v in frfs.items() if v.size == n}
-    freq = None
+    freq: np.ndarray | None = None
+    f_note = freq_note = None
     for name, v in vars_.items():
         vec = _vector(v)
         if (
@@ -251,9 +285,10 @@ def _read_frf(
             and vec.dtype.kind in "iuf"
             and _FREQ.match(_leaf(name))
         ):
-            f = vec.astype(float)
+            scale, f_note = _name_scale(p, name, "frequency")
+            f = vec.astype(float) * scale
             if np.all(np.diff(f) > 0):
-                freq = f
+                freq, freq_note = f, f_note
                 break
     if freq is None:
         df = None
@@ -329,6 +364,8 @@ def _read_frf(
         notes.append(f"coherence: {', '.join(sorted(used))}")
     if left:
         notes.append(f"other variables not read: {', '.join(left)}")
+    if freq_note:
+        notes.append(freq_note)
     meta: dict[str, Any] = {"read_notes": notes}
     try:
         return FRF(

@@ -29,6 +29,7 @@ from ..exceptions import FileFormatError, InputError
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
+from ._guard import axis_scale, quiet_libraries
 from .channelmap import ChannelMap
 from .units import quantity_units
 
@@ -101,26 +102,19 @@ def read_mdf(
         Not an MDF file, no numeric channels, channels named on different
         time bases, uneven sampling, a channel whose quantity cannot be told.
     """
-    try:
-        from asammdf import MDF
-    except ImportError:  # pragma: no cover - optional dependency
-        raise FileFormatError(
-            f"{path}: reading MDF needs asammdf (pip install 'tyredamp[mdf]')"
-        ) from None
     p = check_input_file(path)
     cmap = ChannelMap.from_quantities(quantities).merged(channel_map)
-    try:
-        mdf = MDF(str(p))
-    except Exception as exc:  # asammdf raises MdfException, ValueError ... on garbage
-        raise FileFormatError(f"{p}: not a readable MDF file ({exc})") from None
+    mdf = _open(p)
     skipped: list[str] = []
     sigs, groups = [], []
+    master_units: dict[int, str] = {}
     with mdf:
         masters = getattr(mdf, "masters_db", {})
         groups_: list[Any] = list(mdf.groups)
         for gi, grp in enumerate(groups_):
             for ci, ch in enumerate(grp.channels):
                 if masters.get(gi) == ci:
+                    master_units[gi] = str(getattr(ch, "unit", "") or "")
                     continue
                 try:  # one channel asammdf cannot read (a bus frame ...) is left out
                     sigs.append(mdf.get(group=gi, index=ci))
@@ -162,6 +156,9 @@ def read_mdf(
             keep.append(k)
     if not keep:
         raise FileFormatError(f"{p}: no channel to read; {'; '.join(skipped)}")
+    t_scale, t_note = axis_scale(
+        master_units.get(group), "time", f"{p}: master (time) channel unit"
+    )
     t = np.asarray(sigs[keep[0]].timestamps, dtype=float)
     for k in keep:
         ts = np.asarray(sigs[k].timestamps, dtype=float)
@@ -176,8 +173,8 @@ def read_mdf(
     span = float(t[-1] - t[0])
     if span <= 0 or np.any(dt <= 0) or np.ptp(dt) > 1e-6 * span / (t.size - 1):
         raise FileFormatError(f"{p}: timestamps are not evenly increasing")
-    fs = snap_rate((t.size - 1) / span)
-    notes = [f"left out: {'; '.join(skipped)}"] if skipped else []
+    fs = snap_rate((t.size - 1) / (span * t_scale))
+    notes = ([f"left out: {'; '.join(skipped)}"] if skipped else []) + ([t_note] if t_note else [])
     meta: dict[str, Any] = {}
     return timedata_from_channels(
         p,
@@ -190,6 +187,21 @@ def read_mdf(
         meta=meta,
         notes=notes,
     )
+
+
+def _open(p: Any) -> Any:
+    """The asammdf ``MDF`` object of ``p`` (its loggers quiet: they exist once imported)."""
+    try:
+        from asammdf import MDF
+    except ImportError:  # pragma: no cover - optional dependency
+        raise FileFormatError(
+            f"{p}: reading MDF needs asammdf (pip install 'tyredamp[mdf]')"
+        ) from None
+    try:
+        with quiet_libraries():
+            return MDF(str(p))
+    except Exception as exc:  # asammdf raises MdfException, ValueError ... on garbage
+        raise FileFormatError(f"{p}: not a readable MDF file ({exc})") from None
 
 
 def _only(cmap: ChannelMap, kept: list[str], p: Any, all_names: list[str]) -> ChannelMap:

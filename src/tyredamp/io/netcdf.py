@@ -11,6 +11,7 @@ named arrays; tyredamp reads it back bit for bit.
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from ..exceptions import FileFormatError, InputError, TyredampError
 from ..frf import FRF
 from ._atomic import atomic_path
 from ._common import check_input_file
+from ._guard import axis_scale
 
 __all__ = ["read_netcdf", "write_netcdf"]
 
@@ -57,6 +59,17 @@ def read_netcdf(path: str | os.PathLike[str]) -> FRF:
             ds.load()
             if not str(ds.attrs.get("tyredamp", "")).startswith("frf"):
                 raise FileFormatError(f"{p}: not a tyredamp FRF netCDF file")
+            note = None
+            if "frequency" in ds.coords:
+                scale, note = axis_scale(
+                    ds["frequency"].attrs.get("units"), "frequency", f"{p}: frequency units"
+                )
+                if note:
+                    ds = ds.assign_coords(frequency=ds["frequency"].values * scale)
+                    meta = json.loads(str(ds.attrs.get("meta", "{}")))
+                    if isinstance(meta, dict):
+                        meta["read_notes"] = [*meta.get("read_notes", []), note]
+                        ds.attrs["meta"] = json.dumps(meta)
             return FRF.from_xarray(ds)
     except FileFormatError:
         raise

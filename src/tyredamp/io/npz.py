@@ -40,6 +40,7 @@ from ._common import (
     meta_to_json,
     wrap_errors,
 )
+from ._guard import check_archive
 
 __all__ = ["read_npz", "write_npz"]
 
@@ -86,19 +87,28 @@ def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         np.savez(fh, header=np.array(text), **arrays)
 
 
-def _check_members(p: os.PathLike[str]) -> None:
-    """Refuse members whose .npy header claims more data than the archive holds.
+def _check_members(p: os.PathLike[str], max_bytes: int | None = None) -> None:
+    """Refuse an archive whose members could not be loaded safely, before inflating any.
 
-    A hostile or corrupt header (``shape`` of 1e12 elements) would otherwise
-    make NumPy allocate that much memory before noticing the data is missing;
-    a compressed archive that unpacks to more than the memory available (a
-    "zip bomb") is refused before it is unpacked.
+    Every member, whatever its name, is checked from the archive's directory
+    first (:func:`._guard.check_archive`: the declared sizes fit in
+    ``max_bytes``, default the memory available, and no member inflates
+    more than :data:`._guard.MAX_ARCHIVE_RATIO`-fold: a "zip bomb"); then each
+    member must be a ``.npy`` array (NumPy would inflate any other member
+    whole) whose header claims no more data than the member holds (a ``shape``
+    of 1e12 elements would otherwise be allocated before the data are found
+    missing) and no Python objects.
     """
-    total = 0
+    limit = _available_memory() if max_bytes is None else max_bytes
     with zipfile.ZipFile(p) as zf:
+        what = None if max_bytes is not None or limit is None else "the memory available"
+        total = check_archive(zf, str(p), (1 << 62) if limit is None else limit, limit_text=what)
         for info in zf.infolist():
             if not info.filename.endswith(".npy"):
-                continue
+                raise FileFormatError(
+                    f"{p}: member {info.filename[:60]!r} is not a NumPy array (.npy); a tyredamp "
+                    "NPZ file holds arrays only"
+                )
             with zf.open(info) as fh:
                 version = np.lib.format.read_magic(fh)
                 if version == (1, 0):
@@ -113,13 +123,8 @@ def _check_members(p: os.PathLike[str]) -> None:
                     f"{p}: {info.filename}: header claims shape {shape} ({need} bytes) but the "
                     f"archive holds {info.file_size} bytes; the file is corrupt"
                 )
-            total += need
-    avail = _available_memory()
-    if avail is not None and total > avail:
-        raise InputError(
-            f"{p}: its arrays take {total / 1e9:.3g} GB unpacked, more than the "
-            f"{avail / 1e9:.3g} GB of memory available"
-        )
+    if limit is not None and total > limit:  # pragma: no cover - check_archive refuses first
+        raise InputError(f"{p}: its arrays take {total / 1e9:.3g} GB unpacked")
 
 
 def _available_memory() -> int | None:
@@ -153,8 +158,15 @@ def _check_header(p: os.PathLike[str], head: dict[str, Any]) -> None:
             )
 
 
-def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
+def read_npz(path: str | os.PathLike[str], max_bytes: int | None = None) -> FRF | TimeData:
     """Read a file written by :func:`write_npz`.
+
+    Parameters
+    ----------
+    path : path-like
+    max_bytes : int, optional
+        Most bytes the arrays may take once inflated (default: the memory
+        available); checked from the archive's directory before any is read.
 
     Raises
     ------
@@ -163,7 +175,7 @@ def read_npz(path: str | os.PathLike[str]) -> FRF | TimeData:
     """
     p = check_input_file(path)
     try:
-        _check_members(p)
+        _check_members(p, max_bytes)
         with open(p, "rb") as fh, np.load(fh, allow_pickle=False) as z:
             if "header" not in z.files:
                 raise FileFormatError(f"{p}: not a tyredamp NPZ file (no 'header' entry)")

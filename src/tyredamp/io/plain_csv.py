@@ -47,13 +47,13 @@ from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, Channel
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
+from ._guard import FREQUENCY_UNITS, TIME_UNITS, axis_scale
 from .channelmap import ChannelMap
 from .units import frf_units, parse_unit
 
 __all__ = ["read_plain_csv", "split_column_name"]
 
 _TIME_NAMES = {"time", "t", "zeit", "temps", "tiempo", "x_value", "sec", "seconds", "timestamp"}
-_TIME_UNITS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 _ANGLE = {"deg", "°", "degree", "degrees", "rad", "radian", "radians"}
 _NUM = re.compile(r"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 
@@ -74,12 +74,17 @@ def _refuse_complex_column(p: Path, lines: list[str]) -> None:
         )
 
 
+def _axis_unit(text: str, table: dict[str, float]) -> bool:
+    """Whether ``text`` is one of the axis units of ``table`` (spaces and case ignored)."""
+    return "".join(text.split()).lower().strip("[]()") in table
+
+
 def _is_unit(text: str) -> bool:
     """Whether ``text`` reads as a units label with a dimension (not a bare number)."""
     t = text.strip()
     if not t or _NUM.match(t):
         return False
-    if t.lower() in _TIME_UNITS:
+    if t.lower() in TIME_UNITS or _axis_unit(t, FREQUENCY_UNITS):
         return True
     try:
         u = parse_unit(t)
@@ -238,11 +243,13 @@ def read_plain_csv(
     if len(rows) < len(body):
         notes.append("the last row is incomplete and was left out")
     first_name, first_unit = split[0]
-    if first_unit.strip().lower() in ("hz", "khz") or first_name.lower().startswith("freq"):
+    if _axis_unit(first_unit, FREQUENCY_UNITS) or first_name.lower().startswith(("freq", "omega")):
         return _read_frf(p, cols, split, table, meta, channel_map)
-    t_scale = _TIME_UNITS.get(first_unit.strip().lower())
-    if t_scale is None and first_name.strip().lower() in _TIME_NAMES and not first_unit:
-        t_scale = 1.0
+    t_scale = None
+    if _axis_unit(first_unit, TIME_UNITS) or first_name.strip().lower() in _TIME_NAMES:
+        # a time column: its unit converted to s, any unit other than a time refused
+        t_scale, note = axis_scale(first_unit, "time", f"{p}: column {cols[0]!r}")
+        notes += [note] if note else []
     first = 1
     if t_scale is None:
         stated = _stated_rate(head[:-1])
@@ -357,7 +364,10 @@ def _read_frf(
     channel_map: ChannelMap | None,
 ) -> FRF:
     """An FRF from a frequency column and pairs of columns (re/im or magnitude/phase)."""
-    f = table[:, 0] * (1e3 if split[0][1].strip().lower() == "khz" else 1.0)
+    f_scale, note = axis_scale(split[0][1], "frequency", f"{p}: column {cols[0]!r}")
+    f = table[:, 0] * f_scale
+    if note:
+        meta = {**meta, "read_notes": [*meta.get("read_notes", []), note]}
     items: list[tuple[str, int, int]] = []  # (base name, first column, pair type)
     coh = []
     k = 1

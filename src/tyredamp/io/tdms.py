@@ -23,6 +23,7 @@ from ..exceptions import FileFormatError
 from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
+from ._guard import axis_scale, library_messages, quiet_libraries
 from .channelmap import ChannelMap
 
 __all__ = ["read_tdms"]
@@ -67,8 +68,17 @@ def read_tdms(
         ) from None
     p = check_input_file(path)
     try:
-        f = TdmsFile.read(str(p))
-        groups = [g for g in f.groups() if g.channels()]
+        with quiet_libraries():  # again: npTDMS's loggers exist once it is imported
+            f = TdmsFile.read(str(p))
+            groups = [g for g in f.groups() if g.channels()]
+            said = library_messages()
+        if any("less data than expected" in m for m in said):
+            raise FileFormatError(
+                f"{p}: truncated TDMS file: its last segment holds less data than its header "
+                "declares"
+            )
+    except FileFormatError:
+        raise
     except Exception as exc:  # npTDMS raises ValueError, KeyError, struct.error ... on garbage
         raise FileFormatError(f"{p}: not a readable TDMS file ({exc})") from None
     if group is not None:
@@ -87,7 +97,7 @@ def read_tdms(
         if named:
             groups = named
     chans = list(groups[0].channels())
-    time_dt, time_name = _time_channel(chans)
+    time_dt, time_name = _time_channel(p, chans)
     notes = []
     if time_name is not None:
         notes.append(f"sample interval from the time channel {time_name!r}")
@@ -101,9 +111,24 @@ def read_tdms(
                 "the group has no evenly spaced time channel (Time, t, ...)"
             )
         try:
-            steps.append(float(props.get("wf_increment", time_dt)))
-            arrays.append(np.asarray(c[:], dtype=float))
+            raw = np.asarray(c[:])
+            if raw.dtype.kind == "c":
+                raise FileFormatError(
+                    f"{p}: channel {c.name!r} holds complex values; time data are real "
+                    "(a spectrum or FRF stored in TDMS is not read as time data)"
+                )
+            scale, note = (1.0, None)
+            if "wf_increment" in props:  # in the waveform's x unit (s by default)
+                scale, note = axis_scale(
+                    props.get("wf_xunit_string"), "time", f"{p}: channel {c.name!r} wf_xunit_string"
+                )
+            if note and note not in notes:
+                notes.append(note)
+            steps.append(float(props.get("wf_increment", time_dt)) * scale)
+            arrays.append(np.asarray(raw, dtype=float))
         except (TypeError, ValueError) as exc:
+            if isinstance(exc, FileFormatError):
+                raise
             raise FileFormatError(f"{p}: channel {c.name!r}: {exc}") from None
         names.append(str(c.name))
         units.append(str(props.get("unit_string", "") or ""))
@@ -129,7 +154,7 @@ def read_tdms(
 _TIME_NAMES = {"time", "t", "zeit", "time_s", "timestamp", "x_value", "relative time"}
 
 
-def _time_channel(chans: list[Any]) -> tuple[float | None, str | None]:
+def _time_channel(p: Any, chans: list[Any]) -> tuple[float | None, str | None]:
     """``(interval in s, name)`` of an evenly spaced time channel when a channel lacks
     ``wf_increment`` (files written by scripts rather than LabVIEW waveforms)."""
     if all("wf_increment" in c.properties for c in chans):
@@ -143,7 +168,10 @@ def _time_channel(chans: list[Any]) -> tuple[float | None, str | None]:
             continue
         if t.size < 2:
             continue
-        dt = float(t[-1] - t[0]) / (t.size - 1)
-        if dt > 0 and np.max(np.abs(np.diff(t) - dt)) <= 1e-6 * dt:
+        scale, _ = axis_scale(
+            c.properties.get("unit_string"), "time", f"{p}: time channel {c.name!r} unit"
+        )
+        dt = float(t[-1] - t[0]) / (t.size - 1) * scale
+        if dt > 0 and np.max(np.abs(np.diff(t) * scale - dt)) <= 1e-6 * dt:
             return dt, str(c.name)
     return None, None

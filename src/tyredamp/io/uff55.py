@@ -60,6 +60,8 @@ from ..exceptions import FileFormatError, InputError
 from ..frf import Channel
 from ._atomic import atomic_path
 from ._common import check_input_file, uff_set_types
+from ._guard import guarded_read
+from ._uff_load import check_delimiters
 
 __all__ = ["read_uff55", "uff_has_modes", "write_uff55"]
 
@@ -145,6 +147,7 @@ def write_uff55(model: Any, path: str | os.PathLike[str]) -> Path:
 
 
 def _load55(p: Path) -> list[dict[str, Any]]:
+    check_delimiters(p, p.read_bytes())
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ResourceWarning)
@@ -202,9 +205,13 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
         No data set 55, mixed or unsupported analysis types, modes on
         different nodes, shapes that are all zero, invalid numbers.
     """
+    with guarded_read(path):
+        return _read55(check_input_file(path), inputs)
+
+
+def _read55(p: Path, inputs: list[Channel] | None) -> Any:
     from ..modal.model import ModalModel
 
-    p = check_input_file(path)
     sets = _load55(p)
     kinds = {int(s.get("analysis_type", 0)) for s in sets}
     if kinds - {2, 3}:
@@ -231,6 +238,9 @@ def read_uff55(path: str | os.PathLike[str], inputs: list[Channel] | None = None
             raise FileFormatError(f"{where}: malformed or non-finite node values")
         order = np.argsort(nodes, kind="stable")
         nodes, vals = nodes[order], vals[:, order]
+        twice = nodes[1:][nodes[1:] == nodes[:-1]]
+        if twice.size:
+            raise FileFormatError(f"{where}: node {int(twice[0])} appears more than once")
         if nodes0 is None:
             nodes0 = nodes
         elif not np.array_equal(nodes0, nodes):

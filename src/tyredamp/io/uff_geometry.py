@@ -25,6 +25,7 @@ from __future__ import annotations
 import gc
 import os
 import warnings
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -34,6 +35,8 @@ from numpy.typing import NDArray
 from ..exceptions import FileFormatError
 from ..geometry import Geometry
 from ._common import check_input_file, uff_set_types
+from ._guard import guarded_read
+from ._uff_load import check_delimiters
 
 __all__ = ["read_uff_geometry", "uff_geometry_or_none", "uff_has_geometry"]
 
@@ -68,6 +71,7 @@ class _CS:
 
 
 def _load(p: Any) -> list[dict[str, Any]]:
+    check_delimiters(p, p.read_bytes())
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ResourceWarning)
@@ -195,7 +199,11 @@ def read_uff_geometry(path: str | os.PathLike[str]) -> Geometry:
         or non-finite records, duplicate nodes, trace lines through unknown
         nodes.
     """
-    p = check_input_file(path)
+    with guarded_read(path):
+        return _read_geometry(check_input_file(path))
+
+
+def _read_geometry(p: Path) -> Geometry:
     sets = _load(p)
     cs = _systems(p, sets)
     length = 1.0
@@ -205,6 +213,7 @@ def read_uff_geometry(path: str | os.PathLike[str]) -> Geometry:
             if not np.isfinite(length) or length <= 0:
                 raise FileFormatError(f"{p}: data set 164 length factor {length} is not positive")
     nodes: list[int] = []
+    seen: set[int] = set()
     xyz: list[NDArray[np.float64]] = []
     axes: list[NDArray[np.float64]] = []
     for s in sets:
@@ -243,6 +252,9 @@ def read_uff_geometry(path: str | os.PathLike[str]) -> Geometry:
                     _, ax = disp.to_global(r, th, ph)
             else:
                 ax = disp.rot
+            if int(nums[k]) in seen:
+                raise FileFormatError(f"{p}: node {int(nums[k])} is defined more than once")
+            seen.add(int(nums[k]))
             nodes.append(int(nums[k]))
             xyz.append(pos / length)
             axes.append(ax)

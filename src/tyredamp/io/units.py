@@ -27,6 +27,7 @@ times second (``ms^-2``, ``ms-1``), never the millisecond.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from typing import Literal
@@ -43,6 +44,13 @@ __all__ = [
     "parse_unit",
     "quantity_units",
 ]
+
+#: Longest units label read (characters); the grammar is bounded by it and by the two below.
+MAX_LABEL = 100
+#: Deepest nesting of parentheses in a units label.
+MAX_NESTING = 4
+#: Largest exponent magnitude (``m^4`` is the largest a vibration unit needs; 12 leaves room).
+MAX_EXPONENT = 12
 
 _G = 9.80665
 _LBF = 4.4482216152605
@@ -209,9 +217,11 @@ class _Parser:
             self.toks.append((kind, m.group(kind)))
             pos = m.end()
         self.i = 0
+        self.depth = 0
 
     def error(self, why: str) -> InputError:
-        return InputError(f"units label {self.label!r}: {why}")
+        shown = self.label if len(self.label) <= 60 else self.label[:57] + "..."
+        return InputError(f"units label {shown!r}: {why}")
 
     def peek(self) -> tuple[str, str] | None:
         return self.toks[self.i] if self.i < len(self.toks) else None
@@ -243,7 +253,7 @@ class _Parser:
             else:
                 raise self.error(f"unexpected {tok[1]!r}")
             f2, d2 = self.power()
-            fac = fac * f2 if sign > 0 else fac / f2
+            fac = self._finite(fac * f2 if sign > 0 else fac / f2)
             dim = tuple(a + sign * b for a, b in zip(dim, d2, strict=True))  # type: ignore[assignment]
 
     def power(self) -> tuple[float, Dims]:
@@ -251,7 +261,16 @@ class _Parser:
         n = None if is_number else self.exponent()
         if n is None:
             return fac, dim
-        return fac**n, tuple(d * n for d in dim)  # type: ignore[return-value]
+        try:
+            return self._finite(fac**n), tuple(d * n for d in dim)  # type: ignore[return-value]
+        except OverflowError:
+            raise self.error(f"factor {fac:g} to the power {n} is out of range") from None
+
+    def _finite(self, value: float) -> float:
+        """A scale factor that is a finite, non-zero number (else the label is refused)."""
+        if not (math.isfinite(value) and value != 0.0):
+            raise self.error("its scale factor is zero or out of range")
+        return value
 
     def exponent(self) -> int | None:
         tok = self.peek()
@@ -286,18 +305,28 @@ class _Parser:
 
     def _int(self, text: str) -> int:
         try:
-            return int(text)
+            n = int(text)
         except ValueError:
-            raise self.error(f"exponent {text!r} is not an integer") from None
+            raise self.error(f"exponent {text[:20]!r} is not an integer") from None
+        if abs(n) > MAX_EXPONENT:
+            raise self.error(
+                f"exponent {text[:20]} is not a power a unit is raised to "
+                f"(expected -{MAX_EXPONENT} to {MAX_EXPONENT})"
+            )
+        return n
 
     def atom(self) -> tuple[float, Dims, bool]:
         if self.peek() is None:
             raise self.error("ends where a unit was expected")
         kind, text = self.take()
         if kind == "num":
-            return float(text), (0, 0, 0, 0), True
+            return self._finite(float(text)), (0, 0, 0, 0), True
         if text == "(":
+            self.depth += 1
+            if self.depth > MAX_NESTING:
+                raise self.error(f"parentheses nested deeper than {MAX_NESTING}")
             fac, dim = self.product()
+            self.depth -= 1
             tok = self.peek()
             if tok is None or tok[1] != ")":
                 raise self.error("unbalanced parenthesis")
@@ -326,6 +355,11 @@ def parse_unit(label: str) -> Unit:
     """Parse a units label (module docstring); raise :class:`InputError` naming it."""
     if not isinstance(label, str):
         raise InputError(f"units label: expected text, got {type(label).__name__}")
+    if len(label) > MAX_LABEL:
+        raise InputError(
+            f"units label {label[:40]!r}...: {len(label)} characters; a units label has at "
+            f"most {MAX_LABEL}"
+        )
     fac, dim = _Parser(label).parse()
     return Unit(label=label, factor=float(fac), dimensions=dim[:3], voltage=dim[3])
 

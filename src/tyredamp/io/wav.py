@@ -17,7 +17,9 @@ note in ``meta["read_notes"]`` says so.
 from __future__ import annotations
 
 import os
+import struct
 import warnings
+from pathlib import Path
 
 import numpy as np
 
@@ -47,6 +49,7 @@ def read_wav(path: str | os.PathLike[str], channel_map: ChannelMap | None = None
     from scipy.io import wavfile
 
     p = check_input_file(path)
+    _check_chunks(p)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # WavFileWarning on unknown chunks
@@ -76,3 +79,33 @@ def read_wav(path: str | os.PathLike[str], channel_map: ChannelMap | None = None
         aliases=[[f"ch{k + 1}", f"channel {k + 1}"] for k in range(n)],
         notes=["WAV samples are fractions of the input's full scale, taken as 1 V"],
     )
+
+
+def _check_chunks(p: Path) -> None:
+    """Refuse a RIFF/WAVE file whose chunks declare more bytes than the file holds.
+
+    A copy cut short keeps its header: the ``data`` chunk's declared size (or
+    any chunk header running past the end) shows the truncation, which scipy
+    would otherwise read as a shorter recording. A declared size of 0 or
+    0xFFFFFFFF (a streaming writer that never went back) is not checked.
+    """
+    raw = p.read_bytes()
+    if raw[:4] not in (b"RIFF", b"RIFX") or raw[8:12] != b"WAVE":
+        return  # not RIFF/WAVE: scipy's error names what is wrong
+    order = "<" if raw[:4] == b"RIFF" else ">"
+    pos = 12
+    while pos + 8 <= len(raw):
+        cid = raw[pos : pos + 4]
+        (size,) = struct.unpack(order + "I", raw[pos + 4 : pos + 8])
+        if size in (0, 0xFFFFFFFF):
+            return
+        if pos + 8 + size > len(raw):
+            raise FileFormatError(
+                f"{p}: truncated WAV file: its {cid.decode('latin-1').strip()!r} chunk "
+                f"declares {size} bytes, the file holds {len(raw) - pos - 8}"
+            )
+        if cid == b"data":
+            return
+        pos += 8 + size + (size & 1)
+    if pos < len(raw) or pos == 12:
+        raise FileFormatError(f"{p}: truncated WAV file: a chunk header is cut off")
