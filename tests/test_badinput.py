@@ -913,7 +913,7 @@ def test_warnings_never_precede_the_error(
         warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
         raise tio.FileFormatError("x.npz: broken")
 
-    monkeypatch.setattr("tyredamp.cli.modal.read_frf", noisy)
+    monkeypatch.setattr("tyredamp.io.read_frf", noisy)
     monkeypatch.chdir(tmp_path)
     code, _, err = run_main(["modal", "x.npz", "-o", "m.json"], capsys)
     check_one_error_line(err, code, EXIT_INPUT, "broken")
@@ -925,7 +925,7 @@ def test_last_resort_handler(
     def bug(*a: Any, **k: Any) -> Any:
         raise ZeroDivisionError("division by zero")
 
-    monkeypatch.setattr("tyredamp.cli.modal.read_frf", bug)
+    monkeypatch.setattr("tyredamp.io.read_frf", bug)
     monkeypatch.chdir(tmp_path)
     code, _, err = run_main(["modal", "x.npz", "-o", "m.json"], capsys)
     line = check_one_error_line(err, code, 70, "internal error (ZeroDivisionError: division")
