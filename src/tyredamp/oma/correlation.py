@@ -227,6 +227,9 @@ def correlations(
     if y.ndim != 2:
         raise ShapeError(f"data: expected shape (n_channels, n_samples), got {y.shape}")
     refs = np.arange(y.shape[0]) if references is None else references
+    if block is None:  # at least 2 n_groups blocks, so that every jackknife group is filled
+        n_lags_ = max(int(n_lags), 1)
+        block = max(2 * n_lags_, min(max(4 * n_lags_, 4096), y.shape[1] // (2 * n_groups)))
     acc = CorrelationAccumulator(
         y.shape[0], refs, n_lags, sample_rate, block=block, n_groups=n_groups
     )

@@ -294,15 +294,13 @@ def _finish(
         for j in np.flatnonzero(harm)
     ]
     keep = ~harm if harm.size else np.zeros(0, bool)
-    # a mode whose damping is not told from zero by its own standard error (t < 2)
-    # is not resolved by the record: reported, not kept
-    weak = keep & np.isfinite(sz) & (zeta < 2 * sz)
-    for j in np.flatnonzero(weak):
+    # a mode whose damping is not told from zero by its own standard error (t < 2):
+    # kept, and said so
+    for j in np.flatnonzero(keep & np.isfinite(sz) & (zeta < 2 * sz)):
         notes.append(
-            f"{fn[j]:.4g} Hz left out: damping {100 * zeta[j]:.3g} % +- {100 * sz[j]:.2g} % "
+            f"{fn[j]:.4g} Hz: damping {100 * zeta[j]:.3g} % +- {100 * sz[j]:.2g} % "
             "is not told from zero by this record"
         )
-    keep &= ~weak
     if not keep.any():
         notes.append("no structural mode found: no cluster of poles persisted over the orders")
     return OMAResult(
