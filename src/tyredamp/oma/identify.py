@@ -294,6 +294,18 @@ def _finish(
         for j in np.flatnonzero(harm)
     ]
     keep = ~harm if harm.size else np.zeros(0, bool)
+    # a pole whose frequency scatters over the segments by more than its own half-power
+    # half-bandwidth zeta f is not a resonance the record determines: left out, and said so
+    loose = keep & np.isfinite(sf) & (sf > zeta * fn)
+    for j in np.flatnonzero(loose):
+        notes.append(
+            f"{fn[j]:.4g} Hz left out: its frequency scatters by {sf[j]:.2g} Hz over the "
+            f"segments, more than its half-power half-bandwidth {zeta[j] * fn[j]:.2g} Hz"
+        )
+    keep &= ~loose
+    for j in np.flatnonzero(keep & (zeta <= 0)):
+        notes.append(f"{fn[j]:.4g} Hz left out: no positive damping (a harmonic the test missed?)")
+    keep &= zeta > 0
     # a mode whose damping is not told from zero by its own standard error (t < 2):
     # kept, and said so
     for j in np.flatnonzero(keep & np.isfinite(sz) & (zeta < 2 * sz)):
