@@ -179,6 +179,7 @@ def oma(
     max_order: int | None = None,
     n_groups: int = 16,
     wheel_speed_hz: float | None = None,
+    uncertainty: bool = True,
 ) -> OMAResult:
     """Identify modes from output-only records.
 
@@ -204,6 +205,9 @@ def oma(
     wheel_speed_hz : float, optional
         Rotation frequency of a rolling tyre; harmonics at its multiples are kept
         out of the modes. Without it the speed is detected from the harmonics.
+    uncertainty : bool
+        Compute the jackknife standard errors (SSI; ``n_groups`` more SVDs). Without
+        them (NaN) no mode is left out for its scatter.
 
     Returns
     -------
@@ -238,7 +242,9 @@ def oma(
     st = stabilisation(op, bnd)
     clusters, cut = select_modes(op, st)
     rep = np.array([c.representative for c in clusters], dtype=np.intp)
-    return _finish(y, fs, corr, op, st, clusters, rep, cut, method, bnd, i, refs, wheel_speed_hz)
+    return _finish(
+        y, fs, corr, op, st, clusters, rep, cut, method, bnd, i, refs, wheel_speed_hz, uncertainty
+    )
 
 
 def _finish(
@@ -255,13 +261,17 @@ def _finish(
     i: int,
     refs: list[int],
     wheel: float | None,
+    uncertainty: bool = True,
 ) -> OMAResult:
     """Standard errors, shapes (pLSCF), the harmonic tests and the result."""
     notes: list[str] = []
     poles = op.poles[rep]
     if method == "ssi":
         shapes = op.shapes[rep]
-        sf, sz = jackknife_std(corr, i, op.order[rep], poles, shapes)
+        if uncertainty and rep.size:
+            sf, sz = jackknife_std(corr, i, op.order[rep], poles, shapes)
+        else:
+            sf = sz = np.full(rep.size, np.nan)
     else:
         f, S, beta = half_spectra(corr.R, fs)
         sel = (f >= band[0]) & (f <= band[1])
