@@ -149,13 +149,14 @@ def _defaults(
     block_rows: int | None,
     max_order: int | None,
 ) -> tuple[int, int]:
-    """Block rows ``i`` and the largest order: the lags cover two periods of the
-    lowest frequency of the band (or 1/50 of the sampling rate), and the order
-    reaches twice the modes a noisy record can show (``i n_ref`` bounds it)."""
+    """Block rows ``i`` and the largest order: the ``2 i`` lags cover two periods of
+    the lowest frequency of the band (or 1/50 of the sampling rate) as far as
+    ``i n_ref <= 240`` allows, and the order goes to 120 (``i n_ref`` bounds it)."""
     r = len(refs)
     if block_rows is None:
         f_lo = band[0] if band[0] > 0 else fs / 100
-        block_rows = int(np.clip(np.ceil(fs / f_lo), 20, 120))
+        # at most 240 columns of the Toeplitz matrix (its SVD is repeated per segment)
+        block_rows = int(np.clip(np.ceil(fs / f_lo), 20, max(20, 240 // r)))
         block_rows = max(block_rows, int(np.ceil(80 / r)) + 1)
     n_hi = min(block_rows * r, (block_rows - 1) * y.shape[0])
     order_hi = min(n_hi, 120) if max_order is None else int(max_order)
@@ -305,12 +306,12 @@ def _finish(
     ]
     keep = ~harm if harm.size else np.zeros(0, bool)
     # a pole whose frequency scatters over the segments by more than its own half-power
-    # half-bandwidth zeta f is not a resonance the record determines: left out, and said so
-    loose = keep & np.isfinite(sf) & (sf > zeta * fn)
+    # bandwidth 2 zeta f is not a resonance the record determines: left out, said so
+    loose = keep & np.isfinite(sf) & (sf > 2 * zeta * fn)
     for j in np.flatnonzero(loose):
         notes.append(
             f"{fn[j]:.4g} Hz left out: its frequency scatters by {sf[j]:.2g} Hz over the "
-            f"segments, more than its half-power half-bandwidth {zeta[j] * fn[j]:.2g} Hz"
+            f"segments, more than its half-power bandwidth {2 * zeta[j] * fn[j]:.2g} Hz"
         )
     keep &= ~loose
     for j in np.flatnonzero(keep & (zeta <= 0)):
