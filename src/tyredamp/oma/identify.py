@@ -248,6 +248,13 @@ def oma(
     )
 
 
+def _near_orders(op: OrderPoles, c: Any) -> NDArray[np.intp]:
+    """Up to 5 members of cluster ``c`` nearest its representative's model order."""
+    mem = np.asarray(c.members)
+    d = np.abs(op.order[mem] - op.order[c.representative])
+    return np.asarray(mem[np.argsort(d, kind="stable")[:5]], dtype=np.intp)
+
+
 def _finish(
     y: NDArray[np.float64],
     fs: float,
@@ -266,11 +273,19 @@ def _finish(
 ) -> OMAResult:
     """Standard errors, shapes (pLSCF), the harmonic tests and the result."""
     notes: list[str] = []
-    poles = op.poles[rep]
+    # each mode's estimate: the mean over (up to) 5 orders of its cluster nearest the
+    # representative's order, a smooth statistic the jackknife replicates as it is
+    sub = [_near_orders(op, c) for c in clusters]
+    fm = np.array([np.mean(op.frequency_hz[ix]) for ix in sub]) if sub else np.zeros(0)
+    zm = np.array([np.mean(op.damping_ratio[ix]) for ix in sub]) if sub else np.zeros(0)
+    wm = 2 * np.pi * fm
+    poles = -zm * wm + 1j * wm * np.sqrt(np.clip(1 - zm**2, 0.0, None))
     if method == "ssi":
         shapes = op.shapes[rep]
         if uncertainty and rep.size:
-            sf, sz = jackknife_std(corr, i, op.order[rep], poles, shapes)
+            sf, sz = jackknife_std(
+                corr, i, [op.order[ix] for ix in sub], [op.poles[ix] for ix in sub], shapes
+            )
         else:
             sf = sz = np.full(rep.size, np.nan)
     else:
@@ -305,13 +320,19 @@ def _finish(
         for j in np.flatnonzero(harm)
     ]
     keep = ~harm if harm.size else np.zeros(0, bool)
-    # a pole whose frequency scatters over the segments by more than its own half-power
-    # bandwidth 2 zeta f is not a resonance the record determines: left out, said so
-    loose = keep & np.isfinite(sf) & (sf > 2 * zeta * fn)
+    # a resonance of half-power half-bandwidth B = zeta f seen for T seconds has its
+    # frequency fixed to about B / sqrt(B T) = sqrt(B / T) (Bendat & Piersol, Random
+    # Data, 4th ed. 2010, sec. 8.5.4: the random error of a peak of bandwidth B is that of
+    # B T averages); a pole whose segment scatter is ten times that is not a resonance
+    # the record determines: left out, and said so
+    T = y.shape[1] / fs
+    scale = np.sqrt(np.maximum(zeta, 1e-12) * fn / T)
+    loose = keep & np.isfinite(sf) & (sf > 10 * scale)
     for j in np.flatnonzero(loose):
         notes.append(
             f"{fn[j]:.4g} Hz left out: its frequency scatters by {sf[j]:.2g} Hz over the "
-            f"segments, more than its half-power bandwidth {2 * zeta[j] * fn[j]:.2g} Hz"
+            f"segments, {sf[j] / scale[j]:.0f} times what a mode of its damping shows in "
+            "this record"
         )
     keep &= ~loose
     for j in np.flatnonzero(keep & (zeta <= 0)):

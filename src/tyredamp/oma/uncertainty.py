@@ -55,11 +55,14 @@ def _match(
 def jackknife_std(
     corr: Correlations,
     block_rows: int,
-    orders: NDArray[np.int64],
-    poles: NDArray[np.complex128],
+    orders: list[NDArray[np.int64]],
+    poles: list[NDArray[np.complex128]],
     shapes: NDArray[np.complex128],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Jackknife standard errors of the natural frequency (Hz) and damping ratio.
+
+    The estimator replicated is the one of :func:`tyredamp.oma.identify.oma`: the
+    mean over a few model orders of the mode's pole at each.
 
     Parameters
     ----------
@@ -67,10 +70,10 @@ def jackknife_std(
         With its group sums.
     block_rows : int
         As in the identification.
-    orders : ndarray of int, shape (m,)
-        Model order each mode was taken at.
-    poles : ndarray of complex, shape (m,)
-        Full-record poles (rad/s).
+    orders : list of ndarray of int
+        Per mode, the model orders its estimate averages over.
+    poles : list of ndarray of complex
+        Per mode, the full-record poles (rad/s) at those orders.
     shapes : ndarray of complex, shape (m, n_out)
         Full-record unit shapes.
 
@@ -80,22 +83,30 @@ def jackknife_std(
         NaN where fewer than two replicates kept the mode.
     """
     G = corr.n_groups
-    m = poles.size
+    m = len(orders)
     fr = np.full((G, m), np.nan)
     zr = np.full((G, m), np.nan)
     n_out = corr.R.shape[1]
-    n_hi = int(orders.max()) if m else 0
+    need = np.unique(np.concatenate(orders)) if m else np.zeros(0, int)
+    n_hi = int(need.max()) if m else 0
     for g in range(G):
         T = block_toeplitz(corr.leave_out(g), block_rows)
         U, s, _ = np.linalg.svd(T, full_matrices=False)
-        for n in np.unique(orders):
+        fs_: list[list[float]] = [[] for _ in range(m)]
+        zs_: list[list[float]] = [[] for _ in range(m)]
+        for n in need:
             lam, sh = poles_at_order(U[:, :n_hi], s[:n_hi], int(n), n_out, corr.sample_rate)
-            for j in np.flatnonzero(orders == n):
-                k = _match(lam, sh, complex(poles[j]), shapes[j])
-                if k < 0:
+            for j in range(m):
+                hit = np.flatnonzero(orders[j] == n)
+                if hit.size == 0:
                     continue
-                ok = abs(abs(lam[k]) - abs(poles[j])) < 0.05 * abs(poles[j])
-                if ok and lam[k].real < 0:
-                    fr[g, j] = abs(lam[k]) / (2 * np.pi)
-                    zr[g, j] = -lam[k].real / abs(lam[k])
+                p0 = complex(poles[j][hit[0]])
+                k = _match(lam, sh, p0, shapes[j])
+                if k >= 0 and abs(abs(lam[k]) - abs(p0)) < 0.05 * abs(p0) and lam[k].real < 0:
+                    fs_[j].append(abs(lam[k]) / (2 * np.pi))
+                    zs_[j].append(-lam[k].real / abs(lam[k]))
+        for j in range(m):
+            if len(fs_[j]) == orders[j].size:  # the replicate kept the mode at every order
+                fr[g, j] = np.mean(fs_[j])
+                zr[g, j] = np.mean(zs_[j])
     return np.sqrt(jackknife_variance(fr)), np.sqrt(jackknife_variance(zr))
