@@ -11,7 +11,8 @@
    :class:`tyredamp.oma.CorrelationAccumulator`, then SSI and selection: the peak
    resident memory of the process is printed (``resource.getrusage``).
 
-Run: ``python benchmarks/oma_speed.py`` (``--skip-hour`` for parts 1-2 only).
+Run: ``python benchmarks/oma_speed.py`` (``--skip-hour`` for parts 1-2 only,
+``--only-hour`` for part 3).
 """
 
 from __future__ import annotations
@@ -139,9 +140,11 @@ def hour() -> None:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--skip-hour", action="store_true")
+    ap.add_argument("--only-hour", action="store_true")
     a = ap.parse_args()
-    compare()
-    linear()
+    if not a.only_hour:
+        compare()
+        linear()
     if not a.skip_hour:
         hour()
 
