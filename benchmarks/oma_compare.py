@@ -61,7 +61,9 @@ def _pyoma2(y: np.ndarray, fs: float, q: int, sel: np.ndarray, refs: list[int], 
             kw = {"order_in": "find_min"} if name == "SSIcov" else {}
             ss.mpe(name, sel_freq=list(sel), **kw)
         r = dict(alg.result)
-        out[name] = (np.asarray(r["Fn"], float), np.asarray(r["Xi"], float), dt)
+        fn = np.asarray(r.get("Fn") if r.get("Fn") is not None else [], float).ravel()
+        xi = np.asarray(r.get("Xi") if r.get("Xi") is not None else [], float).ravel()
+        out[name] = (fn, xi, dt)
     return out
 
 
@@ -77,6 +79,9 @@ def _table(label: str, res, other) -> None:
             f"{100 * res.damping_ratio[j]:>7.3f} {100 * res.std_damping_ratio[j]:>6.2g}"
         )
         for f, z, _ in (other or {}).values():
+            if f.size == 0:
+                row += f" | {'(none)':>9} {'':>6} {'':>7}"
+                continue
             k = int(np.argmin(np.abs(f - res.frequency_hz[j])))
             df = 100 * (f[k] - res.frequency_hz[j]) / res.frequency_hz[j]
             row += f" | {f[k]:>9.4f} {df:>6.2f} {100 * z[k]:>7.3f}"
