@@ -32,7 +32,7 @@ FLOORS: tuple[tuple[str, ...], ...] = (
     ("mechanics",),
     ("signal",),
     ("modal", "lateral"),
-    ("damping",),
+    ("damping", "oma"),
     ("virtual",),
     ("tyremodel",),
     ("io",),

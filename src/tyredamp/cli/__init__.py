@@ -74,6 +74,11 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
         "modal_command",
         "Identify real and complex modes of the FRFs in FRF_FILE.",
     ),
+    "oma": (
+        "oma",
+        "oma_command",
+        "Identify modes from output-only time data in FILES (operational modal analysis).",
+    ),
     "report": (
         "report",
         "report_command",

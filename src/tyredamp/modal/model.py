@@ -352,6 +352,8 @@ class ModalModel:
 
             def cz(x: Any) -> NDArray[np.complex128]:
                 a = np.asarray(x, dtype=float)
+                if a.size == 0:  # no entries (a model without inputs: output-only modes)
+                    return np.zeros(0, complex)
                 if a.shape[-1:] != (2,):
                     raise InputError(f"expected [re, im] pairs, got shape {a.shape}")
                 return a[..., 0] + 1j * a[..., 1]

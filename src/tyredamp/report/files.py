@@ -52,6 +52,7 @@ from ..timedata import TimeData
 from ._outcomes import _verdict
 from .build import fmt_pm
 from .html import HtmlReport
+from .oma import oma_section
 
 __all__ = ["ResultFile", "build_files_report", "load_result_file"]
 
@@ -251,6 +252,7 @@ def _modes_section(
         f"Source {src}; band {'-'.join(f'{b:g}' for b in band) if band else '?'} Hz; "
         f"FRF kind {doc.get('frf_kind') or '?'}."
     )
+    oma_section(rep, doc)
     tmodel = None
     if truth is not None and truth is not item:
         tm = truth.obj
