@@ -46,6 +46,7 @@ __all__ = [
     "RollingModes",
     "RollingWave",
     "compare_waves",
+    "resolve_in_tyre",
     "rolling_modes",
     "rotating_frequency",
 ]
@@ -215,35 +216,73 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
-def _resolve(
-    r: OMAResult, fixed: list[RollingWave], fw: float, n_max: int, tol: float
+def resolve_in_tyre(
+    frequency_rot_hz: ArrayLike,
+    fixed: list[RollingWave],
+    wheel_speed_hz: float,
+    *,
+    damping_ratio: ArrayLike | None = None,
+    std_frequency_hz: ArrayLike | None = None,
+    n_max: int = 8,
+    tol: float = 0.01,
 ) -> list[RollingWave]:
-    """Each in-tyre peak matched through eq. (1) to a fixed-frame wave of the same ``n``
-    and direction on the tyre within ``tol`` (relative); otherwise unresolved."""
+    """Wave number and direction of in-tyre peaks through eq. (1) and the fixed-frame waves.
+
+    A peak at ``f_rot`` could be the forward wave ``n`` (seen at ``f_rot + n f_w``
+    from a fixed point) or the backward wave ``n`` (at ``|f_rot - n f_w|``), for
+    every ``n``: eq. (1), Huang & Soedel (1987) eq. 29. It is resolved when a
+    fixed-frame wave with that ``n`` and direction on the tyre lies within
+    ``tol`` (relative) of that frequency (the nearest wins); otherwise it is
+    returned unresolved with its candidates.
+
+    Parameters
+    ----------
+    frequency_rot_hz : array_like, shape (m,)
+        Peaks of the in-tyre sensor, Hz.
+    fixed : list of RollingWave
+        Waves from the fixed sensors (may be empty).
+    wheel_speed_hz : float
+        ``f_w`` in Hz.
+    damping_ratio, std_frequency_hz : array_like, shape (m,), optional
+        Carried into the result (NaN when absent).
+    n_max : int
+        Largest wave number tried.
+    tol : float
+        Relative frequency tolerance of a match.
+
+    Returns
+    -------
+    list of RollingWave
+        One per peak, in the order given.
+    """
+    f_all = np.asarray(frequency_rot_hz, float).ravel()
+    nan = np.full(f_all.size, np.nan)
+    z_all = nan if damping_ratio is None else np.asarray(damping_ratio, float).ravel()
+    s_all = nan if std_frequency_hz is None else np.asarray(std_frequency_hz, float).ravel()
+    fw = float(wheel_speed_hz)
     out = []
-    for j in range(r.n_modes):
-        f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
-        sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
+    for f, z, sf in zip(f_all.tolist(), z_all.tolist(), s_all.tolist(), strict=True):
         cands = []
         for n in range(1, n_max + 1):
             cands.append((n, "forward", f + n * fw))  # forward on the tyre: seen higher
             cands.append((n, "backward", abs(f - n * fw)))
-        hits = []
-        for n, d, ff in cands:
-            for w in fixed:
-                if w.wave_number == n and w.direction == d and abs(w.fixed_hz - ff) <= tol * ff:
-                    hits.append((abs(w.fixed_hz - ff) / ff, n, d, w))
+        hits = [
+            (abs(w.fixed_hz - ff) / ff, n, d, w)
+            for n, d, ff in cands
+            for w in fixed
+            if w.wave_number == n and w.direction == d and abs(w.fixed_hz - ff) <= tol * ff
+        ]
         if hits:
             _, n, d, w = min(hits, key=lambda h: h[0])
-            why = f"f_rot + {'' if d == 'forward' else '-'}n f_w matches the fixed-frame wave"
-            out.append(RollingWave("rotating", n, d, w.fixed_direction, w.fixed_hz, f, z, sf, sz,
-                                   float("nan"), [], why))  # fmt: skip
+            why = f"f_rot {'+' if d == 'forward' else '-'} n f_w matches the fixed-frame wave"
+            out.append(RollingWave("rotating", n, d, w.fixed_direction, w.fixed_hz, f, z, sf,
+                                   float("nan"), float("nan"), [], why))  # fmt: skip
             continue
         why = "one in-tyre peak: wave number and direction not resolved" + (
             " (no fixed-frame wave matches)" if fixed else " (no fixed sensors)"
         )
-        out.append(RollingWave("rotating", None, None, None, float("nan"), f, z, sf, sz,
-                               float("nan"), cands, why))  # fmt: skip
+        out.append(RollingWave("rotating", None, None, None, float("nan"), f, z, sf,
+                               float("nan"), float("nan"), cands, why))  # fmt: skip
     return out
 
 
@@ -278,6 +317,7 @@ def rolling_modes(
     n_max: int = 8,
     tol: float = 0.01,
     n_groups: int = 16,
+    uncertainty: bool = True,
 ) -> RollingModes:
     """Travelling waves of a rolling tyre from fixed and in-tyre output-only records.
 
@@ -302,6 +342,8 @@ def rolling_modes(
         Relative frequency tolerance of an in-tyre-to-fixed match.
     n_groups : int
         Jackknife segments of the SSI (fixed sensors).
+    uncertainty : bool
+        Jackknife standard errors of the fixed-sensor modes (slower).
 
     Returns
     -------
@@ -327,7 +369,7 @@ def rolling_modes(
         if angles_deg is None and any(data.channels[i].angle_deg is None for i in fix):
             raise InputError("angles: the fixed channels carry no angles; give angles_deg")
         r_fix = oma(data.data[fix], data.sample_rate, band=bnd, n_groups=n_groups,
-                    wheel_speed_hz=fw if fw > 0 else None)  # fmt: skip
+                    wheel_speed_hz=fw if fw > 0 else None, uncertainty=uncertainty)  # fmt: skip
         fixed = sorted(_fixed_waves(r_fix, ang, fw), key=lambda w: w.fixed_hz)
     else:
         notes.append(f"{len(fix)} fixed sensor(s): at least 3 are needed for wave numbers")
@@ -335,7 +377,10 @@ def rolling_modes(
     if rot:
         r_rot = oma(data.data[rot[:1]], data.sample_rate, method="plscf", band=bnd,
                     wheel_speed_hz=fw if fw > 0 else None)  # fmt: skip
-        rotating = _resolve(r_rot, fixed, fw, n_max, tol)
+        rotating = resolve_in_tyre(
+            r_rot.frequency_hz, fixed, fw, damping_ratio=r_rot.damping_ratio,
+            std_frequency_hz=r_rot.std_frequency_hz, n_max=n_max, tol=tol,
+        )  # fmt: skip
         if len(rot) > 1:
             notes.append(f"in-tyre sensors: the first of {len(rot)} is used")
         if fw == 0:
