@@ -54,7 +54,8 @@ def test_in_tyre_peaks_resolved_by_the_fixed_frame_waves(truth80: RollingTruth) 
 def test_in_tyre_peak_alone_is_unresolved_with_its_candidates(truth80: RollingTruth) -> None:
     row = truth80.wave(3, "forward")
     (w,) = resolve_in_tyre([row["rotating_hz"]], [], truth80.rotation_hz, n_max=4)
-    assert w.wave_number is None and w.direction is None
+    assert w.wave_number is None
+    assert w.direction is None
     assert (3, "forward") in [(n, d) for n, d, _ in w.candidates]
     ff = {(n, d): f for n, d, f in w.candidates}[(3, "forward")]
     assert_allclose(ff, row["fixed_hz"], rtol=1e-9)  # eq. (1) gives the fixed frequency back
