@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -84,3 +87,35 @@ def test_rolling_modes_end_to_end_at_80_kmh() -> None:
     for c in rot:
         if c["found"]:
             assert abs(c["f_error"]) < 0.02, c  # 2 %: one sensor, pLSCF
+
+
+def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    from tyredamp.cli import main
+
+    try:
+        main(list(argv))
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_cli_rolling_writes_the_waves(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from tyredamp.io import write_timedata
+
+    test = rolling_test(80.0, duration=8.0, sample_rate=512, band=(0, 200), seed=4)
+    src = tmp_path / "rolling.npz"
+    write_timedata(test.data, src)
+    out = tmp_path / "waves.json"
+    code, text, err = _run(capsys, "rolling", str(src), "-o", str(out), "--no-uncertainty")
+    assert code == 0, err
+    assert "wrote" in text
+    doc = json.loads(out.read_text())
+    got = {(w["wave_number"], w["direction"]) for w in doc["waves"] if w["source"] == "fixed"}
+    assert (3, "forward") in got
+    code, _, err = _run(
+        capsys, "rolling", str(src), "-o", str(tmp_path / "x.json"), "--in-tyre", "99"
+    )
+    assert code == 2
+    assert err.startswith("tyredamp: error: --in-tyre")
