@@ -13,8 +13,10 @@ wave, at different frequencies. Two kinds of sensor see them:
   the same wave at the rotating-frame frequency.
 
 The two frames are tied by the kinematics of a wave ``e^{i(omega t + k theta)}``
-on the tyre seen at the fixed angle ``phi = theta + Omega t`` (Huang & Soedel,
-J. Sound Vib. 118(2) (1987) 253-270, eq. 29; :mod:`tyredamp.virtual.rolling_truth`)::
+on the tyre seen at the fixed angle ``phi = theta + Omega t`` (the change of
+frame of Huang & Soedel, J. Sound Vib. 115(2) (1987) 253-274; the relation is
+derived here and in :mod:`tyredamp.virtual.rolling_truth`, whose exact ring
+modes the tests check it against)::
 
     f_fixed = f_rot + s n f_w          (1)
 
@@ -57,8 +59,9 @@ def rotating_frequency(
 ) -> tuple[float, str]:
     """Rotating-frame frequency and direction on the tyre of a fixed-frame wave.
 
-    Eq. (1) of this module, ``f_rot = f_fixed - s n f_w``: Huang & Soedel (1987)
-    eq. 29 (the Doppler relation between the frames of a rotating ring).
+    Eq. (1) of this module, ``f_rot = f_fixed - s n f_w`` (the Doppler relation
+    between the frames of a rotating ring, from the frame change of Huang &
+    Soedel 1987; derived in the module docstring).
 
     Parameters
     ----------
@@ -230,7 +233,7 @@ def resolve_in_tyre(
 
     A peak at ``f_rot`` could be the forward wave ``n`` (seen at ``f_rot + n f_w``
     from a fixed point) or the backward wave ``n`` (at ``|f_rot - n f_w|``), for
-    every ``n``: eq. (1), Huang & Soedel (1987) eq. 29. It is resolved when a
+    every ``n``: eq. (1) of this module. It is resolved when a
     fixed-frame wave with that ``n`` and direction on the tyre lies within
     ``tol`` (relative) of that frequency (the nearest wins); otherwise it is
     returned unresolved with its candidates.
