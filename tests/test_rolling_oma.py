@@ -119,3 +119,19 @@ def test_cli_rolling_writes_the_waves(tmp_path: Path, capsys: pytest.CaptureFixt
     )
     assert code == 2
     assert err.startswith("tyredamp: error: --in-tyre")
+
+
+@pytest.mark.parametrize(
+    ("sign", "member"), [(-1, "forward"), (1, "backward"), (0, "cos")], ids=str
+)
+def test_family_member_of_travelling_and_standing_shapes(sign: int, member: str) -> None:
+    from tyredamp.campaign.families import family_names, mode_wave
+
+    ang = np.arange(16) * 22.5
+    th = np.radians(ang)
+    # e^{-i n theta} e^{i omega t} travels towards +theta; cos n theta stands
+    shape = np.cos(3 * th) if sign == 0 else np.exp(1j * sign * 3 * th)
+    w = mode_wave(ang.tolist(), shape.tolist())
+    assert w is not None
+    assert (w.n, w.member) == (3, member)
+    assert family_names({"F1": [w, w]})["F1"].label == f"n=3 {member}"
