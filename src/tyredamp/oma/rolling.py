@@ -170,6 +170,10 @@ class RollingModes:
     fixed_result, rotating_result : OMAResult or None
         The underlying identifications.
     notes : list of str
+    angles_deg : tuple of float
+        Angles of the fixed sensors (deg), in the order of the shapes.
+    points : tuple of str
+        Names of the fixed sensors.
     """
 
     wheel_speed_hz: float
@@ -178,6 +182,8 @@ class RollingModes:
     fixed_result: OMAResult | None
     rotating_result: OMAResult | None
     notes: list[str] = field(default_factory=list)
+    angles_deg: tuple[float, ...] = ()
+    points: tuple[str, ...] = ()
 
     def table(self) -> list[dict[str, Any]]:
         """Every wave as a dict (:meth:`RollingWave.to_dict`), fixed first."""
@@ -363,6 +369,7 @@ def rolling_modes(
     notes: list[str] = []
     fixed: list[RollingWave] = []
     r_fix = r_rot = None
+    ang: list[float] = []
     if len(fix) >= 3:
         ang = (
             [float(data.channels[i].angle_deg or 0.0) for i in fix]
@@ -388,7 +395,8 @@ def rolling_modes(
             notes.append(f"in-tyre sensors: the first of {len(rot)} is used")
         if fw == 0:
             notes.append("wheel at rest: both frames coincide")
-    return RollingModes(fw, fixed, rotating, r_fix, r_rot, notes)
+    names = tuple(data.channels[i].name or f"{i + 1}" for i in fix) if ang else ()
+    return RollingModes(fw, fixed, rotating, r_fix, r_rot, notes, tuple(ang), names)
 
 
 def compare_waves(
