@@ -263,11 +263,11 @@ def _float(v: Any) -> float:
 
 
 def mode_sets(runs: Sequence[TestRun], model: str) -> list[ModeSet]:
-    """The identified modes of every successful radial test, for :func:`track_modes`."""
+    """The identified modes of every successful radial or rolling test, for :func:`track_modes`."""
     out = []
     for r in runs:
         recs = steps.mode_records(r.spec.study, r.documents, model)
-        if not recs or "modal" not in r.documents:
+        if not recs or not ("modal" in r.documents or "rolling" in r.documents):
             continue
         out.append(
             ModeSet(
@@ -593,7 +593,12 @@ _FILES = (
     "trend_fits.json",
     "campaign.json",
 )
-_DOC_FILES = {"modal": "modes.json", "damping": "damping.json", "fit": "lateral.json"}
+_DOC_FILES = {
+    "modal": "modes.json",
+    "damping": "damping.json",
+    "fit": "lateral.json",
+    "rolling": "waves.json",
+}
 
 
 def write_outputs(

@@ -523,6 +523,8 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
     a roving-hammer test, the same point by reciprocity) and ``shape``
     (complex, one per point). A lateral test has no modes (empty list).
     """
+    if study == "rolling":  # output-only: the fixed-frame modes, no MPC or damping matrix
+        return _rolling_records(documents)
     if study != "radial" or "modal" not in documents or is_skip(documents["modal"]):
         return []
     models = documents["modal"]["models"]
