@@ -9,7 +9,9 @@ import click
 
 from ..documents.jsonfile import write_json
 from ..exceptions import InputError
+from ..studies.steps.rolling import RollingSettings
 from ._common import channel_map, channel_map_options, out_file_option
+from ._settings import settings_from_options, settings_options
 
 __all__ = ["rolling_command"]
 
@@ -35,13 +37,12 @@ def _channel_list(text: str | None, n: int, option: str) -> list[int] | None:
     default=None,
     help="Wheel rotation frequency in Hz (default: from the file's metadata).",
 )
-@click.option("--band", nargs=2, type=float, default=None, help="Band LO HI in Hz.")
 @click.option(
     "--in-tyre",
     default=None,
     help="Channels of the sensors inside the tyre, e.g. 17 (default: channels named T..).",
 )
-@click.option("--no-uncertainty", is_flag=True, help="Skip the jackknife standard errors (faster).")
+@settings_options(RollingSettings)
 @channel_map_options
 def rolling_command(file: Path, out: Path, **o: Any) -> None:
     """Travelling waves of a rolling tyre from output-only time data in FILE.
@@ -61,6 +62,7 @@ def rolling_command(file: Path, out: Path, **o: Any) -> None:
     from ..io._safety import check_output_file
     from ..oma.rolling import rolling_modes
 
+    settings = settings_from_options(RollingSettings, o)
     check_output_file(out, [file])
     td = read_timedata(file, channel_map=channel_map())
     rot = _channel_list(o["in_tyre"], td.n_channels, "--in-tyre")
@@ -68,8 +70,8 @@ def rolling_command(file: Path, out: Path, **o: Any) -> None:
         td,
         o["wheel_speed"],
         rotating_channels=rot,
-        band=tuple(o["band"]) if o["band"] else None,
-        uncertainty=not o["no_uncertainty"],
+        band=settings.band,
+        uncertainty=settings.uncertainty,
     )
     write_json(
         {

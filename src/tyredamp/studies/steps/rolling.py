@@ -39,7 +39,10 @@ class RollingSettings(StepSettings):
         metavar="F_LO F_HI",
     )
     uncertainty: bool = knob(
-        True, "Jackknife standard errors of the fixed-sensor modes.", Boolean(), "--uncertainty"
+        True,
+        "Skip the jackknife standard errors of the modes (faster).",
+        Boolean(),
+        "--no-uncertainty",
     )
 
 
