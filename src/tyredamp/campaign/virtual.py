@@ -436,6 +436,9 @@ def campaign_file_text(spec: VirtualCampaign, tests: list[dict[str, Any]]) -> st
         "samples = 50",
         "",
     ]
+    if any(e["study"] == "rolling" for e in tests):
+        # rolling records cover 0-200 Hz: a band inside it keeps the SSI off the edges
+        lines += ["[settings.rolling.rolling]", "band = [10.0, 190.0]", ""]
     for entry in tests:
         lines.append("[[tests]]")
         lines.append(f"files = {_toml_value(entry['file'])}")
