@@ -57,6 +57,7 @@ COMMANDS: dict[str, tuple[str, ...]] = {
     "modal": ("modal",),
     "damping": ("damping",),
     "fit": ("lateral", "fit"),
+    "rolling": ("rolling",),
 }
 #: Valid names for the list settings whose entries a registry checks.
 NAMES: dict[str, list[str]] = {"models": ["maxwell", "classic"], "reference": ["1+Z", "F2"]}

@@ -23,6 +23,17 @@ principal phase): ``cos`` when the antinode is nearer the reference (the first
 input's angle) than the node, i.e. ``|n (theta_0 - theta_ref)| < 45 deg``
 modulo 180 deg, else ``sin``.
 
+A rolling tyre's modes are travelling waves, not standing pairs: with
+``a cos n theta + b sin n theta = (a - i b)/2 e^{i n theta} + (a + i b)/2
+e^{-i n theta}`` and the time dependence ``e^{i omega t}``, the second term
+travels towards ``+theta`` (Huang & Soedel, J. Sound Vib. 115(2) (1987)
+253-274: the split of a rotating ring's modes into two waves; the
+decomposition is the spatial Fourier series of the shape). A shape whose
+share ``|a + i b|^2 / (|a - i b|^2 + |a + i b|^2)`` is at least 3/4 is the
+member ``forward`` (travelling towards increasing angle: with the rotation
+when the angles run that way), at most 1/4 ``backward``; in between it is a
+standing wave and named ``cos``/``sin`` as above.
+
 Per family
 ----------
 The family's wave number is the one that most of its single-harmonic modes
@@ -47,7 +58,14 @@ from numpy.typing import NDArray
 
 from ..tyremodel.harmonics import harmonic_fit, resolved_wave_numbers
 
-__all__ = ["MIN_FRACTION", "FamilyName", "ModeWave", "family_names", "mode_wave"]
+__all__ = [
+    "MIN_FRACTION",
+    "FamilyName",
+    "ModeWave",
+    "family_names",
+    "mode_wave",
+    "travelling_share",
+]
 
 #: Energy fraction of one harmonic above which a shape counts as that harmonic.
 MIN_FRACTION = 0.8
@@ -64,8 +82,9 @@ class ModeWave:
     fraction : float
         Share of the shape's energy that this harmonic explains, in [0, 1].
     member : str or None
-        ``"cos"`` or ``"sin"`` relative to the reference angle (None for
-        ``n = 0`` or a shape that is not a single harmonic).
+        ``"cos"`` or ``"sin"`` relative to the reference angle, ``"forward"``
+        or ``"backward"`` for a travelling wave (None for ``n = 0`` or a shape
+        that is not a single harmonic).
     """
 
     n: int
@@ -120,8 +139,25 @@ def mode_wave(
     return ModeWave(n=int(best.n), fraction=float(best.fraction), member=member)
 
 
+def travelling_share(coef: NDArray[np.complex128]) -> float:
+    """Share of ``a cos n t + b sin n t`` travelling towards ``+t``.
+
+    ``|a+ib|^2 / (|a-ib|^2 + |a+ib|^2)``: the spatial Fourier split of the module
+    docstring (0.5 for a standing wave).
+    """
+    fwd = abs(coef[0] + 1j * coef[1]) ** 2
+    bwd = abs(coef[0] - 1j * coef[1]) ** 2
+    return float(fwd / (fwd + bwd)) if fwd + bwd > 0 else 0.5
+
+
 def _member(coef: NDArray[np.complex128], n: int, reference_deg: float) -> str:
-    """``cos`` when the antinode of ``a cos n t + b sin n t`` is nearer the reference."""
+    """``forward``/``backward`` for a travelling wave, else ``cos`` when the antinode of
+    ``a cos n t + b sin n t`` is nearer the reference."""
+    share = travelling_share(coef)
+    if share >= 0.75:
+        return "forward"
+    if share <= 0.25:
+        return "backward"
     # principal phase of the complex pair (a, b), then real coefficients
     alpha = 0.5 * np.angle(coef[0] ** 2 + coef[1] ** 2)
     a, b = (coef * np.exp(-1j * alpha)).real
@@ -148,9 +184,10 @@ class FamilyName:
         Share of the family's single-harmonic modes that carry
         ``wave_number`` (NaN without any).
     member : str or None
-        ``"cos"``, ``"sin"``, ``"pair"`` (tracked as a pair) or None.
+        ``"cos"``, ``"sin"``, ``"forward"``, ``"backward"``, ``"pair"``
+        (tracked as a pair) or None.
     label : str
-        ``n=2``, ``n=2 cos``, ``n=2 cos (2nd)``, or the tracking's name when
+        ``n=2``, ``n=2 cos``, ``n=2 forward``, ``n=2 cos (2nd)``, or the tracking's name when
         there is no wave number.
     n_labelled : int
         How many of its modes are single harmonics.
@@ -219,7 +256,7 @@ def family_names(
         key = (name.wave_number, name.member)
         seen[key] += 1
         text = f"n={name.wave_number}"
-        if name.member in ("cos", "sin"):
+        if name.member in ("cos", "sin", "forward", "backward"):
             text += f" {name.member}"
         if seen[key] > 1:
             text += f" ({_ordinal(seen[key])})"

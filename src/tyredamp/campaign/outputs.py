@@ -270,11 +270,11 @@ def _float(v: Any) -> float:
 
 
 def mode_sets(runs: Sequence[TestRun], model: str) -> list[ModeSet]:
-    """The identified modes of every successful radial test, for :func:`track_modes`."""
+    """The identified modes of every successful radial or rolling test, for :func:`track_modes`."""
     out = []
     for r in runs:
         recs = steps.mode_records(r.spec.study, r.documents, model)
-        if not recs or "modal" not in r.documents:
+        if not recs or not ("modal" in r.documents or "rolling" in r.documents):
             continue
         out.append(
             ModeSet(
@@ -291,6 +291,39 @@ def mode_sets(runs: Sequence[TestRun], model: str) -> list[ModeSet]:
     return out
 
 
+def track_by_study(runs: Sequence[TestRun], model: str) -> Tracking:
+    """:func:`track_modes` per study (radial, rolling), families numbered on across studies.
+
+    A rolling test's travelling waves and a standing test's modes are not one
+    family even at one frequency, so each study is tracked on its own; the
+    rolling study's families follow the radial study's (``F{k+1}``, ...), and
+    the scatter is the first study's.
+    """
+    sets = mode_sets(runs, model)
+    study = {r.spec.test_id: r.spec.study for r in runs}
+    groups: dict[str, list[ModeSet]] = defaultdict(list)
+    for m in sets:
+        groups[study[m.test_id]].append(m)
+    if len(groups) <= 1:
+        return track_modes(sets)
+    out = Tracking()
+    offset = 0
+    for name in sorted(groups):  # radial before rolling
+        t = track_modes(groups[name])
+        fams = sorted(set(t.family.values()), key=lambda f: int(f[1:]))
+        ren = {f: f"F{offset + i + 1}" for i, f in enumerate(fams)}
+        offset += len(fams)
+        out.family.update({k: ren[v] for k, v in t.family.items()})
+        out.slot.update(t.slot)
+        out.mac.update(t.mac)
+        out.method.update(t.method)
+        out.distance.update(t.distance)
+        out.pairs |= {ren[p] for p in t.pairs}
+        if not out.scatter:
+            out.scatter = dict(t.scatter)
+    return out
+
+
 def mode_rows(
     runs: Sequence[TestRun], model: str = "complex", tracking: Tracking | None = None
 ) -> list[dict[str, Any]]:
@@ -300,7 +333,7 @@ def mode_rows(
     when not given).
     """
     if tracking is None:
-        tracking = track_modes(mode_sets(runs, model))
+        tracking = track_by_study(runs, model)
     rows = []
     for r in runs:
         for m in steps.mode_records(r.spec.study, r.documents, model):
@@ -603,7 +636,12 @@ _FILES = (
     "trend_fits.json",
     "campaign.json",
 )
-_DOC_FILES = {"modal": "modes.json", "damping": "damping.json", "fit": "lateral.json"}
+_DOC_FILES = {
+    "modal": "modes.json",
+    "damping": "damping.json",
+    "fit": "lateral.json",
+    "rolling": "waves.json",
+}
 
 
 def write_outputs(
@@ -618,7 +656,7 @@ def write_outputs(
     earlier = _summary(out)
     written = set() if earlier is None else set(_listed(earlier))
     model = campaign.tracking.get("model", "complex")
-    tracking = track_modes(mode_sets(runs, model))
+    tracking = track_by_study(runs, model)
     rows = mode_rows(runs, model, tracking)
     lrows = lateral_rows(runs)
     lat_obs, lat_quantities = lateral_trend_rows(lrows)

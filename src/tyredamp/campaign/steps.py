@@ -525,6 +525,8 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
     a roving-hammer test, the same point by reciprocity) and ``shape``
     (complex, one per point). A lateral test has no modes (empty list).
     """
+    if study == "rolling":  # output-only: the fixed-frame modes, no MPC or damping matrix
+        return _rolling_records(documents)
     if study != "radial" or "modal" not in documents or is_skip(documents["modal"]):
         return []
     models = documents["modal"]["models"]
@@ -575,6 +577,32 @@ def mode_records(study: str, documents: Mapping[str, Any], model: str = "complex
             }
         )
     return out
+
+
+def _rolling_records(documents: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The fixed-frame modes of the ``rolling`` step as :func:`mode_records` records."""
+    doc = documents.get("rolling")
+    if doc is None or is_skip(doc):
+        return []
+    angles = [float(a) for a in doc.get("angles_deg", [])]
+    return [
+        {
+            "mode": i + 1,
+            "model": "output-only",
+            "frequency_hz": md["frequency_hz"],
+            "frequency_std_hz": md.get("std_frequency_hz"),
+            "damping_ratio": md["damping_ratio"],
+            "damping_ratio_std": md.get("std_damping_ratio"),
+            "mpc": None,
+            "modal_damping": None,
+            "modal_damping_std": None,
+            "points": list(doc.get("points", [])),
+            "angles_deg": angles,
+            "reference_deg": 0.0,
+            "shape": _complex_vec(md["shape"]),
+        }
+        for i, md in enumerate(doc.get("modes", []))
+    ]
 
 
 def lateral_records(documents: Mapping[str, Any]) -> list[dict[str, Any]]:

@@ -84,6 +84,9 @@ class VirtualCampaign:
         there; ``(1, 5)``, 90 deg apart, sees both members of the odd wave
         numbers, split by the contact patch: a multi-reference campaign with
         doubled modes as pairs).
+    rolling_speeds_kmh : tuple of float
+        Speeds of the output-only rolling tests of the first tyre at every
+        pressure (:mod:`.virtual_rolling`; default none).
     """
 
     n_tyres: int = 3
@@ -94,6 +97,7 @@ class VirtualCampaign:
     periods: int = 8
     seed: int = 0
     drive_points: tuple[int, ...] = (1,)
+    rolling_speeds_kmh: tuple[float, ...] = ()
 
     @classmethod
     def quick(cls, seed: int = 0) -> VirtualCampaign:
@@ -309,6 +313,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
     data = root / "data"
     data.mkdir(parents=True, exist_ok=True)
     total = s.n_tyres * len(s.pressures_bar) * len(s.loads_n) + len(s.lateral_speeds_kmh)
+    total += len(s.rolling_speeds_kmh) * len(s.pressures_bar)
     done = 0
     tests: list[dict[str, Any]] = []
     held: list[dict[str, Any]] = []
@@ -374,6 +379,19 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
             done += 1
             if progress is not None:
                 progress(done, total)
+        if s.rolling_speeds_kmh:
+            from .virtual_rolling import write_rolling_tests
+
+            def tick() -> None:
+                nonlocal done
+                done += 1
+                if progress is not None:
+                    progress(done, total)
+
+            tests += write_rolling_tests(
+                data, tyre_parameters(0, s.seed), s.rolling_speeds_kmh, s.pressures_bar,
+                s.seed, progress=tick,
+            )  # fmt: skip
     doc = {
         "kind": TRUTH_KIND,
         "version": 1,
@@ -386,6 +404,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
             "periods": s.periods,
             "seed": s.seed,
             "drive_points": list(s.drive_points),
+            "rolling_speeds_kmh": list(s.rolling_speeds_kmh),
         },
         "tyres": tyres,
         "tests": tests,
@@ -419,6 +438,9 @@ def campaign_file_text(spec: VirtualCampaign, tests: list[dict[str, Any]]) -> st
         "samples = 50",
         "",
     ]
+    if any(e["study"] == "rolling" for e in tests):
+        # rolling records cover 0-200 Hz: a band inside it keeps the SSI off the edges
+        lines += ["[settings.rolling.rolling]", "band = [10.0, 190.0]", ""]
     for entry in tests:
         lines.append("[[tests]]")
         lines.append(f"files = {_toml_value(entry['file'])}")

@@ -85,6 +85,11 @@ COMMANDS: dict[str, tuple[str, str, str]] = {
         "report_command",
         "Build one HTML report from RESULT_FILES of the other commands.",
     ),
+    "rolling": (
+        "rolling",
+        "rolling_command",
+        "Travelling waves of a rolling tyre from output-only time data in FILE.",
+    ),
     "simulate": (
         "simulate",
         "simulate_group",

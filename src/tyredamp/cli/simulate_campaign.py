@@ -35,8 +35,15 @@ __all__ = ["simulate_campaign_command"]
     metavar="P1,P2,...",
     help="Shaker points of the radial tests; 1,5 sees both members of the doubled modes.",
 )
+@click.option(
+    "--rolling",
+    is_flag=True,
+    help="Add output-only rolling tests of tyre 1 at 0, 40, 80 and 120 km/h at every pressure.",
+)
 @seed_option("Seed of the manufacturing scatter and of the noise.")
-def simulate_campaign_command(out: Path, quick: bool, drive_points: str, seed: int) -> None:
+def simulate_campaign_command(
+    out: Path, quick: bool, drive_points: str, rolling: bool, seed: int
+) -> None:
     """Write a virtual test campaign of the truck tyre, its truth and a campaign file.
 
     3 tyres with manufacturing scatter x 5 pressures (6-9 bar) x 3 loads
@@ -51,6 +58,7 @@ def simulate_campaign_command(out: Path, quick: bool, drive_points: str, seed: i
       tyredamp simulate campaign --out virtual
       tyredamp campaign virtual/campaign.toml --out results
       tyredamp simulate campaign --out pairs --quick --drive-points 1,5
+      tyredamp simulate campaign --out speeds --quick --rolling
     """
     from ..campaign.virtual import VirtualCampaign, check_virtual_output, write_virtual_campaign
 
@@ -58,6 +66,10 @@ def simulate_campaign_command(out: Path, quick: bool, drive_points: str, seed: i
     check_virtual_output(out)
     spec = VirtualCampaign.quick(seed) if quick else VirtualCampaign(seed=seed)
     spec = dataclasses.replace(spec, drive_points=points)
+    if rolling:
+        from ..campaign.virtual_rolling import ROLLING_SPEEDS_KMH
+
+        spec = dataclasses.replace(spec, rolling_speeds_kmh=ROLLING_SPEEDS_KMH)
 
     def progress(done: int, total: int) -> None:
         if sys.stderr.isatty():
@@ -65,9 +77,11 @@ def simulate_campaign_command(out: Path, quick: bool, drive_points: str, seed: i
 
     doc = write_virtual_campaign(out, spec, progress)
     n_r = sum(t["study"] == "radial" for t in doc["tests"])
-    n_l = len(doc["tests"]) - n_r
+    n_o = sum(t["study"] == "rolling" for t in doc["tests"])
+    n_l = len(doc["tests"]) - n_r - n_o
     click.echo(
         f"virtual campaign: {spec.n_tyres} tyres x {len(spec.pressures_bar)} pressures x "
         f"{len(spec.loads_n)} loads = {n_r} radial tests, {n_l} lateral tests"
+        + (f", {n_o} rolling tests" if n_o else "")
     )
     click.echo(f"wrote {out}/ (data/, truth.json, campaign.toml)")

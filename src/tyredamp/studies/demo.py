@@ -20,7 +20,10 @@
   ground-force FRF and ranked, axle-force predictions, the corner frequency
   of the proposed model (eq. 38-40), the single-DOF vehicle (eq. 41-44), the
   2.73 Hz time response and the error of a causal approximation of the
-  hysteretic tyre.
+  hysteretic tyre;
+* the **rolling tyre** (:func:`.rolling.run_rolling`): the rotating virtual
+  tyre at 40 and 80 km/h (80 only with ``quick``) identified output-only,
+  each exact travelling wave beside the identified one.
 
 :func:`tyredamp.report.demo.save_demo` writes what :func:`run_demo` returned
 into a directory (report, results.json, figures, data, modes and damping
@@ -41,6 +44,7 @@ from ..exceptions import InputError
 from .lateral import conditions, run_lateral
 from .radial import run_radial
 from .results import DemoResult
+from .rolling import run_rolling
 from .settings import DemoSettings
 
 __all__ = ["DemoResult", "DemoSettings", "ProgressCallback", "run_demo", "single_threaded_blas"]
@@ -112,10 +116,12 @@ def run_demo(
 
 def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
     t_start = time.perf_counter()
-    n_stages = len(s.radial_pressures_bar) + 4 + len(conditions(s)) + 1
+    n_stages = len(s.radial_pressures_bar) + 4 + len(conditions(s)) + 2
     st = _Stages(n_stages, progress)
     radial = run_radial(s, st.start)
     lateral = run_lateral(s, st.start)
+    st.start("rolling tyre, output-only")
+    rolling = run_rolling((80.0,) if s.quick else (40.0, 80.0), seed=s.seed)
     st.finish()
     return DemoResult(
         settings=s,
@@ -123,4 +129,5 @@ def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
         lateral=lateral,
         timings=dict(st.timings),
         elapsed_s=time.perf_counter() - t_start,
+        rolling=rolling,
     )

@@ -525,6 +525,10 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         "lateral": _lateral_section(result, fnd),
         "warnings": [f.to_dict() for f in fnd.findings],
     }
+    if result.rolling is not None:
+        from .rolling import rolling_section
+
+        doc["rolling"] = rolling_section(result.rolling)
     out = finite(doc)
     assert isinstance(out, dict)
     return out

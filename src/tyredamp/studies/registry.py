@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .steps import DampingStep, FrfStep, LateralFitStep, ModalStep, QualityStep, StepSettings
+from .steps.rolling import RollingStep
 
 __all__ = ["STEPS", "STUDIES", "Study", "settings_class", "step_sections"]
 
@@ -33,6 +34,7 @@ STEPS: dict[str, Any] = {
     "modal": ModalStep,
     "damping": DampingStep,
     "fit": LateralFitStep,
+    "rolling": RollingStep,
 }
 
 
@@ -77,6 +79,7 @@ class Study:
 STUDIES: dict[str, Study] = {
     "radial": Study("radial", ("modal", "damping")),
     "lateral": Study("lateral", ("fit",)),
+    "rolling": Study("rolling", ("rolling",)),
 }
 
 

@@ -360,3 +360,5 @@ class DemoResult:
     timings: dict[str, float] = field(default_factory=dict)
     elapsed_s: float = 0.0
     version: str = __version__
+    #: the rolling tyre identified output-only (:class:`~tyredamp.studies.rolling.RollingStudy`)
+    rolling: Any = None

@@ -1,0 +1,98 @@
+"""Rolling tests of a virtual campaign: speed x pressure on the rotating ring tyre.
+
+Each test is :func:`tyredamp.virtual.rolling_test` (16 fixed sensors every
+22.5 deg from the contact point, one sensor in the tyre, a random road force
+over 0-200 Hz, 40 dB SNR) of the first tyre of the campaign (its manufacturing
+scatter) at one pressure and speed, written as NPZ time data with the rolling
+truth (:meth:`~tyredamp.virtual.RollingTruth.table`) beside it in the
+campaign's ``truth.json``. The rotating ring has no contact-patch stiffness,
+so the load is not an axis of the rolling tests (it is left out, not faked).
+A campaign processes them with the ``rolling`` study
+(:class:`~tyredamp.studies.steps.rolling.RollingStep`) and tracks every
+family (``n=3 forward`` ...) against ``speed_kmh``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..virtual import MeasurementLayout, RingTyre, RingTyreParameters
+
+__all__ = ["ROLLING_SPEEDS_KMH", "write_rolling_tests"]
+
+#: Speeds of ``tyredamp simulate campaign --rolling`` (km/h).
+ROLLING_SPEEDS_KMH = (0.0, 40.0, 80.0, 120.0)
+
+
+def _rolling_tyre(params: RingTyreParameters, pressure_bar: float) -> RingTyre:
+    """The tyre at ``pressure_bar`` as the rolling rig takes it (no shaker attachments)."""
+    layout = MeasurementLayout(attachment_mass=0.0, attachment_damping=0.0)
+    return RingTyre(params.with_pressure(pressure_bar * 1e5), layout, nonproportionality=1.0)
+
+
+def write_rolling_tests(
+    data_dir: Path,
+    params: RingTyreParameters,
+    speeds_kmh: tuple[float, ...],
+    pressures_bar: tuple[float, ...],
+    seed: int,
+    duration: float = 16.0,
+    progress: Callable[[], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Write the rolling tests into ``data_dir``; their campaign entries with the truth.
+
+    Parameters
+    ----------
+    data_dir : Path
+        The campaign's data folder (exists).
+    params : RingTyreParameters
+        The tyre (its pressure is replaced by each of ``pressures_bar``).
+    speeds_kmh, pressures_bar : tuple of float
+        The grid, km/h and bar.
+    seed : int
+        Campaign seed; each test gets its own stream.
+    duration : float
+        Seconds per record.
+    progress : callable, optional
+        Called after each test.
+
+    Returns
+    -------
+    list of dict
+        ``file``, ``study`` (``"rolling"``), ``tyre``, ``pressure_bar``,
+        ``speed_kmh`` and ``rolling_truth`` per test.
+    """
+    from ..io import write_timedata
+    from ..virtual import rolling_test
+
+    out = []
+    for p in pressures_bar:
+        tyre = _rolling_tyre(params, p)
+        for k, v in enumerate(speeds_kmh):
+            name = f"rolling_{p:g}bar_{v:g}kmh.npz"
+            test = rolling_test(
+                v,
+                tyre=tyre,
+                duration=duration,
+                sample_rate=512.0,
+                band=(0.0, 200.0),
+                seed=np.random.default_rng([seed, 4242, k, round(10 * p)]),
+            )
+            write_timedata(test.data, data_dir / name)
+            out.append(
+                {
+                    "file": f"data/{name}",
+                    "study": "rolling",
+                    "tyre": "T1",
+                    "pressure_bar": p,
+                    "speed_kmh": v,
+                    "rolling_truth": test.truth.table(),
+                }
+            )
+            if progress is not None:
+                progress()
+    return out

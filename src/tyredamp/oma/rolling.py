@@ -1,0 +1,441 @@
+"""Rolling-tyre modes from output-only records: travelling waves in both frames.
+
+A rolling tyre has no double modes: each wave number ``n >= 1`` gives a
+*forward* wave (travelling with the rotation on the tyre) and a *backward*
+wave, at different frequencies. Two kinds of sensor see them:
+
+* **Fixed sensors** around the circumference (angles ``phi_j`` in space, the
+  tyre turning towards ``+phi``): every mode identified from them is split
+  into its two spatial waves (:func:`~tyredamp.oma.waves.wave_content`), which
+  gives its wave number ``n`` and its direction of travel *in space*
+  ``s = +1`` (towards ``+phi``) or ``-1``.
+* **One sensor inside the tyre** (turning with the wheel at ``f_w``): it sees
+  the same wave at the rotating-frame frequency.
+
+The two frames are tied by the kinematics of a wave ``e^{i(omega t + k theta)}``
+on the tyre seen at the fixed angle ``phi = theta + Omega t`` (the change of
+frame of Huang & Soedel, J. Sound Vib. 115(2) (1987) 253-274; the relation is
+derived here and in :mod:`tyredamp.virtual.rolling_truth`, whose exact ring
+modes the tests check it against)::
+
+    f_fixed = f_rot + s n f_w          (1)
+
+with ``s = +1`` for a wave that a fixed observer sees travel with the
+rotation. A negative ``f_fixed - s n f_w`` is the same wave with the sign of
+time reversed: it travels the other way on the tyre (a backward wave carried
+forward in space faster than it runs back). So a fixed-frame mode with ``n``
+and ``s`` determines its rotating frequency and its direction on the tyre;
+a peak of the in-tyre sensor alone does not: each ``(n, direction)`` gives
+another ``f_fixed`` from (1), and only a fixed-frame mode with that ``n`` and
+direction at that frequency resolves it. Without fixed sensors the candidates
+are listed and the peak is reported unresolved.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..exceptions import InputError
+from ..timedata import TimeData
+from .identify import OMAResult, oma
+from .waves import wave_content
+
+__all__ = [
+    "RollingModes",
+    "RollingWave",
+    "compare_waves",
+    "resolve_in_tyre",
+    "rolling_modes",
+    "rotating_frequency",
+]
+
+
+def rotating_frequency(
+    fixed_hz: float, wave_number: int, fixed_direction: str, wheel_speed_hz: float
+) -> tuple[float, str]:
+    """Rotating-frame frequency and direction on the tyre of a fixed-frame wave.
+
+    Eq. (1) of this module, ``f_rot = f_fixed - s n f_w`` (the Doppler relation
+    between the frames of a rotating ring, from the frame change of Huang &
+    Soedel 1987; derived in the module docstring).
+
+    Parameters
+    ----------
+    fixed_hz : float
+        Frequency at a fixed point, Hz.
+    wave_number : int
+        ``n >= 0``.
+    fixed_direction : {"forward", "backward", "standing"}
+        Direction of travel seen from a fixed point (``"forward"``: with the rotation).
+    wheel_speed_hz : float
+        Wheel rotation frequency ``f_w`` in Hz.
+
+    Returns
+    -------
+    f_rot : float
+        Hz (``>= 0``).
+    direction : str
+        On the tyre: ``"forward"``, ``"backward"`` or ``"standing"`` (``n = 0``
+        or a standing fixed-frame wave, for which ``f_fixed`` is returned).
+    """
+    if wave_number == 0 or fixed_direction == "standing":
+        return float(fixed_hz), "standing"
+    s = 1.0 if fixed_direction == "forward" else -1.0
+    f = float(fixed_hz) - s * wave_number * float(wheel_speed_hz)
+    if f >= 0:
+        return f, fixed_direction
+    return -f, "backward" if fixed_direction == "forward" else "forward"
+
+
+@dataclass(frozen=True)
+class RollingWave:
+    """One identified travelling wave of a rolling tyre.
+
+    Attributes
+    ----------
+    source : str
+        ``"fixed"`` (from the fixed sensors) or ``"rotating"`` (the in-tyre sensor).
+    wave_number : int or None
+        ``n``; ``None`` when the in-tyre peak is not resolved.
+    direction : str or None
+        On the tyre: ``"forward"`` (with the rotation), ``"backward"``, ``"standing"``.
+    fixed_direction : str or None
+        As a fixed observer sees it travel.
+    fixed_hz, rotating_hz : float
+        Frequency at a fixed point and in the tyre (Hz; NaN where not known).
+    damping_ratio : float
+        As fitted in the frame it was measured in.
+    std_frequency_hz, std_damping_ratio : float
+        Jackknife standard errors (NaN without them).
+    explained : float
+        Share of the fixed-frame shape the two waves of ``n`` explain (NaN for
+        the in-tyre sensor).
+    candidates : list of (int, str, float)
+        For an unresolved in-tyre peak: every ``(n, direction on the tyre,
+        f_fixed)`` it could be.
+    reason : str
+    """
+
+    source: str
+    wave_number: int | None
+    direction: str | None
+    fixed_direction: str | None
+    fixed_hz: float
+    rotating_hz: float
+    damping_ratio: float
+    std_frequency_hz: float
+    std_damping_ratio: float
+    explained: float = float("nan")
+    candidates: list[tuple[int, str, float]] = field(default_factory=list)
+    reason: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-compatible dict (NaN as ``None``)."""
+
+        def num(x: float) -> float | None:
+            return float(x) if np.isfinite(x) else None
+
+        return {
+            "source": self.source,
+            "wave_number": self.wave_number,
+            "direction": self.direction,
+            "fixed_direction": self.fixed_direction,
+            "fixed_hz": num(self.fixed_hz),
+            "rotating_hz": num(self.rotating_hz),
+            "damping_ratio": num(self.damping_ratio),
+            "std_frequency_hz": num(self.std_frequency_hz),
+            "std_damping_ratio": num(self.std_damping_ratio),
+            "explained": num(self.explained),
+            "candidates": [[n, d, f] for n, d, f in self.candidates],
+            "reason": self.reason,
+        }
+
+
+@dataclass(frozen=True)
+class RollingModes:
+    """Travelling waves of a rolling tyre identified output-only.
+
+    Attributes
+    ----------
+    wheel_speed_hz : float
+        Wheel rotation frequency used (Hz).
+    fixed : list of RollingWave
+        From the fixed sensors, ascending in fixed-frame frequency.
+    rotating : list of RollingWave
+        From the in-tyre sensor, ascending in rotating-frame frequency.
+    fixed_result, rotating_result : OMAResult or None
+        The underlying identifications.
+    notes : list of str
+    angles_deg : tuple of float
+        Angles of the fixed sensors (deg), in the order of the shapes.
+    points : tuple of str
+        Names of the fixed sensors.
+    """
+
+    wheel_speed_hz: float
+    fixed: list[RollingWave]
+    rotating: list[RollingWave]
+    fixed_result: OMAResult | None
+    rotating_result: OMAResult | None
+    notes: list[str] = field(default_factory=list)
+    angles_deg: tuple[float, ...] = ()
+    points: tuple[str, ...] = ()
+
+    def table(self) -> list[dict[str, Any]]:
+        """Every wave as a dict (:meth:`RollingWave.to_dict`), fixed first."""
+        return [w.to_dict() for w in self.fixed + self.rotating]
+
+    def format(self) -> str:
+        """The waves as text, one line each."""
+        lines = [
+            f"wheel speed {self.wheel_speed_hz:.4g} Hz",
+            "source    n  on tyre    fixed Hz  in tyre Hz  zeta %  +- f Hz",
+        ]
+        for w in self.fixed + self.rotating:
+            n = "?" if w.wave_number is None else str(w.wave_number)
+            lines.append(
+                f"{w.source:8s} {n:>2s}  {w.direction or 'unresolved':9s} {w.fixed_hz:9.3f}  "
+                f"{w.rotating_hz:10.3f}  {100 * w.damping_ratio:6.2f}  {w.std_frequency_hz:7.3f}"
+            )
+        return "\n".join(lines)
+
+
+def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWave]:
+    """Wave number and direction of each fixed-frame mode; a standing ``n >= 1``
+    shape stands for both waves at one fixed frequency (listed twice)."""
+    out = []
+    for j in range(r.n_modes):
+        wc = wave_content(r.shapes[:, j], angles)
+        f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
+        sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
+        dirs = (
+            ["forward", "backward"]
+            if wc.wave_number > 0 and wc.direction == "standing"
+            else [wc.direction]
+        )
+        for d in dirs:
+            fr, dt = rotating_frequency(f, wc.wave_number, d, fw)
+            why = f"fixed-frame shape: n = {wc.wave_number}, share forward {wc.forward_share:.2f}"
+            out.append(RollingWave("fixed", wc.wave_number, dt, d, f, fr, z, sf, sz,
+                                   wc.explained, [], why))  # fmt: skip
+    return out
+
+
+def resolve_in_tyre(
+    frequency_rot_hz: ArrayLike,
+    fixed: list[RollingWave],
+    wheel_speed_hz: float,
+    *,
+    damping_ratio: ArrayLike | None = None,
+    std_frequency_hz: ArrayLike | None = None,
+    n_max: int = 8,
+    tol: float = 0.01,
+) -> list[RollingWave]:
+    """Wave number and direction of in-tyre peaks through eq. (1) and the fixed-frame waves.
+
+    A peak at ``f_rot`` could be the forward wave ``n`` (seen at ``f_rot + n f_w``
+    from a fixed point) or the backward wave ``n`` (at ``|f_rot - n f_w|``), for
+    every ``n``: eq. (1) of this module. It is resolved when a
+    fixed-frame wave with that ``n`` and direction on the tyre lies within
+    ``tol`` (relative) of that frequency (the nearest wins); otherwise it is
+    returned unresolved with its candidates.
+
+    Parameters
+    ----------
+    frequency_rot_hz : array_like, shape (m,)
+        Peaks of the in-tyre sensor, Hz.
+    fixed : list of RollingWave
+        Waves from the fixed sensors (may be empty).
+    wheel_speed_hz : float
+        ``f_w`` in Hz.
+    damping_ratio, std_frequency_hz : array_like, shape (m,), optional
+        Carried into the result (NaN when absent).
+    n_max : int
+        Largest wave number tried.
+    tol : float
+        Relative frequency tolerance of a match.
+
+    Returns
+    -------
+    list of RollingWave
+        One per peak, in the order given.
+    """
+    f_all = np.asarray(frequency_rot_hz, float).ravel()
+    nan = np.full(f_all.size, np.nan)
+    z_all = nan if damping_ratio is None else np.asarray(damping_ratio, float).ravel()
+    s_all = nan if std_frequency_hz is None else np.asarray(std_frequency_hz, float).ravel()
+    fw = float(wheel_speed_hz)
+    out = []
+    for f, z, sf in zip(f_all.tolist(), z_all.tolist(), s_all.tolist(), strict=True):
+        cands = []
+        for n in range(1, n_max + 1):
+            cands.append((n, "forward", f + n * fw))  # forward on the tyre: seen higher
+            cands.append((n, "backward", abs(f - n * fw)))
+        hits = [
+            (abs(w.fixed_hz - ff) / ff, n, d, w)
+            for n, d, ff in cands
+            for w in fixed
+            if w.wave_number == n and w.direction == d and abs(w.fixed_hz - ff) <= tol * ff
+        ]
+        if hits:
+            _, n, d, w = min(hits, key=lambda h: h[0])
+            why = f"f_rot {'+' if d == 'forward' else '-'} n f_w matches the fixed-frame wave"
+            out.append(RollingWave("rotating", n, d, w.fixed_direction, w.fixed_hz, f, z, sf,
+                                   float("nan"), float("nan"), [], why))  # fmt: skip
+            continue
+        why = "one in-tyre peak: wave number and direction not resolved" + (
+            " (no fixed-frame wave matches)" if fixed else " (no fixed sensors)"
+        )
+        out.append(RollingWave("rotating", None, None, None, float("nan"), f, z, sf,
+                               float("nan"), float("nan"), cands, why))  # fmt: skip
+    return out
+
+
+def _split_channels(
+    data: TimeData,
+    fixed_channels: ArrayLike | None,
+    rotating_channels: ArrayLike | None,
+) -> tuple[list[int], list[int]]:
+    resp = data.response_indices
+    if rotating_channels is None:
+        rot = [i for i in resp if (data.channels[i].name or "").upper().startswith("T")]
+    else:
+        rot = [int(i) for i in np.ravel(rotating_channels)]
+    if fixed_channels is None:
+        fix = [i for i in resp if i not in rot]
+    else:
+        fix = [int(i) for i in np.ravel(fixed_channels)]
+    bad = [i + 1 for i in fix + rot if not 0 <= i < data.n_channels]
+    if bad:
+        raise InputError(f"channels: expected channel numbers 1..{data.n_channels}, got {bad}")
+    return fix, rot
+
+
+def rolling_modes(
+    data: TimeData,
+    wheel_speed_hz: float | None = None,
+    *,
+    fixed_channels: ArrayLike | None = None,
+    rotating_channels: ArrayLike | None = None,
+    angles_deg: ArrayLike | None = None,
+    band: tuple[float, float] | None = None,
+    n_max: int = 8,
+    tol: float = 0.01,
+    n_groups: int = 16,
+    uncertainty: bool = True,
+) -> RollingModes:
+    """Travelling waves of a rolling tyre from fixed and in-tyre output-only records.
+
+    Parameters
+    ----------
+    data : TimeData
+        Output-only records (a force channel, if any, is ignored).
+    wheel_speed_hz : float, optional
+        Wheel rotation frequency in Hz; default ``data.meta["rotation_hz"]``.
+    fixed_channels, rotating_channels : sequence of int, optional
+        0-based channel indices of the sensors fixed in space (at least 3,
+        around the circumference) and inside the tyre (the first one is used).
+        Default: channels named ``T..`` are in the tyre, the other responses fixed.
+    angles_deg : array_like, optional
+        Angles in degrees of the fixed sensors (in the direction of rotation);
+        default their ``angle_deg``.
+    band : (float, float), optional
+        Hz; default the acquisition band or 0 .. 0.45 of the sampling rate.
+    n_max : int
+        Largest wave number tried for an in-tyre peak.
+    tol : float
+        Relative frequency tolerance of an in-tyre-to-fixed match.
+    n_groups : int
+        Jackknife segments of the SSI (fixed sensors).
+    uncertainty : bool
+        Jackknife standard errors of the fixed-sensor modes (slower).
+
+    Returns
+    -------
+    RollingModes
+    """
+    fw = wheel_speed_hz if wheel_speed_hz is not None else data.meta.get("rotation_hz")
+    if fw is None or not np.isfinite(float(fw)) or float(fw) < 0:
+        raise InputError(
+            f"wheel speed: expected the wheel rotation frequency in Hz (>= 0), got {fw!r}"
+        )
+    fw = float(fw)
+    fix, rot = _split_channels(data, fixed_channels, rotating_channels)
+    bnd = band if band is not None else data.acquisition.band_hz
+    notes: list[str] = []
+    fixed: list[RollingWave] = []
+    r_fix = r_rot = None
+    ang: list[float] = []
+    if len(fix) >= 3:
+        ang = (
+            [float(data.channels[i].angle_deg or 0.0) for i in fix]
+            if angles_deg is None
+            else [float(a) for a in np.ravel(angles_deg)]
+        )
+        if angles_deg is None and any(data.channels[i].angle_deg is None for i in fix):
+            raise InputError("angles: the fixed channels carry no angles; give angles_deg")
+        r_fix = oma(data.data[fix], data.sample_rate, band=bnd, n_groups=n_groups,
+                    wheel_speed_hz=fw if fw > 0 else None, uncertainty=uncertainty)  # fmt: skip
+        fixed = sorted(_fixed_waves(r_fix, ang, fw), key=lambda w: w.fixed_hz)
+    else:
+        notes.append(f"{len(fix)} fixed sensor(s): at least 3 are needed for wave numbers")
+    rotating: list[RollingWave] = []
+    if rot:
+        r_rot = oma(data.data[rot[:1]], data.sample_rate, method="plscf", band=bnd,
+                    wheel_speed_hz=fw if fw > 0 else None)  # fmt: skip
+        rotating = resolve_in_tyre(
+            r_rot.frequency_hz, fixed, fw, damping_ratio=r_rot.damping_ratio,
+            std_frequency_hz=r_rot.std_frequency_hz, n_max=n_max, tol=tol,
+        )  # fmt: skip
+        if len(rot) > 1:
+            notes.append(f"in-tyre sensors: the first of {len(rot)} is used")
+        if fw == 0:
+            notes.append("wheel at rest: both frames coincide")
+    names = tuple(data.channels[i].name or f"{i + 1}" for i in fix) if ang else ()
+    return RollingModes(fw, fixed, rotating, r_fix, r_rot, notes, tuple(ang), names)
+
+
+def compare_waves(
+    identified: list[RollingWave], truth: list[dict[str, Any]], frame: str = "fixed"
+) -> list[dict[str, Any]]:
+    """Match identified waves to truth rows (:meth:`RollingTruth.table`) by ``n`` and direction.
+
+    Parameters
+    ----------
+    identified : list of RollingWave
+    truth : list of dict
+        Rows with ``wave_number``, ``direction``, ``fixed_hz``, ``rotating_hz``,
+        ``damping_ratio``, ``fixed_damping_ratio``.
+    frame : {"fixed", "rotating"}
+        Frame whose frequency and damping are compared.
+
+    Returns
+    -------
+    list of dict
+        One per truth row: the truth, the nearest identified wave of the same
+        ``n`` and direction (or ``None``), relative frequency and damping errors.
+    """
+    fk = "fixed_hz" if frame == "fixed" else "rotating_hz"
+    zk = "fixed_damping_ratio" if frame == "fixed" else "damping_ratio"
+    out = []
+    for row in truth:
+        same = [
+            w
+            for w in identified
+            if w.wave_number == row["wave_number"]
+            and (w.direction == row["direction"] or row["wave_number"] == 0)
+        ]
+        best = min(same, key=lambda w: abs(getattr(w, fk) - row[fk]), default=None)
+        rec: dict[str, Any] = {"truth": row, "found": best is not None}
+        if best is not None:
+            rec["frequency_hz"] = float(getattr(best, fk))
+            rec["damping_ratio"] = best.damping_ratio
+            rec["std_frequency_hz"] = best.std_frequency_hz
+            rec["f_error"] = float(getattr(best, fk) / row[fk] - 1)
+            rec["zeta_error"] = float(best.damping_ratio / row[zk] - 1)
+        out.append(rec)
+    return out
