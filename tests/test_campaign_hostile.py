@@ -57,6 +57,18 @@ pressure_bar = 7.0
 """
 
 
+@pytest.fixture(autouse=True)
+def _own_temporary_directory(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    # scratch copies are counted in the temporary directory: a test's own one, so that
+    # campaigns run by other tests at the same time (pytest-xdist) are not counted; a
+    # short path (multiprocessing puts its sockets there, and a socket path is short)
+    d = tempfile.mkdtemp(prefix="td-")
+    monkeypatch.setenv("TMPDIR", d)
+    monkeypatch.setattr(tempfile, "tempdir", d)
+    yield
+    shutil.rmtree(d, ignore_errors=True)
+
+
 def write_tiny_campaign(root: Path) -> Path:
     """Two noisy FRF files of the six-mode chain and a campaign file; returns the file."""
     from tyredamp.io import write_frf

@@ -13,6 +13,8 @@ from __future__ import annotations
 import datetime
 import ipaddress
 import os
+import shutil
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -28,6 +30,18 @@ from tyredamp.cli import main
 from .test_campaign_hostile import _check_one_line_exit_2, tree, write_tiny_campaign
 
 pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(autouse=True)
+def _own_temporary_directory(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
+    # scratch copies are counted in the temporary directory: a test's own one, so that
+    # campaigns run by other tests at the same time (pytest-xdist) are not counted; a
+    # short path (multiprocessing puts its sockets there, and a socket path is short)
+    d = tempfile.mkdtemp(prefix="td-")
+    monkeypatch.setenv("TMPDIR", d)
+    monkeypatch.setattr(tempfile, "tempdir", d)
+    yield
+    shutil.rmtree(d, ignore_errors=True)
 
 
 def _http_status(port: int, path: str) -> int:
