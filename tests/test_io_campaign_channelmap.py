@@ -65,5 +65,5 @@ def test_campaign_modal_step_on_output_only_data(tmp_path: Path) -> None:
         pytest.skip("real-data gallery not found")
     with pytest.raises(InputError, match=r"MPSTD.*output-only data \(no force channel\)") as info:
         steps.process_radial_test(mps)
-    assert "operational modal analysis is not available" in str(info.value)
+    assert "with tyredamp oma (operational modal analysis)" in str(info.value)
     assert "\n" not in str(info.value)

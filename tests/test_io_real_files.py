@@ -201,7 +201,7 @@ def test_cli_output_only_and_bad_maps(tmp_path: Path, capsys: pytest.CaptureFixt
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0
     assert "output-only data (no force channel)" in err
-    assert "operational modal analysis is not available" in err
+    assert "with tyredamp oma (operational modal analysis)" in err
     assert not out.exists()
     csv = str(IMPACT.with_suffix(".csv"))
     for opts, msg in (

@@ -382,9 +382,8 @@ class TimeData:
             ("" if where is None else f"{where}: ")
             + f"output-only data (no force channel): channels {names}; {what} needs a "
             "measured force: name the force channel with --channel NAME=force:N (a "
-            "campaign's channel_map, Python's ChannelMap), or identify modes from output-only "
-            "data with another tool (operational modal analysis is not available in tyredamp "
-            "yet)"
+            "campaign's channel_map, Python's ChannelMap), or identify its modes output-only "
+            "with tyredamp oma (operational modal analysis)"
         )
 
     def require_response(self, what: str = "an FRF", where: object = None) -> None:
