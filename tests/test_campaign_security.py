@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import datetime
 import ipaddress
+import multiprocessing.util
 import os
 import shutil
 import tempfile
@@ -37,6 +38,9 @@ def _own_temporary_directory(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     # scratch copies are counted in the temporary directory: a test's own one, so that
     # campaigns run by other tests at the same time (pytest-xdist) are not counted; a
     # short path (multiprocessing puts its sockets there, and a socket path is short)
+    # multiprocessing keeps one temporary directory per process (its fork server's
+    # socket lives there): made here, before the patch, so that it outlives this test
+    multiprocessing.util.get_temp_dir()
     d = tempfile.mkdtemp(prefix="td-")
     monkeypatch.setenv("TMPDIR", d)
     monkeypatch.setattr(tempfile, "tempdir", d)
