@@ -61,10 +61,10 @@ pressure_bar = 7.0
 @pytest.fixture(autouse=True)
 def _own_temporary_directory(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     # scratch copies are counted in the temporary directory: a test's own one, so that
-    # campaigns run by other tests at the same time (pytest-xdist) are not counted; a
-    # short path (multiprocessing puts its sockets there, and a socket path is short)
-    # multiprocessing keeps one temporary directory per process (its fork server's
-    # socket lives there): made here, before the patch, so that it outlives this test
+    # campaigns run by other tests at the same time (pytest-xdist) are not counted. The
+    # path is short (multiprocessing puts sockets in it), and multiprocessing's own
+    # per-process directory (its fork server's socket) is made before the patch, so
+    # that it outlives this test
     multiprocessing.util.get_temp_dir()
     d = tempfile.mkdtemp(prefix="td-")
     monkeypatch.setenv("TMPDIR", d)

@@ -12,10 +12,7 @@ from __future__ import annotations
 
 import datetime
 import ipaddress
-import multiprocessing.util
 import os
-import shutil
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -28,24 +25,15 @@ from tyredamp.campaign.outputs import write_outputs
 from tyredamp.campaign.runner import TestRun, run_tests
 from tyredamp.cli import main
 
-from .test_campaign_hostile import _check_one_line_exit_2, tree, write_tiny_campaign
+# the hostile tests' own temporary directory serves these tests too (autouse fixture)
+from .test_campaign_hostile import (  # noqa: F401
+    _check_one_line_exit_2,
+    _own_temporary_directory,
+    tree,
+    write_tiny_campaign,
+)
 
 pytestmark = pytest.mark.slow
-
-
-@pytest.fixture(autouse=True)
-def _own_temporary_directory(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
-    # scratch copies are counted in the temporary directory: a test's own one, so that
-    # campaigns run by other tests at the same time (pytest-xdist) are not counted; a
-    # short path (multiprocessing puts its sockets there, and a socket path is short)
-    # multiprocessing keeps one temporary directory per process (its fork server's
-    # socket lives there): made here, before the patch, so that it outlives this test
-    multiprocessing.util.get_temp_dir()
-    d = tempfile.mkdtemp(prefix="td-")
-    monkeypatch.setenv("TMPDIR", d)
-    monkeypatch.setattr(tempfile, "tempdir", d)
-    yield
-    shutil.rmtree(d, ignore_errors=True)
 
 
 def _http_status(port: int, path: str) -> int:
