@@ -32,6 +32,7 @@ __all__ = [
     "parse_drive_points",
     "quiet_run",
     "seed_option",
+    "snr_option",
 ]
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -123,6 +124,18 @@ def seed_option(help_text: str = "Noise seed.") -> Callable[[F], F]:
     """The ``--seed N`` option (integer >= 0, default 0)."""
     return click.option(
         "--seed", type=click.IntRange(min=0), default=0, show_default=True, help=help_text
+    )
+
+
+def snr_option() -> Callable[[F], F]:
+    """The ``--snr DB`` option of the virtual rigs (default 40 dB, ``inf`` for no noise)."""
+    return click.option(
+        "--snr",
+        type=float,
+        default=40.0,
+        show_default=True,
+        metavar="DB",
+        help="Signal-to-noise ratio of every channel, dB ('inf' for no noise).",
     )
 
 

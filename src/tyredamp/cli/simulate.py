@@ -23,7 +23,7 @@ from ..documents.jsonfile import json_text
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_frf, write_timedata
 from ..io._safety import atomic_paths, check_distinct, check_output_file
-from ._common import OutPath, out_file_option, parse_drive_points, seed_option
+from ._common import OutPath, out_file_option, parse_drive_points, seed_option, snr_option
 from .lateral import lateral_group
 from .simulate_campaign import simulate_campaign_command
 from .simulate_rolling import simulate_rolling_command
@@ -58,14 +58,7 @@ def simulate_group() -> None:
     metavar="BAR",
     help="Inflation pressure, bar.",
 )
-@click.option(
-    "--snr",
-    type=float,
-    default=40.0,
-    show_default=True,
-    metavar="DB",
-    help="Signal-to-noise ratio of every channel, dB ('inf' for no noise).",
-)
+@snr_option()
 @seed_option("Noise seed.")
 @click.option(
     "--drive-points",

@@ -16,7 +16,7 @@ from ..documents.jsonfile import json_text
 from ..exceptions import InputError
 from ..io import FORMATS, format_of, write_timedata
 from ..io._safety import atomic_paths, check_distinct, check_output_file
-from ._common import OutPath, out_file_option, seed_option
+from ._common import OutPath, out_file_option, seed_option, snr_option
 
 __all__ = ["simulate_rolling_command"]
 
@@ -89,14 +89,7 @@ def _check_speed(speed: float, pressure_bar: float) -> tuple[float, object]:
     metavar="N",
     help="RMS of the random road force, N.",
 )
-@click.option(
-    "--snr",
-    type=float,
-    default=40.0,
-    show_default=True,
-    metavar="DB",
-    help="Signal-to-noise ratio of every channel, dB ('inf' for no noise).",
-)
+@snr_option()
 @seed_option("Seed of the road force and the noise.")
 @click.option(
     "--truth",
