@@ -61,7 +61,7 @@ def test_coupled_ring_cavity_matches_closed_form_per_wave_number() -> None:
     assert tyre.n_dof == 3 * N - 1
     f = tyre.physical_system.undamped_modes().frequency_hz
     for n in (1, 2, 3, 4):
-        s = float(difference_symbol([n], N, 4)[0])
+        s = float(difference_symbol([n], N, tyre.fd_order)[0])
         closed = cavity_dispersion(
             _ring_q(p, s), s, mass_per_length=p.mass_per_length, radius=p.radius,
             cavity=cav, pressure=p.pressure, band_width=p.width,

@@ -145,7 +145,7 @@ def rotating_ring_roots(
     speed_kmh: float,
     *,
     n_ring: int | None = None,
-    fd_order: int = 4,
+    fd_order: int = 6,
 ) -> NDArray[np.float64]:
     """The four roots ``omega`` (rad/s) of the rotating ring's quartic for each ``n``.
 
@@ -206,7 +206,7 @@ def rotating_ring_dispersion(
     *,
     frame: str = "rotating",
     n_ring: int | None = None,
-    fd_order: int = 4,
+    fd_order: int = 6,
 ) -> NDArray[np.float64]:
     """Frequencies of the forward and backward flexural waves of wave number ``n``.
 
