@@ -150,3 +150,19 @@ def test_start_imports_no_subcommand_and_modal_no_io() -> None:
         "assert 'pyuff' not in sys.modules and 'matplotlib' not in sys.modules\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+@pytest.mark.parametrize("value", ["0", "nan", "25", "abc"])
+@pytest.mark.parametrize("command", [("simulate", "lateral"), ("simulate", "rolling")])
+def test_pressure_is_refused_in_bar_with_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: tuple[str, ...], value: str
+) -> None:
+    out = tmp_path / "never.uff"
+    code, _, err = run(capsys, *command, "--out", str(out), "--pressure", value)
+    assert code == 2
+    line = err.strip()
+    assert "\n" not in line
+    assert "--pressure" in line
+    assert "bar" in line
+    assert "pressure_bar" not in line  # no Python name
+    assert not out.exists()

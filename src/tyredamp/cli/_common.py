@@ -120,10 +120,55 @@ def out_file_option(help_text: str) -> Callable[[F], F]:
     )
 
 
+def format_option(help_text: str = "File format (default from the extension).") -> Callable[[F], F]:
+    """The ``--format NAME`` option of the file-writing commands (the io registry's names)."""
+    from ..io import FORMATS  # the registry's names only; the writers load on use
+
+    return click.option("--format", "fmt", type=click.Choice(FORMATS), help=help_text)
+
+
 def seed_option(help_text: str = "Noise seed.") -> Callable[[F], F]:
     """The ``--seed N`` option (integer >= 0, default 0)."""
     return click.option(
         "--seed", type=click.IntRange(min=0), default=0, show_default=True, help=help_text
+    )
+
+
+class Pressure(click.ParamType):
+    """An inflation pressure in bar: a finite number above 0 and at most ``max_bar``."""
+
+    name = "pressure"
+
+    def __init__(self, max_bar: float = 20.0) -> None:
+        self.max_bar = float(max_bar)
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        if isinstance(value, float):
+            p = value
+        else:
+            try:
+                p = float(value)
+            except (TypeError, ValueError):
+                self.fail(f"expected an inflation pressure in bar, got {value!r}", param, ctx)
+        if not 0.0 < p <= self.max_bar:  # also refuses NaN
+            self.fail(
+                f"expected an inflation pressure above 0 and at most {self.max_bar:g} bar "
+                f"(gauge), got {value} bar",
+                param,
+                ctx,
+            )
+        return p
+
+
+def pressure_option(default: float, max_bar: float = 20.0) -> Callable[[F], F]:
+    """The ``--pressure BAR`` option of the virtual rigs (gauge pressure in bar)."""
+    return click.option(
+        "--pressure",
+        type=Pressure(max_bar),
+        default=default,
+        show_default=True,
+        metavar="BAR",
+        help=f"Inflation (gauge) pressure, bar (above 0, at most {max_bar:g}).",
     )
 
 

@@ -10,11 +10,17 @@ import numpy as np
 
 from ..exceptions import InputError
 from ..frf import FRF
-from ..io import FORMATS, format_of, read_timedata, write_frf
+from ..io import format_of, read_timedata, write_frf
 from ..io._safety import check_output_file
 from ..studies.steps import FrfSettings, FrfStep, samples
 from ..timedata import TimeData
-from ._common import channel_map, channel_map_options, echo_read_notes, out_file_option
+from ._common import (
+    channel_map,
+    channel_map_options,
+    echo_read_notes,
+    format_option,
+    out_file_option,
+)
 from ._settings import settings_from_options, settings_options
 
 __all__ = ["frf_command", "frf_summary", "samples"]
@@ -69,12 +75,7 @@ def _refuse_dependent_forces(td: TimeData) -> None:
 @click.argument("time_file", type=click.Path(dir_okay=False, path_type=Path))
 @out_file_option("FRF file to write (.uff, .unv, .csv, .npz or .nc).")
 @settings_options(FrfSettings)
-@click.option(
-    "--format",
-    "fmt",
-    type=click.Choice(FORMATS),
-    help="Output format; default from the extension (.uff/.unv: binary UFF 58b).",
-)
+@format_option("Output format; default from the extension (.uff/.unv: binary UFF 58b).")
 @channel_map_options
 def frf_command(time_file: Path, out: Path, fmt: str | None, **options: Any) -> None:
     """Estimate FRFs (with coherence) from TIME_FILE and write them to --out.

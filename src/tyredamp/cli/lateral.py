@@ -21,10 +21,10 @@ from typing import Any
 import click
 
 from ..exceptions import InputError
-from ..io import FORMATS, format_of, read_frf, write_frf
+from ..io import format_of, read_frf, write_frf
 from ..io._safety import check_output_file
 from ..studies.steps import LateralFitSettings, LateralFitStep
-from ._common import out_file_option, seed_option
+from ._common import format_option, out_file_option, pressure_option, seed_option
 from ._settings import settings_from_options, settings_options
 
 __all__ = ["lateral_group"]
@@ -132,14 +132,7 @@ def fit_command(frf_file: Path, out: Path, speed: float | None, **options: Any) 
 @click.option(
     "--speed", type=float, default=5.0, show_default=True, metavar="KMH", help="Travel speed, km/h."
 )
-@click.option(
-    "--pressure",
-    type=float,
-    default=1.7,
-    show_default=True,
-    metavar="BAR",
-    help="Inflation pressure, bar.",
-)
+@pressure_option(1.7)
 @seed_option("Noise seed.")
 @click.option(
     "--force",
@@ -155,9 +148,7 @@ def fit_command(frf_file: Path, out: Path, speed: float | None, **options: Any) 
     metavar="REL",
     help="Relative noise per line (default 0.03).",
 )
-@click.option(
-    "--format", "fmt", type=click.Choice(FORMATS), help="File format (default from the extension)."
-)
+@format_option()
 def simulate_command(
     out: Path,
     speed: float,

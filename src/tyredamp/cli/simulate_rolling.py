@@ -14,9 +14,16 @@ import click
 
 from ..documents.jsonfile import json_text
 from ..exceptions import InputError
-from ..io import FORMATS, format_of, write_timedata
+from ..io import format_of, write_timedata
 from ..io._safety import atomic_paths, check_distinct, check_output_file
-from ._common import OutPath, out_file_option, seed_option, snr_option
+from ._common import (
+    OutPath,
+    format_option,
+    out_file_option,
+    pressure_option,
+    seed_option,
+    snr_option,
+)
 
 __all__ = ["simulate_rolling_command"]
 
@@ -42,14 +49,7 @@ def _check_speed(speed: float, pressure_bar: float) -> tuple[float, object]:
 @click.option(
     "--speed", type=float, required=True, metavar="KMH", help="Rolling speed, km/h (>= 0)."
 )
-@click.option(
-    "--pressure",
-    type=click.FloatRange(min=0, max=20),
-    default=7.5,
-    show_default=True,
-    metavar="BAR",
-    help="Inflation pressure, bar.",
-)
+@pressure_option(7.5)
 @click.option(
     "--duration",
     type=click.FloatRange(min=0.5, max=600),
@@ -97,9 +97,7 @@ def _check_speed(speed: float, pressure_bar: float) -> tuple[float, object]:
     type=OutPath(dir_okay=False, path_type=Path),
     help="Also write the forward and backward waves (both frames) as JSON.",
 )
-@click.option(
-    "--format", "fmt", type=click.Choice(FORMATS), help="File format (default from the extension)."
-)
+@format_option()
 def simulate_rolling_command(
     out: Path,
     speed: float,
