@@ -41,6 +41,7 @@ from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+import scipy.linalg as sla
 from scipy.optimize import nnls
 
 from ..dampmodels import DampedSystem, DampingLaw, Exponential, Hysteretic
@@ -55,7 +56,9 @@ __all__ = [
     "ModulusLaw",
     "PronySeries",
     "RubberLaw",
+    "ModalBand",
     "fit_prony",
+    "modal_band_system",
     "rubber_system",
 ]
 
@@ -318,16 +321,9 @@ def rubber_system(
         series (exact state space), :class:`~tyredamp.dampmodels.Hysteretic`
         for a constant loss, :class:`ModulusLaw` otherwise.
     """
-    known = {"sidewall": "K_sidewall", "band": "K_band"}
-    bad = [p for p in parts if p not in known]
-    if bad or not parts:
-        raise InputError(f"parts: expected some of sidewall, band, got {', '.join(bad) or 'none'}")
     M = np.array(ring.M, dtype=np.float64)
     K = np.array(ring.K, dtype=np.float64)
-    K_r = np.zeros_like(K)
-    for part in parts:
-        K_r += getattr(ring, known[part])
-    K_r = 0.5 * (K_r + K_r.T)
+    K_r = _rubber_stiffness(ring, parts)
     e_ref = rubber.modulus(2j * np.pi * reference_hz).real
     if isinstance(rubber, PronySeries):
         C = np.stack(
@@ -338,3 +334,119 @@ def rubber_system(
     if isinstance(rubber, ConstantLoss):
         return DampedSystem(M, K, Hysteretic(rubber.eta * K_r))
     return DampedSystem(M, K, ModulusLaw(K_r, rubber, e_ref))
+
+
+@dataclass(frozen=True, eq=False)
+class ModalBand:
+    """The ring tyre with a fractional Zener rubber, reduced to the modes of one band.
+
+    Attributes
+    ----------
+    system : DampedSystem
+        Mass ``I``, stiffness and damping in the relaxed modal coordinates.
+    shapes : ndarray, shape (16, m)
+        Mass-normalised relaxed mode shapes at the measurement points, 1/sqrt(kg).
+    drive : int
+        Row of ``shapes`` at the drive point.
+    omega : ndarray, shape (m,)
+        Relaxed natural frequencies ``omega_0``, rad/s.
+    c_fractional : ndarray, shape (m, m)
+        ``C'`` of the fractional law ``C' s^alpha`` that the rubber is in the band
+        (to first order in ``(s tau)^alpha``), 1/s^(2 - alpha).
+    alpha : float
+        The rubber's fractional order.
+    """
+
+    system: DampedSystem
+    shapes: NDArray[np.float64]
+    drive: int
+    omega: NDArray[np.float64]
+    c_fractional: NDArray[np.float64]
+    alpha: float
+
+
+def modal_band_system(
+    ring: RingTyre,
+    band_hz: tuple[float, float],
+    rubber: FractionalZener = DEFAULT_TREAD,
+    parts: Sequence[str] = ("sidewall", "band"),
+    reference_hz: float = 100.0,
+    drive: int = 0,
+) -> ModalBand:
+    """The modes of ``band_hz`` of the rubber tyre, one per pair, as a small exact system.
+
+    The rubber on ``K_r`` gives ``D(s) = s^2 M + K + K_r (E*(s)/E_ref - 1)``
+    (:func:`rubber_system`). With the relaxed stiffness ``K_0 = K + K_r
+    (E_0/E_ref - 1)`` and its mass-normalised modes ``Phi_0`` this is
+    ``s^2 I + diag(omega_0^2) + Phi_0^T K_r Phi_0 (E*(s) - E_0)/E_ref``, and
+    since ``E* - E_0 = (E_inf - E_0) x/(1 + x)``, ``x = (s tau)^alpha``
+    (Pritz 1996, eq. (1)), the damping is the fractional law ``C' s^alpha`` with
+    ``C' = Phi_0^T K_r Phi_0 (E_inf - E_0) tau^alpha / E_ref`` to first order in
+    ``|x|`` (Bagley & Torvik 1983, eq. (1)). The ring's modes come in pairs
+    (``cos`` and ``sin`` of each wave number): of each pair only the
+    combination seen from the drive point is kept (the other has no
+    amplitude there), and only the modes whose relaxed frequency lies in
+    ``band_hz``.
+
+    Parameters
+    ----------
+    ring : RingTyre
+    band_hz : (float, float)
+        Relaxed natural frequencies kept, Hz.
+    rubber : FractionalZener
+    parts : sequence of {"sidewall", "band"}
+    reference_hz : float
+        Frequency at which the storage stiffness is the ring's, Hz.
+    drive : int
+        Measurement point of the drive (index into ``ring.point_dofs``).
+
+    Returns
+    -------
+    ModalBand
+    """
+    if not 0 <= band_hz[0] < band_hz[1]:
+        raise InputError(f"band_hz: expected 0 <= low < high Hz, got {band_hz}")
+    M = np.array(ring.M, dtype=np.float64)
+    K_r = _rubber_stiffness(ring, parts)
+    e_ref = rubber.modulus(2j * np.pi * reference_hz).real
+    K0 = np.array(ring.K, dtype=np.float64) + K_r * (rubber.e0 / e_ref - 1)
+    w2, phi = sla.eigh(0.5 * (K0 + K0.T), M)
+    w = np.sqrt(np.clip(w2, 0.0, None))
+    d = int(np.asarray(ring.point_dofs)[drive])
+    cols: list[NDArray[np.float64]] = []
+    omegas: list[float] = []
+    j = 0
+    while j < w.size:
+        k = j + 1
+        while k < w.size and w[k] - w[j] <= 1e-2 * w[j]:  # a pair (split by rounding)
+            k += 1
+        if band_hz[0] <= w[j] / (2 * np.pi) <= band_hz[1]:
+            a = phi[d, j:k]
+            if np.linalg.norm(a) > 1e-9 * np.abs(phi[:, j:k]).max():
+                cols.append(phi[:, j:k] @ (a / np.linalg.norm(a)))
+                omegas.append(float(np.sqrt(np.mean(w2[j:k]))))
+        j = k
+    if not cols:
+        raise InputError(f"band_hz: no mode seen from the drive point in {band_hz} Hz")
+    P = np.column_stack(cols)
+    om = np.array(omegas)
+    kr = P.T @ K_r @ P
+    kr = 0.5 * (kr + kr.T)
+    law = ModulusLaw(kr, rubber, e_ref)
+    # K such that K + kr (E*/E_ref - 1) = diag(omega^2) + kr (E* - E_0)/E_ref
+    system = DampedSystem(np.eye(om.size), np.diag(om**2) + kr * (1 - rubber.e0 / e_ref), law)
+    c = kr * (rubber.e_inf - rubber.e0) * rubber.tau**rubber.alpha / e_ref
+    pts = np.asarray(ring.point_dofs)
+    return ModalBand(system, P[pts], drive, om, c, rubber.alpha)
+
+
+def _rubber_stiffness(ring: RingTyre, parts: Sequence[str]) -> NDArray[np.float64]:
+    """``K_r``: the symmetrised stiffness of ``parts`` of the ring, N/m."""
+    known = {"sidewall": "K_sidewall", "band": "K_band"}
+    bad = [p for p in parts if p not in known]
+    if bad or not parts:
+        raise InputError(f"parts: expected some of sidewall, band, got {', '.join(bad) or 'none'}")
+    K_r = np.zeros_like(np.array(ring.K, dtype=np.float64))
+    for part in parts:
+        K_r += getattr(ring, known[part])
+    return 0.5 * (K_r + K_r.T)
