@@ -26,8 +26,8 @@ from ..virtual import RingTyre
 from ..virtual.rubber import DEFAULT_TREAD, ModalBand, modal_band_system
 
 __all__ = [
-    "DampModelStudy",
     "TRUE_MODEL",
+    "DampModelStudy",
     "dampmodels_section",
     "run_dampmodels",
     "tyre_band_data",
