@@ -136,3 +136,20 @@ def test_modal_band_is_the_fractional_law_to_first_order() -> None:
     frac = band.c_fractional * complex(s) ** band.alpha
     assert abs(x) < 0.01
     assert_allclose(D_red - s * s * np.eye(m) - np.diag(band.omega**2), frac, rtol=2 * abs(x))
+
+
+def test_fit_zener_recovers_a_master_curve() -> None:
+    from tyredamp.virtual.rubber import fit_zener
+
+    true = FractionalZener(e0=3e6, e_inf=1.5e9, tau=2e-7, alpha=0.45)
+    f = np.logspace(-4, 10, 60)  # a master curve over the transition (loss peak near 1e6 Hz)
+    e = np.array([true.modulus(2j * np.pi * fi) for fi in f])
+    fit = fit_zener(f, e.real, e.imag / e.real)
+    # exact data: the four parameters to the solver's tolerance
+    assert_allclose(
+        [fit.e0, fit.e_inf, fit.tau, fit.alpha],
+        [true.e0, true.e_inf, true.tau, true.alpha],
+        rtol=1e-5,
+    )
+    with pytest.raises(InputError, match="at least 4"):
+        fit_zener(f[:3], e.real[:3], (e.imag / e.real)[:3])

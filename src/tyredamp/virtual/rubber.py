@@ -58,6 +58,7 @@ __all__ = [
     "PronySeries",
     "RubberLaw",
     "fit_prony",
+    "fit_zener",
     "modal_band_system",
     "rubber_system",
 ]
@@ -234,6 +235,76 @@ class ConstantLoss(RubberLaw):
 #: transition). Chosen values in the range of tread compounds, not a fit to
 #: one published master curve.
 DEFAULT_TREAD = FractionalZener(e0=7e6, e_inf=7e8, tau=1e-11, alpha=0.3)
+
+
+def fit_zener(frequency: ArrayLike, storage: ArrayLike, loss_factor: ArrayLike) -> FractionalZener:
+    """The fractional Zener law closest to a measured master curve (least squares).
+
+    Fits ``E*(i omega) = (E_0 + E_inf x)/(1 + x)``, ``x = (i omega tau)^alpha``
+    (Pritz 1996, eq. (1)) to storage moduli ``E'`` and loss factors
+    ``tan delta = E''/E'`` at one reference temperature, minimising the
+    squared differences of ``ln E'`` and of ``ln E''`` (both moduli matter over
+    decades; Pritz 1996, sec. 3, fits the same four parameters to measured
+    master curves). The curve must reach over the loss peak, or ``E_inf`` and
+    ``tau`` are not determined separately.
+
+    Parameters
+    ----------
+    frequency : array_like, shape (n,)
+        Reduced frequencies of the master curve, Hz (> 0), ``n >= 4``.
+    storage : array_like, shape (n,)
+        ``E'``, Pa (> 0).
+    loss_factor : array_like, shape (n,)
+        ``tan delta`` (> 0).
+
+    Returns
+    -------
+    FractionalZener
+
+    Raises
+    ------
+    InputError
+        Fewer than four points, or values that are not positive.
+    """
+    from scipy.optimize import least_squares
+    from scipy.special import expit
+
+    f = np.asarray(frequency, dtype=float).ravel()
+    e1 = np.asarray(storage, dtype=float).ravel()
+    eta = np.asarray(loss_factor, dtype=float).ravel()
+    if not f.size == e1.size == eta.size or f.size < 4:
+        raise InputError(
+            "frequency, storage, loss_factor: expected at least 4 points of each, one per "
+            f"frequency, got {f.size}, {e1.size}, {eta.size}"
+        )
+    if not (np.all(f > 0) and np.all(e1 > 0) and np.all(eta > 0) and np.all(np.isfinite(f))):
+        raise InputError("frequency, storage, loss_factor: expected finite values > 0")
+    target = np.concatenate([np.log(e1), np.log(e1 * eta)])
+    w = 2 * np.pi * f
+
+    def unpack(p: NDArray[np.float64]) -> tuple[float, float, float, float]:
+        e0 = float(np.exp(p[0]))
+        return e0, e0 * (1 + float(np.exp(p[1]))), float(np.exp(p[2])), float(expit(p[3]))
+
+    def resid(p: NDArray[np.float64]) -> NDArray[np.float64]:
+        e0, e_inf, tau, alpha = unpack(p)
+        x = (1j * w * tau) ** alpha
+        e = (e0 + e_inf * x) / (1 + x)
+        return np.concatenate([np.log(e.real), np.log(np.abs(e.imag))]) - target
+
+    peak = float(w[np.argmax(eta)])
+    ratio = max(float(e1.max() / e1.min()), 1.0 + 1e-6)
+    best = None
+    for a in (0.2, 0.4, 0.6):
+        # loss peak of the law near omega tau = (E_0/E_inf)^(1/(2 alpha))
+        tau0 = ratio ** (-1 / (2 * a)) / peak
+        p0 = np.array([np.log(e1.min()), np.log(ratio - 1), np.log(tau0), np.log(a / (1 - a))])
+        sol = least_squares(resid, p0, method="trf", x_scale="jac", max_nfev=2000)
+        if best is None or sol.cost < best.cost:
+            best = sol
+    assert best is not None
+    e0, e_inf, tau, alpha = unpack(best.x)
+    return FractionalZener(e0, e_inf, tau, min(alpha, 1.0))
 
 
 def fit_prony(
