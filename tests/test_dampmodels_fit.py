@@ -154,3 +154,21 @@ def test_aw_part2_viscous_modes_consistent() -> None:
     est = exponential_from_modes(md.poles, md.shapes * np.sqrt(2j * md.poles.imag))
     assert est.viscous_consistent
     assert "consistent with viscous" in est.format()
+
+
+def test_demo_tyre_supports_the_fractional_model() -> None:
+    from tyredamp.report.dampmodels import DAMPMODELS_HEADING, dampmodels_report
+    from tyredamp.report.html import HtmlReport
+    from tyredamp.studies.dampmodels import TRUE_MODEL, dampmodels_section, run_dampmodels
+
+    study = run_dampmodels(seed=3)
+    assert study.comparison.best == TRUE_MODEL
+    sec = dampmodels_section(study)
+    fit, truth = sec["fitted"], sec["truth"]
+    # the truth is fractional to first order in (s tau)^alpha (< 1 %): alpha within
+    # 4 standard errors (a correct fit misses that with probability < 1e-4)
+    assert abs(fit["alpha"] - truth["alpha"]) < 4 * fit["alpha_std"]
+    assert all(t["rejected"] for t in sec["tests"] if t["simple"] == "viscous")
+    rep = HtmlReport("t")
+    dampmodels_report(rep, {"damping_models": sec})
+    assert DAMPMODELS_HEADING in rep.render()

@@ -17,6 +17,7 @@ from tyredamp.virtual.rubber import (
     ModulusLaw,
     PronySeries,
     fit_prony,
+    modal_band_system,
     rubber_system,
 )
 
@@ -115,3 +116,40 @@ def test_time_response_prony_and_not_hysteretic() -> None:
     assert_allclose(amp, abs(H), rtol=2e-3)
     with pytest.raises(ShapeError, match="finite state space"):
         DampedSystem(one, 1e4 * one, Hysteretic(100 * one)).time_response(np.zeros((3, 1)), dt)
+
+
+def test_modal_band_is_the_fractional_law_to_first_order() -> None:
+    band = modal_band_system(RingTyre(), (40.0, 110.0))
+    m = band.omega.size
+    assert m >= 2
+    s = 2j * np.pi * 70.0
+    D_red = band.system.dynamic_stiffness(s)
+    e_ref = DEFAULT_TREAD.modulus(2j * np.pi * 100.0).real
+    x = complex(s * DEFAULT_TREAD.tau) ** DEFAULT_TREAD.alpha
+    z = DEFAULT_TREAD
+    kr = band.c_fractional * e_ref / ((z.e_inf - z.e0) * z.tau**z.alpha)
+    # D_red = s^2 I + diag(omega^2) + kr (E* - E_0)/E_ref (Pritz 1996, eq. (1)), to rounding
+    e_star = (z.e0 + z.e_inf * x) / (1 + x)
+    expect = s * s * np.eye(m) + np.diag(band.omega**2) + kr * (e_star - z.e0) / e_ref
+    assert_allclose(D_red, expect, rtol=1e-10, atol=1e-10 * np.abs(expect).max())
+    # the fractional law C' s^alpha is that damping to first order in |x| (< 1 % here)
+    frac = band.c_fractional * complex(s) ** band.alpha
+    assert abs(x) < 0.01
+    assert_allclose(D_red - s * s * np.eye(m) - np.diag(band.omega**2), frac, rtol=2 * abs(x))
+
+
+def test_fit_zener_recovers_a_master_curve() -> None:
+    from tyredamp.virtual.rubber import fit_zener
+
+    true = FractionalZener(e0=3e6, e_inf=1.5e9, tau=2e-7, alpha=0.45)
+    f = np.logspace(-4, 10, 60)  # a master curve over the transition (loss peak near 1e6 Hz)
+    e = np.array([true.modulus(2j * np.pi * fi) for fi in f])
+    fit = fit_zener(f, e.real, e.imag / e.real)
+    # exact data: the four parameters to the solver's tolerance
+    assert_allclose(
+        [fit.e0, fit.e_inf, fit.tau, fit.alpha],
+        [true.e0, true.e_inf, true.tau, true.alpha],
+        rtol=1e-5,
+    )
+    with pytest.raises(InputError, match="at least 4"):
+        fit_zener(f[:3], e.real[:3], (e.imag / e.real)[:3])

@@ -46,6 +46,8 @@ MODELS: tuple[str, ...] = ("proportional", "viscous", "hysteretic", "exponential
 _MU_STARTS = (0.1, 0.3, 1.0, 3.0, 30.0)
 #: Bound on ``|ln mu|`` (mu in 1/s): beyond it the kernel is viscous (or a stiffness) to rounding.
 _LN_MU_MAX = 60.0
+#: Function evaluations of the short run from each start (the best one is then run on).
+_SCOUT_NFEV = 12
 #: Starting derivative orders of the fractional model.
 _ALPHA_STARTS = (0.3, 0.6, 1.0, 1.4)
 
@@ -363,9 +365,18 @@ def fit_model(
     starts = _starts(model, start)
     if warm is not None and warm.model == "viscous" and model not in ("proportional", "viscous"):
         starts.append(_warm_start(model, warm))
+    if len(starts) > 1:  # a short run from each start, then the best one to convergence
+        for x0 in starts:
+            sol = least_squares(
+                resid, x0, jac=jac, method="lm", x_scale="jac", max_nfev=_SCOUT_NFEV
+            )
+            if best is None or sol.cost < best.cost:
+                best = sol
+        assert best is not None
+        starts = [best.x]
     for x0 in starts:
         sol = least_squares(resid, x0, jac=jac, method="lm", x_scale="jac", max_nfev=200)
-        if best is None or sol.cost < best.cost:
+        if best is None or sol.cost <= best.cost:
             best = sol
     assert best is not None
     J = best.jac

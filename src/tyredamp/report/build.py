@@ -25,6 +25,7 @@ from .. import __version__
 from ..modal.quality import RejectedMode, rejected_summary
 from ._cells import _image, _num, _warnings, anchor_id, fmt_pm
 from ._outcomes import _findings, _Page, _status, _verdict_block
+from .dampmodels import dampmodels_report
 from .html import HtmlReport
 from .rolling import rolling_report
 from .tyremodel import tyre_model_brief, tyre_model_report
@@ -718,6 +719,7 @@ def build_demo_report(
     tyre_model_report(rep, result, doc, images, SECTIONS[3])
     _lateral(rep, result, doc, images, page)
     rolling_report(rep, doc)
+    dampmodels_report(rep, doc)
     rep.heading(SECTIONS[5])
     listed = doc.get("files", []) if files is None else files
     rep.paragraph(

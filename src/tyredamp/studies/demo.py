@@ -23,7 +23,9 @@
   hysteretic tyre;
 * the **rolling tyre** (:func:`.rolling.run_rolling`): the rotating virtual
   tyre at 40 and 80 km/h (80 only with ``quick``) identified output-only,
-  each exact travelling wave beside the identified one.
+  each exact travelling wave beside the identified one;
+* the **damping model** (:func:`.dampmodels.run_dampmodels`): every damping
+  model fitted to the rubber tyre's FRFs and ranked, the truth beside it.
 
 :func:`tyredamp.report.demo.save_demo` writes what :func:`run_demo` returned
 into a directory (report, results.json, figures, data, modes and damping
@@ -41,6 +43,7 @@ from collections.abc import Callable
 
 from .._blas import single_threaded_blas
 from ..exceptions import InputError
+from .dampmodels import run_dampmodels
 from .lateral import conditions, run_lateral
 from .radial import run_radial
 from .results import DemoResult
@@ -116,12 +119,14 @@ def run_demo(
 
 def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
     t_start = time.perf_counter()
-    n_stages = len(s.radial_pressures_bar) + 4 + len(conditions(s)) + 2
+    n_stages = len(s.radial_pressures_bar) + 4 + len(conditions(s)) + 3
     st = _Stages(n_stages, progress)
     radial = run_radial(s, st.start)
     lateral = run_lateral(s, st.start)
     st.start("rolling tyre, output-only")
     rolling = run_rolling((80.0,) if s.quick else (40.0, 80.0), seed=s.seed)
+    st.start("damping model of the rubber tyre")
+    damping_models = run_dampmodels(seed=s.seed)
     st.finish()
     return DemoResult(
         settings=s,
@@ -130,4 +135,5 @@ def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
         timings=dict(st.timings),
         elapsed_s=time.perf_counter() - t_start,
         rolling=rolling,
+        damping_models=damping_models,
     )

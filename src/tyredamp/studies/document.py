@@ -529,6 +529,10 @@ def build_results(result: DemoResult, files: Sequence[str] | None = None) -> dic
         from .rolling import rolling_section
 
         doc["rolling"] = rolling_section(result.rolling)
+    if result.damping_models is not None:
+        from .dampmodels import dampmodels_section
+
+        doc["damping_models"] = dampmodels_section(result.damping_models)
     out = finite(doc)
     assert isinstance(out, dict)
     return out

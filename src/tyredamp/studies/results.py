@@ -362,3 +362,6 @@ class DemoResult:
     version: str = __version__
     #: the rolling tyre identified output-only (:class:`~tyredamp.studies.rolling.RollingStudy`)
     rolling: Any = None
+    #: which damping model the virtual tyre's FRFs support
+    #: (:class:`~tyredamp.studies.dampmodels.DampModelStudy`)
+    damping_models: Any = None

@@ -40,6 +40,7 @@ from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numpy as np
+import scipy.linalg as sla
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import nnls
 
@@ -52,10 +53,13 @@ __all__ = [
     "WLF",
     "ConstantLoss",
     "FractionalZener",
+    "ModalBand",
     "ModulusLaw",
     "PronySeries",
     "RubberLaw",
     "fit_prony",
+    "fit_zener",
+    "modal_band_system",
     "rubber_system",
 ]
 
@@ -233,6 +237,76 @@ class ConstantLoss(RubberLaw):
 DEFAULT_TREAD = FractionalZener(e0=7e6, e_inf=7e8, tau=1e-11, alpha=0.3)
 
 
+def fit_zener(frequency: ArrayLike, storage: ArrayLike, loss_factor: ArrayLike) -> FractionalZener:
+    """The fractional Zener law closest to a measured master curve (least squares).
+
+    Fits ``E*(i omega) = (E_0 + E_inf x)/(1 + x)``, ``x = (i omega tau)^alpha``
+    (Pritz 1996, eq. (1)) to storage moduli ``E'`` and loss factors
+    ``tan delta = E''/E'`` at one reference temperature, minimising the
+    squared differences of ``ln E'`` and of ``ln E''`` (both moduli matter over
+    decades; Pritz 1996, sec. 3, fits the same four parameters to measured
+    master curves). The curve must reach over the loss peak, or ``E_inf`` and
+    ``tau`` are not determined separately.
+
+    Parameters
+    ----------
+    frequency : array_like, shape (n,)
+        Reduced frequencies of the master curve, Hz (> 0), ``n >= 4``.
+    storage : array_like, shape (n,)
+        ``E'``, Pa (> 0).
+    loss_factor : array_like, shape (n,)
+        ``tan delta`` (> 0).
+
+    Returns
+    -------
+    FractionalZener
+
+    Raises
+    ------
+    InputError
+        Fewer than four points, or values that are not positive.
+    """
+    from scipy.optimize import least_squares
+    from scipy.special import expit
+
+    f = np.asarray(frequency, dtype=float).ravel()
+    e1 = np.asarray(storage, dtype=float).ravel()
+    eta = np.asarray(loss_factor, dtype=float).ravel()
+    if not f.size == e1.size == eta.size or f.size < 4:
+        raise InputError(
+            "frequency, storage, loss_factor: expected at least 4 points of each, one per "
+            f"frequency, got {f.size}, {e1.size}, {eta.size}"
+        )
+    if not (np.all(f > 0) and np.all(e1 > 0) and np.all(eta > 0) and np.all(np.isfinite(f))):
+        raise InputError("frequency, storage, loss_factor: expected finite values > 0")
+    target = np.concatenate([np.log(e1), np.log(e1 * eta)])
+    w = 2 * np.pi * f
+
+    def unpack(p: NDArray[np.float64]) -> tuple[float, float, float, float]:
+        e0 = float(np.exp(p[0]))
+        return e0, e0 * (1 + float(np.exp(p[1]))), float(np.exp(p[2])), float(expit(p[3]))
+
+    def resid(p: NDArray[np.float64]) -> NDArray[np.float64]:
+        e0, e_inf, tau, alpha = unpack(p)
+        x = (1j * w * tau) ** alpha
+        e = (e0 + e_inf * x) / (1 + x)
+        return np.concatenate([np.log(e.real), np.log(np.abs(e.imag))]) - target
+
+    peak = float(w[np.argmax(eta)])
+    ratio = max(float(e1.max() / e1.min()), 1.0 + 1e-6)
+    best = None
+    for a in (0.2, 0.4, 0.6):
+        # loss peak of the law near omega tau = (E_0/E_inf)^(1/(2 alpha))
+        tau0 = ratio ** (-1 / (2 * a)) / peak
+        p0 = np.array([np.log(e1.min()), np.log(ratio - 1), np.log(tau0), np.log(a / (1 - a))])
+        sol = least_squares(resid, p0, method="trf", x_scale="jac", max_nfev=2000)
+        if best is None or sol.cost < best.cost:
+            best = sol
+    assert best is not None
+    e0, e_inf, tau, alpha = unpack(best.x)
+    return FractionalZener(e0, e_inf, tau, min(alpha, 1.0))
+
+
 def fit_prony(
     law: RubberLaw, f_lo: float, f_hi: float, per_decade: int = 2, n_lines: int = 200
 ) -> PronySeries:
@@ -318,16 +392,9 @@ def rubber_system(
         series (exact state space), :class:`~tyredamp.dampmodels.Hysteretic`
         for a constant loss, :class:`ModulusLaw` otherwise.
     """
-    known = {"sidewall": "K_sidewall", "band": "K_band"}
-    bad = [p for p in parts if p not in known]
-    if bad or not parts:
-        raise InputError(f"parts: expected some of sidewall, band, got {', '.join(bad) or 'none'}")
     M = np.array(ring.M, dtype=np.float64)
     K = np.array(ring.K, dtype=np.float64)
-    K_r = np.zeros_like(K)
-    for part in parts:
-        K_r += getattr(ring, known[part])
-    K_r = 0.5 * (K_r + K_r.T)
+    K_r = _rubber_stiffness(ring, parts)
     e_ref = rubber.modulus(2j * np.pi * reference_hz).real
     if isinstance(rubber, PronySeries):
         C = np.stack(
@@ -338,3 +405,123 @@ def rubber_system(
     if isinstance(rubber, ConstantLoss):
         return DampedSystem(M, K, Hysteretic(rubber.eta * K_r))
     return DampedSystem(M, K, ModulusLaw(K_r, rubber, e_ref))
+
+
+@dataclass(frozen=True, eq=False)
+class ModalBand:
+    """The ring tyre with a fractional Zener rubber, reduced to the modes of one band.
+
+    Attributes
+    ----------
+    system : DampedSystem
+        Mass ``I``, stiffness and damping in the relaxed modal coordinates.
+    shapes : ndarray, shape (16, m)
+        Mass-normalised relaxed mode shapes at the measurement points, 1/sqrt(kg).
+    drive : int
+        Row of ``shapes`` at the drive point.
+    omega : ndarray, shape (m,)
+        Relaxed natural frequencies ``omega_0``, rad/s.
+    c_fractional : ndarray, shape (m, m)
+        ``C'`` of the fractional law ``C' s^alpha`` that the rubber is in the band
+        (to first order in ``(s tau)^alpha``), 1/s^(2 - alpha).
+    alpha : float
+        The rubber's fractional order.
+    """
+
+    system: DampedSystem
+    shapes: NDArray[np.float64]
+    drive: int
+    omega: NDArray[np.float64]
+    c_fractional: NDArray[np.float64]
+    alpha: float
+
+
+def modal_band_system(
+    ring: RingTyre,
+    band_hz: tuple[float, float],
+    rubber: FractionalZener = DEFAULT_TREAD,
+    parts: Sequence[str] = ("sidewall", "band"),
+    reference_hz: float = 100.0,
+    drive: int = 0,
+) -> ModalBand:
+    """The modes of ``band_hz`` of the rubber tyre, one per pair, as a small exact system.
+
+    The rubber on ``K_r`` gives ``D(s) = s^2 M + K + K_r (E*(s)/E_ref - 1)``
+    (:func:`rubber_system`). With the relaxed stiffness ``K_0 = K + K_r
+    (E_0/E_ref - 1)`` and its mass-normalised modes ``Phi_0`` this is
+    ``s^2 I + diag(omega_0^2) + Phi_0^T K_r Phi_0 (E*(s) - E_0)/E_ref``, and
+    since ``E* - E_0 = (E_inf - E_0) x/(1 + x)``, ``x = (s tau)^alpha``
+    (Pritz 1996, eq. (1)), the damping is the fractional law ``C' s^alpha`` with
+    ``C' = Phi_0^T K_r Phi_0 (E_inf - E_0) tau^alpha / E_ref`` to first order in
+    ``|x|`` (Bagley & Torvik 1983, eq. (1)). The ring's modes come in pairs
+    (``cos`` and ``sin`` of each wave number): of each pair only the
+    combination seen from the drive point is kept (the other has no
+    amplitude there), and only the modes whose relaxed frequency lies in
+    ``band_hz``; the kept vectors ``P`` are rotated to the modes of
+    ``(P^T K_0 P, P^T M P)`` (Rayleigh-Ritz), so the reduced system is exactly
+    ``P^T D(s) P``.
+
+    Parameters
+    ----------
+    ring : RingTyre
+    band_hz : (float, float)
+        Relaxed natural frequencies kept, Hz.
+    rubber : FractionalZener
+    parts : sequence of {"sidewall", "band"}
+    reference_hz : float
+        Frequency at which the storage stiffness is the ring's, Hz.
+    drive : int
+        Measurement point of the drive (index into ``ring.point_dofs``).
+
+    Returns
+    -------
+    ModalBand
+    """
+    if not 0 <= band_hz[0] < band_hz[1]:
+        raise InputError(f"band_hz: expected 0 <= low < high Hz, got {band_hz}")
+    M = np.array(ring.M, dtype=np.float64)
+    K_r = _rubber_stiffness(ring, parts)
+    e_ref = rubber.modulus(2j * np.pi * reference_hz).real
+    K0 = np.array(ring.K, dtype=np.float64) + K_r * (rubber.e0 / e_ref - 1)
+    w2, phi = sla.eigh(0.5 * (K0 + K0.T), M)
+    w = np.sqrt(np.clip(w2, 0.0, None))
+    d = int(np.asarray(ring.point_dofs)[drive])
+    cols: list[NDArray[np.float64]] = []
+    j = 0
+    while j < w.size:
+        k = j + 1
+        while k < w.size and w[k] - w[j] <= 1e-2 * w[j]:  # a pair (split by rounding)
+            k += 1
+        if band_hz[0] <= w[j] / (2 * np.pi) <= band_hz[1]:
+            a = phi[d, j:k]
+            if np.linalg.norm(a) > 1e-9 * np.abs(phi[:, j:k]).max():
+                cols.append(phi[:, j:k] @ (a / np.linalg.norm(a)))
+        j = k
+    if not cols:
+        raise InputError(f"band_hz: no mode seen from the drive point in {band_hz} Hz")
+    P = np.column_stack(cols)
+    # Rayleigh-Ritz on the kept vectors: a pair split by the discretisation is not
+    # exactly degenerate, so its combination is rotated to the small problem's modes
+    w2r, rot = sla.eigh(0.5 * (P.T @ K0 @ P + (P.T @ K0 @ P).T), P.T @ M @ P)
+    P = P @ rot
+    om = np.sqrt(np.clip(w2r, 0.0, None))
+    kr = P.T @ K_r @ P
+    kr = 0.5 * (kr + kr.T)
+    law = ModulusLaw(kr, rubber, e_ref)
+    # K such that K + kr (E*/E_ref - 1) = diag(omega^2) + kr (E* - E_0)/E_ref
+    system = DampedSystem(np.eye(om.size), np.diag(om**2) + kr * (1 - rubber.e0 / e_ref), law)
+    c = kr * (rubber.e_inf - rubber.e0) * rubber.tau**rubber.alpha / e_ref
+    pts = np.asarray(ring.point_dofs)
+    return ModalBand(system, P[pts], drive, om, c, rubber.alpha)
+
+
+def _rubber_stiffness(ring: RingTyre, parts: Sequence[str]) -> NDArray[np.float64]:
+    """``K_r``: the symmetrised stiffness of ``parts`` of the ring, N/m."""
+    known = {"sidewall": "K_sidewall", "band": "K_band"}
+    bad = [p for p in parts if p not in known]
+    if bad or not parts:
+        raise InputError(f"parts: expected some of sidewall, band, got {', '.join(bad) or 'none'}")
+    K_r = np.zeros_like(np.array(ring.K, dtype=np.float64))
+    for part in parts:
+        K_r += getattr(ring, known[part])
+    return 0.5 * (K_r + K_r.T)
