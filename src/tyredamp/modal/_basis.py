@@ -139,14 +139,23 @@ def factors(
     f = fitter.f if lines is None else fitter.f[lines]
     w = 2 * np.pi * f
     s = 1j * w
-    kappa = (1j * w) ** fitter.power
-    kappa_low = (1j * w) ** (fitter.power - 2)
+    # (i w)^p = i^p w^p: a real power and one exact complex factor (a complex power
+    # of every line costs several times more)
+    p = fitter.power
+    wp = w**p
+    wl = w ** float(p - 2)
     lw = fitter.line_weights
     if lw is not None:
         lw = lw if lines is None else lw[lines]
-        kappa = kappa * lw
-        kappa_low = kappa_low * lw
+        wp = wp * lw
+        wl = wl * lw
+    kappa = _I_POWER[p % 4] * wp
+    kappa_low = _I_POWER[(p - 2) % 4] * wl
     return s, kappa, kappa_low
+
+
+#: ``i^k`` for ``k = 0 .. 3`` (exact)
+_I_POWER = (1.0 + 0j, 1j, -1.0 + 0j, -1j)
 
 
 def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
