@@ -234,7 +234,7 @@ def truth_stats(seed: int, refitted: bool = True) -> dict[str, Any]:
         om = ml.line_weights_full(np.asarray(pr.variance))
         _, jtj, _, _ = ml._evaluate(plain, th, p_all.size, ref, om)
         cov = np.linalg.pinv(jtj, hermitian=True)
-        crlb_f, crlb_z, _ = ml._pole_se(plain, th, p_all.size, cov)
+        crlb_f, crlb_z, _ = ml.pole_std(plain.w_ref, th, p_all.size, cov)
     # the threshold the identification applies to these data: the rank-one law of
     # several inputs and the correction for line weights estimated from the data
     # (problem.weight_dof), as identify's own

@@ -1,6 +1,6 @@
 """tyredamp against sdypy-EMA (LSCF + LSFD): speed and accuracy on the same FRFs.
 
-Run: ``python benchmarks/perf_compare.py [--quick] [--blas-threads 1] [--set all|tyre|random]
+Run: ``python benchmarks/perf_compare.py [--quick] [--blas-threads 1] [--set all|tyre|random|long]
 [--json PATH]`` (needs the ``bench`` extra: ``pip install -e ".[bench]"``).
 
 For each case both tools get the same FRFs, the same band and the same
@@ -57,6 +57,9 @@ from perf_common import (
 
 #: random MIMO cases (n_out, n_in, n_lines, n_modes, SNR dB) of --set random
 RANDOM = [(4, 1, 1000, 10, 60.0), (16, 2, 3000, 20, 35.0), (32, 2, 4000, 20, 50.0)]
+#: larger random cases of --set long, with their orders: many outputs and inputs,
+#: and a long record (a million lines)
+LONG = [((64, 3, 8000, 20, 30.0), 80), ((4, 1, 1_000_000, 10, 40.0), 40)]
 
 TOOLS = ("tyredamp", "tyredamp no search", "tyredamp lscf+lsfd", "sdypy-EMA")
 
@@ -102,6 +105,8 @@ def compare_case(case: Case, order: int, repeats: int, tools: tuple[str, ...]) -
             "t_residues_s": float(np.median([x.t_residues for x in rs])),
             "t_total_s": float(np.median([x.t_total for x in rs])),
             "t_total_all_s": [x.t_total for x in rs],
+            "t_cpu_s": float(np.median([x.t_cpu for x in rs])),
+            "t_cpu_all_s": [x.t_cpu for x in rs],
             "accuracy": acc,
             "extra": rs[0].extra,
         }
@@ -125,6 +130,7 @@ def print_case(res: dict[str, Any]) -> None:
     for tool, d in res["tools"].items():
         a = d["accuracy"]
         speed = ref["t_total_s"] / d["t_total_s"] if ref else None
+        speed_cpu = ref["t_cpu_s"] / d["t_cpu_s"] if ref else None
         rows.append(
             [
                 tool,
@@ -132,6 +138,8 @@ def print_case(res: dict[str, Any]) -> None:
                 d["t_residues_s"],
                 d["t_total_s"],
                 speed,
+                d["t_cpu_s"],
+                speed_cpu,
                 f"{a['n_found']}/{a['n_true']}",
                 a["max_freq_error"],
                 a["max_damping_error"],
@@ -147,6 +155,8 @@ def print_case(res: dict[str, Any]) -> None:
             "residues s",
             "total s",
             "sdypy/this",
+            "cpu s",
+            "sdypy/this cpu",
             "found",
             "max|df/f|",
             "max|dz/z|",
@@ -169,9 +179,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--json", default=str(RESULTS_DIR / "compare.json"), help="output JSON")
     ap.add_argument(
         "--set",
-        choices=("all", "tyre", "random"),
+        choices=("all", "tyre", "random", "long"),
         default="all",
-        help="the tyre and 128-output cases, the random MIMO cases, or both",
+        help="the tyre and 128-output cases, the random MIMO cases, or both; long: "
+        "64 outputs x 3 inputs x 8000 lines and 4 outputs x 1e6 lines",
     )
     a = ap.parse_args(argv)
     pool = limit_blas(a.blas_threads)
@@ -180,7 +191,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     rep = 3 if a.quick else 7
     t_start = time.perf_counter()
     specs: list[tuple[Any, int, int]] = []
-    if a.set != "random":
+    if a.set in ("all", "tyre"):
         specs += [
             (lambda: tyre_case(40.0, seed=1), 60, rep),
             (lambda: tyre_test_case(seed=0), 60, rep),
@@ -188,7 +199,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         ]
         if not a.quick:
             specs.append((lambda: synthetic_case(1024, 4000, 20, seed=0), 120, 1))
-    if a.set != "tyre":
+    if a.set == "long":
+        specs += [(functools.partial(mimo_case, *spec), order, rep) for spec, order in LONG]
+    if a.set in ("all", "random"):
         # random structures (perf_common.mimo_case): sdypy-EMA sees the first input
         specs += [
             (functools.partial(mimo_case, *spec), order, rep)
@@ -210,6 +223,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             {
                 "case": res["case"],
                 "speedup_total": s["t_total_s"] / t["t_total_s"],
+                "speedup_cpu": s["t_cpu_s"] / t["t_cpu_s"],
                 "speedup_poles": s["t_poles_s"] / max(t["t_poles_s"], 1e-9),
                 "speedup_residues": s["t_residues_s"] / max(t["t_residues_s"], 1e-9),
                 "speedup_total_lscf_lsfd": s["t_total_s"] / ll["t_total_s"],
@@ -222,6 +236,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
         [
             "case",
             "sdypy/tyredamp total",
+            "cpu",
             "poles",
             "residues",
             "sdypy/no search",
@@ -233,6 +248,7 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             [
                 s["case"],
                 s["speedup_total"],
+                s["speedup_cpu"],
                 s["speedup_poles"],
                 s["speedup_residues"],
                 s["speedup_total_no_search"],

@@ -1,6 +1,7 @@
 """Where the time of :func:`~tyredamp.modal.identify_modes` goes, stage by stage.
 
-Run: ``python benchmarks/perf_profile.py [--quick] [--blas-threads 1] [--json PATH]``.
+Run: ``python benchmarks/perf_profile.py [--quick] [--blas-threads 1] [--json PATH]
+[--set tyre|random] [--lines 5e4]``.
 
 Profiles one call (``cProfile``, complex model, default options) on the
 virtual tyre (16 outputs, 799 lines), the synthetic structure with 128
@@ -30,6 +31,7 @@ from perf_common import (
     RESULTS_DIR,
     limit_blas,
     machine_info,
+    mimo_case,
     print_table,
     synthetic_case,
     tyre_case,
@@ -51,6 +53,9 @@ STAGES = (
     ("  residual peaks", "residual_peaks.py", "residual_peaks"),
     ("  coherent scan", "residual_peaks.py", "coherent_scan"),
     ("  trials (_trial)", "search.py", "_trial"),
+    ("  trial evaluations, one block (solve_one)", "_added.py", "solve_one"),
+    ("  trial evaluations, blocks (solve_blocks)", "_added.py", "solve_blocks"),
+    ("  trial evaluations, Q_r kept (solve_all)", "_added.py", "solve_all"),
     ("  joint refits (_joint)", "search.py", "_joint"),
     ("final fit and drop rule (final_complex)", "final.py", "final_complex"),
     ("  maximum-likelihood stage", "final.py", "maximum_likelihood"),
@@ -76,12 +81,12 @@ def check_stages() -> None:
                 raise SystemExit(f"perf_profile: stage {label.strip()!r}: no {fn}() in {file}")
 
 
-def profile_case(name: str, case: Any) -> dict[str, Any]:
-    identify_modes(case.frf, band=case.band, model="complex")  # warm-up (imports, caches)
+def profile_case(name: str, case: Any, order: int | None = None) -> dict[str, Any]:
+    identify_modes(case.frf, band=case.band, model="complex", max_order=order)  # warm-up
     pr = cProfile.Profile()
     t0 = time.perf_counter()
     pr.enable()
-    identify_modes(case.frf, band=case.band, model="complex")
+    identify_modes(case.frf, band=case.band, model="complex", max_order=order)
     pr.disable()
     total = time.perf_counter() - t0
     stats = pstats.Stats(pr).stats  # type: ignore[attr-defined]
@@ -103,17 +108,35 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--quick", action="store_true", help="without the 1024-output case")
     ap.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (default 1)")
     ap.add_argument("--json", default=str(RESULTS_DIR / "profile.json"), help="output JSON")
+    ap.add_argument(
+        "--set",
+        choices=("tyre", "random"),
+        default="tyre",
+        help="the tyre and synthetic cases (default), or the random MIMO cases of "
+        "perf_compare (16x2x3000 35 dB, 32x2x4000 50 dB, order 80) and a long record "
+        "(4 outputs, --lines lines, order 40)",
+    )
+    ap.add_argument("--lines", type=float, default=5e4, help="lines of the long record")
     a = ap.parse_args(argv)
     check_stages()
     pool = limit_blas(a.blas_threads)
     t_start = time.perf_counter()
-    cases = [
-        ("tyre 16x799x6", lambda: tyre_case(40.0, seed=1)),
-        ("synthetic 128x4000x20", lambda: synthetic_case(128, 4000, 20, seed=0)),
+    cases: list[tuple[str, Any, int | None]] = [
+        ("tyre 16x799x6", lambda: tyre_case(40.0, seed=1), None),
+        ("synthetic 128x4000x20", lambda: synthetic_case(128, 4000, 20, seed=0), None),
     ]
     if not a.quick:
-        cases.append(("synthetic 1024x4000x20", lambda: synthetic_case(1024, 4000, 20, seed=0)))
-    results = [profile_case(name, make()) for name, make in cases]
+        cases.append(
+            ("synthetic 1024x4000x20", lambda: synthetic_case(1024, 4000, 20, seed=0), None)
+        )
+    if a.set == "random":
+        n = int(a.lines)
+        cases = [
+            ("16x2x3000 35 dB", lambda: mimo_case(16, 2, 3000, 20, 35.0), 80),
+            ("32x2x4000 50 dB", lambda: mimo_case(32, 2, 4000, 20, 50.0), 80),
+            (f"4x1x{n} 40 dB", lambda: mimo_case(4, 1, n, 10, 40.0), 40),
+        ]
+    results = [profile_case(name, make(), order) for name, make, order in cases]
     rows = []
     for label, _f, _n in STAGES:
         row: list[Any] = [label]

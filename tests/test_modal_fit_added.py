@@ -172,6 +172,51 @@ def test_blocks_with_many_outputs_give_the_same_added_mode(
     assert_allclose(got[2], ref[2], rtol=1e-8)
 
 
+def test_fixed_basis_of_one_block_kept_with_more_columns_than_outputs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # several blocks, the fixed basis larger than the data (more columns than the
+    # two outputs) but no larger than one block of the fits: Q_r of every line is
+    # kept and the added columns formed at once; the refinement of one block to
+    # round-off, and the fixed basis is not formed again per evaluation
+    import tyredamp.modal._basis as basis_mod
+
+    sys_ = chain_system()
+    cm = sys_.complex_modes()
+    rng = np.random.default_rng(8)
+    h = sys_.frf(F, kind="accelerance", inputs=[0, 5]).H[:2]  # 2 outputs, 2 inputs
+    h = h + 1e-3 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    part = cm.psi[[0, 5]].T
+    order = np.argsort(cm.poles.imag)
+    k, keep = int(order[2]), np.delete(order, 2)
+    lo, hi = 0.8 * cm.poles[k].imag, 1.2 * cm.poles[k].imag
+    args = (cm.poles[keep], part[keep], cm.poles[k] * 1.01, np.ones(2))
+    drive = [(0, 0)]
+    ref = ModalFitter(F, h, 2, "complex", drive).fit_added(*args, omega_bounds=(lo, hi))
+    many = ModalFitter(F, h, 2, "complex", drive)
+    qf = many.n_cols(keep.size)
+    assert qf > many.n_out
+    monkeypatch.setattr(basis_mod, "BLOCK_BYTES", 8 * many.n_rows * qf)  # Q_r fits one block
+    monkeypatch.setattr(basis_mod, "MIN_BLOCK_LINES", 37)
+    fx = many.fixed_part(cm.poles[keep], part[keep])
+    assert len(fx.parts) > 1
+    assert fx.qr is not None
+    calls = []
+    real = many._basis_ek
+
+    def counted(th: np.ndarray, m: int, *a: object, **kw: object) -> object:
+        calls.append(m)
+        return real(th, m, *a, **kw)
+
+    monkeypatch.setattr(many, "_basis_ek", counted)
+    got = many.fit_added(*args, omega_bounds=(lo, hi), fixed=fx)
+    assert calls == []  # the fixed basis (m > 1 modes) not formed again
+    # the same refinement by other sums: round-off times the conditioning
+    assert_allclose(got[0], ref[0], rtol=1e-10)
+    assert_allclose(got[1], ref[1], rtol=1e-8)
+    assert_allclose(got[2], ref[2], rtol=1e-8)
+
+
 def test_residual_blocks_against_the_modal_sum() -> None:
     # the residual H - H^ of residual_blocks (one real product of [Re R, Im R, upper,
     # lower] and the columns a + b, i (a - b), kappa, kappa_low) against the modal sum

@@ -189,3 +189,50 @@ def test_projection_matches_least_squares(scale: float) -> None:
     # identities of an orthonormal Q: relative to the largest Gram entry, eps-sized
     assert_allclose(R.T @ R, g, atol=1e-12 * np.abs(g).max())
     assert_allclose(R.T @ qt(X), pw.T @ X, atol=1e-12 * np.abs(pw.T @ X).max() * 10)
+
+
+def test_evaluate_gram_route_matches_the_qr_route(monkeypatch: pytest.MonkeyPatch) -> None:
+    # _evaluate's J^T J, J^T r, cost and coefficients from the Gram matrix of each
+    # output's weighted [Phi | E] (Schur complement) against the Householder-QR route
+    # (taken when the Gram route is refused) and against J formed explicitly by
+    # central differences of the projected residual
+    from tyredamp.modal import ml
+
+    h, v, pi, _ = _data(2)
+    fit = ModalFitter(F, h, 0, "complex", [], upper=True, lower=True)
+    wls = fit.fit(POLES, pi.T.copy())
+    om = line_weights_full(v)
+    assert om is not None
+    part = np.asarray(wls.participation, complex)
+    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+    th = fit.pack(wls.poles, part, ref)
+    cost, jtj, jtr, sol = ml._evaluate(fit, th, 3, ref, om)
+    monkeypatch.setattr(ml, "_gram_chol", lambda g: None)
+    cost_q, jtj_q, jtr_q, sol_q = ml._evaluate(fit, th, 3, ref, om)
+    monkeypatch.undo()
+    # the two routes: eps times the basis condition (~1e4 here) relative to the largest entry
+    assert cost == pytest.approx(cost_q, rel=1e-10)
+    assert_allclose(jtj, jtj_q, rtol=0, atol=1e-9 * np.abs(jtj).max())
+    assert_allclose(jtr, jtr_q, rtol=0, atol=1e-9 * np.abs(jtr).max())
+    assert_allclose(sol["C"], sol_q["C"], rtol=0, atol=1e-9 * np.abs(sol["C"]).max())
+
+    def proj_res(x: np.ndarray) -> np.ndarray:
+        # the variable-projection residual of every output at x (unit-free, weighted)
+        B, _ = fit._basis_ek(x, 3, ref, False)
+        out = []
+        for j in range(N_OUT):
+            pw, yw = B * om[:, j : j + 1], fit.Y[:, j] * om[:, j]
+            out.append(yw - pw @ np.linalg.lstsq(pw, yw, rcond=None)[0])
+        return np.concatenate(out)
+
+    r0 = proj_res(th)
+    J = np.empty((r0.size, th.size))
+    for i in range(th.size):
+        dx = np.zeros(th.size)
+        dx[i] = 1e-6 * max(1.0, abs(th[i]))
+        J[:, i] = (proj_res(th + dx) - proj_res(th - dx)) / (2 * dx[i])
+    assert cost == pytest.approx(float(r0 @ r0), rel=1e-10)  # the same residual
+    # J^T r (J = d r / d theta) is exact for the projected residual (Kaufman's J
+    # differs from the exact Jacobian by a term orthogonal to r); central
+    # differences ~1e-7 relative
+    assert_allclose(jtr, J.T @ r0, rtol=0, atol=1e-5 * np.abs(jtr).max())

@@ -19,9 +19,10 @@ basis, weighted data rows and the rows of ``[Q_r | P_f Y]`` (an orthonormal
 basis of the range of ``Phi_f`` and the data with it projected out: an
 evaluation is then one product ``B1^T [Q_r | P_f Y]`` and ``B1^T B1``); with
 several blocks, the rows of ``Q_r`` of every line when the fixed basis is no
-larger than the data (an evaluation then forms the added columns of every line
-at once when they are no larger than the data either: one basis and three
-products instead of a fixed and an added basis and three products per block).
+larger than the data or than one block of the fits (an evaluation then forms
+the added columns of every line at once when they are no larger than the data
+or one block either: one basis and three products instead of a fixed and an
+added basis and three products per block).
 """
 
 from __future__ import annotations
@@ -120,8 +121,9 @@ def fixed_part(
     qf = fitter.n_cols(m)
     one = len(parts) == 1
     # the fixed basis is kept when it is no larger than the data (many outputs) or
-    # fits one block; otherwise it is formed again block by block when needed
-    keep = one or qf <= fitter.n_out
+    # than one block of the fits (a constant, _basis.BLOCK_BYTES); otherwise it is
+    # formed again block by block when needed
+    keep = one or _no_larger(fitter, qf)
     rows = _Rows(fitter, None, parts, keep)
     yw = np.asarray(fitter._ydata(parts[0]) * w) if one else None
     phi0 = rows.basis(th_f, m, ref, 0) if one else None
@@ -148,6 +150,12 @@ def fixed_part(
         if a is not None:
             a.flags.writeable = False
     return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr)
+
+
+def _no_larger(fitter: Any, n_col: int) -> bool:
+    """Are ``n_col`` real columns of every line no larger than the data rows or than
+    one block of the fits (:data:`~tyredamp.modal._basis.BLOCK_BYTES`)?"""
+    return n_col <= fitter.n_out or 8 * fitter.n_rows * n_col <= _basis.BLOCK_BYTES
 
 
 def line_rows(fitter: Any, sl: slice) -> slice | NDArray[np.intp]:
@@ -222,11 +230,11 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
 
         return solution(g0, G, P, projected, pp1)
 
-    fac_all = _basis.factors(fitter) if fx.qr is not None and n1 <= fitter.n_out else None
+    fac_all = _basis.factors(fitter) if fx.qr is not None and _no_larger(fitter, n1) else None
 
     def solve_all(th: NDArray[np.float64]) -> dict[str, Any]:
         # several blocks, Q_r of every line kept (FixedPart.qr): the added columns of
-        # every line at once (n1 columns, no larger than the data)
+        # every line at once (n1 columns, no larger than the data or one block)
         qr = fx.qr
         assert qr is not None
         pp1 = one.unpack(th, 1, ref1)

@@ -139,14 +139,23 @@ def factors(
     f = fitter.f if lines is None else fitter.f[lines]
     w = 2 * np.pi * f
     s = 1j * w
-    kappa = (1j * w) ** fitter.power
-    kappa_low = (1j * w) ** (fitter.power - 2)
+    # (i w)^p = i^p w^p: a real power and one exact complex factor (a complex power
+    # of every line costs several times more)
+    p = fitter.power
+    wp = w**p
+    wl = w ** float(p - 2)
     lw = fitter.line_weights
     if lw is not None:
         lw = lw if lines is None else lw[lines]
-        kappa = kappa * lw
-        kappa_low = kappa_low * lw
+        wp = wp * lw
+        wl = wl * lw
+    kappa = _I_POWER[p % 4] * wp
+    kappa_low = _I_POWER[(p - 2) % 4] * wl
     return s, kappa, kappa_low
+
+
+#: ``i^k`` for ``k = 0 .. 3`` (exact)
+_I_POWER = (1.0 + 0j, 1j, -1.0 + 0j, -1j)
 
 
 def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
@@ -178,21 +187,23 @@ def rows_t_data(fitter: Any, lines: slice, b: NDArray[np.float64]) -> NDArray[np
 
     ``b`` holds complex columns as real rows (real and imaginary part of each
     entry ``(k, f)`` interleaved, as :func:`basis_ek` returns them), and so does
-    ``Y``: the real inner product of two such columns is ``Re(conj(a)^T y)`` of
-    the complex columns, so ``b^T Y = Re(conj(b_c)^T H_c)`` with ``H_c`` the
-    block of ``fitter.H`` (times the line weights, here put on ``b_c``). Falls
-    back to ``b.T @ ydata(...)`` when ``b`` is not laid out that way.
+    ``Y``: the real inner product of two such columns is ``Re(conj(a)^T y) =
+    a_re^T y_re + a_im^T y_im``, the real product of the two arrays of
+    interleaved parts, so ``b^T Y`` is one real matrix product of ``b^T`` with
+    the block of ``fitter.H`` (times the line weights) viewed as real numbers
+    (half the operations of the complex product ``conj(b_c)^T H_c``, of which
+    only the real part counts). Falls back to ``b.T @ ydata(...)`` when ``b``
+    is not laid out that way.
     """
     bt = b.T
     if not (bt.flags.c_contiguous and bt.shape[1] % 2 == 0):
         return np.asarray(bt @ ydata(fitter, lines))
-    n_out, n_in = fitter.n_out, fitter.n_in
-    bc = bt.view(np.complex128)  # (c, n_in nb), entry (k, f)
+    n_out = fitter.n_out
+    h = fitter.H[:, :, lines]
     lw = fitter.line_weights
-    if lw is not None:
-        bc = (bc.reshape(bc.shape[0], n_in, -1) * lw[lines]).reshape(bc.shape[0], -1)
-    h = fitter.H[:, :, lines].reshape(n_out, -1)
-    return np.asarray((np.conj(bc) @ h.T).real)
+    h = h * lw[lines] if lw is not None else np.ascontiguousarray(h)
+    hr = h.reshape(n_out, -1).view(np.float64)  # (n_out, 2 n_in nb), parts interleaved
+    return np.asarray(bt @ hr.T)
 
 
 def synth(

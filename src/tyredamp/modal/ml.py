@@ -48,7 +48,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
 from scipy.linalg import solve_triangular
 
 from ._linalg import _gram_chol, _levenberg_marquardt
@@ -97,36 +96,69 @@ def _evaluate(
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
     """Cost, ``J^T J``, ``J^T r`` and the coefficients ``C`` (q, n_out) at ``th``.
 
-    With ``M_j = W_j (dPhi / dtheta) C_j`` and ``Q_j^T r_j = 0``: ``J_j^T J_j = M_j^T
-    M_j - (Q_j^T M_j)^T Q_j^T M_j`` and ``J_j^T r_j = -M_j^T r_j``. ``M_j = W_j E
-    S_j`` with ``E`` the distinct derivative columns (:meth:`ModalFitter.basis`)
-    and ``S_j`` sparse (one entry ``coef_d C_j[dcol_d]`` per derivative column).
+    With ``M_j = W_j (dPhi / dtheta) C_j = W_j E S_j^T`` (``E`` the distinct
+    derivative columns, :meth:`ModalFitter.basis`, and ``S_j`` (n_par, n_e) one
+    entry ``coef_d C_j[dcol_d]`` per derivative column) and ``Q_j^T r_j = 0``:
+    ``J_j^T J_j = M_j^T M_j - (Q_j^T M_j)^T Q_j^T M_j = S_j (E^T W_j P_j W_j E)
+    S_j^T`` and ``J_j^T r_j = -S_j E^T W_j r_j`` (``P_j`` the projector on the
+    complement of the range of ``W_j Phi``). ``E^T W_j P_j W_j E`` is the Schur
+    complement ``G_EE - X^T X``, ``X = R_j^-T G_PhiE``, of the Gram matrix ``G``
+    of ``W_j [Phi | E]`` (one symmetric rank-k update per output; Golub & Van
+    Loan, *Matrix Computations*, 4th ed. 2013, sec. 5.3.2, the normal
+    equations); the residual ``r_j`` is formed explicitly (no cancellation in
+    the cost). An output whose weighted basis is too ill-conditioned for the
+    Gram route takes the Householder QR (:func:`_evaluate_qr`).
     """
     B, poles = fitter._basis_ek(th, m, ref, True)
     q = fitter.n_cols(m)
     lay = fitter._layout(m)
     coef = fitter._coef(lay, poles)
-    phi, E = B[:, :q], B[:, q:]
     n_par = th.size
-    n_e = E.shape[1]
+    n_e = B.shape[1] - q
     jtj = np.zeros((n_par, n_par))
     jtr = np.zeros(n_par)
     C = np.zeros((q, fitter.n_out))
     cost = 0.0
+    Y = fitter.Y
+    bw = np.empty_like(B, order="F")
     for j in range(fitter.n_out):
         wj = om[:, j]
-        pw = phi * wj[:, None]
-        yw = fitter.Y[:, j] * wj
-        proj = _projection(pw, yw)
-        C[:, j] = proj[0]
-        r = yw - pw @ C[:, j]  # the residual itself: no cancellation in the cost
+        np.multiply(B, wj[:, None], out=bw)
+        yw = Y[:, j] * wj
+        G = bw.T @ bw  # Gram matrix of W_j [Phi | E] (symmetric rank-k update)
+        fac = _gram_chol(G[:q, :q])
+        if fac is None:
+            c_j, ge, etr, r = _evaluate_qr(bw, yw, q)
+        else:
+            rs, d = fac
+            R = rs * d[None, :]
+            c_j = solve_triangular(R, solve_triangular(R, bw[:, :q].T @ yw, trans="T"))
+            r = yw - bw[:, :q] @ c_j  # the residual itself: no cancellation in the cost
+            X = solve_triangular(R, G[:q, q:], trans="T")
+            ge = G[q:, q:] - X.T @ X  # E^T W P W E
+            etr = bw[:, q:].T @ r
+        C[:, j] = c_j
         cost += float(r @ r)
-        S = sparse.csr_matrix((coef * C[lay.dcol, j], (lay.dpar, lay.ecol)), shape=(n_par, n_e))
-        M = np.asarray((S @ (E * wj[:, None]).T).T)  # (n_rows, n_par)
-        qm = proj[1](M)
-        jtj += M.T @ M - qm.T @ qm
-        jtr -= M.T @ r
+        S = np.zeros((n_par, n_e))
+        np.add.at(S, (lay.dpar, lay.ecol), coef * c_j[lay.dcol])
+        jtj += S @ ge @ S.T
+        jtr -= S @ etr
+    phi = B[:, :q]
     return cost, 0.5 * (jtj + jtj.T), jtr, {"C": C, "phi": phi, "jtj": jtj}
+
+
+def _evaluate_qr(
+    bw: NDArray[np.float64], yw: NDArray[np.float64], q: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Coefficients, ``E^T W P W E``, ``E^T W r`` and the residual ``r`` of one output
+    from the Householder QR of its weighted basis ``bw[:, :q]`` (Golub & Van Loan,
+    sec. 5.3.3): the route of :func:`_evaluate` for an ill-conditioned basis."""
+    c_j, qmap = _projection(bw[:, :q], yw)
+    r = yw - bw[:, :q] @ c_j
+    ew = bw[:, q:]
+    qe = qmap(ew)
+    ge = ew.T @ ew - qe.T @ qe
+    return c_j, ge, ew.T @ r, r
 
 
 def _projection(
