@@ -65,6 +65,30 @@ class DampingDecomposition:
     share: NDArray[np.float64]
     norm_ratio: NDArray[np.float64]
 
+    @property
+    def coupling(self) -> NDArray[np.float64]:
+        """First-order complexity ``|alpha_k^(n)| = omega_n |C'_kn| / |omega_n^2 - omega_k^2|``.
+
+        Radial spec eq. [16] (Adhikari & Woodhouse, J. Sound Vib. 243(1), 2001):
+        the imaginary part that mode ``k`` lends to the complex mode ``n``,
+        relative to its real part; shape (m, m), column ``n``, zero diagonal.
+        A double (``omega_k = omega_n``) that the damping couples gets ``inf``.
+        """
+        w = 2 * np.pi * self.frequency_hz
+        gap = np.abs(w[None, :] ** 2 - w[:, None] ** 2)
+        c = np.abs(self.modal_damping) * w[None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = np.where(gap > 0, c / np.where(gap > 0, gap, 1.0), np.where(c > 0, np.inf, 0.0))
+        np.fill_diagonal(a, 0.0)
+        return np.asarray(a, dtype=np.float64)
+
+    def largest_coupling(self) -> tuple[float, float, float]:
+        """``(f_k, f_n, |alpha_k^(n)|)`` of the largest finite :attr:`coupling` (Hz, Hz, 1)."""
+        a = self.coupling
+        a = np.where(np.isfinite(a), a, 0.0)
+        k, n = np.unravel_index(int(np.argmax(a)), a.shape)
+        return float(self.frequency_hz[k]), float(self.frequency_hz[n]), float(a[k, n])
+
     def as_dict(self) -> dict[str, float]:
         """``{source: share}``."""
         return {n: float(s) for n, s in zip(self.names, self.share, strict=True)}
