@@ -74,10 +74,10 @@ class ContactPatch:
         ``h`` = 20 mm with an effective (unconfined) modulus of about 2 MPa
         on the ``b_c`` = 0.175 m of the 0.24 m tread that touches the road
         (truck rib and drive patterns have a land-to-sea ratio of about
-        0.7). With the default ring the hub stiffness is within -2/+16 % of
+        0.7). With the default ring the hub stiffness is 1-14 % above
         the Goodyear 335/65R22.5 (Project Chrono ``feda`` .tir,
-        Calspan-measured) at its pressures and nominal loads (2.7-6.5 bar)
-        and 0.9 MN/m at 7.5 bar and 25 kN, beside the 1.0 MN/m of the
+        Calspan-measured) at the files' pressures and nominal loads (2.76 and
+        6.55 bar) and 0.9 MN/m at 7.5 bar and 25 kN, beside the 1.0 MN/m of the
         315/80R22.5 bus tyre at 8 bar (Pacejka 2012, appendix 3).
     tangential_stiffness : float
         Tangential (shear) tread stiffness per unit length in N/m^2. Default

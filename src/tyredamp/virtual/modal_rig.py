@@ -341,12 +341,9 @@ def run_modal_test(
         (``data.acquisition.settle_samples`` says how many samples of each
         run to drop) instead of dropping them.
     microphone_deg : float, optional
-        Add a microphone on the rim at this angle (deg, on a ring node; the
-        tyre needs a cavity): a last channel ``P1`` of quantity "pressure"
-        (Pa), the acoustic pressure of the cavity DOFs
-        (:func:`~tyredamp.virtual.microphone.microphone_row`), with its own
-        noise at ``snr_db``. FRF estimators that relate motion to force
-        leave it aside. Default none.
+        A rim microphone at this angle (deg, a ring node; needs a cavity): a
+        last channel ``P1``, "pressure" in Pa, noise at ``snr_db``
+        (:mod:`~tyredamp.virtual.microphone`). Default none.
 
     Returns
     -------
@@ -378,20 +375,9 @@ def run_modal_test(
     periods = (int(settle_periods), int(n_periods), keep_settle)
     run_len = n_keep * p_samples
     n_runs = drive.shape[0]
-    clean = np.concatenate(
-        [
-            _simulate_run(
-                tyre,
-                drive[run][:, None] * exc.signal[None, :],
-                (fs * r, r),
-                initial_state,
-                periods,
-                mic,
-            )
-            for run in range(n_runs)
-        ],
-        axis=1,
-    )
+    runs = [drive[run][:, None] * exc.signal[None, :] for run in range(n_runs)]
+    sim = ((fs * r, r), initial_state, periods, mic)
+    clean = np.concatenate([_simulate_run(tyre, f, *sim) for f in runs], axis=1)
     measured, noise_std = _add_noise(clean, snr_db, rng)
     meta = _notes(tyre, drive, drive_mode, exc, lines, (f_rms, snr_db, noise_std), seed, r)
     meta["initial_state"] = initial_state
@@ -404,19 +390,28 @@ def run_modal_test(
         n_averages=int(n_periods),
         excitation=exc.name,
     )
+    data = _time_data(tyre, measured, fs, meta, acquisition, microphone_deg)
+    return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)
+
+
+def _time_data(
+    tyre: RingTyre,
+    measured: NDArray[np.float64],
+    fs: float,
+    meta: dict[str, Any],
+    acquisition: Acquisition,
+    microphone_deg: float | None,
+) -> TimeData:
+    """The record as :class:`TimeData`: forces, accelerations and the microphone (if any)."""
+    n_in = len(tyre.layout.drive_points)
     channels = tyre.input_channels + tyre.output_channels
     quantities = ["force"] * n_in + ["acceleration"] * len(tyre.point_dofs)
     if microphone_deg is not None:
-        node = microphone_node(tyre, microphone_deg)
-        ang = float(tyre.node_angles_deg[node])
-        channels = (
-            *channels,
-            Channel(node=len(channels) + 1, direction=0, angle_deg=ang, name="P1"),
-        )
+        ang = float(tyre.node_angles_deg[microphone_node(tyre, microphone_deg)])
+        channels = (*channels, Channel(len(channels) + 1, direction=0, angle_deg=ang, name="P1"))
         quantities.append("pressure")
         meta["microphone_deg"] = ang
-    data = TimeData(measured, fs, channels, quantities, meta, acquisition=acquisition)
-    return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)
+    return TimeData(measured, fs, channels, quantities, meta, acquisition=acquisition)
 
 
 def _check_choices(drive_mode: str, excitation: str, initial_state: str) -> None:

@@ -88,7 +88,8 @@ class RingTyreParameters:
         Tangential sidewall stiffness ``k_t = k_t0 + k_tp * p`` (same units
         and argument as the radial one). Defaults 5e4 and 0.6 give
         ``k_t = 5e5`` N/m^2 at 7.5 bar (spec reference value), with the same
-        10 % pressure-independent share.
+        10 % pressure-independent share as the radial one (assumed: no
+        published value separates it).
     radial_damping, tangential_damping : float
         Viscous sidewall dampers per unit length ``c_r``, ``c_t`` in
         N s/m^2. Defaults 280 and 30. They are *not* proportional to
