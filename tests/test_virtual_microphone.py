@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -129,3 +131,24 @@ def test_microphone_determines_the_band_air_damping_term() -> None:
     # (error above 100 %) and determined with it (eq. [18] to first order: a few %)
     assert err["acc"] > 1.0
     assert err["mic"] < 0.1
+
+
+def test_simulate_radial_microphone_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tyredamp.cli import main
+    from tyredamp.io import read_timedata
+
+    out = tmp_path / "mic.npz"
+    main(["simulate", "radial", "--periods", "1", "--microphone", "0", "-o", str(out)])
+    d = read_timedata(out)
+    assert d.quantities[-1] == "pressure"
+    assert d.units[-1] == "Pa"
+    capsys.readouterr()
+    # the microphone needs the cavity: one line, exit 2, nothing written
+    bad = tmp_path / "bad.npz"
+    with pytest.raises(SystemExit) as err:
+        main(["simulate", "radial", "--no-cavity", "--microphone", "0", "-o", str(bad)])
+    assert err.value.code == 2
+    assert "tyredamp: error: --microphone" in capsys.readouterr().err
+    assert not bad.exists()
