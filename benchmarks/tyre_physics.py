@@ -72,7 +72,9 @@ def sources() -> None:
         "bare ring, 350 N s/m tip (older)": RingTyre(
             layout=MeasurementLayout(attachment_mass=0.1, attachment_damping=350.0)
         ),
-        "demo with the former 30 N s/m, 0.1 kg tip": virtual_tyre(7.5, attachment_damping=30.0),
+        "demo with the former 30 N s/m, 0.1 kg tip": RingTyre(
+            layout=MeasurementLayout(attachment_mass=0.1, attachment_damping=30.0), cavity=Cavity()
+        ),
         "demo: free + cavity": virtual_tyre(7.5),
         "free + cavity + splice": virtual_tyre(7.5, splice=True),
         "loaded 25 kN + cavity": virtual_tyre(7.5, load_n=25e3),
