@@ -15,8 +15,8 @@ Prints
    be flagged model-limited): modes generated
    from the analytic ring (spec ``virtual-tyre.md``, via
    ``tyredamp.virtual.analytic_ring_frequencies``) at the true parameters, n =
-   1..7 at 5, 7, 9 bar, the driven member with the 0.1 kg / 30 N s/m shaker
-   attachment, plus Gaussian noise (frequency 0.1 %, shape amplitude 1 %,
+   1..7 at 5, 7, 9 bar, the driven member with the default shaker attachment
+   (0.01 kg, 2 N s/m), plus Gaussian noise (frequency 0.1 %, shape amplitude 1 %,
    damping ratio 2 %) given to the fit as the modal standard errors;
 4. wave numbers of the identified modes and the aliased case (5 bar,
    0-260 Hz: n = 9 seen by 16 points as n = 7);

@@ -3,7 +3,7 @@
 Prints
 
 1. the in-band modes of the default tyre (295/80R22.5, 7.5 bar, drive at point
-   1, 30 N s/m tip loss, ``nonproportionality`` 1): natural frequency, damping ratio, wave
+   1, 2 N s/m tip loss, ``nonproportionality`` 1): natural frequency, damping ratio, wave
    number, visibility from the drive point and modal phase collinearity (MPC)
    of the exact complex modes at the 16 points;
 2. the pressure dependence at 5, 7.5 and 9 bar (analytic formula and the

@@ -402,8 +402,9 @@ def test_report_states_no_outcome_of_the_design_as_failed(demo: tuple[DemoResult
                 assert all(x["residual_to_noise"] > x["threshold"] for x in c["verdicts"].values())
             else:
                 assert any(x["residual_to_noise"] <= x["threshold"] for x in others)
-    # the virtual tyre has non-proportional damping and the rig's tyre is none of the
-    # lateral models, by design: the demo shows both as expected outcomes
+    # the rig's tyre is none of the lateral models, by design: the demo shows that as an
+    # expected outcome (the free radial tyre's modes are nearly real: its real-mode fits
+    # reach the noise at 40 dB, docs/virtual-tyre.md)
     kinds = {pr["verdict"]["real"]["outcome"] for pr in doc["radial"]["pressures"]} | {
         c["verdict"]["outcome"] for c in doc["lateral"]["conditions"]
     }
@@ -434,8 +435,9 @@ def test_report_states_no_outcome_of_the_design_as_failed(demo: tuple[DemoResult
 
 def test_a_genuine_failure_is_stated_once_beside_its_result(demo: tuple[DemoResult, Path]) -> None:
     """A complex-mode fit made 10 % too large at one pressure: a fit that should hold and
-    does not. It fails in red, once, beside its result; the real-mode fit of that band can
-    no longer be explained by it and fails too; the summary links to both."""
+    does not. It fails in red, once, beside its result; the real-mode fit of that band
+    keeps its own verdict (the free tyre's modes are nearly real: it reaches the noise);
+    the summary links to the failure."""
     import html
     from dataclasses import replace
 
@@ -456,14 +458,15 @@ def test_a_genuine_failure_is_stated_once_beside_its_result(demo: tuple[DemoResu
     cx, re_ = pr["verdict"]["complex"], pr["verdict"]["real"]
     assert cx["residual_to_noise"] > cx["threshold"]
     assert cx["outcome"] == "failed"
-    assert re_["outcome"] == "failed"  # its better model fails: nothing explains its miss
+    # the real-mode fit is judged on its own residual: within the noise, it stays ok
+    assert re_["residual_to_noise"] <= re_["threshold"]
+    assert re_["outcome"] == "ok"
     sec = _sections(page)["radial"]
-    for v in (cx, re_):
-        text = html.escape(v["summary"])
-        assert page.count(text) == 1
-        at = sec.index(text)
-        assert sec.rfind('<div class="verdict bad"', 0, at) > sec.rfind("</div>", 0, at)
-    assert page.count("FAILED") == 2
+    text = html.escape(cx["summary"])
+    assert page.count(text) == 1
+    at = sec.index(text)
+    assert sec.rfind('<div class="verdict bad"', 0, at) > sec.rfind("</div>", 0, at)
+    assert page.count("FAILED") == 1
     summary = page[: page.index('<h2 id="s2"')]
     anchor = anchor_id(f"radial:{runs[k].pressure_bar:g}")
     assert f'<li class="failed">{html.escape(cx["subject"])}: does not fit' in summary
@@ -472,9 +475,9 @@ def test_a_genuine_failure_is_stated_once_beside_its_result(demo: tuple[DemoResu
     rows = dict(demo_summary_rows(res2, doc))
     assert rows[cx["subject"]] == cx["brief"]
     assert rows[cx["subject"]].startswith("FAILED (residual ")
-    # the other pressures' real-mode fits stay expected
+    # the other pressures' real-mode fits stay within the noise
     others = [p for p in doc["radial"]["pressures"] if p is not pr]
-    assert all(p["verdict"]["real"]["outcome"] == "expected" for p in others)
+    assert all(p["verdict"]["real"]["outcome"] == "ok" for p in others)
 
 
 def test_a_failed_check_is_stated_once_in_red(demo: tuple[DemoResult, Path]) -> None:

@@ -145,10 +145,18 @@ def test_results_validate_and_agree_with_truth(demo: tuple[DemoResult, Path]) ->
     doc = json.loads((out / "results.json").read_text())
     validate_results(doc)
     rad = doc["radial"]
-    # complex modes fit the non-proportionally damped tyre better; by how much follows the
-    # SNR (sqrt(1 + (B/noise)^2): 1.2 at 30 dB, 2.2 at 40 dB, benchmarks/tyre_physics.py)
-    assert rad["rmsd_complex"] < rad["rmsd_real"] / 1.3
-    assert set(rad["tyre"]["nonproportional_sources"]) >= {"attachment", "cavity"}
+    # the free tyre is nearly proportionally damped: its off-diagonal C' comes from the
+    # sidewall loss in the band-air n = 1 pair (46 and 145 Hz), far apart, so the largest
+    # coupling of eq. [16] is a few thousandths and the real-mode fit reaches the noise
+    # at 40 dB (ratio sqrt(1 + (B/noise)^2): 1.03 at 40 dB, 1.2 at 50 dB,
+    # benchmarks/tyre_physics.py); the shaker tip is below 10 % of C'_off
+    tp = rad["tyre"]
+    src = tp["nonproportional_sources"]
+    assert max(src, key=lambda k: abs(src[k])) == "sidewall radial"
+    assert abs(src["attachment"]) < 0.10
+    assert tp["largest_coupling"]["value"] < 0.01
+    assert_allclose(sorted(tp["largest_coupling"]["frequencies_hz"]), [46.2, 145.0], atol=0.5)
+    assert rad["rmsd_complex"] <= rad["rmsd_real"] < 1.2 * rad["rmsd_complex"]
     matched = [m for m in rad["modes"] if m["true"] and m["complex"]]
     assert len(matched) >= 5
     for m in matched:

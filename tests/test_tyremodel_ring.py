@@ -49,7 +49,7 @@ def fit3(attachment_damping: float | None = None):  # type: ignore[no-untyped-de
     return fit_ring(
         [(p * BAR, modes(p)) for p in (5.0, 7.0, 9.0)],
         radius=TRUE.radius,
-        attachment_mass=0.1,
+        attachment_mass=MeasurementLayout().attachment_mass,  # the tested tyre's tip
         attachment_damping=attachment_damping,
     )
 

@@ -211,9 +211,10 @@ def test_default_modes_in_band_with_realistic_damping(default_tyre: RingTyre) ->
     f, z = tr.frequency_hz[vis], tr.damping_ratio[vis]
     assert np.all((f > 0) & (f < 200))
     assert np.all((z > 0.01) & (z < 0.05))
-    # the bare ring with a realistic 30 N s/m tip loss: nearly real modes, yet complex
+    # the bare ring with the 2 N s/m tip loss (tread under a 10 g tip): nearly real
+    # modes (1 - MPC about 1e-6), yet complex
     assert np.all(tr.mpc[vis] > 0.999)
-    assert np.all(tr.mpc[vis] < 1.0 - 1e-6)
+    assert np.all(tr.mpc[vis] < 1.0 - 1e-8)
     # less non-proportional at nu = 0.5, same damping ratios within 5 %
     tr1 = RingTyre(nonproportionality=0.5).truth()
     vis1 = tr1.select("visible")

@@ -11,7 +11,7 @@ from tyredamp.virtual import MeasurementLayout, RingTyre, RingTyreParameters
 from tyredamp.virtual.assembly import Splice
 from tyredamp.virtual.cavity import Cavity
 from tyredamp.virtual.contact import ContactPatch
-from tyredamp.virtual.sources import damping_decomposition
+from tyredamp.virtual.sources import damping_decomposition, tip_loss_damping
 
 N = 32
 
@@ -60,11 +60,37 @@ def test_loaded_tyre_non_proportionality_from_tyre_sources() -> None:
     tyre = RingTyre(n_ring=N, splice=Splice(), cavity=Cavity(), contact=ContactPatch(25e3))
     dd = damping_decomposition(tyre)
     share = dd.as_dict()
-    # the tread in the patch dominates; the 30 N s/m tip is below 10 % of C'_off
+    # the tread in the patch dominates; the tip is below 10 % of C'_off
     assert abs(share["attachment"]) < 0.10
     assert share["contact"] > 0.5
     assert dd.offdiagonal_share > 0.2
     assert "attachment" in dd.format()
+
+
+@pytest.mark.parametrize("f", [50.0, 150.0, 300.0])
+def test_tip_loss_damping_against_the_tip_mass_on_the_tread(f: float) -> None:
+    m, k, eta = 0.01, 4e4, 0.15
+    w = 2 * np.pi * f
+    # tip mass on the lossy tread spring, band held at x = 1 m: solve the tip's
+    # equation -w^2 m y = -k* (y - x) and take the force on the band k* (y - x)
+    ks = k * (1 + 1j * eta)
+    y = ks / (ks - w * w * m)
+    force = ks * (y - 1.0)
+    # a dashpot c to ground gives force -i w c x: its part in quadrature
+    assert_allclose(tip_loss_damping(m, k, eta, f), -force.imag / w, rtol=1e-12)  # rounding
+
+
+def test_free_tyre_non_proportionality_from_tyre_sources() -> None:
+    lay = MeasurementLayout()
+    # the default tip loss: 10 g below the gauge on the 4e4 N/m tread under a 2 x 2 cm
+    # tip (2 MPa over 20 mm), loss factor 0.15, at the 200 Hz top of the band
+    assert_allclose(lay.attachment_damping, tip_loss_damping(0.01, 4e4, 0.15, 200.0), rtol=0.05)
+    dd = damping_decomposition(RingTyre(n_ring=N, cavity=Cavity()))
+    share = dd.as_dict()
+    # the band-air modes carry the sidewall loss: the tip below 10 % of C'_off
+    assert abs(share["attachment"]) < 0.10
+    assert share["sidewall radial"] > 0.5
+    assert 0.02 < dd.offdiagonal_share < 0.3
 
 
 def test_errors() -> None:
@@ -74,3 +100,5 @@ def test_errors() -> None:
         RingTyre(n_ring=N, splice=1.0)  # type: ignore[arg-type]
     with pytest.raises(InputError, match="band"):
         damping_decomposition(RingTyre(n_ring=N), band=(300.0, 301.0))
+    with pytest.raises(InputError, match="stiffness"):
+        tip_loss_damping(0.01, 0.0, 0.15, 100.0)

@@ -121,10 +121,20 @@ def simulate_group() -> None:
     "--attachment-damping",
     "attachment_damping",
     type=click.FloatRange(min=0),
-    default=30.0,
+    default=2.0,
     show_default=True,
     metavar="NS_M",
-    help="Local tread loss under each shaker tip, N s/m.",
+    help="Local tread loss under each shaker tip, N s/m (the tread between the gauge's "
+    "base and the band; 2: 10 g on a 2 x 2 cm tip at 200 Hz).",
+)
+@click.option(
+    "--microphone",
+    "microphone_deg",
+    type=float,
+    default=None,
+    metavar="DEG",
+    help="Add a rim microphone at this angle (deg, a multiple of 5.625): a last channel P1 "
+    "with the cavity's acoustic pressure in Pa (time data only; needs the cavity).",
 )
 @click.option(
     "--format", "fmt", type=click.Choice(FORMATS), help="File format (default from the extension)."
@@ -143,6 +153,7 @@ def radial_command(
     cavity: bool,
     splice: bool,
     attachment_damping: float,
+    microphone_deg: float | None,
     fmt: str | None,
 ) -> None:
     """Run the virtual modal test of the truck tyre and write time data or FRFs.
@@ -159,6 +170,7 @@ def radial_command(
       tyredamp simulate radial --out tyre_frf.uff --frf --pressure 9 --snr 30 --seed 2
       tyredamp simulate radial --out mimo.uff --drive-points 1,5 --periods 4
       tyredamp simulate radial --out loaded.uff --load 25 --splice
+      tyredamp simulate radial --out with_mic.uff --microphone 0
     """
     from ..studies.demo import single_threaded_blas
     from ..studies.radial import frf_from_time, virtual_tyre
@@ -170,6 +182,11 @@ def radial_command(
         check_distinct([("--out", out), ("--truth", truth_out)])
     out_format = format_of(out, fmt)
     points = parse_drive_points(drive_points)
+    if microphone_deg is not None and (as_frf or not cavity):
+        raise InputError(
+            "--microphone: expected time data of a tyre with its cavity; the microphone "
+            "records pressure, which --frf (motion over force) and --no-cavity leave out"
+        )
     tyre = virtual_tyre(
         pressure,
         points,
@@ -179,7 +196,14 @@ def radial_command(
         attachment_damping=attachment_damping,
     )
     with single_threaded_blas():
-        test = run_modal_test(tyre, n_periods=periods, force_rms=force_rms, snr_db=snr, seed=seed)
+        test = run_modal_test(
+            tyre,
+            n_periods=periods,
+            force_rms=force_rms,
+            snr_db=snr,
+            seed=seed,
+            microphone_deg=microphone_deg,
+        )
     truth_text = None if truth_out is None else _truth_text(test, pressure)
     # both files or neither: a replaced --out is put back when --truth fails
     with atomic_paths([out] if truth_out is None else [out, truth_out]) as tmps:

@@ -49,12 +49,14 @@ def _tyre_physics(tyre: Any) -> dict[str, Any]:
     from ..virtual import damping_decomposition
 
     dd = damping_decomposition(tyre)
+    fk, fn, alpha = dd.largest_coupling()
     return {
         "cavity": tyre.cavity is not None,
         "load_n": 0.0 if tyre.contact is None else tyre.contact.load,
         "attachment_damping_ns_m": tyre.layout.attachment_damping,
         "offdiagonal_share": dd.offdiagonal_share,
         "nonproportional_sources": dd.as_dict(),
+        "largest_coupling": {"frequencies_hz": [fk, fn], "value": alpha},
     }
 
 

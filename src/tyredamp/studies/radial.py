@@ -353,7 +353,7 @@ def virtual_tyre(
     load_n: float = 0.0,
     cavity: bool = True,
     splice: bool = False,
-    attachment_damping: float = 30.0,
+    attachment_damping: float = 2.0,
 ) -> RingTyre:
     """The virtual truck tyre at ``pressure_bar`` with shakers at ``drive_points`` (1-based).
 
@@ -362,7 +362,8 @@ def virtual_tyre(
     which splits each double by 0.06-0.7 Hz but adds almost nothing to the
     non-proportional damping. ``load_n`` > 0 (N) presses it on a
     flat road at 180 deg (:class:`~tyredamp.virtual.ContactPatch`);
-    ``attachment_damping`` (N s/m) is the tread loss under each shaker tip.
+    ``attachment_damping`` (N s/m) is the tread loss under each shaker tip
+    (:class:`~tyredamp.virtual.MeasurementLayout`).
     """
     return RingTyre(
         RingTyreParameters(pressure=pressure_bar * BAR),

@@ -34,7 +34,7 @@ Examples
 >>> test.data
 TimeData(n_channels=17, n_samples=32768, sample_rate=1024 Hz, forces=1)
 >>> round(test.truth.table("visible")[0]["frequency_hz"], 2)  # the n = 1 mode, Hz
-47.88
+47.94
 """
 
 from __future__ import annotations

@@ -9,16 +9,28 @@ brush/foundation contact of Pacejka, *Tire and Vehicle Dynamics*, 3rd ed.,
 2(2), 2022), with a Kelvin-Voigt loss of the tread rubber.
 
 The patch half-length follows from the load and the vertical stiffness of the
-tyre itself: the deflection is ``d = F / K_hub`` and the patch is the chord of
-the deflected circle, ``a = sqrt(2 R d - d^2)`` (Pacejka 2012, sec. 3.2;
-the same law as :class:`~tyredamp.virtual.lateral_rig.AgriculturalTyre`).
+tyre itself: the deflection is ``rho = F / K_hub`` and the half-length is the
+contact-length law of MF-Tyre 6.1 (Pacejka & Besselink, *Tire and Vehicle
+Dynamics*, 3rd ed., 2012, eq. (A3.7)),
+
+``a = R_0 (q_ra2 rho / R_0 + q_ra1 sqrt(rho / R_0))``,
+
+with ``R_0`` the unloaded outer radius (band radius plus tread depth). The
+geometric chord of the deflected circle, ``sqrt(2 R_0 rho)`` (``q_ra1 =
+sqrt 2``), is about twice as long: a tyre's sidewalls bulge and its belt
+bends smoothly into the patch instead of following the road over the whole
+chord, which measured contact lengths show (public MF 6.1 property files
+carry ``Q_RA1`` 0.67 and ``Q_RA2`` 0.73-0.76, the TNO example tyre of
+Pacejka 2012). The chord law made the patch 0.30 m long at 6.5 bar and 25 kN,
+and the hub stiffness, which grows with the patch, 26 % above the
+.tir value.
 ``K_hub`` is the static vertical stiffness between a rigid hub and the road
 (:func:`hub_stiffness`): the ring's stiffness condensed onto the road
 displacement,
 
 ``K_hub = e^T K_c e - e^T K_c (K + K_c)^{-1} K_c e``
 
-(static condensation, Guyan, AIAA J. 3 (1965) 380), with ``K`` the ring with
+((static condensation, Guyan, AIAA J. 3 (1965) 380), with ``K`` the ring with
 the hub fixed, ``K_c`` the tread springs and ``e`` the ring-coordinate image of
 a unit vertical road displacement. Since ``K_hub`` grows with ``a``, the pair
 ``(a, K_hub)`` is found by bisection on ``a`` (:func:`solve_patch`).
@@ -39,6 +51,7 @@ __all__ = [
     "ContactPatch",
     "PatchState",
     "contact_blocks",
+    "contact_half_length",
     "hub_stiffness",
     "patch_intrusion",
     "patch_springs",
@@ -57,13 +70,15 @@ class ContactPatch:
         fitment at 8-9 bar); the demo of a loaded tyre uses 25 kN.
     radial_stiffness : float
         Radial tread stiffness per unit circumferential length in N/m^2.
-        Default 2.5e7: the compression stiffness ``E b / h`` of a tread of
-        about 20 mm over 0.24 m with an effective (unconfined) modulus of
-        about 2 MPa; with the default ring it puts the hub stiffness at
-        7.5 bar and 20-30 kN at 1.1-1.2 MN/m, beside the 0.85 MN/m of the
-        Goodyear 335/65R22.5 at 6.5 bar (Project Chrono ``feda`` .tir,
-        Calspan-measured) and the 1.0 MN/m of the 315/80R22.5 bus tyre at
-        8 bar (Pacejka 2012, appendix 3).
+        Default 1.75e7: the compression stiffness ``E b_c / h`` of a tread of
+        ``h`` = 20 mm with an effective (unconfined) modulus of about 2 MPa
+        on the ``b_c`` = 0.175 m of the 0.24 m tread that touches the road
+        (truck rib and drive patterns have a land-to-sea ratio of about
+        0.7). With the default ring the hub stiffness is 1-14 % above
+        the Goodyear 335/65R22.5 (Project Chrono ``feda`` .tir,
+        Calspan-measured) at the files' pressures and nominal loads (2.76 and
+        6.55 bar) and 0.9 MN/m at 7.5 bar and 25 kN, beside the 1.0 MN/m of the
+        315/80R22.5 bus tyre at 8 bar (Pacejka 2012, appendix 3).
     tangential_stiffness : float
         Tangential (shear) tread stiffness per unit length in N/m^2. Default
         1.2e7: ``G b / h`` with ``G`` = 1 MPa, ``h`` = 20 mm (tread shear;
@@ -77,19 +92,34 @@ class ContactPatch:
         loss factor ``eta``. Default 100 (the middle of the 0-200 Hz band).
     angle_deg : float
         Centre of the patch in deg (0 deg is measurement point 1). Default 180.
+    tread_depth : float
+        Tread rubber between the band and the road in m, > 0 (``R_0 = R +
+        tread_depth`` in the length law). Default 0.02.
+    length_sqrt, length_linear : float
+        ``q_ra1`` and ``q_ra2`` of the contact-length law (module docstring),
+        >= 0. Defaults 0.671 and 0.733 (MF 6.1 ``Q_RA1``, ``Q_RA2`` of the
+        public TNO example property file, Pacejka 2012). ``length_sqrt =
+        sqrt(2)``, ``length_linear = 0`` is the geometric chord.
     """
 
     load: float
-    radial_stiffness: float = 2.5e7
+    radial_stiffness: float = 1.75e7
     tangential_stiffness: float = 1.2e7
     loss_factor: float = 0.15
     loss_frequency: float = 100.0
     angle_deg: float = 180.0
+    tread_depth: float = 0.02
+    length_sqrt: float = 0.671
+    length_linear: float = 0.733
 
     def __post_init__(self) -> None:
         for name in ("load", "radial_stiffness", "tangential_stiffness", "loss_frequency"):
             _check_field(self, name, allow_zero=False)
-        _check_field(self, "loss_factor", allow_zero=True)
+        _check_field(self, "tread_depth", allow_zero=False)
+        for name in ("loss_factor", "length_sqrt", "length_linear"):
+            _check_field(self, name, allow_zero=True)
+        for name in ("tread_depth", "length_sqrt", "length_linear"):
+            object.__setattr__(self, name, float(getattr(self, name)))
         try:
             ang = float(self.angle_deg)
         except (TypeError, ValueError):
@@ -113,7 +143,7 @@ class PatchState:
     half_length : float
         Patch half-length ``a`` in m.
     deflection : float
-        Static vertical deflection ``d = F / K_hub`` in m.
+        Static vertical deflection ``rho = F / K_hub`` in m.
     hub_stiffness : float
         Vertical hub-to-road stiffness ``K_hub`` in N/m.
     radial_springs, tangential_springs : ndarray, shape (n_ring,)
@@ -199,11 +229,23 @@ def hub_stiffness(
     return float(e @ f - f @ x)
 
 
+def contact_half_length(patch: ContactPatch, radius: float, deflection: float) -> float:
+    """Half-length ``a`` (m) of the MF 6.1 contact-length law at ``deflection`` (m).
+
+    ``a = R_0 (q_ra2 rho / R_0 + q_ra1 sqrt(rho / R_0))``, ``R_0 = radius +
+    tread_depth`` (Pacejka & Besselink 2012, eq. (A3.7); module docstring).
+    """
+    r0 = radius + patch.tread_depth
+    x = max(deflection, 0.0) / r0
+    return r0 * (patch.length_linear * x + patch.length_sqrt * math.sqrt(x))
+
+
 def solve_patch(k_ring: NDArray[np.float64], patch: ContactPatch, radius: float) -> PatchState:
     """Patch half-length and hub stiffness consistent with the load (module docstring).
 
-    Bisection on ``a`` of ``g(a) = sqrt(2 R d(a) - d(a)^2) - a`` with
-    ``d(a) = F / K_hub(a)``; ``g`` falls with ``a`` since ``K_hub`` rises.
+    Bisection on ``a`` of ``g(a) = a_law(rho(a)) - a`` with ``rho(a) = F /
+    K_hub(a)`` and ``a_law`` of :func:`contact_half_length`; ``g`` falls with
+    ``a`` since ``K_hub`` rises.
 
     Raises
     ------
@@ -216,7 +258,7 @@ def solve_patch(k_ring: NDArray[np.float64], patch: ContactPatch, radius: float)
         r, t = patch_springs(patch, radius, n, a)
         kh = hub_stiffness(k_ring, r, t, patch)
         d = patch.load / kh
-        return kh, d, math.sqrt(max(2 * radius * d - d * d, 0.0))
+        return kh, d, contact_half_length(patch, radius, d)
 
     lo, hi = 1e-6 * radius, 0.99 * radius
     _, d_hi, a_hi = state(hi)

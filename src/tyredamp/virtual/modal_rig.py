@@ -76,11 +76,12 @@ from scipy.signal import lfilter
 
 from .._validate import as_band, check_positive
 from ..exceptions import InputError
-from ..frf import FRF, FRFKind
-from ..mechanics import ComplexModes, MCKSystem, step_coefficients, time_response
+from ..frf import FRF, Channel, FRFKind
+from ..mechanics import ComplexModes, MCKSystem, TimeResponse, step_coefficients, time_response
 from ..signal.excitation import band_lines, periodic_chirp
 from ..timedata import Acquisition, TimeData
 from .excitation import hadamard_drive_matrix, schroeder_multisine
+from .microphone import microphone_node, microphone_row
 from .ring import RingTyre
 from .truth import TyreTruth
 
@@ -295,6 +296,7 @@ def run_modal_test(
     initial_state: InitialState = "periodic",
     settle_periods: int = 0,
     keep_settle: bool = False,
+    microphone_deg: float | None = None,
 ) -> VirtualModalTest:
     """Run the virtual modal test of paper 000 on a ring tyre.
 
@@ -338,6 +340,10 @@ def run_modal_test(
         Keep the settle periods in the record
         (``data.acquisition.settle_samples`` says how many samples of each
         run to drop) instead of dropping them.
+    microphone_deg : float, optional
+        A rim microphone at this angle (deg, a ring node; needs a cavity): a
+        last channel ``P1``, "pressure" in Pa, noise at ``snr_db``
+        (:mod:`~tyredamp.virtual.microphone`). Default none.
 
     Returns
     -------
@@ -356,6 +362,7 @@ def run_modal_test(
     _check_choices(drive_mode, excitation, initial_state)
     bnd = as_band(band)
     lines = band_lines(fs, p_samples, bnd)
+    mic = None if microphone_deg is None else microphone_row(tyre, microphone_deg)
     truth = tyre.truth(band=bnd)
     rng = np.random.default_rng(seed)
 
@@ -368,15 +375,9 @@ def run_modal_test(
     periods = (int(settle_periods), int(n_periods), keep_settle)
     run_len = n_keep * p_samples
     n_runs = drive.shape[0]
-    clean = np.concatenate(
-        [
-            _simulate_run(
-                tyre, drive[run][:, None] * exc.signal[None, :], fs * r, r, initial_state, periods
-            )
-            for run in range(n_runs)
-        ],
-        axis=1,
-    )
+    runs = [drive[run][:, None] * exc.signal[None, :] for run in range(n_runs)]
+    sim = ((fs * r, r), initial_state, periods, mic)
+    clean = np.concatenate([_simulate_run(tyre, f, *sim) for f in runs], axis=1)
     measured, noise_std = _add_noise(clean, snr_db, rng)
     meta = _notes(tyre, drive, drive_mode, exc, lines, (f_rms, snr_db, noise_std), seed, r)
     meta["initial_state"] = initial_state
@@ -389,15 +390,28 @@ def run_modal_test(
         n_averages=int(n_periods),
         excitation=exc.name,
     )
-    data = TimeData(
-        measured,
-        fs,
-        tyre.input_channels + tyre.output_channels,
-        ["force"] * n_in + ["acceleration"] * len(tyre.point_dofs),
-        meta,
-        acquisition=acquisition,
-    )
+    data = _time_data(tyre, measured, fs, meta, acquisition, microphone_deg)
     return VirtualModalTest(data=data, truth=truth, tyre=tyre, drive_matrix=drive)
+
+
+def _time_data(
+    tyre: RingTyre,
+    measured: NDArray[np.float64],
+    fs: float,
+    meta: dict[str, Any],
+    acquisition: Acquisition,
+    microphone_deg: float | None,
+) -> TimeData:
+    """The record as :class:`TimeData`: forces, accelerations and the microphone (if any)."""
+    n_in = len(tyre.layout.drive_points)
+    channels = tyre.input_channels + tyre.output_channels
+    quantities = ["force"] * n_in + ["acceleration"] * len(tyre.point_dofs)
+    if microphone_deg is not None:
+        ang = float(tyre.node_angles_deg[microphone_node(tyre, microphone_deg)])
+        channels = (*channels, Channel(len(channels) + 1, direction=0, angle_deg=ang, name="P1"))
+        quantities.append("pressure")
+        meta["microphone_deg"] = ang
+    return TimeData(measured, fs, channels, quantities, meta, acquisition=acquisition)
 
 
 def _check_choices(drive_mode: str, excitation: str, initial_state: str) -> None:
@@ -486,26 +500,37 @@ def _checked_options(
 def _simulate_run(
     tyre: RingTyre,
     force_sim: NDArray[np.float64],
-    fs_sim: float,
-    r: int,
+    rates: tuple[float, int],
     initial_state: str,
     periods: tuple[int, int, bool],
+    mic: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
-    """Forces then accelerations of one run, sampled at ``fs_sim / r``.
+    """Forces, accelerations (and the microphone's pressure) of one run, at ``fs_sim / r``.
 
     ``force_sim`` (n_in, P r) is one period of the drive forces at the
-    simulation rate; ``periods`` = (settle periods, recorded periods, keep
-    the settle periods).
+    simulation rate ``rates = (fs_sim, r)``; ``periods`` = (settle periods,
+    recorded periods, keep the settle periods); ``mic`` the pressure row
+    (Pa per DOF) of a microphone, or None.
     """
+    fs_sim, r = rates
     settle_periods, n_periods, keep_settle = periods
     n_keep = n_periods + (settle_periods if keep_settle else 0)
     system = tyre.system
     inputs = tyre.drive_dofs.tolist()
-    outputs = tyre.point_dofs.tolist()
+    n_pts = tyre.point_dofs.size
+    extra = np.array([], dtype=np.intp) if mic is None else np.flatnonzero(mic)
+    outputs = tyre.point_dofs.tolist() + extra.tolist()
+
+    def channels(resp: TimeResponse) -> NDArray[np.float64]:
+        acc = resp.acceleration[:n_pts]
+        if mic is None:
+            return acc
+        return np.vstack([acc, mic[extra] @ resp.displacement[n_pts:]])
+
     if initial_state == "periodic":
         x0, v0 = periodic_initial_state(system, force_sim, fs_sim, inputs)
         resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
-        acc = np.tile(_acquire(resp.acceleration, r), (1, n_keep))
+        acc = np.tile(_acquire(channels(resp), r), (1, n_keep))
     else:
         cm = system.complex_modes()
         blocks = []
@@ -516,7 +541,7 @@ def _simulate_run(
             x0, v0 = _modal_to_physical(cm, q)
             resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
             if k >= settle_periods or keep_settle:
-                blocks.append(_acquire(resp.acceleration, r))
+                blocks.append(_acquire(channels(resp), r))
             q = _modal_propagate(cm, psi_in, ext, 1.0 / fs_sim, q)
         acc = np.concatenate(blocks, axis=1)
     force = np.tile(_acquire(force_sim, r), (1, n_keep))

@@ -347,7 +347,7 @@ class RingTyre:
         Order of the staggered differences (default 6).
     nonproportionality : float
         The knob ``nu`` in [0, 1]. Default 1 (the physical distribution).
-        The bare ring with its 30 N s/m drive-point tip is nearly
+        The bare ring with its 2 N s/m drive-point tip is nearly
         proportional (MPC above 0.999); the coupling of well separated modes
         is bounded by the damping (eq. [16]), so strongly complex modes need
         close modes: a loaded ``contact``, an imperfection or ``splice`` that

@@ -35,7 +35,7 @@ from ..exceptions import InputError
 if TYPE_CHECKING:
     from .ring import RingTyre
 
-__all__ = ["DampingDecomposition", "damping_decomposition"]
+__all__ = ["DampingDecomposition", "damping_decomposition", "tip_loss_damping"]
 
 
 @dataclass(frozen=True)
@@ -65,6 +65,30 @@ class DampingDecomposition:
     share: NDArray[np.float64]
     norm_ratio: NDArray[np.float64]
 
+    @property
+    def coupling(self) -> NDArray[np.float64]:
+        """First-order complexity ``|alpha_k^(n)| = omega_n |C'_kn| / |omega_n^2 - omega_k^2|``.
+
+        Radial spec eq. [16] (Adhikari & Woodhouse, J. Sound Vib. 243(1), 2001):
+        the imaginary part that mode ``k`` lends to the complex mode ``n``,
+        relative to its real part; shape (m, m), column ``n``, zero diagonal.
+        A double (``omega_k = omega_n``) that the damping couples gets ``inf``.
+        """
+        w = 2 * np.pi * self.frequency_hz
+        gap = np.abs(w[None, :] ** 2 - w[:, None] ** 2)
+        c = np.abs(self.modal_damping) * w[None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = np.where(gap > 0, c / np.where(gap > 0, gap, 1.0), np.where(c > 0, np.inf, 0.0))
+        np.fill_diagonal(a, 0.0)
+        return np.asarray(a, dtype=np.float64)
+
+    def largest_coupling(self) -> tuple[float, float, float]:
+        """``(f_k, f_n, |alpha_k^(n)|)`` of the largest finite :attr:`coupling` (Hz, Hz, 1)."""
+        a = self.coupling
+        a = np.where(np.isfinite(a), a, 0.0)
+        k, n = np.unravel_index(int(np.argmax(a)), a.shape)
+        return float(self.frequency_hz[k]), float(self.frequency_hz[n]), float(a[k, n])
+
     def as_dict(self) -> dict[str, float]:
         """``{source: share}``."""
         return {n: float(s) for n, s in zip(self.names, self.share, strict=True)}
@@ -79,6 +103,55 @@ class DampingDecomposition:
         for n, s, r in zip(self.names, self.share, self.norm_ratio, strict=True):
             lines.append(f"{n:22s} {100 * s:7.1f}% {100 * r:7.1f}%")
         return "\n".join(lines)
+
+
+def tip_loss_damping(mass: float, stiffness: float, loss_factor: float, frequency: float) -> float:
+    """Equivalent dashpot (N s/m) on the band of the tread loss under a shaker tip.
+
+    With the force gauge at the tyre surface (ISO 7626-2:2015, sec. 6) the
+    mass ``m`` below the gauge's sensing element (gauge base, stud, glued
+    tip) rides on the tread under the tip, a spring ``k (1 + i eta)`` in
+    series with the band: the tread is worked only by the relative motion of
+    tip and band, not by the band's absolute motion. Eliminating the tip
+    (``-omega^2 m y = -k* (y - x)`` in free vibration) leaves on the band
+    the dynamic stiffness ``-omega^2 m k* / (k* - omega^2 m)``, whose
+    imaginary part is the dashpot
+
+    ``c(omega) = omega^3 m^2 k eta / ((k - omega^2 m)^2 + (k eta)^2)``
+
+    (the loss of a Kelvin element carrying a mass; e.g. Harris & Piersol,
+    *Shock and Vibration Handbook*, 5th ed., 2002, ch. 2, the single-DOF
+    system with structural damping, here seen from its base). It grows as
+    ``omega^3`` far below the tip resonance ``sqrt(k/m)``.
+
+    Parameters
+    ----------
+    mass : float
+        Mass below the sensing element, kg (>= 0).
+    stiffness : float
+        Tread stiffness under the tip, N/m (> 0).
+    loss_factor : float
+        Tread loss factor (>= 0).
+    frequency : float
+        Frequency in Hz (>= 0).
+
+    Returns
+    -------
+    float
+        ``c`` in N s/m.
+    """
+    for name, v, pos in (
+        ("mass", mass, False),
+        ("stiffness", stiffness, True),
+        ("loss_factor", loss_factor, False),
+        ("frequency", frequency, False),
+    ):
+        if not math.isfinite(v) or v < 0 or (pos and v == 0):
+            bound = "> 0" if pos else ">= 0"
+            raise InputError(f"{name}: expected a finite number {bound}, got {v}")
+    w = 2 * math.pi * frequency
+    k = stiffness
+    return w**3 * mass**2 * k * loss_factor / ((k - w * w * mass) ** 2 + (k * loss_factor) ** 2)
 
 
 def _offdiag(a: NDArray[np.float64]) -> NDArray[np.float64]:
