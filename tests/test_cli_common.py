@@ -153,7 +153,9 @@ def test_start_imports_no_subcommand_and_modal_no_io() -> None:
 
 
 @pytest.mark.parametrize("value", ["0", "nan", "25", "abc"])
-@pytest.mark.parametrize("command", [("simulate", "lateral"), ("simulate", "rolling")])
+@pytest.mark.parametrize(
+    "command", [("simulate", "radial"), ("simulate", "lateral"), ("simulate", "rolling")]
+)
 def test_pressure_is_refused_in_bar_with_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], command: tuple[str, ...], value: str
 ) -> None:

@@ -21,9 +21,17 @@ import click
 
 from ..documents.jsonfile import json_text
 from ..exceptions import InputError
-from ..io import FORMATS, format_of, write_frf, write_timedata
+from ..io import format_of, write_frf, write_timedata
 from ..io._safety import atomic_paths, check_distinct, check_output_file
-from ._common import OutPath, out_file_option, parse_drive_points, seed_option, snr_option
+from ._common import (
+    OutPath,
+    format_option,
+    out_file_option,
+    parse_drive_points,
+    pressure_option,
+    seed_option,
+    snr_option,
+)
 from .lateral import lateral_group
 from .simulate_campaign import simulate_campaign_command
 from .simulate_rolling import simulate_rolling_command
@@ -50,14 +58,7 @@ def simulate_group() -> None:
 
 @simulate_group.command("radial")
 @out_file_option("File to write (.uff/.unv: UFF 58b binary, or .csv, .npz).")
-@click.option(
-    "--pressure",
-    type=click.FloatRange(min=0, max=20),
-    default=7.5,
-    show_default=True,
-    metavar="BAR",
-    help="Inflation pressure, bar.",
-)
+@pressure_option(7.5)
 @snr_option()
 @seed_option("Noise seed.")
 @click.option(
@@ -136,9 +137,7 @@ def simulate_group() -> None:
     help="Add a rim microphone at this angle (deg, a multiple of 5.625): a last channel P1 "
     "with the cavity's acoustic pressure in Pa (time data only; needs the cavity).",
 )
-@click.option(
-    "--format", "fmt", type=click.Choice(FORMATS), help="File format (default from the extension)."
-)
+@format_option()
 def radial_command(
     out: Path,
     pressure: float,
