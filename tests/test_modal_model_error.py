@@ -10,11 +10,7 @@ from numpy.testing import assert_allclose
 
 from tyredamp.frf import FRF, Channel
 from tyredamp.modal import identify_modes
-from tyredamp.modal.model_error import (
-    relative_model_error,
-    resonance_groups,
-    resonance_model_error,
-)
+from tyredamp.modal.model_error import relative_model_error
 from tyredamp.modal.search import unresolved_damping
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "real-data"
@@ -96,37 +92,3 @@ def test_measured_beam_modes_are_not_split(k: int, band: tuple[float, float] | N
     assert fn.size == BEAM_MODES.size, fn
     assert r.model_error > 0  # the fit of the noise floor alone leaves structure
     assert any("model error" in w for w in r.warnings)
-
-
-def test_resonance_groups_merge_overlapping_modes() -> None:
-    # 1 Hz lines; reach 3 lines (the modes are narrower than the lines): 100 Hz
-    # covers 97-103, 104 Hz 101-107 (overlap: one group of two), 200 Hz 197-203
-    f = np.arange(0.0, 300.0, 1.0)
-    groups = resonance_groups(f, np.array([200.0, 100.0, 104.0]), np.full(3, 1e-4))
-    assert [(g[0][0], g[0][-1], g[1]) for g in groups] == [(97, 107, 2), (197, 203, 1)]
-    # 2 % damping at 200 Hz: a half-power bandwidth of 8 Hz, reach 24 lines
-    ((lines, n),) = resonance_groups(f, np.array([200.0]), np.array([0.02]))
-    assert (lines[0], lines[-1], n) == (176, 224, 1)
-
-
-def test_the_model_error_is_the_median_over_resonances() -> None:
-    # five resonances; on each, residuals built so that eq. (2) on its lines (its
-    # real observations less one mode's parameters) has the root eps_g exactly:
-    # 0.03, 0.04, 0.05 at three, 0.001 at a split one, 0.8 at a missed one
-    rng = np.random.default_rng(4)
-    f = np.arange(0.0, 100.0, 1.0)
-    H = rng.normal(size=(1, 1, f.size)) + 1j * rng.normal(size=(1, 1, f.size))
-    V = np.full(H.shape, 1e-4)
-    r = np.zeros(H.shape, complex)
-    fn = np.array([10.0, 30.0, 50.0, 70.0, 90.0])
-    groups = resonance_groups(f, fn, np.full(5, 1e-5))
-    k = 4  # one complex mode of one FRF
-    for (lines, n), eps_g in zip(groups, [0.03, 0.001, 0.04, 0.8, 0.05], strict=True):
-        var = V[..., lines] + eps_g**2 * np.abs(H[..., lines]) ** 2
-        # sum 2 |r|^2 / var = 2 n_lines - k: each term (2 n_lines - k) / n_lines
-        scale = (2 * lines.size - k * n) / lines.size
-        r[..., lines] = np.sqrt(var * scale / 2.0)
-    eps = resonance_model_error(H, H + r, V, groups, k)
-    assert_allclose(eps, 0.04, rtol=1e-2)  # the median; brentq tolerance in log(eps)
-    # eq. (2) over the band's lines: the missed resonance lifts it above them all
-    assert relative_model_error(H, H + r, V, 2 * H.size - 5 * k) > 2 * 0.05

@@ -64,7 +64,6 @@ from ..mechanics.modal_sum import kind_factor
 from .model import ModalModel
 from .problem import FitProblem, build_problem
 from .stats import difference_noise
-from .stats import mode_parameters as parameters_per_mode
 
 __all__ = [
     "EPS_TOLERANCE",
@@ -80,8 +79,6 @@ __all__ = [
 PASSES = 3
 #: relative change of ``eps`` below which the repetitions stop
 EPS_TOLERANCE = 0.2
-#: half-width of a resonance's lines, in half-power bandwidths and at least in lines
-RESONANCE_REACH = 3.0
 
 
 @dataclass(frozen=True)
@@ -168,106 +165,6 @@ def relative_model_error(
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-3))
 
 
-def resonance_groups(
-    frequency: NDArray[np.float64],
-    mode_hz: NDArray[np.float64],
-    damping: NDArray[np.float64],
-    reach: float = RESONANCE_REACH,
-) -> list[tuple[NDArray[np.intp], int]]:
-    """The lines of each resonance of a model: ``(lines, modes)`` per group.
-
-    A mode at ``f_n`` with damping ratio ``zeta`` covers the lines within ``reach``
-    half-power bandwidths ``2 zeta f_n`` of ``f_n``, and at least ``reach`` line
-    spacings (a mode narrower than the lines lives on the few lines beside it);
-    modes whose lines overlap form one group (a split peak, a close pair).
-
-    Parameters
-    ----------
-    frequency : ndarray, shape (n_freq,)
-        Lines (Hz, uniform).
-    mode_hz, damping : ndarray, shape (m,)
-        Natural frequencies (Hz) and damping ratios of the model's in-band modes.
-    reach : float
-        Half-width of a mode's lines, in half-power bandwidths and at least in lines.
-
-    Returns
-    -------
-    list of (ndarray of int, int)
-        Each group's line indices and its number of modes, by frequency.
-    """
-    f = np.asarray(frequency, float)
-    if f.size < 2 or np.size(mode_hz) == 0:
-        return []
-    df = float(f[1] - f[0])
-    order = np.argsort(mode_hz)
-    spans = []
-    for i in order:
-        half = reach * max(2.0 * float(damping[i]) * float(mode_hz[i]), df)
-        spans.append([float(mode_hz[i]) - half, float(mode_hz[i]) + half, 1])
-    merged: list[list[float]] = []
-    for a, b, n in spans:
-        if merged and a <= merged[-1][1]:
-            merged[-1][1] = max(merged[-1][1], b)
-            merged[-1][2] += n
-        else:
-            merged.append([a, b, n])
-    out = []
-    for a, b, n in merged:
-        lines = np.flatnonzero((f >= a) & (f <= b))
-        if lines.size:
-            out.append((lines, int(n)))
-    return out
-
-
-def resonance_model_error(
-    H: NDArray[np.complex128],
-    H_model: NDArray[np.complex128],
-    V: NDArray[np.float64],
-    groups: list[tuple[NDArray[np.intp], int]],
-    mode_parameters: int,
-) -> float:
-    """The model error ``eps`` of eq. (1), measured at each resonance and taken as
-    the median over resonances.
-
-    Eq. (2) holds on the lines of each resonance alone (:func:`resonance_groups`),
-    with the degrees of freedom of those lines (their real observations less
-    ``mode_parameters`` per mode of the group): each gives its own ``eps_g``
-    (:func:`relative_model_error`, 0 where the noise explains the residual). Their
-    median is the estimate: the model error is a property of the measurement (its
-    window, its leakage), common to the resonances, whereas a resonance that the fit
-    splits into two poles gives back a small ``eps_g`` and one that the fit misses a
-    large residual. Over the whole band, eq. (2) is a sum that one such resonance
-    dominates (a missed sharp mode holds most of the residual power): its root then
-    depends on which modes the first fit found, and so on the band's edges. The
-    median of ``G`` groups is robust to ``(G - 1) // 2`` of them (Huber & Ronchetti,
-    *Robust Statistics*, 2nd ed. 2009, sec. 1.4, the breakdown point of the median).
-
-    Parameters
-    ----------
-    H, H_model : ndarray, complex, shape (n_out, n_in, n_freq)
-        Data and fitted model on the band's lines.
-    V : ndarray, shape (n_out, n_in, n_freq)
-        Noise variance ``V`` of each line (units of ``H`` squared).
-    groups : list of (ndarray of int, int)
-        Lines and mode count of each resonance (:func:`resonance_groups`).
-    mode_parameters : int
-        Real parameters of one mode (:func:`~tyredamp.modal.stats.mode_parameters`).
-
-    Returns
-    -------
-    float
-        ``eps >= 0``; 0 without groups.
-    """
-    eps = []
-    for lines, n in groups:
-        h = H[:, :, lines]
-        dof = 2 * h.size - mode_parameters * n
-        if dof <= 0:
-            continue
-        eps.append(relative_model_error(h, H_model[:, :, lines], V[:, :, lines], dof))
-    return float(np.median(eps)) if eps else 0.0
-
-
 class Identification(Protocol):
     """What :func:`with_model_error` reads of an identification
     (:class:`~tyredamp.modal.identify.ModalIdentification`)."""
@@ -323,12 +220,10 @@ def with_model_error(
     floor = noise_floor(frf, problem, _model_band(first.models[kind], problem, frf.kind) - H)
     V = floor.variance[:, :, lines]
 
-    k = parameters_per_mode(H.shape[0], H.shape[1], kind)
-
     def eps_of(res: R) -> float:
         m = res.models[kind]
-        groups = resonance_groups(problem.frequency, m.frequency_hz, m.damping_ratio)
-        return resonance_model_error(H, _model_band(m, problem, frf.kind), V, groups, k)
+        dof = m.quality.dof if m.quality is not None else 0
+        return relative_model_error(H, _model_band(m, problem, frf.kind), V, dof)
 
     eps, res = eps_of(first), first
     if eps <= 0.0:
