@@ -38,6 +38,7 @@ from .profile import Z95, fit_intervals
 from .quality import FitQuality, RejectedMode, threshold_text
 from .refitted import refitted_statistics
 from .residual_peaks import local_ratio
+from .resolution import unresolved_pair, unresolved_pair_text
 from .search import (
     ModeSet,
     ModeTest,
@@ -529,6 +530,15 @@ def final_complex(
             break
         m = cur.m
         t = res.significance[:m]
+        pair = unresolved_pair(res.poles[:m], t, _spacing(problem))
+        if pair is not None:
+            weak, strong = pair
+            fs = float(np.abs(res.poles[strong]) / (2.0 * np.pi))
+            why = unresolved_pair_text(fs, _spacing(problem))
+            dropped.append(rejected(complex(res.poles[weak]), why, float(t[weak]), threshold))
+            keep = np.arange(m) != weak
+            cur = ModeSet(cur.poles[keep], cur.part[keep], cur.hp, cur.hl, cur.n_free)
+            continue
         span = residual_span(cfit, res) if test is not None else None
         thr = local_thresholds(cfit, span, res.poles[:m], threshold, test)
         refitted = np.zeros(m, bool)
@@ -567,6 +577,12 @@ def final_complex(
         # likelihood intervals where the linearised ones would be too short
         res.intervals = fit_intervals(cfit, res, cur.m, sigma0)
     return res, cur, dropped, thr
+
+
+def _spacing(problem: FitProblem) -> float:
+    """Line spacing of the band (Hz; 0 with fewer than two lines)."""
+    f = problem.frequency
+    return float(f[1] - f[0]) if f.size > 1 else 0.0
 
 
 def _final_fit(
