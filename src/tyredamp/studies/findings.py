@@ -221,11 +221,19 @@ def demo_findings(result: DemoResult) -> DemoFindings:
             ]
     d = r.damping.diagnostics
     if d.definiteness_modal != "positive definite":
+        why = (
+            "from the terms of the modes whose shapes coincide at the measured points "
+            f"({len(d.collinear_pairs)} pair(s)): those terms are not determined by these "
+            "points; a sensor that sees the pair differently (e.g. a cavity microphone) "
+            "determines them"
+            if d.collinear_pairs
+            else "not a passive damping"
+        )
         findings.append(
             Finding(
                 "radial:damping",
                 "radial damping",
-                f"C' in modal coordinates is {d.definiteness_modal}: not a passive damping",
+                f"C' in modal coordinates is {d.definiteness_modal}: {why}",
             )
         )
     tm = r.tyre_model
