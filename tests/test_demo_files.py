@@ -22,6 +22,10 @@ from tyredamp.studies.verdicts import CAUSE_MEANING
 
 from .test_studies_demo import quick_demo
 
+# the session's one quick demo (quick_demo) serves the modules of this group: one
+# pytest-xdist worker runs them all (pyproject: --dist loadgroup), so it runs once
+pytestmark = pytest.mark.xdist_group("demo")
+
 
 @pytest.fixture(scope="module")
 def demo() -> tuple[DemoResult, Path]:

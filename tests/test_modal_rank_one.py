@@ -34,12 +34,14 @@ def _rank_one_drop(n_out: int, n_in: int, n: int, seed: int, real: bool = False)
     if not real:
         z = z + 1j * rng.normal(size=(n, n_out, n_in))
     g = np.conj(z).transpose(0, 2, 1) @ z  # (n, n_in, n_in)
-    v = np.ones((n, n_in, 1), complex)
+    # einsum on vectors of z's own type: a stacked matmul by (n_in, 1) complex columns
+    # took ~8x longer for the same products
+    v = np.ones((n, n_in), z.dtype)
     for _ in range(80):
-        v = g @ v
+        v = np.einsum("nij,nj->ni", g, v)
         v /= np.linalg.norm(v, axis=1, keepdims=True)
     # the drop of ||Z - psi l^T||^2 over psi at the unit direction l = conj(v): ||Z v||^2
-    return np.sum(np.abs(z @ v) ** 2, axis=(1, 2))
+    return np.sum(np.abs(np.einsum("nij,nj->ni", z, v)) ** 2, axis=1)
 
 
 @pytest.mark.parametrize("n_out", [1, 3, 16])

@@ -18,6 +18,10 @@ from tyredamp.studies.document import build_results
 
 from .test_studies_demo import quick_demo
 
+# the session's one quick demo (quick_demo) serves the modules of this group: one
+# pytest-xdist worker runs them all (pyproject: --dist loadgroup), so it runs once
+pytestmark = pytest.mark.xdist_group("demo")
+
 REFERENCE = Path(__file__).resolve().parents[1] / "docs" / "reference" / "results-json.md"
 
 

@@ -32,6 +32,10 @@ from tyredamp.report.demo import save_demo
 from tyredamp.studies.demo import DemoResult, DemoSettings
 from tyredamp.studies.radial import match_modes
 
+# the session's one quick demo (quick_demo) serves the modules of this group: one
+# pytest-xdist worker runs them all (pyproject: --dist loadgroup), so it runs once
+pytestmark = pytest.mark.xdist_group("demo")
+
 
 @functools.lru_cache(maxsize=1)
 def quick_demo() -> tuple[DemoResult, Path]:
