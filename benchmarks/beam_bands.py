@@ -8,8 +8,14 @@ For every band ``[lo, hi]`` with ``lo`` and ``hi`` from the lists given, each
 single-reference file and the three together (a roving-hammer set) are identified
 with the default settings, and the result is scored: each of the six modes found
 exactly once (within 2 Hz), no split (two poles at one mode), none missed, and no
-other mode (a mode near 901 Hz, where the FRFs of points 2 and 3 have a step, is
-counted apart).
+other mode. Two features of the data are counted apart: a mode near 901 Hz, where
+the FRFs of points 2 and 3 have a step, and a weak mode near 55.2 Hz (damping
+about 0.3 %): all three FRFs have a bump of |H| at 55-56 Hz on the flank of the
+51.5 Hz mode (point 1: 1.07 and 1.01 at 55 and 56 Hz where the flank alone falls
+from 1.14 to 0.89), and the roving set, which weighs the three together, finds it
+at the same frequency and damping in a third of the bands (its evidence is near
+the threshold): a resonance of the test set-up or of the beam's other bending
+plane, which the six-mode reference leaves out.
 
 Usage::
 
@@ -31,6 +37,7 @@ from tyredamp.modal import identify_modes
 
 MODES_HZ = np.array([51.5, 142.2, 278.7, 460.4, 687.2, 958.5])
 STEP_HZ = (899.0, 903.0)
+WEAK_HZ = (54.5, 56.5)
 
 
 def beam_frfs(folder: Path) -> dict[str, FRF]:
@@ -60,14 +67,17 @@ def beam_frfs(folder: Path) -> dict[str, FRF]:
 def score(fn: np.ndarray) -> dict[str, bool]:
     """What one identification got right and wrong."""
     counts = [int(np.sum(np.abs(fn - x) < 2.0)) for x in MODES_HZ]
-    other = [x for x in fn if np.min(np.abs(MODES_HZ - x)) >= 2.0]
+    near = [x for x in fn if np.min(np.abs(MODES_HZ - x)) < 2.0]
+    weak = [x for x in fn if WEAK_HZ[0] < x < WEAK_HZ[1]]
+    other = [x for x in fn if np.min(np.abs(MODES_HZ - x)) >= 2.0 and x not in weak]
     step = [x for x in other if STEP_HZ[0] < x < STEP_HZ[1]]
     return {
         "six once": all(c == 1 for c in counts) and len(other) == len(step),
-        "split": any(c > 1 for c in counts),
+        "split": any(c > 1 for c in counts) or len(near) > 6,
         "missed": any(c == 0 for c in counts),
         "other": len(other) > len(step),
         "step mode": bool(step),
+        "weak mode": bool(weak),
     }
 
 
@@ -82,9 +92,9 @@ def main() -> None:
     lows = [float(x) for x in a.low.split(",")]
     highs = [float(x) for x in a.high.split(",")]
     print(f"{'FRF':>5} {'bands':>6} {'six once':>9} {'split':>6} {'missed':>7} {'other':>6} "
-          f"{'901 Hz':>7} {'median s':>9}")  # fmt: skip
+          f"{'901 Hz':>7} {'55 Hz':>6} {'median s':>9}")  # fmt: skip
     for name, frf in beam_frfs(folder).items():
-        tally = dict.fromkeys(("six once", "split", "missed", "other", "step mode"), 0)
+        tally = dict.fromkeys(("six once", "split", "missed", "other", "step mode", "weak mode"), 0)
         times = []
         for lo, hi in itertools.product(lows, highs):
             t0 = time.perf_counter()
@@ -95,7 +105,8 @@ def main() -> None:
         n = len(lows) * len(highs)
         print(
             f"{name:>5} {n:>6} {tally['six once']:>9} {tally['split']:>6} {tally['missed']:>7} "
-            f"{tally['other']:>6} {tally['step mode']:>7} {np.median(times):>9.2f}"
+            f"{tally['other']:>6} {tally['step mode']:>7} {tally['weak mode']:>6} "
+            f"{np.median(times):>9.2f}"
         )
 
 

@@ -56,6 +56,7 @@ from .modeset import (
     too_damped,
     with_residual,
 )
+from .narrow import narrow_refusal, too_narrow
 from .quality import KEPT, RejectedMode, threshold_text
 from .residual_peaks import (
     local_ratio,
@@ -434,6 +435,16 @@ def _joint(
         )
     p1 = complex(r1.poles[k])
     why = _inadmissible(p1, df, max_damping)
+    if why and too_narrow(p1, df):
+        # its evidence against the threshold raised where the noise of the fit's
+        # residual lies along the response (model error, local_thresholds)
+        thr_n = threshold
+        if test is not None:
+            span = residual_span(fitter, r1)
+            thr_n = float(local_thresholds(fitter, span, r1.poles[k : k + 1], threshold, test)[0])
+        # compared with the modes before the refit (one of them may have left its
+        # place to the trial)
+        why = narrow_refusal(fitter, r1, p1, thr_n, why, k, cur.poles)
     w1 = abs(p1)
     edge = w1 + p1.real <= 2 * np.pi * band[0] or w1 - p1.real >= 2 * np.pi * band[1]
     if why and -p1.real / np.pi >= df and edge:
@@ -531,13 +542,15 @@ def residual_search(
 
     A candidate whose damping ratio exceeds ``max_damping`` (the selection rule
     of the diagram) is not a mode: it is rejected whatever its statistic (a trial
-    stops at that bound, :func:`sigma_bound`, rather than running on). Nor
-    is a trial whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is
-    narrower than the line spacing: such a pole fits single lines (an outlier,
-    the tail of an impact test's low-frequency end) as well as a resonance.
-    A mode of the diagram may be that narrow (a lightly damped mode measured
-    with coarse lines): its frequency is resolved and its damping only bounded
-    (:func:`unresolved_damping`). A trial mode that passes
+    stops at that bound, :func:`sigma_bound`, rather than running on). A trial
+    whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is narrower
+    than the line spacing (a lightly damped mode measured with coarse lines: its
+    frequency is resolved and its damping only bounded, :func:`unresolved_damping`)
+    can also fit single lines (an outlier, a step, the erratic low end of an
+    impact test) or the flank of another mode's misfit: it is kept only when its
+    tails hold evidence beyond those on both sides, away from the ends of the
+    lines and from the other modes (:func:`~tyredamp.modal.narrow.narrow_refusal`),
+    in the trial and again in the joint refit. A trial mode that passes
     is refitted with all modes (:func:`_joint`) and kept when it stays in the
     band, merges with no mode, is still admissible and every mode still passes
     the test; a trial mode that alone crosses a band edge in the joint refit,
@@ -670,6 +683,8 @@ def _try_start(
         return None
     (p_t, l_t, t), w_lim = got
     why = _inadmissible(p_t, df, max_damping)
+    if why and too_narrow(p_t, df):
+        why = narrow_refusal(fitter, res, p_t, threshold, why)
     if not why and -p_t.real >= (1 - 1e-9) * sigma_bound(max_damping, w_lim[1]):
         why = f"damping above the admissible {max_damping:.0%}"  # stopped at the bound
     if not why and t <= threshold:
