@@ -112,6 +112,6 @@ def test_no_pole_within_one_line_of_a_ringing_beam_mode(k: int, band: tuple[floa
         near = fn[np.abs(fn - f0) < 0.02 * f0]
         assert near.size == 1, (f0, fn)
         assert abs(near[0] / f0 - 1) < 5e-4 + 0.05 / f0  # the peer's values carry 0.05 Hz
-    q = r.models["complex"].quality
-    assert q is not None
-    assert any("records of 1 s do not resolve" in x.reason for x in q.rejected)
+    # a pole that close is refused where it arises: by the search (a trial narrower
+    # than the lines within one line of a mode, tyredamp.modal.narrow) or by the
+    # final fit (tyredamp.modal.resolution)

@@ -13,7 +13,7 @@ import numpy as np
 
 from tyredamp.modal import ModalModel
 from tyredamp.modal.fit import FitResult, ModalFitter
-from tyredamp.modal.narrow import at_the_end, narrow_evidence, too_narrow
+from tyredamp.modal.narrow import at_the_end, narrow_evidence, narrow_refusal, too_narrow
 from tyredamp.modal.stats import mode_parameters, mode_threshold
 
 F = np.arange(10.0, 200.0, 1.0)  # 1 Hz lines
@@ -95,3 +95,29 @@ def test_a_pole_on_the_flank_of_another_mode_holds_evidence_on_one_side() -> Non
     # passes the threshold on its side, but a resonance's would on both
     assert lo > _threshold()
     assert hi < 0.5 * _threshold()
+
+
+def test_a_step_between_two_lines_is_refused_and_a_resonance_two_lines_wide_is_kept() -> None:
+    rng = np.random.default_rng(6)
+    broad = _pole(60.0, 0.01)
+    H = ModalModel(np.array([broad]), np.ones((1, 1)), np.ones((1, 1))).frf(F, "receptance").H
+    H = H + SD * (rng.normal(size=H.shape) + 1j * rng.normal(size=H.shape))
+    # a level change of 30 noise levels between the lines at 150 and 151 Hz
+    stepped = H.copy()
+    stepped[0, 0, F > 150.5] += 30 * SD * (1 - 1j)
+    fitter, res = _fit(stepped, broad)
+    at_step = _pole(150.5, 2.0 / (2 * 150.5))  # half-power bandwidth 2 Hz: 2 lines
+    why = narrow_refusal(fitter, res, at_step, _threshold())
+    assert "not a resonance" in why
+    # a resonance of the same width and a peak of a few hundred noise levels
+    w = 2 * np.pi * 150.5
+    peaked = (
+        H
+        + ModalModel(np.array([at_step]), 2.5e-6 * w * np.ones((1, 1)), np.ones((1, 1)))
+        .frf(F, "receptance")
+        .H
+    )
+    fitter, res = _fit(peaked, broad)
+    assert narrow_refusal(fitter, res, at_step, _threshold()) == ""
+    # wider poles are not this rule's
+    assert narrow_refusal(fitter, res, _pole(150.5, 0.02), _threshold()) == ""

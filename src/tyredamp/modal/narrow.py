@@ -41,6 +41,7 @@ from tyredamp.modal.resolution import unresolved_pair_text
 
 __all__ = [
     "EDGE_LINES",
+    "STEP_LINES",
     "WINDOW_LINES",
     "at_the_end",
     "narrow_evidence",
@@ -52,6 +53,10 @@ __all__ = [
 #: at 32 lines is 1/64 of its value half a line away: beyond, nothing to add)
 WINDOW_LINES = 32
 
+
+#: half-power bandwidths (in lines) below which a pole competes with a step or a
+#: spike at its lines (:func:`narrow_refusal`)
+STEP_LINES = 3.0
 
 #: fewest lines either side of a narrow pole for its tails to be weighed: nearer the
 #: end of the lines, the few lines there (the erratic low end of an impact test, a
@@ -188,37 +193,53 @@ def narrow_refusal(
     res: FitResult,
     pole: complex,
     threshold: float,
-    why: str,
     drop: int | None = None,
     others: NDArray[np.complex128] | None = None,
 ) -> str:
-    """Why a ``pole`` narrower than the lines is refused ('' when it is a resonance).
+    """Why a ``pole`` a few lines wide or narrower is refused ('' when it is a resonance,
+    and for wider poles).
 
-    A resonance lies away from the ends of the lines (``EDGE_LINES``), its
-    evidence beyond a spike at its two nearest lines, a step there and the terms
-    of the modes beside it (:func:`narrow_evidence` on the residual of ``res``,
-    without its mode ``drop``) passes half the ``threshold`` on each side of
-    it (a resonance's tails are alike on both sides, so together they pass the
-    threshold), and no mode of ``res`` lies within a line spacing of it (the record
-    does not resolve the two: :mod:`~tyredamp.modal.resolution`; ``others``: the
-    modes to compare with, when not those of ``res``). Otherwise the reason ``why``
-    is returned with the cause.
+    A pole narrower than the lines (:func:`too_narrow`) is a resonance when it lies
+    away from the ends of the lines (``EDGE_LINES``), no mode lies within a line
+    spacing of it (the record does not resolve the two:
+    :mod:`~tyredamp.modal.resolution`; ``others``: the modes to compare with, when
+    not those of ``res`` without its mode ``drop``), and its evidence beyond a spike
+    at its two nearest lines, a step there and the terms of the modes beside it
+    (:func:`narrow_evidence` on the residual of ``res`` without ``drop``) passes half
+    the ``threshold`` on each side of it (a resonance's tails are alike on both
+    sides, so together they pass the threshold). A pole up to ``STEP_LINES`` lines
+    wide, which a step or a spike at its lines can also take for a peak, is a
+    resonance when that evidence passes half the ``threshold`` on each side.
     """
+    df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
+    bw = -pole.real / np.pi  # half-power bandwidth 2 zeta f_n (Hz)
+    if not too_narrow(pole, STEP_LINES * df):
+        return ""
+    if not too_narrow(pole, df):
+        lo, hi = narrow_evidence(fitter, res, pole, drop)
+        if min(lo, hi) > 0.5 * threshold:
+            return ""
+        return (
+            f"half-power bandwidth {bw:.3g} Hz, {bw / df:.2g} lines: beyond a spike at its "
+            f"two nearest lines, a step there and the modes beside it, T = {lo:.3g} below "
+            f"and {hi:.3g} above it, not both above half the threshold {threshold:.3g} (a "
+            "step or an outlying line, not a resonance)"
+        )
+    why = f"half-power bandwidth {bw:.3g} Hz below the line spacing {df:.3g} Hz"
     if at_the_end(fitter.f, pole):
-        return f"{why}; within {EDGE_LINES} lines of the end of the lines"
-    df = float(fitter.f[1] - fitter.f[0])
+        return f"{why}, within {EDGE_LINES} lines of the end of the lines"
     if others is None:
         others = np.delete(res.poles, drop) if drop is not None else res.poles
     near = np.abs(np.abs(others) - abs(pole)) / (2 * np.pi) < df
     if np.any(near):
         # the lines do not resolve it from that mode (resolution.py)
         f_near = float(np.abs(others[near][0]) / (2 * np.pi))
-        return f"{why}; {unresolved_pair_text(f_near, df)}"
+        return f"{why}: {unresolved_pair_text(f_near, df)}"
     lo, hi = narrow_evidence(fitter, res, pole, drop)
     if min(lo, hi) > 0.5 * threshold:
         return ""
     return (
-        f"{why}; beyond a spike at its two nearest lines, a step there and the modes "
+        f"{why}: beyond a spike at its two nearest lines, a step there and the modes "
         f"beside it, T = {lo:.3g} below and {hi:.3g} above it, not both above half the "
         f"threshold {threshold:.3g}"
     )

@@ -56,7 +56,7 @@ from .modeset import (
     too_damped,
     with_residual,
 )
-from .narrow import narrow_refusal, too_narrow
+from .narrow import STEP_LINES, narrow_refusal, too_narrow
 from .quality import KEPT, RejectedMode, threshold_text
 from .residual_peaks import (
     local_ratio,
@@ -435,7 +435,7 @@ def _joint(
         )
     p1 = complex(r1.poles[k])
     why = _inadmissible(p1, df, max_damping)
-    if why and too_narrow(p1, df):
+    if (why and too_narrow(p1, df)) or (not why and too_narrow(p1, STEP_LINES * df)):
         # its evidence against the threshold raised where the noise of the fit's
         # residual lies along the response (model error, local_thresholds)
         thr_n = threshold
@@ -444,10 +444,10 @@ def _joint(
             thr_n = float(local_thresholds(fitter, span, r1.poles[k : k + 1], threshold, test)[0])
         # compared with the modes before the refit (one of them may have left its
         # place to the trial)
-        why = narrow_refusal(fitter, r1, p1, thr_n, why, k, cur.poles)
+        why = narrow_refusal(fitter, r1, p1, thr_n, k, cur.poles)
     w1 = abs(p1)
     edge = w1 + p1.real <= 2 * np.pi * band[0] or w1 - p1.real >= 2 * np.pi * band[1]
-    if why and -p1.real / np.pi >= df and edge:
+    if why and -p1.real > max_damping * w1 and edge:
         # too damped to be a mode, but significant: broad structure (the tails of
         # modes outside the band: its half-power band reaches past an edge) kept as
         # a residual mode, not reported as a mode; the trial mode is the last
@@ -683,8 +683,8 @@ def _try_start(
         return None
     (p_t, l_t, t), w_lim = got
     why = _inadmissible(p_t, df, max_damping)
-    if why and too_narrow(p_t, df):
-        why = narrow_refusal(fitter, res, p_t, threshold, why)
+    if (why and too_narrow(p_t, df)) or not why:
+        why = narrow_refusal(fitter, res, p_t, threshold)
     if not why and -p_t.real >= (1 - 1e-9) * sigma_bound(max_damping, w_lim[1]):
         why = f"damping above the admissible {max_damping:.0%}"  # stopped at the bound
     if not why and t <= threshold:
