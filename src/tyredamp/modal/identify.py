@@ -102,7 +102,7 @@ from .model import ModalModel
 from .model_error import with_model_error
 from .order import Diagram, SelectionRules, default_order, modes_shown, settle_order
 from .out_of_band import search_helpers
-from .problem import FitProblem, build_problem, max_modes
+from .problem import SET_ASIDE, FitProblem, build_problem, max_modes
 from .quality import RejectedMode, merge_rejected
 from .search import (
     FixedParts,
@@ -314,6 +314,8 @@ def identify_modes(
         res, eps = with_model_error(
             frf, variance, first, lambda v, note: _identify(frf, band, o, v, note)
         )
+    if res is not first:  # the last pass was given a variance: first's notes on its own
+        res.warnings[:0] = [w for w in first.warnings[:1] if w.startswith(SET_ASIDE)]
     return res if eps == 0.0 else dataclasses.replace(res, model_error=eps)
 
 
@@ -338,7 +340,7 @@ def _identify(
     p_start = default_order(n_in, n_f, nm_hint) if o.max_order is None else int(o.max_order)
     dg = settle_order(problem, est, p_start, rules, o.max_order is None, o.false_alarm)
     auto = fr is None and o.n_modes is None
-    warnings: list[str] = []
+    warnings: list[str] = [problem.variance_set_aside] if problem.variance_set_aside else []
     modes, rej = _start_modes(problem, dg, fr, o.n_modes, o.min_fraction, warnings)
     fitters = _Fitters.build(problem, o.residuals, modes, o.max_helpers)
     thr, test = _threshold(problem, "complex", o.false_alarm), _mode_test(problem, o.false_alarm)

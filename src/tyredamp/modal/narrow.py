@@ -112,6 +112,7 @@ def narrow_evidence(
     pole: complex,
     drop: int | None = None,
     half_lines: int = WINDOW_LINES,
+    neighbours: bool = True,
 ) -> tuple[float, float]:
     """A pole's evidence beyond a spike and a step at its lines, per side (module docstring).
 
@@ -129,6 +130,11 @@ def narrow_evidence(
         the model whose residual is tested.
     half_lines : int
         Lines either side of the pole in the window.
+    neighbours : bool
+        Whether the terms of the fit's modes in the window, with their derivatives,
+        are in the null model (what the flank of a mode's misfit holds; also what a
+        close second mode wider than the lines looks like, which a parametric fit
+        resolves through its half-power band: left out for such poles).
 
     Returns
     -------
@@ -170,7 +176,8 @@ def narrow_evidence(
     null += [(lw * (fl > f0)).astype(complex), lw.astype(complex)]
     # the modes of the fit within the window: their terms and derivatives (a mode
     # whose pole or residue is a little off leaves that dipole in the residual)
-    for q in poles[(np.abs(poles.imag / (2 * np.pi) - f0) <= half_lines * (fl[-1] - fl[0]) / n)]:
+    near_modes = np.abs(poles.imag / (2 * np.pi) - f0) <= half_lines * (fl[-1] - fl[0]) / n
+    for q in poles[near_modes] if neighbours else []:
         if abs(q - pole) > 1e-9 * abs(pole):
             null += [kap / (s - q), kap / (s - q) ** 2]
     a_p = kap / (s - pole)
@@ -209,19 +216,21 @@ def narrow_refusal(
     the ``threshold`` on each side of it (a resonance's tails are alike on both
     sides, so together they pass the threshold). A pole up to ``STEP_LINES`` lines
     wide, which a step or a spike at its lines can also take for a peak, is a
-    resonance when that evidence passes half the ``threshold`` on each side.
+    resonance when its evidence beyond a spike and a step alone (a close second
+    mode of that width is resolved by its half-power band) passes half the
+    ``threshold`` on each side.
     """
     df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
     bw = -pole.real / np.pi  # half-power bandwidth 2 zeta f_n (Hz)
     if not too_narrow(pole, STEP_LINES * df):
         return ""
     if not too_narrow(pole, df):
-        lo, hi = narrow_evidence(fitter, res, pole, drop)
+        lo, hi = narrow_evidence(fitter, res, pole, drop, neighbours=False)
         if min(lo, hi) > 0.5 * threshold:
             return ""
         return (
             f"half-power bandwidth {bw:.3g} Hz, {bw / df:.2g} lines: beyond a spike at its "
-            f"two nearest lines, a step there and the modes beside it, T = {lo:.3g} below "
+            f"two nearest lines and a step there, T = {lo:.3g} below "
             f"and {hi:.3g} above it, not both above half the threshold {threshold:.3g} (a "
             "step or an outlying line, not a resonance)"
         )

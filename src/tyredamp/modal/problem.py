@@ -100,6 +100,10 @@ class FitProblem:
     noise_note : str
         What a given variance is, for people (e.g. a noise floor plus a model
         error, :mod:`tyredamp.modal.model_error`); "" when nothing is to be said.
+    variance_set_aside : str
+        Why the FRF's own per-line variance was not used ("" when it was, or there
+        was none): one estimated with ``nu <= FEWEST_VARIANCE_DOF`` degrees of
+        freedom (:func:`build_problem`).
     """
 
     frequency: NDArray[np.float64]
@@ -118,6 +122,7 @@ class FitProblem:
     noise_dof: float | None = None
     n_averages: int | None = None
     noise_note: str = ""
+    variance_set_aside: str = ""
 
     @property
     def weight_dof(self) -> float | None:
@@ -326,6 +331,10 @@ def build_problem(
     source, v = _line_variance(frf, lines, Hb, variance)
     nu = variance_dof(frf, source, variance is not None)
     n_avg = _meta_number(frf, "n_averages")
+    aside = ""
+    if v is not None and nu is not None and nu <= FEWEST_VARIANCE_DOF:
+        aside = _set_aside_text(nu, n_avg)
+        source, v, nu = "residual", None, None
     sig = lw = vn = None
     if v is not None:
         vn = v / peak**2 / rms**2
@@ -353,4 +362,29 @@ def build_problem(
         noise_dof=nu if source != "residual" else None,
         n_averages=None if n_avg is None else int(n_avg),
         noise_note=noise_note if source == "variance" else "",
+        variance_set_aside=aside,
+    )
+
+
+#: most degrees of freedom of an estimated per-line variance that is set aside: the
+#: inverse of ``chi2_nu / nu`` has an infinite mean for ``nu <= 2`` and an infinite
+#: variance for ``nu <= 4`` (its moments ``nu / (nu - 2)`` and ``nu^2 / ((nu - 2)^2
+#: (nu - 4))``), so line weights from such a variance are dominated by the few lines
+#: whose variance came out small by chance, and no test of the fit against it has a
+#: finite variance either
+FEWEST_VARIANCE_DOF = 4.0
+
+
+#: how the statement of a variance set aside begins (:attr:`FitProblem.variance_set_aside`)
+SET_ASIDE = "the FRF's per-line variance, estimated from"
+
+
+def _set_aside_text(nu: float, n_avg: float | None) -> str:
+    """The statement of a per-line variance too uncertain to use (for people)."""
+    src = f"{n_avg:g} averages" if n_avg is not None else "the estimator"
+    return (
+        f"{SET_ASIDE} {src} with {nu:.3g} degrees of "
+        f"freedom (at most {FEWEST_VARIANCE_DOF:g}), is too uncertain to weight the lines "
+        "by (the inverse of such an estimate has no finite variance): the noise was "
+        "estimated from the fit's residual instead; more averages give a usable variance"
     )
