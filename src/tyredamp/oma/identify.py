@@ -9,6 +9,7 @@ import numpy as np
 import scipy.signal as ss
 from numpy.typing import ArrayLike, NDArray
 
+from .._blas import blas_threads as blas_limit
 from .._validate import as_band, check_positive
 from ..exceptions import InputError, ShapeError
 from .correlation import Correlations, correlations
@@ -181,6 +182,7 @@ def oma(
     n_groups: int = 16,
     wheel_speed_hz: float | None = None,
     uncertainty: bool = True,
+    blas_threads: int | None = 1,
 ) -> OMAResult:
     """Identify modes from output-only records.
 
@@ -209,11 +211,34 @@ def oma(
     uncertainty : bool
         Compute the jackknife standard errors (SSI; ``n_groups`` more SVDs). Without
         them (NaN) no mode is left out for its scatter.
+    blas_threads : int or None
+        BLAS threads while it runs (default 1: the SSI works on many small
+        matrices, on which more threads cost far more than they gain; ``None``
+        leaves the caller's setting).
 
     Returns
     -------
     OMAResult
     """
+    with blas_limit(blas_threads):
+        return _oma(data, sample_rate, method, references, band, decimate, block_rows,
+                    max_order, n_groups, wheel_speed_hz, uncertainty)  # fmt: skip
+
+
+def _oma(
+    data: ArrayLike,
+    sample_rate: float,
+    method: Method,
+    references: ArrayLike | None,
+    band: tuple[float, float] | None,
+    decimate: int | None,
+    block_rows: int | None,
+    max_order: int | None,
+    n_groups: int,
+    wheel_speed_hz: float | None,
+    uncertainty: bool,
+) -> OMAResult:
+    """The body of :func:`oma` (same parameters)."""
     y0 = np.asarray(data, dtype=float)
     if y0.ndim == 1:
         y0 = y0[None, :]
