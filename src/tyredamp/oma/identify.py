@@ -274,10 +274,18 @@ def _oma(
 
 
 def _near_orders(op: OrderPoles, c: Any) -> NDArray[np.intp]:
-    """Up to 5 members of cluster ``c`` nearest its representative's model order."""
+    """Up to 5 members of cluster ``c`` at its lowest model orders.
+
+    Every member already recurred from the previous order (the distance cut of
+    :func:`~.selection.select_modes`), so the lowest orders hold the mode once it
+    is stable. Higher orders fit more of the correlation estimate's own error:
+    on the rolling virtual tyre the damping ratios drifted down with the order
+    (by 20-40 % at orders 100-120 against 0-10 % at 20-50, 16 fixed sensors,
+    ``benchmarks/rolling_oma.py``), the known over-fitting of SSI at orders far
+    above the number of modes (Reynders, Houbrechts & De Roeck 2012, sec. 3).
+    """
     mem = np.asarray(c.members)
-    d = np.abs(op.order[mem] - op.order[c.representative])
-    return np.asarray(mem[np.argsort(d, kind="stable")[:5]], dtype=np.intp)
+    return np.asarray(mem[np.argsort(op.order[mem], kind="stable")[:5]], dtype=np.intp)
 
 
 def _finish(
@@ -298,8 +306,8 @@ def _finish(
 ) -> OMAResult:
     """Standard errors, shapes (pLSCF), the harmonic tests and the result."""
     notes: list[str] = []
-    # each mode's estimate: the mean over (up to) 5 orders of its cluster nearest the
-    # representative's order, a smooth statistic the jackknife replicates as it is
+    # each mode's estimate: the mean over (up to) 5 of its cluster's lowest orders, a
+    # smooth statistic the jackknife replicates as it is
     sub = [_near_orders(op, c) for c in clusters]
     fm = np.array([np.mean(op.frequency_hz[ix]) for ix in sub]) if sub else np.zeros(0)
     zm = np.array([np.mean(op.damping_ratio[ix]) for ix in sub]) if sub else np.zeros(0)
