@@ -16,6 +16,7 @@ from tyredamp.oma.rolling import (
     resolve_in_tyre,
     rolling_modes,
     rotating_frequency,
+    rotating_pole,
 )
 from tyredamp.virtual import RotatingRing, rolling_test
 from tyredamp.virtual.rolling_truth import RollingTruth
@@ -135,3 +136,20 @@ def test_family_member_of_travelling_and_standing_shapes(sign: int, member: str)
     assert w is not None
     assert (w.n, w.member) == (3, member)
     assert family_names({"F1": [w, w]})["F1"].label == f"n=3 {member}"
+
+
+def test_rotating_pole_moves_the_damped_frequency(truth80: RollingTruth) -> None:
+    # fixed-frame natural frequency |lambda_f| / 2 pi and damping from the exact ring's
+    # decay rate and fixed damped frequency; the rotating pole is the state mode itself
+    fw = truth80.rotation_hz
+    rows = [r for r in truth80.table() if r["wave_number"] > 0]
+    for r, p in zip(truth80.table(), truth80.poles, strict=True):
+        if r["wave_number"] == 0:
+            continue
+        f_nat = np.hypot(r["fixed_hz"], r["decay_rate"] / (2 * np.pi))
+        f, z, d = rotating_pole(f_nat, r["fixed_damping_ratio"], r["wave_number"],
+                                r["fixed_direction"], fw)  # fmt: skip
+        assert d == r["direction"]
+        assert_allclose(f, abs(p) / (2 * np.pi), rtol=1e-9)  # exact kinematics, rounding only
+        assert_allclose(z, r["damping_ratio"], rtol=1e-9)  # the same decay rate, rounding only
+    assert rows

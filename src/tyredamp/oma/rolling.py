@@ -51,6 +51,7 @@ __all__ = [
     "resolve_in_tyre",
     "rolling_modes",
     "rotating_frequency",
+    "rotating_pole",
 ]
 
 
@@ -89,6 +90,49 @@ def rotating_frequency(
     if f >= 0:
         return f, fixed_direction
     return -f, "backward" if fixed_direction == "forward" else "forward"
+
+
+def rotating_pole(
+    fixed_hz: float,
+    damping_ratio: float,
+    wave_number: int,
+    fixed_direction: str,
+    wheel_speed_hz: float,
+) -> tuple[float, float, str]:
+    """Rotating-frame natural frequency and damping ratio of an identified fixed-frame pole.
+
+    An identified pole ``lambda = -sigma + i omega_d`` has the natural frequency
+    ``|lambda| / 2 pi`` and the damping ratio ``sigma / |lambda|``. Eq. (1) of
+    this module moves its *damped* frequency ``omega_d`` by ``-s n Omega`` and
+    keeps its decay rate ``sigma`` (the change of frame multiplies the wave by
+    ``e^{-i s n Omega t}``, Huang & Soedel 1987; :mod:`tyredamp.virtual.rolling_truth`).
+    Applying eq. (1) to the natural frequency instead is off by about
+    ``zeta^2 / 2`` relatively, which grows where the fixed frequency is low.
+
+    Parameters
+    ----------
+    fixed_hz : float
+        Natural frequency ``|lambda| / 2 pi`` at a fixed point, Hz.
+    damping_ratio : float
+        ``sigma / |lambda|`` at a fixed point (0 <= zeta < 1).
+    wave_number, fixed_direction, wheel_speed_hz
+        As in :func:`rotating_frequency`.
+
+    Returns
+    -------
+    f_rot : float
+        ``|lambda_rot| / 2 pi`` in Hz.
+    zeta_rot : float
+        ``sigma / |lambda_rot|``.
+    direction : str
+        On the tyre.
+    """
+    z = float(np.clip(damping_ratio, 0.0, 1.0))
+    sigma = z * float(fixed_hz)  # in Hz units: sigma / 2 pi
+    fd = float(fixed_hz) * np.sqrt(1.0 - z * z)
+    fr, d = rotating_frequency(fd, wave_number, fixed_direction, wheel_speed_hz)
+    mag = float(np.hypot(fr, sigma))
+    return mag, (sigma / mag if mag > 0 else z), d
 
 
 @dataclass(frozen=True)
@@ -218,7 +262,7 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
             else [wc.direction]
         )
         for d in dirs:
-            fr, dt = rotating_frequency(f, wc.wave_number, d, fw)
+            fr, _, dt = rotating_pole(f, z, wc.wave_number, d, fw)
             why = f"fixed-frame shape: n = {wc.wave_number}, share forward {wc.forward_share:.2f}"
             out.append(RollingWave("fixed", wc.wave_number, dt, d, f, fr, z, sf, sz,
                                    wc.explained, [], why))  # fmt: skip
@@ -435,6 +479,7 @@ def compare_waves(
             rec["frequency_hz"] = float(getattr(best, fk))
             rec["damping_ratio"] = best.damping_ratio
             rec["std_frequency_hz"] = best.std_frequency_hz
+            rec["std_damping_ratio"] = best.std_damping_ratio
             rec["f_error"] = float(getattr(best, fk) / row[fk] - 1)
             rec["zeta_error"] = float(best.damping_ratio / row[zk] - 1)
         out.append(rec)
