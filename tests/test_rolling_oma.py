@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -153,3 +154,16 @@ def test_rotating_pole_moves_the_damped_frequency(truth80: RollingTruth) -> None
         assert_allclose(f, abs(p) / (2 * np.pi), rtol=1e-9)  # exact kinematics, rounding only
         assert_allclose(z, r["damping_ratio"], rtol=1e-9)  # the same decay rate, rounding only
     assert rows
+
+
+def test_in_tyre_match_widens_to_three_standard_errors(truth80: RollingTruth) -> None:
+    row = truth80.wave(3, "forward")
+    fw = truth80.rotation_hz
+    # the fixed-frame wave 1.5 % off: beyond the 1 % tolerance, within 3 x its 1 % error
+    off = RollingWave("fixed", 3, "forward", row["fixed_direction"], 1.015 * row["fixed_hz"],
+                      float("nan"), 0.02, 0.01 * row["fixed_hz"], 0.0)  # fmt: skip
+    tight = dataclasses.replace(off, std_frequency_hz=0.001 * row["fixed_hz"])
+    (w,) = resolve_in_tyre([row["rotating_hz"]], [off], fw, n_max=4)
+    assert (w.wave_number, w.direction) == (3, "forward")
+    (w,) = resolve_in_tyre([row["rotating_hz"]], [tight], fw, n_max=4)
+    assert w.wave_number is None

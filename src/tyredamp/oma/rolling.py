@@ -269,6 +269,12 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
+def _match_tol(w: RollingWave, f: float, tol: float) -> float:
+    """Hz: ``tol f``, or three standard errors of ``w``'s frequency where wider."""
+    sf = w.std_frequency_hz
+    return max(tol * f, 3.0 * sf) if np.isfinite(sf) else tol * f
+
+
 def resolve_in_tyre(
     frequency_rot_hz: ArrayLike,
     fixed: list[RollingWave],
@@ -285,8 +291,9 @@ def resolve_in_tyre(
     from a fixed point) or the backward wave ``n`` (at ``|f_rot - n f_w|``), for
     every ``n``: eq. (1) of this module. It is resolved when a
     fixed-frame wave with that ``n`` and direction on the tyre lies within
-    ``tol`` (relative) of that frequency (the nearest wins); otherwise it is
-    returned unresolved with its candidates.
+    ``tol`` (relative) of that frequency, or within three of its standard errors
+    where these are wider (the nearest in units of its tolerance wins); otherwise
+    it is returned unresolved with its candidates.
 
     Parameters
     ----------
@@ -320,10 +327,12 @@ def resolve_in_tyre(
             cands.append((n, "forward", f + n * fw))  # forward on the tyre: seen higher
             cands.append((n, "backward", abs(f - n * fw)))
         hits = [
-            (abs(w.fixed_hz - ff) / ff, n, d, w)
+            (abs(w.fixed_hz - ff) / _match_tol(w, ff, tol), n, d, w)
             for n, d, ff in cands
             for w in fixed
-            if w.wave_number == n and w.direction == d and abs(w.fixed_hz - ff) <= tol * ff
+            if w.wave_number == n
+            and w.direction == d
+            and abs(w.fixed_hz - ff) <= _match_tol(w, ff, tol)
         ]
         if hits:
             _, n, d, w = min(hits, key=lambda h: h[0])
