@@ -150,7 +150,9 @@ class RollingWave:
     fixed_direction : str or None
         As a fixed observer sees it travel.
     fixed_hz, rotating_hz : float
-        Frequency at a fixed point and in the tyre (Hz; NaN where not known).
+        Natural frequency ``|lambda| / 2 pi`` at a fixed point and in the tyre
+        (Hz; NaN where not known); a fixed-frame wave's in-tyre frequency is
+        its pole moved by :func:`rotating_pole`.
     damping_ratio : float
         As fitted in the frame it was measured in.
     std_frequency_hz, std_damping_ratio : float
