@@ -18,8 +18,27 @@ import time
 
 import numpy as np
 
-from tyredamp.oma.rolling import compare_waves, rolling_modes
+from tyredamp._blas import single_threaded_blas
+from tyredamp.oma.rolling import RollingWave, compare_waves, rolling_modes
 from tyredamp.virtual import rolling_test
+
+
+def _split_errors(waves: list[RollingWave], truth: list[dict]) -> list[float]:
+    """|error of f_backward - f_forward| / f_mean (rotating frame) for each n both found."""
+    out = []
+    for n in sorted({r["wave_number"] for r in truth if r["wave_number"] > 0}):
+        t = {r["direction"]: r["rotating_hz"] for r in truth if r["wave_number"] == n}
+        w: dict[str, list[float]] = {}
+        for x in waves:
+            if x.wave_number == n and x.direction in t and np.isfinite(x.rotating_hz):
+                w.setdefault(x.direction, []).append(x.rotating_hz)
+        if len(t) < 2 or len(w) < 2:
+            continue
+        est = {d: min(v, key=lambda f: abs(f - t[d])) for d, v in w.items()}
+        d_est = est["backward"] - est["forward"]
+        d_true = t["backward"] - t["forward"]
+        out.append(abs(d_est - d_true) / (0.5 * (t["backward"] + t["forward"])))
+    return out
 
 
 def _run(speed: float, seed: int, duration: float, band: tuple[float, float]) -> dict:
@@ -46,6 +65,12 @@ def _run(speed: float, seed: int, duration: float, band: tuple[float, float]) ->
         for c in cmp
         if c["found"] and np.isfinite(c["std_frequency_hz"])
     ]
+    zcover = [
+        abs(c["damping_ratio"] - c["truth"]["fixed_damping_ratio"]) <= 1.96 * c["std_damping_ratio"]
+        for c in cmp
+        if c["found"] and np.isfinite(c["std_damping_ratio"])
+    ]
+    rot_split = [r for r in test.truth.table() if band[0] + 5 <= r["rotating_hz"] <= band[1] - 10]
     return {
         "n": len(cmp),
         "found": sum(c["found"] for c in cmp),
@@ -53,11 +78,19 @@ def _run(speed: float, seed: int, duration: float, band: tuple[float, float]) ->
         "z_ok": sum(c["found"] and abs(c["zeta_error"]) <= 0.10 for c in cmp),
         "false": false,
         "cover": cover,
+        "zcover": zcover,
+        "split_fixed": _split_errors(m.fixed, rot_split),
+        "split_rot": _split_errors(m.rotating, rot_split),
+        "zerr": [c["zeta_error"] for c in cmp if c["found"]],
         "rot_n": len(rot),
         "rot_ok": sum(c["found"] and abs(c["f_error"]) <= 0.005 for c in rot),
         "unresolved": sum(w.wave_number is None for w in m.rotating),
         "time": dt,
     }
+
+
+def _pct(x: list) -> str:
+    return f"{100 * np.mean(x):.0f}%" if x else "-"
 
 
 def main() -> None:
@@ -68,18 +101,27 @@ def main() -> None:
     a = ap.parse_args()
     band = (0.0, 200.0)
     print(f"band {band} Hz, {a.duration:g} s records, 16 fixed + 1 in-tyre sensor, {a.draws} draws")
-    print("speed  waves  found  f<0.5%  z<10%  false/run  coverage  in-tyre ok  unresolved  s/run")
+    print(
+        "speed  waves  found  f<0.5%  z<10%  med|dz|  false/run  cover f  cover z  "
+        "in-tyre ok  unresolved  split<0.5% fixed  in-tyre  s/run"
+    )
     for v in [float(s) for s in a.speeds.split(",")]:
-        runs = [_run(v, seed, a.duration, band) for seed in range(a.draws)]
+        with single_threaded_blas():
+            runs = [_run(v, seed, a.duration, band) for seed in range(a.draws)]
         cov = [c for r in runs for c in r["cover"]]
-        tot = sum(r["n"] for r in runs)
+        zcov = [c for r in runs for c in r["zcover"]]
+        sf = [e <= 0.005 for r in runs for e in r["split_fixed"]]
+        sr = [e <= 0.005 for r in runs for e in r["split_rot"]]
+        zerr = [abs(e) for r in runs for e in r["zerr"]]
         print(
-            f"{v:5.0f}  {tot:5d}  {sum(r['found'] for r in runs):5d}  "
+            f"{v:5.0f}  {sum(r['n'] for r in runs):5d}  {sum(r['found'] for r in runs):5d}  "
             f"{sum(r['f_ok'] for r in runs):6d}  {sum(r['z_ok'] for r in runs):5d}  "
-            f"{np.mean([r['false'] for r in runs]):9.1f}  "
-            f"{100 * np.mean(cov) if cov else float('nan'):7.0f}%  "
+            f"{100 * np.median(zerr) if zerr else float('nan'):6.1f}%  "
+            f"{np.mean([r['false'] for r in runs]):9.1f}  {_pct(cov):>7s}  {_pct(zcov):>7s}  "
             f"{sum(r['rot_ok'] for r in runs):4d}/{sum(r['rot_n'] for r in runs):<5d}  "
-            f"{sum(r['unresolved'] for r in runs):10d}  {np.mean([r['time'] for r in runs]):5.1f}",
+            f"{sum(r['unresolved'] for r in runs):10d}  "
+            f"{sum(sf):5d}/{len(sf):<5d}  {sum(sr):5d}/{len(sr):<5d}  "
+            f"{np.mean([r['time'] for r in runs]):5.1f}",
             flush=True,
         )
 

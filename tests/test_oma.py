@@ -213,3 +213,17 @@ def test_bad_input_one_line(data: np.ndarray, kwargs: dict, match: str) -> None:
     with pytest.raises(InputError, match=match) as exc:
         oma(data, 100.0, **kwargs)
     assert "\n" not in str(exc.value)
+
+
+def test_mode_estimate_from_the_lowest_stable_orders() -> None:
+    from tyredamp.oma.identify import _near_orders
+    from tyredamp.oma.selection import ModeCluster
+    from tyredamp.oma.ssi import OrderPoles
+
+    # one pole per order 10, 20, .., 100, stored in a shuffled order: the estimate
+    # takes the members of the five lowest orders, whatever their storage order
+    orders = np.array([70, 10, 100, 40, 20, 90, 30, 60, 50, 80])
+    poles = -1.0 + 2j * np.pi * (50.0 + orders / 1000)
+    op = OrderPoles(orders, poles, np.ones((10, 2), complex), np.sort(orders))
+    c = ModeCluster(np.arange(10, dtype=np.intp), 2, 10)
+    assert sorted(op.order[_near_orders(op, c)].tolist()) == [10, 20, 30, 40, 50]

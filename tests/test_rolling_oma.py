@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from tyredamp.oma.rolling import (
     resolve_in_tyre,
     rolling_modes,
     rotating_frequency,
+    rotating_pole,
 )
 from tyredamp.virtual import RotatingRing, rolling_test
 from tyredamp.virtual.rolling_truth import RollingTruth
@@ -135,3 +137,33 @@ def test_family_member_of_travelling_and_standing_shapes(sign: int, member: str)
     assert w is not None
     assert (w.n, w.member) == (3, member)
     assert family_names({"F1": [w, w]})["F1"].label == f"n=3 {member}"
+
+
+def test_rotating_pole_moves_the_damped_frequency(truth80: RollingTruth) -> None:
+    # fixed-frame natural frequency |lambda_f| / 2 pi and damping from the exact ring's
+    # decay rate and fixed damped frequency; the rotating pole is the state mode itself
+    fw = truth80.rotation_hz
+    rows = [r for r in truth80.table() if r["wave_number"] > 0]
+    for r, p in zip(truth80.table(), truth80.poles, strict=True):
+        if r["wave_number"] == 0:
+            continue
+        f_nat = np.hypot(r["fixed_hz"], r["decay_rate"] / (2 * np.pi))
+        f, z, d = rotating_pole(f_nat, r["fixed_damping_ratio"], r["wave_number"],
+                                r["fixed_direction"], fw)  # fmt: skip
+        assert d == r["direction"]
+        assert_allclose(f, abs(p) / (2 * np.pi), rtol=1e-9)  # exact kinematics, rounding only
+        assert_allclose(z, r["damping_ratio"], rtol=1e-9)  # the same decay rate, rounding only
+    assert rows
+
+
+def test_in_tyre_match_widens_to_three_standard_errors(truth80: RollingTruth) -> None:
+    row = truth80.wave(3, "forward")
+    fw = truth80.rotation_hz
+    # the fixed-frame wave 1.5 % off: beyond the 1 % tolerance, within 3 x its 1 % error
+    off = RollingWave("fixed", 3, "forward", row["fixed_direction"], 1.015 * row["fixed_hz"],
+                      float("nan"), 0.02, 0.01 * row["fixed_hz"], 0.0)  # fmt: skip
+    tight = dataclasses.replace(off, std_frequency_hz=0.001 * row["fixed_hz"])
+    (w,) = resolve_in_tyre([row["rotating_hz"]], [off], fw, n_max=4)
+    assert (w.wave_number, w.direction) == (3, "forward")
+    (w,) = resolve_in_tyre([row["rotating_hz"]], [tight], fw, n_max=4)
+    assert w.wave_number is None

@@ -51,6 +51,7 @@ __all__ = [
     "resolve_in_tyre",
     "rolling_modes",
     "rotating_frequency",
+    "rotating_pole",
 ]
 
 
@@ -91,6 +92,49 @@ def rotating_frequency(
     return -f, "backward" if fixed_direction == "forward" else "forward"
 
 
+def rotating_pole(
+    fixed_hz: float,
+    damping_ratio: float,
+    wave_number: int,
+    fixed_direction: str,
+    wheel_speed_hz: float,
+) -> tuple[float, float, str]:
+    """Rotating-frame natural frequency and damping ratio of an identified fixed-frame pole.
+
+    An identified pole ``lambda = -sigma + i omega_d`` has the natural frequency
+    ``|lambda| / 2 pi`` and the damping ratio ``sigma / |lambda|``. Eq. (1) of
+    this module moves its *damped* frequency ``omega_d`` by ``-s n Omega`` and
+    keeps its decay rate ``sigma`` (the change of frame multiplies the wave by
+    ``e^{-i s n Omega t}``, Huang & Soedel 1987; :mod:`tyredamp.virtual.rolling_truth`).
+    Applying eq. (1) to the natural frequency instead is off by about
+    ``zeta^2 / 2`` relatively, which grows where the fixed frequency is low.
+
+    Parameters
+    ----------
+    fixed_hz : float
+        Natural frequency ``|lambda| / 2 pi`` at a fixed point, Hz.
+    damping_ratio : float
+        ``sigma / |lambda|`` at a fixed point (0 <= zeta < 1).
+    wave_number, fixed_direction, wheel_speed_hz
+        As in :func:`rotating_frequency`.
+
+    Returns
+    -------
+    f_rot : float
+        ``|lambda_rot| / 2 pi`` in Hz.
+    zeta_rot : float
+        ``sigma / |lambda_rot|``.
+    direction : str
+        On the tyre.
+    """
+    z = float(np.clip(damping_ratio, 0.0, 1.0))
+    sigma = z * float(fixed_hz)  # in Hz units: sigma / 2 pi
+    fd = float(fixed_hz) * np.sqrt(1.0 - z * z)
+    fr, d = rotating_frequency(fd, wave_number, fixed_direction, wheel_speed_hz)
+    mag = float(np.hypot(fr, sigma))
+    return mag, (sigma / mag if mag > 0 else z), d
+
+
 @dataclass(frozen=True)
 class RollingWave:
     """One identified travelling wave of a rolling tyre.
@@ -106,7 +150,9 @@ class RollingWave:
     fixed_direction : str or None
         As a fixed observer sees it travel.
     fixed_hz, rotating_hz : float
-        Frequency at a fixed point and in the tyre (Hz; NaN where not known).
+        Natural frequency ``|lambda| / 2 pi`` at a fixed point and in the tyre
+        (Hz; NaN where not known); a fixed-frame wave's in-tyre frequency is
+        its pole moved by :func:`rotating_pole`.
     damping_ratio : float
         As fitted in the frame it was measured in.
     std_frequency_hz, std_damping_ratio : float
@@ -218,11 +264,17 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
             else [wc.direction]
         )
         for d in dirs:
-            fr, dt = rotating_frequency(f, wc.wave_number, d, fw)
+            fr, _, dt = rotating_pole(f, z, wc.wave_number, d, fw)
             why = f"fixed-frame shape: n = {wc.wave_number}, share forward {wc.forward_share:.2f}"
             out.append(RollingWave("fixed", wc.wave_number, dt, d, f, fr, z, sf, sz,
                                    wc.explained, [], why))  # fmt: skip
     return out
+
+
+def _match_tol(w: RollingWave, f: float, tol: float) -> float:
+    """Hz: ``tol f``, or three standard errors of ``w``'s frequency where wider."""
+    sf = w.std_frequency_hz
+    return max(tol * f, 3.0 * sf) if np.isfinite(sf) else tol * f
 
 
 def resolve_in_tyre(
@@ -241,8 +293,9 @@ def resolve_in_tyre(
     from a fixed point) or the backward wave ``n`` (at ``|f_rot - n f_w|``), for
     every ``n``: eq. (1) of this module. It is resolved when a
     fixed-frame wave with that ``n`` and direction on the tyre lies within
-    ``tol`` (relative) of that frequency (the nearest wins); otherwise it is
-    returned unresolved with its candidates.
+    ``tol`` (relative) of that frequency, or within three of its standard errors
+    where these are wider (the nearest in units of its tolerance wins); otherwise
+    it is returned unresolved with its candidates.
 
     Parameters
     ----------
@@ -276,10 +329,12 @@ def resolve_in_tyre(
             cands.append((n, "forward", f + n * fw))  # forward on the tyre: seen higher
             cands.append((n, "backward", abs(f - n * fw)))
         hits = [
-            (abs(w.fixed_hz - ff) / ff, n, d, w)
+            (abs(w.fixed_hz - ff) / _match_tol(w, ff, tol), n, d, w)
             for n, d, ff in cands
             for w in fixed
-            if w.wave_number == n and w.direction == d and abs(w.fixed_hz - ff) <= tol * ff
+            if w.wave_number == n
+            and w.direction == d
+            and abs(w.fixed_hz - ff) <= _match_tol(w, ff, tol)
         ]
         if hits:
             _, n, d, w = min(hits, key=lambda h: h[0])
@@ -435,6 +490,7 @@ def compare_waves(
             rec["frequency_hz"] = float(getattr(best, fk))
             rec["damping_ratio"] = best.damping_ratio
             rec["std_frequency_hz"] = best.std_frequency_hz
+            rec["std_damping_ratio"] = best.std_damping_ratio
             rec["f_error"] = float(getattr(best, fk) / row[fk] - 1)
             rec["zeta_error"] = float(best.damping_ratio / row[zk] - 1)
         out.append(rec)
