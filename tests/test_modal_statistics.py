@@ -391,9 +391,20 @@ def test_mode_statistic_with_estimated_line_weights() -> None:
     assert weight_factor(5.0) == 2.0
 
 
-def test_variance_from_three_averages_is_not_tested_against() -> None:
-    # nu = 4: a term 2 F(2, 4) has no variance; the second-difference noise is used
-    g = _fit_quality(_averaged_frf(3, 0), TWO_DOF)
+def test_variance_from_three_averages_is_set_aside() -> None:
+    # nu = 4: the inverse of chi2_4 / 4 has no variance, so neither have line weights
+    # from it nor a term 2 F(2, 4) of the test: the noise comes from the data instead
+    frf = _averaged_frf(3, 0)
+    pr = build_problem(frf)
+    assert pr.noise_source == "residual"
+    assert pr.line_weights is None
+    assert pr.noise_dof is None
+    assert "3 averages with 4 degrees of freedom" in pr.variance_set_aside
+    g = _fit_quality(frf, TWO_DOF)
     assert g.noise_dof is None
     assert "second differences" in g.noise
-    assert "from 3 averages has nu = 4" in g.noise
+    # 4 averages (nu = 6) are used
+    assert build_problem(_averaged_frf(4, 0)).noise_source != "residual"
+    # and identify_modes says why the variance was not used
+    r = identify_modes(frf, band=(frf.frequency[1], frf.frequency[-1]))
+    assert any("3 averages with 4 degrees of freedom" in w for w in r.warnings)
