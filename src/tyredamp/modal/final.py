@@ -33,6 +33,7 @@ from .fit import FitResult, ModalFitter
 from .indicators import mean_phase_deviation, modal_phase_collinearity
 from .ml import ml_refine
 from .model import ModalModel
+from .narrow import unresolved_damping
 from .problem import FitProblem
 from .profile import Z95, fit_intervals
 from .quality import FitQuality, RejectedMode, threshold_text
@@ -46,7 +47,6 @@ from .search import (
     local_thresholds,
     rejected,
     residual_span,
-    unresolved_damping,
 )
 from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
 

@@ -3,7 +3,7 @@
 A mode whose half-power bandwidth ``2 zeta f_n`` is below the line spacing
 ``df`` (a lightly damped structure measured with coarse lines, e.g. a free beam
 at 0.02 % damping and 1 Hz lines) is a real mode whose frequency the lines fix
-and whose damping they only bound (:func:`~tyredamp.modal.search.unresolved_damping`).
+and whose damping they only bound (:func:`unresolved_damping`).
 A pole that narrow can also fit what is not a resonance: one outlying line (a
 spike) or a level change between two lines (a step, e.g. where the records of an
 impact test were joined). The two differ away from the pole: a resonance of any
@@ -47,6 +47,7 @@ __all__ = [
     "narrow_evidence",
     "narrow_refusal",
     "too_narrow",
+    "unresolved_damping",
 ]
 
 #: lines either side of a narrow pole over which its evidence is weighed (its tail
@@ -251,4 +252,22 @@ def narrow_refusal(
         f"{why}: beyond a spike at its two nearest lines, a step there and the modes "
         f"beside it, T = {lo:.3g} below and {hi:.3g} above it, not both above half the "
         f"threshold {threshold:.3g}"
+    )
+
+
+def unresolved_damping(frequency_hz: float, damping_ratio: float, df: float) -> str:
+    """The statement for a mode whose half-power band is narrower than the lines ('' if not).
+
+    The half-power bandwidth ``2 zeta f_n`` (Hz) of such a mode lies between two
+    lines ``df`` apart: the lines fix its frequency, but any damping with a
+    bandwidth below ``df`` fits them alike, so the data bound the damping ratio,
+    ``zeta < df / (2 f_n)``, and do not measure it.
+    """
+    if not (df > 0 and frequency_hz > 0) or 2.0 * damping_ratio * frequency_hz >= df:
+        return ""
+    return (
+        f"mode at {frequency_hz:.5g} Hz: half-power bandwidth "
+        f"{2.0 * damping_ratio * frequency_hz:.2g} Hz below the line spacing {df:.3g} Hz: "
+        f"its damping is not resolved by the lines (zeta < {df / (2.0 * frequency_hz):.2%}, "
+        "an upper bound; measure with finer lines for a value)"
     )

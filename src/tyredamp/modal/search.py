@@ -288,6 +288,36 @@ def _inadmissible(p: complex, df: float, max_damping: float) -> str:
     return ""
 
 
+def _narrow_joint(
+    fitter: ModalFitter,
+    r1: FitResult,
+    k: int,
+    cur: ModeSet,
+    threshold: float,
+    test: ModeTest | None,
+) -> str:
+    """Why the trial mode ``k`` of the joint refit ``r1``, a few lines wide or narrower,
+    is refused ('' when it is a resonance, :func:`~tyredamp.modal.narrow.narrow_refusal`):
+    its evidence against the threshold raised where the noise of the fit's residual
+    lies along the response (model error, :func:`local_thresholds`), and compared
+    with the modes ``cur`` before the refit (one of them may have left its place to
+    the trial)."""
+    thr = threshold
+    if test is not None:
+        span = residual_span(fitter, r1)
+        thr = float(local_thresholds(fitter, span, r1.poles[k : k + 1], threshold, test)[0])
+    return narrow_refusal(fitter, r1, complex(r1.poles[k]), thr, k, cur.poles)
+
+
+def _repeated_start(fitter: ModalFitter, cur: ModeSet, seen: list[complex], p0: complex) -> bool:
+    """Whether the start ``p0`` lies within twice the merge distance of a current mode
+    or of an earlier start (with several inputs, of a current residual mode only: a
+    start at a mode's pole may be a repeated root's)."""
+    held = cur.all()[0] if fitter.n_in == 1 else cur.hp
+    p_all = np.concatenate([held, np.asarray(seen, complex)])
+    return bool(p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE)
+
+
 def _held_outside(
     r1: FitResult,
     k: int,
@@ -436,15 +466,7 @@ def _joint(
     p1 = complex(r1.poles[k])
     why = _inadmissible(p1, df, max_damping)
     if (why and too_narrow(p1, df)) or (not why and too_narrow(p1, STEP_LINES * df)):
-        # its evidence against the threshold raised where the noise of the fit's
-        # residual lies along the response (model error, local_thresholds)
-        thr_n = threshold
-        if test is not None:
-            span = residual_span(fitter, r1)
-            thr_n = float(local_thresholds(fitter, span, r1.poles[k : k + 1], threshold, test)[0])
-        # compared with the modes before the refit (one of them may have left its
-        # place to the trial)
-        why = narrow_refusal(fitter, r1, p1, thr_n, k, cur.poles)
+        why = _narrow_joint(fitter, r1, k, cur, threshold, test)
     w1 = abs(p1)
     edge = w1 + p1.real <= 2 * np.pi * band[0] or w1 - p1.real >= 2 * np.pi * band[1]
     if why and -p1.real > max_damping * w1 and edge:
@@ -545,12 +567,14 @@ def residual_search(
     stops at that bound, :func:`sigma_bound`, rather than running on). A trial
     whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is narrower
     than the line spacing (a lightly damped mode measured with coarse lines: its
-    frequency is resolved and its damping only bounded, :func:`unresolved_damping`)
-    can also fit single lines (an outlier, a step, the erratic low end of an
-    impact test) or the flank of another mode's misfit: it is kept only when its
-    tails hold evidence beyond those on both sides, away from the ends of the
-    lines and from the other modes (:func:`~tyredamp.modal.narrow.narrow_refusal`),
-    in the trial and again in the joint refit. A trial mode that passes
+    frequency is resolved and its damping only bounded,
+    :func:`~tyredamp.modal.narrow.unresolved_damping`) can also fit single lines
+    (an outlier, a step, the erratic low end of an impact test) or the flank of
+    another mode's misfit: it is kept only when its tails hold evidence beyond
+    those on both sides, away from the ends of the lines and from the other
+    modes (:func:`~tyredamp.modal.narrow.narrow_refusal`; poles up to 3 lines
+    wide against a spike and a step), in the trial and again in the joint
+    refit. A trial mode that passes
     is refitted with all modes (:func:`_joint`) and kept when it stays in the
     band, merges with no mode, is still admissible and every mode still passes
     the test; a trial mode that alone crosses a band edge in the joint refit,
@@ -607,10 +631,7 @@ def residual_search(
         from_diagram = {complex(c[0]) for c in pending}
         pending = []
         for k, (p0, l0) in enumerate(starts):
-            # several inputs: a start at a current mode's pole may be a repeated root's
-            held = cur.all()[0] if fitter.n_in == 1 else cur.hp
-            p_all = np.concatenate([held, np.asarray(seen, complex)])
-            if p_all.size and np.min(np.abs(p_all - p0) / abs(p0)) < 2 * MERGE:
+            if _repeated_start(fitter, cur, seen, p0):
                 if complex(p0) in from_diagram:
                     tried.append(rejected(p0, SAME_START))
                 continue
@@ -772,21 +793,3 @@ def _split(
         if r1.significance[j] > thr_j[0]:
             return got
     return None
-
-
-def unresolved_damping(frequency_hz: float, damping_ratio: float, df: float) -> str:
-    """The statement for a mode whose half-power band is narrower than the lines ('' if not).
-
-    The half-power bandwidth ``2 zeta f_n`` (Hz) of such a mode lies between two
-    lines ``df`` apart: the lines fix its frequency, but any damping with a
-    bandwidth below ``df`` fits them alike, so the data bound the damping ratio,
-    ``zeta < df / (2 f_n)``, and do not measure it.
-    """
-    if not (df > 0 and frequency_hz > 0) or 2.0 * damping_ratio * frequency_hz >= df:
-        return ""
-    return (
-        f"mode at {frequency_hz:.5g} Hz: half-power bandwidth "
-        f"{2.0 * damping_ratio * frequency_hz:.2g} Hz below the line spacing {df:.3g} Hz: "
-        f"its damping is not resolved by the lines (zeta < {df / (2.0 * frequency_hz):.2%}, "
-        "an upper bound; measure with finer lines for a value)"
-    )
