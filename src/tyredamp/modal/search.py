@@ -632,8 +632,7 @@ def residual_search(
         pending = []
         for k, (p0, l0) in enumerate(starts):
             if _repeated_start(fitter, cur, seen, p0):
-                if complex(p0) in from_diagram:
-                    tried.append(rejected(p0, SAME_START))
+                tried += [rejected(p0, SAME_START)] if complex(p0) in from_diagram else []
                 continue
             if n_tried >= MAX_TRIALS:
                 tried += capped(view[0], starts[k:], from_diagram, zeta0, threshold)
