@@ -41,7 +41,14 @@ from ..documents.jsonfile import write_json
 from ..exceptions import InputError
 from ..io import write_frf
 from ..io._safety import atomic_dir, atomic_path, check_output_dir
-from ..virtual import Imperfection, MeasurementLayout, RingTyre, RingTyreParameters
+from ..virtual import (
+    Cavity,
+    ContactPatch,
+    Imperfection,
+    MeasurementLayout,
+    RingTyre,
+    RingTyreParameters,
+)
 
 __all__ = [
     "TRUTH_KIND",
@@ -167,12 +174,18 @@ def _tyre(
     load_n: float,
     drive_points: tuple[int, ...] = (1,),
 ) -> RingTyre:
+    """The physical virtual tyre of one test: the tyre of ``tyredamp simulate radial``.
+
+    Shaker tips of the default :class:`~tyredamp.virtual.MeasurementLayout`
+    (10 g, 2 N s/m tread loss under each tip), the rubber losses of the ring,
+    the air cavity and, for ``load_n`` > 0, the loaded
+    :class:`~tyredamp.virtual.ContactPatch` (its length from the load and the
+    tyre's own vertical stiffness at this pressure), with the physical damping
+    (``nonproportionality`` 1).
+    """
     p = params.with_pressure(pressure_bar * BAR)
-    # the campaign's tyre as it was before the physical sources (virtual/contact.py,
-    # cavity.py): a 350 N s/m tip damper at half its off-diagonal C'; moving it to
-    # ContactPatch and the 30 N s/m tip changes the campaign's truth (its owner's call)
-    layout = MeasurementLayout(drive_points=drive_points, attachment_damping=350.0)
-    return RingTyre(p, layout, nonproportionality=0.5, imperfections=contact_patch(p, load_n))
+    contact = ContactPatch(load_n) if load_n > 0 else None
+    return RingTyre(p, MeasurementLayout(drive_points=drive_points), cavity=Cavity(), contact=contact)
 
 
 def tyre_truth(
