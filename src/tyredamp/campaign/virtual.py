@@ -15,7 +15,7 @@ Pressure and load
 The pressure acts through the tyre itself: the hoop tension and the
 pressure part of the sidewall stiffness grow with it
 (:meth:`~tyredamp.virtual.RingTyreParameters.with_pressure`), and so does
-the cavity's speed of sound. A load ``F`` (N) presses the tyre on a flat road
+the density of the air in the cavity. A load ``F`` (N) presses the tyre on a flat road
 at 180 deg (the shaker is at point 1, 0 deg) through the
 :class:`~tyredamp.virtual.ContactPatch`: radial and tangential tread springs
 over the patch, whose half-length follows from the deflection ``F / K_hub``
