@@ -57,6 +57,7 @@ from .virtual_check import compare_with_truth
 __all__ = [
     "TRUTH_KIND",
     "VirtualCampaign",
+    "campaign_tyre",
     "check_virtual_output",
     "compare_with_truth",
     "tyre_truth",
@@ -133,7 +134,7 @@ def tyre_parameters(index: int, seed: int = 0) -> RingTyreParameters:
     )
 
 
-def _tyre(
+def campaign_tyre(
     params: RingTyreParameters,
     pressure_bar: float,
     load_n: float,
@@ -191,7 +192,7 @@ def _truth_modes(
     drive_points: tuple[int, ...],
     which: str,
 ) -> list[dict]:
-    truth = _tyre(params, pressure_bar, load_n, drive_points).truth()
+    truth = campaign_tyre(params, pressure_bar, load_n, drive_points).truth()
     out = []
     idx = (
         truth.select("visible")
@@ -315,7 +316,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
                 for p in s.pressures_bar:
                     name = f"{tid}_{p:g}bar_{load:g}N.uff"
                     seed = len(tests) + 1 + 1000 * s.seed
-                    tyre = _tyre(params, p, load, s.drive_points)
+                    tyre = campaign_tyre(params, p, load, s.drive_points)
                     test = run_modal_test(tyre, n_periods=s.periods, seed=seed)
                     write_frf(estimate_frf(test.data, "H1"), data / name)
                     tests.append(
