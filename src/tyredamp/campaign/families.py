@@ -42,12 +42,13 @@ carry, provided they are a majority of the family's labelled modes
 numbers (a patch at one angle couples harmonic ``n`` with ``n +- 1``,
 ``n +- 2``, ...), and a mode near the air cavity's resonance shares its
 motion with the cavity's, so a family's shapes can all be mixtures, none a
-single harmonic. Such a family (or one whose single-harmonic modes disagree)
-takes the *dominant* harmonic: the one with the largest summed energy
+single harmonic. Such a family takes the *dominant* harmonic: the one with the largest summed energy
 fraction over its modes' best harmonics; it is marked ``mixed`` and its label
 says so (``n=1 mixed``), with ``agreement`` the share of its modes whose best
-harmonic that is and ``fraction`` their mean energy fraction. Only a family
-with no shape to analyse has no wave number. Its member is the majority member of
+harmonic that is and ``fraction`` their mean energy fraction. A family
+whose single-harmonic modes do not agree (no majority: modes of different
+wave numbers tracked together) or that has no shape to analyse has no wave
+number and says so. Its member is the majority member of
 its modes (``pair`` for a family tracked as a pair, whose slots ``a``/``b``
 are the lower and upper member). The label reads ``n=2``, ``n=2 cos`` or,
 when two families share one wave number and member, ``n=2 cos (2nd)``.
@@ -186,7 +187,8 @@ class FamilyName:
     family : str
         The tracking's name (``F1``, ...).
     wave_number : int or None
-        The family's wave number (None: no mode shape could be analysed).
+        The family's wave number (None: its single-harmonic modes do not
+        agree on one, or no mode shape could be analysed).
     agreement : float
         Share of the family's single-harmonic modes that carry
         ``wave_number``; for a ``mixed`` family, the share of its analysed
@@ -286,6 +288,8 @@ def _family_wave(fam: str, waves: Sequence[ModeWave | None], pair: bool) -> Fami
                     member = m_best if m_count / sum(members.values()) > 0.5 else None
             frac = float(np.mean([w.fraction for w in labelled if w.n == n]))
             return FamilyName(fam, n, agreement, member, fam, len(labelled), False, frac)
+        # single harmonics that disagree: modes of different wave numbers in one family
+        return FamilyName(fam, None, agreement, None, fam, len(labelled))
     known = [w for w in waves if w is not None]
     if not known:
         return FamilyName(fam, None, math.nan, None, fam, len(labelled))
