@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
@@ -70,3 +71,17 @@ def test_manufacturing_scatter_is_seeded_and_small() -> None:
         assert abs(t.bending_stiffness / base.bending_stiffness - 1) < 0.15  # 5 sigma of 3 %
         assert abs(t.mass_per_length / base.mass_per_length - 1) < 0.05
     assert VirtualCampaign().held_out_bar == (6.375, 7.125, 7.875, 8.625)
+
+
+def test_a_breathing_shape_with_standard_errors_gets_its_amplitude_error() -> None:
+    # a loaded tyre's mixed shape can be best fitted by n = 0; its one-coefficient
+    # covariance gives the amplitude error sqrt(sigma^2 / (2 J)) of a constant fitted to J
+    # points of complex standard error sigma (half the complex variance in the real part)
+    from tyredamp.tyremodel.wavenumber import _label_shape
+
+    theta = np.arange(16) * 2 * np.pi / 16
+    sigma = np.full(16, 0.1)
+    label = _label_shape(theta, np.full(16, 2.0 + 0j), sigma, 7)
+    assert label.n == 0
+    assert label.amplitude_std is not None
+    assert_allclose(label.amplitude_std, math.sqrt(0.1**2 / (2 * 16)), rtol=1e-12)  # rounding
