@@ -64,17 +64,19 @@ def main() -> None:
         print(f"failed tests: {failed or 'none'}")
         truth = json.loads((data / "truth.json").read_text(encoding="utf-8"))
         check = compare_with_truth(results, truth, runs)
-        print("family  tests  true wave number per tyre")
+        print("family  label            tests  true wave number per tyre")
         n_tests = {f["family"]: f["n_tests"] for f in results.summary["families"]}
+        label = {f["family"]: f["label"] for f in results.summary["families"]}
         for fam, by_tyre in sorted(check["families"].items(), key=lambda kv: int(kv[0][1:])):
             waves = ", ".join(
                 f"{t}: {sorted(v, key=str)}" for t, v in sorted(by_tyre.items(), key=str)
             )
-            print(f"{fam:<7} {n_tests[fam]:>5}  {waves}")
-        print(f"swaps (a family with two wave numbers for one tyre): {check['swaps'] or 'none'}")
+            print(f"{fam:<7} {label[fam]:<16} {n_tests[fam]:>5}  {waves}")
+        print(f"swaps (a family with two true branches for one tyre): {check['swaps'] or 'none'}")
         print(f"identified modes with no true mode: {check['unmatched'] or 'none'}")
         print(f"families tracked as pairs (slots a, b): {check['pairs'] or 'none'}")
         print(f"pair slots holding both true members: {check['slot_swaps'] or 'none'}")
+        _print_attachment_share(truth)
         held = check["held_out"]
         print(
             f"held-out pressure trends: {len(held)} points, max |relative error| "
@@ -87,6 +89,26 @@ def main() -> None:
                 f"{h['pressure_bar']:g} bar: trend {h['trend_hz']:.4f} +- {h['trend_std_hz']:.4f} "
                 f"Hz, truth {h['true_hz']:.4f} Hz, error {100 * h['relative_error']:+.4f} %"
             )
+
+
+def _print_attachment_share(truth: dict) -> None:
+    """Share of the shaker tips in the off-diagonal modal damping of the first tyre."""
+    from tyredamp.campaign.virtual import campaign_tyre, tyre_parameters
+    from tyredamp.virtual.sources import damping_decomposition
+
+    spec = truth["spec"]
+    params = tyre_parameters(0, spec["seed"])
+    worst = 0.0
+    for load in spec["loads_n"]:
+        for p in (min(spec["pressures_bar"]), max(spec["pressures_bar"])):
+            tyre = campaign_tyre(params, p, load, tuple(spec["drive_points"]))
+            d = damping_decomposition(tyre)
+            k = d.names.index("attachment")
+            worst = max(worst, abs(float(d.share[k])), float(d.norm_ratio[k]))
+    print(
+        f"drive-point attachment in the off-diagonal C' (tyre 1, extreme pressures): "
+        f"at most {100 * worst:.1f} % (share or norm ratio)"
+    )
 
 
 if __name__ == "__main__":

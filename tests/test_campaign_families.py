@@ -74,6 +74,10 @@ def test_family_takes_the_majority_wave_number_and_member() -> None:
             "F2": [_w(2), _w(3)],  # no majority
             "F3": [_w(3, fraction=MIN_FRACTION / 2), None],  # nothing labelled
             "F4": [_w(4, "cos"), _w(4, "sin")],  # tracked as a pair
+            "F5": [None, None],  # no shape analysed
+            # mixed shapes (a loaded patch): harmonic 1 carries 0.45 + 0.5 + 0.3 = 1.25 of
+            # the summed best fractions, harmonic 2 0.6
+            "F6": [_w(1, None, 0.45), _w(2, None, 0.6), _w(1, None, 0.5), _w(1, None, 0.3)],
         },
         pairs=["F4"],
     )
@@ -82,9 +86,18 @@ def test_family_takes_the_majority_wave_number_and_member() -> None:
     assert names["F1"].agreement == pytest.approx(0.75)
     assert names["F2"].wave_number is None
     assert names["F2"].label == "F2"
-    assert names["F3"].wave_number is None
+    # no single harmonic: the dominant one, said to be mixed
+    assert names["F3"].wave_number == 3
     assert names["F3"].n_labelled == 0
-    assert math.isnan(names["F3"].agreement)
+    assert names["F3"].mixed
+    assert names["F3"].label == "n=3 mixed"
+    assert names["F5"].wave_number is None
+    assert math.isnan(names["F5"].agreement)
+    assert names["F6"].wave_number == 1
+    assert names["F6"].agreement == pytest.approx(3 / 4)  # 3 of 4 modes have 1 as best
+    assert names["F6"].fraction == pytest.approx((0.45 + 0.5 + 0.3) / 3)  # closed form
+    assert names["F6"].to_dict()["wave_mixed"] is True
+    assert not names["F1"].mixed
     assert names["F4"].member == "pair"
     assert names["F4"].label == "n=4"
 

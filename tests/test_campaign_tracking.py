@@ -338,3 +338,33 @@ def test_excitation_layout_of_a_ring_test_with_two_shakers() -> None:
         "single_member": list(range(1, 9)),
     }
     assert excitation_layout(run([0.0, None])) is None  # an angle unknown: nothing said
+
+
+def test_three_overlapping_modes_are_grouped_as_the_families_are() -> None:
+    # a single mode of wave number 4 beside a doubled n = 1 pair; at the second pressure
+    # all three half-power bands overlap and the single mode is nearer the pair's lower
+    # member than the members are to each other
+    f1, z1 = np.array([135.0, 144.9, 146.2]), np.array([0.005, 0.005, 0.005])
+    f2, z2 = np.array([144.6, 146.1, 148.3]), np.array([0.017, 0.010, 0.015])
+    pair_rot = np.column_stack([ring_shape(1, 0.3), ring_shape(1, 0.3 + np.pi / 2)])
+    a = ModeSet(
+        "a",
+        {"tyre": "A", "pressure_bar": 7.5},
+        f1,
+        z1,
+        np.column_stack([ring_shape(4), ring_shape(1), ring_shape(1, np.pi / 2)]),
+        POINTS,
+    )
+    b = ModeSet(
+        "b", {"tyre": "A", "pressure_bar": 9.0}, f2, z2,
+        np.column_stack([ring_shape(4, 0.05), pair_rot]), POINTS,
+    )  # fmt: skip
+    assert group_pairs(f2, z2) == [(0, 1), (2,)]  # closest first pairs the wrong two
+    tr = track_modes([a, b])
+    assert tr.family[("a", 0)] == tr.family[("b", 0)]  # the n = 4 mode: one family, no slot
+    assert tr.slot[("b", 0)] == ""
+    # the doubled pair stays one pair family, its members in slots a and b
+    assert tr.family[("a", 1)] == tr.family[("b", 1)] == tr.family[("b", 2)]
+    assert [tr.slot[("b", q)] for q in (1, 2)] == ["a", "b"]
+    assert tr.family[("a", 1)] in tr.pairs
+    assert tr.family[("a", 0)] not in tr.pairs

@@ -38,8 +38,17 @@ Per family
 ----------
 The family's wave number is the one that most of its single-harmonic modes
 carry, provided they are a majority of the family's labelled modes
-(``agreement`` is that share); otherwise, or with no labelled mode, the
-family has no wave number and says so. Its member is the majority member of
+(``agreement`` is that share). A loaded tyre's contact patch mixes wave
+numbers (a patch at one angle couples harmonic ``n`` with ``n +- 1``,
+``n +- 2``, ...), and a mode near the air cavity's resonance shares its
+motion with the cavity's, so a family's shapes can all be mixtures, none a
+single harmonic. Such a family takes the *dominant* harmonic: the one with the largest summed energy
+fraction over its modes' best harmonics; it is marked ``mixed`` and its label
+says so (``n=1 mixed``), with ``agreement`` the share of its modes whose best
+harmonic that is and ``fraction`` their mean energy fraction. A family
+whose single-harmonic modes do not agree (no majority: modes of different
+wave numbers tracked together) or that has no shape to analyse has no wave
+number and says so. Its member is the majority member of
 its modes (``pair`` for a family tracked as a pair, whose slots ``a``/``b``
 are the lower and upper member). The label reads ``n=2``, ``n=2 cos`` or,
 when two families share one wave number and member, ``n=2 cos (2nd)``.
@@ -50,7 +59,7 @@ from __future__ import annotations
 import math
 from collections import Counter, defaultdict
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -178,11 +187,12 @@ class FamilyName:
     family : str
         The tracking's name (``F1``, ...).
     wave_number : int or None
-        The family's wave number (None: its modes do not agree on one, or
-        none is a single harmonic).
+        The family's wave number (None: its single-harmonic modes do not
+        agree on one, or no mode shape could be analysed).
     agreement : float
         Share of the family's single-harmonic modes that carry
-        ``wave_number`` (NaN without any).
+        ``wave_number``; for a ``mixed`` family, the share of its analysed
+        modes whose best harmonic it is (NaN without any).
     member : str or None
         ``"cos"``, ``"sin"``, ``"forward"``, ``"backward"``, ``"pair"``
         (tracked as a pair) or None.
@@ -191,6 +201,12 @@ class FamilyName:
         there is no wave number.
     n_labelled : int
         How many of its modes are single harmonics.
+    mixed : bool
+        The wave number is the dominant harmonic of mixed shapes (module
+        docstring), not that of single-harmonic modes.
+    fraction : float
+        Mean energy fraction of ``wave_number`` in the modes whose best
+        harmonic it is (NaN without any).
     """
 
     family: str
@@ -199,6 +215,8 @@ class FamilyName:
     member: str | None
     label: str
     n_labelled: int
+    mixed: bool = False
+    fraction: float = math.nan
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-JSON form."""
@@ -209,6 +227,8 @@ class FamilyName:
             "member": self.member,
             "label": self.label,
             "n_labelled": self.n_labelled,
+            "wave_mixed": self.mixed,
+            "wave_fraction": None if math.isnan(self.fraction) else self.fraction,
         }
 
 
@@ -231,39 +251,58 @@ def family_names(
     """
     out: dict[str, FamilyName] = {}
     for fam, waves in families.items():
-        labelled = [w for w in waves if w is not None and w.single]
-        n: int | None = None
-        agreement = math.nan
-        member = None
-        if labelled:
-            (n_best, count), *_ = Counter(w.n for w in labelled).most_common(1)
-            agreement = count / len(labelled)
-            if agreement > 0.5:
-                n = int(n_best)
-                if fam in pairs:
-                    member = "pair"
-                elif n > 0:
-                    members = Counter(w.member for w in labelled if w.n == n and w.member)
-                    if members:
-                        (m_best, m_count), *_ = members.most_common(1)
-                        member = m_best if m_count / sum(members.values()) > 0.5 else None
-        out[fam] = FamilyName(fam, n, agreement, member, fam, len(labelled))
+        out[fam] = _family_wave(fam, waves, fam in pairs)
     # labels; families sharing one wave number and member are told apart by frequency order
-    seen: dict[tuple[int, str | None], int] = defaultdict(int)
+    seen: dict[tuple[int, str | None, bool], int] = defaultdict(int)
     for fam, name in out.items():
         if name.wave_number is None:
             continue
-        key = (name.wave_number, name.member)
+        key = (name.wave_number, name.member, name.mixed)
         seen[key] += 1
         text = f"n={name.wave_number}"
         if name.member in ("cos", "sin", "forward", "backward"):
             text += f" {name.member}"
+        if name.mixed:
+            text += " mixed"
         if seen[key] > 1:
             text += f" ({_ordinal(seen[key])})"
-        out[fam] = FamilyName(
-            fam, name.wave_number, name.agreement, name.member, text, name.n_labelled
-        )
+        out[fam] = replace(name, label=text)
     return out
+
+
+def _family_wave(fam: str, waves: Sequence[ModeWave | None], pair: bool) -> FamilyName:
+    """Wave number and member of one family from its modes' waves (module docstring)."""
+    labelled = [w for w in waves if w is not None and w.single]
+    if labelled:
+        (n_best, count), *_ = Counter(w.n for w in labelled).most_common(1)
+        agreement = count / len(labelled)
+        if agreement > 0.5:
+            n = int(n_best)
+            member = None
+            if pair:
+                member = "pair"
+            elif n > 0:
+                members = Counter(w.member for w in labelled if w.n == n and w.member)
+                if members:
+                    (m_best, m_count), *_ = members.most_common(1)
+                    member = m_best if m_count / sum(members.values()) > 0.5 else None
+            frac = float(np.mean([w.fraction for w in labelled if w.n == n]))
+            return FamilyName(fam, n, agreement, member, fam, len(labelled), False, frac)
+        # single harmonics that disagree: modes of different wave numbers in one family
+        return FamilyName(fam, None, agreement, None, fam, len(labelled))
+    known = [w for w in waves if w is not None]
+    if not known:
+        return FamilyName(fam, None, math.nan, None, fam, len(labelled))
+    # mixed shapes: the harmonic with the largest summed energy fraction
+    energy: dict[int, float] = defaultdict(float)
+    for w in known:
+        energy[w.n] += w.fraction
+    n = max(sorted(energy), key=lambda k: energy[k])
+    mine = [w.fraction for w in known if w.n == n]
+    member = "pair" if pair else None
+    return FamilyName(
+        fam, n, len(mine) / len(known), member, fam, len(labelled), True, float(np.mean(mine))
+    )
 
 
 def _ordinal(k: int) -> str:

@@ -9,7 +9,15 @@ physical mode seen at different pressures, loads, speeds, tyres):
    ``|f_i - f_j| < zeta_i f_i + zeta_j f_j`` (modal overlap above one), form a
    *pair*: the doubled cos/sin modes of one wave number of a nearly
    axisymmetric tyre, whose individual shapes rotate freely inside their
-   2-D subspace from test to test. A pair is matched as a whole by the
+   2-D subspace from test to test. Where three or more neighbours overlap
+   in a row (a doubled mode beside a cavity resonance), every grouping of
+   them into disjoint pairs and singles is tried
+   (:func:`~tyredamp.campaign.pairing.pairings`) and the one whose units
+   match the families already found at the least total cost (step 3; a mode
+   starting a family, or left without a partner by a match of a pair with a
+   single mode, costs more than any admissible match) is kept; the
+   first test of a campaign is grouped closest neighbours first. A pair is
+   matched as a whole by the
    subspace MAC, the mean squared cosine of the principal angles between the
    two mode-shape subspaces (for single modes this is the usual MAC,
    ``|u^H v|^2 / (|u|^2 |v|^2)``; Allemang 2003 for the MAC, Björck & Golub
@@ -73,7 +81,6 @@ stated standard errors allow).
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -84,6 +91,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from ..exceptions import InputError
+from .pairing import group_pairs, pairings
 
 __all__ = [
     "FALLBACK_ALPHA",
@@ -165,37 +173,6 @@ class ModeSet:
         object.__setattr__(self, "points", tuple(self.points))
 
 
-def group_pairs(frequency_hz: ArrayLike1, damping_ratio: ArrayLike1) -> list[tuple[int, ...]]:
-    """Group modes into units: pairs with overlapping half-power bands, else singles.
-
-    Two modes ``i``, ``j`` form a pair when ``|f_i - f_j| < zeta_i f_i + zeta_j f_j``;
-    the closest qualifying neighbours are paired first and a mode belongs to at
-    most one pair. Returns index tuples in increasing frequency.
-    """
-    f = np.asarray(frequency_hz, dtype=float)
-    z = np.abs(np.asarray(damping_ratio, dtype=float))
-    order = np.argsort(f, kind="stable")
-    cand = []
-    for a, b in itertools.pairwise(order):
-        d = abs(f[b] - f[a])
-        if d < z[a] * f[a] + z[b] * f[b]:
-            cand.append((d, int(a), int(b)))
-    used: set[int] = set()
-    pairs: dict[int, tuple[int, ...]] = {}
-    for _, a, b in sorted(cand):
-        if a not in used and b not in used:
-            used |= {a, b}
-            pairs[a] = (a, b)
-    units = []
-    for i in order:
-        i = int(i)
-        if i in pairs:
-            units.append(pairs[i])
-        elif i not in used:
-            units.append((i,))
-    return units
-
-
 ArrayLike1 = Sequence[float] | NDArray[np.float64]
 
 
@@ -235,10 +212,13 @@ class _Unit:
     damping_std: float = 0.0
 
 
-def _units(s: ModeSet, i: int) -> list[_Unit]:
-    """The matching units (pairs and singles) of one test, with their mean f and zeta."""
+def _units(s: ModeSet, i: int, grouping: Sequence[tuple[int, ...]] | None = None) -> list[_Unit]:
+    """The matching units (pairs and singles) of one test, with their mean f and zeta.
+
+    ``grouping`` (index tuples) defaults to :func:`group_pairs`.
+    """
     out = []
-    for u in group_pairs(s.frequency_hz, s.damping_ratio):
+    for u in group_pairs(s.frequency_hz, s.damping_ratio) if grouping is None else grouping:
         q = list(u)
         sf = np.nan_to_num(s.frequency_std_hz[q], nan=0.0)  # type: ignore[index]
         sz = np.nan_to_num(s.damping_ratio_std[q], nan=0.0)  # type: ignore[index]
@@ -426,6 +406,74 @@ def _shapes_at(s: ModeSet, modes: tuple[int, ...], points: Sequence[str]) -> NDA
     return s.shapes[np.ix_(idx, list(modes))]
 
 
+#: Cost of a mode that starts a family of its own, or that a match leaves without a
+#: partner (a pair matched to a single mode): above every admissible match, whose cost
+#: ``(1 - MAC) + (Delta f / gap)^2`` stays below 1.5 (fallback: below 1).
+_NEW = 1.5
+
+
+def _match_units(
+    reps: Sequence[_Unit],
+    cur: Sequence[_Unit],
+    s: ModeSet,
+    sets: Sequence[ModeSet],
+    units: Sequence[Sequence[_Unit]],
+    stats: tuple[float, float, Mapping[int, float]],
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Costs of matching the units ``cur`` of test ``s`` to the families' ``reps``.
+
+    Returns the total cost of the best assignment (admissible matches, plus
+    :data:`_NEW` for each mode left to start a family) and the cost, MAC and
+    ``z`` matrices, shape (len(reps), len(cur)) (module docstring, steps 3-4).
+    A match between a pair and a single mode costs :data:`_NEW` more (one mode
+    is left without a partner), so the grouping into pairs that matches the
+    families' own grouping is preferred.
+    """
+    tau_f, tau_z, limit = stats
+    cost = np.full((len(reps), len(cur)), _FAR)
+    macs = np.full((len(reps), len(cur)), np.nan)
+    zs = np.full((len(reps), len(cur)), np.nan)
+    for a, rep in enumerate(reps):
+        rs = sets[rep.test]
+        common = [p for p in rs.points if p in s.points]
+        if len(common) < MIN_COMMON_POINTS:
+            # no shapes to compare: frequency and damping (module docstring, step 4)
+            gap_r = _nearest_gap(rep, units[rep.test])
+            for b, unit in enumerate(cur):
+                df = abs(unit.frequency - rep.frequency)
+                z2, dof = _fallback_z2(rep, unit, tau_f, tau_z)
+                zs[a, b] = math.sqrt(z2)
+                if z2 < limit[dof] and 2 * df < min(gap_r, _nearest_gap(unit, cur)):
+                    cost[a, b] = z2 / limit[dof]
+            continue
+        own = rs.shapes[:, list(rep.modes)]
+        alike = [
+            u.frequency
+            for u in units[rep.test]
+            if u is not rep and subspace_mac(own, rs.shapes[:, list(u.modes)]) >= MAC_MIN
+        ]
+        gap = min((abs(rep.frequency - f) for f in alike), default=math.inf)
+        ur = _shapes_at(rs, rep.modes, common)
+        for b, unit in enumerate(cur):
+            m = subspace_mac(ur, _shapes_at(s, unit.modes, common))
+            df = abs(unit.frequency - rep.frequency)
+            macs[a, b] = m
+            if m >= MAC_MIN and df < gap:
+                rel = 0.0 if math.isinf(gap) else df / gap
+                cost[a, b] = (1.0 - m) + rel**2
+    for a, rep in enumerate(reps):
+        for b, unit in enumerate(cur):
+            if cost[a, b] < _FAR:
+                cost[a, b] += _NEW * abs(len(unit.modes) - len(rep.modes))
+    total = _NEW * sum(len(u.modes) for u in cur)
+    if reps and cur:
+        rows, cols = linear_sum_assignment(cost)
+        for a, b in zip(rows, cols, strict=True):
+            if cost[a, b] < _FAR:
+                total += cost[a, b] - _NEW * len(cur[b].modes)
+    return float(total), cost, macs, zs
+
+
 def track_modes(sets: Sequence[ModeSet]) -> Tracking:
     """Match the modes of all tests into families (see the module docstring).
 
@@ -451,44 +499,22 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
     how: dict[tuple[int, tuple[int, ...]], tuple[str, float, float]] = {}
     for i in order:
         s = sets[i]
-        cur = units[i]
-        if not cur:
+        if not units[i]:
             continue
-        reps: list[_Unit] = []
-        for fam in members:
-            j = min(fam, key=lambda t: (dist(s, sets[t]), t))
-            reps.append(fam[j])
-        cost = np.full((len(reps), len(cur)), _FAR)
-        macs = np.full((len(reps), len(cur)), np.nan)
-        zs = np.full((len(reps), len(cur)), np.nan)
-        for a, rep in enumerate(reps):
-            rs = sets[rep.test]
-            common = [p for p in rs.points if p in s.points]
-            if len(common) < MIN_COMMON_POINTS:
-                # no shapes to compare: frequency and damping (module docstring, step 4)
-                gap_r = _nearest_gap(rep, units[rep.test])
-                for b, unit in enumerate(cur):
-                    df = abs(unit.frequency - rep.frequency)
-                    z2, dof = _fallback_z2(rep, unit, tau_f, tau_z)
-                    zs[a, b] = math.sqrt(z2)
-                    if z2 < limit[dof] and 2 * df < min(gap_r, _nearest_gap(unit, cur)):
-                        cost[a, b] = z2 / limit[dof]
-                continue
-            own = rs.shapes[:, list(rep.modes)]
-            alike = [
-                u.frequency
-                for u in units[rep.test]
-                if u is not rep and subspace_mac(own, rs.shapes[:, list(u.modes)]) >= MAC_MIN
-            ]
-            gap = min((abs(rep.frequency - f) for f in alike), default=math.inf)
-            ur = _shapes_at(rs, rep.modes, common)
-            for b, unit in enumerate(cur):
-                m = subspace_mac(ur, _shapes_at(s, unit.modes, common))
-                df = abs(unit.frequency - rep.frequency)
-                macs[a, b] = m
-                if m >= MAC_MIN and df < gap:
-                    rel = 0.0 if math.isinf(gap) else df / gap
-                    cost[a, b] = (1.0 - m) + rel**2
+        reps = [fam[min(fam, key=lambda t: (dist(s, sets[t]), t))] for fam in members]
+        # the grouping of overlapping modes into pairs whose units match the families best
+        best: tuple[float, list[_Unit], Any] | None = None
+        for grouping in pairings(s.frequency_hz, s.damping_ratio):
+            cur = _units(s, i, grouping)
+            match = _match_units(reps, cur, s, sets, units, (tau_f, tau_z, limit))
+            if best is None or match[0] < best[0] - 1e-9:
+                best = (match[0], cur, match[1:])
+            if not reps:
+                break
+        if best is None:  # pairings() yields at least the closest-first grouping
+            continue
+        _, cur, (cost, macs, zs) = best
+        units[i] = cur
         taken: set[int] = set()
         if reps:
             rows, cols = linear_sum_assignment(cost)

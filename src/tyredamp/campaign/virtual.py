@@ -1,22 +1,27 @@
 """A virtual test campaign: several truck tyres x pressures x loads, plus the lateral rig.
 
-Each virtual tyre is the ring tyre of :mod:`tyredamp.virtual` with
+Each virtual tyre is the physical ring tyre of :mod:`tyredamp.virtual`, the
+tyre of ``tyredamp simulate radial`` (docs ``virtual-tyre.md``), with
 *manufacturing scatter*: its bending stiffness, band mass, radial sidewall
 stiffness and radial damping are drawn around the defaults (relative standard
-deviations 3, 1, 5 and 5 %, seeded per tyre).
+deviations 3, 1, 5 and 5 %, seeded per tyre). Its damping is the physical
+one: the rubber losses of band and sidewalls, the air cavity, the 10 g tip
+with its 2 N s/m tread loss under each shaker
+(:func:`~tyredamp.virtual.sources.tip_loss_damping`) and, under load, the
+tread in the contact patch.
 
-Load
-----
-The ring tyre has no contact model, so a load ``F`` (N) on a flat surface is
-modelled as a small documented change: a *contact-patch foundation* of
-radial stiffness ``k_c`` per unit length (N/m^2, default 1e6, two thirds of
-the sidewall ``k_r``) over the arc of the contact patch at 180 deg (the
-bottom; the shaker is at point 1, 0 deg). The patch length is
-``2 a = F / (p b)`` (contact pressure equal to the inflation pressure ``p``
-over the belt width ``b``); each ring node gets ``k_c`` times the length of
-its cell inside the patch (:func:`contact_patch`), so the stiffness changes
-smoothly with load and pressure. Rolling, tread deflection and the change of
-the hoop tension by the load are not modelled.
+Pressure and load
+-----------------
+The pressure acts through the tyre itself: the hoop tension and the
+pressure part of the sidewall stiffness grow with it
+(:meth:`~tyredamp.virtual.RingTyreParameters.with_pressure`), and so does
+the density of the air in the cavity. A load ``F`` (N) presses the tyre on a flat road
+at 180 deg (the shaker is at point 1, 0 deg) through the
+:class:`~tyredamp.virtual.ContactPatch`: radial and tangential tread springs
+over the patch, whose half-length follows from the deflection ``F / K_hub``
+by the MF-Tyre 6.1 contact-length law (Pacejka & Besselink 2012, eq. (A3.7)),
+``K_hub`` the tyre's own vertical stiffness at that pressure; a heavier load
+or a softer tyre gives a longer patch, which splits the doubled modes more.
 
 The truth of every test (exact modes at the 16 points) is written beside it,
 and also the truth at *held-out* pressures (the midpoints between tested
@@ -35,20 +40,26 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from ..documents.jsonfile import write_json
 from ..exceptions import InputError
 from ..io import write_frf
 from ..io._safety import atomic_dir, atomic_path, check_output_dir
-from ..virtual import Imperfection, MeasurementLayout, RingTyre, RingTyreParameters
+from ..virtual import (
+    Cavity,
+    ContactPatch,
+    MeasurementLayout,
+    RingTyre,
+    RingTyreParameters,
+)
+from .virtual_check import compare_with_truth
 
 __all__ = [
     "TRUTH_KIND",
     "VirtualCampaign",
+    "campaign_tyre",
     "check_virtual_output",
     "compare_with_truth",
-    "contact_patch",
     "tyre_truth",
     "write_virtual_campaign",
 ]
@@ -56,8 +67,6 @@ __all__ = [
 BAR = 1.0e5
 #: ``kind`` of the truth.json of a virtual campaign.
 TRUTH_KIND = "tyredamp-virtual-campaign-truth"
-#: Default contact-patch foundation stiffness per unit length, N/m^2.
-CONTACT_STIFFNESS = 1.0e6
 
 
 @dataclass(frozen=True)
@@ -125,54 +134,26 @@ def tyre_parameters(index: int, seed: int = 0) -> RingTyreParameters:
     )
 
 
-def contact_patch(
-    params: RingTyreParameters,
-    load_n: float,
-    n_ring: int = 64,
-    stiffness: float = CONTACT_STIFFNESS,
-) -> tuple[Imperfection, ...]:
-    """Radial springs of the contact patch of a load ``load_n`` (N) at 180 deg.
-
-    The patch half-angle is ``a / R`` with ``2 a = F / (p b)``; node ``i`` (at
-    ``360 i / n_ring`` deg, cell of width ``2 pi R / n_ring``) gets the spring
-    ``stiffness * (length of its cell inside the patch)`` in N/m.
-
-    Raises
-    ------
-    InputError
-        A negative or non-finite load, or a load on an uninflated tyre.
-    """
-    if not (math.isfinite(load_n) and load_n >= 0):
-        raise InputError(f"load_n: expected a load >= 0 N, got {load_n}")
-    if load_n == 0:
-        return ()
-    if params.pressure <= 0:
-        raise InputError("load_n: a loaded tyre needs an inflation pressure > 0")
-    r = params.radius
-    half = load_n / (2 * params.pressure * params.width) / r  # patch half-angle, rad
-    h = 2 * np.pi / n_ring
-    out = []
-    for i in range(n_ring):
-        theta = i * h
-        lo = max(theta - h / 2, np.pi - half)
-        hi = min(theta + h / 2, np.pi + half)
-        if hi > lo:
-            out.append(Imperfection(math.degrees(theta), stiffness=stiffness * r * (hi - lo)))
-    return tuple(out)
-
-
-def _tyre(
+def campaign_tyre(
     params: RingTyreParameters,
     pressure_bar: float,
     load_n: float,
     drive_points: tuple[int, ...] = (1,),
 ) -> RingTyre:
+    """The physical virtual tyre of one test: the tyre of ``tyredamp simulate radial``.
+
+    Shaker tips of the default :class:`~tyredamp.virtual.MeasurementLayout`
+    (10 g, 2 N s/m tread loss under each tip), the rubber losses of the ring,
+    the air cavity and, for ``load_n`` > 0, the loaded
+    :class:`~tyredamp.virtual.ContactPatch` (its length from the load and the
+    tyre's own vertical stiffness at this pressure), with the physical damping
+    (``nonproportionality`` 1).
+    """
     p = params.with_pressure(pressure_bar * BAR)
-    # the campaign's tyre as it was before the physical sources (virtual/contact.py,
-    # cavity.py): a 350 N s/m tip damper at half its off-diagonal C'; moving it to
-    # ContactPatch and the 30 N s/m tip changes the campaign's truth (its owner's call)
-    layout = MeasurementLayout(drive_points=drive_points, attachment_damping=350.0)
-    return RingTyre(p, layout, nonproportionality=0.5, imperfections=contact_patch(p, load_n))
+    contact = ContactPatch(load_n) if load_n > 0 else None
+    return RingTyre(
+        p, MeasurementLayout(drive_points=drive_points), cavity=Cavity(), contact=contact
+    )
 
 
 def tyre_truth(
@@ -211,7 +192,7 @@ def _truth_modes(
     drive_points: tuple[int, ...],
     which: str,
 ) -> list[dict]:
-    truth = _tyre(params, pressure_bar, load_n, drive_points).truth()
+    truth = campaign_tyre(params, pressure_bar, load_n, drive_points).truth()
     out = []
     idx = (
         truth.select("visible")
@@ -335,7 +316,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
                 for p in s.pressures_bar:
                     name = f"{tid}_{p:g}bar_{load:g}N.uff"
                     seed = len(tests) + 1 + 1000 * s.seed
-                    tyre = _tyre(params, p, load, s.drive_points)
+                    tyre = campaign_tyre(params, p, load, s.drive_points)
                     test = run_modal_test(tyre, n_periods=s.periods, seed=seed)
                     write_frf(estimate_frf(test.data, "H1"), data / name)
                     tests.append(
@@ -395,7 +376,16 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
     doc = {
         "kind": TRUTH_KIND,
         "version": 1,
-        "contact_stiffness_n_m2": CONTACT_STIFFNESS,
+        "contact": {
+            k: getattr(ContactPatch(1.0), k)
+            for k in (
+                "radial_stiffness",
+                "tangential_stiffness",
+                "loss_factor",
+                "length_sqrt",
+                "length_linear",
+            )
+        },
         "spec": {
             "n_tyres": s.n_tyres,
             "pressures_bar": list(s.pressures_bar),
@@ -449,152 +439,3 @@ def campaign_file_text(spec: VirtualCampaign, tests: list[dict[str, Any]]) -> st
                 lines.append(f"{k} = {_toml_value(entry[k])}")
         lines.append("")
     return "\n".join(lines)
-
-
-def _true_match(
-    freqs: NDArray[np.float64], shapes: NDArray[np.complex128], truth: list[dict[str, Any]]
-) -> list[tuple[int, int] | None]:
-    """The true mode matched to each identified mode (assignment on MAC and frequency).
-
-    Each match is ``(wave number, rank)``, ``rank`` the position of the true
-    mode among the true modes of that wave number by frequency (0 lower).
-    """
-    from scipy.optimize import linear_sum_assignment
-
-    from .tracking import MAC_MIN, subspace_mac
-
-    if not truth or freqs.size == 0:
-        return [None] * int(freqs.size)
-    cost = np.full((freqs.size, len(truth)), 1e6)
-    for i in range(freqs.size):
-        for j, t in enumerate(truth):
-            psi = np.array([complex(a, b) for a, b in t["shape"]])
-            mac = subspace_mac(shapes[:, i], psi)
-            rel = abs(freqs[i] - t["frequency_hz"]) / t["frequency_hz"]
-            if mac >= MAC_MIN and rel < 0.05:
-                cost[i, j] = (1 - mac) + rel
-    out: list[tuple[int, int] | None] = [None] * int(freqs.size)
-    for i, j in zip(*linear_sum_assignment(cost), strict=True):
-        if cost[i, j] < 1e6:
-            t = truth[int(j)]
-            same = sorted(u["frequency_hz"] for u in truth if u["wave_number"] == t["wave_number"])
-            out[int(i)] = (int(t["wave_number"]), same.index(t["frequency_hz"]))
-    return out
-
-
-def compare_with_truth(results: Any, truth: dict[str, Any], runs: Any) -> dict[str, Any]:
-    """Check a campaign's results on the virtual campaign against its truth.
-
-    Parameters
-    ----------
-    results : CampaignResults
-        From :func:`tyredamp.campaign.outputs.write_outputs`.
-    truth : dict
-        The ``truth.json`` document of :func:`write_virtual_campaign`.
-    runs : sequence of TestRun
-        The runs (their mode shapes are matched to the true shapes).
-
-    Returns
-    -------
-    dict
-        ``families``: family -> {tyre: set of true wave numbers} (one number
-        each when there is no swap); ``unmatched``: identified modes with no
-        true mode; ``weak``: identified modes that are measurable true modes
-        below the visibility threshold (``weak_modes`` of the truth: test,
-        mode, frequency, wave number); ``swaps``: families holding two wave numbers for one tyre;
-        ``pairs``: families tracked as pairs; ``slot_swaps``: a pair's slot
-        (``a``/``b``) holding both true members of the pair for one tyre;
-        ``held_out``: one row per (family, tyre, load, held-out pressure) with
-        the trend, the truth and the relative error; ``max_held_out_error``.
-    """
-    from . import steps
-
-    by_file = {t["file"]: t for t in truth["tests"] if t["study"] == "radial"}
-    wave: dict[tuple[str, int], tuple[int, int] | None] = {}
-    weak: dict[tuple[str, int], int] = {}  # (test, mode) -> wave number of a weak true mode
-    for r in runs:
-        t = by_file.get(r.spec.rel)
-        recs = steps.mode_records(r.spec.study, r.documents)
-        if t is None or not recs:
-            continue
-        freqs = np.array([m["frequency_hz"] for m in recs], dtype=float)
-        shapes = np.column_stack([m["shape"] for m in recs])
-        found = _true_match(freqs, shapes, t["modes"])
-        rest = [k for k, m in enumerate(found) if m is None]
-        if rest and t.get("weak_modes"):
-            # identified modes that are no visible mode: a weakly driven true mode?
-            for k, m in zip(
-                rest, _true_match(freqs[rest], shapes[:, rest], t["weak_modes"]), strict=True
-            ):
-                if m is not None:
-                    weak[(r.spec.test_id, k + 1)] = m[0]
-        for k, m in enumerate(found):
-            wave[(r.spec.test_id, k + 1)] = m
-    families: dict[str, dict[str, set[int | None]]] = {}
-    slots: dict[tuple[str, str, str], set[int]] = {}
-    unmatched = []
-    weak_found = []
-    for row in results.modes:
-        key = (row["test_id"], row["mode"])
-        match = wave.get(key)
-        wn = None if match is None else match[0]
-        if match is None and key in weak:
-            wn = weak[key]
-            weak_found.append((row["test_id"], row["mode"], row["frequency_hz"], wn))
-        elif match is None:
-            unmatched.append((row["test_id"], row["mode"], row["frequency_hz"]))
-        families.setdefault(row["family"], {}).setdefault(row["tyre"], set()).add(wn)
-        if match is not None and row["slot"]:
-            slots.setdefault((row["family"], row["slot"], row["tyre"]), set()).add(match[1])
-    slot_swaps = [(k, sorted(v)) for k, v in slots.items() if len(v) > 1]
-    swaps = [
-        (fam, tyre, sorted(v, key=str))
-        for fam, d in families.items()
-        for tyre, v in d.items()
-        if len(v - {None}) > 1
-    ]
-    fam_wave = {
-        fam: next(iter(set().union(*d.values()) - {None}), None) for fam, d in families.items()
-    }
-    held = []
-    for about, fit, _ in results.fits:
-        if about["quantity"] != "frequency_hz" or about["condition"] != "pressure_bar":
-            continue
-        n_true = fam_wave.get(about["family"])
-        load = about["fixed"].get("load_n")
-        for h in truth["held_out"]:
-            if h["tyre"] != about["tyre"] or h["load_n"] != load:
-                continue
-            if not fit.x0 - fit.xs <= h["pressure_bar"] <= fit.x0 + fit.xs:
-                continue  # only inside the tested range of this series
-            true = sorted(m["frequency_hz"] for m in h["modes"] if m["wave_number"] == n_true)
-            slot = about["slot"]
-            if slot and len(true) == 2:
-                true = [true["ab".index(slot)]]  # a pair: slot a is the lower member
-            if len(true) != 1:
-                continue
-            f, sf = fit.predict([h["pressure_bar"]])
-            held.append(
-                {
-                    "family": about["family"],
-                    "slot": about["slot"],
-                    "wave_number": n_true,
-                    "tyre": about["tyre"],
-                    "load_n": load,
-                    "pressure_bar": h["pressure_bar"],
-                    "trend_hz": float(f[0]),
-                    "trend_std_hz": float(sf[0]),
-                    "true_hz": true[0],
-                    "relative_error": float(f[0] / true[0] - 1),
-                }
-            )
-    return {
-        "families": families,
-        "unmatched": unmatched,
-        "weak": weak_found,
-        "swaps": swaps,
-        "pairs": sorted({k[0] for k in slots}, key=lambda f: int(f[1:])),
-        "slot_swaps": slot_swaps,
-        "held_out": held,
-        "max_held_out_error": max((abs(h["relative_error"]) for h in held), default=float("nan")),
-    }

@@ -47,7 +47,8 @@ def simulate_campaign_command(
     """Write a virtual test campaign of the truck tyre, its truth and a campaign file.
 
     3 tyres with manufacturing scatter x 5 pressures (6-9 bar) x 3 loads
-    (10-30 kN, a contact-patch foundation; see tyredamp.campaign.virtual):
+    (10-30 kN, on the contact patch of the physical virtual tyre of
+    'tyredamp simulate radial'; see tyredamp.campaign.virtual):
     radial modal tests as UFF FRF files (16 points, drive point 1, 40 dB);
     the lateral rolling rig at 5, 10 and 15 km/h; truth.json with the exact
     modes of every test and at held-out pressures; campaign.toml for

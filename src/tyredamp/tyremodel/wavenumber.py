@@ -483,8 +483,8 @@ def _label_shape(
         antinode = float(np.mod(raw_deg + period / 2, period) - period / 2)
     amp_std = None
     if sig is not None and amp > 0:
-        u = np.array([ar, br]) / amp
-        cov_real = 0.5 * best.covariance
+        cov_real = 0.5 * best.covariance  # (1, 1) for n = 0: b is not fitted
+        u = (np.array([ar, br]) / amp)[: cov_real.shape[0]]
         amp_std = float(math.sqrt(max(float(u @ cov_real @ u), 0.0)))
     pval = None
     if best.chi2 is not None and best.dof > 0:
