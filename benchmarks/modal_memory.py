@@ -1,7 +1,8 @@
 """Memory per frequency line and narrow-band time of ``identify_modes`` (issue 15).
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/modal_memory.py [--lines 1e5 3e5 1e6 4e6]
-[--long 2e6]``.
+[--long 2e6] [--model complex|both]`` (``--long 0``: no narrow-band run; ``--model both``:
+the real-mode model too, the default of ``tyredamp modal``).
 
 Each size runs in a fresh process: a 1 x 1 accelerance of a 6-mode system
 (20-190 Hz, 1-3 % damping) on ``n`` uniform lines over 0-200 Hz with 40 dB
@@ -36,7 +37,7 @@ import numpy as np
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
 
-n = int(float(sys.argv[1])); band = json.loads(sys.argv[2])
+n = int(float(sys.argv[1])); band = json.loads(sys.argv[2]); model = sys.argv[3]
 fn = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0])
 z = np.array([0.03, 0.02, 0.02, 0.015, 0.012, 0.01])
 w = 2 * np.pi * fn
@@ -51,7 +52,7 @@ def make(n):
     del e
     return FRF(f[1:], h, kind="accelerance")
 # one-time costs of the process (library buffers, code) are not per line: a warm-up
-identify_modes(make(4001), band=None if band is None else tuple(band), model="complex")
+identify_modes(make(4001), band=None if band is None else tuple(band), model=model)
 frf = make(n)
 import ctypes
 try:
@@ -70,7 +71,7 @@ try:
 except OSError:
     base, hwm = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024, False
 t = time.perf_counter()
-res = identify_modes(frf, band=None if band is None else tuple(band), model="complex")
+res = identify_modes(frf, band=None if band is None else tuple(band), model=model)
 dt = time.perf_counter() - t
 peak = status("VmHWM") if hwm else resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 print(json.dumps({"n": frf.frequency.size, "base": base, "peak": peak, "time": dt, "hwm": hwm,
@@ -79,9 +80,9 @@ print(json.dumps({"n": frf.frequency.size, "base": base, "peak": peak, "time": d
 """
 
 
-def run(n: float, band: tuple[float, float] | None) -> dict[str, Any]:
+def run(n: float, band: tuple[float, float] | None, model: str = "complex") -> dict[str, Any]:
     out = subprocess.run(
-        [sys.executable, "-c", CHILD, str(n), json.dumps(band)],
+        [sys.executable, "-c", CHILD, str(n), json.dumps(band), model],
         check=False,
         capture_output=True,
         text=True,
@@ -96,14 +97,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--lines", nargs="+", type=float, default=[1e5, 3e5, 1e6, 4e6])
     ap.add_argument("--long", type=float, default=2e6, help="lines of the narrow-band run")
+    ap.add_argument("--model", choices=("complex", "both"), default="complex")
     args = ap.parse_args()
-    print("peak memory of identify_modes above the data (1 x 1 FRF, whole axis, complex modes)")
+    what = "complex modes" if args.model == "complex" else "complex and real modes"
+    print(f"peak memory of identify_modes above the data (1 x 1 FRF, whole axis, {what})")
     print(
         f"{'lines':>10} {'modes':>5} {'order':>5} {'time [s]':>9} {'peak above data [MB]':>21} "
         f"{'B/line above data':>18}"
     )
     for n in args.lines:
-        r = run(n, None)
+        r = run(n, None, args.model)
         if "error" in r:
             print(f"{int(n):>10} failed: {r['error']}")
             continue
@@ -113,6 +116,8 @@ def main() -> None:
             f"{int(r['n']):>10} {int(r['modes']):>5} {int(r['order']):>5} {r['time']:>9.2f} "
             f"{extra / 1e6:>21.1f} {extra / r['n']:>18.0f}{how}"
         )
+    if args.long <= 0:
+        return
     print(f"\nnarrow band of a long FRF ({args.long:.0e} lines)")
     whole = run(args.long, None)
     narrow = run(args.long, (40.0, 60.0))
