@@ -408,3 +408,20 @@ def test_variance_from_three_averages_is_set_aside() -> None:
     # and identify_modes says why the variance was not used
     r = identify_modes(frf, band=(frf.frequency[1], frf.frequency[-1]))
     assert any("3 averages with 4 degrees of freedom" in w for w in r.warnings)
+
+
+def test_difference_noise_per_input_follows_each_frfs_noise() -> None:
+    # white noise of variance 1 on input 1 and 2 on input 2 of one output, 20000 lines
+    rng = np.random.default_rng(11)
+    s2 = np.array([1.0, 2.0])
+    e = rng.normal(size=(1, 2, 20000)) + 1j * rng.normal(size=(1, 2, 20000))
+    H = e * np.sqrt(s2 / 2)[None, :, None]
+    per = difference_noise(H, per_input=True)
+    # the median of 20000 exponentials: relative standard error 1 / (ln 2 sqrt(n)) = 1 %
+    assert_allclose(per[0], s2, rtol=0.04)
+    # one median over both inputs: the median m of the mixture solves
+    # exp(-m) + exp(-m / 2) = 1, m = -2 ln((sqrt(5) - 1) / 2) = 0.9624, so m / ln 2 =
+    # 1.388 against the mean 1.5 (7.4 % low)
+    m = -2 * np.log((np.sqrt(5) - 1) / 2)
+    assert_allclose(difference_noise(H)[0], m / np.log(2), rtol=0.03)
+    assert difference_noise(H)[0] < 0.95 * np.mean(s2)

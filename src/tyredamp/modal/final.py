@@ -234,13 +234,13 @@ def goodness(
             false_alarm=false_alarm,
             noise_dof=nu,
         )
-    var = difference_noise(problem.H)
+    var = difference_noise(problem.H, per_input=True)  # (n_out, n_in): each FRF's noise
     if not np.all(np.isfinite(var)) or np.any(var <= 0):
         return goodness_of_fit(
             float("nan"), n_obs - n_par, "unknown", n_rejected=n_rejected, false_alarm=false_alarm
         )
     # |e|^2 / (s^2 / 2) per real and imaginary part: chi-square with 2 dof per entry
-    chi2 = 2.0 * float(np.einsum("okf,o->", sq, 1.0 / var))
+    chi2 = 2.0 * float(np.einsum("okf,ok->", sq, 1.0 / var))
     label = "from second differences of adjacent lines"
     if few:
         label += (

@@ -101,7 +101,7 @@ def noise_floor(
     frf: FRF, problem: FitProblem, residual: NDArray[np.complex128] | None = None
 ) -> NoiseFloor:
     """``V`` of eq. (1) on the whole axis of ``frf``, for a fit whose noise was
-    estimated from its residual: per output the larger of two robust estimates, the
+    estimated from its residual: per FRF the larger of two robust estimates, the
     noise floor from second differences of the band's lines
     (:func:`~tyredamp.modal.stats.difference_noise`) and the median of the fit's own
     ``residual`` (shape (n_out, n_in, n_band), units of ``H``; ``|r|^2`` of complex
@@ -110,11 +110,11 @@ def noise_floor(
     noise that adjacent lines share (a window's leakage), which second differences
     cancel."""
     full = np.empty(frf.H.shape)
-    s2 = difference_noise(problem.H) * problem.scale**2
+    s2 = difference_noise(problem.H, per_input=True) * problem.scale**2  # (n_out, n_in)
     if residual is not None and residual.size:
-        r2 = (residual.real**2 + residual.imag**2).reshape(residual.shape[0], -1)
-        s2 = np.fmax(s2, np.median(r2, axis=1) / math.log(2.0))
-    full[:] = s2[:, None, None]
+        r2 = residual.real**2 + residual.imag**2
+        s2 = np.fmax(s2, np.median(r2, axis=2) / math.log(2.0))
+    full[:] = s2[:, :, None]
     return NoiseFloor(full, "the noise of the fit's residual (a median over lines)")
 
 
