@@ -41,10 +41,12 @@ def _split_errors(waves: list[RollingWave], truth: list[dict]) -> list[float]:
     return out
 
 
-def _run(speed: float, seed: int, duration: float, band: tuple[float, float]) -> dict:
+def _run(
+    speed: float, seed: int, duration: float, band: tuple[float, float], spatial: bool = False
+) -> dict:
     test = rolling_test(speed, duration=duration, sample_rate=512, band=band, seed=seed)
     t0 = time.perf_counter()
-    m = rolling_modes(test.data)
+    m = rolling_modes(test.data, spatial=spatial)
     dt = time.perf_counter() - t0
     truth = [r for r in test.truth.table() if band[0] + 5 <= r["fixed_hz"] <= band[1] - 10]
     cmp = compare_waves(m.fixed, truth, "fixed")
@@ -98,6 +100,7 @@ def main() -> None:
     ap.add_argument("--draws", type=int, default=5)
     ap.add_argument("--duration", type=float, default=16.0)
     ap.add_argument("--speeds", default="0,40,80,120")
+    ap.add_argument("--spatial", action="store_true", help="one identification per wave number")
     a = ap.parse_args()
     band = (0.0, 200.0)
     print(f"band {band} Hz, {a.duration:g} s records, 16 fixed + 1 in-tyre sensor, {a.draws} draws")
@@ -107,7 +110,7 @@ def main() -> None:
     )
     for v in [float(s) for s in a.speeds.split(",")]:
         with single_threaded_blas():
-            runs = [_run(v, seed, a.duration, band) for seed in range(a.draws)]
+            runs = [_run(v, seed, a.duration, band, a.spatial) for seed in range(a.draws)]
         cov = [c for r in runs for c in r["cover"]]
         zcov = [c for r in runs for c in r["zcover"]]
         sf = [e <= 0.005 for r in runs for e in r["split_fixed"]]

@@ -42,6 +42,7 @@ from numpy.typing import ArrayLike
 from ..exceptions import InputError
 from ..timedata import TimeData
 from .identify import OMAResult, oma
+from .spatial import equally_spaced, spatial_spectra, travelling_channels
 from .waves import wave_content
 
 __all__ = [
@@ -271,6 +272,55 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
+_FLOOR_RATIO = 10.0
+"""A wave's channel must hold this many times the median power of all channels
+at its frequency (sensor noise spreads evenly over the wave numbers)."""
+
+
+def _is_peak(s: Any, f_axis: Any, f: float, z: float) -> bool:
+    """Whether the spectrum ``s`` peaks inside ``f -+ max(2 zeta f, 2 bins)`` (not
+    on the skirt of a stronger neighbour, which rises towards one edge)."""
+    half = max(2 * abs(z) * f, 2 * (f_axis[1] - f_axis[0]))
+    inside = np.flatnonzero(np.abs(f_axis - f) <= half)
+    k = int(np.argmax(s[inside]))
+    return 0 < k < inside.size - 1
+
+
+def _spatial_waves(
+    y: Any, fs: float, angles: list[float], fw: float, kw: dict[str, Any]
+) -> list[RollingWave]:
+    """Waves of each wave-number channel ``n = 0 .. (K - 1) // 2``, the backward
+    and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`)."""
+    out: list[RollingWave] = []
+    K = len(angles)
+    fs_, S = spatial_spectra(y, fs, angles)
+    floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
+    for n in range(0, (K - 1) // 2 + 1):
+        if n == 0:
+            parts = [("standing", oma(travelling_channels(y, angles, 0)[0], fs, **kw))]
+        else:
+            bwd, fwd = travelling_channels(y, angles, n)
+            parts = [("backward", oma(bwd, fs, **kw)), ("forward", oma(fwd, fs, **kw))]
+        for d, r in parts:
+            for j in range(r.n_modes):
+                f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
+                k = int(np.argmin(np.abs(fs_ - f)))
+                ratio = float(S[int(d == "forward"), n, k] / floor[k])
+                if ratio < _FLOOR_RATIO or not _is_peak(S[int(d == "forward"), n], fs_, f, z):
+                    continue
+                sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
+                alias = f" (aliases {K - n}, {K + n})" if n > 0 else ""
+                other = S[int(d != "forward"), n, k] / floor[k] if n > 0 else ratio
+                why = (
+                    f"wave-number channel {'-' if d == 'forward' else '+'}{n}{alias}: power "
+                    f"{ratio:.3g} x the median channel, the opposite direction {other:.3g} x"
+                )
+                fr, _, dt = rotating_pole(f, z, n, d, fw)
+                out.append(RollingWave("fixed", n, dt, d, f, fr, z, sf, sz, float("nan"),
+                                       [], why))  # fmt: skip
+    return out
+
+
 def _match_tol(w: RollingWave, f: float, tol: float) -> float:
     """Hz: ``tol f``, or three standard errors of ``w``'s frequency where wider."""
     sf = w.std_frequency_hz
@@ -382,6 +432,7 @@ def rolling_modes(
     tol: float = 0.01,
     n_groups: int = 16,
     uncertainty: bool = True,
+    spatial: bool = False,
 ) -> RollingModes:
     """Travelling waves of a rolling tyre from fixed and in-tyre output-only records.
 
@@ -408,6 +459,11 @@ def rolling_modes(
         Jackknife segments of the SSI (fixed sensors).
     uncertainty : bool
         Jackknife standard errors of the fixed-sensor modes (slower).
+    spatial : bool
+        Identify each wave number and direction apart from the spatial DFT of
+        the fixed sensors (:mod:`.spatial`; they must be equally spaced around
+        the circumference). Default: all fixed sensors together, each mode
+        split into waves afterwards (any layout).
 
     Returns
     -------
@@ -433,9 +489,19 @@ def rolling_modes(
         )
         if angles_deg is None and any(data.channels[i].angle_deg is None for i in fix):
             raise InputError("angles: the fixed channels carry no angles; give angles_deg")
-        r_fix = oma(data.data[fix], data.sample_rate, band=bnd, n_groups=n_groups,
-                    wheel_speed_hz=fw if fw > 0 else None, uncertainty=uncertainty)  # fmt: skip
-        fixed = sorted(_fixed_waves(r_fix, ang, fw), key=lambda w: w.fixed_hz)
+        kw: dict[str, Any] = {"band": bnd, "n_groups": n_groups, "uncertainty": uncertainty,
+                              "wheel_speed_hz": fw if fw > 0 else None}  # fmt: skip
+        if spatial and not equally_spaced(ang):
+            raise InputError("angles: the wave-number route needs fixed sensors equally "
+                             f"spaced around the circumference, got {ang} deg")  # fmt: skip
+        if spatial:
+            fixed = _spatial_waves(data.data[fix], data.sample_rate, ang, fw, kw)
+            notes.append(f"fixed sensors: each wave number 0..{(len(fix) - 1) // 2} identified "
+                         "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
+        else:
+            r_fix = oma(data.data[fix], data.sample_rate, **kw)
+            fixed = _fixed_waves(r_fix, ang, fw)
+        fixed = sorted(fixed, key=lambda w: w.fixed_hz)
     else:
         notes.append(f"{len(fix)} fixed sensor(s): at least 3 are needed for wave numbers")
     rotating: list[RollingWave] = []
