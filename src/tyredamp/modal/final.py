@@ -204,15 +204,16 @@ def goodness(
 ) -> GoodnessOfFit:
     """Goodness of fit of ``sq = |H_model - H|^2`` (normalised units, (n_out, n_in, n_f)).
 
-    A known variance: chi-square; one estimated with ``nu > 4`` degrees of
-    freedom (``problem.noise_dof``): the ``F``-corrected test of
-    :mod:`tyredamp.modal.stats`; one estimated with ``nu <= 4`` (too few
-    averages for the cost to have a variance): the second-difference noise.
+    A known variance: chi-square; one estimated with ``nu`` degrees of freedom
+    (``problem.noise_dof``): the ``F``-corrected test of
+    :mod:`tyredamp.modal.stats` (one with ``nu <= 4``, too few averages for the
+    cost to have a variance, is set aside by
+    :func:`~tyredamp.modal.problem.build_problem`); none: the second-difference
+    noise of each FRF.
     """
     n_obs = 2 * sq.size
     nu = problem.noise_dof
-    few = nu is not None and not nu > 4.0
-    if problem.variance is not None and not few:
+    if problem.variance is not None:
         v = problem.variance
         pos = v > 0
         # E|e|^2 = V: real and imaginary part each of variance V / 2, 2 dof per entry
@@ -242,11 +243,6 @@ def goodness(
     # |e|^2 / (s^2 / 2) per real and imaginary part: chi-square with 2 dof per entry
     chi2 = 2.0 * float(np.einsum("okf,ok->", sq, 1.0 / var))
     label = "from second differences of adjacent lines"
-    if few:
-        label += (
-            f" (the per-line variance from {problem.n_averages} averages has nu = {nu:.3g} "
-            "<= 4 dof, too few to test against)"
-        )
     return goodness_of_fit(
         chi2, n_obs - n_par, label, n_rejected=n_rejected, false_alarm=false_alarm
     )

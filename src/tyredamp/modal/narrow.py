@@ -17,22 +17,22 @@ A spike holds nothing there and a step is flat.
 :func:`narrow_evidence` makes that a likelihood-ratio test: the residual of a
 fit without the pole, in units of each output's noise, over a window of lines
 around it, is explained by the null model (free values at the two lines
-nearest the pole, a step at the pole's frequency and a constant, each FRF with
-its own complex coefficients) and by the null model plus the pole (its residue
-free per FRF); the drop in the residual sum of squares is the pole's evidence
-beyond what a spike or a step explains, compared by the caller with the mode
-test's threshold. With Gaussian noise of unit variance per real part the drop
-is chi-squared with two degrees of freedom per FRF when the pole is absent
-(Wilks' theorem for a fixed pole; the mode test's threshold covers the pole's
-search), so a noise spike or a step does not pass, and a resonance narrower
-than the lines does.
+nearest the pole, a step at the pole's frequency and a constant, and for a pole
+narrower than the lines the terms of the fit's modes in the window with their
+derivatives, each FRF with its own complex coefficients) and by the null model
+plus the pole (its residue free per FRF); the drop in the residual sum of
+squares, below and above the pole, is its evidence beyond what these explain,
+compared by :func:`narrow_refusal` with the mode test's threshold. With
+Gaussian noise of unit variance per real part the drop is chi-squared with two
+degrees of freedom per FRF when the pole is absent (Wilks' theorem for a fixed
+pole; the mode test's threshold covers the pole's search), so a noise spike or
+a step does not pass, and a resonance narrower than the lines does.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats as sps
 
 from tyredamp.modal._basis import factors, residual_lines
 from tyredamp.modal.fit import FitResult, ModalFitter
@@ -93,18 +93,6 @@ def _fit(a: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float64]:
     """The residual of the least-squares fit of every column of ``y`` by ``a``."""
     coef, *_ = np.linalg.lstsq(a, y, rcond=None)
     return np.asarray(y - a @ coef)
-
-
-def local_scale(r: NDArray[np.float64], n_frf: int) -> float:
-    """The noise level of a window's residual ``r`` (2 L, n_frf; real parts, then
-    imaginary parts, in units of the noise) against the noise alone (1 when it is
-    the noise): the median over the lines of the residual power ``sum |e|^2`` over
-    the median of its law for the noise, chi-squared with ``2 n_frf`` degrees of
-    freedom. A median, so that the few lines a pole or a spike leaves do not count:
-    what it measures is the model error the window holds beside the noise."""
-    n = r.shape[0] // 2
-    p = np.sum(r[:n] ** 2 + r[n:] ** 2, axis=1)
-    return float(max(np.median(p) / sps.chi2.median(2 * n_frf), 1.0))
 
 
 def narrow_evidence(
