@@ -134,6 +134,7 @@ def fixed_part(
         qf,
         fitter._yss * w**2,
         (phi0, yw) if phi0 is not None and yw is not None else None,
+        fitter.n_rows,
     )
     qy = qr = None
     r = tmap.shape[1]
@@ -185,7 +186,17 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
     def solution(g0: Any, G: Any, P: Any, projected: Any, pp1: Any) -> dict[str, Any]:
         # columns mostly in span(Phi_f): the QR route of the projected rows
         force = bool((G.diagonal() < _PROJ_TOL * g0.diagonal()).any())
-        sol = _vp_solve(G, P, q1, fx.yyp, projected, residual=force, gradient=True, cancel=yy)
+        sol = _vp_solve(
+            G,
+            P,
+            q1,
+            fx.yyp,
+            projected,
+            residual=force,
+            gradient=True,
+            cancel=yy,
+            n_rows=fitter.n_rows,
+        )
         sol["lay"] = lay1
         sol["coef"] = one._coef(lay1, pp1[0])
         return sol

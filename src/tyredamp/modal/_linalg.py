@@ -16,9 +16,9 @@ from scipy.linalg import blas, lapack
 #: largest condition estimate of the unit-column Gram matrix of the basis for which
 #: the projection is taken from the Gram blocks (relative error ~ eps * this)
 _MAX_GRAM_COND = 1e6
-#: largest condition estimate of that Gram matrix for which a basis held as one
-#: block is orthogonalised by Cholesky QR twice (:func:`_cholqr2`; beyond, and for
-#: several blocks, Householder): ``eps cond`` must stay far below 1 for the first
+#: largest condition estimate of that Gram matrix for which the basis is
+#: orthogonalised by Cholesky QR twice (:func:`_cholqr2`; beyond, by the blocked
+#: Householder QR): ``eps cond`` must stay far below 1 for the first
 #: Cholesky factor to be accurate enough for the second pass to orthogonalise
 _MAX_CQR2_COND = 1e10
 #: a squared norm ``||x||^2 - ||Q^T x||^2`` smaller than this fraction of the
@@ -29,11 +29,20 @@ _CANCEL_TOL = 1e-6
 _PROJ_TOL = 1e-4
 
 
+def _one_or(one: Any, blocks: Any) -> Any:
+    """``blocks`` (a callable returning an iterator of row blocks), or one that
+    returns the single block ``one`` when it is given."""
+    if one is None:
+        return blocks
+    return lambda: iter((one,))
+
+
 def _fixed_range(
     blocks: Any,
     q: int,
     yy: NDArray[np.float64],
     one: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    n_rows: int | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The range of a fixed basis ``Phi``; ``blocks()`` returns its row blocks ``(Phi_b,
     Y_b)`` with those of the data (called again when a second pass is needed).
@@ -47,10 +56,10 @@ def _fixed_range(
     (:func:`_qr_blocks`) and the SVD ``R = U S V^T`` (``r`` singular values above
     ``1e-13`` times the largest): ``Q_r = Q U_r = Phi V_r S_r^-1``, so ``T = V_r
     S_r^-1`` and ``Q_r^T Y = U_r^T Q^T Y`` (a rank-deficient ``Phi`` included).
-    ``one = (Phi, Y)`` when they are one block: an ill-conditioned ``Phi`` of full
+    ``one = (Phi, Y)`` when they are one block. An ill-conditioned ``Phi`` of full
     rank (condition estimate up to :data:`_MAX_CQR2_COND`) is orthogonalised by
-    CholeskyQR2 first (:func:`_cholqr2`: ``T = D^-1 R_1^-1 R_2^-1``, ``Q^T Y = R_2^-T
-    Q_1^T Y``), with the same cancellation test.
+    CholeskyQR2 first, block by block (:func:`_cholqr2`: ``T = D^-1 R_1^-1
+    R_2^-1``, ``Q^T Y = R_2^-T Q_1^T Y``), with the same cancellation test.
     """
     G = np.zeros((q, q))
     P = np.zeros((q, yy.size))
@@ -65,10 +74,10 @@ def _fixed_range(
         if not (yyp < _CANCEL_TOL * yy).any():
             tmap = lapack.dtrtri(rs)[0] / d[:, None]  # R^-1 with R = rs diag(d)
             return np.asarray(tmap), np.asarray(qty), np.asarray(yyp)
-    cq = None if one is None or fac is not None else _cqr2_factor(G, one[0])
-    if cq is not None and one is not None:
-        r1, r2, d, q1 = cq
-        qty = lapack.dtrtrs(r2, q1.T @ one[1], trans=1)[0]
+    cq = None if fac is not None else _cqr2_products(G, q, _one_or(one, blocks), n_rows)
+    if cq is not None:
+        r1, r2, d, q1y = cq
+        qty = lapack.dtrtrs(r2, q1y, trans=1)[0]
         yyp = yy - np.einsum("ij,ij->j", qty, qty)
         if not (yyp < _CANCEL_TOL * yy).any():
             tmap = (lapack.dtrtri(r1)[0] @ lapack.dtrtri(r2)[0]) / d[:, None]
@@ -147,6 +156,7 @@ def _vp_solve(
     gradient: bool,
     cancel: NDArray[np.float64] | None = None,
     one: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    n_rows: int | None = None,
 ) -> dict[str, Any]:
     """Variable projection from the Gram blocks of ``B = [Phi | E]``.
 
@@ -164,9 +174,9 @@ def _vp_solve(
         Returns an iterable of row blocks ``(B_b, Y_b)`` of ``B`` and ``Y``
         (together every row once), called only when the basis is too
         ill-conditioned for its Gram matrix or the cost would lose accuracy:
-        the projection then comes from a QR factorisation of ``[Phi | E]``
-        accumulated block by block (:func:`_qr_blocks`), no ``n_rows`` array
-        is formed.
+        the projection then comes from CholeskyQR2 of ``Phi`` (:func:`_cholqr2`)
+        or a QR factorisation of ``[Phi | E]`` accumulated block by block
+        (:func:`_qr_blocks`); no ``n_rows`` array is formed.
     residual : bool
         Take the projection from the QR route whatever the conditioning (else
         only when ``cost`` loses accuracy by cancellation: ``cost_j < _CANCEL_TOL
@@ -176,9 +186,13 @@ def _vp_solve(
     cancel : ndarray, shape (n_out,), optional
         Reference of the cancellation test (default ``||Q^T Y_j||^2``).
     one : (ndarray, ndarray), optional
-        ``B`` and ``Y`` themselves when they are one block: an ill-conditioned
-        ``Phi`` is then orthogonalised by :func:`_cholqr2` (when its condition
-        allows), not by the Householder QR.
+        ``B`` and ``Y`` themselves when they are one block (used, not rebuilt,
+        by the passes of :func:`_cholqr2`). An ill-conditioned ``Phi`` is
+        orthogonalised by :func:`_cholqr2` (when its condition allows), not by
+        the Householder QR.
+    n_rows : int, optional
+        Number of rows of ``B`` (the shift of the shifted CholeskyQR3 start,
+        :func:`_shifted_start`).
 
     Returns
     -------
@@ -213,8 +227,9 @@ def _vp_solve(
         if not (cost_out < _CANCEL_TOL * (ct2 if cancel is None else cancel)).any():
             R, C = rs * d[None, :], lapack.dtrtrs(rs, Ct)[0] / d[:, None]
             return _gram_solution(G, P, q, (R, C, Ct, QtE), cost_out, gradient, qr=False)
-    if fac is None and not residual and one is not None:
-        got = _cholqr2(G, P, q, yy, one, gradient=gradient, cancel=cancel)
+    if fac is None and not residual:
+        blocks = _one_or(one, explicit)
+        got = _cholqr2(G, P, q, yy, blocks, gradient=gradient, cancel=cancel, n_rows=n_rows)
         if got is not None:
             return got
     Rb, Z, rho = _qr_blocks(explicit(), G.shape[0], P.shape[1])
@@ -245,21 +260,77 @@ def _vp_solve(
     }
 
 
-def _cqr2_factor(
-    g: NDArray[np.float64], phi: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], Any] | None:
-    """CholeskyQR2 of ``Phi`` (rows ``phi``, Gram matrix ``g``): ``R_1``, ``R_2``, ``D``
-    and ``Q_1 = Phi D^-1 R_1^-1`` (:func:`_cholqr2`), or None when the condition
-    estimate of ``D^-1 g D^-1`` exceeds :data:`_MAX_CQR2_COND` or a factorisation fails."""
-    fac = _gram_chol(g, _MAX_CQR2_COND)
-    if fac is None:
+def _shifted_start(
+    g: NDArray[np.float64], q: int, blocks: Any, n_rows: int | None
+) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """The first step of shifted CholeskyQR3 for a Gram matrix ``g`` beyond
+    :data:`_MAX_CQR2_COND`: ``R_1`` (upper) and ``D`` with ``Q_1 = Phi D^-1 R_1^-1``
+    well enough conditioned for CholeskyQR2, or None.
+
+    With ``X = Phi D^-1`` (unit columns), ``R_0`` is the Cholesky factor of ``X^T X +
+    s I`` for the shift ``s = 11 (m q + q (q + 1)) u ||X||_2^2`` (``m`` rows, ``u`` the
+    unit round-off), which keeps the factorisation of the computed Gram matrix from
+    breaking down; ``X R_0^-1`` has a condition number of about ``(s /
+    sigma_min^2)^(1/2)``, its Gram matrix is summed over the blocks and factored again
+    (``R_s``), and ``R_1 = R_s R_0`` (Fukaya, Kannan, Nakatsukasa, Zhang & Yamamoto,
+    *SIAM J. Sci. Comput.* 42, 2020, Algorithm 4.1 and eq. 4.2). ``n_rows`` None
+    counts a million rows (a larger shift: a little less range of condition).
+    """
+    dg = g.diagonal()
+    if g.shape[0] == 0 or not all(0.0 < v < math.inf for v in dg.tolist()):
         return None
-    r1, d = fac
-    q1 = blas.dtrsm(1.0, r1, phi / d, side=1, lower=0)  # Phi D^-1 R_1^-1
-    r2, info = lapack.dpotrf(q1.T @ q1, lower=0, clean=1)
+    d = np.sqrt(dg)
+    gs = g / np.multiply.outer(d, d)
+    m = 1_000_000 if n_rows is None else max(int(n_rows), q)
+    shift = 11.0 * (m * q + q * (q + 1)) * np.finfo(float).eps / 2 * np.linalg.eigvalsh(gs)[-1]
+    r0, info = lapack.dpotrf(_plus_diag(gs, shift), lower=0, clean=1)
     if info != 0:
         return None
-    return r1, r2, d, q1
+    s0 = np.zeros((q, q))
+    for B, _ in blocks():
+        x0 = blas.dtrsm(1.0, r0, B[:, :q] / d, side=1, lower=0)  # Phi_b D^-1 R_0^-1
+        s0 += x0.T @ x0
+    fac = _gram_chol(s0, _MAX_CQR2_COND)
+    if fac is None:
+        return None
+    rs, ds = fac
+    return (rs * ds[None, :]) @ r0, d
+
+
+def _cqr2_products(
+    g: NDArray[np.float64], q: int, blocks: Any, n_rows: int | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], Any] | None:
+    """CholeskyQR2 of ``Phi`` (Gram matrix ``g``; ``blocks()`` yields the row blocks
+    ``(B_b, Y_b)`` of ``B = [Phi | E]`` and the data): ``R_1``, ``R_2``, ``D`` and
+    ``Q_1^T [E | Y]`` with ``Q_1 = Phi D^-1 R_1^-1`` (:func:`_cholqr2`), or None when a
+    factorisation fails or ``Phi`` is too ill-conditioned even for the shifted start.
+
+    ``R_1`` is the Cholesky factor of ``D^-1 g D^-1`` when its condition estimate is
+    within :data:`_MAX_CQR2_COND`; beyond, the shifted start of
+    :func:`_shifted_start` (shifted CholeskyQR3, one more pass over the blocks).
+    ``Q_1`` is formed one block of rows at a time (``Q_1^T Q_1`` and ``Q_1^T [E |
+    Y]`` are sums over the blocks), so a basis held in several blocks costs one more
+    pass of matrix products, not a Householder QR per block.
+    """
+    fac = _gram_chol(g, _MAX_CQR2_COND)
+    if fac is not None:
+        rs, d = fac
+        r1 = rs
+    else:
+        start = _shifted_start(g, q, blocks, n_rows)
+        if start is None:
+            return None
+        r1, d = start
+    s = np.zeros((q, q))
+    xy: Any = 0.0
+    for B, Y in blocks():
+        q1 = blas.dtrsm(1.0, r1, B[:, :q] / d, side=1, lower=0)  # Phi_b D^-1 R_1^-1
+        s += q1.T @ q1
+        xy = xy + np.concatenate([q1.T @ B[:, q:], q1.T @ Y], axis=1)
+    r2, info = lapack.dpotrf(s, lower=0, clean=1)
+    if info != 0:
+        return None
+    return r1, r2, d, xy
 
 
 def _cholqr2(
@@ -267,16 +338,19 @@ def _cholqr2(
     P: NDArray[np.float64],
     q: int,
     yy: NDArray[np.float64],
-    one: tuple[NDArray[np.float64], NDArray[np.float64]],
+    blocks: Any,
     *,
     gradient: bool,
     cancel: NDArray[np.float64] | None,
+    n_rows: int | None = None,
 ) -> dict[str, Any] | None:
     """The projection of :func:`_vp_solve` with ``Phi`` orthogonalised by Cholesky
     QR twice, or None (condition beyond :data:`_MAX_CQR2_COND`, a failed
     factorisation, or a cost that would lose accuracy by cancellation).
 
-    ``one = (B, Y)``: the rows of ``B = [Phi | E]`` and of the data. With ``D``
+    ``blocks()``: the row blocks ``(B_b, Y_b)`` of ``B = [Phi | E]`` and of the data
+    (together every row once; called again for each pass); ``n_rows`` their number
+    of rows (the shift of :func:`_shifted_start`). With ``D``
     the column norms of ``Phi`` and ``R_1`` the Cholesky factor of ``D^-1 Phi^T
     Phi D^-1``, ``Q_1 = Phi D^-1 R_1^-1`` is formed explicitly; the Cholesky
     factor ``R_2`` of ``Q_1^T Q_1`` (condition ``1 + O(eps cond(Phi)^2)``) gives
@@ -289,13 +363,12 @@ def _cholqr2(
     :func:`_vp_solve` (``E^T P E``, ``E^T r`` and the cost by subtraction, the
     same cancellation test).
     """
-    B, Y = one
     ne = G.shape[0] - q
-    fac = _cqr2_factor(G[:q, :q], B[:, :q])
+    fac = _cqr2_products(G[:q, :q], q, blocks, n_rows)
     if fac is None:
         return None
-    r1, r2, d, q1 = fac
-    x = lapack.dtrtrs(r2, np.concatenate([q1.T @ B[:, q:], q1.T @ Y], axis=1), trans=1)[0]
+    r1, r2, d, xy = fac
+    x = lapack.dtrtrs(r2, xy, trans=1)[0]
     QtE, Ct = x[:, :ne], x[:, ne:]
     ct2 = (Ct * Ct).sum(axis=0)
     cost_out = yy - ct2

@@ -40,27 +40,26 @@ complement of the basis, ``r`` the residual), and from them ``J^T J`` and
 ``J^T r`` -- neither ``Q``, nor the residual, nor the ``(n_out n_in n_freq) x
 n_param`` Jacobian is formed. This is accurate to ``eps cond(Phi)^2`` (the
 columns scaled to unit norm); for a basis whose condition estimate is too
-large for that, or when the cost would lose accuracy by cancellation, the
-same quantities come from a Householder QR of ``[Phi | E]`` with ``Q^T``
-applied to ``Y`` (:func:`~tyredamp.modal._linalg._vp_solve`). The refinement
-is a bounded Levenberg-Marquardt iteration on these normal equations.
+large for that, ``Phi`` is orthogonalised by CholeskyQR2 (shifted CholeskyQR3
+beyond its range), and when the cost would lose accuracy by cancellation or
+the condition exceeds even that, the same quantities come from a Householder
+QR of ``[Phi | E]`` with ``Q^T`` applied to ``Y``
+(:func:`~tyredamp.modal._linalg._vp_solve`). The refinement is a bounded
+Levenberg-Marquardt iteration on these normal equations.
 
-Memory: the Gram blocks, the QR and the fitted FRFs are summed
-over blocks of lines of a fixed size (:func:`~tyredamp.modal._basis.blocks`,
-about 1 MB); the basis of all lines, the weighted data ``Y`` and the
-residual are never held, so a fit costs the data plus a constant. The data
-rows, ``s = i w`` and ``kappa`` of a block are formed when needed (the
-attributes ``Y``, ``s``, ``kappa``, ``kappa_low`` form them for all lines on
-request); with several blocks ``B^T Y`` comes from the complex data
-(:func:`~tyredamp.modal._basis.rows_t_data`), no data rows are formed. When
-the data rows fit one block (the common case: 16 outputs x 800 lines are 0.2
-MB), the fitter forms them and the line factors once and keeps them (no
-more than the one block of a blocked fit), a basis is formed once per
-evaluation for both routes, and an ill-conditioned basis is orthogonalised
-by CholeskyQR2 (:func:`~tyredamp.modal._linalg._cholqr2`) rather than by
-Householder. A fitter keeps nothing between calls: what one call can reuse
-from another is passed explicitly -- the fixed part of ``fit_added``
-(:meth:`ModalFitter.fixed_part`, an immutable
+Memory: the Gram blocks, the QR and the fitted FRFs are summed over blocks of
+lines of a fixed size (:func:`~tyredamp.modal._basis.blocks`, 8 MB); the basis
+of all lines, the weighted data ``Y`` and the residual are never held, so a fit
+costs the data plus a constant. The data rows, ``s = i w`` and ``kappa`` of a
+block are formed when needed (the attributes ``Y``, ``s``, ``kappa``,
+``kappa_low`` form them for all lines on request); with several blocks ``B^T
+Y`` comes from the complex data (:func:`~tyredamp.modal._basis.rows_t_data`),
+no data rows are formed. When the data rows fit one block (the common case: 16
+outputs x 800 lines are 0.2 MB), the fitter forms them and the line factors
+once and keeps them (no more than the one block of a blocked fit), and a basis
+is formed once per evaluation for every route. A fitter keeps nothing between
+calls: what one call can reuse from another is passed explicitly -- the fixed
+part of ``fit_added`` (:meth:`ModalFitter.fixed_part`, an immutable
 :class:`~tyredamp.modal._added.FixedPart` formed once per fixed mode set) and
 a previous intermediate fit at rest (``fit(..., start=res)``).
 
@@ -401,6 +400,7 @@ class ModalFitter:
             residual=residual,
             gradient=gradient and derivatives,
             one=one,
+            n_rows=self.n_rows,
         )
         if lay is not None:
             sol["lay"] = lay
