@@ -97,3 +97,21 @@ def test_modal_package_names_resolve() -> None:
     assert set(modal.__all__) <= set(dir(modal))
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         modal.nothing
+
+
+def test_a_refused_file_loads_no_linear_algebra(tmp_path: Path) -> None:
+    # `tyredamp modal` checks its settings (the estimator's name among them) and
+    # reads the file before anything of the identification is imported
+    bad = tmp_path / "bad.uff"
+    bad.write_text("not a universal file\n")
+    statement = (
+        "from tyredamp.cli import main\n"
+        "try:\n"
+        f"    main(['modal', {str(bad)!r}, '-o', {str(tmp_path / 'm.json')!r}])\n"
+        "except SystemExit:\n"
+        "    pass"
+    )
+    mods = _loaded(statement)
+    assert "tyredamp.modal.lscf" not in mods
+    assert _heavy(mods) == []
+    assert not (tmp_path / "m.json").exists()

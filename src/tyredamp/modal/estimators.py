@@ -27,13 +27,15 @@ ignored by the selection.
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import InputError
-from .lscf import PoleSet, plscf
+
+if TYPE_CHECKING:
+    from .lscf import PoleSet
 
 __all__ = [
     "DEFAULT_ESTIMATOR",
@@ -80,8 +82,24 @@ class PoleEstimator(Protocol):
     ) -> PoleSet: ...
 
 
+def _plscf(
+    frequency: NDArray[np.float64],
+    H: NDArray[np.complex128],
+    max_order: int,
+    *,
+    min_order: int,
+    band: tuple[float, float],
+    order_step: int,
+) -> PoleSet:
+    """:func:`~tyredamp.modal.lscf.plscf`, imported at the first call: naming the
+    estimators (a setting checked, a command refusing its file) loads no linear algebra."""
+    from .lscf import plscf
+
+    return plscf(frequency, H, max_order, min_order=min_order, band=band, order_step=order_step)
+
+
 #: The pole estimators selectable by name (``--estimator``, a campaign's ``estimator``).
-ESTIMATORS: dict[str, PoleEstimator] = {"plscf": plscf}
+ESTIMATORS: dict[str, PoleEstimator] = {"plscf": _plscf}
 #: The estimator used when none is named.
 DEFAULT_ESTIMATOR = "plscf"
 
