@@ -165,6 +165,8 @@ def test_demo_tyre_supports_the_fractional_model() -> None:
     assert study.comparison.best == TRUE_MODEL
     sec = dampmodels_section(study)
     fit, truth = sec["fitted"], sec["truth"]
+    # the fits start from the modes identified in the noisy FRFs: all three found
+    assert len(fit["frequency_hz"]) == len(truth["frequency_hz"]) == 3
     # the truth is fractional to first order in (s tau)^alpha (< 1 %): alpha within
     # 4 standard errors (a correct fit misses that with probability < 1e-4)
     assert abs(fit["alpha"] - truth["alpha"]) < 4 * fit["alpha_std"]

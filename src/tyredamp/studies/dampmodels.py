@@ -6,9 +6,11 @@ of one band (:func:`~tyredamp.virtual.rubber.modal_band_system`); its exact
 receptances at the measurement points, driven at one of them, get complex
 noise at 40 dB (standard deviation 1 % of ``|H|`` per line). Every damping
 model of :data:`~tyredamp.dampmodels.MODELS` is fitted to them and ranked
-(:func:`~tyredamp.dampmodels.compare_models`), starting from the tyre's
-exact modes turned into a viscous modal model (the part-1 estimate, as a
-modal fit would give it). Beside the verdict stands the truth: in this band
+(:func:`~tyredamp.dampmodels.compare_models`), starting from the modes that
+:func:`~tyredamp.modal.identify_modes` identifies in the same noisy FRFs,
+turned into a viscous modal model (the part-1 estimate), as a user's chain
+does it (``tyredamp modal``, then ``tyredamp damping --models``). Beside the
+verdict stands the truth: in this band
 the rubber is the fractional law ``C' s^alpha`` to first order in
 ``(s tau)^alpha`` (below 1 % here), with the rubber's ``alpha``.
 """
@@ -21,7 +23,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..dampmodels import ModelComparison, compare_models, start_from_modes
+from ..dampmodels import ModalStart, ModelComparison, compare_models, start_from_modes
 from ..virtual import RingTyre
 from ..virtual.rubber import DEFAULT_TREAD, ModalBand, modal_band_system
 
@@ -29,6 +31,7 @@ __all__ = [
     "TRUE_MODEL",
     "DampModelStudy",
     "dampmodels_section",
+    "identified_start",
     "run_dampmodels",
     "tyre_band_data",
 ]
@@ -88,12 +91,39 @@ def tyre_band_data(
     return b, f, np.asarray(H0 + sig * noise, dtype=complex), sig
 
 
+def identified_start(
+    band: ModalBand, frequency: NDArray[np.float64], H: NDArray[np.complex128], sigma: Any
+) -> ModalStart:
+    """The viscous start of the model fits from the modes identified in ``H``.
+
+    The receptances (16 points, input at the drive point, complex noise of
+    standard deviation ``sigma`` per part: variance ``2 sigma^2``) go through
+    :func:`~tyredamp.modal.identify_modes` (complex modes, eq. [10] shapes); the
+    start is :func:`~tyredamp.dampmodels.start_from_modes` of their poles and
+    second-order shapes ``psi sqrt(2 i Im p)`` (as ``tyredamp damping --models``
+    takes them from a modes file).
+    """
+    from ..frf import FRF, Channel
+    from ..modal import identify_modes
+
+    n = band.shapes.shape[0]
+    points = tuple(Channel(k + 1, 3, 360.0 * k / n, f"P{k + 1}") for k in range(n))
+    frf = FRF(
+        frequency,
+        H,
+        kind="receptance",
+        outputs=points,
+        inputs=(points[band.drive],),
+        variance=2.0 * np.broadcast_to(sigma, H.shape) ** 2,
+    )
+    mm = identify_modes(frf, model="complex").models["complex"]
+    return start_from_modes(mm.poles, mm.psi_out * np.sqrt(2j * mm.poles.imag))
+
+
 def run_dampmodels(seed: int = 0, n_lines: int = 60) -> DampModelStudy:
     """Fit and rank every damping model on the virtual tyre's noisy FRFs (module docstring)."""
     b, f, H, sig = tyre_band_data(np.random.default_rng(seed), n_lines)
-    md = b.system.modes()
-    start = start_from_modes(md.poles, b.shapes @ md.shapes * np.sqrt(2j * md.poles.imag))
-    cmp = compare_models(f, H, sig, [b.drive], start)
+    cmp = compare_models(f, H, sig, [b.drive], identified_start(b, f, H, sig))
     return DampModelStudy(b, f, cmp, SNR_DB)
 
 
