@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from numpy.testing import assert_allclose
+from numpy.testing import assert_allclose, assert_array_equal
 
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
@@ -208,3 +208,25 @@ def test_pure_noise_reports_its_one_mode_as_not_significant() -> None:
     assert m.quality.statistic[0] <= m.quality.thresholds[0]
     assert m.quality.kept[0].startswith("the only mode left, not significant")
     assert any("no mode passes the mode test" in w for w in m.meta["warnings"])
+
+
+def test_prominent_peaks_are_those_of_scipy_find_peaks() -> None:
+    # reference: scipy.signal.find_peaks with the same prominence (kept when the
+    # prominence reaches it; prominent_peaks keeps it when it exceeds it, hence the
+    # next float up), on noise, random walks and rounded values (plateaus)
+    from scipy.signal import find_peaks
+
+    from tyredamp.modal.order import prominent_peaks
+
+    rng = np.random.default_rng(0)
+    for trial in range(600):
+        r = rng.normal(size=int(rng.integers(3, 300)))
+        if trial % 3 == 0:
+            r = np.round(r, 1)
+        if trial % 5 == 0:
+            r = np.cumsum(r)
+        prom = float(rng.uniform(0.0, 2.0))
+        ref = find_peaks(r, prominence=np.nextafter(prom, np.inf))[0]
+        assert_array_equal(prominent_peaks(r, prom), ref)
+    assert prominent_peaks(np.array([1.0, 2.0]), 0.0).size == 0
+    assert prominent_peaks(np.array([0.0, 1.0, 1.0, 1.0, 0.0]), 0.5).tolist() == [2]

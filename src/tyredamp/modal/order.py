@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import find_peaks
+from numpy.typing import NDArray
 
 from .estimators import PoleEstimator
 from .lscf import PoleSet
@@ -102,7 +102,7 @@ def modes_shown(problem: FitProblem, false_alarm: float = FALSE_ALARM) -> int:
     factor over the lines, ``alpha = false_alarm``). A local maximum counts as a
     peak when it rises more than ``2 z`` above the higher of the two minima that
     separate it from higher ground (its topographic prominence,
-    :func:`scipy.signal.find_peaks`): a maximum and a minimum can each be moved
+    :func:`prominent_peaks`): a maximum and a minimum can each be moved
     by ``z``. Close modes that share one peak count once, so this is a lower
     bound of the modes in the band; it does not grow with the number of lines
     when the lines only sample the same resonances more finely.
@@ -129,8 +129,80 @@ def modes_shown(problem: FitProblem, false_alarm: float = FALSE_ALARM) -> int:
         # every resonance wider than two windows (closer ones count once)
         k = n_f // _PEAK_POINTS
         r = r[: k * _PEAK_POINTS].reshape(_PEAK_POINTS, k).max(axis=1)
-    peaks, _ = find_peaks(r, prominence=2.0 * z)
-    return int(peaks.size)
+    return int(prominent_peaks(r, 2.0 * z).size)
+
+
+def prominent_peaks(r: NDArray[np.float64], prominence: float) -> NDArray[np.intp]:
+    """Indices of the local maxima of ``r`` whose topographic prominence exceeds
+    ``prominence`` (the peaks of :func:`scipy.signal.find_peaks` with that
+    ``prominence``, without importing :mod:`scipy.signal`).
+
+    A maximum is a sample, or the middle of a run of equal samples, higher than
+    both neighbours (the two ends are never maxima). From a maximum of value
+    ``v`` the interval on each side runs to the first sample higher than ``v``
+    (or to the end of ``r``); the prominence is ``v`` less the higher of the two
+    intervals' minima (the key col on the way to higher ground). The nearest
+    higher samples come from a monotonic stack and the minima from a sparse
+    table of range minima: ``O(n log n)``.
+    """
+    r = np.asarray(r, dtype=float)
+    n = r.size
+    if n < 3:
+        return np.zeros(0, dtype=np.intp)
+    # maxima: a rise into a run of equal values followed by a fall
+    edges = np.flatnonzero(np.diff(r)) + 1  # starts of runs of equal values
+    starts = np.concatenate([[0], edges])
+    ends = np.concatenate([edges - 1, [n - 1]])
+    inner = (starts > 0) & (ends < n - 1)
+    starts, ends = starts[inner], ends[inner]
+    peak = (r[starts - 1] < r[starts]) & (r[ends + 1] < r[starts])
+    k = (starts[peak] + ends[peak]) // 2
+    if k.size == 0:
+        return np.zeros(0, dtype=np.intp)
+    left, right = _nearest_higher(r)
+    lo = left[k] + 1
+    hi = right[k] - 1
+    table = [r]  # table[j][i] = min(r[i : i + 2^j])
+    while (1 << len(table)) <= n:
+        w = 1 << (len(table) - 1)
+        table.append(np.minimum(table[-1][:-w], table[-1][w:]))
+
+    def range_min(a: NDArray[np.intp], b: NDArray[np.intp]) -> NDArray[np.float64]:
+        # min of r[a..b] (inclusive): two overlapping windows of the largest width
+        lvl = np.floor(np.log2(b - a + 1)).astype(np.intp)
+        out = np.empty(a.size)
+        for j in np.unique(lvl):
+            sel = lvl == j
+            t = table[j]
+            out[sel] = np.minimum(t[a[sel]], t[b[sel] - (1 << j) + 1])
+        return out
+
+    col = np.maximum(range_min(lo, k), range_min(k, hi))
+    return np.asarray(k[r[k] - col > prominence], dtype=np.intp)
+
+
+def _nearest_higher(r: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """For each sample, the index of the nearest strictly higher sample to the
+    left (-1 when none) and to the right (``n`` when none): monotonic stacks."""
+    n = r.size
+    v = r.tolist()
+    left = np.full(n, -1, dtype=np.intp)
+    right = np.full(n, n, dtype=np.intp)
+    stack: list[int] = []
+    for i in range(n):
+        while stack and v[stack[-1]] <= v[i]:
+            stack.pop()
+        if stack:
+            left[i] = stack[-1]
+        stack.append(i)
+    stack = []
+    for i in range(n - 1, -1, -1):
+        while stack and v[stack[-1]] <= v[i]:
+            stack.pop()
+        if stack:
+            right[i] = stack[-1]
+        stack.append(i)
+    return left, right
 
 
 def order_cap(n_in: int, n_f: int, p_start: int, n_shown: int) -> int:

@@ -29,11 +29,11 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats as sps
 
 from ..mechanics.modal_sum import pole_from_frequency_damping
 from ._basis import factors, residual_lines, residual_power
 from .fit import FitResult, ModalFitter
+from .stats import chi2_isf
 
 __all__ = [
     "ResidualPeaks",
@@ -73,7 +73,7 @@ def noise_mean(pw: NDArray[np.float64], k_terms: int) -> float:
     """Mean residual power per line under noise from the median of ``pw``, whose
     lines are ``chi2(2 k_terms) / 2`` distributed (up to a scale) under noise."""
     k2 = 2 * max(int(k_terms), 1)
-    ratio = k2 / float(sps.chi2.ppf(0.5, k2))
+    ratio = k2 / chi2_isf(0.5, k2)
     return float(np.median(pw)) * ratio
 
 

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats as sps
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
@@ -71,6 +70,7 @@ from .search_starts import (
     unique_candidates,
 )
 from .span_noise import SpanNoise
+from .stats import chi2_isf_each
 from .thresholds import ModeTest, local_thresholds, residual_span
 
 __all__ = [
@@ -747,7 +747,7 @@ def _split(
     m, k = cur.m, 2 * fitter.n_out * fitter.n_in
     p = res.poles[:m]
     rho, n = local_ratio(fitter.f, pw, p)
-    level = sps.chi2.isf(0.05 / max(m, 1), k * n) / (k * n)
+    level = chi2_isf_each(0.05 / max(m, 1), k * n) / (k * n)
     if not np.any(rho > level):
         return None
     # where the noise lies along the response (threshold raised), the residual near

@@ -93,12 +93,16 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import integrate, optimize
 from scipy import special as sps_special
-from scipy import stats as sps
 
 __all__ = [
     "GoodnessOfFit",
+    "chi2_isf",
+    "chi2_isf_each",
+    "chi2_sf",
     "cost_reference",
     "difference_noise",
+    "f_isf",
+    "f_sf",
     "goodness_of_fit",
     "mode_null_isf",
     "mode_null_sf",
@@ -116,17 +120,50 @@ FALSE_ALARM = 0.01
 _DIFF_BLOCK = 16384
 
 
+def chi2_sf(x: float, df: float) -> float:
+    """``P(chi2_df > x)``: the regularised upper incomplete gamma function
+    ``Q(df / 2, x / 2)`` (:func:`scipy.special.chdtrc`; the special functions
+    behind ``scipy.stats.chi2``, without importing ``scipy.stats``)."""
+    return float(sps_special.chdtrc(df, x))
+
+
+def chi2_isf(q: float, df: float) -> float:
+    """``chi2_df^-1(1 - q)``: the ``x`` with ``chi2_sf(x, df) = q``
+    (:func:`scipy.special.chdtri`)."""
+    return float(sps_special.chdtri(df, q))
+
+
+def chi2_isf_each(q: float, df: NDArray[np.float64]) -> NDArray[np.float64]:
+    """:func:`chi2_isf` for each of the degrees of freedom ``df`` (any shape)."""
+    return np.asarray(sps_special.chdtri(np.asarray(df, dtype=float), q), dtype=float)
+
+
 @functools.lru_cache(maxsize=1024)
 def _chi2_isf(q: float, df: float) -> float:
-    """``chi2_df^-1(1 - q)`` (``scipy.stats.chi2.isf``), cached: an identification asks
-    for the same few quantiles many times."""
-    return float(sps.chi2.isf(q, df))
+    """:func:`chi2_isf`, cached: an identification asks for the same few quantiles
+    many times."""
+    return chi2_isf(q, df)
+
+
+def f_sf(x: float, dfn: float, dfd: float) -> float:
+    """``P(F_(dfn, dfd) > x)`` (:func:`scipy.special.fdtrc`)."""
+    return float(sps_special.fdtrc(dfn, dfd, x))
+
+
+def f_isf(q: float, dfn: float, dfd: float) -> float:
+    """``F_(dfn, dfd)^-1(1 - q)``. The upper tail of ``F`` is ``P(F > x) =
+    I_y(dfd / 2, dfn / 2)`` with ``y = dfd / (dfd + dfn x)`` (Abramowitz & Stegun
+    26.6.2), so ``x = dfd (1 - y) / (dfn y)`` with ``y`` the inverse regularised
+    incomplete beta function of ``q`` (accurate for small ``q``, where ``1 - q``
+    would round)."""
+    y = float(sps_special.betaincinv(0.5 * dfd, 0.5 * dfn, q))
+    return dfd * (1.0 - y) / (dfn * y)
 
 
 @functools.lru_cache(maxsize=256)
 def _f_isf(q: float, dfn: float, dfd: float) -> float:
-    """``F_(dfn, dfd)^-1(1 - q)`` (``scipy.stats.f.isf``), cached as :func:`_chi2_isf`."""
-    return float(sps.f.isf(q, dfn, dfd))
+    """:func:`f_isf`, cached as :func:`_chi2_isf`."""
+    return f_isf(q, dfn, dfd)
 
 
 #: the largest smaller dimension of the residue for which the exact law of its
@@ -171,7 +208,7 @@ def rank_one_sf(x: float, n_out: int, n_in: int, kind: str = "complex") -> float
         return 1.0
     if kind == "real":
         if m == 1:
-            return float(sps.chi2.sf(x, n))
+            return chi2_sf(x, n)
         return _real_rank_one_sf(float(x), m, n)
     if m > _RANK_ONE_MAX:
         raise ValueError(f"rank_one_sf: min(n_out, n_in) = {m} > {_RANK_ONE_MAX}")
@@ -287,7 +324,7 @@ def mode_null_sf(x: float, n_out: int, n_in: int, kind: str = "complex") -> floa
     if not x > 0.0:
         return 1.0
     if m == 1:
-        return float(sps.chi2.sf(x, mode_parameters(n_out, n_in, kind)))
+        return chi2_sf(x, mode_parameters(n_out, n_in, kind))
 
     def f(b: float) -> float:
         return 0.5 * math.exp(-0.5 * b) * rank_one_sf(x - b, n_out, n_in, kind)
@@ -561,7 +598,7 @@ def goodness_of_fit(
     dof = max(int(dof), 1)
     mean, c, d = cost_reference(dof, noise_dof)
     chi2 = float(resid_ss)
-    p = float(sps.chi2.sf(chi2 / c, d)) if np.isfinite(chi2) else 0.0
+    p = chi2_sf(chi2 / c, d) if np.isfinite(chi2) else 0.0
     passed = p >= false_alarm
     if noise_dof is None:
         stat = f"chi2/dof = {chi2 / dof:.3g}"

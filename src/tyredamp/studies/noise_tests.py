@@ -17,10 +17,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import stats
+from scipy import special
 
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF
+from ..modal.stats import chi2_isf, chi2_sf, f_isf, f_sf
 
 __all__ = [
     "ALPHA",
@@ -85,7 +86,7 @@ class NoiseTest:
     def structured(self) -> bool:
         """True when the residual is correlated across lines beyond what white noise
         gives (one-sided at the level ``ALPHA``): a misfit rather than noise."""
-        return bool(self.correlation_z > stats.norm.isf(ALPHA))
+        return bool(self.correlation_z > -special.ndtri(ALPHA))
 
     ratio: float
     threshold: float
@@ -182,11 +183,11 @@ def noise_test(
     q = s_res / s_var
     nu = 2.0 * s_var**2 / float((v**2).sum())
     if math.isinf(noise_dof_factor):
-        thr = float(stats.chi2.ppf(1 - alpha, nu) / nu)
-        p = float(stats.chi2.sf(q * nu, nu))
+        thr = chi2_isf(alpha, nu) / nu
+        p = chi2_sf(q * nu, nu)
     else:
-        thr = float(stats.f.ppf(1 - alpha, nu, noise_dof_factor * nu))
-        p = float(stats.f.sf(q, nu, noise_dof_factor * nu))
+        thr = f_isf(alpha, nu, noise_dof_factor * nu)
+        p = f_sf(q, nu, noise_dof_factor * nu)
     excess = np.clip(e2 - v, 0.0, None).reshape(-1, f.size).sum(axis=0)
     region = None
     if excess.sum() > 0:
@@ -349,5 +350,5 @@ def _outlying_lines(
     over ``N`` values, ``k`` the floor's degrees of freedom over its running median."""
     u2 = (np.abs(residual) ** 2 / variance).reshape(-1, f.size)
     k = 2.0 * _FLOOR_DOF * _FLOOR_LINES
-    limit = float(stats.f.isf(alpha / u2.size, 2, k))
+    limit = f_isf(alpha / u2.size, 2, k)
     return [float(x) for x in f[np.any(u2 > limit, axis=0)]]

@@ -46,6 +46,7 @@ from ..virtual import (
 )
 from .results import DampingComparison, ModeMatch, PressureRun, RadialStudy
 from .settings import BAR, DemoSettings
+from .steps.modal import label_wave_numbers
 from .tyremodel import tyre_model_from_runs
 
 __all__ = [
@@ -190,27 +191,6 @@ def modes_from_frf(
         variance=variance,
         estimator=estimator,
     )
-
-
-def label_wave_numbers(model: ModalModel) -> None:
-    """Put each mode's circumferential wave number into ``model.meta`` (in place).
-
-    Only when every output carries its angle on the ring (``Channel.angle_deg``):
-    ``wave_number``, ``wave_number_label`` and ``wave_number_fraction`` from
-    :func:`tyredamp.tyremodel.wave_number_analysis`; nothing otherwise, nor
-    when the angles cannot carry a Fourier fit (too few, repeated).
-    """
-    from ..tyremodel.wavenumber import wave_number_analysis
-
-    if model.n_modes == 0 or any(c.angle_deg is None for c in model.outputs):
-        return
-    try:
-        wa = wave_number_analysis(model)
-    except InputError:
-        return
-    model.meta["wave_number"] = [m.n for m in wa.modes]
-    model.meta["wave_number_label"] = [m.label for m in wa.modes]
-    model.meta["wave_number_fraction"] = [m.fraction for m in wa.modes]
 
 
 def damping_from_modes(

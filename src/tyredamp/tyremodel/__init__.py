@@ -25,20 +25,52 @@
 
 from __future__ import annotations
 
-from .harmonics import alias_candidates, harmonic_fit, resolved_wave_numbers
-from .lateral import LateralCarcass, lateral_carcass, read_lateral_carcass
-from .pipeline import TyreModelResult, build_tyre_model
-from .rigid import NOT_FROM_RADIAL_TEST, RigidRingParameters, rigid_ring_from_modes
-from .ring import (
-    RingFit,
-    RingObservation,
-    fit_ring,
-    ring_amplitude,
-    ring_frequency,
-    ring_observations,
-)
-from .tir import parse_tir, tir_text
-from .wavenumber import ModeWaveNumber, WaveNumberAnalysis, wave_number_analysis
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .harmonics import alias_candidates, harmonic_fit, resolved_wave_numbers
+    from .lateral import LateralCarcass, lateral_carcass, read_lateral_carcass
+    from .pipeline import TyreModelResult, build_tyre_model
+    from .rigid import NOT_FROM_RADIAL_TEST, RigidRingParameters, rigid_ring_from_modes
+    from .ring import (
+        RingFit,
+        RingObservation,
+        fit_ring,
+        ring_amplitude,
+        ring_frequency,
+        ring_observations,
+    )
+    from .tir import parse_tir, tir_text
+    from .wavenumber import ModeWaveNumber, WaveNumberAnalysis, wave_number_analysis
+
+#: the module of each public name: loaded on first access (PEP 562), so that a
+#: step that needs the wave numbers does not load the lateral fits, the ring
+#: updating and their optimisers
+_WHERE = {
+    "NOT_FROM_RADIAL_TEST": "rigid",
+    "LateralCarcass": "lateral",
+    "ModeWaveNumber": "wavenumber",
+    "RigidRingParameters": "rigid",
+    "RingFit": "ring",
+    "RingObservation": "ring",
+    "TyreModelResult": "pipeline",
+    "WaveNumberAnalysis": "wavenumber",
+    "alias_candidates": "harmonics",
+    "build_tyre_model": "pipeline",
+    "fit_ring": "ring",
+    "harmonic_fit": "harmonics",
+    "lateral_carcass": "lateral",
+    "parse_tir": "tir",
+    "read_lateral_carcass": "lateral",
+    "resolved_wave_numbers": "harmonics",
+    "rigid_ring_from_modes": "rigid",
+    "ring_amplitude": "ring",
+    "ring_frequency": "ring",
+    "ring_observations": "ring",
+    "tir_text": "tir",
+    "wave_number_analysis": "wavenumber",
+}
 
 __all__ = [
     "NOT_FROM_RADIAL_TEST",
@@ -64,3 +96,17 @@ __all__ = [
     "tir_text",
     "wave_number_analysis",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """The public names on first access (PEP 562, see ``_WHERE``)."""
+    mod = _WHERE.get(name)
+    if mod is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(f"{__name__}.{mod}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

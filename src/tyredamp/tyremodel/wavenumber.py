@@ -59,11 +59,11 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.stats import chi2
 
 from .._validate import as_finite
 from ..exceptions import InputError, ShapeError
 from ..modal.model import ModalModel
+from ..modal.stats import chi2_sf
 from .harmonics import (
     HarmonicFit,
     alias_candidates,
@@ -488,7 +488,7 @@ def _label_shape(
         amp_std = float(math.sqrt(max(float(u @ cov_real @ u), 0.0)))
     pval = None
     if best.chi2 is not None and best.dof > 0:
-        pval = float(chi2.sf(best.chi2, best.dof))
+        pval = chi2_sf(best.chi2, best.dof)
     return _ShapeLabel(
         n=n,
         fraction=best.fraction,

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from ...exceptions import InputError
 from ...frf import FRF
 from ._settings import (
     Band,
@@ -27,8 +28,9 @@ from ._settings import (
 
 if TYPE_CHECKING:
     from ...modal.identify import ModalIdentification
+    from ...modal.model import ModalModel
 
-__all__ = ["MODAL_MODELS", "ModalSettings", "ModalStep"]
+__all__ = ["MODAL_MODELS", "ModalSettings", "ModalStep", "label_wave_numbers"]
 
 #: The default false-alarm rate of the mode test (:data:`tyredamp.modal.stats.FALSE_ALARM`)
 #: and pole estimator (:data:`tyredamp.modal.estimators.DEFAULT_ESTIMATOR`), named here so
@@ -124,14 +126,14 @@ class ModalStep:
 
         Each model gets the wave numbers of its modes when the outputs carry
         their angles on the ring
-        (:func:`~tyredamp.studies.radial.label_wave_numbers`); the verdicts are
-        returned, not stored in the models (:meth:`document` stores them).
+        (:func:`label_wave_numbers`); the verdicts are returned, not stored in
+        the models (:meth:`document` stores them).
         """
-        from ..radial import label_wave_numbers, modes_from_frf
+        from ...modal.identify import identify_modes
         from ..verdicts import modal_verdicts
 
         s = settings
-        res = modes_from_frf(
+        res = identify_modes(
             frf,
             band=s.band,
             model=s.model,  # type: ignore[arg-type]
@@ -162,3 +164,24 @@ class ModalStep:
         for name, v in verdicts.items():
             doc["models"][name].setdefault("meta", {})["verdict"] = v.to_dict()
         return doc
+
+
+def label_wave_numbers(model: ModalModel) -> None:
+    """Put each mode's circumferential wave number into ``model.meta`` (in place).
+
+    Only when every output carries its angle on the ring (``Channel.angle_deg``):
+    ``wave_number``, ``wave_number_label`` and ``wave_number_fraction`` from
+    :func:`tyredamp.tyremodel.wave_number_analysis`; nothing otherwise, nor
+    when the angles cannot carry a Fourier fit (too few, repeated).
+    """
+    from ...tyremodel.wavenumber import wave_number_analysis
+
+    if model.n_modes == 0 or any(c.angle_deg is None for c in model.outputs):
+        return
+    try:
+        wa = wave_number_analysis(model)
+    except InputError:
+        return
+    model.meta["wave_number"] = [m.n for m in wa.modes]
+    model.meta["wave_number_label"] = [m.label for m in wa.modes]
+    model.meta["wave_number_fraction"] = [m.fraction for m in wa.modes]
