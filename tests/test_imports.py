@@ -115,3 +115,31 @@ def test_a_refused_file_loads_no_linear_algebra(tmp_path: Path) -> None:
     assert "tyredamp.modal.lscf" not in mods
     assert _heavy(mods) == []
     assert not (tmp_path / "m.json").exists()
+
+
+def test_a_modal_run_loads_neither_scipy_stats_nor_signal(tmp_path: Path) -> None:
+    # the identification and its verdicts take their distributions from
+    # scipy.special; scipy.stats and scipy.signal cost half a second to import
+    import numpy as np
+
+    from tyredamp.frf import FRF
+    from tyredamp.io import write_frf
+
+    f = np.linspace(1.0, 200.0, 200)
+    s = 2j * np.pi * f
+    p = -0.02 * 2 * np.pi * 60 + 2j * np.pi * 60
+    h = (1 / (s - p) + 1 / (s - np.conj(p)))[None, None, :] * np.ones((2, 1, 1))
+    h = h + 1e-4 * np.random.default_rng(0).normal(size=h.shape)
+    npz = tmp_path / "small.npz"
+    write_frf(FRF(f, h, kind="receptance"), npz)
+    statement = (
+        "from tyredamp.cli import main\n"
+        "try:\n"
+        f"    main(['modal', {str(npz)!r}, '-o', {str(tmp_path / 'm.json')!r}])\n"
+        "except SystemExit as e:\n"
+        "    assert not e.code, e.code"
+    )
+    mods = _loaded(statement)
+    assert (tmp_path / "m.json").is_file()
+    assert "scipy.stats" not in mods
+    assert "scipy.signal" not in mods
