@@ -90,3 +90,43 @@ def test_one_line_is_not_a_band_error(here: Path, capsys: pytest.CaptureFixture[
     line = check_one_error_line(err, code, 2, "line")
     assert "band:" not in line
     assert snapshot(here) == before
+
+
+def test_lines_without_data_at_the_end_are_left_out(
+    here: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An analyser's export zeroes the lines beyond its cut-off: they leave the band.
+
+    Every FRF exactly zero from 30 Hz on (the third mode, 28.7 Hz, stays inside):
+    the modes are those of the same data cut at 30 Hz, and the warning says so.
+    """
+    freq = np.linspace(0.5, 40.0, 300)
+    frf = _frf(freq)
+    h = frf.H.copy()
+    h[:, :, freq > 30.0] = 0.0
+    write_frf(FRF(freq, h, outputs=frf.outputs, inputs=frf.inputs), here / "x.npz")
+    code, out, err = run_main(["modal", "x.npz", "-o", "m.json"], capsys)
+    assert code == 0, err
+    doc = json.loads((here / "m.json").read_text())
+    f = sorted(m["frequency_hz"] for m in doc["models"]["complex"]["modes"])
+    np.testing.assert_allclose(f, TRUE_HZ, rtol=1e-3)  # noise-free data: 0.1 % is loose
+    assert doc["band_hz"][1] == pytest.approx(freq[freq <= 30.0][-1])
+    assert "exactly zero were left out of the band" in out + err
+
+
+def test_lines_without_data_inside_the_band_are_refused(
+    here: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    freq = np.linspace(0.5, 40.0, 300)
+    frf = _frf(freq)
+    h = frf.H.copy()
+    h[:, :, 100:104] = 0.0
+    write_frf(FRF(freq, h, outputs=frf.outputs, inputs=frf.inputs), here / "x.npz")
+    before = snapshot(here)
+    code, _, err = run_main(["modal", "x.npz", "-o", "m.json"], capsys)
+    line = check_one_error_line(err, code, 2, "exactly zero at 4 line(s)")
+    assert "--band" in line
+    assert snapshot(here) == before
+    # the same file with a band that leaves them out is identified
+    code, _, err = run_main(["modal", "x.npz", "-o", "m.json", "--band", "15", "40"], capsys)
+    assert code == 0, err

@@ -340,7 +340,7 @@ def _identify(
     p_start = default_order(n_in, n_f, nm_hint) if o.max_order is None else int(o.max_order)
     dg = settle_order(problem, est, p_start, rules, o.max_order is None, o.false_alarm)
     auto = fr is None and o.n_modes is None
-    warnings: list[str] = [problem.variance_set_aside] if problem.variance_set_aside else []
+    warnings = [w for w in (problem.variance_set_aside, problem.lines_left_out) if w]
     modes, rej = _start_modes(problem, dg, fr, o.n_modes, o.min_fraction, warnings)
     fitters = _Fitters.build(problem, o.residuals, modes, o.max_helpers)
     thr, test = _threshold(problem, "complex", o.false_alarm), _mode_test(problem, o.false_alarm)

@@ -104,6 +104,9 @@ class FitProblem:
         Why the FRF's own per-line variance was not used ("" when it was, or there
         was none): one estimated with ``nu <= FEWEST_VARIANCE_DOF`` degrees of
         freedom (:func:`build_problem`).
+    lines_left_out : str
+        The lines at the band's ends at which every FRF is exactly zero, left out
+        of the band ("" when none; :func:`build_problem`).
     """
 
     frequency: NDArray[np.float64]
@@ -123,6 +126,7 @@ class FitProblem:
     n_averages: int | None = None
     noise_note: str = ""
     variance_set_aside: str = ""
+    lines_left_out: str = ""
 
     @property
     def weight_dof(self) -> float | None:
@@ -295,7 +299,8 @@ def build_problem(
     ------
     InputError
         Not an FRF, a bad band, a band without lines, a non-uniform axis, an
-        all-zero band or a bad variance.
+        all-zero band, lines without data inside the band (every FRF exactly
+        zero there; at the band's ends they are left out) or a bad variance.
     """
     if not isinstance(frf, FRF):
         raise InputError(f"frf: expected an FRF, got {type(frf).__name__}")
@@ -316,6 +321,9 @@ def build_problem(
             f"band (--band): no line above 0 Hz in [{lo:g}, {hi:g}] Hz; the data cover "
             f"[{fa[0]:g}, {fa[-1]:g}] Hz"
         )
+    i0, i1, empty = _without_empty_lines(frf.H, fa, i0, i1)
+    if empty:
+        lo, hi = max(lo, float(fa[i0])), min(hi, float(fa[i1 - 1]))
     lines = np.arange(i0, i1)
     f = np.ascontiguousarray(fa[i0:i1])
     check_uniform(f)
@@ -363,7 +371,48 @@ def build_problem(
         n_averages=None if n_avg is None else int(n_avg),
         noise_note=noise_note if source == "variance" else "",
         variance_set_aside=aside,
+        lines_left_out=empty,
     )
+
+
+def _without_empty_lines(
+    H: NDArray[np.complex128], fa: NDArray[np.float64], i0: int, i1: int
+) -> tuple[int, int, str]:
+    """The band's lines ``i0:i1`` without the leading and trailing lines at which
+    every FRF is exactly zero, and what was left out ("" when nothing).
+
+    A measured FRF is never exactly zero at a line with data: such lines are
+    lines without data (an analyser's export beyond its anti-alias cut-off, a
+    masked band). At the band's ends they are left out (a modal sum fitted to
+    them would be asked to vanish there); inside the band they cannot be (the
+    pole estimators need uniform lines), and the band is refused.
+    """
+    empty = ~np.any(H[:, :, i0:i1] != 0, axis=(0, 1))
+    if not np.any(empty):
+        return i0, i1, ""
+    full = np.flatnonzero(~empty)
+    if full.size == 0:
+        return i0, i1, ""  # an all-zero band: refused by the caller
+    a, b = i0 + int(full[0]), i0 + int(full[-1]) + 1
+    inner = np.flatnonzero(empty[a - i0 : b - i0])
+    if inner.size:
+        k = a + inner
+        raise InputError(
+            f"H: every FRF is exactly zero at {k.size} line(s) inside the band "
+            f"({fa[k[0]]:g}-{fa[k[-1]]:g} Hz): lines without data (a dropout or a masked "
+            "band); choose a band without them (--band)"
+        )
+    parts = []
+    if a > i0:
+        parts.append(f"{fa[i0]:g}-{fa[a - 1]:g} Hz ({a - i0} lines)")
+    if b < i1:
+        parts.append(f"{fa[b]:g}-{fa[i1 - 1]:g} Hz ({i1 - b} lines)")
+    note = (
+        "the lines at which every FRF is exactly zero were left out of the band: "
+        + " and ".join(parts)
+        + " (lines without data, e.g. beyond an analyser's anti-alias cut-off)"
+    )
+    return a, b, note
 
 
 #: most degrees of freedom of an estimated per-line variance that is set aside: the
