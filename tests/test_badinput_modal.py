@@ -130,3 +130,18 @@ def test_lines_without_data_inside_the_band_are_refused(
     # the same file with a band that leaves them out is identified
     code, _, err = run_main(["modal", "x.npz", "-o", "m.json", "--band", "15", "40"], capsys)
     assert code == 0, err
+
+
+def test_a_dead_output_is_named(here: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """An output whose FRF is zero at every line (an unplugged channel) made the
+    goodness of fit NaN; it is refused, named."""
+    freq = np.linspace(0.5, 40.0, 300)
+    frf = _frf(freq)
+    h = frf.H.copy()
+    h[1] = 0.0
+    write_frf(FRF(freq, h, outputs=frf.outputs, inputs=frf.inputs), here / "x.npz")
+    before = snapshot(here)
+    code, _, err = run_main(["modal", "x.npz", "-o", "m.json"], capsys)
+    line = check_one_error_line(err, code, 2, "dead or unplugged")
+    assert f"output {frf.outputs[1].label} " in line
+    assert snapshot(here) == before

@@ -332,6 +332,7 @@ def build_problem(
     peak = float(np.max(np.abs(Hb)))
     if not peak > 0:
         raise InputError(f"H: every FRF is zero in [{lo:g}, {hi:g}] Hz; nothing to identify")
+    _refuse_dead_channels(frf, Hb, lo, hi)
     Hn = Hb / peak
     rms = float(np.sqrt(np.vdot(Hn, Hn).real / Hn.size))
     Hn /= rms  # in place: one copy of the band's data
@@ -373,6 +374,24 @@ def build_problem(
         variance_set_aside=aside,
         lines_left_out=empty,
     )
+
+
+def _refuse_dead_channels(frf: FRF, Hb: NDArray[np.complex128], lo: float, hi: float) -> None:
+    """Refuse an output or input whose FRFs are exactly zero at every line of the
+    band (a dead or unplugged channel): its noise would be zero and every test of
+    the fit undefined."""
+    for axis, label, chans in ((0, "output", frf.outputs), (1, "input", frf.inputs)):
+        other = (1, 2) if axis == 0 else (0, 2)
+        dead = np.flatnonzero(~np.any(Hb != 0, axis=other))
+        if dead.size:
+            names = ", ".join(
+                chans[k].label if k < len(chans) else f"#{k + 1}" for k in dead.tolist()
+            )
+            raise InputError(
+                f"H: the FRFs of {label} {names} are exactly zero at every line in "
+                f"[{lo:g}, {hi:g}] Hz (a dead or unplugged channel); leave it out of the "
+                "file (or of the channel map) and identify the others"
+            )
 
 
 def _without_empty_lines(
