@@ -10,6 +10,8 @@
   identifiability verdicts; predictions of modes and FRFs.
 * :mod:`.rigid` -- in-plane rigid-ring (MF-Swift) parameters from the n = 1
   modes, with what a radial test cannot give stated.
+* :mod:`.windup` -- the belt's wind-up (``FREQ_WINDUP``, ``DAMP_WINDUP``,
+  ``BELT_IYY``) from the ``n = 0`` mode of a tangential test.
 * :mod:`.tir` -- the in-plane ``.tir`` fragment (writer) and a reader of
   every public ``.tir`` property file; :mod:`.tirmerge` -- identified
   values merged into a complete base ``.tir``.
@@ -39,6 +41,7 @@ from .ring import (
 )
 from .tir import parse_tir, tir_text
 from .wavenumber import ModeWaveNumber, WaveNumberAnalysis, wave_number_analysis
+from .windup import WindupParameters, windup_budget, windup_from_modes
 
 __all__ = [
     "NOT_FROM_RADIAL_TEST",
@@ -49,6 +52,7 @@ __all__ = [
     "RingObservation",
     "TyreModelResult",
     "WaveNumberAnalysis",
+    "WindupParameters",
     "alias_candidates",
     "build_tyre_model",
     "fit_ring",
@@ -63,4 +67,6 @@ __all__ = [
     "ring_observations",
     "tir_text",
     "wave_number_analysis",
+    "windup_budget",
+    "windup_from_modes",
 ]

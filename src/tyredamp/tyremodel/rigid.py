@@ -28,7 +28,8 @@ What a radial modal test gives
   belt with no radial motion, so radial accelerometers cannot see it:
   ``FREQ_WINDUP``, ``DAMP_WINDUP`` and ``BELT_IYY`` need tangential
   (circumferential) measurement (``BELT_IYY`` of a thin ring would be
-  ``m_b R^2``, an assumption reported as such, not a measurement). Lateral and
+  ``m_b R^2``, an assumption reported as such, not a measurement); a
+  tangential test gives them (:mod:`~tyredamp.tyremodel.windup`). Lateral and
   yaw modes, the overall (footprint) stiffnesses and the tyre mass need other
   tests.
 
