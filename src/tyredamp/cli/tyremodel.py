@@ -31,7 +31,6 @@ import click
 from ..documents.jsonfile import json_text
 from ..exceptions import FileFormatError, InputError
 from ..io._safety import atomic_dir, check_output_dir, private_matplotlib_config
-from ..virtual.tangential import TANGENTIAL_DIRECTION
 from ._common import OutPath
 
 if TYPE_CHECKING:
@@ -537,6 +536,8 @@ def _tyre_model(
                 f"{path}: the test pressure is not recorded in the file; give --pressure"
             )
         inputs.append((pb * _BAR, mdl, path.name))
+    from ..virtual.tangential import TANGENTIAL_DIRECTION
+
     for _, mdl, src in inputs:
         if {abs(c.direction) for c in mdl.outputs} == {TANGENTIAL_DIRECTION}:
             raise InputError(

@@ -247,6 +247,38 @@ def build_tyre_model(
         )
         for (_, mdl, _), wa, r in zip(items, analyses, rigid, strict=True)
     )
+    pairs, windups, budgets = _with_windups(
+        items, tangential, budgets, radius, attachment_mass, attachment_damping or 0.0, assumptions
+    )
+    preds = _predictions(ring, predict_pressures)
+    return TyreModelResult(
+        pressures=tuple(float(p) for p, _, _ in items),
+        sources=tuple(str(s) for _, _, s in items),
+        analyses=tuple(analyses),
+        ring=ring,
+        rigid=rigid,
+        lateral=tuple(lateral),
+        predictions=preds,
+        budgets=budgets,
+        warnings=tuple(warnings),
+        windups=windups,
+        tangential_sources=tuple(None if t is None else t[2] for t in pairs),
+    )
+
+
+_Test = tuple[float | None, ModalModel, str]
+
+
+def _with_windups(
+    items: list[tuple[float, ModalModel, str]],
+    tangential: Sequence[_Test],
+    budgets: tuple[UncertaintyBudget, ...],
+    radius: float,
+    attachment_mass: float,
+    attachment_damping: float,
+    assumptions: Assumptions | None,
+) -> tuple[list[_Test | None], tuple[WindupParameters | None, ...], tuple[UncertaintyBudget, ...]]:
+    """The tangential test, wind-up and joined budget of each radial pressure (:mod:`.windup`)."""
     pairs = _pair_tangential(tangential, [p for p, _, _ in items])
     windups = tuple(
         None
@@ -256,7 +288,7 @@ def build_tyre_model(
             radius=radius,
             pressure=items[i][0],
             attachment_mass=attachment_mass,
-            attachment_damping=attachment_damping or 0.0,
+            attachment_damping=attachment_damping,
             source=t[2],
         )
         for i, t in enumerate(pairs)
@@ -277,26 +309,13 @@ def build_tyre_model(
                 w,
                 analysis=wave_number_analysis(t[1]),
                 attachment_mass=attachment_mass,
-                attachment_damping=attachment_damping or 0.0,
+                attachment_damping=attachment_damping,
                 assumptions=assumptions,
             )
         )
         for b, w, t in zip(budgets, windups, pairs, strict=True)
     )
-    preds = _predictions(ring, predict_pressures)
-    return TyreModelResult(
-        pressures=tuple(float(p) for p, _, _ in items),
-        sources=tuple(str(s) for _, _, s in items),
-        analyses=tuple(analyses),
-        ring=ring,
-        rigid=rigid,
-        lateral=tuple(lateral),
-        predictions=preds,
-        budgets=budgets,
-        warnings=tuple(warnings),
-        windups=windups,
-        tangential_sources=tuple(None if t is None else t[2] for t in pairs),
-    )
+    return pairs, windups, budgets
 
 
 def _pair_tangential(

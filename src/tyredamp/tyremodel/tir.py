@@ -39,6 +39,29 @@ def _fmt(x: float) -> str:
     return f"{x:.10g}"
 
 
+def _windup_lines(
+    windup: WindupParameters | None, budget: UncertaintyBudget | None, inertia: bool = False
+) -> list[str]:
+    """``BELT_IYY`` (``inertia``) or ``FREQ_WINDUP``, ``DAMP_WINDUP`` lines; none without."""
+    if windup is None:
+        return []
+
+    def why(key: str, default: str) -> str:
+        return budget.comment(key) if budget is not None else default
+
+    if inertia:
+        return [
+            f"BELT_IYY = {_fmt(windup.belt_iyy)}  $ belt inertia from the n = 0 rotation shape, "
+            + why("BELT_IYY", f"+- {windup.belt_iyy_std:.3g} kg m^2 (statistical only)")
+        ]
+    return [
+        f"FREQ_WINDUP = {_fmt(windup.freq_windup)}  $ n = 0 belt rotation (tangential "
+        "test), Hz, " + why("FREQ_WINDUP", f"+- {windup.freq_windup_std:.3g} (statistical only)"),
+        f"DAMP_WINDUP = {_fmt(windup.damp_windup)}  $ its damping ratio, "
+        + why("DAMP_WINDUP", f"+- {windup.damp_windup_std:.3g} (statistical only)"),
+    ]
+
+
 def tir_text(
     rigid: RigidRingParameters,
     *,
@@ -113,11 +136,7 @@ def tir_text(
         f"BELT_MASS = {_fmt(rigid.belt_mass)}  $ belt mass from the n = 1 mode shape, "
         + why("BELT_MASS", f"+- {rigid.belt_mass_std:.3g} kg (statistical only)"),
     ]
-    if windup is not None:
-        lines.append(
-            f"BELT_IYY = {_fmt(windup.belt_iyy)}  $ belt inertia from the n = 0 rotation shape, "
-            + why("BELT_IYY", f"+- {windup.belt_iyy_std:.3g} kg m^2 (statistical only)")
-        )
+    lines += _windup_lines(windup, budget, inertia=True)
     for key in ("MASS", "IXX", "IYY", "BELT_IXX", "BELT_IYY"):
         if windup is None or key != "BELT_IYY":
             lines.append(f"$ {key}: not given by this test ({ng.get(key, 'not measured')})")
@@ -132,14 +151,7 @@ def tir_text(
         f"DAMP_LONG = {_fmt(rigid.damp_long)}  $ its damping ratio, "
         + why("DAMP_LONG", f"+- {rigid.damp_long_std:.3g} (statistical only)"),
     ]
-    if windup is not None:
-        lines += [
-            f"FREQ_WINDUP = {_fmt(windup.freq_windup)}  $ n = 0 belt rotation (tangential "
-            "test), Hz, "
-            + why("FREQ_WINDUP", f"+- {windup.freq_windup_std:.3g} (statistical only)"),
-            f"DAMP_WINDUP = {_fmt(windup.damp_windup)}  $ its damping ratio, "
-            + why("DAMP_WINDUP", f"+- {windup.damp_windup_std:.3g} (statistical only)"),
-        ]
+    lines += _windup_lines(windup, budget)
     for key in (
         *(("FREQ_WINDUP", "DAMP_WINDUP") if windup is None else ()),
         "FREQ_LAT",

@@ -350,10 +350,8 @@ def run_modal_test(
         last channel ``P1``, "pressure" in Pa, noise at ``snr_db``
         (:mod:`~tyredamp.virtual.microphone`). Default none.
     direction : {"radial", "tangential"}
-        Drive and measure radially (default, paper 000) or along the
-        circumference (:mod:`~tyredamp.virtual.tangential`: the test that sees
-        the wind-up mode; channels with direction code 1, the attachment on
-        the tangential DOF, ``data.meta["measured_direction"]`` says so).
+        Drive and measure radially (default) or along the circumference
+        (:mod:`~tyredamp.virtual.tangential`; ``data.meta["measured_direction"]``).
 
     Returns
     -------
@@ -369,9 +367,7 @@ def run_modal_test(
     tyre, fs, p_samples, f_rms = _checked_options(
         tyre, sample_rate, period, n_periods, settle_periods, oversample, force_rms, snr_db
     )
-    _check_choices(drive_mode, excitation, initial_state)
-    if direction not in ("radial", "tangential"):
-        raise InputError(f"direction: expected 'radial' or 'tangential', got {direction!r}")
+    _check_choices(drive_mode, excitation, initial_state, direction)
     if direction == "tangential":
         tyre = tangential_tyre(tyre)
     bnd = as_band(band)
@@ -430,7 +426,11 @@ def _time_data(
     return TimeData(measured, fs, channels, quantities, meta, acquisition=acquisition)
 
 
-def _check_choices(drive_mode: str, excitation: str, initial_state: str) -> None:
+def _check_choices(
+    drive_mode: str, excitation: str, initial_state: str, direction: str = "radial"
+) -> None:
+    if direction not in ("radial", "tangential"):
+        raise InputError(f"direction: expected 'radial' or 'tangential', got {direction!r}")
     if drive_mode not in ("sequential", "simultaneous"):
         raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
     if excitation not in ("chirp", "multisine"):
