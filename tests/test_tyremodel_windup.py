@@ -182,7 +182,9 @@ def test_windup_budget_calibration_closed_form() -> None:
 def test_windup_identified_from_the_noisy_virtual_test() -> None:
     from tyredamp.studies.radial import frf_from_time, modes_from_frf
 
-    t = run_modal_test(tyre(), direction="tangential", seed=5, n_periods=2, band=(0.0, 100.0))
+    t = run_modal_test(
+        tyre(), direction="tangential", seed=5, n_periods=2, band=(0.0, 100.0), oversample=4
+    )
     frf = frf_from_time(t.data, "H1")
     mdl = modes_from_frf(frf, band=(5.0, 100.0), model="complex").models["complex"]
     lay = tyre().layout
@@ -296,3 +298,74 @@ def test_cli_bad_tangential_input(
     assert len(err.strip().splitlines()) == 1
     assert message in err
     assert not out.exists()
+
+
+def test_merge_writes_the_windup_keys() -> None:
+    from tyredamp.tyremodel import build_tyre_model
+
+    rad = tyre().truth((0.0, 200.0)).modal_model()
+    tan = tangential_truth().modal_model("all")
+    res = build_tyre_model(
+        [(7.5 * BAR, rad, "rad.json")], radius=R, tangential=[(7.5 * BAR, tan, "tan.json")]
+    )
+    base = "\n".join(
+        [
+            "[MDI_HEADER]",
+            "FILE_TYPE = 'tir'",
+            "[UNITS]",
+            "LENGTH = 'meter'",
+            "FORCE = 'newton'",
+            "MASS = 'kg'",
+            "TIME = 'second'",
+            "[OPERATING_CONDITIONS]",
+            "INFLPRES = 750000",
+            "[INERTIA]",
+            "BELT_IYY = 1.0  $ the supplier's",
+        ]
+    )
+    merged = parse_tir(res.merged_tir(base, "base.tir"))
+    w = res.windups[0]
+    assert w is not None
+    assert_allclose(merged["INERTIA"]["BELT_IYY"], w.belt_iyy, rtol=1e-6)  # 7 digits written
+    assert_allclose(merged["STRUCTURAL"]["FREQ_WINDUP"], w.freq_windup, rtol=1e-6)
+    assert_allclose(merged["STRUCTURAL"]["DAMP_WINDUP"], w.damp_windup, rtol=1e-6)
+    doc = res.rigid_document()["rigid_ring"][0]
+    assert "FREQ_WINDUP" not in doc["not_given"]
+    assert doc["windup"]["BELT_IYY"]["value"] == w.belt_iyy
+    # a tangential test at a pressure without a radial test is refused
+    with pytest.raises(InputError, match=r"radial tests are at 7\.5 bar"):
+        build_tyre_model(
+            [(7.5 * BAR, rad, "rad.json")], radius=R, tangential=[(9 * BAR, tan, "tan.json")]
+        )
+
+
+def test_simulate_tangential_test(tmp_path: Path) -> None:
+    from tyredamp.documents.modes import read_modes
+    from tyredamp.io import read_frf
+
+    out, truth_file = tmp_path / "tan.npz", tmp_path / "truth.json"
+    res = CliRunner().invoke(
+        cli,
+        [
+            "simulate",
+            "radial",
+            "--direction",
+            "tangential",
+            "--frf",
+            "--periods",
+            "1",
+            "--no-cavity",
+            "--out",
+            str(out),
+            "--truth",
+            str(truth_file),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert "true wind-up (n = 0 rotation)" in res.output
+    frf = read_frf(out)
+    assert {c.direction for c in frf.outputs} == {1}
+    mdl = read_modes(truth_file)["complex"]
+    w = windup_from_modes(mdl, radius=R, attachment_mass=0.01, attachment_damping=2.0)
+    # the exact modes written: the truth to O(zeta^2) (test_windup_from_exact_modes_equals_truth)
+    assert_allclose(w.freq_windup, windup_truth(tyre()).bare_frequency_hz, rtol=1e-5)
