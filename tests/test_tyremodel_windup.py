@@ -195,22 +195,28 @@ def test_windup_identified_from_the_noisy_virtual_test() -> None:
         attachment_damping=lay.attachment_damping,
     )
     wt = windup_truth(tyre())
-    # 40 dB SNR on every channel, 2 averages: over seeds 1-8 (benchmarks/windup.py) the
-    # errors stay below 7e-5 (frequency), 1.7 % (damping) and 0.08 % (inertia) unless the
-    # fit splits the resonance into two poles (then noted, 3.5 % on the inertia)
-    assert_allclose(w.freq_windup, wt.bare_frequency_hz, rtol=2e-4)
-    assert_allclose(w.damp_windup, wt.bare_damping_ratio, rtol=0.03)
+    # 40 dB SNR on every channel, 2 averages: over seeds 1-20 (benchmarks/windup.py) the
+    # errors stay below 2e-4 (frequency), 2.7 % (damping) and 0.15 % (inertia), also when
+    # the fit splits the resonance into two poles (4 seeds in 20)
+    assert_allclose(w.freq_windup, wt.bare_frequency_hz, rtol=4e-4)
+    assert_allclose(w.damp_windup, wt.bare_damping_ratio, rtol=0.05)
     assert_allclose(w.belt_iyy, wt.inertia, rtol=0.005)
-    assert not w.notes or "split" not in " ".join(w.notes)
 
 
-def test_split_rotation_mode_uses_the_largest_and_says_so() -> None:
+def test_split_rotation_poles_are_combined_and_said() -> None:
     th = np.radians(np.arange(16) * 22.5)
-    mdl = synthetic([0.05 * np.ones(16), 0.3 * np.ones(16), 0.2 * np.cos(th)], [33.8, 34.0, 48.0])
+    one = np.ones(16)
+    # a resonance split into two in-phase poles 0.2 Hz apart (bandwidth 0.68 Hz), a third
+    # uniform mode far away, and an n = 1 mode
+    mdl = synthetic([0.05 * one, 0.3 * one, 0.2 * np.cos(th), 0.04 * one], [33.8, 34.0, 48.0, 90.0])
     w = windup_from_modes(mdl, radius=R)
-    assert w.index == 1
-    assert_allclose(w.belt_iyy, R**2 / 0.3**2, rtol=1e-12)  # closed form R^2 / A_t^2
-    assert any("split" in n for n in w.notes)
+    assert w.index == 1  # the pole of largest amplitude leads
+    # closed form: the residues add, A_t^2 = 0.05^2 + 0.3^2; frequency weighted by them
+    assert_allclose(w.belt_iyy, R**2 / (0.05**2 + 0.3**2), rtol=1e-12)
+    f_mean = (0.05**2 * 33.8 + 0.3**2 * 34.0) / (0.05**2 + 0.3**2)
+    assert_allclose(w.freq_windup, f_mean, rtol=1e-12)
+    assert any("split the rotation into 2 poles" in n for n in w.notes)
+    assert any("90 Hz are not used" in n for n in w.notes)
 
 
 # ----------------------------------------------------------------------------- CLI

@@ -21,7 +21,8 @@ fraction reaches ``min_fraction``, the one with the largest mass-normalised
 amplitude (the smallest modal inertia: the belt's rotation, which the
 drive moves most) is used; with the rim held a tyre has one such mode in the
 band of a modal test, so a second one (a fit that split the resonance into
-two poles) is reported in the notes.
+two poles) is combined with it: the poles within three half-power
+bandwidths of it have their residues summed (notes say so).
 
 ``BELT_IYY`` from the mass-normalised shape
 -------------------------------------------
@@ -237,38 +238,40 @@ def windup_from_modes(
     scale = check_positive(shape_scale, "shape_scale")
     wa = analysis if analysis is not None else wave_number_analysis(model)
     m, others = _rotation_mode(wa, min_fraction, source)
-    k = m.index
-    phi_d2 = (
-        scale * float(np.sum(np.abs(model.psi_in[:, k]) ** 2)) * 2.0 * float(model.poles[k].imag)
-    )
-    share = 1.0 - m_a * phi_d2
+    members, apart = _split_members(m, others)
+    c = _combined(model, members, scale)
+    share = 1.0 - m_a * c["phi_d2"]
     if share <= 0:
         raise PhysicsError(
             f"{source}: attachment_mass exceeds the modal mass of the wind-up mode (check the mass)"
         )
-    a = m.amplitude * math.sqrt(scale)
-    iyy = share * r**2 / a**2
-    w_meas = 2 * math.pi * m.frequency_hz
-    f0 = m.frequency_hz / math.sqrt(share)
-    z0 = (2 * m.damping_ratio * w_meas - c_a * phi_d2) / (2 * w_meas * math.sqrt(share))
-    sf = model.std.get("frequency_hz")
-    sz = model.std.get("damping_ratio")
-    sf0 = _finite(None if sf is None else float(sf[k])) / math.sqrt(share)
-    sz0 = _finite(None if sz is None else float(sz[k])) / math.sqrt(share)
-    si = 2.0 * _finite(m.amplitude_std) / m.amplitude * iyy
+    iyy = share * r**2 / c["a2"]
+    w_meas = 2 * math.pi * c["f"]
+    f0 = c["f"] / math.sqrt(share)
+    z0 = (2 * c["z"] * w_meas - c_a * c["phi_d2"]) / (2 * w_meas * math.sqrt(share))
+    sf0 = c["sf"] / math.sqrt(share)
+    sz0 = c["sz"] / math.sqrt(share)
+    si = 2.0 * c["rel_a"] * iyy
     w0, sw0 = 2 * math.pi * f0, 2 * math.pi * sf0
     kk = iyy * w0**2
     skk = kk * math.hypot(si / iyy, 2 * sw0 / w0)
     cc = 2 * z0 * iyy * w0
     scc = abs(cc) * math.sqrt((sz0 / z0) ** 2 + (si / iyy) ** 2 + (sw0 / w0) ** 2) if z0 else 0.0
     notes = []
-    if others:
+    if len(members) > 1:
         notes.append(
-            f"{len(others) + 1} modes are uniform rotations (n = 0) at "
-            + ", ".join(f"{o.frequency_hz:.4g}" for o in (m, *others))
-            + f" Hz; the one of largest amplitude ({m.frequency_hz:.4g} Hz) is used: a belt on "
-            "a held rim has one, so the others may be a fit that split its resonance (check "
-            "the identification)"
+            f"the fit split the rotation into {len(members)} poles at "
+            + ", ".join(f"{o.frequency_hz:.4g}" for o in members)
+            + " Hz (within three half-power bandwidths): their residues are summed and "
+            "frequency and damping averaged with the residues as weights (more averages "
+            "usually give one pole)"
+        )
+    if apart:
+        notes.append(
+            "other uniform-rotation (n = 0) modes at "
+            + ", ".join(f"{o.frequency_hz:.4g}" for o in apart)
+            + f" Hz are not used: the one of largest amplitude ({m.frequency_hz:.4g} Hz) is the "
+            "belt's rotation on the held rim"
         )
     if si == 0:
         notes.append("no shape standard errors in the modes: BELT_IYY without uncertainty")
@@ -289,11 +292,70 @@ def windup_from_modes(
         k_windup_std=skk,
         c_windup=cc,
         c_windup_std=scc,
-        index=k,
-        fraction=m.fraction,
+        index=m.index,
+        fraction=min(o.fraction for o in members),
         radius=r,
         notes=notes,
     )
+
+
+def _split_members(
+    main: ModeWaveNumber, others: list[ModeWaveNumber]
+) -> tuple[list[ModeWaveNumber], list[ModeWaveNumber]]:
+    """The ``n = 0`` poles of the main one's resonance (a split fit) and those apart.
+
+    A pole within three half-power bandwidths ``2 zeta f`` of the main one
+    belongs to its resonance.
+    """
+    width = 3 * 2 * max(main.damping_ratio, 1e-4) * main.frequency_hz
+    near = [o for o in others if abs(o.frequency_hz - main.frequency_hz) <= width]
+    return [main, *near], [o for o in others if o not in near]
+
+
+def _combined(model: ModalModel, members: list[ModeWaveNumber], scale: float) -> dict[str, float]:
+    """Squared amplitude, drive-point ``phi_d^2``, frequency, damping of the rotation's poles.
+
+    One pole: ``A_t^2`` and ``phi_d^2 = 2 Omega sum_i |psi_d,i|^2``. Poles of a
+    split fit: their residues add up to the resonance's, so ``A_t^2 = |sum_k
+    a_k^2|`` (``a_k`` the complex ``n = 0`` coefficient of the second-order
+    shape) and ``phi_d^2 = |sum_k 2 i Omega_k sum_i psi_d,ik^2|``; frequency,
+    damping and standard errors are the means weighted by ``|a_k|^2``.
+    """
+    sf = model.std.get("frequency_hz")
+    sz = model.std.get("damping_ratio")
+    om = model.poles.imag
+    if len(members) == 1:
+        m = members[0]
+        k = m.index
+        rows = [m]
+        a2 = m.amplitude**2
+        phi_d2 = float(np.sum(np.abs(model.psi_in[:, k]) ** 2)) * 2.0 * float(om[k])
+    else:
+        rows = members
+        cplx = []
+        for o in members:
+            mean = complex(np.mean(model.psi_out[:, o.index] * np.sqrt(2j * om[o.index])))
+            cplx.append(o.amplitude**2 * np.exp(2j * np.angle(mean)))
+        a2 = abs(sum(cplx))
+        phi_d2 = abs(sum(2j * om[o.index] * np.sum(model.psi_in[:, o.index] ** 2) for o in rows))
+    wts = np.array([o.amplitude**2 for o in rows])
+    wts = wts / wts.sum()
+
+    def wmean(vals: list[float]) -> float:
+        return float(np.dot(wts, vals))
+
+    def wstd(vals: list[float]) -> float:
+        return float(np.sqrt(np.sum((wts * np.asarray(vals)) ** 2)))
+
+    return {
+        "a2": scale * a2,
+        "phi_d2": scale * phi_d2,
+        "f": wmean([o.frequency_hz for o in rows]),
+        "z": wmean([o.damping_ratio for o in rows]),
+        "sf": wstd([_finite(None if sf is None else float(sf[o.index])) for o in rows]),
+        "sz": wstd([_finite(None if sz is None else float(sz[o.index])) for o in rows]),
+        "rel_a": wstd([_finite(o.amplitude_std) / o.amplitude for o in rows]),
+    }
 
 
 def _finite(x: float | None) -> float:
