@@ -343,6 +343,13 @@ def test_merge_writes_the_windup_keys() -> None:
         build_tyre_model(
             [(7.5 * BAR, rad, "rad.json")], radius=R, tangential=[(9 * BAR, tan, "tan.json")]
         )
+    # and a second one at the same pressure
+    with pytest.raises(InputError, match="a second tangential test"):
+        build_tyre_model(
+            [(7.5 * BAR, rad, "rad.json")],
+            radius=R,
+            tangential=[(None, tan, "tan.json"), (7.5 * BAR, tan, "tan2.json")],
+        )
 
 
 def test_simulate_tangential_test(tmp_path: Path) -> None:

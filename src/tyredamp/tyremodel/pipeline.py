@@ -331,7 +331,8 @@ def _pair_tangential(
             if len(pressures) != 1:
                 raise InputError(
                     f"{src}: the tangential test records no pressure and there are "
-                    f"{len(pressures)} radial tests; give its pressure"
+                    f"{len(pressures)} radial tests; give its pressure (command line: "
+                    "--tangential-pressure)"
                 )
             k = 0
         else:
