@@ -236,7 +236,7 @@ def radial_command(
     click.echo(_true_modes_line(test))
     if direction == "tangential":
         click.echo(_windup_line(test.tyre))
-    click.echo(_sources_line(tyre))
+    click.echo(_sources_line(test.tyre))
     click.echo(f"wrote {out} ({out_format}, {what})")
     if truth_out is not None:
         click.echo(f"wrote {truth_out} (exact modes, modes JSON)")
