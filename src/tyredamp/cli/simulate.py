@@ -137,6 +137,14 @@ def simulate_group() -> None:
     help="Add a rim microphone at this angle (deg, a multiple of 5.625): a last channel P1 "
     "with the cavity's acoustic pressure in Pa (time data only; needs the cavity).",
 )
+@click.option(
+    "--direction",
+    type=click.Choice(["radial", "tangential"]),
+    default="radial",
+    show_default=True,
+    help="Drive and measure radially, or along the circumference (the tangential test "
+    "that sees the belt's wind-up mode, for tyredamp tyre-model --tangential).",
+)
 @format_option()
 def radial_command(
     out: Path,
@@ -153,6 +161,7 @@ def radial_command(
     splice: bool,
     attachment_damping: float,
     microphone_deg: float | None,
+    direction: str,
     fmt: str | None,
 ) -> None:
     """Run the virtual modal test of the truck tyre and write time data or FRFs.
@@ -170,6 +179,7 @@ def radial_command(
       tyredamp simulate radial --out mimo.uff --drive-points 1,5 --periods 4
       tyredamp simulate radial --out loaded.uff --load 25 --splice
       tyredamp simulate radial --out with_mic.uff --microphone 0
+      tyredamp simulate radial --out tangential.uff --frf --direction tangential
     """
     from ..studies.demo import single_threaded_blas
     from ..studies.radial import frf_from_time, virtual_tyre
@@ -202,6 +212,7 @@ def radial_command(
             snr_db=snr,
             seed=seed,
             microphone_deg=microphone_deg,
+            direction=direction,  # type: ignore[arg-type]
         )
     truth_text = None if truth_out is None else _truth_text(test, pressure)
     # both files or neither: a replaced --out is put back when --truth fails
@@ -223,7 +234,9 @@ def radial_command(
         f"SNR {snr:g} dB, seed {seed}"
     )
     click.echo(_true_modes_line(test))
-    click.echo(_sources_line(tyre))
+    if direction == "tangential":
+        click.echo(_windup_line(test.tyre))
+    click.echo(_sources_line(test.tyre))
     click.echo(f"wrote {out} ({out_format}, {what})")
     if truth_out is not None:
         click.echo(f"wrote {truth_out} (exact modes, modes JSON)")
@@ -234,12 +247,24 @@ def _truth_text(test: Any, pressure: float) -> str:
     from ..documents.modes import modes_document
 
     doc = modes_document(
-        {"complex": test.truth.modal_model("visible")},
+        {"complex": test.truth.modal_model(_truth_modes(test))},
         source=f"truth: virtual ring tyre at {pressure:g} bar",
         band_hz=test.truth.band,
         frf_kind="receptance",
     )
     return json_text(doc)
+
+
+def _windup_line(tyre: Any) -> str:
+    """``true wind-up (n = 0): ...`` of a tangential test."""
+    from ..virtual import windup_truth
+
+    w = windup_truth(tyre)
+    return (
+        f"true wind-up (n = 0 rotation): {w.frequency_hz:.3f} Hz (zeta {100 * w.damping_ratio:.3f} "
+        f"%) with the shaker tip, {w.bare_frequency_hz:.3f} Hz (zeta "
+        f"{100 * w.bare_damping_ratio:.3f} %) without; belt inertia {w.inertia:.4g} kg m^2"
+    )
 
 
 def _sources_line(tyre: Any) -> str:
@@ -269,8 +294,14 @@ def _true_modes_line(test: Any) -> str:
     tr = test.truth
     return "true modes (Hz): " + ", ".join(
         f"{tr.frequency_hz[i]:.2f} (zeta {100 * tr.damping_ratio[i]:.2f} %)"
-        for i in tr.select("visible")
+        for i in tr.select(_truth_modes(test))
     )
+
+
+def _truth_modes(test: Any) -> Any:
+    """The truth's modes a test sees: every in-band mode for a tangential one (wind-up too)."""
+    tangential = getattr(test.tyre, "measured_direction", "radial") == "tangential"
+    return "all" if tangential else "visible"
 
 
 _LATERAL = lateral_group.commands["simulate"]

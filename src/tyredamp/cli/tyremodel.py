@@ -9,7 +9,8 @@ pressures and writes into the new directory ``DIR``:
   correlations and identifiability verdicts, predictions;
 * ``rigid_ring.json`` -- in-plane rigid-ring (MF-Swift) parameters per
   pressure, the fields the test cannot give, lateral carcass quantities;
-* ``tyre_inplane_<p>bar.tir`` -- the in-plane ``.tir`` subset per pressure;
+* ``tyre_inplane_<p>bar.tir`` -- the in-plane ``.tir`` subset per pressure
+  (with ``--tangential``: the wind-up keys of that pressure too);
 * ``ring_frequencies.png`` -- identified against updated-ring frequencies.
 
 All files are written into a temporary directory beside ``DIR`` first and
@@ -63,11 +64,14 @@ def _finite(options: dict[str, float | None]) -> None:
 
 @dataclass(frozen=True)
 class _Options:
-    """Uncertainty assumptions, base files ``{output name: (base name, text)}``, --force."""
+    """Uncertainty assumptions, base files ``{output name: (base name, text)}``, --force,
+    the tangential modes files and their pressures (bar, text)."""
 
     assumptions: Any
     bases: dict[str, tuple[str, str]]
     force: bool
+    tangential: tuple[Path, ...] = ()
+    tangential_pressures: str | None = None
 
 
 def _read_bases(paths: tuple[Path, ...]) -> dict[str, tuple[str, str]]:
@@ -256,6 +260,20 @@ def write_all_or_none(out_dir: Path, writers: dict[str, Callable[[Path], None]])
     "the merged copy goes into --out); repeatable.",
 )
 @click.option(
+    "--tangential",
+    "tangential_files",
+    multiple=True,
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Modes JSON of a tangential test (tyredamp modal of circumferential FRFs) for "
+    "FREQ_WINDUP, DAMP_WINDUP, BELT_IYY; one per pressure, repeatable.",
+)
+@click.option(
+    "--tangential-pressure",
+    "tangential_pressures",
+    metavar="P1,P2,...",
+    help="Pressure of each tangential modes file in bar (default from the files' metadata).",
+)
+@click.option(
     "--force-sensitivity-error",
     type=click.FloatRange(min=0, max=50),
     default=1.0,
@@ -308,6 +326,8 @@ def tyre_model_command(
     lateral_pressure: float | None,
     geometry_file: Path | None,
     merge_into: tuple[Path, ...],
+    tangential_files: tuple[Path, ...],
+    tangential_pressures: str | None,
     force_sensitivity_error: float,
     acceleration_sensitivity_error: float,
     attachment_mass_error: float,
@@ -322,7 +342,10 @@ def tyre_model_command(
     once with the modal standard errors as weights; the in-plane rigid-ring
     parameters (BELT_MASS, FREQ_LONG, DAMP_LONG) come from the n = 1 modes.
     Fields a radial test cannot give (wind-up, lateral, yaw) are listed, not
-    invented. Each value carries its uncertainty budget (statistical,
+    invented. A tangential test (--tangential: circumferential FRFs, its modes
+    identified by tyredamp modal) adds the wind-up: FREQ_WINDUP, DAMP_WINDUP
+    and BELT_IYY from its n = 0 rotation mode, found from the shapes'
+    harmonic content. Each value carries its uncertainty budget (statistical,
     calibration of the transducers, attachment mass and damping, rigid
     translation) and the assumptions it rests on.
 
@@ -340,6 +363,8 @@ def tyre_model_command(
     Example:
       tyredamp tyre-model m5.json m7.json m9.json --pressure 5,7,9 \\
           --radius 0.5 --attachment-mass 0.1 --out tyre_model
+      tyredamp tyre-model radial.json --tangential tangential.json \\
+          --pressure 7.5 --radius 0.5 --out tyre_model
     """
     from ..tyremodel.budget import Assumptions
 
@@ -366,6 +391,8 @@ def tyre_model_command(
         ),
         _read_bases(merge_into),
         force,
+        tangential_files,
+        tangential_pressures,
     )
     with private_matplotlib_config():
         _tyre_model(
@@ -442,6 +469,36 @@ def _read_tyre_modes(path: Path, model_kind: str, geometry_file: Path | None) ->
     return ring
 
 
+def _read_tangential(
+    opts: _Options | None, model_kind: str, geometry_file: Path | None
+) -> list[tuple[float | None, ModalModel, str]]:
+    """The tangential tests: ``(pressure in Pa or None, modes, file name)``, checked."""
+    from ..io import FILE_FORMATS
+    from ..tyremodel.windup import check_tangential
+
+    if opts is None or not opts.tangential:
+        return []
+    files = opts.tangential
+    p_list = _float_list(opts.tangential_pressures, "--tangential-pressure", _MAX_BAR)
+    if p_list is not None and len(p_list) != len(files):
+        raise InputError(
+            f"--tangential-pressure: expected one pressure per tangential file ({len(files)}), "
+            f"got {len(p_list)}"
+        )
+    out: list[tuple[float | None, ModalModel, str]] = []
+    for i, path in enumerate(files):
+        if path.suffix.lower() in FILE_FORMATS["uff58b"].extensions:
+            raise InputError(
+                f"--tangential: {path}: expected a modes JSON (tyredamp modal of the tangential "
+                "FRFs), got a UFF file"
+            )
+        mdl = _read_tyre_modes(path, model_kind, geometry_file)
+        check_tangential(mdl, str(path))
+        pb = p_list[i] if p_list is not None else _meta_pressure_bar(path, mdl)
+        out.append((None if pb is None else pb * _BAR, mdl, path.name))
+    return out
+
+
 def _tyre_model(
     modes_files: tuple[Path, ...],
     out: Path,
@@ -479,6 +536,15 @@ def _tyre_model(
                 f"{path}: the test pressure is not recorded in the file; give --pressure"
             )
         inputs.append((pb * _BAR, mdl, path.name))
+    from ..virtual.tangential import TANGENTIAL_DIRECTION
+
+    for _, mdl, src in inputs:
+        if {abs(c.direction) for c in mdl.outputs} == {TANGENTIAL_DIRECTION}:
+            raise InputError(
+                f"{src}: the response channels are tangential; give a tangential test with "
+                "--tangential (the flexible ring needs a radial test)"
+            )
+    tangential = _read_tangential(opts, model_kind, geometry_file)
     preds = [p * _BAR for p in (_float_list(predict, "--predict", _MAX_BAR) or [])]
     lateral = []
     for lf in lateral_files:
@@ -494,6 +560,7 @@ def _tyre_model(
         lateral=lateral,
         assumptions=opts.assumptions if opts else None,
         force=bool(opts and opts.force),
+        tangential=tangential,
     )
     ring_text = json_text(res.ring_document(), indent=1)
     rigid_text = json_text(res.rigid_document(), indent=1)
@@ -540,15 +607,23 @@ def _echo_summary(res: Any) -> None:
     )
     for row in ring.format_table().splitlines():
         click.echo("  " + row)
-    for r, b in zip(res.rigid, res.budgets, strict=True):
+    for k, (r, b) in enumerate(zip(res.rigid, res.budgets, strict=True)):
         pb = "?" if r.pressure is None else f"{r.pressure / _BAR:g} bar"
         t = b.total
+        w = res.windup(k)
+        wind = (
+            "FREQ_WINDUP, DAMP_WINDUP, BELT_IYY not given (wind-up needs a tangential test: "
+            "--tangential)"
+            if w is None
+            else f"wind-up from {res.tangential_source(k)}: FREQ_WINDUP {w.freq_windup:.4g} +- "
+            f"{t['FREQ_WINDUP']:.2g} Hz, DAMP_WINDUP {w.damp_windup:.4g} +- "
+            f"{t['DAMP_WINDUP']:.2g}, BELT_IYY {w.belt_iyy:.4g} +- {t['BELT_IYY']:.2g} kg m^2"
+        )
         click.echo(
             f"rigid ring ({pb}): BELT_MASS {r.belt_mass:.4g} +- {t['BELT_MASS']:.2g} kg, "
             f"FREQ_LONG {r.freq_long:.4g} +- {t['FREQ_LONG']:.2g} Hz, DAMP_LONG "
             f"{r.damp_long:.4g} +- {t['DAMP_LONG']:.2g} (1 sigma with calibration and "
-            "attachment; budgets in rigid_ring.json); FREQ_WINDUP, DAMP_WINDUP, BELT_IYY not "
-            "given (wind-up needs tangential measurement)"
+            f"attachment; budgets in rigid_ring.json); {wind}"
         )
     for w in res.warnings:
         click.echo(f"warning: {w}")

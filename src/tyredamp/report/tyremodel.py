@@ -87,8 +87,9 @@ def _tyre_model_rigid(rep: HtmlReport, tm: dict[str, Any], doc: dict[str, Any]) 
         caption="In-plane rigid ring (MF-Swift) per pressure from the identified n = 1 modes, "
         "beside the same quantities computed from the exact modes of the virtual tyre "
         "(attachment mass and damper removed). FREQ_WINDUP, DAMP_WINDUP and BELT_IYY are not "
-        "given: the wind-up mode (n = 0) has no radial motion, so radial accelerometers "
-        "cannot see it."
+        "given by these tests: the wind-up mode (n = 0) has no radial motion, so radial "
+        "accelerometers cannot see it; a tangential test gives them (tyredamp tyre-model "
+        "--tangential)."
         + (
             f" The complex-mode fit at {', '.join(failed)} did not pass its verdict (see the "
             "radial study): its modes, and what is derived from them here, carry more error "

@@ -10,6 +10,8 @@
   identifiability verdicts; predictions of modes and FRFs.
 * :mod:`.rigid` -- in-plane rigid-ring (MF-Swift) parameters from the n = 1
   modes, with what a radial test cannot give stated.
+* :mod:`.windup` -- the belt's wind-up (``FREQ_WINDUP``, ``DAMP_WINDUP``,
+  ``BELT_IYY``) from the ``n = 0`` mode of a tangential test.
 * :mod:`.tir` -- the in-plane ``.tir`` fragment (writer) and a reader of
   every public ``.tir`` property file; :mod:`.tirmerge` -- identified
   values merged into a complete base ``.tir``.
@@ -43,6 +45,7 @@ if TYPE_CHECKING:
     )
     from .tir import parse_tir, tir_text
     from .wavenumber import ModeWaveNumber, WaveNumberAnalysis, wave_number_analysis
+    from .windup import WindupParameters, windup_budget, windup_from_modes
 
 #: the module of each public name: loaded on first access (PEP 562), so that a
 #: step that needs the wave numbers does not load the lateral fits, the ring
@@ -70,6 +73,9 @@ _WHERE = {
     "ring_observations": "ring",
     "tir_text": "tir",
     "wave_number_analysis": "wavenumber",
+    "WindupParameters": "windup",
+    "windup_budget": "windup",
+    "windup_from_modes": "windup",
 }
 
 __all__ = [
@@ -81,6 +87,7 @@ __all__ = [
     "RingObservation",
     "TyreModelResult",
     "WaveNumberAnalysis",
+    "WindupParameters",
     "alias_candidates",
     "build_tyre_model",
     "fit_ring",
@@ -95,6 +102,8 @@ __all__ = [
     "ring_observations",
     "tir_text",
     "wave_number_analysis",
+    "windup_budget",
+    "windup_from_modes",
 ]
 
 

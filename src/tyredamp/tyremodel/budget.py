@@ -43,7 +43,14 @@ __all__ = ["Assumptions", "UncertaintyBudget", "rigid_ring_budget"]
 
 #: The ``.tir`` keys the rigid ring gives, with the attribute names of their values.
 KEYS = {"BELT_MASS": "belt_mass", "FREQ_LONG": "freq_long", "DAMP_LONG": "damp_long"}
-_UNITS = {"BELT_MASS": "kg", "FREQ_LONG": "Hz", "DAMP_LONG": ""}
+_UNITS = {
+    "BELT_MASS": "kg",
+    "FREQ_LONG": "Hz",
+    "DAMP_LONG": "",
+    "BELT_IYY": "kg m^2",
+    "FREQ_WINDUP": "Hz",
+    "DAMP_WINDUP": "",
+}
 
 
 @dataclass(frozen=True)
@@ -114,6 +121,16 @@ class UncertaintyBudget:
         if self.assumptions.get(key):
             text += f"; assumes {self.assumptions[key]}"
         return text
+
+    def joined(self, other: UncertaintyBudget) -> UncertaintyBudget:
+        """This budget with the keys of ``other`` added (e.g. the wind-up's)."""
+        return UncertaintyBudget(
+            terms={**self.terms, **other.terms},
+            total={**self.total, **other.total},
+            assumptions={**self.assumptions, **other.assumptions},
+            without_attachment_damping=self.without_attachment_damping,
+            inputs=self.inputs,
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dictionary."""

@@ -11,6 +11,10 @@ returns the documents the command line writes (``tyredamp tyre-model``):
 * ``rigid_ring.json`` -- rigid-ring parameters per pressure, what the test
   cannot give, lateral carcass quantities;
 * one ``.tir`` subset per pressure (:func:`~tyredamp.tyremodel.tir_text`).
+
+A tangential test at a pressure (``tangential=``) adds the belt's wind-up
+(``FREQ_WINDUP``, ``DAMP_WINDUP``, ``BELT_IYY``, :mod:`.windup`) to that
+pressure's rigid ring, budget and ``.tir``.
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ from .ring import FoundationLaw, RingFit, fit_ring, ring_observations
 from .tir import tir_text
 from .tirmerge import merged_text
 from .wavenumber import WaveNumberAnalysis, wave_number_analysis
+from .windup import WINDUP_KEYS, WindupParameters, windup_budget, windup_from_modes
 
 __all__ = ["TyreModelResult", "build_tyre_model"]
 
@@ -56,8 +61,13 @@ class TyreModelResult:
     predictions : list of dict
         Modes of the updated ring at the requested extra pressures.
     budgets : tuple of UncertaintyBudget
-        Uncertainty budget of each pressure's rigid-ring values.
+        Uncertainty budget of each pressure's rigid-ring values (and wind-up).
     warnings : tuple of str
+    windups : tuple of WindupParameters or None
+        The wind-up of each pressure from its tangential test (None: no
+        tangential test at that pressure).
+    tangential_sources : tuple of str or None
+        The tangential test of each pressure.
     """
 
     pressures: tuple[float, ...]
@@ -69,6 +79,12 @@ class TyreModelResult:
     predictions: list[dict[str, Any]]
     budgets: tuple[UncertaintyBudget, ...] = ()
     warnings: tuple[str, ...] = ()
+    windups: tuple[WindupParameters | None, ...] = ()
+    tangential_sources: tuple[str | None, ...] = ()
+
+    def windup(self, k: int) -> WindupParameters | None:
+        """The wind-up of input ``k`` (None without a tangential test)."""
+        return self.windups[k] if k < len(self.windups) else None
 
     def ring_document(self) -> dict[str, Any]:
         """The ``ring.json`` document."""
@@ -89,8 +105,15 @@ class TyreModelResult:
             "tyredamp_version": __version__,
             "kind": "tyre-rigid-ring",
             "rigid_ring": [
-                {"source": s, **r.to_dict(), "uncertainty_budget": b.to_dict()}
-                for s, r, b in zip(self.sources, self.rigid, self.budgets, strict=True)
+                {
+                    "source": s,
+                    **r.to_dict(),
+                    **_windup_entry(self.windup(k), self.tangential_source(k), r),
+                    "uncertainty_budget": b.to_dict(),
+                }
+                for k, (s, r, b) in enumerate(
+                    zip(self.sources, self.rigid, self.budgets, strict=True)
+                )
             ],
             "lateral_carcass": [c.to_dict() for c in self.lateral],
             "warnings": list(self.warnings),
@@ -100,14 +123,23 @@ class TyreModelResult:
         """``{file name: text}`` of the ``.tir`` fragments, one per pressure."""
         out: dict[str, str] = {}
         comments = [c.comment() for c in self.lateral] + [f"warning: {w}" for w in self.warnings]
-        for s, p, r, b in zip(self.sources, self.pressures, self.rigid, self.budgets, strict=True):
+        rows = zip(self.sources, self.pressures, self.rigid, self.budgets, strict=True)
+        for i, (s, p, r, b) in enumerate(rows):
             name = f"tyre_inplane_{p / _BAR:g}bar.tir"
             k = 2
             while name in out:
                 name = f"tyre_inplane_{p / _BAR:g}bar_{k}.tir"
                 k += 1
-            out[name] = tir_text(r, source=s, extra_comments=comments, budget=b)
+            ts = self.tangential_source(i)
+            src = s if ts is None else f"{s} (radial), {ts} (tangential)"
+            out[name] = tir_text(
+                r, source=src, extra_comments=comments, budget=b, windup=self.windup(i)
+            )
         return out
+
+    def tangential_source(self, k: int) -> str | None:
+        """The tangential test of input ``k``, if any."""
+        return self.tangential_sources[k] if k < len(self.tangential_sources) else None
 
     def merged_tir(self, base_text: str, base_name: str, *, force: bool = False) -> str:
         """The identified values merged into a complete base ``.tir`` (:mod:`.tirmerge`).
@@ -130,6 +162,7 @@ def build_tyre_model(
     lateral: Sequence[LateralCarcass] = (),
     assumptions: Assumptions | None = None,
     force: bool = False,
+    tangential: Sequence[tuple[float | None, ModalModel, str]] = (),
 ) -> TyreModelResult:
     """Wave numbers, ring updating, rigid ring and lateral bridge in one call.
 
@@ -152,6 +185,10 @@ def build_tyre_model(
     force : bool
         Keep lateral tests at another pressure than the radial ones (with a
         warning) instead of refusing them.
+    tangential : sequence of (pressure or None, ModalModel, source)
+        Identified modes of tangential tests (:mod:`.windup`), each paired
+        with the radial test of the same pressure (within 2 %; a test without
+        a pressure goes with the only radial test).
 
     Raises
     ------
@@ -210,6 +247,9 @@ def build_tyre_model(
         )
         for (_, mdl, _), wa, r in zip(items, analyses, rigid, strict=True)
     )
+    pairs, windups, budgets = _with_windups(
+        items, tangential, budgets, radius, attachment_mass, attachment_damping or 0.0, assumptions
+    )
     preds = _predictions(ring, predict_pressures)
     return TyreModelResult(
         pressures=tuple(float(p) for p, _, _ in items),
@@ -221,7 +261,106 @@ def build_tyre_model(
         predictions=preds,
         budgets=budgets,
         warnings=tuple(warnings),
+        windups=windups,
+        tangential_sources=tuple(None if t is None else t[2] for t in pairs),
     )
+
+
+_Test = tuple[float | None, ModalModel, str]
+
+
+def _with_windups(
+    items: list[tuple[float, ModalModel, str]],
+    tangential: Sequence[_Test],
+    budgets: tuple[UncertaintyBudget, ...],
+    radius: float,
+    attachment_mass: float,
+    attachment_damping: float,
+    assumptions: Assumptions | None,
+) -> tuple[list[_Test | None], tuple[WindupParameters | None, ...], tuple[UncertaintyBudget, ...]]:
+    """The tangential test, wind-up and joined budget of each radial pressure (:mod:`.windup`)."""
+    pairs = _pair_tangential(tangential, [p for p, _, _ in items])
+    windups = tuple(
+        None
+        if t is None
+        else windup_from_modes(
+            t[1],
+            radius=radius,
+            pressure=items[i][0],
+            attachment_mass=attachment_mass,
+            attachment_damping=attachment_damping,
+            source=t[2],
+        )
+        for i, t in enumerate(pairs)
+    )
+    for w, t in zip(windups, pairs, strict=True):
+        if w is not None and t is not None and not (w.damp_windup > 0 and w.belt_iyy > 0):
+            raise InputError(
+                f"{t[2]}: the wind-up damping ratio is {w.damp_windup:.3g} once the attachment "
+                "damping is removed: the given attachment damping exceeds the measured losses "
+                "(a .tir with a negative damper would be unstable)"
+            )
+    budgets = tuple(
+        b
+        if w is None or t is None
+        else b.joined(
+            windup_budget(
+                t[1],
+                w,
+                analysis=wave_number_analysis(t[1]),
+                attachment_mass=attachment_mass,
+                attachment_damping=attachment_damping,
+                assumptions=assumptions,
+            )
+        )
+        for b, w, t in zip(budgets, windups, pairs, strict=True)
+    )
+    return pairs, windups, budgets
+
+
+def _pair_tangential(
+    tangential: Sequence[tuple[float | None, ModalModel, str]], pressures: list[float]
+) -> list[tuple[float | None, ModalModel, str] | None]:
+    """The tangential test of each radial pressure (or None); refuses unpaired tests."""
+    out: list[tuple[float | None, ModalModel, str] | None] = [None] * len(pressures)
+    for t in tangential:
+        p, mdl, src = t
+        if not isinstance(mdl, ModalModel):
+            raise InputError(f"{src}: expected a ModalModel, got {type(mdl).__name__}")
+        if p is None:
+            if len(pressures) != 1:
+                raise InputError(
+                    f"{src}: the tangential test records no pressure and there are "
+                    f"{len(pressures)} radial tests; give its pressure (command line: "
+                    "--tangential-pressure)"
+                )
+            k = 0
+        else:
+            near = [i for i, q in enumerate(pressures) if abs(q - p) <= 0.02 * q]
+            if not near:
+                have = ", ".join(f"{q / _BAR:g}" for q in pressures)
+                raise InputError(
+                    f"{src}: tangential test at {p / _BAR:g} bar, but the radial tests are at "
+                    f"{have} bar; the wind-up is written beside a radial test of its pressure"
+                )
+            k = near[0]
+        if out[k] is not None:
+            raise InputError(
+                f"{src}: a second tangential test at {pressures[k] / _BAR:g} bar "
+                f"(the first: {out[k][2]})"  # type: ignore[index]
+            )
+        out[k] = t
+    return out
+
+
+def _windup_entry(
+    w: WindupParameters | None, source: str | None, r: RigidRingParameters
+) -> dict[str, Any]:
+    """The wind-up keys of one pressure's ``rigid_ring.json`` entry and what is left."""
+    if w is None:
+        return {}
+    left = {k: v for k, v in r.not_given.items() if k not in WINDUP_KEYS}
+    return {"tangential_source": source, "windup": w.to_dict(), "not_given": left}
 
 
 def _with_skipped(ring: RingFit, skipped: list[str]) -> RingFit:

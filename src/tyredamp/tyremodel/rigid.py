@@ -28,7 +28,8 @@ What a radial modal test gives
   belt with no radial motion, so radial accelerometers cannot see it:
   ``FREQ_WINDUP``, ``DAMP_WINDUP`` and ``BELT_IYY`` need tangential
   (circumferential) measurement (``BELT_IYY`` of a thin ring would be
-  ``m_b R^2``, an assumption reported as such, not a measurement). Lateral and
+  ``m_b R^2``, an assumption reported as such, not a measurement); a
+  tangential test gives them (:mod:`~tyredamp.tyremodel.windup`). Lateral and
   yaw modes, the overall (footprint) stiffnesses and the tyre mass need other
   tests.
 
@@ -53,9 +54,12 @@ __all__ = ["NOT_FROM_RADIAL_TEST", "RigidRingParameters", "rigid_ring_from_modes
 
 #: ``.tir`` fields of the in-plane rigid ring that a radial modal test cannot give, and why.
 NOT_FROM_RADIAL_TEST: dict[str, str] = {
-    "FREQ_WINDUP": "wind-up (n = 0 rotation) has no radial motion: needs tangential measurement",
-    "DAMP_WINDUP": "wind-up (n = 0 rotation) has no radial motion: needs tangential measurement",
-    "BELT_IYY": "needs the wind-up mode (tangential measurement); a thin ring would give m_b R^2",
+    "FREQ_WINDUP": "wind-up (n = 0 rotation) has no radial motion: needs a tangential test "
+    "(--tangential)",
+    "DAMP_WINDUP": "wind-up (n = 0 rotation) has no radial motion: needs a tangential test "
+    "(--tangential)",
+    "BELT_IYY": "needs the wind-up mode of a tangential test (--tangential); a thin ring would "
+    "give m_b R^2",
     "BELT_IXX": "out-of-plane (lateral/camber) test",
     "FREQ_LAT": "out-of-plane (lateral) test",
     "DAMP_LAT": "out-of-plane (lateral) test",

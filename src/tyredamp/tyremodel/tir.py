@@ -9,7 +9,9 @@ ratios dimensionless, as MF-Swift defines ``FREQ_*`` and ``DAMP_*``.
 
 :func:`tir_text` writes only the fields a radial in-plane modal test gives
 (``[INERTIA] BELT_MASS``, ``[STRUCTURAL] FREQ_LONG, DAMP_LONG``, the
-pressure in ``[OPERATING_CONDITIONS] INFLPRES``) and lists every other
+pressure in ``[OPERATING_CONDITIONS] INFLPRES``; with a tangential test also
+``[INERTIA] BELT_IYY`` and ``[STRUCTURAL] FREQ_WINDUP, DAMP_WINDUP``,
+:mod:`.windup`) and lists every other
 in-plane or structural field it cannot give in ``$`` comments with the
 reason; derived quantities (belt stiffness and damping, lateral carcass
 values) appear as comments too, since they are not ``.tir`` keys.
@@ -28,6 +30,7 @@ from .. import __version__
 from ..exceptions import FileFormatError
 from .budget import UncertaintyBudget
 from .rigid import RigidRingParameters
+from .windup import WindupParameters
 
 __all__ = ["TirLine", "decode_tir", "parse_tir", "scan_tir", "tir_text"]
 
@@ -36,12 +39,36 @@ def _fmt(x: float) -> str:
     return f"{x:.10g}"
 
 
+def _windup_lines(
+    windup: WindupParameters | None, budget: UncertaintyBudget | None, inertia: bool = False
+) -> list[str]:
+    """``BELT_IYY`` (``inertia``) or ``FREQ_WINDUP``, ``DAMP_WINDUP`` lines; none without."""
+    if windup is None:
+        return []
+
+    def why(key: str, default: str) -> str:
+        return budget.comment(key) if budget is not None else default
+
+    if inertia:
+        return [
+            f"BELT_IYY = {_fmt(windup.belt_iyy)}  $ belt inertia from the n = 0 rotation shape, "
+            + why("BELT_IYY", f"+- {windup.belt_iyy_std:.3g} kg m^2 (statistical only)")
+        ]
+    return [
+        f"FREQ_WINDUP = {_fmt(windup.freq_windup)}  $ n = 0 belt rotation (tangential "
+        "test), Hz, " + why("FREQ_WINDUP", f"+- {windup.freq_windup_std:.3g} (statistical only)"),
+        f"DAMP_WINDUP = {_fmt(windup.damp_windup)}  $ its damping ratio, "
+        + why("DAMP_WINDUP", f"+- {windup.damp_windup_std:.3g} (statistical only)"),
+    ]
+
+
 def tir_text(
     rigid: RigidRingParameters,
     *,
     source: str = "",
     extra_comments: Sequence[str] = (),
     budget: UncertaintyBudget | None = None,
+    windup: WindupParameters | None = None,
 ) -> str:
     """The in-plane ``.tir`` fragment of one pressure as text.
 
@@ -61,6 +88,10 @@ def tir_text(
     budget : UncertaintyBudget, optional
         The values' uncertainty budgets and assumptions (written beside
         them); without it the statistical standard errors only.
+    windup : WindupParameters, optional
+        The wind-up from a tangential test at the same pressure
+        (:func:`~tyredamp.tyremodel.windup.windup_from_modes`): writes
+        ``BELT_IYY``, ``FREQ_WINDUP`` and ``DAMP_WINDUP``.
 
     Returns
     -------
@@ -76,7 +107,8 @@ def tir_text(
         "$ [VERTICAL], NOMPRES and the Magic Formula coefficients, so a simulator would fill",
         "$ them with defaults. Merge it into a complete file: tyredamp tyre-model ... "
         "--merge-into BASE.tir",
-        f"$ In-plane values written by tyredamp {__version__} from a radial modal test.",
+        f"$ In-plane values written by tyredamp {__version__} from a radial modal test"
+        + (" and a tangential modal test." if windup is not None else "."),
     ]
     if source:
         lines.append(f"$ source: {source}")
@@ -104,9 +136,11 @@ def tir_text(
         f"BELT_MASS = {_fmt(rigid.belt_mass)}  $ belt mass from the n = 1 mode shape, "
         + why("BELT_MASS", f"+- {rigid.belt_mass_std:.3g} kg (statistical only)"),
     ]
+    lines += _windup_lines(windup, budget, inertia=True)
     for key in ("MASS", "IXX", "IYY", "BELT_IXX", "BELT_IYY"):
-        lines.append(f"$ {key}: not given by this test ({ng.get(key, 'not measured')})")
-    if rigid.thin_ring_iyy is not None:
+        if windup is None or key != "BELT_IYY":
+            lines.append(f"$ {key}: not given by this test ({ng.get(key, 'not measured')})")
+    if rigid.thin_ring_iyy is not None and windup is None:
         lines.append(
             f"$   (thin-ring assumption m_b R^2 = {rigid.thin_ring_iyy:.5g} kg m^2, not measured)"
         )
@@ -117,9 +151,9 @@ def tir_text(
         f"DAMP_LONG = {_fmt(rigid.damp_long)}  $ its damping ratio, "
         + why("DAMP_LONG", f"+- {rigid.damp_long_std:.3g} (statistical only)"),
     ]
+    lines += _windup_lines(windup, budget)
     for key in (
-        "FREQ_WINDUP",
-        "DAMP_WINDUP",
+        *(("FREQ_WINDUP", "DAMP_WINDUP") if windup is None else ()),
         "FREQ_LAT",
         "DAMP_LAT",
         "FREQ_YAW",
@@ -134,6 +168,12 @@ def tir_text(
         f"{rigid.k_long:.6g} +- {rigid.k_long_std:.3g} N/m, damping 2 zeta m_b omega = "
         f"{rigid.c_long:.6g} +- {rigid.c_long_std:.3g} N s/m"
     )
+    if windup is not None:
+        lines.append(
+            f"$ derived (not .tir keys): belt rotational stiffness I omega_0^2 = "
+            f"{windup.k_windup:.6g} +- {windup.k_windup_std:.3g} N m/rad, damping "
+            f"2 zeta_0 I omega_0 = {windup.c_windup:.6g} +- {windup.c_windup_std:.3g} N m s/rad"
+        )
     for c in extra_comments:
         lines.append(f"$ {c}")
     return "\n".join(lines) + "\n"

@@ -304,6 +304,26 @@ def merged_text(res: Any, base_text: str, name: str, *, force: bool = False) -> 
         ),
         TirValue("OPERATING_CONDITIONS", "INFLPRES", p, f"tyredamp: pressure of the test {test}"),
     ]
+    wu = res.windup(k)
+    if wu is not None:
+        values += [
+            TirValue("INERTIA", "BELT_IYY", wu.belt_iyy, f"tyredamp: {budget.comment('BELT_IYY')}"),
+            TirValue(
+                "STRUCTURAL",
+                "FREQ_WINDUP",
+                wu.freq_windup,
+                f"tyredamp: {budget.comment('FREQ_WINDUP')}",
+            ),
+            TirValue(
+                "STRUCTURAL",
+                "DAMP_WINDUP",
+                wu.damp_windup,
+                f"tyredamp: {budget.comment('DAMP_WINDUP')}",
+            ),
+        ]
+    given = ["BELT_MASS", "FREQ_LONG", "DAMP_LONG"] + (
+        [] if wu is None else ["BELT_IYY", "FREQ_WINDUP", "DAMP_WINDUP"]
+    )
     if "NOMPRES" not in doc.get("OPERATING_CONDITIONS", {}):
         nom = pb if pb is not None else p
         values.append(
@@ -317,14 +337,15 @@ def merged_text(res: Any, base_text: str, name: str, *, force: bool = False) -> 
             )
         )
     header = [
-        f"tyredamp {__version__}: BELT_MASS, FREQ_LONG, DAMP_LONG identified from the radial "
-        f"modal test {test}",
+        f"tyredamp {__version__}: {', '.join(given)} identified from the radial "
+        f"modal test {test}"
+        + ("" if wu is None else f" and the tangential test {res.tangential_source(k)}"),
         f"(tests: {', '.join(res.sources)}); INFLPRES set to the test's pressure. Base file: "
         f"{name}" + ("" if pb is None else f" ({pb / _BAR:.3g} bar)") + ", every other line kept.",
         "Each identified line gives +- 1 sigma with its sources and what it assumes; the base's "
         "value follows in its comment.",
         "Not given by this test (base values kept): "
-        + ", ".join(sorted(NOT_FROM_RADIAL_TEST))
+        + ", ".join(sorted(k for k in NOT_FROM_RADIAL_TEST if k not in given))
         + ".",
     ]
     if pb is not None and abs(p - pb) > PRESSURE_TOLERANCE * pb:

@@ -65,6 +65,7 @@ from .rotation import (
     rotating_ring_roots,
 )
 from .sources import DampingDecomposition, damping_decomposition
+from .tangential import WindupTruth, bare_ring_windup, tangential_tyre, windup_truth
 from .truth import TyreTruth, modal_phase_collinearity, wave_numbers
 
 __all__ = [
@@ -88,7 +89,9 @@ __all__ = [
     "VirtualLateralRig",
     "VirtualModalTest",
     "ViscoelasticStringTyre",
+    "WindupTruth",
     "analytic_ring_frequencies",
+    "bare_ring_windup",
     "critical_speed_kmh",
     "damping_decomposition",
     "difference_symbol",
@@ -105,5 +108,7 @@ __all__ = [
     "run_modal_test",
     "schroeder_multisine",
     "staggered_weights",
+    "tangential_tyre",
     "wave_numbers",
+    "windup_truth",
 ]

@@ -3,7 +3,9 @@
 The tyre (its full ring discretisation) is driven radially at the drive
 point(s) by a periodic chirp and the radial accelerations at the measured
 points are recorded together with the forces, with independent Gaussian
-noise on every channel. The response is computed with
+noise on every channel (``direction="tangential"``: driven and measured
+along the circumference, :mod:`~tyredamp.virtual.tangential`, the test that
+sees the belt's wind-up mode). The response is computed with
 :func:`tyredamp.mechanics.time_response` (exact modal integration with a
 first-order hold of the sampled force).
 
@@ -83,6 +85,7 @@ from ..timedata import Acquisition, TimeData
 from .excitation import hadamard_drive_matrix, schroeder_multisine
 from .microphone import microphone_node, microphone_row
 from .ring import RingTyre
+from .tangential import tangential_tyre
 from .truth import TyreTruth
 
 __all__ = ["VirtualModalTest", "periodic_initial_state", "run_modal_test"]
@@ -90,6 +93,7 @@ __all__ = ["VirtualModalTest", "periodic_initial_state", "run_modal_test"]
 DriveMode = Literal["sequential", "simultaneous"]
 InitialState = Literal["periodic", "rest"]
 ExcitationKind = Literal["chirp", "multisine"]
+Direction = Literal["radial", "tangential"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -297,6 +301,7 @@ def run_modal_test(
     settle_periods: int = 0,
     keep_settle: bool = False,
     microphone_deg: float | None = None,
+    direction: Direction = "radial",
 ) -> VirtualModalTest:
     """Run the virtual modal test of paper 000 on a ring tyre.
 
@@ -344,6 +349,9 @@ def run_modal_test(
         A rim microphone at this angle (deg, a ring node; needs a cavity): a
         last channel ``P1``, "pressure" in Pa, noise at ``snr_db``
         (:mod:`~tyredamp.virtual.microphone`). Default none.
+    direction : {"radial", "tangential"}
+        Drive and measure radially (default) or along the circumference
+        (:mod:`~tyredamp.virtual.tangential`; ``data.meta["measured_direction"]``).
 
     Returns
     -------
@@ -359,7 +367,9 @@ def run_modal_test(
     tyre, fs, p_samples, f_rms = _checked_options(
         tyre, sample_rate, period, n_periods, settle_periods, oversample, force_rms, snr_db
     )
-    _check_choices(drive_mode, excitation, initial_state)
+    _check_choices(drive_mode, excitation, initial_state, direction)
+    if direction == "tangential":
+        tyre = tangential_tyre(tyre)
     bnd = as_band(band)
     lines = band_lines(fs, p_samples, bnd)
     mic = None if microphone_deg is None else microphone_row(tyre, microphone_deg)
@@ -381,6 +391,8 @@ def run_modal_test(
     measured, noise_std = _add_noise(clean, snr_db, rng)
     meta = _notes(tyre, drive, drive_mode, exc, lines, (f_rms, snr_db, noise_std), seed, r)
     meta["initial_state"] = initial_state
+    if direction == "tangential":
+        meta["measured_direction"] = "tangential"
     meta["elapsed_s"] = _time.perf_counter() - t_start
     acquisition = Acquisition(
         period_samples=p_samples,
@@ -414,7 +426,11 @@ def _time_data(
     return TimeData(measured, fs, channels, quantities, meta, acquisition=acquisition)
 
 
-def _check_choices(drive_mode: str, excitation: str, initial_state: str) -> None:
+def _check_choices(
+    drive_mode: str, excitation: str, initial_state: str, direction: str = "radial"
+) -> None:
+    if direction not in ("radial", "tangential"):
+        raise InputError(f"direction: expected 'radial' or 'tangential', got {direction!r}")
     if drive_mode not in ("sequential", "simultaneous"):
         raise InputError(f"drive_mode: expected 'sequential' or 'simultaneous', got {drive_mode!r}")
     if excitation not in ("chirp", "multisine"):
