@@ -536,13 +536,18 @@ def _tyre_model(
                 f"{path}: the test pressure is not recorded in the file; give --pressure"
             )
         inputs.append((pb * _BAR, mdl, path.name))
+    from ..io import FILE_FORMATS
     from ..virtual.tangential import TANGENTIAL_DIRECTION
 
-    for _, mdl, src in inputs:
-        if {abs(c.direction) for c in mdl.outputs} == {TANGENTIAL_DIRECTION}:
+    for (_, mdl, src), path in zip(inputs, modes_files, strict=True):
+        # a UFF 55 file's shapes were projected on the radius above (direction 1 there)
+        uff = path.suffix.lower() in FILE_FORMATS["uff58b"].extensions
+        if not uff and {abs(c.direction) for c in mdl.outputs} == {TANGENTIAL_DIRECTION}:
             raise InputError(
-                f"{src}: the response channels are tangential; give a tangential test with "
-                "--tangential (the flexible ring needs a radial test)"
+                f"{src}: the response channels are tangential (UFF direction "
+                f"{TANGENTIAL_DIRECTION} on the ring, as tyredamp's tangential test writes "
+                "them); give a tangential test with --tangential (the flexible ring needs a "
+                "radial test)"
             )
     tangential = _read_tangential(opts, model_kind, geometry_file)
     preds = [p * _BAR for p in (_float_list(predict, "--predict", _MAX_BAR) or [])]
