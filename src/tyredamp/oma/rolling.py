@@ -46,13 +46,17 @@ from .spatial import equally_spaced, spatial_spectra, travelling_channels
 from .waves import wave_content
 
 __all__ = [
+    "FLOOR_RATIO",
     "RollingModes",
     "RollingWave",
+    "SpatialPole",
     "compare_waves",
     "resolve_in_tyre",
     "rolling_modes",
     "rotating_frequency",
     "rotating_pole",
+    "select_spatial_poles",
+    "spatial_poles",
 ]
 
 
@@ -272,26 +276,68 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
-_FLOOR_RATIO = 10.0
+FLOOR_RATIO = 10.0
 """A wave's channel must hold this many times the median power of all channels
-at its frequency (sensor noise spreads evenly over the wave numbers)."""
+at its frequency (sensor noise spreads evenly over the wave numbers; the
+benchmark ``rolling_oma.py --thresholds`` compares other values)."""
+
+
+@dataclass(frozen=True)
+class SpatialPole:
+    """One pole of one wave-number channel, before the selection.
+
+    Attributes
+    ----------
+    wave_number : int
+    direction : str
+        As a fixed observer sees it: ``"backward"``, ``"forward"`` or ``"standing"``.
+    frequency_hz, damping_ratio, std_frequency_hz, std_damping_ratio : float
+        As identified from the channel's 2-channel record (Hz; NaN without errors).
+    ratio, other : float
+        Power of this channel and of the opposite direction at the pole's
+        frequency over the median of all channels there.
+    peak : bool
+        Whether the channel's spectrum peaks near the pole (:func:`_is_peak`).
+    """
+
+    wave_number: int
+    direction: str
+    frequency_hz: float
+    damping_ratio: float
+    std_frequency_hz: float
+    std_damping_ratio: float
+    ratio: float
+    other: float
+    peak: bool
 
 
 def _is_peak(s: Any, f_axis: Any, f: float, z: float) -> bool:
     """Whether the spectrum ``s`` peaks inside ``f -+ max(2 zeta f, 2 bins)`` (not
     on the skirt of a stronger neighbour, which rises towards one edge)."""
-    half = max(2 * abs(z) * f, 2 * (f_axis[1] - f_axis[0]))
+    half = _peak_half_width(float(f_axis[1] - f_axis[0]), f, z)
     inside = np.flatnonzero(np.abs(f_axis - f) <= half)
     k = int(np.argmax(s[inside]))
     return 0 < k < inside.size - 1
 
 
-def _spatial_waves(
-    y: Any, fs: float, angles: list[float], fw: float, kw: dict[str, Any]
-) -> list[RollingWave]:
-    """Waves of each wave-number channel ``n = 0 .. (K - 1) // 2``, the backward
-    and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`)."""
-    out: list[RollingWave] = []
+def _peak_half_width(resolution: float, f: float, z: float) -> float:
+    """Hz: ``max(2 zeta f, 2 bins)``, two half-power half-bandwidths of a pole."""
+    return float(max(2 * abs(z) * f, 2 * resolution))
+
+
+def spatial_poles(
+    y: Any, fs: float, angles: list[float], kw: dict[str, Any]
+) -> tuple[list[SpatialPole], float]:
+    """Every pole of each wave-number channel ``n = 0 .. (K - 1) // 2``, the
+    backward and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`).
+
+    Returns
+    -------
+    poles : list of SpatialPole
+    resolution : float
+        Hz, the bin of the spectra the poles were checked on.
+    """
+    out: list[SpatialPole] = []
     K = len(angles)
     fs_, S = spatial_spectra(y, fs, angles)
     floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
@@ -302,22 +348,83 @@ def _spatial_waves(
             bwd, fwd = travelling_channels(y, angles, n)
             parts = [("backward", oma(bwd, fs, **kw)), ("forward", oma(fwd, fs, **kw))]
         for d, r in parts:
+            c = int(d == "forward")
             for j in range(r.n_modes):
                 f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
                 k = int(np.argmin(np.abs(fs_ - f)))
-                ratio = float(S[int(d == "forward"), n, k] / floor[k])
-                if ratio < _FLOOR_RATIO or not _is_peak(S[int(d == "forward"), n], fs_, f, z):
-                    continue
-                sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
-                alias = f" (aliases {K - n}, {K + n})" if n > 0 else ""
-                other = S[int(d != "forward"), n, k] / floor[k] if n > 0 else ratio
-                why = (
-                    f"wave-number channel {'-' if d == 'forward' else '+'}{n}{alias}: power "
-                    f"{ratio:.3g} x the median channel, the opposite direction {other:.3g} x"
-                )
-                fr, _, dt = rotating_pole(f, z, n, d, fw)
-                out.append(RollingWave("fixed", n, dt, d, f, fr, z, sf, sz, float("nan"),
-                                       [], why))  # fmt: skip
+                ratio = float(S[c, n, k] / floor[k])
+                other = float(S[1 - c, n, k] / floor[k]) if n > 0 else ratio
+                out.append(SpatialPole(n, d, f, z, float(r.std_frequency_hz[j]),
+                                       float(r.std_damping_ratio[j]), ratio, other,
+                                       _is_peak(S[c, n], fs_, f, z)))  # fmt: skip
+    return out, float(fs_[1] - fs_[0])
+
+
+def select_spatial_poles(
+    poles: list[SpatialPole],
+    band: tuple[float, float],
+    resolution: float,
+    floor_ratio: float = FLOOR_RATIO,
+) -> list[SpatialPole]:
+    """The poles of :func:`spatial_poles` taken for waves.
+
+    A pole is kept when (i) its channel holds ``floor_ratio`` times the median
+    power of all channels at its frequency, (ii) the channel's spectrum peaks
+    within ``f -+ max(2 zeta f, 2 bins)``, (iii) that window lies inside
+    ``band``: a peak whose resonance the band cuts may be the band's edge (the
+    filter's transition), not a mode; and (iv) no stronger pole of the same
+    channel lies within the sum of their half-power half-bandwidths
+    ``zeta_1 f_1 + zeta_2 f_2`` (one channel holds one wave per resonance: two
+    poles closer than that are one resonance split by the fit, Ewins, Modal
+    Testing 2000, sec. 4.3: the half-power points of a mode lie at
+    ``f (1 -+ zeta)``).
+
+    Parameters
+    ----------
+    poles : list of SpatialPole
+    band : (float, float)
+        Hz, the band of the identification.
+    resolution : float
+        Hz, the bin of the spectra.
+    floor_ratio : float
+        Threshold of (i).
+
+    Returns
+    -------
+    list of SpatialPole
+        Strongest first.
+    """
+    lo, hi = band
+    keep = []
+    for p in sorted(poles, key=lambda q: -q.ratio):
+        half = _peak_half_width(resolution, p.frequency_hz, p.damping_ratio)
+        if p.ratio < floor_ratio or not p.peak or p.frequency_hz + half > hi:
+            continue
+        if lo > 0 and p.frequency_hz - half < lo:
+            continue
+        if any(q.wave_number == p.wave_number and q.direction == p.direction
+               and abs(q.frequency_hz - p.frequency_hz)
+               <= q.damping_ratio * q.frequency_hz + p.damping_ratio * p.frequency_hz
+               for q in keep):  # fmt: skip
+            continue
+        keep.append(p)
+    return keep
+
+
+def _spatial_waves(poles: list[SpatialPole], K: int, fw: float) -> list[RollingWave]:
+    """The selected poles as waves, with their channel and power in the reason."""
+    out: list[RollingWave] = []
+    for p in poles:
+        n, d = p.wave_number, p.direction
+        alias = f" (aliases {K - n}, {K + n})" if n > 0 else ""
+        why = (
+            f"wave-number channel {'-' if d == 'forward' else '+'}{n}{alias}: power "
+            f"{p.ratio:.3g} x the median channel, the opposite direction {p.other:.3g} x"
+        )
+        fr, _, dt = rotating_pole(p.frequency_hz, p.damping_ratio, n, d, fw)
+        out.append(RollingWave("fixed", n, dt, d, p.frequency_hz, fr, p.damping_ratio,
+                               p.std_frequency_hz, p.std_damping_ratio, float("nan"), [],
+                               why))  # fmt: skip
     return out
 
 
@@ -492,10 +599,15 @@ def rolling_modes(
         kw: dict[str, Any] = {"band": bnd, "n_groups": n_groups, "uncertainty": uncertainty,
                               "wheel_speed_hz": fw if fw > 0 else None}  # fmt: skip
         if spatial and not equally_spaced(ang):
-            raise InputError("angles: the wave-number route needs fixed sensors equally "
-                             f"spaced around the circumference, got {ang} deg")  # fmt: skip
+            got = ", ".join(f"{a:g}" for a in ang)
+            raise InputError(
+                f"angles: the wave-number route needs the {len(ang)} fixed sensors "
+                f"every {360 / len(ang):g} deg around the tyre, got {got} deg"
+            )
         if spatial:
-            fixed = _spatial_waves(data.data[fix], data.sample_rate, ang, fw, kw)
+            poles, res = spatial_poles(data.data[fix], data.sample_rate, ang, kw)
+            edges = bnd if bnd is not None else (0.0, 0.45 * data.sample_rate)
+            fixed = _spatial_waves(select_spatial_poles(poles, edges, res), len(ang), fw)
             notes.append(f"fixed sensors: each wave number 0..{(len(fix) - 1) // 2} identified "
                          "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
         else:

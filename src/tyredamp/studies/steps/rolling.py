@@ -44,6 +44,13 @@ class RollingSettings(StepSettings):
         Boolean(),
         "--no-uncertainty",
     )
+    spatial: bool = knob(
+        False,
+        "Identify each wave number and direction apart (fixed sensors equally spaced "
+        "around the tyre).",
+        Boolean(),
+        "--spatial",
+    )
 
 
 class RollingStep:
@@ -61,7 +68,11 @@ class RollingStep:
         from ...oma.rolling import rolling_modes
 
         res = rolling_modes(
-            data, wheel_speed_hz, band=settings.band, uncertainty=settings.uncertainty
+            data,
+            wheel_speed_hz,
+            band=settings.band,
+            uncertainty=settings.uncertainty,
+            spatial=settings.spatial,
         )
         return res, []
 
