@@ -106,21 +106,27 @@ def _run(
 
 
 def _thresholds(
-    speed: float, seed: int, duration: float, band: tuple[float, float], values: list[float]
+    speed: float,
+    seed: int,
+    duration: float,
+    band: tuple[float, float],
+    values: list[float | None],
 ) -> list[tuple[int, int, int]]:
-    """(truth waves, found, false) of the wave-number route for each threshold."""
+    """(truth waves, found, false) of the wave-number route for each threshold of the
+    channel power (``None``: the F-test threshold of ``select_spatial_poles``); the
+    poles identified once, without standard errors."""
     test = rolling_test(speed, duration=duration, sample_rate=512, band=band, seed=seed)
     d = test.data
     fix = [i for i in d.response_indices if not (d.channels[i].name or "").upper().startswith("T")]
     ang = [float(d.channels[i].angle_deg or 0.0) for i in fix]
     fw = float(d.meta["rotation_hz"])
     kw = {"band": d.acquisition.band_hz, "uncertainty": False, "wheel_speed_hz": fw or None}
-    poles, res = spatial_poles(d.data[fix], d.sample_rate, ang, kw)
+    poles, res, dof = spatial_poles(d.data[fix], d.sample_rate, ang, kw)
     truth = [r for r in test.truth.table() if band[0] + 5 <= r["fixed_hz"] <= band[1] - 10]
     out = []
     for v in values:
         waves = []
-        for p in select_spatial_poles(poles, d.acquisition.band_hz or band, res, v):
+        for p in select_spatial_poles(poles, d.acquisition.band_hz or band, res, dof, v):
             f, z, n, fd = p.frequency_hz, p.damping_ratio, p.wave_number, p.direction
             fr, _, dt = rotating_pole(f, z, n, fd, fw)
             waves.append(RollingWave("fixed", n, dt, fd, f, fr, z, np.nan, np.nan))
@@ -181,9 +187,12 @@ def main() -> None:
 
 
 def _threshold_table(a: argparse.Namespace) -> None:
-    values = [float(v) for v in a.thresholds.split(",")]
+    values: list[float | None] = [
+        None if v == "auto" else float(v) for v in a.thresholds.split(",")
+    ]
     print(f"wave-number route, {a.duration:g} s records, {a.draws} draws: found / false per run")
-    print("speed  waves  " + "  ".join(f"x{v:<10g}" for v in values))
+    heads = ["F-test" if v is None else f"x{v:g}" for v in values]
+    print("speed  waves  " + "  ".join(f"{h:<11s}" for h in heads))
     for v in [float(s) for s in a.speeds.split(",")]:
         with single_threaded_blas():
             runs = [_thresholds(v, s, a.duration, (0.0, 200.0), values) for s in range(a.draws)]

@@ -42,11 +42,18 @@ from numpy.typing import ArrayLike
 from ..exceptions import InputError
 from ..timedata import TimeData
 from .identify import OMAResult, oma
-from .spatial import equally_spaced, spatial_spectra, travelling_channels
+from .spatial import (
+    equally_spaced,
+    peak_contrast,
+    power_threshold,
+    spatial_spectra,
+    travelling_channels,
+    welch_dof,
+)
 from .waves import wave_content
 
 __all__ = [
-    "FLOOR_RATIO",
+    "ALPHA",
     "RollingModes",
     "RollingWave",
     "SpatialPole",
@@ -276,10 +283,8 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
-FLOOR_RATIO = 10.0
-"""A wave's channel must hold this many times the median power of all channels
-at its frequency (sensor noise spreads evenly over the wave numbers; the
-benchmark ``rolling_oma.py --thresholds`` compares other values)."""
+ALPHA = 1e-3
+"""Probability that sensor noise alone passes each test of :func:`select_spatial_poles`."""
 
 
 @dataclass(frozen=True)
@@ -296,8 +301,11 @@ class SpatialPole:
     ratio, other : float
         Power of this channel and of the opposite direction at the pole's
         frequency over the median of all channels there.
-    peak : bool
-        Whether the channel's spectrum peaks near the pole (:func:`_is_peak`).
+    contrast : float
+        How far the channel's spectrum rises at the pole above its flanks
+        (:func:`~tyredamp.oma.spatial.peak_contrast`).
+    orders : int
+        Model orders the pole persisted over in its channel's stabilisation.
     """
 
     wave_number: int
@@ -308,38 +316,39 @@ class SpatialPole:
     std_damping_ratio: float
     ratio: float
     other: float
-    peak: bool
-
-
-def _is_peak(s: Any, f_axis: Any, f: float, z: float) -> bool:
-    """Whether the spectrum ``s`` peaks inside ``f -+ max(2 zeta f, 2 bins)`` (not
-    on the skirt of a stronger neighbour, which rises towards one edge)."""
-    half = _peak_half_width(float(f_axis[1] - f_axis[0]), f, z)
-    inside = np.flatnonzero(np.abs(f_axis - f) <= half)
-    k = int(np.argmax(s[inside]))
-    return 0 < k < inside.size - 1
-
-
-def _peak_half_width(resolution: float, f: float, z: float) -> float:
-    """Hz: ``max(2 zeta f, 2 bins)``, two half-power half-bandwidths of a pole."""
-    return float(max(2 * abs(z) * f, 2 * resolution))
+    contrast: float
+    orders: int
 
 
 def spatial_poles(
     y: Any, fs: float, angles: list[float], kw: dict[str, Any]
-) -> tuple[list[SpatialPole], float]:
+) -> tuple[list[SpatialPole], float, float]:
     """Every pole of each wave-number channel ``n = 0 .. (K - 1) // 2``, the
     backward and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`).
+
+    Parameters
+    ----------
+    y : array_like, shape (K, n_samples)
+        The fixed sensors, equally spaced.
+    fs : float
+        Hz.
+    angles : list of float
+        Their angles, deg.
+    kw : dict
+        Options of :func:`~tyredamp.oma.identify.oma`.
 
     Returns
     -------
     poles : list of SpatialPole
     resolution : float
-        Hz, the bin of the spectra the poles were checked on.
+        Hz, the bin of the channel spectra.
+    dof : float
+        Degrees of freedom of each bin of those spectra (:func:`.spatial.welch_dof`).
     """
     out: list[SpatialPole] = []
     K = len(angles)
-    fs_, S = spatial_spectra(y, fs, angles)
+    nperseg = 1024
+    fs_, S = spatial_spectra(y, fs, angles, nperseg)
     floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
     for n in range(0, (K - 1) // 2 + 1):
         if n == 0:
@@ -356,28 +365,37 @@ def spatial_poles(
                 other = float(S[1 - c, n, k] / floor[k]) if n > 0 else ratio
                 out.append(SpatialPole(n, d, f, z, float(r.std_frequency_hz[j]),
                                        float(r.std_damping_ratio[j]), ratio, other,
-                                       _is_peak(S[c, n], fs_, f, z)))  # fmt: skip
-    return out, float(fs_[1] - fs_[0])
+                                       peak_contrast(S[c, n], fs_, f, z),
+                                       int(r.n_orders[j])))  # fmt: skip
+    return out, float(fs_[1] - fs_[0]), welch_dof(np.shape(y)[-1], nperseg)
 
 
 def select_spatial_poles(
     poles: list[SpatialPole],
     band: tuple[float, float],
     resolution: float,
-    floor_ratio: float = FLOOR_RATIO,
+    dof: float,
+    floor_ratio: float | None = None,
+    alpha: float = ALPHA,
 ) -> list[SpatialPole]:
     """The poles of :func:`spatial_poles` taken for waves.
 
-    A pole is kept when (i) its channel holds ``floor_ratio`` times the median
-    power of all channels at its frequency, (ii) the channel's spectrum peaks
-    within ``f -+ max(2 zeta f, 2 bins)``, (iii) that window lies inside
-    ``band``: a peak whose resonance the band cuts may be the band's edge (the
-    filter's transition), not a mode; and (iv) no stronger pole of the same
-    channel lies within the sum of their half-power half-bandwidths
-    ``zeta_1 f_1 + zeta_2 f_2`` (one channel holds one wave per resonance: two
-    poles closer than that are one resonance split by the fit, Ewins, Modal
-    Testing 2000, sec. 4.3: the half-power points of a mode lie at
-    ``f (1 -+ zeta)``).
+    With ``q`` the ratio two PSD estimates of one level exceed with
+    probability ``alpha`` (:func:`.spatial.power_threshold`), a pole is kept
+    when (i) its channel holds ``q`` times (or ``floor_ratio`` times, when
+    given) the median power of all channels at its frequency: sensor noise
+    spreads evenly over the wave numbers, so the median is the noise level;
+    (ii) the channel's spectrum rises at the pole ``q`` times above its flanks
+    at ``f -+ max(2 zeta f, 3 bins)`` (:func:`.spatial.peak_contrast`; a
+    resonance gives about 5, the skirt of a stronger one less than 1); (iii)
+    those flanks lie inside ``band``: a peak the band cuts may be the band's
+    edge (the filter's transition), not a mode; and (iv) no stronger pole of
+    the same channel that persisted over more model orders lies within the sum
+    of their half-power half-bandwidths ``zeta_1 f_1 + zeta_2 f_2`` (one
+    channel holds one wave per resonance: two poles closer than that are one
+    resonance the fit split, and the one stable over more orders is the
+    better fit; the half-power points of a mode lie at ``f (1 -+ zeta)``,
+    Ewins, Modal Testing, 2nd ed. 2000, sec. 2.2).
 
     Parameters
     ----------
@@ -386,26 +404,30 @@ def select_spatial_poles(
         Hz, the band of the identification.
     resolution : float
         Hz, the bin of the spectra.
-    floor_ratio : float
-        Threshold of (i).
+    dof : float
+        Degrees of freedom of each bin.
+    floor_ratio : float, optional
+        A fixed threshold for (i) instead of ``q`` (the benchmark compares values).
+    alpha : float
+        False-pass probability of each test for noise alone.
 
     Returns
     -------
     list of SpatialPole
-        Strongest first.
+        Most stable first.
     """
     lo, hi = band
-    keep = []
-    for p in sorted(poles, key=lambda q: -q.ratio):
-        half = _peak_half_width(resolution, p.frequency_hz, p.damping_ratio)
-        if p.ratio < floor_ratio or not p.peak or p.frequency_hz + half > hi:
+    q = power_threshold(dof, alpha)
+    floor = q if floor_ratio is None else float(floor_ratio)
+    keep: list[SpatialPole] = []
+    for p in sorted(poles, key=lambda x: (-x.orders, -x.ratio)):
+        f, z = p.frequency_hz, p.damping_ratio
+        off = max(2 * abs(z) * f, 3 * resolution)
+        if p.ratio < floor or p.contrast < q or f + off > hi or (lo > 0 and f - off < lo):
             continue
-        if lo > 0 and p.frequency_hz - half < lo:
-            continue
-        if any(q.wave_number == p.wave_number and q.direction == p.direction
-               and abs(q.frequency_hz - p.frequency_hz)
-               <= q.damping_ratio * q.frequency_hz + p.damping_ratio * p.frequency_hz
-               for q in keep):  # fmt: skip
+        if any(x.wave_number == p.wave_number and x.direction == p.direction
+               and abs(x.frequency_hz - f) <= x.damping_ratio * x.frequency_hz + z * f
+               for x in keep):  # fmt: skip
             continue
         keep.append(p)
     return keep
@@ -605,9 +627,10 @@ def rolling_modes(
                 f"every {360 / len(ang):g} deg around the tyre, got {got} deg"
             )
         if spatial:
-            poles, res = spatial_poles(data.data[fix], data.sample_rate, ang, kw)
+            poles, res, dof = spatial_poles(data.data[fix], data.sample_rate, ang, kw)
             edges = bnd if bnd is not None else (0.0, 0.45 * data.sample_rate)
-            fixed = _spatial_waves(select_spatial_poles(poles, edges, res), len(ang), fw)
+            kept = select_spatial_poles(poles, edges, res, dof)
+            fixed = _spatial_waves(kept, len(ang), fw)
             notes.append(f"fixed sensors: each wave number 0..{(len(fix) - 1) // 2} identified "
                          "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
         else:
