@@ -166,3 +166,32 @@ def test_rolling_modes_spatial_refuses_an_irregular_layout() -> None:
     td = _rolling_record(0, angles_deg=[0, 40, 90, 135, 180, 225, 270, 315], n_samples=4096)
     with pytest.raises(InputError, match="every 45 deg"):
         rolling_modes(td, uncertainty=False, spatial=True)
+
+
+def test_cli_rolling_spatial(tmp_path, capsys) -> None:
+    from tyredamp.io import write_timedata
+
+    from .test_rolling_oma import _run
+
+    src = write_timedata(_rolling_record(2, n_samples=2**14), tmp_path / "ring.npz")
+    out = tmp_path / "waves.json"
+    code, text, err = _run(capsys, "rolling", str(src), "-o", str(out), "--spatial",
+                           "--no-uncertainty")  # fmt: skip
+    assert code == 0, err
+    assert "identified apart" in text
+    import json
+
+    got = {(w["wave_number"], w["fixed_direction"]) for w in json.loads(out.read_text())["waves"]}
+    # a 128 s record: what it finds are waves of WAVES (accuracy is the test above)
+    assert got
+    assert got <= {(n, d) for n, d, _, _ in WAVES}
+    # an irregular layout: one line naming the file and the layout, exit 2, nothing written
+    bad = _rolling_record(2, angles_deg=[0, 40, 90, 135, 180, 225, 270, 315], n_samples=4096)
+    src2 = write_timedata(bad, tmp_path / "irregular.npz")
+    out2 = tmp_path / "x.json"
+    code, _, err = _run(capsys, "rolling", str(src2), "-o", str(out2), "--spatial")
+    assert code == 2
+    assert err.startswith("tyredamp: error: irregular.npz: angles:")
+    assert "every 45 deg" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not out2.exists()
