@@ -173,7 +173,7 @@ def test_cli_rolling_spatial(tmp_path, capsys) -> None:
 
     from .test_rolling_oma import _run
 
-    src = write_timedata(_rolling_record(2, n_samples=2**14), tmp_path / "ring.npz")
+    src = write_timedata(_rolling_record(2, n_samples=2**13), tmp_path / "ring.npz")
     out = tmp_path / "waves.json"
     code, text, err = _run(capsys, "rolling", str(src), "-o", str(out), "--spatial",
                            "--no-uncertainty")  # fmt: skip
@@ -182,7 +182,7 @@ def test_cli_rolling_spatial(tmp_path, capsys) -> None:
     import json
 
     got = {(w["wave_number"], w["fixed_direction"]) for w in json.loads(out.read_text())["waves"]}
-    # a 128 s record: what it finds are waves of WAVES (accuracy is the test above)
+    # a 64 s record: what it finds are waves of WAVES (accuracy is the test above)
     assert got
     assert got <= {(n, d) for n, d, _, _ in WAVES}
     # an irregular layout: one line naming the file and the layout, exit 2, nothing written
