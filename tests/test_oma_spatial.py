@@ -195,3 +195,29 @@ def test_cli_rolling_spatial(tmp_path, capsys) -> None:
     assert "every 45 deg" in err
     assert len(err.strip().splitlines()) == 1
     assert not out2.exists()
+
+
+def test_select_spatial_poles_rules() -> None:
+    from tyredamp.oma.rolling import SpatialPole, select_spatial_poles
+
+    def pole(f, z=0.01, ratio=100.0, contrast=5.0, orders=30, n=2, d="forward"):
+        return SpatialPole(n, d, f, z, np.nan, np.nan, ratio, 1.0, contrast, orders)
+
+    dof = spatial.welch_dof(64 * 512, 1024)
+    q = spatial.power_threshold(dof)
+    poles = [
+        pole(50.0),  # a clean wave: kept
+        pole(50.6, orders=20),  # 0.6 Hz away, within 0.5 + 0.506 Hz, fewer orders: merged
+        pole(80.0, ratio=0.9 * q),  # below the noise threshold
+        pole(90.0, contrast=0.9 * q),  # no peak above its flanks
+        pole(197.0),  # its flank at 197 + 2 zeta f = 200.94 Hz is beyond the 200 Hz band
+        pole(50.6, d="backward"),  # the other direction's channel: its own wave
+    ]
+    got = select_spatial_poles(poles, (0.0, 200.0), 0.5, dof)
+    assert sorted((p.frequency_hz, p.direction) for p in got) == [
+        (50.0, "forward"),
+        (50.6, "backward"),
+    ]
+    # a fixed threshold replaces only the noise test
+    got = select_spatial_poles(poles, (0.0, 200.0), 0.5, dof, floor_ratio=0.5 * q)
+    assert (80.0, "forward") in {(p.frequency_hz, p.direction) for p in got}

@@ -389,8 +389,9 @@ def select_spatial_poles(
     at ``f -+ max(2 zeta f, 3 bins)`` (:func:`.spatial.peak_contrast`; a
     resonance gives about 5, the skirt of a stronger one less than 1); (iii)
     those flanks lie inside ``band``: a peak the band cuts may be the band's
-    edge (the filter's transition), not a mode; and (iv) no stronger pole of
-    the same channel that persisted over more model orders lies within the sum
+    edge (the filter's transition), not a mode; and (iv) no pole of the same
+    channel that persisted over more model orders (on a tie: with more power)
+    lies within the sum
     of their half-power half-bandwidths ``zeta_1 f_1 + zeta_2 f_2`` (one
     channel holds one wave per resonance: two poles closer than that are one
     resonance the fit split, and the one stable over more orders is the
