@@ -155,6 +155,17 @@ def test_rolling_modes_spatial_finds_each_wave_and_nothing_else() -> None:
         assert w.direction == d_rot
         # same 0.5 % as the fixed frame, carried through f_rot = f_fixed - s n f_w
         assert_allclose(w.rotating_hz, f_rot, rtol=5e-3 * f / f_rot)
+    # the campaign's document: each wave a mode whose shape splits back into its n and direction
+    from tyredamp.oma import wave_content
+    from tyredamp.studies.steps.rolling import RollingStep
+
+    doc = RollingStep.document(m, "ring.npz")
+    got = set()
+    for mode in doc["modes"]:
+        shape = np.array(mode["shape"]) @ np.array([1.0, 1j])
+        wc = wave_content(shape, doc["angles_deg"])
+        got.add((wc.wave_number, wc.direction))
+    assert got == {(n, d) for n, d, _, _ in WAVES}
 
 
 def test_rolling_modes_spatial_refuses_an_irregular_layout() -> None:

@@ -26,6 +26,7 @@ __all__ = [
     "spatial_channels",
     "spatial_spectra",
     "travelling_channels",
+    "wave_shape",
     "welch_dof",
 ]
 
@@ -226,3 +227,27 @@ def peak_contrast(s: ArrayLike, f_axis: ArrayLike, f: float, zeta: float) -> flo
     top = float(np.max(S[k - half : k + half + 1]))
     flank = float(max(S[k - off], S[k + off]))
     return top / flank if flank > 0 else float("inf")
+
+
+def wave_shape(wave_number: int, direction: str, angles_deg: ArrayLike) -> NDArray[np.complex128]:
+    """Unit shape at the sensor angles of one travelling wave of a wave-number channel.
+
+    In ``psi(theta) = a e^{i n theta} + b e^{-i n theta}`` (module docstring,
+    Huang & Soedel 1987, eq. 21) the backward wave is ``a`` and the forward wave
+    ``b``, so a backward wave has the shape ``e^{i n theta_k}``, a forward one
+    ``e^{-i n theta_k}`` and ``n = 0`` ones.
+
+    Parameters
+    ----------
+    wave_number : int
+    direction : {"backward", "forward", "standing"}
+        As a fixed observer sees it.
+    angles_deg : array_like, shape (K,)
+
+    Returns
+    -------
+    ndarray of complex, shape (K,)
+    """
+    th = np.deg2rad(np.asarray(angles_deg, float).ravel())
+    s = -1.0 if direction == "forward" else 1.0
+    return np.exp(1j * s * wave_number * th)

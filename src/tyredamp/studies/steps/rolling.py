@@ -85,7 +85,23 @@ class RollingStep:
         """
         r = result.fixed_result
         modes = []
-        if r is not None:
+        if r is None:  # the wave-number route: each wave is a mode of one wave number
+            from ...oma.spatial import wave_shape
+
+            for w in result.fixed:
+                n, d = int(w.wave_number or 0), w.fixed_direction or "standing"
+                psi = wave_shape(n, d, result.angles_deg)
+                sf, sz = w.std_frequency_hz, w.std_damping_ratio
+                modes.append(
+                    {
+                        "frequency_hz": w.fixed_hz,
+                        "damping_ratio": w.damping_ratio,
+                        "std_frequency_hz": sf if np.isfinite(sf) else None,
+                        "std_damping_ratio": sz if np.isfinite(sz) else None,
+                        "shape": np.column_stack([psi.real, psi.imag]).tolist(),
+                    }
+                )
+        else:
             for j in range(r.n_modes):
                 sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
                 modes.append(
