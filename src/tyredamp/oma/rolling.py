@@ -592,8 +592,9 @@ def rolling_modes(
     spatial : bool
         Identify each wave number and direction apart from the spatial DFT of
         the fixed sensors (:mod:`.spatial`; they must be equally spaced around
-        the circumference). Default: all fixed sensors together, each mode
-        split into waves afterwards (any layout).
+        the circumference), its poles kept by :func:`select_spatial_poles`.
+        Default: all fixed sensors together, each mode split into waves
+        afterwards (any layout).
 
     Returns
     -------
