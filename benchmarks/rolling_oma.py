@@ -8,7 +8,14 @@ the false fixed-frame modes (no truth wave of that n and direction within
 2 %), the coverage of the +-1.96 sigma frequency intervals over the draws, and
 the in-tyre peaks resolved within 0.5 %.
 
-Usage: python benchmarks/rolling_oma.py [--draws 5] [--duration 16]
+With ``--spatial`` the wave-number route (one identification per wave number
+and direction); ``--thresholds 3,10,30`` then also prints, per speed, the waves
+found and the false ones when the channel-power threshold of
+:func:`tyredamp.oma.rolling.select_spatial_poles` takes each value (the poles
+identified once per draw).
+
+Usage: python benchmarks/rolling_oma.py [--draws 5] [--duration 16] [--spatial]
+       [--thresholds 3,10,30]
 """
 
 from __future__ import annotations
@@ -19,7 +26,14 @@ import time
 import numpy as np
 
 from tyredamp._blas import single_threaded_blas
-from tyredamp.oma.rolling import RollingWave, compare_waves, rolling_modes
+from tyredamp.oma.rolling import (
+    RollingWave,
+    compare_waves,
+    rolling_modes,
+    rotating_pole,
+    select_spatial_poles,
+    spatial_poles,
+)
 from tyredamp.virtual import rolling_test
 
 
@@ -91,6 +105,45 @@ def _run(
     }
 
 
+def _thresholds(
+    speed: float,
+    seed: int,
+    duration: float,
+    band: tuple[float, float],
+    values: list[float | None],
+) -> list[tuple[int, int, int]]:
+    """(truth waves, found, false) of the wave-number route for each threshold of the
+    channel power (``None``: the F-test threshold of ``select_spatial_poles``); the
+    poles identified once, without standard errors."""
+    test = rolling_test(speed, duration=duration, sample_rate=512, band=band, seed=seed)
+    d = test.data
+    fix = [i for i in d.response_indices if not (d.channels[i].name or "").upper().startswith("T")]
+    ang = [float(d.channels[i].angle_deg or 0.0) for i in fix]
+    fw = float(d.meta["rotation_hz"])
+    kw = {"band": d.acquisition.band_hz, "uncertainty": False, "wheel_speed_hz": fw or None}
+    poles, res, dof = spatial_poles(d.data[fix], d.sample_rate, ang, kw)
+    truth = [r for r in test.truth.table() if band[0] + 5 <= r["fixed_hz"] <= band[1] - 10]
+    out = []
+    for v in values:
+        waves = []
+        for p in select_spatial_poles(poles, d.acquisition.band_hz or band, res, dof, v):
+            f, z, n, fd = p.frequency_hz, p.damping_ratio, p.wave_number, p.direction
+            fr, _, dt = rotating_pole(f, z, n, fd, fw)
+            waves.append(RollingWave("fixed", n, dt, fd, f, fr, z, np.nan, np.nan))
+        cmp = compare_waves(waves, truth, "fixed")
+        false = sum(
+            not any(
+                r["wave_number"] == w.wave_number
+                and (r["direction"] == w.direction or r["wave_number"] == 0)
+                and abs(r["fixed_hz"] / w.fixed_hz - 1) < 0.02
+                for r in truth
+            )
+            for w in waves
+        )
+        out.append((len(cmp), sum(c["found"] for c in cmp), false))
+    return out
+
+
 def _pct(x: list) -> str:
     return f"{100 * np.mean(x):.0f}%" if x else "-"
 
@@ -101,7 +154,11 @@ def main() -> None:
     ap.add_argument("--duration", type=float, default=16.0)
     ap.add_argument("--speeds", default="0,40,80,120")
     ap.add_argument("--spatial", action="store_true", help="one identification per wave number")
+    ap.add_argument("--thresholds", default="", help="channel-power thresholds to compare")
     a = ap.parse_args()
+    if a.thresholds:
+        _threshold_table(a)
+        return
     band = (0.0, 200.0)
     print(f"band {band} Hz, {a.duration:g} s records, 16 fixed + 1 in-tyre sensor, {a.draws} draws")
     print(
@@ -127,6 +184,23 @@ def main() -> None:
             f"{np.mean([r['time'] for r in runs]):5.1f}",
             flush=True,
         )
+
+
+def _threshold_table(a: argparse.Namespace) -> None:
+    values: list[float | None] = [
+        None if v == "auto" else float(v) for v in a.thresholds.split(",")
+    ]
+    print(f"wave-number route, {a.duration:g} s records, {a.draws} draws: found / false per run")
+    heads = ["F-test" if v is None else f"x{v:g}" for v in values]
+    print("speed  waves  " + "  ".join(f"{h:<11s}" for h in heads))
+    for v in [float(s) for s in a.speeds.split(",")]:
+        with single_threaded_blas():
+            runs = [_thresholds(v, s, a.duration, (0.0, 200.0), values) for s in range(a.draws)]
+        cells = [
+            f"{sum(r[i][1] for r in runs):3d} / {np.mean([r[i][2] for r in runs]):4.1f}"
+            for i in range(len(values))
+        ]
+        print(f"{v:5.0f}  {sum(r[0][0] for r in runs):5d}  " + "  ".join(cells), flush=True)
 
 
 if __name__ == "__main__":

@@ -66,13 +66,17 @@ def rolling_command(file: Path, out: Path, **o: Any) -> None:
     check_output_file(out, [file])
     td = read_timedata(file, channel_map=channel_map())
     rot = _channel_list(o["in_tyre"], td.n_channels, "--in-tyre")
-    m = rolling_modes(
-        td,
-        o["wheel_speed"],
-        rotating_channels=rot,
-        band=settings.band,
-        uncertainty=settings.uncertainty,
-    )
+    try:
+        m = rolling_modes(
+            td,
+            o["wheel_speed"],
+            rotating_channels=rot,
+            band=settings.band,
+            uncertainty=settings.uncertainty,
+            spatial=settings.spatial,
+        )
+    except InputError as exc:
+        raise InputError(f"{file.name}: {exc}") from None
     write_json(
         {
             "kind": "rolling_waves",

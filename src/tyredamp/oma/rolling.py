@@ -42,17 +42,28 @@ from numpy.typing import ArrayLike
 from ..exceptions import InputError
 from ..timedata import TimeData
 from .identify import OMAResult, oma
-from .spatial import equally_spaced, spatial_spectra, travelling_channels
+from .spatial import (
+    equally_spaced,
+    peak_contrast,
+    power_threshold,
+    spatial_spectra,
+    travelling_channels,
+    welch_dof,
+)
 from .waves import wave_content
 
 __all__ = [
+    "ALPHA",
     "RollingModes",
     "RollingWave",
+    "SpatialPole",
     "compare_waves",
     "resolve_in_tyre",
     "rolling_modes",
     "rotating_frequency",
     "rotating_pole",
+    "select_spatial_poles",
+    "spatial_poles",
 ]
 
 
@@ -272,28 +283,72 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
-_FLOOR_RATIO = 10.0
-"""A wave's channel must hold this many times the median power of all channels
-at its frequency (sensor noise spreads evenly over the wave numbers)."""
+ALPHA = 1e-3
+"""Probability that sensor noise alone passes each test of :func:`select_spatial_poles`."""
 
 
-def _is_peak(s: Any, f_axis: Any, f: float, z: float) -> bool:
-    """Whether the spectrum ``s`` peaks inside ``f -+ max(2 zeta f, 2 bins)`` (not
-    on the skirt of a stronger neighbour, which rises towards one edge)."""
-    half = max(2 * abs(z) * f, 2 * (f_axis[1] - f_axis[0]))
-    inside = np.flatnonzero(np.abs(f_axis - f) <= half)
-    k = int(np.argmax(s[inside]))
-    return 0 < k < inside.size - 1
+@dataclass(frozen=True)
+class SpatialPole:
+    """One pole of one wave-number channel, before the selection.
+
+    Attributes
+    ----------
+    wave_number : int
+    direction : str
+        As a fixed observer sees it: ``"backward"``, ``"forward"`` or ``"standing"``.
+    frequency_hz, damping_ratio, std_frequency_hz, std_damping_ratio : float
+        As identified from the channel's 2-channel record (Hz; NaN without errors).
+    ratio, other : float
+        Power of this channel and of the opposite direction at the pole's
+        frequency over the median of all channels there.
+    contrast : float
+        How far the channel's spectrum rises at the pole above its flanks
+        (:func:`~tyredamp.oma.spatial.peak_contrast`).
+    orders : int
+        Model orders the pole persisted over in its channel's stabilisation.
+    """
+
+    wave_number: int
+    direction: str
+    frequency_hz: float
+    damping_ratio: float
+    std_frequency_hz: float
+    std_damping_ratio: float
+    ratio: float
+    other: float
+    contrast: float
+    orders: int
 
 
-def _spatial_waves(
-    y: Any, fs: float, angles: list[float], fw: float, kw: dict[str, Any]
-) -> list[RollingWave]:
-    """Waves of each wave-number channel ``n = 0 .. (K - 1) // 2``, the backward
-    and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`)."""
-    out: list[RollingWave] = []
+def spatial_poles(
+    y: Any, fs: float, angles: list[float], kw: dict[str, Any]
+) -> tuple[list[SpatialPole], float, float]:
+    """Every pole of each wave-number channel ``n = 0 .. (K - 1) // 2``, the
+    backward and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`).
+
+    Parameters
+    ----------
+    y : array_like, shape (K, n_samples)
+        The fixed sensors, equally spaced.
+    fs : float
+        Hz.
+    angles : list of float
+        Their angles, deg.
+    kw : dict
+        Options of :func:`~tyredamp.oma.identify.oma`.
+
+    Returns
+    -------
+    poles : list of SpatialPole
+    resolution : float
+        Hz, the bin of the channel spectra.
+    dof : float
+        Degrees of freedom of each bin of those spectra (:func:`.spatial.welch_dof`).
+    """
+    out: list[SpatialPole] = []
     K = len(angles)
-    fs_, S = spatial_spectra(y, fs, angles)
+    nperseg = 1024
+    fs_, S = spatial_spectra(y, fs, angles, nperseg)
     floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
     for n in range(0, (K - 1) // 2 + 1):
         if n == 0:
@@ -302,22 +357,97 @@ def _spatial_waves(
             bwd, fwd = travelling_channels(y, angles, n)
             parts = [("backward", oma(bwd, fs, **kw)), ("forward", oma(fwd, fs, **kw))]
         for d, r in parts:
+            c = int(d == "forward")
             for j in range(r.n_modes):
                 f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
                 k = int(np.argmin(np.abs(fs_ - f)))
-                ratio = float(S[int(d == "forward"), n, k] / floor[k])
-                if ratio < _FLOOR_RATIO or not _is_peak(S[int(d == "forward"), n], fs_, f, z):
-                    continue
-                sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
-                alias = f" (aliases {K - n}, {K + n})" if n > 0 else ""
-                other = S[int(d != "forward"), n, k] / floor[k] if n > 0 else ratio
-                why = (
-                    f"wave-number channel {'-' if d == 'forward' else '+'}{n}{alias}: power "
-                    f"{ratio:.3g} x the median channel, the opposite direction {other:.3g} x"
-                )
-                fr, _, dt = rotating_pole(f, z, n, d, fw)
-                out.append(RollingWave("fixed", n, dt, d, f, fr, z, sf, sz, float("nan"),
-                                       [], why))  # fmt: skip
+                ratio = float(S[c, n, k] / floor[k])
+                other = float(S[1 - c, n, k] / floor[k]) if n > 0 else ratio
+                out.append(SpatialPole(n, d, f, z, float(r.std_frequency_hz[j]),
+                                       float(r.std_damping_ratio[j]), ratio, other,
+                                       peak_contrast(S[c, n], fs_, f, z),
+                                       int(r.n_orders[j])))  # fmt: skip
+    return out, float(fs_[1] - fs_[0]), welch_dof(np.shape(y)[-1], nperseg)
+
+
+def select_spatial_poles(
+    poles: list[SpatialPole],
+    band: tuple[float, float],
+    resolution: float,
+    dof: float,
+    floor_ratio: float | None = None,
+    alpha: float = ALPHA,
+) -> list[SpatialPole]:
+    """The poles of :func:`spatial_poles` taken for waves.
+
+    With ``q`` the ratio two PSD estimates of one level exceed with
+    probability ``alpha`` (:func:`.spatial.power_threshold`), a pole is kept
+    when (i) its channel holds ``q`` times (or ``floor_ratio`` times, when
+    given) the median power of all channels at its frequency: sensor noise
+    spreads evenly over the wave numbers, so the median is the noise level;
+    (ii) the channel's spectrum rises at the pole ``q`` times above its flanks
+    at ``f -+ max(2 zeta f, 3 bins)`` (:func:`.spatial.peak_contrast`; a
+    resonance gives about 5, the skirt of a stronger one less than 1); (iii)
+    those flanks lie inside ``band``: a peak the band cuts may be the band's
+    edge (the filter's transition), not a mode; and (iv) no pole of the same
+    channel that persisted over more model orders (on a tie: with more power)
+    lies within the sum
+    of their half-power half-bandwidths ``zeta_1 f_1 + zeta_2 f_2`` (one
+    channel holds one wave per resonance: two poles closer than that are one
+    resonance the fit split, and the one stable over more orders is the
+    better fit; the half-power points of a mode lie at ``f (1 -+ zeta)``,
+    Ewins, Modal Testing, 2nd ed. 2000, sec. 2.2).
+
+    Parameters
+    ----------
+    poles : list of SpatialPole
+    band : (float, float)
+        Hz, the band of the identification.
+    resolution : float
+        Hz, the bin of the spectra.
+    dof : float
+        Degrees of freedom of each bin.
+    floor_ratio : float, optional
+        A fixed threshold for (i) instead of ``q`` (the benchmark compares values).
+    alpha : float
+        False-pass probability of each test for noise alone.
+
+    Returns
+    -------
+    list of SpatialPole
+        Most stable first.
+    """
+    lo, hi = band
+    q = power_threshold(dof, alpha)
+    floor = q if floor_ratio is None else float(floor_ratio)
+    keep: list[SpatialPole] = []
+    for p in sorted(poles, key=lambda x: (-x.orders, -x.ratio)):
+        f, z = p.frequency_hz, p.damping_ratio
+        off = max(2 * abs(z) * f, 3 * resolution)
+        if p.ratio < floor or p.contrast < q or f + off > hi or (lo > 0 and f - off < lo):
+            continue
+        if any(x.wave_number == p.wave_number and x.direction == p.direction
+               and abs(x.frequency_hz - f) <= x.damping_ratio * x.frequency_hz + z * f
+               for x in keep):  # fmt: skip
+            continue
+        keep.append(p)
+    return keep
+
+
+def _spatial_waves(poles: list[SpatialPole], K: int, fw: float) -> list[RollingWave]:
+    """The selected poles as waves, with their channel and power in the reason."""
+    out: list[RollingWave] = []
+    for p in poles:
+        n, d = p.wave_number, p.direction
+        alias = f" (aliases {K - n}, {K + n})" if n > 0 else ""
+        why = (
+            f"wave-number channel {'-' if d == 'forward' else '+'}{n}{alias}: power "
+            f"{p.ratio:.3g} x the median channel, the opposite direction {p.other:.3g} x"
+        )
+        fr, _, dt = rotating_pole(p.frequency_hz, p.damping_ratio, n, d, fw)
+        out.append(RollingWave("fixed", n, dt, d, p.frequency_hz, fr, p.damping_ratio,
+                               p.std_frequency_hz, p.std_damping_ratio, float("nan"), [],
+                               why))  # fmt: skip
     return out
 
 
@@ -462,8 +592,9 @@ def rolling_modes(
     spatial : bool
         Identify each wave number and direction apart from the spatial DFT of
         the fixed sensors (:mod:`.spatial`; they must be equally spaced around
-        the circumference). Default: all fixed sensors together, each mode
-        split into waves afterwards (any layout).
+        the circumference), its poles kept by :func:`select_spatial_poles`.
+        Default: all fixed sensors together, each mode split into waves
+        afterwards (any layout).
 
     Returns
     -------
@@ -492,10 +623,16 @@ def rolling_modes(
         kw: dict[str, Any] = {"band": bnd, "n_groups": n_groups, "uncertainty": uncertainty,
                               "wheel_speed_hz": fw if fw > 0 else None}  # fmt: skip
         if spatial and not equally_spaced(ang):
-            raise InputError("angles: the wave-number route needs fixed sensors equally "
-                             f"spaced around the circumference, got {ang} deg")  # fmt: skip
+            got = ", ".join(f"{a:g}" for a in ang)
+            raise InputError(
+                f"angles: the wave-number route needs the {len(ang)} fixed sensors "
+                f"every {360 / len(ang):g} deg around the tyre, got {got} deg"
+            )
         if spatial:
-            fixed = _spatial_waves(data.data[fix], data.sample_rate, ang, fw, kw)
+            poles, res, dof = spatial_poles(data.data[fix], data.sample_rate, ang, kw)
+            edges = bnd if bnd is not None else (0.0, 0.45 * data.sample_rate)
+            kept = select_spatial_poles(poles, edges, res, dof)
+            fixed = _spatial_waves(kept, len(ang), fw)
             notes.append(f"fixed sensors: each wave number 0..{(len(fix) - 1) // 2} identified "
                          "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
         else:

@@ -44,6 +44,13 @@ class RollingSettings(StepSettings):
         Boolean(),
         "--no-uncertainty",
     )
+    spatial: bool = knob(
+        False,
+        "Identify each wave number and direction apart (fixed sensors equally spaced "
+        "around the tyre).",
+        Boolean(),
+        "--spatial",
+    )
 
 
 class RollingStep:
@@ -61,7 +68,11 @@ class RollingStep:
         from ...oma.rolling import rolling_modes
 
         res = rolling_modes(
-            data, wheel_speed_hz, band=settings.band, uncertainty=settings.uncertainty
+            data,
+            wheel_speed_hz,
+            band=settings.band,
+            uncertainty=settings.uncertainty,
+            spatial=settings.spatial,
         )
         return res, []
 
@@ -74,7 +85,23 @@ class RollingStep:
         """
         r = result.fixed_result
         modes = []
-        if r is not None:
+        if r is None:  # the wave-number route: each wave is a mode of one wave number
+            from ...oma.spatial import wave_shape
+
+            for w in result.fixed:
+                n, d = int(w.wave_number or 0), w.fixed_direction or "standing"
+                psi = wave_shape(n, d, result.angles_deg)
+                sf, sz = w.std_frequency_hz, w.std_damping_ratio
+                modes.append(
+                    {
+                        "frequency_hz": w.fixed_hz,
+                        "damping_ratio": w.damping_ratio,
+                        "std_frequency_hz": sf if np.isfinite(sf) else None,
+                        "std_damping_ratio": sz if np.isfinite(sz) else None,
+                        "shape": np.column_stack([psi.real, psi.imag]).tolist(),
+                    }
+                )
+        else:
             for j in range(r.n_modes):
                 sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
                 modes.append(
