@@ -95,7 +95,10 @@ class VirtualCampaign:
         doubled modes as pairs).
     rolling_speeds_kmh : tuple of float
         Speeds of the output-only rolling tests of the first tyre at every
-        pressure (:mod:`.virtual_rolling`; default none).
+        pressure (:mod:`.virtual_rolling`: the tyre of ``tyredamp simulate
+        rolling``, without the cavity and the contact patch, which the
+        rotating frame does not support; ``truth.json`` says so under
+        ``rolling_tyre``; default none).
     """
 
     n_tyres: int = 3
@@ -400,6 +403,10 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
         "tests": tests,
         "held_out": held,
     }
+    if s.rolling_speeds_kmh:
+        from .virtual_rolling import ROLLING_TYRE
+
+        doc["rolling_tyre"] = dict(ROLLING_TYRE)
     write_json(doc, root / "truth.json")
     with atomic_path(root / "campaign.toml") as tmp:
         tmp.write_text(campaign_file_text(s, tests), encoding="utf-8")
