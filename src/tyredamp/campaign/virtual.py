@@ -53,6 +53,7 @@ from ..virtual import (
     RingTyreParameters,
 )
 from .virtual_check import compare_with_truth
+from .virtual_rolling import ROLLING_TYRE, write_rolling_tests
 
 __all__ = [
     "TRUTH_KIND",
@@ -364,7 +365,6 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
             if progress is not None:
                 progress(done, total)
         if s.rolling_speeds_kmh:
-            from .virtual_rolling import write_rolling_tests
 
             def tick() -> None:
                 nonlocal done
@@ -404,9 +404,7 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
         "held_out": held,
     }
     if s.rolling_speeds_kmh:
-        from .virtual_rolling import ROLLING_TYRE
-
-        doc["rolling_tyre"] = dict(ROLLING_TYRE)
+        doc["rolling_tyre"] = dict(ROLLING_TYRE)  # what the rolling tests' tyre is and lacks
     write_json(doc, root / "truth.json")
     with atomic_path(root / "campaign.toml") as tmp:
         tmp.write_text(campaign_file_text(s, tests), encoding="utf-8")
