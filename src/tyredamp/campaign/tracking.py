@@ -37,16 +37,15 @@ physical mode seen at different pressures, loads, speeds, tyres):
    mode is closer to this family than its look-alike neighbour was, which
    also keeps spatially aliased wave numbers apart); modes left over start
    new families. Shapes are compared at the points common to both tests.
-   ``Delta f`` is taken from the family's own trend over the conditions
-   where its members give one (:mod:`~tyredamp.campaign.family_trend`: a
-   least-squares plane, its prediction at the new test), else from the
-   representative. Where no mode of a similar shape stands beside the
-   representative (no gap to bound the change), the change must also pass
-   ``Delta f^2 / var <`` the ``1 - 1e-3`` quantile (:data:`FALLBACK_ALPHA`) of
-   the squared Student t of the trend's residual degrees of freedom, ``var``
-   the trend's prediction variance plus the new mode's squared standard error
-   (at least the representative's: a noise-free line does not pin it), so
-   that a family cannot jump to an unrelated mode far from its own course.
+   Where no mode of a similar shape stands beside the representative (no
+   gap to bound the change) and the family's members give a trend over the
+   conditions (:mod:`~tyredamp.campaign.family_trend`: a least-squares plane,
+   its prediction ``f_t`` at the new test), ``(f - f_t)^2 / var`` must also
+   stay below the ``1 - 1e-3`` quantile (:data:`FALLBACK_ALPHA`) of the squared
+   Student t of the trend's residual degrees of freedom, ``var`` the trend's
+   prediction variance plus the new mode's squared standard error (at least
+   the representative's: a noise-free line does not pin it), so that a family
+   cannot jump to an unrelated mode far from its own course.
 4. Where the MAC cannot be formed (fewer than 2 points common to the two
    tests: one response point each, as with a single accelerometer or a
    roving hammer, or shapes at disjoint points), modes are matched by
@@ -479,7 +478,7 @@ def _match_units(
         t_lim = math.inf if bound is None else change_limit(t_dof, FALLBACK_ALPHA)
         for b, unit in enumerate(cur):
             m = subspace_mac(ur, _shapes_at(s, unit.modes, common))
-            df = abs(unit.frequency - f_ref)
+            df = abs(unit.frequency - rep.frequency)
             macs[a, b] = m
             free = bound is None or (
                 frequency_change_z2(unit.frequency, f_ref, bound + unit.frequency_std**2) < t_lim
