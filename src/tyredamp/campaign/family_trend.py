@@ -13,9 +13,10 @@ about the prediction is
 
 ``s^2 (1 + [(X^T X)^-1]_00)``
 
-(the prediction interval of linear regression: Draper & Smith, *Applied
-Regression Analysis*, 3rd ed., Wiley 1998, eq. (3.1.7) with the new
-observation's own variance added, their section 3.1); a change ``d`` from the
+(the variance of a new observation about a least-squares prediction, the
+prediction interval of linear regression; for a straight line it is
+``s^2 (1 + 1/n + (x_0 - xbar)^2 / S_xx)``, Draper & Smith, *Applied Regression
+Analysis*, 3rd ed., Wiley 1998, ch. 1, the form the tests check); a change ``d`` from the
 prediction is then admissible when ``d^2 / var`` is below the squared
 Student-t quantile with ``n - p`` degrees of freedom (:func:`change_limit`;
 with 1 or 2 residual degrees of freedom the scale ``s`` is barely known and
