@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -127,6 +128,7 @@ def reference_frequency(
     return pred, (var if var > 0 else None), dof
 
 
+@lru_cache(maxsize=256)
 def change_limit(dof: float, alpha: float) -> float:
     """Upper ``1 - alpha`` quantile of ``z^2`` for ``dof`` residual degrees of freedom.
 

@@ -91,8 +91,9 @@ stated standard errors allow).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -434,7 +435,7 @@ def _match_units(
     s: ModeSet,
     sets: Sequence[ModeSet],
     units: Sequence[Sequence[_Unit]],
-    stats: tuple[float, float, Mapping[int, float], Sequence[tuple[float, float, float] | None]],
+    stats: tuple[float, float, Mapping[int, float], Callable[[int], Any]],
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Costs of matching the units ``cur`` of test ``s`` to the families' ``reps``.
 
@@ -444,10 +445,10 @@ def _match_units(
     A match between a pair and a single mode costs :data:`_NEW` more (one mode
     is left without a partner), so the grouping into pairs that matches the
     families' own grouping is preferred. ``stats`` holds ``tau_f``, ``tau_z``,
-    the chi-square limits by degrees of freedom and each family's trend
-    (prediction, variance; None where there is none).
+    the chi-square limits by degrees of freedom and a function giving family
+    ``a``'s trend (:func:`~tyredamp.campaign.family_trend.family_trend`).
     """
-    tau_f, tau_z, limit, trends = stats
+    tau_f, tau_z, limit, trend_of = stats
     cost = np.full((len(reps), len(cur)), _FAR)
     macs = np.full((len(reps), len(cur)), np.nan)
     zs = np.full((len(reps), len(cur)), np.nan)
@@ -472,9 +473,12 @@ def _match_units(
         ]
         gap = min((abs(rep.frequency - f) for f in alike), default=math.inf)
         ur = _shapes_at(rs, rep.modes, common)
-        f_ref, var, t_dof = reference_frequency(rep.frequency, trends[a], rep.frequency_std**2)
         # no look-alike beside it: the change is bounded by the family's own course
-        bound = None if math.isfinite(gap) or var is None else var
+        f_ref, bound, t_dof = rep.frequency, None, math.inf
+        if math.isinf(gap):
+            f_ref, bound, t_dof = reference_frequency(
+                rep.frequency, trend_of(a), rep.frequency_std**2
+            )
         t_lim = math.inf if bound is None else change_limit(t_dof, FALLBACK_ALPHA)
         for b, unit in enumerate(cur):
             m = subspace_mac(ur, _shapes_at(s, unit.modes, common))
@@ -528,16 +532,15 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
         if not units[i]:
             continue
         reps = [fam[min(fam, key=lambda t: (dist(s, sets[t]), t))] for fam in members]
-        trends = [
-            family_trend([(sets[t].conditions, u.frequency) for t, u in fam.items()],
-                         s.conditions, span)
-            for fam in members
-        ]  # fmt: skip
+        trend_of = lru_cache(maxsize=None)(
+            lambda a, s=s: family_trend([(sets[t].conditions, u.frequency)
+                                         for t, u in members[a].items()], s.conditions, span)
+        )  # fmt: skip
         # the grouping of overlapping modes into pairs whose units match the families best
         best: tuple[float, list[_Unit], Any] | None = None
         for grouping in pairings(s.frequency_hz, s.damping_ratio):
             cur = _units(s, i, grouping)
-            match = _match_units(reps, cur, s, sets, units, (tau_f, tau_z, limit, trends))
+            match = _match_units(reps, cur, s, sets, units, (tau_f, tau_z, limit, trend_of))
             if best is None or match[0] < best[0] - 1e-9:
                 best = (match[0], cur, match[1:])
             if not reps:
