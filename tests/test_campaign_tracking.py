@@ -368,3 +368,49 @@ def test_three_overlapping_modes_are_grouped_as_the_families_are() -> None:
     assert [tr.slot[("b", q)] for q in (1, 2)] == ["a", "b"]
     assert tr.family[("a", 1)] in tr.pairs
     assert tr.family[("a", 0)] not in tr.pairs
+
+
+def _crossing_sets(seed: int) -> tuple[list[ModeSet], dict[tuple[str, int], str]]:
+    """A flat doubled pair (n = 1 mixed with n = 5) crossed by a rising n = 5 branch.
+
+    The n = 5 branch is not seen below 8 bar and the pair not at 8 bar, as where
+    the air cavity of a tyre crosses its n = 5 modes; each mode's true branch.
+    """
+    rng = np.random.default_rng(seed)
+    hybrid = ring_shape(1) + 1.2 * ring_shape(5)  # a pair member half of n = 5
+    pair = np.column_stack([hybrid, ring_shape(1, np.pi / 2)])
+    sets, branch = [], {}
+    for k, p in enumerate((6.0, 6.5, 7.0, 7.5, 8.0, 8.5)):
+        f, z, shapes, names = [60.0 + 2 * k], [0.01], [ring_shape(2)], ["n2"]
+        if p != 8.0:  # the pair: 144 and 148 Hz, flat in pressure
+            f += [144.0 + 0.2 * k, 148.0 + 0.2 * k]
+            z += [0.02, 0.02]
+            shapes += [pair[:, 0], pair[:, 1]]
+            names += ["pair", "pair"]
+        if p >= 8.0:  # n = 5: 12 Hz per bar, above the pair from 8 bar
+            f.append(158.0 + 12 * (p - 8.0))
+            z.append(0.01)
+            shapes.append(ring_shape(5))
+            names.append("n5")
+        f_noisy = np.array(f) * (1 + 2e-4 * rng.standard_normal(len(f)))
+        tid = f"t{k}"
+        sets.append(ModeSet(tid, {"tyre": "A", "pressure_bar": p}, f_noisy, np.array(z),
+                            np.column_stack(shapes), POINTS))  # fmt: skip
+        branch.update({(tid, q): name for q, name in enumerate(names)})
+    return sets, branch
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_family_does_not_jump_off_its_course_to_a_crossing_branch(seed: int) -> None:
+    sets, branch = _crossing_sets(seed)
+    # the n = 5 mode lies half in the pair's subspace: its shape alone does not tell them apart
+    mac = subspace_mac(np.column_stack([sets[0].shapes[:, 1], sets[0].shapes[:, 2]]),
+                       sets[4].shapes[:, 1])  # fmt: skip
+    assert mac >= MAC_MIN
+    tr = track_modes(sets)
+    held: dict[str, set[str]] = {}
+    for key, fam in tr.family.items():
+        held.setdefault(fam, set()).add(branch[key])
+    assert all(len(b) == 1 for b in held.values()), held  # no family holds two branches
+    # the flat pair keeps one family through all its pressures
+    assert len({tr.family[(s.test_id, 1)] for s in sets if s.test_id != "t4"}) == 1

@@ -37,6 +37,15 @@ physical mode seen at different pressures, loads, speeds, tyres):
    mode is closer to this family than its look-alike neighbour was, which
    also keeps spatially aliased wave numbers apart); modes left over start
    new families. Shapes are compared at the points common to both tests.
+   Where no mode of a similar shape stands beside the representative (no
+   gap to bound the change) and the family's members give a trend over the
+   conditions (:mod:`~tyredamp.campaign.family_trend`: a least-squares plane,
+   its prediction ``f_t`` at the new test), ``(f - f_t)^2 / var`` must also
+   stay below the ``1 - 1e-3`` quantile (:data:`FALLBACK_ALPHA`) of the squared
+   Student t of the trend's residual degrees of freedom, ``var`` the trend's
+   prediction variance plus the new mode's squared standard error (at least
+   the representative's: a noise-free line does not pin it), so that a family
+   cannot jump to an unrelated mode far from its own course.
 4. Where the MAC cannot be formed (fewer than 2 points common to the two
    tests: one response point each, as with a single accelerometer or a
    roving hammer, or shapes at disjoint points), modes are matched by
@@ -82,8 +91,9 @@ stated standard errors allow).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -91,6 +101,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from ..exceptions import InputError
+from .family_trend import change_limit, family_trend, frequency_change_z2, reference_frequency
 from .pairing import group_pairs, pairings
 
 __all__ = [
@@ -375,12 +386,18 @@ def _numeric_conditions(sets: Sequence[ModeSet]) -> list[str]:
     return names
 
 
-def _distance_fn(sets: Sequence[ModeSet]) -> Any:
-    names = _numeric_conditions(sets)
+def _spans(sets: Sequence[ModeSet]) -> dict[str, float]:
+    """Range of each numeric condition over the campaign (1 where it does not vary)."""
     span = {}
-    for c in names:
+    for c in _numeric_conditions(sets):
         vals = [float(s.conditions[c]) for s in sets if s.conditions.get(c) is not None]
         span[c] = (max(vals) - min(vals)) if vals and max(vals) > min(vals) else 1.0
+    return span
+
+
+def _distance_fn(sets: Sequence[ModeSet]) -> Any:
+    names = _numeric_conditions(sets)
+    span = _spans(sets)
 
     def dist(a: ModeSet, b: ModeSet) -> float:
         d = 0.0 if a.conditions.get("tyre") == b.conditions.get("tyre") else _FAR
@@ -418,7 +435,7 @@ def _match_units(
     s: ModeSet,
     sets: Sequence[ModeSet],
     units: Sequence[Sequence[_Unit]],
-    stats: tuple[float, float, Mapping[int, float]],
+    stats: tuple[float, float, Mapping[int, float], Callable[[int], Any]],
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Costs of matching the units ``cur`` of test ``s`` to the families' ``reps``.
 
@@ -427,9 +444,11 @@ def _match_units(
     ``z`` matrices, shape (len(reps), len(cur)) (module docstring, steps 3-4).
     A match between a pair and a single mode costs :data:`_NEW` more (one mode
     is left without a partner), so the grouping into pairs that matches the
-    families' own grouping is preferred.
+    families' own grouping is preferred. ``stats`` holds ``tau_f``, ``tau_z``,
+    the chi-square limits by degrees of freedom and a function giving family
+    ``a``'s trend (:func:`~tyredamp.campaign.family_trend.family_trend`).
     """
-    tau_f, tau_z, limit = stats
+    tau_f, tau_z, limit, trend_of = stats
     cost = np.full((len(reps), len(cur)), _FAR)
     macs = np.full((len(reps), len(cur)), np.nan)
     zs = np.full((len(reps), len(cur)), np.nan)
@@ -454,11 +473,21 @@ def _match_units(
         ]
         gap = min((abs(rep.frequency - f) for f in alike), default=math.inf)
         ur = _shapes_at(rs, rep.modes, common)
+        # no look-alike beside it: the change is bounded by the family's own course
+        f_ref, bound, t_dof = rep.frequency, None, math.inf
+        if math.isinf(gap):
+            f_ref, bound, t_dof = reference_frequency(
+                rep.frequency, trend_of(a), rep.frequency_std**2
+            )
+        t_lim = math.inf if bound is None else change_limit(t_dof, FALLBACK_ALPHA)
         for b, unit in enumerate(cur):
             m = subspace_mac(ur, _shapes_at(s, unit.modes, common))
             df = abs(unit.frequency - rep.frequency)
             macs[a, b] = m
-            if m >= MAC_MIN and df < gap:
+            free = bound is None or (
+                frequency_change_z2(unit.frequency, f_ref, bound + unit.frequency_std**2) < t_lim
+            )
+            if m >= MAC_MIN and df < gap and free:
                 rel = 0.0 if math.isinf(gap) else df / gap
                 cost[a, b] = (1.0 - m) + rel**2
     for a, rep in enumerate(reps):
@@ -490,6 +519,7 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
 
     names = _numeric_conditions(sets)
     dist = _distance_fn(sets)
+    span = _spans(sets)
     order = sorted(range(len(sets)), key=lambda i: _sort_key(sets[i], names))
     units: list[list[_Unit]] = [_units(s, i) for i, s in enumerate(sets)]
     tau_f, tau_z, n_scatter = mode_scatter(sets, order)
@@ -502,11 +532,15 @@ def track_modes(sets: Sequence[ModeSet]) -> Tracking:
         if not units[i]:
             continue
         reps = [fam[min(fam, key=lambda t: (dist(s, sets[t]), t))] for fam in members]
+        trend_of = lru_cache(maxsize=None)(
+            lambda a, s=s: family_trend([(sets[t].conditions, u.frequency)
+                                         for t, u in members[a].items()], s.conditions, span)
+        )  # fmt: skip
         # the grouping of overlapping modes into pairs whose units match the families best
         best: tuple[float, list[_Unit], Any] | None = None
         for grouping in pairings(s.frequency_hz, s.damping_ratio):
             cur = _units(s, i, grouping)
-            match = _match_units(reps, cur, s, sets, units, (tau_f, tau_z, limit))
+            match = _match_units(reps, cur, s, sets, units, (tau_f, tau_z, limit, trend_of))
             if best is None or match[0] < best[0] - 1e-9:
                 best = (match[0], cur, match[1:])
             if not reps:

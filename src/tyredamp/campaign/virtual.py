@@ -53,6 +53,7 @@ from ..virtual import (
     RingTyreParameters,
 )
 from .virtual_check import compare_with_truth
+from .virtual_rolling import ROLLING_TYRE, write_rolling_tests
 
 __all__ = [
     "TRUTH_KIND",
@@ -95,7 +96,10 @@ class VirtualCampaign:
         doubled modes as pairs).
     rolling_speeds_kmh : tuple of float
         Speeds of the output-only rolling tests of the first tyre at every
-        pressure (:mod:`.virtual_rolling`; default none).
+        pressure (:mod:`.virtual_rolling`: the tyre of ``tyredamp simulate
+        rolling``, without the cavity and the contact patch, which the
+        rotating frame does not support; ``truth.json`` says so under
+        ``rolling_tyre``; default none).
     """
 
     n_tyres: int = 3
@@ -361,7 +365,6 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
             if progress is not None:
                 progress(done, total)
         if s.rolling_speeds_kmh:
-            from .virtual_rolling import write_rolling_tests
 
             def tick() -> None:
                 nonlocal done
@@ -400,6 +403,8 @@ def _write(s: VirtualCampaign, root: Path, progress: Any) -> dict[str, Any]:
         "tests": tests,
         "held_out": held,
     }
+    if s.rolling_speeds_kmh:
+        doc["rolling_tyre"] = dict(ROLLING_TYRE)  # what the rolling tests' tyre is and lacks
     write_json(doc, root / "truth.json")
     with atomic_path(root / "campaign.toml") as tmp:
         tmp.write_text(campaign_file_text(s, tests), encoding="utf-8")

@@ -38,7 +38,8 @@ __all__ = ["simulate_campaign_command"]
 @click.option(
     "--rolling",
     is_flag=True,
-    help="Add output-only rolling tests of tyre 1 at 0, 40, 80 and 120 km/h at every pressure.",
+    help="Add output-only rolling tests of tyre 1 at 0, 40, 80 and 120 km/h at every pressure "
+    "(the tyre of 'tyredamp simulate rolling': no air cavity, no contact patch).",
 )
 @seed_option("Seed of the manufacturing scatter and of the noise.")
 def simulate_campaign_command(

@@ -405,6 +405,12 @@ class RotatingRing:
             tyre = RingTyre(layout=layout, nonproportionality=1.0)
         if not isinstance(tyre, RingTyre):
             raise InputError(f"tyre: expected a RingTyre, got {type(tyre).__name__}")
+        for part, what in ((tyre.cavity, "an air cavity"), (tyre.contact, "a contact patch")):
+            if part is not None:
+                raise InputError(
+                    f"tyre: expected a ring tyre without {what} (the rotating ring does not "
+                    f"model it), got one with {what}"
+                )
         self.tyre = tyre
         self.speed_kmh = float(speed_kmh)
         self.omega = spin_rate(speed_kmh, tyre.params.radius)
