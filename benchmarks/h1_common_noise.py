@@ -49,9 +49,9 @@ def _tmax(E: np.ndarray, V: np.ndarray, f: np.ndarray) -> tuple[float, complex]:
 
 def main() -> None:
     from tyredamp.campaign.virtual import _tyre, tyre_parameters
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.stats import mode_parameters, mode_threshold, span_threshold
+    from tyredamp.modal.fit.fit import ModalFitter
+    from tyredamp.modal.problem.problem import build_problem
+    from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold, span_threshold
     from tyredamp.signal import estimate_frf
     from tyredamp.timedata import TimeData
     from tyredamp.virtual import run_modal_test
@@ -105,7 +105,7 @@ def main() -> None:
 def _span_of_error(fit: object, E: np.ndarray, lw: np.ndarray, s2: np.ndarray) -> object:
     """:func:`~tyredamp.modal.span_noise.span_noise` with the error ``E`` as the
     residual (the span of the noisy data, as the identification sees it)."""
-    from tyredamp.modal.span_noise import SpanNoise
+    from tyredamp.modal.search.span_noise import SpanNoise
 
     H = fit.H  # type: ignore[attr-defined]
     n_out, n_in = H.shape[:2]

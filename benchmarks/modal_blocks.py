@@ -22,7 +22,7 @@ import time
 import numpy as np
 from perf_common import limit_blas, mimo_case
 
-from tyredamp.modal import _basis, identify_modes
+from tyredamp.modal.fit import _basis, identify_modes
 
 CASES = [(4, 1, 1000, 10, 60.0), (16, 2, 3000, 20, 35.0), (32, 2, 4000, 20, 50.0)]
 

@@ -38,7 +38,7 @@ def one(args: tuple[int, float]) -> tuple[int, float, dict[str, Any], dict[str, 
     seed, kappa = args
     import modal_statistics as ms
 
-    import tyredamp.modal.profile as prof
+    import tyredamp.modal.fit.profile as prof
 
     prof.KAPPA = kappa
     warnings.simplefilter("ignore")
@@ -49,7 +49,7 @@ def one(args: tuple[int, float]) -> tuple[int, float, dict[str, Any], dict[str, 
 def main() -> None:
     import modal_statistics as ms
 
-    import tyredamp.modal.profile as prof
+    import tyredamp.modal.fit.profile as prof
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--snr", type=float, default=20.0, choices=ms.SNRS)

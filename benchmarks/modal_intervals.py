@@ -36,7 +36,7 @@ import numpy as np
 
 from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
-from tyredamp.modal import profile as prof
+from tyredamp.modal.fit import profile as prof
 from tyredamp.modal.model import ModalModel
 
 F = np.arange(40.0, 60.0, 0.075)

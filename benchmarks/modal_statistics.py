@@ -204,10 +204,10 @@ def truth_stats(seed: int, refitted: bool = True) -> dict[str, Any]:
     bounds from the Fisher information with the variance of every entry
     (:mod:`tyredamp.modal.ml`).
     """
-    from tyredamp.modal import ml
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.stats import mode_parameters, mode_threshold
+    from tyredamp.modal.fit import ml
+    from tyredamp.modal.fit.fit import ModalFitter
+    from tyredamp.modal.problem.problem import build_problem
+    from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
     s = system(seed)
     frf, var = frf_of(s, seed)
@@ -311,7 +311,7 @@ def _refitted_lr(
     the threshold and 1.3 times refitted (seed 194). Elsewhere ``t_fixed``
     stands (isolated modes far above the threshold)."""
     from tyredamp.exceptions import ConvergenceError
-    from tyredamp.modal.refitted import overlapping
+    from tyredamp.modal.search.refitted import overlapping
 
     out = np.asarray(t_fixed, float).copy()
     stronger = np.any(overlapping(poles) & (out[None, :] > out[:, None]), axis=1)

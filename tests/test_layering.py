@@ -221,8 +221,8 @@ def test_cycle_finder_finds_a_circle() -> None:
 @pytest.mark.parametrize(
     ("module", "is_pkg", "source", "expected"),
     [
-        ("tyredamp.modal.fit", False, "from ..frf import FRF", ["tyredamp.frf"]),
-        ("tyredamp.modal", True, "from .fit import X", ["tyredamp.modal.fit"]),
+        ("tyredamp.modal.fit.fit", False, "from ...frf import FRF", ["tyredamp.frf"]),
+        ("tyredamp.modal", True, "from .fit.fit import X", ["tyredamp.modal.fit.fit"]),
         ("tyredamp.cli.demo", False, "from .. import __version__", ["tyredamp"]),
         ("tyredamp.io", True, "from . import uff", ["tyredamp.io.uff"]),
     ],

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from tyredamp.modal import _basis
-from tyredamp.modal.fit import ModalFitter
+from tyredamp.modal.fit import _basis
+from tyredamp.modal.fit.fit import ModalFitter
 
 
 @pytest.mark.parametrize("n_in", [1, 3])

@@ -10,8 +10,8 @@ from numpy.testing import assert_allclose
 
 from tyredamp.frf import FRF, Channel
 from tyredamp.modal import identify_modes
-from tyredamp.modal.model_error import relative_model_error
-from tyredamp.modal.narrow import unresolved_damping
+from tyredamp.modal.problem.model_error import relative_model_error
+from tyredamp.modal.search.narrow import unresolved_damping
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "real-data"
 BEAM = REAL / "ladisk_pyuff" / "data"

@@ -14,8 +14,8 @@ from scipy.optimize import least_squares
 from tyredamp.cli.modal import modes_table
 from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
-from tyredamp.modal import profile as prof
-from tyredamp.modal.fit import ModalFitter, pole_bounds
+from tyredamp.modal.fit import profile as prof
+from tyredamp.modal.fit.fit import ModalFitter, pole_bounds
 from tyredamp.modal.model import ModalModel
 
 F = np.arange(40.0, 60.0, 0.075)

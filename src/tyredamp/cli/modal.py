@@ -9,7 +9,7 @@ import click
 import numpy as np
 
 from ..exceptions import InputError
-from ..modal.quality import rejected_summary
+from ..modal.statistics.quality import rejected_summary
 from ..studies.steps import ModalSettings, ModalStep
 from ._common import channel_map, channel_map_options, out_file_option
 from ._settings import settings_from_options, settings_options

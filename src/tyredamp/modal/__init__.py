@@ -16,10 +16,14 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from .estimators import PoleEstimator
-    from .fit import FitResult, ModalFitter
+    from .fit.fit import FitResult, ModalFitter
     from .identify import ModalIdentification, identify_modes
-    from .indicators import (
+    from .model import ModalModel, ModeKind
+    from .poles.estimators import PoleEstimator
+    from .poles.lscf import PoleSet, plscf
+    from .poles.selection import Cluster, StabilityFlags, cluster_poles, stability_flags
+    from .problem.problem import FitProblem, build_problem
+    from .statistics.indicators import (
         auto_mac,
         discrepancy,
         equivalent_real_modes,
@@ -29,41 +33,37 @@ if TYPE_CHECKING:
         relative_error,
         rmsd,
     )
-    from .lscf import PoleSet, plscf
-    from .model import ModalModel, ModeKind
-    from .problem import FitProblem, build_problem
-    from .quality import FitQuality, RejectedMode
-    from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
+    from .statistics.quality import FitQuality, RejectedMode
 
 #: public name -> submodule; a name is imported on first access (PEP 562), so that
 #: ``import tyredamp.modal.model`` (the command line, the modes file) does not load
 #: the identification and SciPy's optimisers
 _WHERE = {
-    "Cluster": "selection",
-    "FitProblem": "problem",
-    "FitQuality": "quality",
-    "FitResult": "fit",
-    "ModalFitter": "fit",
+    "Cluster": "poles.selection",
+    "FitProblem": "problem.problem",
+    "FitQuality": "statistics.quality",
+    "FitResult": "fit.fit",
+    "ModalFitter": "fit.fit",
     "ModalIdentification": "identify",
     "ModalModel": "model",
     "ModeKind": "model",
-    "PoleEstimator": "estimators",
-    "PoleSet": "lscf",
-    "RejectedMode": "quality",
-    "StabilityFlags": "selection",
-    "auto_mac": "indicators",
-    "build_problem": "problem",
-    "cluster_poles": "selection",
-    "discrepancy": "indicators",
-    "equivalent_real_modes": "indicators",
+    "PoleEstimator": "poles.estimators",
+    "PoleSet": "poles.lscf",
+    "RejectedMode": "statistics.quality",
+    "StabilityFlags": "poles.selection",
+    "auto_mac": "statistics.indicators",
+    "build_problem": "problem.problem",
+    "cluster_poles": "poles.selection",
+    "discrepancy": "statistics.indicators",
+    "equivalent_real_modes": "statistics.indicators",
     "identify_modes": "identify",
-    "mac": "indicators",
-    "mean_phase_deviation": "indicators",
-    "modal_phase_collinearity": "indicators",
-    "plscf": "lscf",
-    "relative_error": "indicators",
-    "rmsd": "indicators",
-    "stability_flags": "selection",
+    "mac": "statistics.indicators",
+    "mean_phase_deviation": "statistics.indicators",
+    "modal_phase_collinearity": "statistics.indicators",
+    "plscf": "poles.lscf",
+    "relative_error": "statistics.indicators",
+    "rmsd": "statistics.indicators",
+    "stability_flags": "poles.selection",
 }
 
 __all__ = [

@@ -29,18 +29,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
-from .fit import FitResult, ModalFitter
-from .indicators import mean_phase_deviation, modal_phase_collinearity
-from .ml import ml_refine
+from .fit.fit import FitResult, ModalFitter
+from .fit.ml import ml_refine
+from .fit.profile import Z95, fit_intervals
 from .model import ModalModel
-from .narrow import unresolved_damping
-from .problem import FitProblem
-from .profile import Z95, fit_intervals
-from .quality import FitQuality, RejectedMode, threshold_text
-from .refitted import refitted_statistics
-from .residual_peaks import local_ratio
-from .resolution import unresolved_pair, unresolved_pair_text
-from .search import (
+from .problem.problem import FitProblem
+from .search.narrow import unresolved_damping
+from .search.refitted import refitted_statistics
+from .search.residual_peaks import local_ratio
+from .search.resolution import unresolved_pair, unresolved_pair_text
+from .search.search import (
     ModeSet,
     ModeTest,
     fit_checked,
@@ -48,7 +46,9 @@ from .search import (
     rejected,
     residual_span,
 )
-from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
+from .statistics.indicators import mean_phase_deviation, modal_phase_collinearity
+from .statistics.quality import FitQuality, RejectedMode, threshold_text
+from .statistics.stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
 __all__ = ["fit_real", "goodness", "to_model", "unscale"]
 

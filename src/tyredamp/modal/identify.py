@@ -93,18 +93,18 @@ from .._validate import as_finite
 from ..exceptions import InputError
 from ..frf import FRF
 from ..mechanics.modal_sum import pole_from_frequency_damping
-from .compress import _compress, combine_outputs
-from .estimators import PoleEstimator, get_estimator
 from .final import ModelContext, final_complex, fit_real, to_model
-from .fit import FitResult, ModalFitter
-from .lscf import PoleSet, plscf
+from .fit.fit import FitResult, ModalFitter
 from .model import ModalModel
-from .model_error import with_model_error
-from .order import Diagram, SelectionRules, default_order, modes_shown, settle_order
-from .out_of_band import search_helpers
-from .problem import SET_ASIDE, FitProblem, build_problem, max_modes
-from .quality import RejectedMode, merge_rejected
-from .search import (
+from .poles.estimators import PoleEstimator, get_estimator
+from .poles.lscf import PoleSet, plscf
+from .poles.order import Diagram, SelectionRules, default_order, modes_shown, settle_order
+from .poles.selection import Cluster, StabilityFlags
+from .problem.compress import _compress, combine_outputs
+from .problem.model_error import with_model_error
+from .problem.problem import SET_ASIDE, FitProblem, build_problem, max_modes
+from .search.out_of_band import search_helpers
+from .search.search import (
     FixedParts,
     ModeSet,
     ModeTest,
@@ -112,8 +112,8 @@ from .search import (
     rejected,
     residual_search,
 )
-from .selection import Cluster, StabilityFlags
-from .stats import FALSE_ALARM, mode_parameters, mode_threshold
+from .statistics.quality import RejectedMode, merge_rejected
+from .statistics.stats import FALSE_ALARM, mode_parameters, mode_threshold
 
 __all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..modal.lscf import plscf
+from ..modal.poles.lscf import plscf
 from .ssi import OrderPoles, _normalised
 
 __all__ = ["half_spectra", "plscf_poles", "residue_shapes"]

@@ -548,7 +548,7 @@ def _rejected_in(model: Any, f: NDArray[np.float64], excess: NDArray[np.float64]
     q = getattr(model, "quality", None)
     if q is None or not q.rejected or f.size < 2:
         return ""
-    from ..modal.quality import short_reason, strongest_rejected
+    from ..modal.statistics.quality import short_reason, strongest_rejected
 
     ex = np.clip(excess, 0.0, None).reshape(-1, f.size).sum(axis=0)
     total = float(ex.sum())

@@ -38,7 +38,7 @@ DEFAULT_ESTIMATOR = "plscf"
 
 
 def _estimators() -> Any:
-    from ...modal.estimators import ESTIMATORS
+    from ...modal.poles.estimators import ESTIMATORS
 
     return ESTIMATORS
 

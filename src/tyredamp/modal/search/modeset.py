@@ -13,10 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import ConvergenceError
-from .fit import FitResult, ModalFitter
-from .quality import RejectedMode
-from .selection import same_place_distinct
+from ...exceptions import ConvergenceError
+from ..fit.fit import FitResult, ModalFitter
+from ..poles.selection import same_place_distinct
+from ..statistics.quality import RejectedMode
 
 __all__ = [
     "MERGE",

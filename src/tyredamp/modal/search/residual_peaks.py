@@ -31,9 +31,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats as sps
 
-from ..mechanics.modal_sum import pole_from_frequency_damping
-from ._basis import factors, residual_lines, residual_power
-from .fit import FitResult, ModalFitter
+from ...mechanics.modal_sum import pole_from_frequency_damping
+from ..fit._basis import factors, residual_lines, residual_power
+from ..fit.fit import FitResult, ModalFitter
 
 __all__ = [
     "ResidualPeaks",

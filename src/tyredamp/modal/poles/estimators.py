@@ -32,7 +32,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import InputError
+from ...exceptions import InputError
 from .lscf import PoleSet, plscf
 
 __all__ = [

@@ -41,10 +41,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats as sps
 
-from ..exceptions import ConvergenceError
-from ..mechanics.modal_sum import pole_quantities
-from ._added import FixedPart
-from .fit import FitResult, ModalFitter
+from ...exceptions import ConvergenceError
+from ...mechanics.modal_sum import pole_quantities
+from ..fit._added import FixedPart
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.quality import KEPT, RejectedMode, threshold_text
 from .modeset import (
     MERGE,
     ModeSet,
@@ -57,7 +58,6 @@ from .modeset import (
     with_residual,
 )
 from .narrow import STEP_LINES, narrow_refusal, too_narrow
-from .quality import KEPT, RejectedMode, threshold_text
 from .residual_peaks import (
     local_ratio,
     residual_view,

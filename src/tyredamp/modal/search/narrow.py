@@ -34,10 +34,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from tyredamp.modal._basis import factors, residual_lines
-from tyredamp.modal.fit import FitResult, ModalFitter
-from tyredamp.modal.residual_peaks import model_of
-from tyredamp.modal.resolution import unresolved_pair_text
+from ..fit._basis import factors, residual_lines
+from ..fit.fit import FitResult, ModalFitter
+from .residual_peaks import model_of
+from .resolution import unresolved_pair_text
 
 __all__ = [
     "EDGE_LINES",

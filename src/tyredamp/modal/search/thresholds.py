@@ -9,10 +9,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from .fit import FitResult, ModalFitter
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.stats import FALSE_ALARM, span_threshold
 from .residual_peaks import model_of
 from .span_noise import SpanNoise, span_noise
-from .stats import FALSE_ALARM, span_threshold
 
 __all__ = ["ModeTest", "local_thresholds", "residual_span"]
 

@@ -45,10 +45,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _basis
+from ..fit import _basis
 
 if TYPE_CHECKING:
-    from .fit import ModalFitter
+    from ..fit.fit import ModalFitter
 
 __all__ = ["SpanNoise", "span_noise"]
 

@@ -11,12 +11,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..exceptions import ConvergenceError
-from ..mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
-from ._basis import factors, residual_blocks
-from .fit import FitResult, ModalFitter
+from ...exceptions import ConvergenceError
+from ...mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
+from ..fit._basis import factors, residual_blocks
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.quality import RejectedMode
 from .modeset import outside_side, with_residual
-from .quality import RejectedMode
 from .residual_peaks import model_of, rank_one_statistic
 from .search import (
     FIRST_NFEV,

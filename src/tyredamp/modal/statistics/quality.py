@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..exceptions import InputError
+from ...exceptions import InputError
 
 __all__ = [
     "FitQuality",

@@ -17,11 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import find_peaks
 
+from ..problem.problem import FitProblem
+from ..statistics.stats import FALSE_ALARM, difference_noise
 from .estimators import PoleEstimator
 from .lscf import PoleSet
-from .problem import FitProblem
 from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
-from .stats import FALSE_ALARM, difference_noise
 
 __all__ = [
     "Diagram",

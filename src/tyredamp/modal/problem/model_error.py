@@ -59,11 +59,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
-from ..frf import FRF, FRFKind
-from ..mechanics.modal_sum import kind_factor
-from .model import ModalModel
+from ...frf import FRF, FRFKind
+from ...mechanics.modal_sum import kind_factor
+from ..model import ModalModel
+from ..statistics.stats import difference_noise
 from .problem import FitProblem, build_problem
-from .stats import difference_noise
 
 __all__ = [
     "EPS_TOLERANCE",

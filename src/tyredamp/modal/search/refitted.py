@@ -34,9 +34,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import ConvergenceError
-from ._linalg import _gn_point
-from .fit import FitResult, ModalFitter
+from ...exceptions import ConvergenceError
+from ..fit._linalg import _gn_point
+from ..fit.fit import FitResult, ModalFitter
 from .search import JOINT_NFEV, SEARCH_TOL, ModeSet
 
 __all__ = ["OVERLAP", "REFIT_NFEV", "overlapping", "refit_candidates", "refitted_statistics"]

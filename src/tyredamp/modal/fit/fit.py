@@ -86,10 +86,10 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import InputError
+from ...exceptions import InputError
+from ..problem.compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 from . import _added, _basis, _scaling
 from ._linalg import _extra_ss, _levenberg_marquardt, _vp_solve, at_rest
-from .compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
 

@@ -49,9 +49,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_band
-from ..exceptions import InputError, ShapeError
-from ..frf import FRF, KIND_POWER
+from ..._validate import as_band
+from ...exceptions import InputError, ShapeError
+from ...frf import FRF, KIND_POWER
 
 __all__ = ["FitProblem", "NoiseSource", "build_problem", "line_factor_dof", "max_modes"]
 
