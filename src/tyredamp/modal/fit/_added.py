@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from . import _basis
 from ._linalg import _PROJ_TOL, _fixed_range, _vp_solve
+from ._state import FitterState
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,7 @@ class _Rows:
     """The fixed basis and data rows of the blocks, within one call (nothing is
     kept between calls but what the :class:`FixedPart` holds)."""
 
-    def __init__(self, fitter: Any, fx: FixedPart | None, parts: Any, keep: bool) -> None:
+    def __init__(self, fitter: FitterState, fx: FixedPart | None, parts: Any, keep: bool) -> None:
         self.fitter, self.fx, self.parts, self.keep = fitter, fx, parts, keep
         self.cols: dict[int, NDArray[np.float64]] = {}
 
@@ -107,7 +108,7 @@ class _Rows:
 
 
 def fixed_part(
-    fitter: Any,
+    fitter: FitterState,
     th_f: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -152,13 +153,13 @@ def fixed_part(
     return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr)
 
 
-def _no_larger(fitter: Any, n_col: int) -> bool:
+def _no_larger(fitter: FitterState, n_col: int) -> bool:
     """Are ``n_col`` real columns of every line no larger than the data rows or than
     one block of the fits (:data:`~tyredamp.modal._basis.BLOCK_BYTES`)?"""
     return n_col <= fitter.n_out or 8 * fitter.n_rows * n_col <= _basis.BLOCK_BYTES
 
 
-def line_rows(fitter: Any, sl: slice) -> slice | NDArray[np.intp]:
+def line_rows(fitter: FitterState, sl: slice) -> slice | NDArray[np.intp]:
     """The rows of the lines ``sl`` among the rows of every line (``(k, f)``, real and
     imaginary part interleaved, :func:`~tyredamp.modal._basis.ydata`): a slice for one
     input, else the indices in the order of the rows of a block."""
@@ -170,7 +171,13 @@ def line_rows(fitter: Any, sl: slice) -> slice | NDArray[np.intp]:
     return np.stack([2 * e, 2 * e + 1], axis=1).ravel()
 
 
-def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], lay1: Any) -> Any:
+def added_solver(
+    fitter: FitterState,
+    one: FitterState,
+    fx: FixedPart,
+    ref1: NDArray[np.intp],
+    lay1: _basis.Layout,
+) -> Any:
     """The projection at the added mode's parameters (``solve(th)`` of
     :meth:`ModalFitter._refine`); ``one``: the fitter of the added mode alone (no
     residual terms), ``lay1`` its derivative layout."""
@@ -187,7 +194,7 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
         force = bool((G.diagonal() < _PROJ_TOL * g0.diagonal()).any())
         sol = _vp_solve(G, P, q1, fx.yyp, projected, residual=force, gradient=True, cancel=yy)
         sol["lay"] = lay1
-        sol["coef"] = one._coef(lay1, pp1[0])
+        sol["coef"] = _basis.coef(lay1, pp1[0])  # ModalFitter._coef
         return sol
 
     def solve_one(th: NDArray[np.float64]) -> dict[str, Any]:

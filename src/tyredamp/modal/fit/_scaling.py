@@ -13,9 +13,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.linalg import lapack
 
+from ._state import FitterState
+
 
 def scale(
-    fitter: Any,
+    fitter: FitterState,
     th: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -54,7 +56,7 @@ def scale(
 
 
 def scale_jacobian(
-    fitter: Any,
+    fitter: FitterState,
     th: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -133,7 +135,7 @@ def scale_jacobian(
 
 
 def shape_std(
-    fitter: Any,
+    fitter: FitterState,
     th: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],

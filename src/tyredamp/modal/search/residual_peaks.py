@@ -25,7 +25,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -330,7 +329,7 @@ def _rank_one_off_fitted(
 
 
 def _scan_scale(
-    fit: Any,
+    fit: ModalFitter,
     f: NDArray[np.float64],
     z: float,
     resid: Callable[[slice], NDArray[np.complex128]],
@@ -404,7 +403,7 @@ class ScanGrid:
 
 
 def coherent_scan(
-    fitter: object,
+    fitter: ModalFitter,
     model: tuple[
         NDArray[np.complex128],
         NDArray[np.complex128],
@@ -432,7 +431,7 @@ def coherent_scan(
     most of a weak mode's share between two strong ones). ``model`` is the
     fit's ``(poles, residues (n_out, n_in, m), (upper, lower))``.
     """
-    fit: Any = fitter
+    fit = fitter
     f = np.asarray(fit.f, dtype=np.float64)
     empty = ScanGrid(np.zeros(0, complex), np.zeros(0), np.zeros(0, bool))
     if f.size < 3 or not f[0] > 0:
