@@ -5,9 +5,55 @@ The usual entry point is :func:`identify_modes` (FRFs in, real and complex
 stages are public too: :func:`build_problem` (band cut, normalisation, noise
 model), a :class:`PoleEstimator` (default :func:`plscf`, poles over model
 orders), :func:`stability_flags` and :func:`cluster_poles` (automatic
-selection), :mod:`.search` (mode test, residual search), :class:`ModalFitter`
-(LSFD and variable-projection refinement), :mod:`.stats` and
-:mod:`.indicators`. The modes JSON file is :mod:`tyredamp.documents.modes`.
+selection), :mod:`.search.search` (mode test, residual search),
+:class:`ModalFitter` (LSFD and variable-projection refinement),
+:mod:`.statistics.stats` and :mod:`.statistics.indicators`. The modes JSON file
+is :mod:`tyredamp.documents.modes`.
+
+Map of the package (one group per step of the method; a group imports only
+from the groups below it; the layering test of the package enforces it):
+
+``identify.py``, ``final.py`` (top)
+    The pipeline: :func:`identify_modes` runs the steps below in order and
+    ``final`` turns the last fit into a :class:`ModalModel` with its quality
+    (maximum-likelihood stage, intervals, goodness of fit).
+``search/``
+    Which modes the data hold: the mode test and the residual search on one
+    fitter (``search``), its mode set (``modeset``), out-of-band residual
+    modes (``out_of_band``), where trials start (``search_starts``,
+    ``residual_peaks``), each mode's threshold (``thresholds``,
+    ``span_noise``), poles narrower than the lines (``narrow``,
+    ``resolution``) and the statistic with the neighbours refitted
+    (``refitted``). Its own group because it decides the mode count from
+    fits: it uses the fitter and the diagram's poles, neither uses it.
+``poles/`` and ``fit/`` (side by side, independent of each other)
+    ``poles/``: the stabilisation diagram, from the FRFs to candidate poles
+    without residues: pLSCF (``lscf``), the estimator protocol and registry
+    (``estimators``), stability flags and clusters (``selection``), the model
+    order (``order``). ``fit/``: residues and poles fitted to the FRFs for a
+    given set of modes: :class:`ModalFitter` (``fit``) with its basis,
+    linear algebra, scaling and added-mode projection (``_basis``,
+    ``_linalg``, ``_scaling``, ``_added``, ``_state``), the
+    maximum-likelihood refinement (``ml``) and likelihood intervals
+    (``profile``). A diagram never fits residues and a fit never builds a
+    diagram: the two methods split here.
+``problem/``
+    The data as the fits see them: the band-limited, normalised FRFs and their
+    noise model (``problem``), principal combinations of many outputs
+    (``compress``) and the noise level raised by the model error
+    (``model_error``, which reads a :class:`ModalModel`).
+``model.py``
+    The result: :class:`ModalModel` (poles and mode shapes that synthesise
+    FRFs), light to import (the command line and the modes file load it
+    without the identification).
+``statistics/`` (ground)
+    How a fit is judged, on plain arrays: the mode test, noise estimates and
+    goodness of fit (``stats``), MAC, MPC and the fit indicators
+    (``indicators``) and the fit-quality record (``quality``). Imports nothing
+    else of the package.
+
+The subpackages' ``__init__`` modules hold only their docstring (nothing is
+imported with them), so a deep import loads only what it names.
 """
 
 from __future__ import annotations
