@@ -1,5 +1,5 @@
 """Coverage of the 95 % intervals on the random-MDOF corpus, with the likelihood
-intervals of :mod:`tyredamp.modal.profile` and without them (issue 16).
+intervals of :mod:`tyredamp.modal.fit.profile` and without them (issue 16).
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/modal_coverage.py --snr 20 --systems 24``
 (about 8 minutes with 2 jobs at 20 dB on a 2-core machine).

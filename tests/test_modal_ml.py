@@ -1,4 +1,4 @@
-"""Maximum-likelihood refinement with the per-line variance (modal.ml) against an
+"""Maximum-likelihood refinement with the per-line variance (modal.fit.ml) against an
 independent full least-squares fit, its Fisher standard errors, and the choice
 of weights (modal.final.full_weights)."""
 
@@ -137,7 +137,7 @@ def test_identify_uses_the_full_variance_when_known() -> None:
     # one level per output, below the noise of the strong lines (it varies 35-fold
     # along the axis), so the fit leaves structure, and the identification is
     # repeated against that level plus a noise proportional to the response
-    # (modal.model_error): a per-line variance, so the ML stage runs on it, and the
+    # (modal.problem.model_error): a per-line variance, so the ML stage runs on it, and the
     # verdict names it; the modes stay those of the known variance
     r0 = identify_modes(frf, model="complex")
     m0 = r0.models["complex"]

@@ -1,4 +1,4 @@
-"""Likelihood intervals of f and zeta (modal.profile): the linearised interval in
+"""Likelihood intervals of f and zeta (modal.fit.profile): the linearised interval in
 the linear limit, the likelihood-ratio cut at their ends (checked against an
 independent profile of a hand-written model), the rule of which modes are
 profiled, and the intervals in the identified model and its JSON."""

@@ -1,4 +1,4 @@
-"""The mode statistic with the neighbours' poles refitted (modal.refitted): a
+"""The mode statistic with the neighbours' poles refitted (modal.search.refitted): a
 second pole beside a strong mode passes with the other poles held but not as
 the likelihood ratio of the maximised models; a true weak neighbour passes
 both; separated modes are not refitted."""

@@ -1,5 +1,5 @@
 """Where the residual search looks for missed modes (issue 16):
-``modal.residual_peaks``.
+``modal.search.residual_peaks``.
 
 * the residual power's noise mean from its median (chi-square scaling);
 * broad structure that no 5-line window shows is found by the matched windows;

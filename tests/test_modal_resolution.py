@@ -1,4 +1,4 @@
-"""Two poles the lines cannot tell apart (tyredamp.modal.resolution)."""
+"""Two poles the lines cannot tell apart (tyredamp.modal.search.resolution)."""
 
 from __future__ import annotations
 

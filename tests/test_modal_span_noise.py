@@ -1,4 +1,4 @@
-"""Noise along the response (modal.span_noise) and the mode threshold it raises
+"""Noise along the response (modal.search.span_noise) and the mode threshold it raises
 (stats.span_threshold, search.local_thresholds)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The damping bound of the residual search's trials (modal.search.sigma_bound and
+"""The damping bound of the residual search's trials (modal.search.search.sigma_bound and
 ModalFitter.fit_added(sigma_max=...))."""
 
 from __future__ import annotations

@@ -75,7 +75,7 @@ def modes_table(name: str, model: ModalModel) -> list[str]:
 
 def _likelihood_rows(model: ModalModel) -> list[str]:
     """The 95 % likelihood intervals of the modes that have one (a weak mode, whose
-    linearised interval would be too short; :mod:`tyredamp.modal.profile`): the
+    linearised interval would be too short; :mod:`tyredamp.modal.fit.profile`): the
     +- columns hold the half-width of the symmetric interval around them."""
     how = model.meta.get("interval_method")
     fi, zi = model.meta.get("interval_frequency_hz"), model.meta.get("interval_damping_ratio")

@@ -1,9 +1,9 @@
-"""The projection of :meth:`~tyredamp.modal.fit.ModalFitter.fit_added`: one added
+"""The projection of :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit_added`: one added
 mode refined with the other modes held fixed.
 
 The fixed basis ``Phi_f`` (the fixed modes and the residual terms) is projected
 out of the data once (:func:`fixed_part`: the range map of
-:func:`~tyredamp.modal._linalg._fixed_range`); an evaluation at the added
+:func:`~tyredamp.modal.fit._linalg._fixed_range`); an evaluation at the added
 mode's parameters (:func:`added_solver`) then needs only the Gram blocks of the
 added columns ``B1 = [Phi_1 | E_1]`` against ``Phi_f``, themselves and the data
 (Frisch-Waugh-Lovell theorem, e.g. Seber & Lee, *Linear Regression Analysis*,
@@ -11,10 +11,10 @@ added columns ``B1 = [Phi_1 | E_1]`` against ``Phi_f``, themselves and the data
 
 The residual search tries many candidates against the same fixed modes: the
 fixed part (:class:`FixedPart`, from :meth:`ModalFitter.fixed_part
-<tyredamp.modal.fit.ModalFitter.fixed_part>`) is an immutable value that the
+<tyredamp.modal.fit.fit.ModalFitter.fixed_part>`) is an immutable value that the
 caller forms once per fixed mode set and passes to each ``fit_added``; the
 fitter keeps nothing between calls. It holds the range map and, when the data
-fit one block (:func:`~tyredamp.modal._basis.one_block`), that block's fixed
+fit one block (:func:`~tyredamp.modal.fit._basis.one_block`), that block's fixed
 basis, weighted data rows and the rows of ``[Q_r | P_f Y]`` (an orthonormal
 basis of the range of ``Phi_f`` and the data with it projected out: an
 evaluation is then one product ``B1^T [Q_r | P_f Y]`` and ``B1^T B1``); with
@@ -155,13 +155,13 @@ def fixed_part(
 
 def _no_larger(fitter: FitterState, n_col: int) -> bool:
     """Are ``n_col`` real columns of every line no larger than the data rows or than
-    one block of the fits (:data:`~tyredamp.modal._basis.BLOCK_BYTES`)?"""
+    one block of the fits (:data:`~tyredamp.modal.fit._basis.BLOCK_BYTES`)?"""
     return n_col <= fitter.n_out or 8 * fitter.n_rows * n_col <= _basis.BLOCK_BYTES
 
 
 def line_rows(fitter: FitterState, sl: slice) -> slice | NDArray[np.intp]:
     """The rows of the lines ``sl`` among the rows of every line (``(k, f)``, real and
-    imaginary part interleaved, :func:`~tyredamp.modal._basis.ydata`): a slice for one
+    imaginary part interleaved, :func:`~tyredamp.modal.fit._basis.ydata`): a slice for one
     input, else the indices in the order of the rows of a block."""
     n_f, n_in = fitter.n_f, fitter.n_in
     start, stop, _ = sl.indices(n_f)

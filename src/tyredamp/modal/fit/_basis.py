@@ -1,8 +1,8 @@
 """The real basis of the modal fits and its derivative columns.
 
-Functions of a :class:`~tyredamp.modal.fit.ModalFitter` (its methods
+Functions of a :class:`~tyredamp.modal.fit.fit.ModalFitter` (its methods
 ``_basis_ek``, ``_basis_real``, ``_layout``, ``_coef``); the layout of the
-columns is stated in the docstring of :mod:`tyredamp.modal.fit`.
+columns is stated in the docstring of :mod:`tyredamp.modal.fit.fit`.
 """
 
 from __future__ import annotations

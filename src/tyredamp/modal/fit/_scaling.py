@@ -1,8 +1,8 @@
 """Mass-normalised scaling of a modal fit and the standard errors of its shapes.
 
-Functions of a :class:`~tyredamp.modal.fit.ModalFitter` (its methods
+Functions of a :class:`~tyredamp.modal.fit.fit.ModalFitter` (its methods
 ``_scale``, ``_scale_jacobian`` and ``_shape_std``); the equations are stated
-in the docstring of :mod:`tyredamp.modal.fit` (scaling, uncertainty).
+in the docstring of :mod:`tyredamp.modal.fit.fit` (scaling, uncertainty).
 """
 
 from __future__ import annotations
@@ -214,7 +214,7 @@ def pole_std(
     """Standard errors of f (Hz), zeta and the pole (rad/s) of the ``m`` modes by the
     delta method from the covariance ``cth`` of the parameters ``th`` (poles first:
     ``sigma = w_ref exp(x1)``, ``Omega = w_ref x2``, the pole parametrisation of
-    :class:`~tyredamp.modal.fit.ModalFitter`)."""
+    :class:`~tyredamp.modal.fit.fit.ModalFitter`)."""
     ar = np.arange(m)
     sig = w_ref * np.exp(th[0 : 2 * m : 2])
     om = w_ref * th[1 : 2 * m : 2]

@@ -178,7 +178,7 @@ def stability_flags(
     Parameters
     ----------
     ps : PoleSet
-        Poles over model orders from :func:`~tyredamp.modal.lscf.plscf`.
+        Poles over model orders from :func:`~tyredamp.modal.poles.lscf.plscf`.
     band : (float, float), optional
         Band (Hz) for the damped frequency; default ``ps.band_hz``.
     max_damping : float

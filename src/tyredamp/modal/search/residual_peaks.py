@@ -1,6 +1,6 @@
 """Where a fit's residual holds structure a missed mode could explain.
 
-The residual search (:func:`~tyredamp.modal.search.residual_search`) starts
+The residual search (:func:`~tyredamp.modal.search.search.residual_search`) starts
 trial modes at the peaks of the residual power per line, summed over the FRFs
 in units of each output's noise variance (a mode indicator on the residual).
 A missed mode of damping ratio ``zeta`` at ``f`` leaves its residual power
@@ -11,7 +11,7 @@ damping ratios (a matched filter per scale, its width proportional to the
 frequency), and a line is a candidate when one of these sums stands out of
 the noise's own scatter and could hold a mode that passes the test: the cost
 drop of a mode fitted there is at least the excess within its band (the mode
-test's statistic ``T``, :mod:`tyredamp.modal.stats`).
+test's statistic ``T``, :mod:`tyredamp.modal.statistics.stats`).
 
 The noise level of a line is the mean of the residual power under noise,
 estimated robustly from its median: the residual power of a line is a sum of
@@ -479,8 +479,8 @@ def model_of(
     tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
     NDArray[np.float64],
 ]:
-    """A fit's model for the residual functions of :mod:`._basis`: poles, residues
-    ``R = u l`` (n_out, n_in, m; u unscaled without drive points, or scaled),
+    """A fit's model for the residual functions of :mod:`~tyredamp.modal.fit._basis`: poles,
+    residues ``R = u l`` (n_out, n_in, m; u unscaled without drive points, or scaled),
     residual terms, and each output's noise variance (at least the fitter's floor)."""
     residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
     s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))

@@ -1,5 +1,5 @@
 """Where the residual search tries a mode, and the records of the candidates it
-did not keep for a reason of their own (stage 3 of :mod:`tyredamp.modal.search`).
+did not keep for a reason of their own (stage 3 of :mod:`tyredamp.modal.search.search`).
 
 Each round starts trial modes at the coherent scan's trial poles, or else at the
 residual's peaks where the scan finds room for a mode, then at the diagram's
