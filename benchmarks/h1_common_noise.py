@@ -13,12 +13,12 @@ the script prints per draw:
 
 * ``in/off``: the median over the lines of the noise variance per complex
   direction in the span of ``H(f)`` over that off it (17-line windows; 1 for
-  independent outputs, :mod:`tyredamp.modal.span_noise`);
+  independent outputs, :mod:`tyredamp.modal.search.span_noise`);
 * ``T max``: the largest statistic of one mode fitted to the noise alone
   (pole on a grid of 0.05 Hz and damping ratios 0.15-2.5 %, rank-one
   residue, separable weights) -- what a noise mode reaches;
 * for (a) also the base threshold of the mode test and the raised threshold
-  at that pole (:func:`tyredamp.modal.stats.span_threshold`, from ``E``).
+  at that pole (:func:`tyredamp.modal.statistics.stats.span_threshold`, from ``E``).
 """
 
 from __future__ import annotations
@@ -49,9 +49,9 @@ def _tmax(E: np.ndarray, V: np.ndarray, f: np.ndarray) -> tuple[float, complex]:
 
 def main() -> None:
     from tyredamp.campaign.virtual import _tyre, tyre_parameters
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.stats import mode_parameters, mode_threshold, span_threshold
+    from tyredamp.modal.fit.fit import ModalFitter
+    from tyredamp.modal.problem.problem import build_problem
+    from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold, span_threshold
     from tyredamp.signal import estimate_frf
     from tyredamp.timedata import TimeData
     from tyredamp.virtual import run_modal_test
@@ -103,9 +103,9 @@ def main() -> None:
 
 
 def _span_of_error(fit: object, E: np.ndarray, lw: np.ndarray, s2: np.ndarray) -> object:
-    """:func:`~tyredamp.modal.span_noise.span_noise` with the error ``E`` as the
+    """:func:`~tyredamp.modal.search.span_noise.span_noise` with the error ``E`` as the
     residual (the span of the noisy data, as the identification sees it)."""
-    from tyredamp.modal.span_noise import SpanNoise
+    from tyredamp.modal.search.span_noise import SpanNoise
 
     H = fit.H  # type: ignore[attr-defined]
     n_out, n_in = H.shape[:2]

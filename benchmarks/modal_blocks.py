@@ -4,7 +4,7 @@ Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/modal_blocks.py [--repeat 3]
 [--sizes 1e6 8e6]``.
 
 The fits accumulate their Gram blocks over blocks of lines of
-``tyredamp.modal._basis.BLOCK_BYTES`` (a constant cap: the memory of a block
+``tyredamp.modal.fit._basis.BLOCK_BYTES`` (a constant cap: the memory of a block
 does not grow with the lines). Each case (:func:`perf_common.mimo_case`) is
 identified with every block size in turn, alternating the order between
 repeats (one BLAS thread; the machine is shared, so medians and ratios count,
@@ -22,7 +22,8 @@ import time
 import numpy as np
 from perf_common import limit_blas, mimo_case
 
-from tyredamp.modal import _basis, identify_modes
+from tyredamp.modal import identify_modes
+from tyredamp.modal.fit import _basis
 
 CASES = [(4, 1, 1000, 10, 60.0), (16, 2, 3000, 20, 35.0), (32, 2, 4000, 20, 50.0)]
 

@@ -1,5 +1,5 @@
 """Coverage of the 95 % intervals on the random-MDOF corpus, with the likelihood
-intervals of :mod:`tyredamp.modal.profile` and without them (issue 16).
+intervals of :mod:`tyredamp.modal.fit.profile` and without them (issue 16).
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/modal_coverage.py --snr 20 --systems 24``
 (about 8 minutes with 2 jobs at 20 dB on a 2-core machine).
@@ -38,7 +38,7 @@ def one(args: tuple[int, float]) -> tuple[int, float, dict[str, Any], dict[str, 
     seed, kappa = args
     import modal_statistics as ms
 
-    import tyredamp.modal.profile as prof
+    import tyredamp.modal.fit.profile as prof
 
     prof.KAPPA = kappa
     warnings.simplefilter("ignore")
@@ -49,7 +49,7 @@ def one(args: tuple[int, float]) -> tuple[int, float, dict[str, Any], dict[str, 
 def main() -> None:
     import modal_statistics as ms
 
-    import tyredamp.modal.profile as prof
+    import tyredamp.modal.fit.profile as prof
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--snr", type=float, default=20.0, choices=ms.SNRS)

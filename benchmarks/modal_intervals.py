@@ -10,7 +10,7 @@ per fit. ``--kind real``: the modes are real (proportional damping) and the
 first table scores the real-mode model (``model="both"``).
 :func:`~tyredamp.modal.identify_modes` as a user calls it (automatic mode
 count, noise from the residual), once with the likelihood intervals of
-:mod:`tyredamp.modal.profile` (the default) and once with them switched off
+:mod:`tyredamp.modal.fit.profile` (the default) and once with them switched off
 (``KAPPA`` infinite: the linearised intervals of every earlier version). Per
 case it prints the weak mode's median statistic ``T``, the share of draws
 that found both modes, and the share of those whose interval holds the true
@@ -36,7 +36,7 @@ import numpy as np
 
 from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
-from tyredamp.modal import profile as prof
+from tyredamp.modal.fit import profile as prof
 from tyredamp.modal.model import ModalModel
 
 F = np.arange(40.0, 60.0, 0.075)

@@ -17,7 +17,7 @@ import numpy as np
 from tyredamp.frf import FRF
 from tyredamp.mechanics import modal_sum_receptance, pole_from_frequency_damping
 from tyredamp.modal.identify import identify_modes
-from tyredamp.modal.lscf import plscf
+from tyredamp.modal.poles.lscf import plscf
 
 
 def synthetic(n_out: int, n_lines: int, n_modes: int, seed: int = 0) -> tuple[FRF, np.ndarray]:

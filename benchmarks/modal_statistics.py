@@ -26,7 +26,7 @@ gets the FRF and nothing else (noise from the residual). With ``--noise
 response`` half of each output's noise power follows ``|H_jk(f)|^2`` (a
 per-line variance that the separable model ``sigma_j^2 g_f`` cannot hold, as
 with an H1 estimate's input noise) and the identification is given that
-variance (maximum-likelihood final stage, :mod:`tyredamp.modal.ml`).
+variance (maximum-likelihood final stage, :mod:`tyredamp.modal.fit.ml`).
 
 Per SNR the table prints:
 
@@ -59,7 +59,7 @@ Per SNR the table prints:
 * ``cover f, zeta``: share of those errors within the reported 95 % interval
   (``1.96`` standard errors; 0.95 for honest intervals);
 * ``interval f, zeta``: the same share for the 95 % intervals in the model's
-  meta (the likelihood intervals of :mod:`tyredamp.modal.profile` where the
+  meta (the likelihood intervals of :mod:`tyredamp.modal.fit.profile` where the
   pole's standard error is a noticeable share of its half-width, which the
   symmetric ``1.96 std`` holds; the linearised interval elsewhere);
 * ``no hidden f, zeta``: the coverage over the matched significant modes that
@@ -185,7 +185,7 @@ def identify(seed: int) -> dict[str, Any]:
         "sf": np.asarray(c.std["frequency_hz"]).tolist(),
         "sz": np.asarray(c.std["damping_ratio"]).tolist(),
         # the 95 % intervals (likelihood intervals where the pole's standard error is
-        # a noticeable share of its half-width, :mod:`tyredamp.modal.profile`)
+        # a noticeable share of its half-width, :mod:`tyredamp.modal.fit.profile`)
         "fi": np.asarray(c.meta.get("interval_frequency_hz", np.zeros((0, 2)))).tolist(),
         "zi": np.asarray(c.meta.get("interval_damping_ratio", np.zeros((0, 2)))).tolist(),
         "time": time.perf_counter() - t,
@@ -202,12 +202,12 @@ def truth_stats(seed: int, refitted: bool = True) -> dict[str, Any]:
     with the noise RMS per output. Noise that follows the response: the
     significance with the separable weights the identification tests with, the
     bounds from the Fisher information with the variance of every entry
-    (:mod:`tyredamp.modal.ml`).
+    (:mod:`tyredamp.modal.fit.ml`).
     """
-    from tyredamp.modal import ml
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.stats import mode_parameters, mode_threshold
+    from tyredamp.modal.fit import ml
+    from tyredamp.modal.fit.fit import ModalFitter
+    from tyredamp.modal.problem.problem import build_problem
+    from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
     s = system(seed)
     frf, var = frf_of(s, seed)
@@ -306,12 +306,12 @@ def _refitted_lr(
     mode beside them, which the statistic at the true poles (``t_fixed``, the
     other poles held) does not allow. Computed (in band) where ``t_fixed`` lies
     within ``LR_RANGE`` times ``thr``, and beyond it for a mode whose resonance
-    overlaps a stronger mode's (:func:`tyredamp.modal.refitted.overlapping`): a broad
+    overlaps a stronger mode's (:func:`tyredamp.modal.search.refitted.overlapping`): a broad
     mode 0.65 half-widths from one 800 times stronger gave ``t_fixed`` 33 times
     the threshold and 1.3 times refitted (seed 194). Elsewhere ``t_fixed``
     stands (isolated modes far above the threshold)."""
     from tyredamp.exceptions import ConvergenceError
-    from tyredamp.modal.refitted import overlapping
+    from tyredamp.modal.search.refitted import overlapping
 
     out = np.asarray(t_fixed, float).copy()
     stronger = np.any(overlapping(poles) & (out[None, :] > out[:, None]), axis=1)

@@ -16,7 +16,7 @@ import numpy as np
 
 from tyredamp.frf import FRF
 from tyredamp.modal.identify import identify_modes
-from tyredamp.modal.indicators import mac
+from tyredamp.modal.statistics.indicators import mac
 from tyredamp.virtual import Imperfection, MeasurementLayout, RingTyre
 
 F = np.arange(0.25, 200.01, 0.25)

@@ -380,7 +380,7 @@ def _timed_names(module: ModuleType, names: Sequence[str], acc: list[float]) -> 
 
 
 #: the pole stage as :mod:`tyredamp.modal.identify` calls it: the automatic order
-#: and its diagram (:func:`~tyredamp.modal.order.settle_order`: pLSCF, the flags,
+#: and its diagram (:func:`~tyredamp.modal.poles.order.settle_order`: pLSCF, the flags,
 #: the clusters) and the picking of given frequencies
 POLE_STAGE = ("settle_order", "plscf", "stability_flags", "cluster_poles", "_pick_frequencies")
 

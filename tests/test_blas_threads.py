@@ -11,7 +11,7 @@ from threadpoolctl import threadpool_info, threadpool_limits
 from tyredamp._blas import blas_threads
 from tyredamp.exceptions import InputError
 from tyredamp.modal import identify_modes
-from tyredamp.modal.lscf import plscf
+from tyredamp.modal.poles.lscf import plscf
 
 from .test_modal_statistics import weak_beside_strong
 

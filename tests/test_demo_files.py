@@ -358,7 +358,7 @@ def test_report_summarises_the_rejected_candidates(demo: tuple[DemoResult, Path]
     its own short reason; every reason is in the modes JSON it names."""
     import html
 
-    from tyredamp.modal.quality import RejectedMode, short_reason, strongest_rejected
+    from tyredamp.modal.statistics.quality import RejectedMode, short_reason, strongest_rejected
 
     result, out = demo
     ident = result.radial.main.identification

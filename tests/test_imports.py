@@ -57,8 +57,8 @@ def test_step_settings_name_what_the_registries_hold() -> None:
     # the settings carry the registries' names so that they load without SciPy
     from tyredamp.damping import METHODS
     from tyredamp.lateral.models import MODELS
-    from tyredamp.modal.estimators import DEFAULT_ESTIMATOR
-    from tyredamp.modal.stats import FALSE_ALARM
+    from tyredamp.modal.poles.estimators import DEFAULT_ESTIMATOR
+    from tyredamp.modal.statistics.stats import FALSE_ALARM
     from tyredamp.signal.estimators import ESTIMATORS
     from tyredamp.studies.steps import damping, frf, lateral_fit, modal
 
@@ -112,7 +112,7 @@ def test_a_refused_file_loads_no_linear_algebra(tmp_path: Path) -> None:
         "    pass"
     )
     mods = _loaded(statement)
-    assert "tyredamp.modal.lscf" not in mods
+    assert "tyredamp.modal.poles.lscf" not in mods
     assert _heavy(mods) == []
     assert not (tmp_path / "m.json").exists()
 

@@ -48,6 +48,21 @@ FLOOR = {name: i for i, names in enumerate(FLOORS) for name in names}
 #: The ground floor's modules form one unit (they import each other freely, without circles).
 GROUND = "ground"
 
+#: Groups of :mod:`tyredamp.modal` from the ground up (the map in its docstring):
+#: a group imports only from lower floors; groups on one floor are independent.
+MODAL_FLOORS: tuple[tuple[str, ...], ...] = (
+    ("statistics",),
+    ("model",),
+    ("problem",),
+    ("poles", "fit"),
+    ("search",),
+    ("pipeline",),
+)
+MODAL_FLOOR = {name: i for i, names in enumerate(MODAL_FLOORS) for name in names}
+#: Modules at the top of :mod:`tyredamp.modal` and their group (the package itself,
+#: ``tyredamp.modal``, is the pipeline's: it names the public API of every group).
+MODAL_TOP = {"model": "model", "identify": "pipeline", "final": "pipeline"}
+
 MAX_FUNCTION_LINES = 120
 MAX_MODULE_LINES = 800
 #: Subpackages exempt from the size limits (none at present).
@@ -161,6 +176,44 @@ def test_no_import_from_a_higher_floor() -> None:
     assert not bad, "imports that go up or sideways:\n" + "\n".join(bad)
 
 
+def _modal_group(module: str) -> str | None:
+    """The group of a module of :mod:`tyredamp.modal` (None outside it): its
+    subpackage, or ``MODAL_TOP``'s entry for a module at the top."""
+    parts = module.split(".")
+    if parts[:2] != ["tyredamp", "modal"]:
+        return None
+    if len(parts) == 2:
+        return "pipeline"
+    return MODAL_TOP.get(parts[2], parts[2])
+
+
+def test_every_modal_module_has_a_group_with_a_floor() -> None:
+    modal = [m for m in _modules() if _modal_group(m) is not None]
+    assert "tyredamp.modal.fit.fit" in modal  # the walk sees the subpackages
+    missing = sorted(m for m in modal if _modal_group(m) not in MODAL_FLOOR)
+    assert not missing, f"modal modules without a group in MODAL_FLOORS/MODAL_TOP: {missing}"
+
+
+def test_modal_groups_import_only_from_lower_floors() -> None:
+    bad = []
+    for e in _graph():
+        sg, tg = _modal_group(e.source), _modal_group(e.target)
+        if sg is None or tg is None or sg == tg:
+            continue
+        if MODAL_FLOOR[tg] >= MODAL_FLOOR[sg]:
+            bad.append(f"{e.source}:{e.line} ({sg}) imports {e.target} ({tg})")
+    assert not bad, "modal imports that go up or sideways:\n" + "\n".join(bad)
+
+
+def test_modal_group_of_a_module() -> None:
+    # the checker itself: subpackage, a top module and the package
+    assert _modal_group("tyredamp.modal.search.narrow") == "search"
+    assert _modal_group("tyredamp.modal.model") == "model"
+    assert _modal_group("tyredamp.modal.identify") == "pipeline"
+    assert _modal_group("tyredamp.modal") == "pipeline"
+    assert _modal_group("tyredamp.lateral.models") is None
+
+
 def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     """Strongly connected components with more than one node (Tarjan)."""
     index: dict[str, int] = {}
@@ -221,8 +274,8 @@ def test_cycle_finder_finds_a_circle() -> None:
 @pytest.mark.parametrize(
     ("module", "is_pkg", "source", "expected"),
     [
-        ("tyredamp.modal.fit", False, "from ..frf import FRF", ["tyredamp.frf"]),
-        ("tyredamp.modal", True, "from .fit import X", ["tyredamp.modal.fit"]),
+        ("tyredamp.modal.fit.fit", False, "from ...frf import FRF", ["tyredamp.frf"]),
+        ("tyredamp.modal", True, "from .fit.fit import X", ["tyredamp.modal.fit.fit"]),
         ("tyredamp.cli.demo", False, "from .. import __version__", ["tyredamp"]),
         ("tyredamp.io", True, "from . import uff", ["tyredamp.io.uff"]),
     ],

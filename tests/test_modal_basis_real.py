@@ -1,4 +1,4 @@
-"""The real-mode basis (modal._basis.basis_real): its derivative columns against
+"""The real-mode basis (modal.fit._basis.basis_real): its derivative columns against
 finite differences."""
 
 from __future__ import annotations
@@ -7,14 +7,14 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from tyredamp.modal import _basis
-from tyredamp.modal.fit import ModalFitter
+from tyredamp.modal.fit import _basis
+from tyredamp.modal.fit.fit import ModalFitter
 
 
 @pytest.mark.parametrize("n_in", [1, 3])
 def test_real_basis_derivatives_match_finite_differences(n_in: int) -> None:
     # D's first two columns per mode are d Phi / d x1 and d Phi / d x2 with
-    # sigma = w_ref exp(x1), Omega = w_ref x2 (modal.fit's parameters); the others
+    # sigma = w_ref exp(x1), Omega = w_ref x2 (modal.fit.fit's parameters); the others
     # are Phi's column of the mode at each free input (participation entries)
     rng = np.random.default_rng(1)
     f = np.linspace(1.0, 200.0, 300)

@@ -8,8 +8,8 @@ from numpy.testing import assert_allclose
 
 from tyredamp.exceptions import InputError
 from tyredamp.mechanics import MCKSystem
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.indicators import mac
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.statistics.indicators import mac
 
 from .helpers import chain_system
 
@@ -254,7 +254,7 @@ def test_derivative_columns_are_scaled_copies_of_the_distinct_columns(
 def test_normal_equations_match_the_explicit_kaufman_formulas(
     kind: str, inputs: list[int], gram: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import tyredamp.modal._linalg as fit_mod
+    import tyredamp.modal.fit._linalg as fit_mod
 
     if not gram:  # every basis "ill-conditioned": the QR route
         monkeypatch.setattr(fit_mod, "_MAX_GRAM_COND", 0.0)

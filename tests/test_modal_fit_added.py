@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from tyredamp.modal.fit import ModalFitter
+from tyredamp.modal.fit.fit import ModalFitter
 
 from .helpers import chain_system
 
@@ -61,7 +61,7 @@ def test_blocks_of_lines_give_the_same_fits(kind: str, monkeypatch: pytest.Monke
     # the Gram blocks, the QR route and the fitted FRFs are summed over blocks of
     # lines (no per-line array of the fits): blocks of a few lines must give the
     # fits of one block (every line at once) to round-off
-    import tyredamp.modal._basis as basis_mod
+    import tyredamp.modal.fit._basis as basis_mod
 
     sys_ = chain_system()
     cm = sys_.complex_modes()
@@ -104,8 +104,8 @@ def test_fit_added_gram_blocks_match_the_explicit_projection(
     # subtraction would lose accuracy; forcing the QR route everywhere must give the
     # same refinement, and its residual is that of a linear fit with all modes at the
     # refined pole
-    import tyredamp.modal._added as added_mod
-    import tyredamp.modal._linalg as lin_mod
+    import tyredamp.modal.fit._added as added_mod
+    import tyredamp.modal.fit._linalg as lin_mod
 
     sys_ = chain_system()
     cm = sys_.complex_modes()
@@ -140,7 +140,7 @@ def test_blocks_with_many_outputs_give_the_same_added_mode(
     # than its columns), the fixed part keeps Q_r of every line and an evaluation
     # forms the added columns of every line at once: the refinement of one block
     # (every line at once) to round-off, with line weights and one or two inputs
-    import tyredamp.modal._basis as basis_mod
+    import tyredamp.modal.fit._basis as basis_mod
 
     sys_ = chain_system(n=12)
     cm = sys_.complex_modes()
@@ -179,7 +179,7 @@ def test_fixed_basis_of_one_block_kept_with_more_columns_than_outputs(
     # two outputs) but no larger than one block of the fits: Q_r of every line is
     # kept and the added columns formed at once; the refinement of one block to
     # round-off, and the fixed basis is not formed again per evaluation
-    import tyredamp.modal._basis as basis_mod
+    import tyredamp.modal.fit._basis as basis_mod
 
     sys_ = chain_system()
     cm = sys_.complex_modes()
@@ -222,7 +222,7 @@ def test_residual_blocks_against_the_modal_sum() -> None:
     # lower] and the columns a + b, i (a - b), kappa, kappa_low) against the modal sum
     # sum_n R_n kappa / (s - p_n) + conj(R_n) kappa / (s - conj p_n) + upper kappa +
     # lower kappa / (i w)^2 written out, line weights applied
-    import tyredamp.modal._basis as basis_mod
+    import tyredamp.modal.fit._basis as basis_mod
 
     sys_ = chain_system()
     cm = sys_.complex_modes()

@@ -13,9 +13,9 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from tyredamp.exceptions import InputError
-from tyredamp.modal import _basis
-from tyredamp.modal._linalg import _levenberg_marquardt, at_rest
-from tyredamp.modal.fit import ModalFitter
+from tyredamp.modal.fit import _basis
+from tyredamp.modal.fit._linalg import _levenberg_marquardt, at_rest
+from tyredamp.modal.fit.fit import ModalFitter
 
 from .helpers import chain_system
 
@@ -224,7 +224,7 @@ def test_ill_conditioned_basis_by_cholesky_qr(
     # Householder QR is taken
     from scipy.linalg import lapack
 
-    import tyredamp.modal._linalg as lin
+    import tyredamp.modal.fit._linalg as lin
 
     sys_ = chain_system()
     cm = sys_.complex_modes()
@@ -333,7 +333,7 @@ def test_basis_times_data_from_the_complex_data(kind: str) -> None:
 def test_the_search_forms_one_fixed_part_per_mode_set() -> None:
     # FixedParts (owned by the caller of the search stages): the same mode set gives
     # the same value, another mode set a new one, equal to the fitter's fixed_part
-    from tyredamp.modal.search import FixedParts
+    from tyredamp.modal.search.search import FixedParts
 
     _, h, fixed, _, _ = _case("complex")
     fit = _fitter(h)
@@ -357,7 +357,7 @@ def test_fixed_range_of_an_ill_conditioned_basis_in_blocks(
     # CholeskyQR2, then its shifted start) held in three row blocks; reference: the
     # projector from numpy's SVD of Phi. Q_r^T X = T^T Phi^T X must be orthonormal
     # coordinates of the range, ||P Y||^2 the residual power, and no Householder QR
-    import tyredamp.modal._linalg as lin
+    import tyredamp.modal.fit._linalg as lin
 
     rng = np.random.default_rng(3)
     n, q = 600, 12

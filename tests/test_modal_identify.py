@@ -10,7 +10,7 @@ from tyredamp.exceptions import InputError
 from tyredamp.frf import FRF, Channel
 from tyredamp.mechanics import MCKSystem
 from tyredamp.modal.identify import identify_modes
-from tyredamp.modal.indicators import mac, relative_error, rmsd
+from tyredamp.modal.statistics.indicators import mac, relative_error, rmsd
 
 F = np.arange(0.25, 200.01, 0.25)
 N_RING = 32
@@ -204,7 +204,7 @@ def test_virtual_tyre_default() -> None:
 
 def test_many_outputs_use_compressed_search_and_full_final_fit() -> None:
     from tyredamp.mechanics import modal_sum_receptance, pole_from_frequency_damping
-    from tyredamp.modal.fit import ModalFitter, compress_outputs
+    from tyredamp.modal.fit.fit import ModalFitter, compress_outputs
 
     rng = np.random.default_rng(7)
     f = np.linspace(0.5, 100.0, 400)
@@ -284,7 +284,7 @@ def test_automatic_order_resolves_a_band_full_of_modes() -> None:
 def test_automatic_order_trial_that_finds_nothing_keeps_the_diagram(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    import tyredamp.modal.order as ident
+    import tyredamp.modal.poles.order as ident
 
     frf = ring_frf(ring_system(), [0], seed=1)
     ref = identify_modes(frf, band=(0.0, 200.0), model="complex")

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from tyredamp.exceptions import ShapeError
-from tyredamp.modal.indicators import (
+from tyredamp.modal.statistics.indicators import (
     auto_mac,
     discrepancy,
     equivalent_real_modes,

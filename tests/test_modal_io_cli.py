@@ -14,7 +14,7 @@ from tyredamp.documents.modes import modes_document, read_modes_json, write_mode
 from tyredamp.exceptions import FileFormatError, InputError
 from tyredamp.io import write_frf
 from tyredamp.modal.model import ModalModel
-from tyredamp.modal.quality import short_reason, strongest_rejected
+from tyredamp.modal.statistics.quality import short_reason, strongest_rejected
 
 from .helpers import chain_system
 

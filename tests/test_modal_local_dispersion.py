@@ -18,9 +18,9 @@ from numpy.testing import assert_allclose
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
 from tyredamp.modal.final import local_dispersion
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.problem import build_problem
-from tyredamp.modal.residual_peaks import LOCAL_HALF, LOCAL_LINES
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.problem.problem import build_problem
+from tyredamp.modal.search.residual_peaks import LOCAL_HALF, LOCAL_LINES
 
 F = np.arange(5.0, 60.0, 0.02)
 BAND = (8.0, 55.0)

@@ -7,9 +7,9 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from tyredamp.exceptions import InputError, ShapeError
-from tyredamp.modal.indicators import mac
-from tyredamp.modal.lscf import PoleSet, plscf
-from tyredamp.modal.selection import StabilityFlags, cluster_poles, stability_flags
+from tyredamp.modal.poles.lscf import PoleSet, plscf
+from tyredamp.modal.poles.selection import StabilityFlags, cluster_poles, stability_flags
+from tyredamp.modal.statistics.indicators import mac
 
 from .helpers import chain_system
 
@@ -197,7 +197,7 @@ def _one_linkage(ps: PoleSet, flags: StabilityFlags, cut: float = 0.01) -> list[
     from scipy.cluster.hierarchy import fcluster, linkage
     from scipy.spatial.distance import squareform
 
-    from tyredamp.modal.selection import _repeated_slots
+    from tyredamp.modal.poles.selection import _repeated_slots
 
     idx = np.flatnonzero(flags.stable)
     p, lv, od = ps.poles[idx], ps.participation[idx], ps.order[idx]
@@ -276,7 +276,7 @@ def test_clusters_of_a_dense_pole_cloud_equal_one_complete_linkage(n_in: int) ->
 
 
 def test_threshold_edges_hold_every_pair_within_the_cut() -> None:
-    from tyredamp.modal.selection import _threshold_edges
+    from tyredamp.modal.poles.selection import _threshold_edges
 
     # clumps of poles all around the circle (arg p wraps at -pi/pi) over a decade of |p|
     rng = np.random.default_rng(4)
@@ -299,7 +299,7 @@ def test_threshold_edges_hold_every_pair_within_the_cut() -> None:
 
 
 def test_aberth_roots_equal_companion_eigenvalues() -> None:
-    from tyredamp.modal.lscf import _aberth
+    from tyredamp.modal.poles.lscf import _aberth
 
     rng = np.random.default_rng(4)
     # roots near the unit circle (poles), a few far inside and outside, real pairs
@@ -324,7 +324,7 @@ def test_aberth_roots_equal_companion_eigenvalues() -> None:
 
 
 def test_plscf_aberth_orders_equal_eigenvalue_orders(monkeypatch: pytest.MonkeyPatch) -> None:
-    import tyredamp.modal.lscf as lscf_mod
+    import tyredamp.modal.poles.lscf as lscf_mod
 
     rng = np.random.default_rng(6)
     h = chain_system().frf(F, inputs=[0]).H
@@ -341,7 +341,7 @@ def test_plscf_aberth_orders_equal_eigenvalue_orders(monkeypatch: pytest.MonkeyP
 
 
 def test_companion_eigvals_equal_numpy_eigvals_of_the_companion() -> None:
-    from tyredamp.modal.lscf import _companion, _companion_eigvals
+    from tyredamp.modal.poles.lscf import _companion, _companion_eigvals
 
     rng = np.random.default_rng(11)
     # one input: the roots of a polynomial built from known roots (closed form)
@@ -363,7 +363,7 @@ def test_companion_eigvals_equal_numpy_eigvals_of_the_companion() -> None:
 
 
 def test_aberth_any_degree_equals_companion_eigenvalues() -> None:
-    from tyredamp.modal.lscf import _aberth, _companion
+    from tyredamp.modal.poles.lscf import _aberth, _companion
 
     rng = np.random.default_rng(12)
     # degrees at and around the block lengths of the evaluation (b = isqrt(n) + 1).
@@ -385,7 +385,7 @@ def test_aberth_any_degree_equals_companion_eigenvalues() -> None:
 
 
 def test_unit_powers_equal_cosine_and_sine() -> None:
-    from tyredamp.modal.lscf import _unit_powers
+    from tyredamp.modal.poles.lscf import _unit_powers
 
     theta = np.linspace(0.0, np.pi, 333)
     eps = np.finfo(float).eps
@@ -404,7 +404,7 @@ def test_unit_powers_equal_cosine_and_sine() -> None:
 
 
 def test_plscf_cholesky_fallback_gives_the_same_poles(monkeypatch: pytest.MonkeyPatch) -> None:
-    import tyredamp.modal.lscf as lscf_mod
+    import tyredamp.modal.poles.lscf as lscf_mod
 
     rng = np.random.default_rng(13)
     h = chain_system().frf(F, inputs=[0, 3]).H

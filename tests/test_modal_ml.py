@@ -1,4 +1,4 @@
-"""Maximum-likelihood refinement with the per-line variance (modal.ml) against an
+"""Maximum-likelihood refinement with the per-line variance (modal.fit.ml) against an
 independent full least-squares fit, its Fisher standard errors, and the choice
 of weights (modal.final.full_weights)."""
 
@@ -12,9 +12,9 @@ from scipy.optimize import least_squares
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
 from tyredamp.modal.final import full_weights
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.ml import fisher_scale, line_weights_full, ml_refine
-from tyredamp.modal.problem import build_problem, line_factor_dof
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.fit.ml import fisher_scale, line_weights_full, ml_refine
+from tyredamp.modal.problem.problem import build_problem, line_factor_dof
 
 F = np.linspace(5.0, 50.0, 400)
 FN = np.array([15.0, 16.0, 30.0])
@@ -137,7 +137,7 @@ def test_identify_uses_the_full_variance_when_known() -> None:
     # one level per output, below the noise of the strong lines (it varies 35-fold
     # along the axis), so the fit leaves structure, and the identification is
     # repeated against that level plus a noise proportional to the response
-    # (modal.model_error): a per-line variance, so the ML stage runs on it, and the
+    # (modal.problem.model_error): a per-line variance, so the ML stage runs on it, and the
     # verdict names it; the modes stay those of the known variance
     r0 = identify_modes(frf, model="complex")
     m0 = r0.models["complex"]
@@ -171,7 +171,7 @@ def test_projection_matches_least_squares(scale: float) -> None:
     # column nearly repeats the first (condition ~1e9, beyond the Gram limit: the QR
     # route): fitted values as lstsq's, and Q^T of an orthonormal basis Q of the
     # range: R = Q^T pw has R^T R = pw^T pw and R^T Q^T X = pw^T X
-    from tyredamp.modal.ml import _projection
+    from tyredamp.modal.fit.ml import _projection
 
     rng = np.random.default_rng(3)
     pw = rng.normal(size=(400, 6))
@@ -196,7 +196,7 @@ def test_evaluate_gram_route_matches_the_qr_route(monkeypatch: pytest.MonkeyPatc
     # output's weighted [Phi | E] (Schur complement) against the Householder-QR route
     # (taken when the Gram route is refused) and against J formed explicitly by
     # central differences of the projected residual
-    from tyredamp.modal import ml
+    from tyredamp.modal.fit import ml
 
     h, v, pi, _ = _data(2)
     fit = ModalFitter(F, h, 0, "complex", [], upper=True, lower=True)

@@ -1,4 +1,4 @@
-"""The noise level that includes model error (tyredamp.modal.model_error)."""
+"""The noise level that includes model error (tyredamp.modal.problem.model_error)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from numpy.testing import assert_allclose
 
 from tyredamp.frf import FRF, Channel
 from tyredamp.modal import identify_modes
-from tyredamp.modal.model_error import relative_model_error
-from tyredamp.modal.narrow import unresolved_damping
+from tyredamp.modal.problem.model_error import relative_model_error
+from tyredamp.modal.search.narrow import unresolved_damping
 
 REAL = Path(__file__).resolve().parents[2] / "shared" / "real-data"
 BEAM = REAL / "ladisk_pyuff" / "data"
@@ -104,7 +104,7 @@ def test_measured_beam_modes_are_not_split(k: int, band: tuple[float, float] | N
 @pytest.mark.parametrize(("k", "band"), [(2, (10.0, 985.0)), (3, (5.0, 1000.0))])
 def test_no_pole_within_one_line_of_a_ringing_beam_mode(k: int, band: tuple[float, float]) -> None:
     # bands where a pole beside the ringing 142, 687 or 958 Hz mode (within one line
-    # of it) was reported as a second mode (tyredamp.modal.resolution); the 901 Hz
+    # of it) was reported as a second mode (tyredamp.modal.search.resolution); the 901 Hz
     # step of points 2 and 3 is not counted here
     r = identify_modes(_beam(k), band=band, model="complex")
     fn = r.models["complex"].frequency_hz
@@ -113,5 +113,5 @@ def test_no_pole_within_one_line_of_a_ringing_beam_mode(k: int, band: tuple[floa
         assert near.size == 1, (f0, fn)
         assert abs(near[0] / f0 - 1) < 5e-4 + 0.05 / f0  # the peer's values carry 0.05 Hz
     # a pole that close is refused where it arises: by the search (a trial narrower
-    # than the lines within one line of a mode, tyredamp.modal.narrow) or by the
-    # final fit (tyredamp.modal.resolution)
+    # than the lines within one line of a mode, tyredamp.modal.search.narrow) or by the
+    # final fit (tyredamp.modal.search.resolution)

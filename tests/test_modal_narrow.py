@@ -12,9 +12,9 @@ from dataclasses import replace
 import numpy as np
 
 from tyredamp.modal import ModalModel
-from tyredamp.modal.fit import FitResult, ModalFitter
-from tyredamp.modal.narrow import at_the_end, narrow_evidence, narrow_refusal, too_narrow
-from tyredamp.modal.stats import mode_parameters, mode_threshold
+from tyredamp.modal.fit.fit import FitResult, ModalFitter
+from tyredamp.modal.search.narrow import at_the_end, narrow_evidence, narrow_refusal, too_narrow
+from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
 F = np.arange(10.0, 200.0, 1.0)  # 1 Hz lines
 SD = 1e-6  # noise per real part, in the units of H

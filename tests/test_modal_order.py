@@ -9,11 +9,11 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
-from tyredamp.modal._linalg import _fixed_range, _qr_blocks
-from tyredamp.modal.estimators import PoleEstimator
-from tyredamp.modal.lscf import PoleSet
-from tyredamp.modal.order import modes_shown, order_cap
-from tyredamp.modal.problem import build_problem
+from tyredamp.modal.fit._linalg import _fixed_range, _qr_blocks
+from tyredamp.modal.poles.estimators import PoleEstimator
+from tyredamp.modal.poles.lscf import PoleSet
+from tyredamp.modal.poles.order import modes_shown, order_cap
+from tyredamp.modal.problem.problem import build_problem
 
 FN = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0])
 ZETA = np.array([0.03, 0.02, 0.02, 0.015, 0.012, 0.01])
@@ -150,7 +150,7 @@ def test_no_stable_mode_at_the_cap_raises_the_order_up_to_escalate_times_it(
     system of 37 modes failed with "no stable mode up to order 20"), up to
     ESCALATE times the cap: pure noise of 3 inputs x 900 lines ran to the line
     limit (order 448, minutes of companion eigenvalues for no mode)."""
-    import tyredamp.modal.order as order
+    import tyredamp.modal.poles.order as order
 
     pr = build_problem(_six_modes(2001), (20.0, 190.0))
     w = 2 * np.pi * FN
@@ -180,7 +180,7 @@ def test_without_a_persistent_cluster_the_mode_test_decides(
     # orders of many inputs, noisy data) starts from its most persistent cluster;
     # the residual search adds the others that pass the test (it raised "no
     # stable mode found" on a 20 dB band of 4 inputs holding two strong modes)
-    import tyredamp.modal.order as order
+    import tyredamp.modal.poles.order as order
 
     real = order.cluster_poles
 
@@ -216,7 +216,7 @@ def test_prominent_peaks_are_those_of_scipy_find_peaks() -> None:
     # next float up), on noise, random walks and rounded values (plateaus)
     from scipy.signal import find_peaks
 
-    from tyredamp.modal.order import prominent_peaks
+    from tyredamp.modal.poles.order import prominent_peaks
 
     rng = np.random.default_rng(0)
     for trial in range(600):

@@ -1,4 +1,4 @@
-"""Likelihood intervals of f and zeta (modal.profile): the linearised interval in
+"""Likelihood intervals of f and zeta (modal.fit.profile): the linearised interval in
 the linear limit, the likelihood-ratio cut at their ends (checked against an
 independent profile of a hand-written model), the rule of which modes are
 profiled, and the intervals in the identified model and its JSON."""
@@ -14,8 +14,8 @@ from scipy.optimize import least_squares
 from tyredamp.cli.modal import modes_table
 from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
-from tyredamp.modal import profile as prof
-from tyredamp.modal.fit import ModalFitter, pole_bounds
+from tyredamp.modal.fit import profile as prof
+from tyredamp.modal.fit.fit import ModalFitter, pole_bounds
 from tyredamp.modal.model import ModalModel
 
 F = np.arange(40.0, 60.0, 0.075)

@@ -12,7 +12,7 @@ from scipy import stats as sps
 
 from tyredamp.modal import identify_modes
 from tyredamp.modal.model import ModalModel
-from tyredamp.modal.stats import (
+from tyredamp.modal.statistics.stats import (
     mode_null_isf,
     mode_null_sf,
     mode_parameters,

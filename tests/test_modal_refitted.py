@@ -1,4 +1,4 @@
-"""The mode statistic with the neighbours' poles refitted (modal.refitted): a
+"""The mode statistic with the neighbours' poles refitted (modal.search.refitted): a
 second pole beside a strong mode passes with the other poles held but not as
 the likelihood ratio of the maximised models; a true weak neighbour passes
 both; separated modes are not refitted."""
@@ -8,11 +8,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tyredamp.modal.fit import FitResult, ModalFitter
+from tyredamp.modal.fit.fit import FitResult, ModalFitter
 from tyredamp.modal.model import ModalModel
-from tyredamp.modal.refitted import OVERLAP, refit_candidates, refitted_statistics
-from tyredamp.modal.search import ModeSet
-from tyredamp.modal.stats import mode_parameters, mode_threshold
+from tyredamp.modal.search.refitted import OVERLAP, refit_candidates, refitted_statistics
+from tyredamp.modal.search.search import ModeSet
+from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
 F = np.arange(60.0, 140.0, 0.1)
 P_STRONG = -0.02 * 2 * np.pi * 100 + 2j * np.pi * 100

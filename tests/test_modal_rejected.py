@@ -15,8 +15,8 @@ import warnings
 import numpy as np
 
 from tyredamp.modal import identify_modes
-from tyredamp.modal.quality import KEPT, RejectedMode, merge_rejected
-from tyredamp.modal.search_starts import MAX_TRIALS
+from tyredamp.modal.search.search_starts import MAX_TRIALS
+from tyredamp.modal.statistics.quality import KEPT, RejectedMode, merge_rejected
 
 from .test_modal_search import BAND, _dense_band
 from .test_modal_statistics import F, noisy, weak_beside_strong

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from tyredamp.modal import ModalModel, identify_modes
-from tyredamp.modal.lscf import PoleSet
-from tyredamp.modal.selection import cluster_poles, same_place_distinct, stability_flags
+from tyredamp.modal.poles.lscf import PoleSet
+from tyredamp.modal.poles.selection import cluster_poles, same_place_distinct, stability_flags
 
 
 def _repeated_system(n_in: int, seed: int) -> ModalModel:
@@ -112,10 +112,10 @@ def test_residual_search_adds_the_second_mode_of_a_repeated_root() -> None:
     # the second mode of a root holds its own participation: its residual is not
     # in the span of the first's column, and a trial mode near the first's pole
     # takes it; the joint refit keeps both (different participation: no merge)
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.search import ModeSet, fit_checked, residual_search
-    from tyredamp.modal.stats import mode_parameters, mode_threshold
+    from tyredamp.modal.fit.fit import ModalFitter
+    from tyredamp.modal.problem.problem import build_problem
+    from tyredamp.modal.search.search import ModeSet, fit_checked, residual_search
+    from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
     mdl = _repeated_system(2, 9)
     frf = mdl.frf(np.linspace(5.0, 220.0, 1500), "receptance")

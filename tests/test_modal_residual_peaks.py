@@ -1,5 +1,5 @@
 """Where the residual search looks for missed modes (issue 16):
-``modal.residual_peaks``.
+``modal.search.residual_peaks``.
 
 * the residual power's noise mean from its median (chi-square scaling);
 * broad structure that no 5-line window shows is found by the matched windows;
@@ -25,10 +25,10 @@ from scipy import stats as sps
 
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel
-from tyredamp.modal._basis import factors
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.problem import build_problem
-from tyredamp.modal.residual_peaks import (
+from tyredamp.modal.fit._basis import factors
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.problem.problem import build_problem
+from tyredamp.modal.search.residual_peaks import (
     SCAN_HALF,
     _off_fitted,
     _rank_one_off_fitted,

@@ -1,11 +1,11 @@
-"""Two poles the lines cannot tell apart (tyredamp.modal.resolution)."""
+"""Two poles the lines cannot tell apart (tyredamp.modal.search.resolution)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from tyredamp.mechanics.modal_sum import pole_from_frequency_damping
-from tyredamp.modal.resolution import unresolved_pair, unresolved_pair_text
+from tyredamp.modal.search.resolution import unresolved_pair, unresolved_pair_text
 
 
 def _poles(fn: list[float], zeta: list[float]) -> np.ndarray:

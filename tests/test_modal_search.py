@@ -16,9 +16,9 @@ import pytest
 
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.problem import build_problem
-from tyredamp.modal.stats import mode_parameters, mode_threshold
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.problem.problem import build_problem
+from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
 BAND = (22.0, 98.0)
 

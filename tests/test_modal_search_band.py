@@ -14,7 +14,7 @@ import pytest
 
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, identify_modes
-from tyredamp.modal.search import MERGE
+from tyredamp.modal.search.search import MERGE
 
 FN = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0])
 ZETA = np.array([0.03, 0.02, 0.02, 0.015, 0.012, 0.01])
@@ -104,9 +104,9 @@ def test_a_joint_refit_that_loses_every_mode_leaves_the_search_going() -> None:
     # dragged out of the band by the joint refit: the mode test goes on from the
     # residues at the current poles (it raised "every mode crossed the band edge",
     # and so did a few modes of a band that holds many)
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.search import ModeSet, reject_by_test
+    from tyredamp.modal.fit.fit import ModalFitter
+    from tyredamp.modal.problem.problem import build_problem
+    from tyredamp.modal.search.search import ModeSet, reject_by_test
 
     w = 2 * np.pi * 97.0
     p = complex(-0.02 * w, w * np.sqrt(1 - 0.02**2))
@@ -179,10 +179,10 @@ def test_a_residual_mode_starts_where_the_residual_asks_for_it(f_out: float) -> 
     at ``f_out`` above it, noise-free. The out-of-band search holds it with a residual
     mode at its pole wherever it lies within a factor 2 of the edge, and the start
     just beyond the edge lies within 5 % of the mode there."""
-    from tyredamp.modal.fit import ModalFitter
-    from tyredamp.modal.out_of_band import _scan_start, search_helpers
-    from tyredamp.modal.problem import build_problem
-    from tyredamp.modal.search import ModeSet
+    from tyredamp.modal.fit.fit import ModalFitter
+    from tyredamp.modal.problem.problem import build_problem
+    from tyredamp.modal.search.out_of_band import _scan_start, search_helpers
+    from tyredamp.modal.search.search import ModeSet
 
     fn, zeta = np.array([480.0, f_out]), np.array([0.01, 0.01])
     w = 2 * np.pi * fn

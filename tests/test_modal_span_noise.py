@@ -1,4 +1,4 @@
-"""Noise along the response (modal.span_noise) and the mode threshold it raises
+"""Noise along the response (modal.search.span_noise) and the mode threshold it raises
 (stats.span_threshold, search.local_thresholds)."""
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy import stats as sps
 
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.search import ModeTest, local_thresholds
-from tyredamp.modal.span_noise import WINDOW, span_noise
-from tyredamp.modal.stats import mode_parameters, mode_threshold, span_threshold
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.search.search import ModeTest, local_thresholds
+from tyredamp.modal.search.span_noise import WINDOW, span_noise
+from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold, span_threshold
 
 from .helpers import chain_system
 
@@ -96,7 +96,7 @@ def test_white_noise_as_large_as_the_response_is_not_taken_for_noise_along_it() 
 
 
 def _residual(fit: ModalFitter, res: Any, r: np.ndarray) -> np.ndarray:
-    from tyredamp.modal import _basis
+    from tyredamp.modal.fit import _basis
 
     blocks = _basis.residual_blocks(fit, res.poles, r, (res.upper, res.lower))
     return np.concatenate([blk for _, blk in blocks], axis=2)
@@ -177,7 +177,7 @@ def test_one_input_split_equals_the_qr_projection() -> None:
     # with one input the in-span power is |u^H e|^2 / ||u||^2 (no QR): the same as
     # the projection on the QR basis of the column, to round-off; a line where the
     # data vanish takes the QR route (its basis is some unit vector)
-    from tyredamp.modal.span_noise import _split
+    from tyredamp.modal.search.span_noise import _split
 
     rng = np.random.default_rng(11)
     n_out, n_f = 7, 50

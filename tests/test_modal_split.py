@@ -15,11 +15,11 @@ from numpy.testing import assert_allclose
 
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel
-from tyredamp.modal.fit import FitResult, ModalFitter
-from tyredamp.modal.problem import build_problem
-from tyredamp.modal.residual_peaks import power_of
-from tyredamp.modal.search import ModeSet, ModeTest, _split
-from tyredamp.modal.stats import mode_parameters, mode_threshold
+from tyredamp.modal.fit.fit import FitResult, ModalFitter
+from tyredamp.modal.problem.problem import build_problem
+from tyredamp.modal.search.residual_peaks import power_of
+from tyredamp.modal.search.search import ModeSet, ModeTest, _split
+from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
 F_TRUE = np.array([20.0, 41.0, 41.5, 80.0])
 
@@ -71,7 +71,7 @@ def test_a_complete_fit_tries_no_pair() -> None:
 def test_a_trial_is_followed_beyond_its_window_to_the_mode() -> None:
     """A trial started 5 % above a missed mode stops at its ±3 % window; followed
     (``search._follow``) it reaches the mode, unless it would run onto a fitted one."""
-    from tyredamp.modal.search import FOLLOW, TRIAL_SPAN, FixedParts, _follow, _trial
+    from tyredamp.modal.search.search import FOLLOW, TRIAL_SPAN, FixedParts, _follow, _trial
 
     fit, p, band, _, _ = _setup()
     keep = np.array([0, 1, 3])  # 41.5 Hz missed; its neighbour at 41.0 is fitted

@@ -13,13 +13,13 @@ from tyredamp.damping import identify_damping
 from tyredamp.exceptions import InputError
 from tyredamp.frf import FRF, Channel
 from tyredamp.modal import ModalModel, identify_modes
-from tyredamp.modal.estimators import PoleEstimator
 from tyredamp.modal.final import goodness
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.lscf import PoleSet
-from tyredamp.modal.problem import build_problem, line_factor_dof
-from tyredamp.modal.quality import FitQuality
-from tyredamp.modal.stats import (
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.poles.estimators import PoleEstimator
+from tyredamp.modal.poles.lscf import PoleSet
+from tyredamp.modal.problem.problem import build_problem, line_factor_dof
+from tyredamp.modal.statistics.quality import FitQuality
+from tyredamp.modal.statistics.stats import (
     GoodnessOfFit,
     cost_reference,
     difference_noise,

@@ -21,7 +21,7 @@ from tyredamp.frf import FRF
 from tyredamp.io import write_frf
 from tyredamp.modal.identify import identify_modes
 from tyredamp.modal.model import ModalModel
-from tyredamp.modal.quality import FitQuality
+from tyredamp.modal.statistics.quality import FitQuality
 
 from .test_modal_span_noise import INPUTS, F, _data
 

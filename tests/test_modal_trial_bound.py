@@ -1,4 +1,4 @@
-"""The damping bound of the residual search's trials (modal.search.sigma_bound and
+"""The damping bound of the residual search's trials (modal.search.search.sigma_bound and
 ModalFitter.fit_added(sigma_max=...))."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ import numpy as np
 from numpy.testing import assert_allclose
 
 from tyredamp.mechanics.modal_sum import pole_from_frequency_damping
-from tyredamp.modal.fit import ModalFitter
-from tyredamp.modal.search import sigma_bound
+from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.search.search import sigma_bound
 
 from .helpers import chain_system
 

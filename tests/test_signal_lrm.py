@@ -7,7 +7,7 @@ import pytest
 import scipy.signal
 
 from tyredamp import InputError
-from tyredamp.modal.problem import build_problem
+from tyredamp.modal.problem.problem import build_problem
 from tyredamp.signal import estimate_frf
 from tyredamp.signal.lrm import local_frf, local_variance_dof
 from tyredamp.timedata import Acquisition, TimeData

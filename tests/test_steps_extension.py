@@ -28,8 +28,8 @@ from tyredamp.cli._settings import settings_from_options, settings_options
 from tyredamp.exceptions import InputError
 from tyredamp.frf import FRF
 from tyredamp.io import read_frf, write_frf
-from tyredamp.modal.estimators import ESTIMATORS
-from tyredamp.modal.lscf import PoleSet, plscf
+from tyredamp.modal.poles.estimators import ESTIMATORS
+from tyredamp.modal.poles.lscf import PoleSet, plscf
 from tyredamp.studies.registry import STEPS, STUDIES, Study
 from tyredamp.studies.steps import Integer, StepSettings, knob
 

@@ -29,8 +29,8 @@ from tyredamp.campaign.steps import (
 from tyredamp.cli import cli
 from tyredamp.cli._settings import option_param, settings_from_options
 from tyredamp.exceptions import InputError
-from tyredamp.modal.estimators import ESTIMATORS
-from tyredamp.modal.lscf import plscf
+from tyredamp.modal.poles.estimators import ESTIMATORS
+from tyredamp.modal.poles.lscf import plscf
 from tyredamp.studies.registry import STEPS, STUDIES, settings_class
 from tyredamp.studies.steps import (
     Band,
@@ -228,7 +228,7 @@ def test_false_alarm_reaches_the_automatic_order(monkeypatch: pytest.MonkeyPatch
     which caps the automatic order (it used to stay at the default rate there)."""
     import numpy as np
 
-    from tyredamp.modal import order
+    from tyredamp.modal.poles import order
     from tyredamp.studies.steps import ModalSettings, ModalStep
 
     from .helpers import chain_system

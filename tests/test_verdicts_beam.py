@@ -16,7 +16,7 @@ import pytest
 from tyredamp.cli import main
 from tyredamp.frf import FRF
 from tyredamp.io import write_frf
-from tyredamp.modal.quality import RejectedMode, rejected_summary, short_reason
+from tyredamp.modal.statistics.quality import RejectedMode, rejected_summary, short_reason
 
 
 def real_data() -> Path:

@@ -9,7 +9,7 @@ import click
 import numpy as np
 
 from ..exceptions import InputError
-from ..modal.quality import rejected_summary
+from ..modal.statistics.quality import rejected_summary
 from ..studies.steps import ModalSettings, ModalStep
 from ._common import channel_map, channel_map_options, out_file_option
 from ._settings import settings_from_options, settings_options
@@ -75,7 +75,7 @@ def modes_table(name: str, model: ModalModel) -> list[str]:
 
 def _likelihood_rows(model: ModalModel) -> list[str]:
     """The 95 % likelihood intervals of the modes that have one (a weak mode, whose
-    linearised interval would be too short; :mod:`tyredamp.modal.profile`): the
+    linearised interval would be too short; :mod:`tyredamp.modal.fit.profile`): the
     +- columns hold the half-width of the symmetric interval around them."""
     how = model.meta.get("interval_method")
     fi, zi = model.meta.get("interval_frequency_hz"), model.meta.get("interval_damping_ratio")

@@ -5,9 +5,55 @@ The usual entry point is :func:`identify_modes` (FRFs in, real and complex
 stages are public too: :func:`build_problem` (band cut, normalisation, noise
 model), a :class:`PoleEstimator` (default :func:`plscf`, poles over model
 orders), :func:`stability_flags` and :func:`cluster_poles` (automatic
-selection), :mod:`.search` (mode test, residual search), :class:`ModalFitter`
-(LSFD and variable-projection refinement), :mod:`.stats` and
-:mod:`.indicators`. The modes JSON file is :mod:`tyredamp.documents.modes`.
+selection), :mod:`.search.search` (mode test, residual search),
+:class:`ModalFitter` (LSFD and variable-projection refinement),
+:mod:`.statistics.stats` and :mod:`.statistics.indicators`. The modes JSON file
+is :mod:`tyredamp.documents.modes`.
+
+Map of the package (one group per step of the method; a group imports only
+from the groups below it; the layering test of the package enforces it):
+
+``identify.py``, ``final.py`` (top)
+    The pipeline: :func:`identify_modes` runs the steps below in order and
+    ``final`` turns the last fit into a :class:`ModalModel` with its quality
+    (maximum-likelihood stage, intervals, goodness of fit).
+``search/``
+    Which modes the data hold: the mode test and the residual search on one
+    fitter (``search``), its mode set (``modeset``), out-of-band residual
+    modes (``out_of_band``), where trials start (``search_starts``,
+    ``residual_peaks``), each mode's threshold (``thresholds``,
+    ``span_noise``), poles narrower than the lines (``narrow``,
+    ``resolution``) and the statistic with the neighbours refitted
+    (``refitted``). Its own group because it decides the mode count from
+    fits: it uses the fitter and the diagram's poles, neither uses it.
+``poles/`` and ``fit/`` (side by side, independent of each other)
+    ``poles/``: the stabilisation diagram, from the FRFs to candidate poles
+    without residues: pLSCF (``lscf``), the estimator protocol and registry
+    (``estimators``), stability flags and clusters (``selection``), the model
+    order (``order``). ``fit/``: residues and poles fitted to the FRFs for a
+    given set of modes: :class:`ModalFitter` (``fit``) with its basis,
+    linear algebra, scaling and added-mode projection (``_basis``,
+    ``_linalg``, ``_scaling``, ``_added``, ``_state``), the
+    maximum-likelihood refinement (``ml``) and likelihood intervals
+    (``profile``). A diagram never fits residues and a fit never builds a
+    diagram: the two methods split here.
+``problem/``
+    The data as the fits see them: the band-limited, normalised FRFs and their
+    noise model (``problem``), principal combinations of many outputs
+    (``compress``) and the noise level raised by the model error
+    (``model_error``, which reads a :class:`ModalModel`).
+``model.py``
+    The result: :class:`ModalModel` (poles and mode shapes that synthesise
+    FRFs), light to import (the command line and the modes file load it
+    without the identification).
+``statistics/`` (ground)
+    How a fit is judged, on plain arrays: the mode test, noise estimates and
+    goodness of fit (``stats``), MAC, MPC and the fit indicators
+    (``indicators``) and the fit-quality record (``quality``). Imports nothing
+    else of the package.
+
+The subpackages' ``__init__`` modules hold only their docstring (nothing is
+imported with them), so a deep import loads only what it names.
 """
 
 from __future__ import annotations
@@ -16,10 +62,14 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from .estimators import PoleEstimator
-    from .fit import FitResult, ModalFitter
+    from .fit.fit import FitResult, ModalFitter
     from .identify import ModalIdentification, identify_modes
-    from .indicators import (
+    from .model import ModalModel, ModeKind
+    from .poles.estimators import PoleEstimator
+    from .poles.lscf import PoleSet, plscf
+    from .poles.selection import Cluster, StabilityFlags, cluster_poles, stability_flags
+    from .problem.problem import FitProblem, build_problem
+    from .statistics.indicators import (
         auto_mac,
         discrepancy,
         equivalent_real_modes,
@@ -29,41 +79,37 @@ if TYPE_CHECKING:
         relative_error,
         rmsd,
     )
-    from .lscf import PoleSet, plscf
-    from .model import ModalModel, ModeKind
-    from .problem import FitProblem, build_problem
-    from .quality import FitQuality, RejectedMode
-    from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
+    from .statistics.quality import FitQuality, RejectedMode
 
 #: public name -> submodule; a name is imported on first access (PEP 562), so that
 #: ``import tyredamp.modal.model`` (the command line, the modes file) does not load
 #: the identification and SciPy's optimisers
 _WHERE = {
-    "Cluster": "selection",
-    "FitProblem": "problem",
-    "FitQuality": "quality",
-    "FitResult": "fit",
-    "ModalFitter": "fit",
+    "Cluster": "poles.selection",
+    "FitProblem": "problem.problem",
+    "FitQuality": "statistics.quality",
+    "FitResult": "fit.fit",
+    "ModalFitter": "fit.fit",
     "ModalIdentification": "identify",
     "ModalModel": "model",
     "ModeKind": "model",
-    "PoleEstimator": "estimators",
-    "PoleSet": "lscf",
-    "RejectedMode": "quality",
-    "StabilityFlags": "selection",
-    "auto_mac": "indicators",
-    "build_problem": "problem",
-    "cluster_poles": "selection",
-    "discrepancy": "indicators",
-    "equivalent_real_modes": "indicators",
+    "PoleEstimator": "poles.estimators",
+    "PoleSet": "poles.lscf",
+    "RejectedMode": "statistics.quality",
+    "StabilityFlags": "poles.selection",
+    "auto_mac": "statistics.indicators",
+    "build_problem": "problem.problem",
+    "cluster_poles": "poles.selection",
+    "discrepancy": "statistics.indicators",
+    "equivalent_real_modes": "statistics.indicators",
     "identify_modes": "identify",
-    "mac": "indicators",
-    "mean_phase_deviation": "indicators",
-    "modal_phase_collinearity": "indicators",
-    "plscf": "lscf",
-    "relative_error": "indicators",
-    "rmsd": "indicators",
-    "stability_flags": "selection",
+    "mac": "statistics.indicators",
+    "mean_phase_deviation": "statistics.indicators",
+    "modal_phase_collinearity": "statistics.indicators",
+    "plscf": "poles.lscf",
+    "relative_error": "statistics.indicators",
+    "rmsd": "statistics.indicators",
+    "stability_flags": "poles.selection",
 }
 
 __all__ = [

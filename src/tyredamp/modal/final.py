@@ -1,15 +1,15 @@
 """Final stage of an identification: the maximum-likelihood fit of each model,
 its goodness of fit and the :class:`~tyredamp.modal.model.ModalModel` with its
-:class:`~tyredamp.modal.quality.FitQuality`.
+:class:`~tyredamp.modal.statistics.quality.FitQuality`.
 
 The final fits weight every line by the noise model of the
-:class:`~tyredamp.modal.problem.FitProblem`. With a per-line variance (given,
+:class:`~tyredamp.modal.problem.problem.FitProblem`. With a per-line variance (given,
 or estimated from the coherence and the averages) the fit is weighted by its
 separable approximation ``sigma_j^2 g_f``; when the variance is given, or
 estimated well enough that weighting every entry by its own estimate beats
 that approximation (:func:`full_weights`), this weighted least-squares fit
 starts the maximum-likelihood refinement of poles, participation and
-residues with the variance of every entry (:mod:`~tyredamp.modal.ml`, the
+residues with the variance of every entry (:mod:`~tyredamp.modal.fit.ml`, the
 default final stage), whose standard errors come from its Fisher
 information. Otherwise the noise level of each output is estimated from the
 residual of the search's model (a generous model) and the fit iterates it
@@ -29,18 +29,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import ConvergenceError
 from ..mechanics.modal_sum import pole_quantities
-from .fit import FitResult, ModalFitter
-from .indicators import mean_phase_deviation, modal_phase_collinearity
-from .ml import ml_refine
+from .fit.fit import FitResult, ModalFitter
+from .fit.ml import ml_refine
+from .fit.profile import Z95, fit_intervals
 from .model import ModalModel
-from .narrow import unresolved_damping
-from .problem import FitProblem
-from .profile import Z95, fit_intervals
-from .quality import FitQuality, RejectedMode, threshold_text
-from .refitted import refitted_statistics
-from .residual_peaks import local_ratio
-from .resolution import unresolved_pair, unresolved_pair_text
-from .search import (
+from .problem.problem import FitProblem
+from .search.narrow import unresolved_damping
+from .search.refitted import refitted_statistics
+from .search.residual_peaks import local_ratio
+from .search.resolution import unresolved_pair, unresolved_pair_text
+from .search.search import (
     ModeSet,
     ModeTest,
     fit_checked,
@@ -48,7 +46,9 @@ from .search import (
     rejected,
     residual_span,
 )
-from .stats import GoodnessOfFit, difference_noise, goodness_of_fit
+from .statistics.indicators import mean_phase_deviation, modal_phase_collinearity
+from .statistics.quality import FitQuality, RejectedMode, threshold_text
+from .statistics.stats import GoodnessOfFit, difference_noise, goodness_of_fit
 
 __all__ = ["fit_real", "goodness", "to_model", "unscale"]
 
@@ -113,7 +113,7 @@ def fit_real(
     modes (in-band first) and the mode set they belong to. ``sigma0``: the
     noise per output of the final fits; with it, the modes whose linearised
     intervals would be too short get likelihood intervals
-    (:func:`~tyredamp.modal.profile.fit_intervals`), as in the complex model.
+    (:func:`~tyredamp.modal.fit.profile.fit_intervals`), as in the complex model.
     """
     p0, l0, modes = start
     m, nf = modes.m, modes.n_free
@@ -206,9 +206,9 @@ def goodness(
 
     A known variance: chi-square; one estimated with ``nu`` degrees of freedom
     (``problem.noise_dof``): the ``F``-corrected test of
-    :mod:`tyredamp.modal.stats` (one with ``nu <= 4``, too few averages for the
+    :mod:`tyredamp.modal.statistics.stats` (one with ``nu <= 4``, too few averages for the
     cost to have a variance, is set aside by
-    :func:`~tyredamp.modal.problem.build_problem`); none: the second-difference
+    :func:`~tyredamp.modal.problem.problem.build_problem`); none: the second-difference
     noise of each FRF.
     """
     n_obs = 2 * sq.size
@@ -280,7 +280,7 @@ def local_dispersion(
 ) -> NDArray[np.float64]:
     """Each in-band mode's local dispersion: the mean residual power per line
     within two half-widths of the mode over its mean over the band
-    (:func:`~tyredamp.modal.residual_peaks.local_ratio`), at least 1 (n_band,).
+    (:func:`~tyredamp.modal.search.residual_peaks.local_ratio`), at least 1 (n_band,).
 
     The standard errors of a weighted least-squares or maximum-likelihood fit
     assume that the residual is noise of the estimated level everywhere; where
@@ -323,7 +323,7 @@ def _intervals_95(
     """The standard errors and 95 % intervals of the in-band modes (sorted by ``o``;
     ``u`` the unscaled fit, ``inflate`` the square root of each mode's local
     dispersion): the likelihood interval where it was formed
-    (:mod:`~tyredamp.modal.profile`), else the linearised one, each half scaled by
+    (:mod:`~tyredamp.modal.fit.profile`), else the linearised one, each half scaled by
     the local dispersion; the standard error of a mode with a likelihood interval
     is the half-width of the symmetric interval that holds it, over 1.96. Returns
     the ``std`` entries and the ``meta`` entries of the intervals."""
@@ -377,7 +377,7 @@ def to_model(
     """ModalModel of one fit (normalised data) in the data's units, and its
     discrepancy per line (RMS over FRFs, FRF unit).
 
-    Fit indicators: RMSD eq. [19] (as :func:`~tyredamp.modal.indicators.rmsd`), its
+    Fit indicators: RMSD eq. [19] (as :func:`~tyredamp.modal.statistics.indicators.rmsd`), its
     value per FRF and the relative error (as ``relative_error``), computed in
     the normalised units and scaled back (no overflow for any data magnitude).
     """
@@ -505,13 +505,13 @@ def final_complex(
     ``threshold`` (automatic mode count): the final fit holds the mode test too,
     each mode's threshold raised with ``test`` where the noise of the fit's
     residual lies along the response
-    (:func:`~tyredamp.modal.search.local_thresholds`). A mode whose statistic
+    (:func:`~tyredamp.modal.search.thresholds.local_thresholds`). A mode whose statistic
     fell to its threshold in the final refinement (its pole moved onto noise,
     e.g. a damping that collapsed) is dropped, the weakest first, and the fit
     repeated. Also returns the threshold applied to each kept in-band mode (fit
     order; None without ``threshold``). When every mode passes with the other
     poles held, modes beside a stronger one are tested once more with the
-    neighbours' poles refitted (:mod:`~tyredamp.modal.refitted`: the likelihood
+    neighbours' poles refitted (:mod:`~tyredamp.modal.search.refitted`: the likelihood
     ratio of the maximised models) and dropped, the weakest first, when that
     fails.
     """
@@ -567,7 +567,7 @@ def final_complex(
         keep = np.arange(m) != worst
         cur = ModeSet(cur.poles[keep], cur.part[keep], cur.hp, cur.hl, cur.n_free)
     if refine:
-        # the ML refinement keeps the WLS fit's statistics (:mod:`~tyredamp.modal.ml`),
+        # the ML refinement keeps the WLS fit's statistics (:mod:`~tyredamp.modal.fit.ml`),
         # so the thresholds they were tested against stand
         res = maximum_likelihood(problem, cfit, res)
         # likelihood intervals where the linearised ones would be too short
@@ -656,7 +656,7 @@ def full_weights(problem: FitProblem) -> bool:
 
 
 def maximum_likelihood(problem: FitProblem, fitter: ModalFitter, res: FitResult) -> FitResult:
-    """The maximum-likelihood refinement (:func:`~tyredamp.modal.ml.ml_refine`) of the
+    """The maximum-likelihood refinement (:func:`~tyredamp.modal.fit.ml.ml_refine`) of the
     weighted fit ``res`` of ``fitter`` when the per-line variance is known, or
     estimated and :func:`full_weights` says its own weights are the better ones."""
     if problem.variance is None or not full_weights(problem):

@@ -4,14 +4,14 @@ Pipeline of :func:`identify_modes` (spec ``radial-damping.md`` steps 3-6):
 
 1. poles of the model orders ``max_order / 4 .. max_order`` (every
    ``order_step``-th, default every second) by pLSCF
-   (:func:`~tyredamp.modal.lscf.plscf`);
-2. stabilisation and automatic selection (:mod:`~tyredamp.modal.selection`),
+   (:func:`~tyredamp.modal.poles.lscf.plscf`);
+2. stabilisation and automatic selection (:mod:`~tyredamp.modal.poles.selection`),
    no frequencies needed; a mode count or approximate frequencies may be given;
 3. residues by LSFD with the complex-mode model; modes whose contribution to
    the FRFs is negligible are rejected (rule below) and the fit repeated;
 4. for each requested model (``"complex"``: eq. [10]; ``"real"``: eq. [2]/[3])
    non-linear refinement of poles, participation and residues over all FRFs
-   together (:class:`~tyredamp.modal.fit.ModalFitter`), mass-normalised
+   together (:class:`~tyredamp.modal.fit.fit.ModalFitter`), mass-normalised
    scaling from the drive points, standard errors, fit indicators.
 
 Automatic order of step 1 (``max_order`` not given; ``n = n_in`` inputs, ``m``
@@ -42,7 +42,7 @@ roots; ``limit = 2 n_freq / (n_in + 1) - 2``):
 
 No order exceeds ``limit``, nor the cap set by the modes the data show:
 ``max(p_start, ceil(8 (M + 2) / n))`` with ``M`` the resonance peaks of the
-FRFs that stand out of their noise (:func:`~tyredamp.modal.order.modes_shown`:
+FRFs that stand out of their noise (:func:`~tyredamp.modal.poles.order.modes_shown`:
 prominence of the FRFs in noise units above twice the largest excursion
 ``n_freq`` lines of noise make at the false-alarm rate), i.e. twice the roots
 the sizing rule asks for those modes. The cap follows the resonances, not the
@@ -54,12 +54,12 @@ alone costs; each raise or trial recomputes pLSCF at the higher order, and a
 rejected trial costs one pLSCF at about twice the final order.
 
 Mode count of step 3 (automatic selection only), decided by statistics
-(:mod:`~tyredamp.modal.stats`, :mod:`~tyredamp.modal.search`): each mode's
+(:mod:`~tyredamp.modal.statistics.stats`, :mod:`~tyredamp.modal.search.search`): each mode's
 statistic ``T`` (the rise of the weighted cost, in units of the noise
 variance, when the mode is removed) must exceed ``chi2_k^-1(1 - alpha /
 n_freq)`` (``k`` the mode's parameters, ``alpha`` the false-alarm rate,
 default 1 %), raised where the residual's noise lies along the response
-(:mod:`~tyredamp.modal.span_noise`, :func:`~tyredamp.modal.stats.span_threshold`:
+(:mod:`~tyredamp.modal.search.span_noise`, :func:`~tyredamp.modal.statistics.stats.span_threshold`:
 an H1 estimate's input noise is common to the outputs and lies in the span
 of ``H(f)``, where a mode's shape lies); the weakest failing mode is dropped
 and the rest refitted.
@@ -72,7 +72,7 @@ vectors parallel too: two modes at one pole with different participation
 are a repeated root), is dropped and the fit repeated.
 
 The data are cut to the band and normalised first
-(:func:`~tyredamp.modal.problem.build_problem`): the result does not depend
+(:func:`~tyredamp.modal.problem.problem.build_problem`): the result does not depend
 on the magnitude of the data, and the noise model (given per-line variance,
 coherence and averages, or the residual) weights the final
 maximum-likelihood fits (:mod:`~tyredamp.modal.final`), whose goodness of
@@ -93,18 +93,18 @@ from .._validate import as_finite
 from ..exceptions import InputError
 from ..frf import FRF
 from ..mechanics.modal_sum import pole_from_frequency_damping
-from .compress import _compress, combine_outputs
-from .estimators import PoleEstimator, get_estimator
 from .final import ModelContext, final_complex, fit_real, to_model
-from .fit import FitResult, ModalFitter
-from .lscf import PoleSet, plscf
+from .fit.fit import FitResult, ModalFitter
 from .model import ModalModel
-from .model_error import with_model_error
-from .order import Diagram, SelectionRules, default_order, modes_shown, settle_order
-from .out_of_band import search_helpers
-from .problem import SET_ASIDE, FitProblem, build_problem, max_modes
-from .quality import RejectedMode, merge_rejected
-from .search import (
+from .poles.estimators import PoleEstimator, get_estimator
+from .poles.lscf import PoleSet, plscf
+from .poles.order import Diagram, SelectionRules, default_order, modes_shown, settle_order
+from .poles.selection import Cluster, StabilityFlags
+from .problem.compress import _compress, combine_outputs
+from .problem.model_error import with_model_error
+from .problem.problem import SET_ASIDE, FitProblem, build_problem, max_modes
+from .search.out_of_band import search_helpers
+from .search.search import (
     FixedParts,
     ModeSet,
     ModeTest,
@@ -112,8 +112,8 @@ from .search import (
     rejected,
     residual_search,
 )
-from .selection import Cluster, StabilityFlags
-from .stats import FALSE_ALARM, mode_parameters, mode_threshold
+from .statistics.quality import RejectedMode, merge_rejected
+from .statistics.stats import FALSE_ALARM, mode_parameters, mode_threshold
 
 __all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
 
@@ -135,8 +135,9 @@ class ModalIdentification:
     Attributes
     ----------
     models : dict of str to ModalModel
-        ``"complex"`` and/or ``"real"``; each has its :class:`~tyredamp.modal.quality.FitQuality`
-        in ``quality`` (goodness of fit, each mode's test statistic), standard
+        ``"complex"`` and/or ``"real"``; each has its
+        :class:`~tyredamp.modal.statistics.quality.FitQuality` in ``quality`` (goodness
+        of fit, each mode's test statistic), standard
         errors in ``std``, and the same indicators in ``meta`` (``"rmsd"``,
         eq. [19], FRF unit; ``"relative_error"``, ``"warnings"``, ``"mpc"``,
         ``"mpd_deg"``, ...).
@@ -152,7 +153,7 @@ class ModalIdentification:
         Persistent clusters (candidate modes before the residue fit).
     rejected : list of dict
         Candidates dropped, each ``{"frequency_hz", "damping_ratio", "reason",
-        "statistic", "threshold"}`` (:class:`~tyredamp.modal.quality.RejectedMode`).
+        "statistic", "threshold"}`` (:class:`~tyredamp.modal.statistics.quality.RejectedMode`).
     frequency : ndarray, shape (n_freq,)
         Lines used (Hz; a read-only view of the FRF's axis, no copy).
     discrepancy : dict of str to ndarray
@@ -163,7 +164,7 @@ class ModalIdentification:
         Noise model of the fit: ``"variance"``, ``"coherence"`` or ``"residual"``.
     model_error : float
         Relative model error ``eps`` included in the noise (0: none;
-        :mod:`tyredamp.modal.model_error`): the fit of the measured noise alone
+        :mod:`tyredamp.modal.problem.model_error`): the fit of the measured noise alone
         left structure, and the modes were decided against eq. (1) there.
     """
 
@@ -240,7 +241,7 @@ def identify_modes(
         Modal models to fit (default both).
     n_modes : int, optional
         Modes to keep (the most persistent clusters); default automatic (the
-        mode test). At most :func:`~tyredamp.modal.problem.max_modes`.
+        mode test). At most :func:`~tyredamp.modal.problem.problem.max_modes`.
     frequencies : array_like of float, optional
         Approximate natural frequencies (Hz) of the wanted modes; overrides ``n_modes``.
     max_order : int, optional
@@ -253,10 +254,10 @@ def identify_modes(
         Non-linear refinement (default True); without it the poles stay at the
         estimator's values (standard errors still from the Gauss-Newton covariance).
     max_damping, cluster_distance, min_fraction : float
-        Selection rules, see :mod:`tyredamp.modal.selection`.
+        Selection rules, see :mod:`tyredamp.modal.poles.selection`.
     false_alarm : float
         False-alarm rate of the mode test and level of the goodness-of-fit
-        test (default 0.01; :mod:`tyredamp.modal.stats`).
+        test (default 0.01; :mod:`tyredamp.modal.statistics.stats`).
     min_contribution : float
         Optional extra rule: drop modes whose synthesised FRFs have an RMS below
         this fraction of the data's (default 0: off).
@@ -266,11 +267,11 @@ def identify_modes(
     variance : array_like, shape (n_out, n_in, n_freq), optional
         Variance of each line of ``frf.H``; default ``frf.variance`` when
         present, else from the coherence and ``meta["n_averages"]``, else
-        estimated from the residual (:mod:`tyredamp.modal.problem`).
+        estimated from the residual (:mod:`tyredamp.modal.problem.problem`).
     estimator : PoleEstimator or str, optional
-        Pole estimator, or its name in :data:`~tyredamp.modal.estimators.ESTIMATORS`
-        (default ``"plscf"``, :func:`~tyredamp.modal.lscf.plscf`; protocol in
-        :mod:`tyredamp.modal.estimators`).
+        Pole estimator, or its name in :data:`~tyredamp.modal.poles.estimators.ESTIMATORS`
+        (default ``"plscf"``, :func:`~tyredamp.modal.poles.lscf.plscf`; protocol in
+        :mod:`tyredamp.modal.poles.estimators`).
     search : bool
         Residual-driven search for missed modes (default True; automatic count).
     blas_threads : int or None
@@ -327,7 +328,7 @@ def _identify(
     noise_note: str = "",
 ) -> ModalIdentification:
     """The body of :func:`identify_modes` (``noise_note`` says what a given
-    ``variance`` is, :attr:`~tyredamp.modal.problem.FitProblem.noise_note`)."""
+    ``variance`` is, :attr:`~tyredamp.modal.problem.problem.FitProblem.noise_note`)."""
     if o.model not in ("both", "complex", "real"):
         raise InputError(f"model: expected 'both', 'complex' or 'real', got {o.model!r}")
     problem = build_problem(frf, band, variance=variance, noise_note=noise_note)
@@ -385,7 +386,8 @@ def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:
 
 
 def _mode_test(problem: FitProblem, false_alarm: float) -> ModeTest:
-    """What each complex mode's own threshold needs (:class:`~tyredamp.modal.search.ModeTest`)."""
+    """What each complex mode's own threshold needs
+    (:class:`~tyredamp.modal.search.thresholds.ModeTest`)."""
     n_out, n_in, n_f = problem.shape
     return ModeTest(mode_parameters(n_out, n_in, "complex"), n_f, false_alarm)
 
@@ -462,7 +464,7 @@ def _candidates(
     n_shown: int | None = None,
 ) -> tuple[list[Cluster], list[Cluster], list[RejectedMode]]:
     """Modes to fit and other persistent modes to fit as in-band residual modes;
-    ``n_shown``: the peaks the data show (:func:`~.order.modes_shown`), for the
+    ``n_shown``: the peaks the data show (:func:`~.poles.order.modes_shown`), for the
     start of an automatic count whose diagram kept no cluster."""
     if fr is not None:
         cand = _pick_frequencies(fr, dg.kept + dg.weak, dg.poles, dg.flags)
@@ -551,7 +553,7 @@ def _select(
 
     ``thresholds``: the mode test's threshold and what each in-band mode's own
     threshold needs (raised where the noise lies along the response,
-    :func:`~tyredamp.modal.search.local_thresholds`)."""
+    :func:`~tyredamp.modal.search.thresholds.local_thresholds`)."""
     thr, test = thresholds
     sfit = fitters.sfit
     band = (float(sfit.f[0]), float(sfit.f[-1]))

@@ -21,7 +21,7 @@ from .._validate import as_finite, as_frequency
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..mechanics.modal_sum import kind_factor, modal_sum_receptance, pole_quantities
-from .quality import FitQuality
+from .statistics.quality import FitQuality
 
 __all__ = ["ModalModel", "ModeKind"]
 

@@ -9,7 +9,7 @@ with an exponential window ``w_i = exp(-beta i)`` (Peeters & Van der
 Auweraer, "PolyMAX: a revision of operational modal analysis", IOMAC 2005,
 eq. 3-4; Cauberghe, PhD thesis VUB 2004, sec. 3.4). It has the modal form
 ``sum_k phi_k g_k^T / (i omega - lambda_k) + c.c.`` of an FRF, so the pLSCF
-pole estimator of :mod:`tyredamp.modal.lscf` applies unchanged; the window adds
+pole estimator of :mod:`tyredamp.modal.poles.lscf` applies unchanged; the window adds
 ``beta f_s`` to every decay rate, which is subtracted from the poles
 (``lambda = lambda_w + beta f_s``). The shapes follow from a linear
 least-squares fit of the residues at the selected poles (the LSFD step).
@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..modal.lscf import plscf
+from ..modal.poles.lscf import plscf
 from .ssi import OrderPoles, _normalised
 
 __all__ = ["half_spectra", "plscf_poles", "residue_shapes"]

@@ -1,4 +1,4 @@
-"""Stabilisation diagram of the pole estimation (:mod:`tyredamp.modal.lscf`)."""
+"""Stabilisation diagram of the pole estimation (:mod:`tyredamp.modal.poles.lscf`)."""
 
 from __future__ import annotations
 
@@ -45,9 +45,9 @@ def plot_stabilisation(
     Parameters
     ----------
     poles : PoleSet
-        :class:`tyredamp.modal.lscf.PoleSet` (``order``, ``frequency_hz``).
+        :class:`tyredamp.modal.poles.lscf.PoleSet` (``order``, ``frequency_hz``).
     flags : StabilityFlags
-        :class:`tyredamp.modal.selection.StabilityFlags` of the same poles.
+        :class:`tyredamp.modal.poles.selection.StabilityFlags` of the same poles.
     frf : FRF, optional
         The FRFs the poles were estimated from.
     selected_hz : array_like, optional

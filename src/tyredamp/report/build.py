@@ -22,7 +22,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from .. import __version__
-from ..modal.quality import RejectedMode, rejected_summary
+from ..modal.statistics.quality import RejectedMode, rejected_summary
 from ._cells import _image, _num, _warnings, anchor_id, fmt_pm
 from ._outcomes import _findings, _Page, _status, _verdict_block
 from .dampmodels import dampmodels_report

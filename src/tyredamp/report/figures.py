@@ -394,7 +394,7 @@ def _lateral(result: DemoResult) -> FigureSet:
 
 def _mac_figure(result: DemoResult) -> tuple[Figure, str]:
     """Auto-MAC of the identified shapes at the main pressure and MAC across pressures."""
-    from ..modal.indicators import auto_mac, mac
+    from ..modal.statistics.indicators import auto_mac, mac
 
     runs = result.radial.runs
     main = runs[0]

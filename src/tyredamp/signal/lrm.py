@@ -80,7 +80,7 @@ def local_variance_dof(
     docstring): ``2 n + 1 - n_par`` complex, twice as many real degrees of
     freedom (Pintelon et al. 2010, part I, sec. 4; Seber & Lee 2003, thm. 3.5).
     Stated as ``FRF.meta["variance_dof"]`` by the local methods of
-    :func:`~tyredamp.signal.estimate_frf` (:mod:`tyredamp.modal.problem`).
+    :func:`~tyredamp.signal.estimate_frf` (:mod:`tyredamp.modal.problem.problem`).
     Arguments as in :func:`local_frf`.
     """
     half, n_par = _local_size(int(n_in), order, half_width, rational)
@@ -257,7 +257,7 @@ def local_method_frf(
         "overlap": 0.0,
         "settle_samples": settle,
         "local_order": 2,
-        # the local fit's residual degrees of freedom (modal.problem: goodness of fit)
+        # the local fit's residual degrees of freedom (modal.problem.problem: goodness of fit)
         "variance_dof": local_variance_dof(len(ref_idx), rational=rational),
     }
     if detection is not None:

@@ -21,7 +21,7 @@ from scipy import special
 
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF
-from ..modal.stats import chi2_isf, chi2_sf, f_isf, f_sf
+from ..modal.statistics.stats import chi2_isf, chi2_sf, f_isf, f_sf
 
 __all__ = [
     "ALPHA",
@@ -42,7 +42,7 @@ _FLOOR_LINES = 21
 #: Differences of the noise floor: fourth differences (binomial weights), which
 #: cancel a cubic trend of the FRF over five lines, so that a smooth FRF between
 #: few lines per half-power band adds little (the second differences of
-#: :func:`tyredamp.modal.stats.difference_noise` cancel only a straight line)
+#: :func:`tyredamp.modal.statistics.stats.difference_noise` cancel only a straight line)
 _DIFF = np.array([1.0, -4.0, 6.0, -4.0, 1.0])
 #: Fewest lines a fit is judged on without coherence.
 _MIN_LINES = 8

@@ -26,10 +26,10 @@ from scipy.optimize import linear_sum_assignment
 from ..damping import DampingModel, Method, identify_damping
 from ..exceptions import InputError
 from ..frf import FRF, Channel
-from ..modal.estimators import PoleEstimator
 from ..modal.identify import ModalIdentification, ModelChoice, identify_modes
 from ..modal.model import ModalModel
-from ..modal.stats import FALSE_ALARM
+from ..modal.poles.estimators import PoleEstimator
+from ..modal.statistics.stats import FALSE_ALARM
 from ..signal import CheckResult, linearity_check, quality_check, reciprocity_check
 from ..signal.checks import merge_inputs
 from ..signal.estimators import Estimator, estimate_frf

@@ -48,7 +48,7 @@ The verdict judges a fit from the data alone:
 
 * **without coherence** (an impact-test FRF exported alone): the noise is
   estimated from the data themselves, from differences of adjacent lines
-  (as :func:`tyredamp.modal.stats.difference_noise`, but fourth differences
+  (as :func:`tyredamp.modal.statistics.stats.difference_noise`, but fourth differences
   ``d_f = H_{f-2} - 4 H_{f-1} + 6 H_f - 4 H_{f+1} + H_{f+2}``, which cancel a
   cubic trend, with ``E|d|^2 = 70 s^2`` for white noise of variance ``s^2``),
   as a running median over 21 lines of each FRF (``median |d|^2 = 70 s^2
@@ -548,7 +548,7 @@ def _rejected_in(model: Any, f: NDArray[np.float64], excess: NDArray[np.float64]
     q = getattr(model, "quality", None)
     if q is None or not q.rejected or f.size < 2:
         return ""
-    from ..modal.quality import short_reason, strongest_rejected
+    from ..modal.statistics.quality import short_reason, strongest_rejected
 
     ex = np.clip(excess, 0.0, None).reshape(-1, f.size).sum(axis=0)
     total = float(ex.sum())

@@ -63,7 +63,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._validate import as_finite
 from ..exceptions import InputError, ShapeError
 from ..modal.model import ModalModel
-from ..modal.stats import chi2_sf
+from ..modal.statistics.stats import chi2_sf
 from .harmonics import (
     HarmonicFit,
     alias_candidates,

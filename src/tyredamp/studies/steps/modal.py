@@ -32,15 +32,16 @@ if TYPE_CHECKING:
 
 __all__ = ["MODAL_MODELS", "ModalSettings", "ModalStep", "label_wave_numbers"]
 
-#: The default false-alarm rate of the mode test (:data:`tyredamp.modal.stats.FALSE_ALARM`)
-#: and pole estimator (:data:`tyredamp.modal.estimators.DEFAULT_ESTIMATOR`), named here so
-#: that the settings load without SciPy; a test keeps them equal.
+#: The default false-alarm rate of the mode test
+#: (:data:`tyredamp.modal.statistics.stats.FALSE_ALARM`) and pole estimator
+#: (:data:`tyredamp.modal.poles.estimators.DEFAULT_ESTIMATOR`), named here so that the
+#: settings load without SciPy; a test keeps them equal.
 FALSE_ALARM = 0.01
 DEFAULT_ESTIMATOR = "plscf"
 
 
 def _estimators() -> Any:
-    from ...modal.estimators import ESTIMATORS
+    from ...modal.poles.estimators import ESTIMATORS
 
     return ESTIMATORS
 

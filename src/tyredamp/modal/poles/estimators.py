@@ -2,7 +2,7 @@
 
 A pole estimator turns the FRFs of a band into the poles (and participation
 vectors) of a range of model orders, the raw data of a stabilisation
-diagram. :func:`~tyredamp.modal.lscf.plscf` (poly-reference LSCF) is the
+diagram. :func:`~tyredamp.modal.poles.lscf.plscf` (poly-reference LSCF) is the
 default; any callable with the signature of :class:`PoleEstimator` plugs in
 (LSCE, SSI, a maximum-likelihood estimator, or a test double that returns
 known poles)::
@@ -19,7 +19,7 @@ the command line (``tyredamp modal --estimator NAME``), a campaign file
 (``identify_modes(frf, estimator="NAME")``) then all select it by that name.
 
 The identification calls it with the normalised data of the band (unit RMS,
-:class:`~tyredamp.modal.problem.FitProblem`) and reads, per pole, its order
+:class:`~tyredamp.modal.problem.problem.FitProblem`) and reads, per pole, its order
 (stability is judged between consecutive computed orders) and its
 participation vector; poles outside the band or with ``Im p <= 0`` are
 ignored by the selection.
@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import InputError
+from ...exceptions import InputError
 
 if TYPE_CHECKING:
     from .lscf import PoleSet

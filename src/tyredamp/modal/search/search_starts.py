@@ -1,5 +1,5 @@
 """Where the residual search tries a mode, and the records of the candidates it
-did not keep for a reason of their own (stage 3 of :mod:`tyredamp.modal.search`).
+did not keep for a reason of their own (stage 3 of :mod:`tyredamp.modal.search.search`).
 
 Each round starts trial modes at the coherent scan's trial poles, or else at the
 residual's peaks where the scan finds room for a mode, then at the diagram's
@@ -16,10 +16,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
-from .fit import FitResult, ModalFitter
+from ...mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.quality import RejectedMode
 from .modeset import rejected
-from .quality import RejectedMode
 from .residual_peaks import SCAN_SHARE, ScanGrid, residual_peaks, room
 from .thresholds import ModeTest, local_thresholds, residual_span
 

@@ -1,9 +1,9 @@
 """Maximum-likelihood refinement with the full per-line noise model.
 
-The fits of :mod:`~tyredamp.modal.fit` share one basis over the outputs, so
+The fits of :mod:`~tyredamp.modal.fit.fit` share one basis over the outputs, so
 they can weight a known per-line variance ``V_jkf`` (output ``j``, input
 ``k``, line ``f``) only through its separable approximation ``sigma_j^2 g_f``
-(:mod:`~tyredamp.modal.problem`). When the variance is known, the final stage
+(:mod:`~tyredamp.modal.problem.problem`). When the variance is known, the final stage
 (:func:`ml_refine`) starts from that weighted least-squares (WLS) fit and
 minimises the Gaussian negative log-likelihood (times two) of the data with
 the variance of every entry::
@@ -18,7 +18,7 @@ projection, Golub & Pereyra 1973): for each output the weighted basis ``W_j
 Phi`` is orthonormalised (``Q_j R_j``), the residual is ``r_j = (I - Q_j
 Q_j^T) W_j y_j`` and Kaufman's Jacobian ``J_j = -(I - Q_j Q_j^T) W_j (dPhi /
 dtheta) C_j``; Gauss-Newton/Levenberg-Marquardt steps on ``sum_j J_j^T J_j``
-and ``sum_j J_j^T r_j`` (:func:`~tyredamp.modal._linalg._levenberg_marquardt`).
+and ``sum_j J_j^T r_j`` (:func:`~tyredamp.modal.fit._linalg._levenberg_marquardt`).
 The cost per evaluation is ``n_out`` QR factorisations of the ``(2 n_in
 n_freq) x q`` basis: a few evaluations from the WLS start.
 
@@ -37,7 +37,7 @@ information is multiplied by ``nu / (nu - 4)``. With ``nu <= 4`` (no finite
 second moment) it is scaled by the residual variance ``cost / dof`` instead.
 The standard errors of the mode shapes, the contributions and the mode
 statistics ``T`` are kept from the WLS fit (the delta method of
-:mod:`~tyredamp.modal._scaling` and the extra sum of squares on the shared
+:mod:`~tyredamp.modal.fit._scaling` and the extra sum of squares on the shared
 basis).
 """
 
@@ -168,7 +168,7 @@ def _projection(
     the map ``X -> Q^T X`` of an orthonormal basis ``Q`` of their range.
 
     From the Cholesky factor of the unit-column Gram matrix ``pw^T pw`` when its
-    condition estimate allows (:func:`~tyredamp.modal._linalg._gram_chol`; ``pw =
+    condition estimate allows (:func:`~tyredamp.modal.fit._linalg._gram_chol`; ``pw =
     Q R`` with ``R^T R = pw^T pw``, so ``Q^T X = R^-T pw^T X`` and ``C = R^-1 Q^T
     yw``: the normal equations, Golub & Van Loan, *Matrix Computations*, 4th ed.
     2013, sec. 5.3.1-5.3.2, relative error ~ eps times the condition estimate);
@@ -209,7 +209,7 @@ def ml_refine(
         Real degrees of freedom of an estimated variance (None: known).
     max_nfev, tol : int, float
         Evaluation limit and convergence threshold (units of the residual
-        variance, :func:`~tyredamp.modal._linalg._levenberg_marquardt`).
+        variance, :func:`~tyredamp.modal.fit._linalg._levenberg_marquardt`).
 
     Returns
     -------

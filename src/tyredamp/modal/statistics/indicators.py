@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_finite
-from ..exceptions import ShapeError
+from ..._validate import as_finite
+from ...exceptions import ShapeError
 
 __all__ = [
     "auto_mac",

@@ -1,7 +1,7 @@
 """The mode statistic with the neighbours' poles refitted (the final fit's last word).
 
 The mode statistic ``T`` of a fit (:attr:`FitResult.significance
-<tyredamp.modal.fit.FitResult.significance>`) is the rise of the cost when the
+<tyredamp.modal.fit.fit.FitResult.significance>`) is the rise of the cost when the
 mode is removed and the linear terms refitted, the *other poles held*. That is
 the likelihood ratio of the nested models only when the other poles would not
 move without the mode. Beside a much stronger mode they do: a second pole
@@ -21,7 +21,7 @@ rad/s: where one resonance's pole can take up the other's response) or an
 overlapping residual mode, the model without it (every pole free, from the
 final fit's values), and takes ``T`` as the drop of the residual power when
 the mode is added to that refitted model, in units of each output's noise (as
-the search's trials, :func:`~tyredamp.modal.search._trial`). Modes without
+the search's trials, :func:`~tyredamp.modal.search.search._trial`). Modes without
 such a neighbour keep ``T`` (their neighbours' poles do not move), so a band
 of separated modes costs no refit; a mode whose ``T`` stays above its
 threshold with twice the Gauss-Newton decrement of the model without it taken
@@ -34,9 +34,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import ConvergenceError
-from ._linalg import _gn_point
-from .fit import FitResult, ModalFitter
+from ...exceptions import ConvergenceError
+from ..fit._linalg import _gn_point
+from ..fit.fit import FitResult, ModalFitter
 from .search import JOINT_NFEV, SEARCH_TOL, ModeSet
 
 __all__ = ["OVERLAP", "REFIT_NFEV", "overlapping", "refit_candidates", "refitted_statistics"]

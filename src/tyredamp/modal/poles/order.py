@@ -1,4 +1,4 @@
-"""Automatic model order of the stabilisation diagram (rules in :mod:`.identify`).
+"""Automatic model order of the stabilisation diagram (rules in :mod:`tyredamp.modal.identify`).
 
 :func:`settle_order` computes the diagram of the starting order with the pole
 estimator and raises the order by the sizing rule and by trials of an
@@ -17,11 +17,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ..problem.problem import FitProblem
+from ..statistics.stats import FALSE_ALARM, difference_noise
 from .estimators import PoleEstimator
 from .lscf import PoleSet
-from .problem import FitProblem
 from .selection import Cluster, StabilityFlags, cluster_poles, stability_flags
-from .stats import FALSE_ALARM, difference_noise
 
 __all__ = [
     "Diagram",
@@ -50,7 +50,7 @@ ESCALATE = 4
 
 @dataclass(frozen=True)
 class SelectionRules:
-    """Rules of the stabilisation diagram (:mod:`tyredamp.modal.selection`)."""
+    """Rules of the stabilisation diagram (:mod:`tyredamp.modal.poles.selection`)."""
 
     order_step: int = 2
     max_damping: float = 0.2
@@ -94,7 +94,7 @@ def modes_shown(problem: FitProblem, false_alarm: float = FALSE_ALARM) -> int:
 
     The indicator is ``r(f) = (sum_jk |H_jk(f)|^2 / s_j^2)^(1/2)``, the FRFs
     in units of each output's noise ``s_j`` (from second differences of
-    adjacent lines, :func:`~tyredamp.modal.stats.difference_noise`). The noise
+    adjacent lines, :func:`~tyredamp.modal.statistics.stats.difference_noise`). The noise
     moves ``r`` by about one unit at any level (``|h + e| - |h|`` has a
     standard deviation below 1 for ``e`` of unit variance), and the largest of
     ``n_f`` such excursions stays below ``z = (2 ln(n_f / alpha))^(1/2)`` with

@@ -2,16 +2,16 @@
 residual-driven search for missed modes.
 
 Three stages of :func:`~tyredamp.modal.identify.identify_modes` (automatic
-mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
+mode count), all on one :class:`~tyredamp.modal.fit.fit.ModalFitter`:
 
-1. :func:`~tyredamp.modal.out_of_band.search_helpers`: out-of-band residual
+1. :func:`~tyredamp.modal.search.out_of_band.search_helpers`: out-of-band residual
    modes above and below the band (docstring there);
 2. :func:`reject_by_test`: each in-band mode's statistic ``T`` (the rise of
    the weighted cost, in units of the noise variance, when the mode is
-   removed; :mod:`tyredamp.modal.stats`) against the threshold of the
+   removed; :mod:`tyredamp.modal.statistics.stats`) against the threshold of the
    stated false-alarm rate, raised for each mode where the residual's noise
    lies along the response (an H1 estimate's input noise, common to the
-   outputs: :mod:`tyredamp.modal.span_noise`, :func:`local_thresholds`); the
+   outputs: :mod:`tyredamp.modal.search.span_noise`, :func:`local_thresholds`); the
    weakest failing mode is dropped and the rest refitted, until every mode
    passes;
 3. :func:`residual_search`: candidates for missed modes, from the diagram
@@ -19,15 +19,15 @@ mode count), all on one :class:`~tyredamp.modal.fit.ModalFitter`:
    the peaks of the residual (the fit's residual power per line, in units of
    the noise, summed over the FRFs, over 5 lines and over windows matched to
    half-power bands: a mode indicator on the residual,
-   :mod:`tyredamp.modal.residual_peaks`; the starts of a round and the records
+   :mod:`tyredamp.modal.search.residual_peaks`; the starts of a round and the records
    of the candidates not kept for a reason of their own are in
-   :mod:`tyredamp.modal.search_starts`) where the coherent scan finds room
+   :mod:`tyredamp.modal.search.search_starts`) where the coherent scan finds room
    for a mode; when those add nothing, the maxima of the coherent scan itself
    (the mode test's statistic of a pole held at each point of a grid, the
    fitted modes' residues refitted, rank-one with their participation held when
    there are several inputs: a weak mode beside a strong one, a broad
    mode spread over many lines). Each is refined alone with the other modes
-   held fixed (:meth:`~tyredamp.modal.fit.ModalFitter.fit_added`, its
+   held fixed (:meth:`~tyredamp.modal.fit.fit.ModalFitter.fit_added`, its
    frequency within 3 % of the start, followed beyond that window while its
    statistic grows); a candidate whose cost drop passes the mode test is
    refined with all modes, and kept when it still passes (its own threshold
@@ -40,10 +40,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import ConvergenceError
-from ..mechanics.modal_sum import pole_quantities
-from ._added import FixedPart
-from .fit import FitResult, ModalFitter
+from ...exceptions import ConvergenceError
+from ...mechanics.modal_sum import pole_quantities
+from ..fit._added import FixedPart
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.quality import KEPT, RejectedMode, threshold_text
+from ..statistics.stats import chi2_isf_each
 from .modeset import (
     MERGE,
     ModeSet,
@@ -56,7 +58,6 @@ from .modeset import (
     with_residual,
 )
 from .narrow import STEP_LINES, narrow_refusal, too_narrow
-from .quality import KEPT, RejectedMode, threshold_text
 from .residual_peaks import (
     local_ratio,
     residual_view,
@@ -70,7 +71,6 @@ from .search_starts import (
     unique_candidates,
 )
 from .span_noise import SpanNoise
-from .stats import chi2_isf_each
 from .thresholds import ModeTest, local_thresholds, residual_span
 
 __all__ = [
@@ -297,7 +297,7 @@ def _narrow_joint(
     test: ModeTest | None,
 ) -> str:
     """Why the trial mode ``k`` of the joint refit ``r1``, a few lines wide or narrower,
-    is refused ('' when it is a resonance, :func:`~tyredamp.modal.narrow.narrow_refusal`):
+    is refused ('' when it is a resonance, :func:`~tyredamp.modal.search.narrow.narrow_refusal`):
     its evidence against the threshold raised where the noise of the fit's residual
     lies along the response (model error, :func:`local_thresholds`), and compared
     with the modes ``cur`` before the refit (one of them may have left its place to
@@ -328,7 +328,7 @@ def _held_outside(
 ) -> bool:
     """Whether the joint refit ``r1`` lost only the trial mode ``k``, across a band
     edge to within a factor 2 of it (the range of the residual modes of
-    :func:`~tyredamp.modal.out_of_band.search_helpers`), where it is admissible,
+    :func:`~tyredamp.modal.search.out_of_band.search_helpers`), where it is admissible,
     passes the mode test and fewer than ``max_helpers`` residual modes lie on that
     side. ``limits``: the mode test's threshold, the line spacing and the
     admissible damping ratio."""
@@ -568,11 +568,11 @@ def residual_search(
     whose half-power bandwidth ``2 zeta f_n = -Re p / pi`` (Hz) is narrower
     than the line spacing (a lightly damped mode measured with coarse lines: its
     frequency is resolved and its damping only bounded,
-    :func:`~tyredamp.modal.narrow.unresolved_damping`) can also fit single lines
+    :func:`~tyredamp.modal.search.narrow.unresolved_damping`) can also fit single lines
     (an outlier, a step, the erratic low end of an impact test) or the flank of
     another mode's misfit: it is kept only when its tails hold evidence beyond
     those on both sides, away from the ends of the lines and from the other
-    modes (:func:`~tyredamp.modal.narrow.narrow_refusal`; poles up to 3 lines
+    modes (:func:`~tyredamp.modal.search.narrow.narrow_refusal`; poles up to 3 lines
     wide against a spike and a step), in the trial and again in the joint
     refit. A trial mode that passes
     is refitted with all modes (:func:`_joint`) and kept when it stays in the
@@ -581,7 +581,7 @@ def residual_search(
     to an admissible pole within a factor 2 of the edge that passes the test, is
     a mode outside the band whose tail the data hold: it is kept as a residual
     mode while fewer than ``max_helpers`` lie on that side (the limit of
-    :func:`~tyredamp.modal.out_of_band.search_helpers`). Otherwise it is
+    :func:`~tyredamp.modal.search.out_of_band.search_helpers`). Otherwise it is
     rejected for what the joint refit did (e.g. "joint refit: crossed the band
     edge", a mode outside the band whose tail the trial had taken), and a later
     trial that ends at the same pole (within ``2 MERGE``) against the same modes
@@ -595,7 +595,7 @@ def residual_search(
     half-power band, the same pole as a mode or an earlier start, the round's
     ``MAX_TRIALS`` reached), where its trial mode went and why it was rejected,
     or ``KEPT`` (its trial mode is now a mode;
-    :func:`~tyredamp.modal.quality.merge_rejected` joins a candidate's records
+    :func:`~tyredamp.modal.statistics.quality.merge_rejected` joins a candidate's records
     and leaves the kept ones out). With
     ``test``, the added mode must also pass its own threshold in the joint
     refit, raised where the noise of that fit's residual (the mode in it: a

@@ -44,23 +44,23 @@ large for that, ``Phi`` is orthogonalised by CholeskyQR2 (shifted CholeskyQR3
 beyond its range), and when the cost would lose accuracy by cancellation or
 the condition exceeds even that, the same quantities come from a Householder
 QR of ``[Phi | E]`` with ``Q^T`` applied to ``Y``
-(:func:`~tyredamp.modal._linalg._vp_solve`). The refinement is a bounded
+(:func:`~tyredamp.modal.fit._linalg._vp_solve`). The refinement is a bounded
 Levenberg-Marquardt iteration on these normal equations.
 
 Memory: the Gram blocks, the QR and the fitted FRFs are summed over blocks of
-lines of a fixed size (:func:`~tyredamp.modal._basis.blocks`, 8 MB); the basis
+lines of a fixed size (:func:`~tyredamp.modal.fit._basis.blocks`, 8 MB); the basis
 of all lines, the weighted data ``Y`` and the residual are never held, so a fit
 costs the data plus a constant. The data rows, ``s = i w`` and ``kappa`` of a
 block are formed when needed (the attributes ``Y``, ``s``, ``kappa``,
 ``kappa_low`` form them for all lines on request); with several blocks ``B^T
-Y`` comes from the complex data (:func:`~tyredamp.modal._basis.rows_t_data`),
+Y`` comes from the complex data (:func:`~tyredamp.modal.fit._basis.rows_t_data`),
 no data rows are formed. When the data rows fit one block (the common case: 16
 outputs x 800 lines are 0.2 MB), the fitter forms them and the line factors
 once and keeps them (no more than the one block of a blocked fit), and a basis
 is formed once per evaluation for every route. A fitter keeps nothing between
 calls: what one call can reuse from another is passed explicitly -- the fixed
 part of ``fit_added`` (:meth:`ModalFitter.fixed_part`, an immutable
-:class:`~tyredamp.modal._added.FixedPart` formed once per fixed mode set) and
+:class:`~tyredamp.modal.fit._added.FixedPart` formed once per fixed mode set) and
 a previous intermediate fit at rest (``fit(..., start=res)``).
 
 Scaling (spec step 3 and eq. [10]): with drive points ``(j_k, k)`` (output
@@ -85,10 +85,10 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import InputError
+from ...exceptions import InputError
+from ..problem.compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 from . import _added, _basis, _scaling
 from ._linalg import _extra_ss, _levenberg_marquardt, _vp_solve, at_rest
-from .compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
 
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
 
@@ -139,7 +139,7 @@ class FitResult:
     #: (``ModalFitter.fit(..., start=this)``); None when not known to be at rest
     rest: tuple[NDArray[np.float64], float] | None = None
     #: 95 % intervals of the in-band modes' f and zeta (fit order;
-    #: :class:`~tyredamp.modal.profile.Intervals`), set by the final stage
+    #: :class:`~tyredamp.modal.fit.profile.Intervals`), set by the final stage
     intervals: Any = None
 
 
@@ -356,7 +356,7 @@ class ModalFitter:
         """Projection at ``th`` for the data weighted by ``w`` (n_out,) per output.
 
         The Gram blocks ``B^T B`` and ``B^T Y`` of ``B = [Phi | E]`` are summed over
-        blocks of lines (:func:`~tyredamp.modal._basis.blocks`; neither the basis nor
+        blocks of lines (:func:`~tyredamp.modal.fit._basis.blocks`; neither the basis nor
         the weighted data of all lines is formed) and solved by :func:`_vp_solve`,
         which goes through the blocks again for the QR route. With ``residual=True``
         the QR route is taken (no cancellation in the cost); otherwise only when
@@ -552,7 +552,7 @@ class ModalFitter:
     ) -> _added.FixedPart:
         """The fixed part of :meth:`fit_added` for the fixed modes ``poles`` (m,)
         and ``part`` (m, n_in): an immutable value (the range of their basis and
-        of the residual terms, :mod:`~tyredamp.modal._added`) to form once and
+        of the residual terms, :mod:`~tyredamp.modal.fit._added`) to form once and
         pass as ``fixed`` to every ``fit_added`` against these modes."""
         got = self._fixed_modes(poles, part, self._added_fitter()[2])
         return _added.fixed_part(self, *got, src=(poles, part))
@@ -661,7 +661,7 @@ class ModalFitter:
     @staticmethod
     def _at_rest(x: NDArray[np.float64], sol: dict[str, Any]) -> bool:
         """Would a refinement started at its result ``x`` (strictly inside the bounds)
-        stop at once (:func:`~tyredamp.modal._linalg.at_rest`)?"""
+        stop at once (:func:`~tyredamp.modal.fit._linalg.at_rest`)?"""
         lb, ub, dof, tol = sol["lm"]
         inside = bool(np.all((x > lb + 1e-9) & (x < ub - 1e-9)))
         return inside and at_rest(x, sol["cost"], sol["jtj"], sol["jtr"], (lb, ub), tol, dof)

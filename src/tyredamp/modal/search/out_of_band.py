@@ -2,7 +2,7 @@
 
 :func:`search_helpers` refines the diagram's modes, then adds residual modes
 above and below the band while they pass the mode test
-(:mod:`tyredamp.modal.search` holds the trials and the other stages).
+(:mod:`tyredamp.modal.search.search` holds the trials and the other stages).
 """
 
 from __future__ import annotations
@@ -11,12 +11,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..exceptions import ConvergenceError
-from ..mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
-from ._basis import factors, residual_blocks
-from .fit import FitResult, ModalFitter
+from ...exceptions import ConvergenceError
+from ...mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
+from ..fit._basis import factors, residual_blocks
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.quality import RejectedMode
 from .modeset import outside_side, with_residual
-from .quality import RejectedMode
 from .residual_peaks import model_of, rank_one_statistic
 from .search import (
     FIRST_NFEV,
@@ -157,7 +157,7 @@ def _scan_start(
     of the range ``edge`` (Hz, the side's factor 2 beyond the band edge) whose
     column ``kappa / (s - p)`` over the band's lines explains most of the
     residual, in units of each output's noise (the rank-one statistic of the
-    coherent scan, :func:`~tyredamp.modal.residual_peaks.coherent_scan`, over
+    coherent scan, :func:`~tyredamp.modal.search.residual_peaks.coherent_scan`, over
     every line: a mode outside the band reaches into it with its tail). Grids of
     damping ``SCAN_SCALES`` times ``zeta0``, step ``zeta f``. None when the
     range holds no grid point."""

@@ -1,7 +1,7 @@
 """The mode set of the automatic mode count and its checked fit.
 
 :class:`ModeSet` holds the current modes of the search stages
-(:mod:`tyredamp.modal.search`, :mod:`tyredamp.modal.out_of_band`,
+(:mod:`tyredamp.modal.search.search`, :mod:`tyredamp.modal.search.out_of_band`,
 :mod:`tyredamp.modal.final`); :func:`fit_checked` fits them and drops the
 modes a fit lost (:func:`lost_modes`: left their side of the band, or merged).
 """
@@ -13,10 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import ConvergenceError
-from .fit import FitResult, ModalFitter
-from .quality import RejectedMode
-from .selection import same_place_distinct
+from ...exceptions import ConvergenceError
+from ..fit.fit import FitResult, ModalFitter
+from ..poles.selection import same_place_distinct
+from ..statistics.quality import RejectedMode
 
 __all__ = [
     "MERGE",
@@ -154,7 +154,7 @@ def fit_checked(
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Fit the modes; drop any that left its side of the band or merged, and refit.
 
-    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.ModalFitter.fit`, ``start`` (the
+    ``fit_kw`` go to :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit`, ``start`` (the
     fit the modes come from, if any) to its first fit. Returns the fit, the
     modes at the fit's values and the dropped ones.
     """

@@ -31,13 +31,13 @@ residual of the least-squares H1 over the averages, no overlap correction),
 else unknown: taken as known. The local methods (LRM/LPM, ``n_averages =
 1``) state the local fit's ``2 (2 n + 1 - n_par)``
 (:func:`~tyredamp.signal.lrm.local_variance_dof`). The goodness of fit
-corrects for them (:mod:`tyredamp.modal.stats`).
+corrects for them (:mod:`tyredamp.modal.statistics.stats`).
 
 A known variance ``V_jkf`` enters the fit as a separable model ``sigma_j^2
 g_f`` (``sigma_j^2`` the mean variance of output ``j``, ``g_f`` the mean of
 ``V_jkf / sigma_j^2`` over outputs and inputs at line ``f``): the fitter
 shares one basis over the outputs, so the line factor weights the basis rows
-and the output factor the data columns (:class:`~tyredamp.modal.fit.ModalFitter`).
+and the output factor the data columns (:class:`~tyredamp.modal.fit.fit.ModalFitter`).
 """
 
 from __future__ import annotations
@@ -49,9 +49,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_band
-from ..exceptions import InputError, ShapeError
-from ..frf import FRF, KIND_POWER
+from ..._validate import as_band
+from ...exceptions import InputError, ShapeError
+from ...frf import FRF, KIND_POWER
 
 __all__ = ["FitProblem", "NoiseSource", "build_problem", "line_factor_dof", "max_modes"]
 
@@ -99,7 +99,7 @@ class FitProblem:
         Averages the variance was estimated from (``meta["n_averages"]``), for the verdict.
     noise_note : str
         What a given variance is, for people (e.g. a noise floor plus a model
-        error, :mod:`tyredamp.modal.model_error`); "" when nothing is to be said.
+        error, :mod:`tyredamp.modal.problem.model_error`); "" when nothing is to be said.
     variance_set_aside : str
         Why the FRF's own per-line variance was not used ("" when it was, or there
         was none): one estimated with ``nu <= FEWEST_VARIANCE_DOF`` degrees of
@@ -139,7 +139,7 @@ class FitProblem:
         them fewer; they are measured from the scatter of the factor between
         adjacent lines (:func:`line_factor_dof`) and the smaller count is
         taken. None when the weights are known or absent
-        (:func:`~tyredamp.modal.stats.mode_threshold`).
+        (:func:`~tyredamp.modal.statistics.stats.mode_threshold`).
         """
         if self.noise_dof is None or self.line_weights is None:
             return None

@@ -1,6 +1,6 @@
 """Linear algebra of the modal fits: variable projection from Gram blocks or a
 blocked QR, the extra sum of squares of a mode, and the bounded
-Levenberg-Marquardt iteration (used by :class:`~tyredamp.modal.fit.ModalFitter`)."""
+Levenberg-Marquardt iteration (used by :class:`~tyredamp.modal.fit.fit.ModalFitter`)."""
 
 from __future__ import annotations
 

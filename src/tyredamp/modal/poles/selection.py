@@ -44,8 +44,8 @@ from numpy.typing import NDArray
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..exceptions import InputError
-from ..mechanics.modal_sum import pole_quantities
+from ...exceptions import InputError
+from ...mechanics.modal_sum import pole_quantities
 from .lscf import PoleSet
 
 _SLACK = 1e-6  # relative widening of the candidate search (rounding of log|p|, arg p)
@@ -178,7 +178,7 @@ def stability_flags(
     Parameters
     ----------
     ps : PoleSet
-        Poles over model orders from :func:`~tyredamp.modal.lscf.plscf`.
+        Poles over model orders from :func:`~tyredamp.modal.poles.lscf.plscf`.
     band : (float, float), optional
         Band (Hz) for the damped frequency; default ``ps.band_hz``.
     max_damping : float

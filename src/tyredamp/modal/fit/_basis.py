@@ -1,8 +1,8 @@
 """The real basis of the modal fits and its derivative columns.
 
-Functions of a :class:`~tyredamp.modal.fit.ModalFitter` (its methods
+Functions of a :class:`~tyredamp.modal.fit.fit.ModalFitter` (its methods
 ``_basis_ek``, ``_basis_real``, ``_layout``, ``_coef``); the layout of the
-columns is stated in the docstring of :mod:`tyredamp.modal.fit`.
+columns is stated in the docstring of :mod:`tyredamp.modal.fit.fit`.
 """
 
 from __future__ import annotations
@@ -14,11 +14,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ._state import FitterState
+
 #: derivative-column layouts (layout) per (kind, m, n_in, q, w_ref)
 LAYOUTS: dict[tuple[str, int, int, int, float], Layout] = {}
 
 
-def layout(fitter: Any, m: int) -> Layout:
+def layout(fitter: FitterState, m: int) -> Layout:
     """Derivative columns of ``m`` modes: ``D = E[:, ecol] * coef`` (cached, read-only).
 
     Complex modes: per mode ``n`` the columns of ``E`` are ``[S]``, ``[i T]``
@@ -105,7 +107,7 @@ KEEP_BYTES = 1_000_000
 MIN_BLOCK_LINES = 256
 
 
-def blocks(fitter: Any, n_col: int) -> list[slice]:
+def blocks(fitter: FitterState, n_col: int) -> list[slice]:
     """Blocks of lines for arrays of ``n_col`` real columns (``2 n_in`` rows per line).
 
     One block when the lines fit in :data:`BLOCK_BYTES`; otherwise blocks of
@@ -120,7 +122,7 @@ def blocks(fitter: Any, n_col: int) -> list[slice]:
     return [slice(a, min(a + nb, n_f)) for a in range(0, n_f, nb)]
 
 
-def one_block(fitter: Any) -> bool:
+def one_block(fitter: FitterState) -> bool:
     """Do the data rows of every line fit in :data:`KEEP_BYTES` (and one block,
     :data:`BLOCK_BYTES`)? The fitter then keeps them (no more memory than one block
     of a blocked fit)."""
@@ -128,7 +130,7 @@ def one_block(fitter: Any) -> bool:
 
 
 def factors(
-    fitter: Any, lines: slice | None = None
+    fitter: FitterState, lines: slice | None = None
 ) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]]:
     """``s = i w``, ``kappa = (i w)^power`` and ``kappa_low = (i w)^(power - 2)`` of the
     lines (times the line weights when the fitter has them), computed when needed
@@ -151,14 +153,15 @@ def factors(
         wl = wl * lw
     kappa = _I_POWER[p % 4] * wp
     kappa_low = _I_POWER[(p - 2) % 4] * wl
-    return s, kappa, kappa_low
+    c128 = np.complex128  # the dtypes already are complex128 (no copy): typed for mypy
+    return np.asarray(s, c128), np.asarray(kappa, c128), np.asarray(kappa_low, c128)
 
 
 #: ``i^k`` for ``k = 0 .. 3`` (exact)
 _I_POWER = (1.0 + 0j, 1j, -1.0 + 0j, -1j)
 
 
-def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
+def ydata(fitter: FitterState, lines: slice | None = None) -> NDArray[np.float64]:
     """Data rows of the lines (``(k, f)``, real and imaginary part interleaved), (rows, n_out).
 
     Weighted by the line weights when the fitter has them; row ``2 i`` is the
@@ -181,7 +184,7 @@ def ydata(fitter: Any, lines: slice | None = None) -> NDArray[np.float64]:
     return Y
 
 
-def rows_t_data(fitter: Any, lines: slice, b: NDArray[np.float64]) -> NDArray[np.float64]:
+def rows_t_data(fitter: FitterState, lines: slice, b: NDArray[np.float64]) -> NDArray[np.float64]:
     """``b^T Y`` (c, n_out) of basis rows ``b`` (rows of ``lines``, c columns) and the
     data rows of those lines, without forming ``Y``.
 
@@ -207,7 +210,11 @@ def rows_t_data(fitter: Any, lines: slice, b: NDArray[np.float64]) -> NDArray[np
 
 
 def synth(
-    fitter: Any, th: NDArray[np.float64], m: int, ref: NDArray[np.intp], coef: NDArray[np.float64]
+    fitter: FitterState,
+    th: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    coef: NDArray[np.float64],
 ) -> NDArray[np.complex128]:
     """Fitted FRFs ``Phi coef`` (unweighted), complex, (n_out, n_in, n_f), block by block.
 
@@ -226,7 +233,7 @@ def synth(
 
 
 def residual_power(
-    fitter: Any,
+    fitter: FitterState,
     poles: NDArray[np.complex128],
     residues: NDArray[np.complex128],
     terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
@@ -246,7 +253,7 @@ def residual_power(
 
 
 def residual_blocks(
-    fitter: Any,
+    fitter: FitterState,
     poles: NDArray[np.complex128],
     residues: NDArray[np.complex128],
     terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
@@ -258,7 +265,7 @@ def residual_blocks(
 
 
 def residual_lines(
-    fitter: Any,
+    fitter: FitterState,
     poles: NDArray[np.complex128],
     residues: NDArray[np.complex128],
     terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
@@ -298,7 +305,7 @@ def residual_lines(
 
 
 def basis_ek(
-    fitter: Any,
+    fitter: FitterState,
     th: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -397,7 +404,7 @@ def basis_ek(
 
 
 def basis_real(
-    fitter: Any,
+    fitter: FitterState,
     poles: NDArray[np.complex128],
     part: NDArray[np.complex128],
     ref: NDArray[np.intp],

@@ -41,10 +41,10 @@ import numpy as np
 import scipy.linalg as sla
 from numpy.typing import ArrayLike, NDArray
 
-from .._validate import as_band, as_finite, as_frequency
-from ..exceptions import InputError, ShapeError
-from ..mechanics.modal_sum import pole_quantities
-from .problem import check_uniform
+from ..._validate import as_band, as_finite, as_frequency
+from ...exceptions import InputError, ShapeError
+from ...mechanics.modal_sum import pole_quantities
+from ..problem.problem import check_uniform
 
 __all__ = ["PoleSet", "plscf"]
 

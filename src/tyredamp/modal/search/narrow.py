@@ -34,10 +34,10 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from tyredamp.modal._basis import factors, residual_lines
-from tyredamp.modal.fit import FitResult, ModalFitter
-from tyredamp.modal.residual_peaks import model_of
-from tyredamp.modal.resolution import unresolved_pair_text
+from ..fit._basis import factors, residual_lines
+from ..fit.fit import FitResult, ModalFitter
+from .residual_peaks import model_of
+from .resolution import unresolved_pair_text
 
 __all__ = [
     "EDGE_LINES",
@@ -198,7 +198,7 @@ def narrow_refusal(
     A pole narrower than the lines (:func:`too_narrow`) is a resonance when it lies
     away from the ends of the lines (``EDGE_LINES``), no mode lies within a line
     spacing of it (the record does not resolve the two:
-    :mod:`~tyredamp.modal.resolution`; ``others``: the modes to compare with, when
+    :mod:`~tyredamp.modal.search.resolution`; ``others``: the modes to compare with, when
     not those of ``res`` without its mode ``drop``), and its evidence beyond a spike
     at its two nearest lines, a step there and the terms of the modes beside it
     (:func:`narrow_evidence` on the residual of ``res`` without ``drop``) passes half

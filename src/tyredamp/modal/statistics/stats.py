@@ -32,12 +32,12 @@ real, the largest eigenvalue of a real Wishart matrix (Chiani 2017,
 The threshold depends neither on the noise level nor on the scale of the
 data; ``T`` is measured in units of the noise. ``T`` is divided by the
 residual variance of the weighted fit itself (``s^2 = cost / dof`` over
-every line, :class:`~tyredamp.modal.fit.ModalFitter`), not by the per-line
+every line, :class:`~tyredamp.modal.fit.fit.ModalFitter`), not by the per-line
 variance estimates, so the inflation ``nu / (nu - 2)`` of the goodness of fit
 (below) cancels to first order. What is left comes from the line weights
 ``w_f = 1 / g^_f`` being estimates (``nu_w`` degrees of freedom: ``nu n_out``,
 the separable line factor averages the independent residual powers of the
-outputs, :mod:`tyredamp.modal.problem`): with ``b_f = g_f / g^_f`` the
+outputs, :mod:`tyredamp.modal.problem.problem`): with ``b_f = g_f / g^_f`` the
 projection onto a mode's weighted columns explains ``sum b_f^2 a_f / sum b_f
 a_f`` noise units (``a_f`` the mode's share of line ``f``), between ``E b =
 nu_w / (nu_w - 2)`` (one line) and ``E b^2 / E b = nu_w / (nu_w - 4)`` (many
@@ -51,10 +51,10 @@ larger of the two (:func:`mode_threshold`). ``nu_w`` is ``nu n_out`` for
 outputs with independent noise, fewer when the noise is common to the
 outputs (an H1 estimate's input noise): measured from the scatter of the
 line factor between adjacent lines
-(:func:`~tyredamp.modal.problem.line_factor_dof`). Noise common to the
+(:func:`~tyredamp.modal.problem.problem.line_factor_dof`). Noise common to the
 outputs also concentrates along the response, where a mode's shape lies; the
 search raises each mode's threshold by what the residual shows there
-(:func:`span_threshold`, :mod:`tyredamp.modal.span_noise`).
+(:func:`span_threshold`, :mod:`tyredamp.modal.search.span_noise`).
 
 Goodness of fit (:func:`goodness_of_fit`): the weighted cost of the final
 fit against its chi-square expectation ``n_obs - n_par`` when the noise is
@@ -433,7 +433,7 @@ def span_threshold(
 
     ``span = (lambda_in, lambda_out, n)``: the noise variance per complex
     direction in the span of ``H(f)`` and off it, in units of the fit's noise,
-    summed over ``n`` lines (:mod:`tyredamp.modal.span_noise`). Of a mode's
+    summed over ``n`` lines (:mod:`tyredamp.modal.search.span_noise`). Of a mode's
     ``k`` parameters, ``a = min(4 n_in, k)`` can lie along the span (the
     ``n_in`` complex components of the residue's shape there, the
     participation and the pole, whose derivatives follow the shape), the

@@ -1,9 +1,9 @@
-"""The projection of :meth:`~tyredamp.modal.fit.ModalFitter.fit_added`: one added
+"""The projection of :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit_added`: one added
 mode refined with the other modes held fixed.
 
 The fixed basis ``Phi_f`` (the fixed modes and the residual terms) is projected
 out of the data once (:func:`fixed_part`: the range map of
-:func:`~tyredamp.modal._linalg._fixed_range`); an evaluation at the added
+:func:`~tyredamp.modal.fit._linalg._fixed_range`); an evaluation at the added
 mode's parameters (:func:`added_solver`) then needs only the Gram blocks of the
 added columns ``B1 = [Phi_1 | E_1]`` against ``Phi_f``, themselves and the data
 (Frisch-Waugh-Lovell theorem, e.g. Seber & Lee, *Linear Regression Analysis*,
@@ -11,10 +11,10 @@ added columns ``B1 = [Phi_1 | E_1]`` against ``Phi_f``, themselves and the data
 
 The residual search tries many candidates against the same fixed modes: the
 fixed part (:class:`FixedPart`, from :meth:`ModalFitter.fixed_part
-<tyredamp.modal.fit.ModalFitter.fixed_part>`) is an immutable value that the
+<tyredamp.modal.fit.fit.ModalFitter.fixed_part>`) is an immutable value that the
 caller forms once per fixed mode set and passes to each ``fit_added``; the
 fitter keeps nothing between calls. It holds the range map and, when the data
-fit one block (:func:`~tyredamp.modal._basis.one_block`), that block's fixed
+fit one block (:func:`~tyredamp.modal.fit._basis.one_block`), that block's fixed
 basis, weighted data rows and the rows of ``[Q_r | P_f Y]`` (an orthonormal
 basis of the range of ``Phi_f`` and the data with it projected out: an
 evaluation is then one product ``B1^T [Q_r | P_f Y]`` and ``B1^T B1``); with
@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from . import _basis
 from ._linalg import _PROJ_TOL, _fixed_range, _vp_solve
+from ._state import FitterState
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,7 @@ class _Rows:
     """The fixed basis and data rows of the blocks, within one call (nothing is
     kept between calls but what the :class:`FixedPart` holds)."""
 
-    def __init__(self, fitter: Any, fx: FixedPart | None, parts: Any, keep: bool) -> None:
+    def __init__(self, fitter: FitterState, fx: FixedPart | None, parts: Any, keep: bool) -> None:
         self.fitter, self.fx, self.parts, self.keep = fitter, fx, parts, keep
         self.cols: dict[int, NDArray[np.float64]] = {}
 
@@ -107,7 +108,7 @@ class _Rows:
 
 
 def fixed_part(
-    fitter: Any,
+    fitter: FitterState,
     th_f: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -153,15 +154,15 @@ def fixed_part(
     return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr)
 
 
-def _no_larger(fitter: Any, n_col: int) -> bool:
+def _no_larger(fitter: FitterState, n_col: int) -> bool:
     """Are ``n_col`` real columns of every line no larger than the data rows or than
-    one block of the fits (:data:`~tyredamp.modal._basis.BLOCK_BYTES`)?"""
+    one block of the fits (:data:`~tyredamp.modal.fit._basis.BLOCK_BYTES`)?"""
     return n_col <= fitter.n_out or 8 * fitter.n_rows * n_col <= _basis.BLOCK_BYTES
 
 
-def line_rows(fitter: Any, sl: slice) -> slice | NDArray[np.intp]:
+def line_rows(fitter: FitterState, sl: slice) -> slice | NDArray[np.intp]:
     """The rows of the lines ``sl`` among the rows of every line (``(k, f)``, real and
-    imaginary part interleaved, :func:`~tyredamp.modal._basis.ydata`): a slice for one
+    imaginary part interleaved, :func:`~tyredamp.modal.fit._basis.ydata`): a slice for one
     input, else the indices in the order of the rows of a block."""
     n_f, n_in = fitter.n_f, fitter.n_in
     start, stop, _ = sl.indices(n_f)
@@ -171,7 +172,13 @@ def line_rows(fitter: Any, sl: slice) -> slice | NDArray[np.intp]:
     return np.stack([2 * e, 2 * e + 1], axis=1).ravel()
 
 
-def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], lay1: Any) -> Any:
+def added_solver(
+    fitter: FitterState,
+    one: FitterState,
+    fx: FixedPart,
+    ref1: NDArray[np.intp],
+    lay1: _basis.Layout,
+) -> Any:
     """The projection at the added mode's parameters (``solve(th)`` of
     :meth:`ModalFitter._refine`); ``one``: the fitter of the added mode alone (no
     residual terms), ``lay1`` its derivative layout."""
@@ -198,7 +205,7 @@ def added_solver(fitter: Any, one: Any, fx: FixedPart, ref1: NDArray[np.intp], l
             n_rows=fitter.n_rows,
         )
         sol["lay"] = lay1
-        sol["coef"] = one._coef(lay1, pp1[0])
+        sol["coef"] = _basis.coef(lay1, pp1[0])  # ModalFitter._coef
         return sol
 
     def solve_one(th: NDArray[np.float64]) -> dict[str, Any]:

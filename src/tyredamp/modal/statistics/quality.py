@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..exceptions import InputError
+from ...exceptions import InputError
 
 __all__ = [
     "FitQuality",
@@ -180,7 +180,7 @@ def rejected_summary(rejected: Sequence[RejectedMode], n: int = 3) -> str:
 def threshold_text(thr: float, base: float) -> str:
     """A mode's threshold ``thr`` for a reason text; says when the noise along the
     response raised it above the base threshold ``base``
-    (:func:`~tyredamp.modal.search.local_thresholds`)."""
+    (:func:`~tyredamp.modal.search.thresholds.local_thresholds`)."""
     if thr > base:
         return f"{thr:.3g} (raised from {base:.3g}: noise along the response)"
     return f"{thr:.3g}"
@@ -210,11 +210,11 @@ class FitQuality:
         Lines of the band.
     noise_source : str
         ``"variance"``, ``"coherence"`` or ``"residual"`` (see
-        :mod:`tyredamp.modal.problem`).
+        :mod:`tyredamp.modal.problem.problem`).
     noise_rms_per_output : ndarray, shape (n_out,)
         Noise RMS per output (FRF unit; read-only): known, or the residual RMS.
     chi2, dof, p_value : float, int, float
-        Goodness-of-fit test (:func:`tyredamp.modal.stats.goodness_of_fit`).
+        Goodness-of-fit test (:func:`tyredamp.modal.statistics.stats.goodness_of_fit`).
     passed : bool
         The cost is within its chi-square range.
     verdict : str
@@ -223,7 +223,7 @@ class FitQuality:
         Mode statistic ``T`` of each mode (cost rise in units of the noise
         variance when the mode is removed; read-only).
     threshold : float
-        Base threshold of ``T`` (:func:`tyredamp.modal.stats.mode_threshold`).
+        Base threshold of ``T`` (:func:`tyredamp.modal.statistics.stats.mode_threshold`).
     false_alarm : float
         Level of the mode test and of the goodness-of-fit test.
     kept : tuple of str
@@ -237,7 +237,7 @@ class FitQuality:
     thresholds : ndarray, shape (m,)
         The threshold applied to each mode's ``T`` (read-only): ``threshold``
         raised where the residual's noise lies along the response
-        (:func:`tyredamp.modal.search.local_thresholds`), ``threshold`` itself
+        (:func:`tyredamp.modal.search.thresholds.local_thresholds`), ``threshold`` itself
         where it was not raised or no test was made (modes asked for, real
         modes). Default (empty): ``threshold`` for every mode, as in records
         written before it existed.

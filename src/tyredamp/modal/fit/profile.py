@@ -1,6 +1,6 @@
 """Likelihood intervals of the natural frequencies and damping ratios.
 
-The standard errors of :mod:`~tyredamp.modal.fit` and :mod:`~tyredamp.modal.ml`
+The standard errors of :mod:`~tyredamp.modal.fit.fit` and :mod:`~tyredamp.modal.fit.ml`
 are linearised (Gauss-Newton, ``s^2 (J^T J)^-1``): the interval ``theta^ +-
 1.96 sd`` is exact when the model is linear in its parameters near the
 optimum. A mode's FRF is not linear in its pole on the scale of its half-power
@@ -258,7 +258,7 @@ def profile_mode(
     profile never reached the cut, :func:`_end`), None when a profile failed.
 
     ``evaluate(theta) -> (cost, J^T J, J^T r, by-product)`` is the fit's cost
-    (:meth:`~tyredamp.modal.fit.ModalFitter._solve` with its normal equations),
+    (:meth:`~tyredamp.modal.fit.fit.ModalFitter._solve` with its normal equations),
     ``theta`` its optimum (poles first, :meth:`ModalFitter.pack` layout), ``sd``
     the linearised standard errors of f (Hz) and zeta (the first steps),
     ``w_ref`` the fitter's reference frequency (rad/s), ``scale`` the cost at

@@ -1,8 +1,8 @@
 """Mass-normalised scaling of a modal fit and the standard errors of its shapes.
 
-Functions of a :class:`~tyredamp.modal.fit.ModalFitter` (its methods
+Functions of a :class:`~tyredamp.modal.fit.fit.ModalFitter` (its methods
 ``_scale``, ``_scale_jacobian`` and ``_shape_std``); the equations are stated
-in the docstring of :mod:`tyredamp.modal.fit` (scaling, uncertainty).
+in the docstring of :mod:`tyredamp.modal.fit.fit` (scaling, uncertainty).
 """
 
 from __future__ import annotations
@@ -13,9 +13,11 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.linalg import lapack
 
+from ._state import FitterState
+
 
 def scale(
-    fitter: Any,
+    fitter: FitterState,
     th: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -54,7 +56,7 @@ def scale(
 
 
 def scale_jacobian(
-    fitter: Any,
+    fitter: FitterState,
     th: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -133,7 +135,7 @@ def scale_jacobian(
 
 
 def shape_std(
-    fitter: Any,
+    fitter: FitterState,
     th: NDArray[np.float64],
     m: int,
     ref: NDArray[np.intp],
@@ -212,7 +214,7 @@ def pole_std(
     """Standard errors of f (Hz), zeta and the pole (rad/s) of the ``m`` modes by the
     delta method from the covariance ``cth`` of the parameters ``th`` (poles first:
     ``sigma = w_ref exp(x1)``, ``Omega = w_ref x2``, the pole parametrisation of
-    :class:`~tyredamp.modal.fit.ModalFitter`)."""
+    :class:`~tyredamp.modal.fit.fit.ModalFitter`)."""
     ar = np.arange(m)
     sig = w_ref * np.exp(th[0 : 2 * m : 2])
     om = w_ref * th[1 : 2 * m : 2]

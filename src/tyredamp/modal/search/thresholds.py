@@ -1,6 +1,6 @@
 """Each mode's own threshold: the mode test's, raised where the residual's noise
-lies along the response (:mod:`tyredamp.modal.span_noise`,
-:func:`~tyredamp.modal.stats.span_threshold`)."""
+lies along the response (:mod:`tyredamp.modal.search.span_noise`,
+:func:`~tyredamp.modal.statistics.stats.span_threshold`)."""
 
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from .fit import FitResult, ModalFitter
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.stats import FALSE_ALARM, span_threshold
 from .residual_peaks import model_of
 from .span_noise import SpanNoise, span_noise
-from .stats import FALSE_ALARM, span_threshold
 
 __all__ = ["ModeTest", "local_thresholds", "residual_span"]
 
@@ -21,7 +21,7 @@ __all__ = ["ModeTest", "local_thresholds", "residual_span"]
 class ModeTest:
     """What a mode's own threshold needs besides the base one: the parameters
     ``k`` of a mode, the lines of the band and the false-alarm rate
-    (:func:`~tyredamp.modal.stats.span_threshold`)."""
+    (:func:`~tyredamp.modal.statistics.stats.span_threshold`)."""
 
     k: int
     n_lines: int
@@ -29,7 +29,7 @@ class ModeTest:
 
 
 def residual_span(fitter: ModalFitter, res: FitResult) -> SpanNoise:
-    """Residual noise in and off the span of the data (:mod:`~tyredamp.modal.span_noise`)."""
+    """Residual noise in and off the span of the data (:mod:`~tyredamp.modal.search.span_noise`)."""
     poles, residues, terms, s2 = model_of(fitter, res)
     return span_noise(fitter, poles, residues, terms, s2)
 
@@ -42,7 +42,7 @@ def local_thresholds(
     test: ModeTest | None,
 ) -> NDArray[np.float64]:
     """Each pole's threshold: ``threshold`` raised where the residual's noise lies
-    along the response (:func:`~tyredamp.modal.stats.span_threshold`); ``threshold``
+    along the response (:func:`~tyredamp.modal.statistics.stats.span_threshold`); ``threshold``
     for every pole without ``test`` or ``span``."""
     if test is None or span is None:
         return np.full(poles.size, float(threshold))

@@ -1,6 +1,6 @@
 """Where a fit's residual holds structure a missed mode could explain.
 
-The residual search (:func:`~tyredamp.modal.search.residual_search`) starts
+The residual search (:func:`~tyredamp.modal.search.search.residual_search`) starts
 trial modes at the peaks of the residual power per line, summed over the FRFs
 in units of each output's noise variance (a mode indicator on the residual).
 A missed mode of damping ratio ``zeta`` at ``f`` leaves its residual power
@@ -11,7 +11,7 @@ damping ratios (a matched filter per scale, its width proportional to the
 frequency), and a line is a candidate when one of these sums stands out of
 the noise's own scatter and could hold a mode that passes the test: the cost
 drop of a mode fitted there is at least the excess within its band (the mode
-test's statistic ``T``, :mod:`tyredamp.modal.stats`).
+test's statistic ``T``, :mod:`tyredamp.modal.statistics.stats`).
 
 The noise level of a line is the mean of the residual power under noise,
 estimated robustly from its median: the residual power of a line is a sum of
@@ -25,15 +25,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..mechanics.modal_sum import pole_from_frequency_damping
-from ._basis import factors, residual_lines, residual_power
-from .fit import FitResult, ModalFitter
-from .stats import chi2_isf
+from ...mechanics.modal_sum import pole_from_frequency_damping
+from ..fit._basis import factors, residual_lines, residual_power
+from ..fit.fit import FitResult, ModalFitter
+from ..statistics.stats import chi2_isf
 
 __all__ = [
     "ResidualPeaks",
@@ -330,7 +329,7 @@ def _rank_one_off_fitted(
 
 
 def _scan_scale(
-    fit: Any,
+    fit: ModalFitter,
     f: NDArray[np.float64],
     z: float,
     resid: Callable[[slice], NDArray[np.complex128]],
@@ -404,7 +403,7 @@ class ScanGrid:
 
 
 def coherent_scan(
-    fitter: object,
+    fitter: ModalFitter,
     model: tuple[
         NDArray[np.complex128],
         NDArray[np.complex128],
@@ -432,7 +431,7 @@ def coherent_scan(
     most of a weak mode's share between two strong ones). ``model`` is the
     fit's ``(poles, residues (n_out, n_in, m), (upper, lower))``.
     """
-    fit: Any = fitter
+    fit = fitter
     f = np.asarray(fit.f, dtype=np.float64)
     empty = ScanGrid(np.zeros(0, complex), np.zeros(0), np.zeros(0, bool))
     if f.size < 3 or not f[0] > 0:
@@ -480,8 +479,8 @@ def model_of(
     tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
     NDArray[np.float64],
 ]:
-    """A fit's model for the residual functions of :mod:`._basis`: poles, residues
-    ``R = u l`` (n_out, n_in, m; u unscaled without drive points, or scaled),
+    """A fit's model for the residual functions of :mod:`~tyredamp.modal.fit._basis`: poles,
+    residues ``R = u l`` (n_out, n_in, m; u unscaled without drive points, or scaled),
     residual terms, and each output's noise variance (at least the fitter's floor)."""
     residues = res.psi_out[:, None, :] * res.psi_in[None, :, :]
     s2 = np.maximum(res.sigma_out**2, np.maximum(fitter.noise_floor**2, 1e-300))

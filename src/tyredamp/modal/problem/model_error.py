@@ -59,11 +59,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize
 
-from ..frf import FRF, FRFKind
-from ..mechanics.modal_sum import kind_factor
-from .model import ModalModel
+from ...frf import FRF, FRFKind
+from ...mechanics.modal_sum import kind_factor
+from ..model import ModalModel
+from ..statistics.stats import difference_noise
 from .problem import FitProblem, build_problem
-from .stats import difference_noise
 
 __all__ = [
     "EPS_TOLERANCE",
@@ -103,7 +103,7 @@ def noise_floor(
     """``V`` of eq. (1) on the whole axis of ``frf``, for a fit whose noise was
     estimated from its residual: per FRF the larger of two robust estimates, the
     noise floor from second differences of the band's lines
-    (:func:`~tyredamp.modal.stats.difference_noise`) and the median of the fit's own
+    (:func:`~tyredamp.modal.statistics.stats.difference_noise`) and the median of the fit's own
     ``residual`` (shape (n_out, n_in, n_band), units of ``H``; ``|r|^2`` of complex
     Gaussian noise is exponential with median ``s^2 ln 2``). A median leaves out the
     few lines near sharp peaks where the model errs; the residual's median also holds

@@ -1,6 +1,6 @@
 """Noise along the response: how much of the residual lies in the span of ``H(f)``.
 
-The mode test (:mod:`tyredamp.modal.stats`) counts each of a mode's ``k``
+The mode test (:mod:`tyredamp.modal.statistics.stats`) counts each of a mode's ``k``
 parameters as taking one noise unit out of the cost, as it does when the
 noise of the outputs is independent with the variance the fit assumes. An H1
 estimate from signals with input (force) noise breaks that. With ``Y = H X +
@@ -33,7 +33,7 @@ thresholds of weak true modes. The sums over
 the lines near a candidate (its half-power band, at least ``WINDOW`` lines
 either side) give ``lambda_in`` and ``lambda_out``, the noise variance per
 direction in and off the span in units of the fit's noise
-(:func:`~tyredamp.modal.stats.span_threshold` turns them into the mode's
+(:func:`~tyredamp.modal.statistics.stats.span_threshold` turns them into the mode's
 threshold). With ``n_out <= n_in`` nothing is off the span, and both are 1.
 """
 
@@ -45,10 +45,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _basis
+from ..fit import _basis
 
 if TYPE_CHECKING:
-    from .fit import ModalFitter
+    from ..fit.fit import ModalFitter
 
 __all__ = ["SpanNoise", "span_noise"]
 
@@ -120,8 +120,8 @@ def span_noise(
 ) -> SpanNoise:
     """Residual power in and off the span of ``H(f)`` per line (module docstring).
 
-    Arguments as :func:`~tyredamp.modal._basis.residual_power` (``fitter`` a
-    :class:`~tyredamp.modal.fit.ModalFitter`, ``s2`` its noise variance per
+    Arguments as :func:`~tyredamp.modal.fit._basis.residual_power` (``fitter`` a
+    :class:`~tyredamp.modal.fit.fit.ModalFitter`, ``s2`` its noise variance per
     output).
     """
     n_out, n_in, n_f = fitter.H.shape
