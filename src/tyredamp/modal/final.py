@@ -48,7 +48,7 @@ from .search.search import (
 )
 from .statistics.indicators import mean_phase_deviation, modal_phase_collinearity
 from .statistics.quality import FitQuality, RejectedMode, threshold_text
-from .statistics.stats import GoodnessOfFit, difference_noise, goodness_of_fit
+from .statistics.stats import GoodnessOfFit, chi2_isf, difference_noise, goodness_of_fit
 
 __all__ = ["fit_real", "goodness", "to_model", "unscale"]
 
@@ -273,6 +273,37 @@ class ModelContext:
     #: ``threshold`` raised where the noise lies along the response
     #: (:func:`final_complex`); None: ``threshold`` for every mode
     thresholds: NDArray[np.float64] | None = None
+    #: each in-band mode's noise along the response over the fit's noise, where it
+    #: exceeds its scatter (fit order; :func:`noise_along_response`); None: not measured
+    along: NDArray[np.float64] | None = None
+
+
+def noise_along_response(
+    fitter: ModalFitter, res: FitResult, n_band: int, alpha: float = 0.05
+) -> NDArray[np.float64]:
+    """Each in-band mode's noise variance along the response, in units of the fit's
+    noise, where it is significantly above 1; 1 elsewhere (n_band,).
+
+    With a noisy force, the H1 error ``-H N X^+`` is common to the outputs and lies
+    in the span of ``H(f)`` (errors in variables; :mod:`~tyredamp.modal.search.span_noise`),
+    which near a mode is the mode's shape: the pole and the shape are estimated
+    from that direction, whose noise is ``lambda_in`` times the fit's, while their
+    linearised standard errors take every direction at the fit's level (too small
+    by up to ``sqrt(n_out)``). ``lambda_in`` over ``n`` lines around the mode holds
+    ``2 n_in^2 n`` real units of noise, so under independent outputs ``lambda_in
+    nu`` is ``chi2_nu`` with ``nu = 2 n_in^2 n``; it is used where it exceeds that
+    law's upper ``alpha`` quantile over ``nu``.
+    """
+    out = np.ones(n_band)
+    if n_band == 0:
+        return out
+    span = residual_span(fitter, res)
+    for i, p in enumerate(res.poles[:n_band]):
+        lam, _, n = span.at(complex(p))
+        nu = 2.0 * fitter.n_in**2 * n
+        if n > 0 and lam > chi2_isf(alpha, nu) / nu:
+            out[i] = lam
+    return out
 
 
 def local_dispersion(
@@ -402,7 +433,8 @@ def to_model(
     o = np.argsort(u.poles[:n_band].imag)
     poles, psi_out, psi_in = u.poles[o], u.psi_out[:, o], u.psi_in[:, o]
     disp = local_dispersion(pr, res, sq, n_band)[o]
-    inflate = np.sqrt(disp)
+    along = np.ones(n_band) if ctx.along is None else np.asarray(ctx.along, dtype=float)[o]
+    inflate = np.sqrt(np.maximum(disp, along))
     std, intervals = _intervals_95(res, u, o, poles, inflate)
     n_f = pr.H.shape[-1]
     rmsd = float(c * np.sqrt(sq.sum()) / sq.size)
@@ -468,6 +500,7 @@ def to_model(
         "drive_point_phi2": u.drive_phi2[o],
         "std_pole": res.std_pole[o] * inflate,
         "local_dispersion": disp,
+        "noise_along_response": along,
         **intervals,
         "n_residual_modes": len(res.poles) - n_band,
         "warnings": list(res.warnings) + unresolved,
@@ -498,7 +531,7 @@ def final_complex(
     combined: ModalFitter | None,
     threshold: float | None = None,
     test: ModeTest | None = None,
-) -> tuple[FitResult, ModeSet, list[RejectedMode], NDArray[np.float64] | None]:
+) -> tuple[FitResult, ModeSet, list[RejectedMode], NDArray[np.float64] | None, NDArray[np.float64]]:
     """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
     combinations (many outputs), whose poles then give the residues of every output.
 
@@ -509,7 +542,8 @@ def final_complex(
     fell to its threshold in the final refinement (its pole moved onto noise,
     e.g. a damping that collapsed) is dropped, the weakest first, and the fit
     repeated. Also returns the threshold applied to each kept in-band mode (fit
-    order; None without ``threshold``). When every mode passes with the other
+    order; None without ``threshold``) and each in-band mode's noise along the
+    response (:func:`noise_along_response`, fit order). When every mode passes with the other
     poles held, modes beside a stronger one are tested once more with the
     neighbours' poles refitted (:mod:`~tyredamp.modal.search.refitted`: the likelihood
     ratio of the maximised models) and dropped, the weakest first, when that
@@ -572,7 +606,7 @@ def final_complex(
         res = maximum_likelihood(problem, cfit, res)
         # likelihood intervals where the linearised ones would be too short
         res.intervals = fit_intervals(cfit, res, cur.m, sigma0)
-    return res, cur, dropped, thr
+    return res, cur, dropped, thr, noise_along_response(cfit, res, cur.m)
 
 
 def _spacing(problem: FitProblem) -> float:

@@ -642,9 +642,9 @@ def _final_models(
     base: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet] = (*modes.all(), modes)
     for kind in kinds:
         extra_warn: list[str] = []
-        thresholds = None
+        thresholds = along = None
         if kind == "complex":
-            res, cur, dropped, thresholds = final_complex(
+            res, cur, dropped, thresholds, along = final_complex(
                 problem,
                 fitters.cfit,
                 modes,
@@ -677,6 +677,7 @@ def _final_models(
             rejected=tuple(rej),
             method=ctx["method"],
             thresholds=thresholds,
+            along=along,
         )
         models[kind], disc[kind] = to_model(res, n_band, c)
     return models, disc
