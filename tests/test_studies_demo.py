@@ -216,7 +216,9 @@ def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> No
         assert_allclose(tir["STRUCTURAL"]["FREQ_LONG"], rr["FREQ_LONG"]["value"], rtol=1e-8)
     # recovered against the virtual tyre's own parameters (taken here from the defaults,
     # not from the document): EI within 5 % (the 64-node finite-difference ring alone reads
-    # as 3 % less EI, see from_exact_modes), tension and k_r within 2 % at every pressure
+    # as 3 % less EI, see from_exact_modes), tension within 3 % and k_r within 5 % at every
+    # pressure (the fitted ring has neither the air cavity nor the rubber: the tension
+    # takes 2-2.5 % of that, moving with the weights the modes' standard errors give)
     true = RingTyreParameters()
     par = {p["name"]: p for p in tm["parameters"]}
     assert_allclose(par["EI"]["value"], true.bending_stiffness, rtol=0.05)
@@ -225,7 +227,7 @@ def test_tyre_model_section_files_and_truth(demo: tuple[DemoResult, Path]) -> No
     assert par["EI"]["verdict"] == "identified"
     for pp, p in zip(tm["per_pressure"], pressures, strict=True):
         tp = true.with_pressure(p * 1e5)
-        assert_allclose(pp["T0"]["value"], tp.hoop_tension, rtol=0.02)
+        assert_allclose(pp["T0"]["value"], tp.hoop_tension, rtol=0.03)  # see above
         # the fitted ring has no air cavity, whose coupling lowers n = 1 by 4 %: its k_r
         # reads about 3 % low
         assert_allclose(pp["k_r"]["value"], tp.radial_stiffness, rtol=0.05)
@@ -269,8 +271,9 @@ def test_tyre_model_single_pressure(demo: tuple[DemoResult, Path]) -> None:
     par = {p["name"]: p for p in sec["parameters"]}
     tp = RingTyreParameters(pressure=main.pressure_bar * 1e5)
     assert_allclose(par["T0"]["true"], tp.hoop_tension, rtol=1e-12)
-    assert_allclose(par["T0"]["value"], tp.hoop_tension, rtol=0.02)
-    assert_allclose(par["k_r"]["value"], tp.radial_stiffness, rtol=0.05)  # no cavity in the ring
+    # no cavity nor rubber in the fitted ring: tension within 3 %, k_r within 5 %
+    assert_allclose(par["T0"]["value"], tp.hoop_tension, rtol=0.03)
+    assert_allclose(par["k_r"]["value"], tp.radial_stiffness, rtol=0.05)
     assert_allclose(par["EI"]["value"], tp.bending_stiffness, rtol=0.05)
 
 
