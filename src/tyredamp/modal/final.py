@@ -101,7 +101,7 @@ def fit_real(
     search: ModalFitter | None,
     start: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet],
     sigma0: NDArray[np.float64] | None = None,
-) -> tuple[FitResult, int, list[str]]:
+) -> tuple[FitResult, int, list[str], NDArray[np.float64]]:
     """Real-mode fit (pole-pair optimisation) started from the complex-mode poles.
 
     The real model keeps the modes of the complex model. When its refinement
@@ -114,6 +114,8 @@ def fit_real(
     noise per output of the final fits; with it, the modes whose linearised
     intervals would be too short get likelihood intervals
     (:func:`~tyredamp.modal.fit.profile.fit_intervals`), as in the complex model.
+    Also returns the in-band modes' noise along the response
+    (:func:`noise_along_response`), as :func:`final_complex` does.
     """
     p0, l0, modes = start
     m, nf = modes.m, modes.n_free
@@ -130,7 +132,8 @@ def fit_real(
     sigma = problem.sigma_out
     passes = 1 if sigma is not None else 2
     if not refine:
-        return fitter.fit(p0, l0, refine=False, sigma=sigma), m, []
+        res = fitter.fit(p0, l0, refine=False, sigma=sigma)
+        return res, m, [], noise_along_response(fitter, res, m)
     start_p, start_l = p0, l0
     why, bad = "", -1
     if search is not None:
@@ -162,7 +165,7 @@ def fit_real(
                 res = ml
             # likelihood intervals where the linearised ones would be too short
             res.intervals = fit_intervals(fitter, res, m, sigma0)
-            return res, m, []
+            return res, m, [], noise_along_response(fitter, res, m)
         if bad >= m + nf:
             keep = np.arange(start_p.size) != bad
             start_p, start_l, p0, l0 = start_p[keep], start_l[keep], p0[keep], l0[keep]
@@ -175,6 +178,7 @@ def fit_real(
             f"real-mode refinement not acceptable ({why}): poles kept at the complex-mode "
             "values, real residues fitted"
         ],
+        noise_along_response(fitter, res, m),
     )
 
 

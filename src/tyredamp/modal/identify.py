@@ -659,7 +659,9 @@ def _final_models(
             n_band = cur.m
         else:
             compressed = fitters.sfit if fitters.sfit is not fitters.cfit else None
-            res, n_band, extra_warn = fit_real(problem, residuals, refine, compressed, base, sigma0)
+            res, n_band, extra_warn, along = fit_real(
+                problem, residuals, refine, compressed, base, sigma0
+            )
         res.warnings.extend(extra_warn)
         kept = ctx["kept"]
         if kept is not None and len(kept) != n_band:
