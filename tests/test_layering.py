@@ -28,7 +28,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "tyredamp"
 
 #: Floors from the ground up; a package imports only from lower floors.
 FLOORS: tuple[tuple[str, ...], ...] = (
-    ("__init__", "exceptions", "_validate", "_blas", "frf", "timedata", "geometry"),
+    ("__init__", "exceptions", "_validate", "_blas", "_lazy", "frf", "timedata", "geometry"),
     ("mechanics",),
     ("signal",),
     ("modal", "lateral"),

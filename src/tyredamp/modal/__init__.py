@@ -58,8 +58,9 @@ imported with them), so a deep import loads only what it names.
 
 from __future__ import annotations
 
-from importlib import import_module
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
 
 if TYPE_CHECKING:
     from .fit.fit import FitResult, ModalFitter
@@ -140,16 +141,4 @@ __all__ = [
     "stability_flags",
 ]
 
-
-def __getattr__(name: str) -> Any:
-    """The public names on first access (PEP 562, see ``_WHERE``)."""
-    mod = _WHERE.get(name)
-    if mod is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(import_module(f"{__name__}.{mod}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_names(__name__, _WHERE, __all__, globals())

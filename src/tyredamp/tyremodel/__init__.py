@@ -27,8 +27,9 @@
 
 from __future__ import annotations
 
-from importlib import import_module
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
 
 if TYPE_CHECKING:
     from .harmonics import alias_candidates, harmonic_fit, resolved_wave_numbers
@@ -106,16 +107,4 @@ __all__ = [
     "windup_from_modes",
 ]
 
-
-def __getattr__(name: str) -> Any:
-    """The public names on first access (PEP 562, see ``_WHERE``)."""
-    mod = _WHERE.get(name)
-    if mod is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(import_module(f"{__name__}.{mod}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *__all__})
+__getattr__, __dir__ = lazy_names(__name__, _WHERE, __all__, globals())
