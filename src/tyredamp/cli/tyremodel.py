@@ -413,6 +413,13 @@ def tyre_model_command(
         )
 
 
+def _is_uff(path: Path) -> bool:
+    """Is ``path`` named as a UFF file (modes from another program, data sets 55)?"""
+    from ..io import FILE_FORMATS
+
+    return path.suffix.lower() in FILE_FORMATS["uff58b"].extensions
+
+
 def _read_tyre_modes(path: Path, model_kind: str, geometry_file: Path | None) -> ModalModel:
     """The modes of one file as radial shapes with their angles around the tread.
 
@@ -425,9 +432,8 @@ def _read_tyre_modes(path: Path, model_kind: str, geometry_file: Path | None) ->
     in one line.
     """
     from ..damping.modeset import at_shape_points, scaling_problem
-    from ..io import FILE_FORMATS
 
-    uff = path.suffix.lower() in FILE_FORMATS["uff58b"].extensions
+    uff = _is_uff(path)
     from ..documents.modes import read_modes
 
     models = read_modes(path)  # a UFF file of data sets 55 or a modes JSON
@@ -473,7 +479,6 @@ def _read_tangential(
     opts: _Options | None, model_kind: str, geometry_file: Path | None
 ) -> list[tuple[float | None, ModalModel, str]]:
     """The tangential tests: ``(pressure in Pa or None, modes, file name)``, checked."""
-    from ..io import FILE_FORMATS
     from ..tyremodel.windup import check_tangential
 
     if opts is None or not opts.tangential:
@@ -487,7 +492,7 @@ def _read_tangential(
         )
     out: list[tuple[float | None, ModalModel, str]] = []
     for i, path in enumerate(files):
-        if path.suffix.lower() in FILE_FORMATS["uff58b"].extensions:
+        if _is_uff(path):
             raise InputError(
                 f"--tangential: {path}: expected a modes JSON (tyredamp modal of the tangential "
                 "FRFs), got a UFF file"
@@ -536,13 +541,11 @@ def _tyre_model(
                 f"{path}: the test pressure is not recorded in the file; give --pressure"
             )
         inputs.append((pb * _BAR, mdl, path.name))
-    from ..io import FILE_FORMATS
     from ..virtual.tangential import TANGENTIAL_DIRECTION
 
     for (_, mdl, src), path in zip(inputs, modes_files, strict=True):
         # a UFF 55 file's shapes were projected on the radius above (direction 1 there)
-        uff = path.suffix.lower() in FILE_FORMATS["uff58b"].extensions
-        if not uff and {abs(c.direction) for c in mdl.outputs} == {TANGENTIAL_DIRECTION}:
+        if not _is_uff(path) and {abs(c.direction) for c in mdl.outputs} == {TANGENTIAL_DIRECTION}:
             raise InputError(
                 f"{src}: the response channels are tangential (UFF direction "
                 f"{TANGENTIAL_DIRECTION} on the ring, as tyredamp's tangential test writes "
