@@ -12,6 +12,7 @@ from tyredamp import InputError, PhysicsError, ShapeError, TyredampError
 from tyredamp.mechanics import (
     MCKSystem,
     modal_damping_matrix,
+    periodic_response_lines,
     pole_from_frequency_damping,
     proportional_part,
     rayleigh_coefficients,
@@ -222,6 +223,25 @@ def test_time_response_periodic_steady_state() -> None:
     err = np.max(np.abs(last - ss)) / np.max(np.abs(ss))
     # exact up to the truncated alias sum (~1/m^4 tail) and the transient left
     assert err < 1e-6
+
+
+def test_periodic_response_lines_equal_the_settled_time_response() -> None:
+    """DFT closed form of the FOH recursion (spec eq. [10]) vs stepping it to steady state."""
+    s = chain_system(n=3, k=2.0e3, c_local=(3.0, 1.0, 0.5))
+    fs, n = 64.0, 64
+    rng = np.random.default_rng(4)
+    force = rng.normal(size=(2, n))
+    n_per = 60  # the slowest mode's transient decays below 1e-10 of the response
+    r = time_response(s, np.tile(force, n_per), fs, inputs=[0, 2], outputs=[1, 2])
+    disp, acc = periodic_response_lines(s, force, fs, [0, 2], [1, 2], n // 2 + 1)
+    for got, sampled in ((disp, r.displacement), (acc, r.acceleration)):
+        want = np.fft.rfft(sampled[:, -n:], axis=1)
+        # the same discrete system: equal to rounding and the transient left
+        assert_allclose(got, want, rtol=0, atol=1e-8 * np.abs(want).max())
+    with pytest.raises(ShapeError, match="n_lines"):
+        periodic_response_lines(s, force, fs, [0, 2], [1], n // 2 + 2)
+    with pytest.raises(ShapeError, match="one row per input"):
+        periodic_response_lines(s, force[:1], fs, [0, 2], [1], 3)
 
 
 def test_time_response_harmonic_matches_frf() -> None:

@@ -27,7 +27,7 @@ from .proportional import (
     rayleigh_damping,
     rayleigh_damping_ratios,
 )
-from .response import TimeResponse, step_coefficients, time_response
+from .response import TimeResponse, periodic_response_lines, step_coefficients, time_response
 from .system import ComplexModes, MCKSystem, UndampedModes, normalisation_constants
 
 __all__ = [
@@ -44,6 +44,7 @@ __all__ = [
     "modal_damping_matrix",
     "modal_sum_receptance",
     "normalisation_constants",
+    "periodic_response_lines",
     "pole_from_frequency_damping",
     "pole_quantities",
     "proportional_part",

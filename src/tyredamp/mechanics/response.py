@@ -23,7 +23,7 @@ from .._validate import as_finite, check_positive
 from ..exceptions import ShapeError
 from .system import MCKSystem, _dofs
 
-__all__ = ["TimeResponse", "step_coefficients", "time_response"]
+__all__ = ["TimeResponse", "periodic_response_lines", "step_coefficients", "time_response"]
 
 #: Modes handled at once when accumulating the physical response.
 _MODE_CHUNK = 64
@@ -165,3 +165,82 @@ def time_response(
     return TimeResponse(
         time=np.arange(ns, dtype=float) * h, displacement=disp, velocity=vel, acceleration=acc
     )
+
+
+def periodic_response_lines(
+    system: MCKSystem,
+    force_period: ArrayLike,
+    sample_rate: float,
+    inputs: Sequence[int],
+    outputs: Sequence[int],
+    n_lines: int,
+) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
+    """First DFT lines of the periodic steady-state response to a periodic force.
+
+    The force repeats with period ``N / sample_rate`` (``N`` samples, first-order
+    hold between samples as in :func:`time_response`). In the periodic steady
+    state each complex mode's sequence ``q_k`` of :func:`time_response`,
+    ``q_{k+1} = Phi q_k + (E0 - E1) g_k + E1 g_{k+1}`` with ``g = psi^T f``
+    (spec eq. [10], coefficients of :func:`step_coefficients`), is periodic, so
+    its DFT over one period obeys ``z Q = Phi Q + (E0 - E1) G + E1 z G`` with
+    ``z = exp(2 pi i l / N)`` at line ``l``:
+
+    ``Q_l = (E0 - E1 + E1 z) / (z - Phi) G_l``.
+
+    The physical response is ``x = 2 Re sum psi q`` and
+    ``a = 2 Re sum p^2 psi q + M^-1 f`` (the direct term of the acceleration);
+    the DFT of ``conj(psi q)`` at line ``l`` is that of the mode with conjugate
+    pole, shape and coefficients, so the conjugate modes enter as modes of
+    their own. The result equals the DFT of the sampled response of
+    :func:`time_response` started from the periodic state, to rounding, without
+    stepping through the ``N`` samples of every mode.
+
+    Parameters
+    ----------
+    system : MCKSystem
+        An underdamped system.
+    force_period : array_like, shape (n_in, N)
+        One period of the forces in N (the sample after the last is the first).
+    sample_rate : float
+        Samples per second (Hz).
+    inputs, outputs : sequence of int
+        DOF indices of the forces and of the responses.
+    n_lines : int
+        Number of DFT lines returned, ``0 <= l < n_lines <= N // 2 + 1``.
+
+    Returns
+    -------
+    displacement, acceleration : ndarray, shape (n_out, n_lines), complex
+        The unnormalised DFT (``numpy.fft.rfft`` convention) of one period of
+        the displacement (m) and the acceleration (m/s^2) at ``outputs``.
+    """
+    fs = check_positive(sample_rate, "sample_rate")
+    f = as_finite(force_period, "force_period")
+    if f.ndim == 1:
+        f = f[None, :]
+    ii = _dofs(inputs, system.n_dof, "inputs")
+    oi = _dofs(outputs, system.n_dof, "outputs")
+    if f.ndim != 2 or f.shape[0] != ii.size:
+        raise ShapeError(
+            f"force_period: expected shape ({ii.size}, n_samples), one row per input, got {f.shape}"
+        )
+    n = f.shape[1]
+    if not 0 < int(n_lines) <= n // 2 + 1:
+        raise ShapeError(f"n_lines: expected 1..{n // 2 + 1} for {n} samples, got {n_lines}")
+    lines = int(n_lines)
+    cm = system.complex_modes()
+    phi, e0, e1 = step_coefficients(cm.poles, 1.0 / fs)
+    # each conjugate pair as two modes: (p, psi, coefficients) and their conjugates
+    p = np.concatenate([cm.poles, cm.poles.conj()])
+    psi = np.concatenate([cm.psi, cm.psi.conj()], axis=1)
+    phi, e0, e1 = (np.concatenate([c, c.conj()]) for c in (phi, e0, e1))
+    force = np.fft.rfft(f, axis=1)[:, :lines]  # (n_in, lines)
+    z = np.exp(2j * np.pi * np.arange(lines) / n)
+    transfer = ((e0 - e1)[:, None] + e1[:, None] * z) / (z - phi[:, None])
+    q = transfer * (psi[ii].T @ force)  # (2m, lines)
+    disp = psi[oi] @ q
+    unit = np.zeros((system.n_dof, ii.size))
+    unit[ii, np.arange(ii.size)] = 1.0
+    minv_block = sla.cho_solve(sla.cho_factor(system.M), unit)[oi]
+    acc = (psi[oi] * p**2) @ q + minv_block @ force
+    return disp, acc

@@ -21,15 +21,18 @@ period inside ``band``.
 
 Steady state
 ------------
-By default the simulation starts in the exact periodic steady state: for each
-complex mode, ``q' = p q + psi^T f`` (spec eq. [10]) is propagated over one
-period from rest with the same one-step coefficients as ``time_response``
-(:func:`~tyredamp.mechanics.step_coefficients`), giving ``q_P``; the periodic
-initial value is ``q*(0) = q_P / (1 - e^{p T})``, and
-``x0 = 2 Re sum psi q*``, ``v0 = 2 Re sum p psi q*``. One period is then
-simulated with ``time_response`` from ``(x0, v0)``; the noise-free
-steady-state response is exactly periodic, so the record is that period
-repeated, plus independent noise. ``initial_state="rest"`` instead simulates
+By default the record is the exact periodic steady state. For each complex
+mode, ``q' = p q + psi^T f`` (spec eq. [10]) with the one-step coefficients of
+``time_response`` (:func:`~tyredamp.mechanics.step_coefficients`) is a
+recursion whose periodic solution has, at each DFT line of the period, the
+closed form of :func:`~tyredamp.mechanics.periodic_response_lines`; the lines
+the acquisition keeps are formed there and transformed back, which equals
+simulating one period with ``time_response`` from the periodic initial state
+(:func:`periodic_initial_state`, ``q*(0) = q_P / (1 - e^{p T})`` with ``q_P``
+one period propagated from rest) to rounding, without stepping through the
+samples. The noise-free steady-state response is exactly periodic, so the
+record is that period repeated, plus independent noise.
+``initial_state="rest"`` instead simulates
 every period from rest (the transient decays with the slowest mode, about
 ``1 / sigma_min`` s) and drops ``settle_periods`` leading periods, or keeps
 them and says so in ``data.acquisition.settle_samples``.
@@ -79,7 +82,14 @@ from scipy.signal import lfilter
 from .._validate import as_band, check_positive
 from ..exceptions import InputError
 from ..frf import FRF, Channel, FRFKind
-from ..mechanics import ComplexModes, MCKSystem, TimeResponse, step_coefficients, time_response
+from ..mechanics import (
+    ComplexModes,
+    MCKSystem,
+    TimeResponse,
+    periodic_response_lines,
+    step_coefficients,
+    time_response,
+)
 from ..signal.excitation import band_lines, periodic_chirp
 from ..timedata import Acquisition, TimeData
 from .excitation import hadamard_drive_matrix, schroeder_multisine
@@ -544,9 +554,15 @@ def _simulate_run(
         return np.vstack([acc, mic[extra] @ resp.displacement[n_pts:]])
 
     if initial_state == "periodic":
-        x0, v0 = periodic_initial_state(system, force_sim, fs_sim, inputs)
-        resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
-        acc = np.tile(_acquire(channels(resp), r), (1, n_keep))
+        p = force_sim.shape[1] // r
+        kept = p // 2 + p % 2  # the lines _acquire keeps: 0 <= l < p / 2
+        disp, acc_lines = periodic_response_lines(system, force_sim, fs_sim, inputs, outputs, kept)
+        rows = acc_lines[:n_pts]
+        if mic is not None:
+            rows = np.vstack([rows, mic[extra] @ disp[n_pts:]])
+        spec = np.zeros((rows.shape[0], p // 2 + 1), dtype=complex)
+        spec[:, :kept] = rows
+        acc = np.tile(np.fft.irfft(spec, n=p, axis=1) / r, (1, n_keep))
     else:
         cm = system.complex_modes()
         blocks = []
