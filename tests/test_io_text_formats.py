@@ -17,6 +17,8 @@ from tyredamp.timedata import TimeData
 from .test_io_roundtrip import sample_timedata
 from .test_io_uff import foreign_frf_sets, write_foreign
 
+REAL = Path(__file__).resolve().parents[2] / "shared" / "real-data"
+
 G = 9.80665
 
 
@@ -230,6 +232,20 @@ def test_lvm_written_here(tmp_path: Path) -> None:
     td = read_timedata(p, ChannelMap.parse([], ["Hammer=2 mV/N"]))
     assert_allclose(td.data[0], np.array([0.5, -0.5, 0.25, 0.0]) / 2e-3, rtol=1e-15)
     assert_array_equal(td.data[1], [1.25, 2.5, -1.0, 0.125])
+
+
+def test_lvm_damaged_header_is_refused_in_one_line(tmp_path: Path) -> None:
+    """A header line lost (the decimal separator's) turns lvm_read's fields into tuples."""
+    src = REAL / "ladisk_lvm_read" / "data" / "short.lvm"
+    if not src.is_file():
+        pytest.skip("real-data gallery not found")
+    lines = src.read_bytes().split(b"\n")
+    assert lines[4].startswith(b"Decimal_Separator")
+    lines[4] = b"1,2,3,4,5,6,7,8,9"
+    p = tmp_path / "short.lvm"
+    p.write_bytes(b"\n".join(lines))
+    with pytest.raises(FileFormatError, match="segment 1: header or data not readable"):
+        read_timedata(p)
 
 
 def test_mat_variants(tmp_path: Path) -> None:

@@ -65,34 +65,26 @@ def read_lvm(path: str | os.PathLike[str], channel_map: ChannelMap | None = None
         lvm = lvm_read.read_str(text)
     except Exception as exc:  # lvm_read raises ValueError, SyntaxError, IndexError ... on garbage
         raise FileFormatError(f"{p}: not a readable LVM file ({exc})") from None
-    n_seg = int(lvm.get("Segments", 0))
+    try:
+        n_seg = int(lvm.get("Segments", 0))
+    except (TypeError, ValueError):
+        raise FileFormatError(f"{p}: the header's segment count is not a number") from None
     names: list[str] = []
     units: list[str] = []
     blocks: list[np.ndarray] = []
     dt = None
     for k in range(n_seg):
-        seg = lvm[k]
         where = f"{p}: segment {k + 1}"
-        data = np.asarray(seg.get("data", []), dtype=float)
-        if data.ndim != 2 or data.shape[0] == 0:
-            raise FileFormatError(f"{where}: no samples")
-        seg_names = [str(c) for c in seg.get("Channel names", [])]
-        if seg_names[-1:] == ["Comment"]:
-            seg_names = seg_names[:-1]
-        if seg_names[:1] == ["X_Value"] and len(seg_names) == data.shape[1]:
-            seg_names, data = seg_names[1:], data[:, 1:]
-        if len(seg_names) != data.shape[1]:
-            raise FileFormatError(
-                f"{where}: {len(seg_names)} channel names but {data.shape[1]} columns of data"
-            )
-        steps = [float(d) for d in seg.get("Delta_X", []) if d == d][: len(seg_names)]
-        if not steps or any(abs(s - steps[0]) > 1e-9 * abs(steps[0]) for s in steps):
-            raise FileFormatError(f"{where}: channels have different or no Delta_X {steps}")
-        if not steps[0] > 0:
-            raise FileFormatError(f"{where}: Delta_X {steps[0]} is not a positive interval")
+        try:
+            seg = lvm[k]
+            seg_names, data, steps = _segment(seg, where)
+            seg_units = [str(u) for u in seg.get("Y_Unit_Label", [""] * len(seg_names))]
+        except (TypeError, ValueError, KeyError, IndexError, AttributeError) as exc:
+            # lvm_read hands on whatever a damaged header parses to (tuples, lists, text)
+            raise FileFormatError(f"{where}: header or data not readable ({exc})") from None
         if k == 0:
             names, dt = seg_names, steps[0]
-            units = [str(u) for u in seg.get("Y_Unit_Label", [""] * len(names))][: len(names)]
+            units = seg_units[: len(names)]
             units += [""] * (len(names) - len(units))
         elif seg_names != names or abs(steps[0] - float(dt or 0)) > 1e-9 * steps[0]:
             raise FileFormatError(
@@ -124,3 +116,25 @@ def read_lvm(path: str | os.PathLike[str], channel_map: ChannelMap | None = None
         meta=meta,
         acquisition=Acquisition(run_starts=starts) if len(starts) > 1 else None,
     )
+
+
+def _segment(seg: Any, where: str) -> tuple[list[str], np.ndarray, list[float]]:
+    """Channel names, data (n_samples, n_channels) and sample intervals of one segment."""
+    data = np.asarray(seg.get("data", []), dtype=float)
+    if data.ndim != 2 or data.shape[0] == 0:
+        raise FileFormatError(f"{where}: no samples")
+    seg_names = [str(c) for c in seg.get("Channel names", [])]
+    if seg_names[-1:] == ["Comment"]:
+        seg_names = seg_names[:-1]
+    if seg_names[:1] == ["X_Value"] and len(seg_names) == data.shape[1]:
+        seg_names, data = seg_names[1:], data[:, 1:]
+    if len(seg_names) != data.shape[1]:
+        raise FileFormatError(
+            f"{where}: {len(seg_names)} channel names but {data.shape[1]} columns of data"
+        )
+    steps = [float(d) for d in seg.get("Delta_X", []) if d == d][: len(seg_names)]
+    if not steps or any(abs(s - steps[0]) > 1e-9 * abs(steps[0]) for s in steps):
+        raise FileFormatError(f"{where}: channels have different or no Delta_X {steps}")
+    if not steps[0] > 0:
+        raise FileFormatError(f"{where}: Delta_X {steps[0]} is not a positive interval")
+    return seg_names, data, steps
