@@ -42,6 +42,7 @@ from ..timedata import TimeData
 from ._channels import snap_rate, timedata_from_channels
 from ._common import check_input_file
 from ._guard import axis_scale
+from ._mat5 import check_mat5
 from .channelmap import ChannelMap
 from .units import frf_units
 
@@ -85,6 +86,8 @@ _ROLE_KIND = {"acceleration": "accelerance", "velocity": "mobility", "displaceme
 def _load(p: Any) -> dict[str, np.ndarray]:
     from scipy.io import loadmat
 
+    with open(p, "rb") as fh:
+        check_mat5(fh.read(), str(p))  # before SciPy trusts the element sizes
     try:
         raw = loadmat(str(p), squeeze_me=False, struct_as_record=True)
     except NotImplementedError:
