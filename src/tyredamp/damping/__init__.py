@@ -11,29 +11,65 @@ damping fits (:func:`compare_proportional`) and Monte Carlo standard errors
 
 from __future__ import annotations
 
-from .diagnostics import DampingDiagnostics, definiteness, findings
-from .estimate import identify_damping, no_std_note
-from .identify import (
-    METHODS,
-    Method,
-    ModalDampingEstimate,
-    align_signs,
-    first_order_damping,
-    modal_damping_from_modes,
-    modal_system_shapes,
-    normalise_shapes,
-    physical_matrices,
-)
-from .lancaster import LancasterMatrices, lancaster_matrices
-from .model import DampingModel
-from .proportional import (
-    ProportionalComparison,
-    compare_proportional,
-    comparison_grid,
-    fit_rayleigh,
-    reduced_receptance,
-)
-from .uncertainty import MonteCarloResult, missing_std, monte_carlo_std
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
+
+if TYPE_CHECKING:
+    from .diagnostics import DampingDiagnostics, definiteness, findings
+    from .estimate import identify_damping, no_std_note
+    from .identify import (
+        METHODS,
+        Method,
+        ModalDampingEstimate,
+        align_signs,
+        first_order_damping,
+        modal_damping_from_modes,
+        modal_system_shapes,
+        normalise_shapes,
+        physical_matrices,
+    )
+    from .lancaster import LancasterMatrices, lancaster_matrices
+    from .model import DampingModel
+    from .proportional import (
+        ProportionalComparison,
+        compare_proportional,
+        comparison_grid,
+        fit_rayleigh,
+        reduced_receptance,
+    )
+    from .uncertainty import MonteCarloResult, missing_std, monte_carlo_std
+
+#: the module of each public name: loaded on first access (PEP 562), so that
+#: reading where a mode set's shapes are (:mod:`.modeset`) does not load the
+#: estimators and their optimisers
+_WHERE = {
+    "DampingDiagnostics": "diagnostics",
+    "DampingModel": "model",
+    "LancasterMatrices": "lancaster",
+    "METHODS": "identify",
+    "Method": "identify",
+    "ModalDampingEstimate": "identify",
+    "MonteCarloResult": "uncertainty",
+    "ProportionalComparison": "proportional",
+    "align_signs": "identify",
+    "compare_proportional": "proportional",
+    "comparison_grid": "proportional",
+    "definiteness": "diagnostics",
+    "findings": "diagnostics",
+    "first_order_damping": "identify",
+    "fit_rayleigh": "proportional",
+    "identify_damping": "estimate",
+    "lancaster_matrices": "lancaster",
+    "missing_std": "uncertainty",
+    "modal_damping_from_modes": "identify",
+    "modal_system_shapes": "identify",
+    "monte_carlo_std": "uncertainty",
+    "no_std_note": "estimate",
+    "normalise_shapes": "identify",
+    "physical_matrices": "identify",
+    "reduced_receptance": "proportional",
+}
 
 __all__ = [
     "METHODS",
@@ -62,3 +98,5 @@ __all__ = [
     "physical_matrices",
     "reduced_receptance",
 ]
+
+__getattr__, __dir__ = lazy_names(__name__, _WHERE, __all__, globals())

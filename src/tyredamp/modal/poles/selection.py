@@ -41,8 +41,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import cKDTree
 
 from ...exceptions import InputError
 from ...mechanics.modal_sum import pole_quantities
@@ -232,7 +230,7 @@ def _threshold_edges(
     """Pairs of poles of different orders at rule-3 distance ``<= cut``.
 
     Returns ``(i, j, d)`` with ``i < j`` (each pair once) and ``d`` the distance
-    of rule 3. Candidates come from a k-d tree: with ``m <= M`` the two moduli
+    of rule 3. Candidates come from :func:`_pairs_within`: with ``m <= M`` the two moduli
     and ``theta`` the angle between the poles, ``|p_i - p_j| >= M - m`` and
     ``|p_i - p_j| >= M sin(theta)`` (``>= M`` for ``theta > pi/2``), so a pole
     distance ``<= cut < 1`` implies ``log M - log m <= -log(1 - cut)`` and
@@ -254,8 +252,7 @@ def _threshold_edges(
         # arg p wraps at -pi/pi: poles within the bound above -pi get a copy past pi
         wrap = np.flatnonzero(ang < -np.pi + r_ang)
         x = np.vstack([x, x[wrap] + [0.0, 2 * np.pi / r_ang]])
-        ij = cKDTree(x).query_pairs(1.0 + _SLACK, p=np.inf, output_type="ndarray")
-        i, j = ij[:, 0].astype(np.int64), ij[:, 1].astype(np.int64)  # i < j
+        i, j = _pairs_within(x, 1.0 + _SLACK)  # i < j
         if wrap.size:
             keep = i < n  # two copies: the same pair as the two originals
             i, j = i[keep], np.concatenate([np.arange(n), wrap])[j[keep]]
@@ -277,6 +274,41 @@ def _threshold_edges(
         d = np.maximum(d + (1.0 - mac), 0.0)
     keep = d <= cut
     return i[keep], j[keep], d[keep]
+
+
+def _pairs_within(x: NDArray[np.float64], r: float) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Every pair ``i < j`` of rows of ``x`` (n, 2) within max-norm distance ``r``.
+
+    A sweep along the first coordinate: after sorting by it, the rows within
+    ``r`` of row ``k`` there are the next ones up to a binary-searched end;
+    those candidates keep the pairs whose second coordinates are within ``r``
+    too. Pairs come sorted by ``(i, j)``.
+    """
+    n = x.shape[0]
+    order = np.argsort(x[:, 0], kind="stable")
+    xs = x[order]
+    end = np.searchsorted(xs[:, 0], xs[:, 0] + r, side="right")
+    count = np.maximum(end - np.arange(n) - 1, 0)
+    a = np.repeat(np.arange(n), count)
+    b = a + 1 + np.arange(a.size) - np.repeat(np.cumsum(count) - count, count)
+    keep = (xs[b, 0] - xs[a, 0] <= r) & (np.abs(xs[b, 1] - xs[a, 1]) <= r)
+    i, j = order[a[keep]], order[b[keep]]
+    i, j = np.minimum(i, j).astype(np.int64), np.maximum(i, j).astype(np.int64)
+    srt = np.lexsort((j, i))
+    return i[srt], j[srt]
+
+
+def _components(adjacent: NDArray[np.bool_]) -> NDArray[np.intp]:
+    """Connected components of the undirected graph of a symmetric boolean
+    matrix: each node labelled by the smallest node index of its component
+    (labels spread as running minima over the edges until none changes)."""
+    n = adjacent.shape[0]
+    comp = np.arange(n)
+    while True:
+        new = np.minimum(comp, np.min(np.where(adjacent, comp[None, :], n), axis=1))
+        if np.array_equal(new, comp):
+            return comp
+        comp = new
 
 
 def _repeated_roots(
@@ -457,7 +489,7 @@ def _repeated_slots(
     mean = (
         np.bincount(labels, p.real, n_lab) / count + 1j * np.bincount(labels, p.imag, n_lab) / count
     )
-    _, comp = connected_components(_same_place(mean[:, None], mean[None, :]), directed=False)
+    comp = _components(_same_place(mean[:, None], mean[None, :]))
     out = labels.copy()
     for c in np.unique(comp):
         group = np.flatnonzero(comp == c)

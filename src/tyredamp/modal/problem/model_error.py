@@ -57,7 +57,6 @@ from typing import Protocol, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize
 
 from ...frf import FRF, FRFKind
 from ...mechanics.modal_sum import kind_factor
@@ -162,6 +161,8 @@ def relative_model_error(
         return math.exp(hi)
     if excess(lo) <= 0:
         return math.exp(lo)
+    from scipy import optimize  # only when there is a model error: slow to import
+
     return math.exp(optimize.brentq(excess, lo, hi, xtol=1e-3))
 
 

@@ -91,7 +91,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import integrate, optimize
 from scipy import special as sps_special
 
 __all__ = [
@@ -326,6 +325,8 @@ def mode_null_sf(x: float, n_out: int, n_in: int, kind: str = "complex") -> floa
     if m == 1:
         return chi2_sf(x, mode_parameters(n_out, n_in, kind))
 
+    from scipy import integrate  # several inputs only: scipy.integrate is slow to import
+
     def f(b: float) -> float:
         return 0.5 * math.exp(-0.5 * b) * rank_one_sf(x - b, n_out, n_in, kind)
 
@@ -353,6 +354,8 @@ def mode_null_isf(level: float, n_out: int, n_in: int, kind: str = "complex") ->
     hi = 2.0 * lo + 10.0
     while mode_null_sf(hi, n_out, n_in, kind) > level:
         hi *= 2.0
+    from scipy import optimize  # several inputs only: scipy.optimize is slow to import
+
     lv = math.log(level)
     return float(
         optimize.brentq(
