@@ -117,7 +117,7 @@ def test_a_refused_file_loads_no_linear_algebra(tmp_path: Path) -> None:
     assert not (tmp_path / "m.json").exists()
 
 
-def test_a_modal_run_loads_neither_scipy_stats_nor_signal(tmp_path: Path) -> None:
+def test_a_modal_run_loads_only_what_it_needs(tmp_path: Path) -> None:
     # the identification and its verdicts take their distributions from
     # scipy.special; scipy.stats and scipy.signal cost half a second to import
     import numpy as np
@@ -143,3 +143,7 @@ def test_a_modal_run_loads_neither_scipy_stats_nor_signal(tmp_path: Path) -> Non
     assert (tmp_path / "m.json").is_file()
     assert "scipy.stats" not in mods
     assert "scipy.signal" not in mods
+    # nor what only several inputs, a model error or the damping step need
+    for heavy in ("scipy.optimize", "scipy.integrate", "scipy.spatial", "scipy.sparse.csgraph"):
+        assert heavy not in mods, heavy
+    assert "tyredamp.damping.estimate" not in mods
