@@ -37,6 +37,7 @@ from ..lateral.response import ForceKind
 from ..virtual.lateral_rig import KMH, VirtualLateralRig
 from .results import LateralCondition, LateralStudy, TimeTest, VehicleStudy
 from .settings import DemoSettings
+from .steps import LateralFitSettings
 
 __all__ = [
     "fit_models",
@@ -105,13 +106,22 @@ def measure_condition(
     rig: VirtualLateralRig,
     pressure_bar: float,
     speed_kmh: float,
-    models: Sequence[str],
+    fit: LateralFitSettings,
     seed: int,
 ) -> LateralCondition:
-    """Ground- and axle-force FRFs of the rig at one condition, every model fitted to the ground."""
+    """Ground- and axle-force FRFs of the rig at one condition, every model fitted to the ground.
+
+    The fit is the registered ``fit`` step
+    (:class:`~tyredamp.studies.steps.LateralFitStep`, the recipe of ``tyredamp
+    lateral fit`` and of a campaign) with the settings ``fit``
+    (the demo's: :meth:`DemoSettings.step_settings`); the speed, force and
+    wheel mass come from the rig's FRF.
+    """
+    from .registry import STEPS
+
     ground = rig.measure(speed_kmh, pressure_bar, "ground", seed)
     axle = rig.measure(speed_kmh, pressure_bar, "axle", seed)
-    ranking = fit_models(ground, models)
+    (ranking, _), _ = STEPS["fit"].run(ground.frf, fit)
     return LateralCondition(
         pressure_bar, speed_kmh, ground, axle, ranking, rig.truth(speed_kmh, pressure_bar)
     )
@@ -198,10 +208,11 @@ def run_lateral(s: DemoSettings, stage: StageCallback | None = None) -> LateralS
             stage(name)
 
     rig = VirtualLateralRig()
+    fit = s.step_settings()["fit"]
     lat: list[LateralCondition] = []
     for p, v in conditions(s):
         start(f"lateral: {len(s.lateral_models)} model fits at {p:g} bar, {v:g} km/h")
-        lat.append(measure_condition(rig, p, v, s.lateral_models, s.seed))
+        lat.append(measure_condition(rig, p, v, fit, s.seed))
     ref_p, ref_v = s.reference_condition
     ref = next(c for c in lat if c.pressure_bar == ref_p and c.speed_kmh == ref_v)
 
