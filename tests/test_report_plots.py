@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from tyredamp.exceptions import InputError
 from tyredamp.report import plots
 from tyredamp.report.demo import save_demo
-from tyredamp.report.plots import PLACES, Plot, register_plot, render_plots
+from tyredamp.report.plots import PLACES, Plot, demo_figures, register_plot
 from tyredamp.studies.demo import DemoResult
 
 from .test_studies_demo import quick_demo
@@ -75,7 +75,7 @@ def test_render_keeps_registry_order_and_leaves_out_empty_plots(
     register_plot(Plot("one", "lateral:vehicle", one))
     register_plot(Plot("nothing", "radial:checks", lambda _: None))
     register_plot(Plot("two", "radial:fits", two))
-    built = render_plots(object())  # type: ignore[arg-type]
+    built = demo_figures(object())  # type: ignore[arg-type]
     assert list(built) == ["one", "two_a", "two_b"]
     assert [r.section for r in built.values()] == ["lateral:vehicle", "radial:fits", "radial:fits"]
     assert [r.caption for r in built.values()] == ["one", "a", "b"]
@@ -96,7 +96,7 @@ def test_registry_refuses_what_it_cannot_place(monkeypatch: pytest.MonkeyPatch) 
     monkeypatch.setattr(plots, "PLOTS", {k: plots.PLOTS[k] for k in ("fig02_again",)})
     register_plot(Plot("fig02_real_fit", "radial:fits", blank))
     with pytest.raises(InputError, match="'fig02_real_fit' exists already"):
-        render_plots(object())  # type: ignore[arg-type]
+        demo_figures(object())  # type: ignore[arg-type]
 
 
 def test_every_place_is_in_the_report() -> None:

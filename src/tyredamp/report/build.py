@@ -3,7 +3,7 @@
 :func:`build_demo_report` lays out the page from a
 :class:`~tyredamp.studies.demo.DemoResult`, its results document
 (:func:`tyredamp.studies.document.build_results`) and the rendered figures
-(:func:`tyredamp.report.figures.demo_figures`; each at the place its entry of
+(:func:`tyredamp.report.plots.demo_figures`; each at the place its entry of
 :data:`tyredamp.report.plots.PLOTS` names). Sections: summary, inputs and
 settings, the radial study (checks, stabilisation, modes with standard errors
 beside the truth, real against complex fit, mode shapes, damping matrices with

@@ -35,7 +35,7 @@ from ..studies.tyremodel import tyre_model_files
 from ..timedata import TimeData
 from ._cells import ReportImage
 from .build import build_demo_report
-from .figures import demo_figures
+from .plots import demo_figures
 
 __all__ = ["check_output_dir", "save_demo"]
 

@@ -5,7 +5,7 @@ when it has nothing to show; :func:`lateral_frf_figures` returns several
 named figures); :data:`tyredamp.report.plots.PLOTS` lists them with their
 name (the PNG file stem: ``fig02_real_fit`` ... ``fig15_time_response``; the
 numbers follow the papers' figures where there is one) and their place in
-the report. :func:`demo_figures` builds every registered plot. Only
+the report, and :func:`tyredamp.report.plots.demo_figures` builds them. Only
 :class:`matplotlib.figure.Figure` objects are used (no pyplot).
 """
 
@@ -36,7 +36,6 @@ if TYPE_CHECKING:
     from ..frf import FRF
     from ..lateral.response import ForceKind
     from ..studies.results import DemoResult, LateralCondition
-    from .plots import Rendered
 
 __all__ = [
     "PAPER_MODELS",
@@ -44,7 +43,6 @@ __all__ = [
     "complex_fit_figure",
     "corner_frequency_figure",
     "damping_figure",
-    "demo_figures",
     "discrepancy_figure",
     "lateral_frf_figures",
     "mac_figure",
@@ -576,11 +574,3 @@ def _residual_zoom(
         f"amplitude zoomed on {lo:.0f}-{f[-1]:.0f} Hz (below), the upper part of the band where "
         "the paper saw the real-mode fit depart.",
     )
-
-
-def demo_figures(result: DemoResult) -> dict[str, Rendered]:
-    """Every registered plot (:data:`tyredamp.report.plots.PLOTS`) in report order:
-    ``{name: Rendered(figure, caption, section)}``."""
-    from .plots import render_plots
-
-    return render_plots(result)

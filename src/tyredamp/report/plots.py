@@ -3,7 +3,7 @@
 A plot is a :class:`Plot`: its name, its place in the report and its builder
 (a function of the :class:`~tyredamp.studies.results.DemoResult` that returns
 the figure and its caption). :data:`PLOTS` holds every plot in report order;
-:func:`tyredamp.report.figures.demo_figures` builds them,
+:func:`demo_figures` builds them,
 :func:`tyredamp.report.demo.save_demo` writes each as ``figures/<name>.png``
 and :func:`tyredamp.report.build.build_demo_report` puts each, with its
 caption, at its place (:data:`PLACES`), after the plots registered there
@@ -32,7 +32,7 @@ from . import figures as f
 if TYPE_CHECKING:
     from ..studies.results import DemoResult
 
-__all__ = ["PLACES", "PLOTS", "Plot", "Rendered", "register_plot", "render_plots"]
+__all__ = ["PLACES", "PLOTS", "Plot", "Rendered", "demo_figures", "register_plot"]
 
 #: The places of the report a plot can stand in (its ``section``), in page order.
 PLACES: dict[str, str] = {
@@ -139,7 +139,7 @@ def register_plot(plot: Plot) -> Plot:
     return plot
 
 
-def render_plots(result: DemoResult) -> dict[str, Rendered]:
+def demo_figures(result: DemoResult) -> dict[str, Rendered]:
     """Every plot of :data:`PLOTS` built from ``result``: ``{file stem: Rendered}``.
 
     Raises

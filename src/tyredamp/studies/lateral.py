@@ -13,31 +13,24 @@ causal approximation) and :func:`run_lateral`, the whole study of the demo.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from ..exceptions import InputError, PhysicsError
-from ..frf import FRF
+from ..exceptions import PhysicsError
 from ..lateral import (
-    DEFAULT_MODELS,
-    LateralData,
     LateralVehicle,
-    Ranking,
     Resonance,
     causal_error,
     figure7_curves,
     harmonic_response,
-    rank_models,
 )
-from ..lateral.fit import Criterion, Weights
-from ..lateral.response import ForceKind
-from ..virtual.lateral_rig import KMH, VirtualLateralRig
+from ..virtual.lateral_rig import VirtualLateralRig
 from .results import LateralCondition, LateralStudy, TimeTest, VehicleStudy
 from .settings import DemoSettings
 from .steps import LateralFitSettings
+from .steps.lateral_fit import fit_models, lateral_data
 
 __all__ = [
     "fit_models",
@@ -53,54 +46,6 @@ StageCallback = Callable[[str], None]
 
 
 # ---------------------------------------------------------------------------- steps
-def lateral_data(
-    frf: FRF,
-    *,
-    speed_kmh: float | None = None,
-    force: ForceKind | None = None,
-    wheel_mass: float | None = None,
-) -> LateralData:
-    """A lateral measurement from an FRF; conditions not given come from its ``meta``.
-
-    Parameters
-    ----------
-    frf : FRF
-        Lateral acceleration (or displacement, velocity) per lateral force.
-    speed_kmh : float, optional
-        Rolling speed, km/h (> 0).
-    force : {"ground", "axle"}, optional
-        Where the force acts.
-    wheel_mass : float, optional
-        Wheel mass, kg.
-    """
-    if speed_kmh is not None and not (math.isfinite(speed_kmh) and speed_kmh > 0):
-        raise InputError(f"speed: expected a speed > 0 km/h, got {speed_kmh}")
-    return LateralData.from_frf(
-        frf,
-        speed=None if speed_kmh is None else speed_kmh * KMH,
-        force=force,
-        wheel_mass=wheel_mass,
-    )
-
-
-def fit_models(
-    data: LateralData,
-    models: Sequence[str] = DEFAULT_MODELS,
-    *,
-    criterion: Criterion = "bic",
-    band: tuple[float, float] | None = None,
-    weights: Weights | ArrayLike = "auto",
-    channel: tuple[int, int] | None = None,
-) -> Ranking:
-    """Fit every model to the same data and weights and rank them (AIC/BIC).
-
-    See :func:`tyredamp.lateral.fit_model` for ``band``, ``weights`` and ``channel``.
-    """
-    return rank_models(
-        data, models, criterion=criterion, band=band, weights=weights, channel=channel
-    )
-
-
 # --------------------------------------------------------------- on the virtual rig
 def measure_condition(
     rig: VirtualLateralRig,

@@ -27,14 +27,12 @@ from scipy.optimize import linear_sum_assignment
 
 from ..damping import DampingModel
 from ..exceptions import InputError
-from ..frf import FRF, Channel
+from ..frf import FRF
 from ..modal.identify import ModalIdentification, ModelChoice, identify_modes
 from ..modal.poles.estimators import PoleEstimator
 from ..modal.statistics.stats import FALSE_ALARM
 from ..signal import CheckResult, linearity_check, reciprocity_check
 from ..signal.checks import merge_inputs
-from ..signal.estimators import Estimator, estimate_frf
-from ..signal.estimators import Method as FRFMethod
 from ..timedata import TimeData
 from ..virtual import (
     Cavity,
@@ -50,6 +48,7 @@ from .results import DampingComparison, ModeMatch, PressureRun, RadialStudy
 from .settings import BAR, DemoSettings
 from .steps import QualitySettings, QualityStep
 from .steps.damping import damping_from_modes
+from .steps.frf import frf_from_time
 from .steps.modal import label_wave_numbers
 from .tyremodel import tyre_model_from_runs
 
@@ -73,59 +72,6 @@ StageCallback = Callable[[str], None]
 
 
 # ---------------------------------------------------------------------------- steps
-def frf_from_time(
-    data: TimeData,
-    estimator: Estimator = "H1",
-    *,
-    reference: Sequence[Channel | int | str] | None = None,
-    method: FRFMethod | None = None,
-    segment_samples: int | None = None,
-    period_samples: int | None = None,
-    settle_samples: int | None = None,
-    band: tuple[float, float] | None = None,
-    detect: bool = True,
-) -> FRF:
-    """FRFs with coherence from force and response time data (spec step 2).
-
-    Parameters
-    ----------
-    data : TimeData
-        Force and response channels.
-    estimator : {"H1", "H2", "Hv"}
-        FRF estimator.
-    reference : sequence of Channel, int or str, optional
-        Force channels; default: every force channel.
-    method : {"cyclic", "welch", "transient", "lrm", "lpm"}, optional
-        Averaging method; default chosen from the data's acquisition record
-        or, when ``detect``, from the force itself (cyclic for periodic
-        excitation); see :func:`tyredamp.signal.estimate_frf`.
-    segment_samples : int, optional
-        Segment length of Welch/transient averaging, samples.
-    period_samples : int, optional
-        Excitation period, samples (overrides the acquisition record).
-    settle_samples : int, optional
-        Samples dropped at the start of the record or of each run (start
-        transient); default from the record or detected.
-    band : (float, float), optional
-        Lines to keep, Hz.
-    detect : bool
-        Detect periodicity and the start transient from the data when the
-        acquisition record does not state them
-        (:mod:`tyredamp.signal.periodicity`).
-    """
-    return estimate_frf(
-        data,
-        estimator,
-        reference=list(reference) if reference else None,
-        method=method,
-        segment_samples=segment_samples,
-        period_samples=period_samples,
-        settle_samples=settle_samples,
-        band=band,
-        detect=detect,
-    )
-
-
 def check_linearity(
     frfs: Sequence[FRF], threshold: float = 0.05, band: tuple[float, float] | None = None
 ) -> CheckResult:
