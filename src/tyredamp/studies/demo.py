@@ -27,6 +27,12 @@
 * the **damping model** (:func:`.dampmodels.run_dampmodels`): every damping
   model fitted to the rubber tyre's FRFs and ranked, the truth beside it.
 
+Each identification runs a registered step
+(:data:`tyredamp.studies.registry.STEPS`: ``frf``, ``checks``, ``modal``,
+``damping``, ``fit``, ``rolling``), the recipe of the command line and of a
+campaign, with the settings :meth:`DemoSettings.step_settings` makes from
+the demo's own.
+
 :func:`tyredamp.report.demo.save_demo` writes what :func:`run_demo` returned
 into a directory (report, results.json, figures, data, modes and damping
 JSON).
