@@ -946,7 +946,7 @@ def slow(*a, **k):
     time.sleep(60)
 s._fsync_file = slow
 import tyredamp.studies.demo as demo
-import tyredamp.report.figures as figs
+import tyredamp.report.plots as figs
 demo.run_demo = lambda *a, **k: None
 figs.demo_figures = slow
 from tyredamp.cli import main

@@ -6,11 +6,11 @@ import html
 import math
 import re
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 from .html import HtmlReport
 
-__all__ = ["anchor_id", "fmt_pm"]
+__all__ = ["ReportImage", "anchor_id", "fmt_pm"]
 
 
 def fmt_pm(value: float | None, std: float | None, digits: int = 4, scale: float = 1.0) -> str:
@@ -29,10 +29,20 @@ def _num(v: Any, spec: str = ".4g") -> str:
     return format(v, spec)
 
 
-def _image(rep: HtmlReport, images: Mapping[str, tuple[bytes, str]], name: str) -> None:
-    if name in images:
-        png, caption = images[name]
-        rep.image(png, caption)
+class ReportImage(NamedTuple):
+    """A rendered plot of the demo report: PNG bytes, caption and place
+    (a key of :data:`tyredamp.report.plots.PLACES`; empty: shown nowhere)."""
+
+    png: bytes
+    caption: str
+    section: str = ""
+
+
+def _images(rep: HtmlReport, images: Mapping[str, ReportImage], section: str) -> None:
+    """Every image of ``section`` with its caption, in the order of ``images``."""
+    for img in images.values():
+        if img.section == section:
+            rep.image(img.png, img.caption)
 
 
 def anchor_id(about: str) -> str:

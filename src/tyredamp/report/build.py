@@ -3,7 +3,8 @@
 :func:`build_demo_report` lays out the page from a
 :class:`~tyredamp.studies.demo.DemoResult`, its results document
 (:func:`tyredamp.studies.document.build_results`) and the rendered figures
-(:func:`tyredamp.report.figures.demo_figures`). Sections: summary, inputs and
+(:func:`tyredamp.report.plots.demo_figures`; each at the place its entry of
+:data:`tyredamp.report.plots.PLOTS` names). Sections: summary, inputs and
 settings, the radial study (checks, stabilisation, modes with standard errors
 beside the truth, real against complex fit, mode shapes, damping matrices with
 diagnostics in words, pressures), the tyre model (flexible ring across the
@@ -23,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 from .. import __version__
 from ..modal.statistics.quality import RejectedMode, rejected_summary
-from ._cells import _image, _num, _warnings, anchor_id, fmt_pm
+from ._cells import ReportImage, _images, _num, _warnings, anchor_id, fmt_pm
 from ._outcomes import _findings, _Page, _status, _verdict_block
 from .dampmodels import dampmodels_report
 from .html import HtmlReport
@@ -308,10 +309,10 @@ def _radial(
         "this tyre they lie at the anti-resonances, where the response is small, and below "
         "the first mode, outside that band."
     )
-    _image(rep, images, "checks")
+    _images(rep, images, "radial:checks")
 
     rep.heading("Stabilisation diagram", 3)
-    _image(rep, images, "stabilisation")
+    _images(rep, images, "radial:stabilisation")
     ident = r.main.identification
     if ident.rejected:
         line = rejected_summary([RejectedMode.from_dict(x) for x in ident.rejected])
@@ -361,11 +362,9 @@ def _radial(
         "couples the modes (off-diagonal C')."
     )
     rep.paragraph(_physics_note(rad))
-    for name in ("fig02_real_fit", "fig03_complex_fit", "fig04_discrepancy", "residual_zoom"):
-        _image(rep, images, name)
+    _images(rep, images, "radial:fits")
     rep.heading("Mode shapes", 3)
-    _image(rep, images, "mode_shapes")
-    _image(rep, images, "mac")
+    _images(rep, images, "radial:shapes")
 
     _radial_damping(rep, doc, images)
     _radial_pressures(rep, doc, images, page)
@@ -406,7 +405,7 @@ def _radial_damping(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
     rep.paragraph("What the numbers say:")
     rep.bullets(dmp["findings"])
     _warnings(rep, doc, "radial:damping")
-    _image(rep, images, "fig05_damping")
+    _images(rep, images, "radial:damping")
 
 
 def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any, page: _Page) -> None:
@@ -461,7 +460,7 @@ def _radial_pressures(rep: HtmlReport, doc: dict[str, Any], images: Any, page: _
             pr["modes"],
             f"Modes at {pr['pressure_bar']:g} bar ({pr['n_averages']} averages), as above.",
         )
-    _image(rep, images, "pressures")
+    _images(rep, images, "radial:pressures")
 
 
 def _lateral(
@@ -480,7 +479,7 @@ def _lateral(
         "model (eq. 40). The values the paper quotes, 3.87 dB and 0.694 dB, are those of "
         "h/K = 0.2."
     )
-    _image(rep, images, "fig07_corner_frequency")
+    _images(rep, images, "lateral:corner")
 
     _lateral_ranking(rep, lat)
     conds = lat["conditions"]
@@ -516,11 +515,8 @@ def _lateral(
     for c in conds:
         _warnings(rep, doc, f"lateral:{c['label']}")
     _lateral_parameters(rep, result)
-    speeds = result.settings.lateral_speeds_kmh
     rep.heading("Measured against predicted FRFs (paper Figs. 11-14)", 3)
-    for force in ("ground", "axle"):
-        for v in speeds:
-            _image(rep, images, _fig_name(images, force, v))
+    _images(rep, images, "lateral:frfs")
 
     _lateral_vehicle(rep, doc, images)
 
@@ -667,8 +663,7 @@ def _lateral_vehicle(rep: HtmlReport, doc: dict[str, Any], images: Any) -> None:
         f"{tr['frequency_hz']:g} Hz, not noise.",
     )
     _warnings(rep, doc, "lateral:time")
-    _image(rep, images, "vehicle")
-    _image(rep, images, "fig15_time_response")
+    _images(rep, images, "lateral:vehicle")
     ca = tr["causal"]
     rep.paragraph(
         f"Causality: the hysteretic tyre 1/(K + i h) is not causal; its impulse response has a "
@@ -692,17 +687,10 @@ def _within_noise(conds: list[dict[str, Any]], model: str) -> str:
     return f"{ok} of {len(vs)}{span}"
 
 
-def _fig_name(images: Mapping[str, Any], force: str, v: float) -> str:
-    for name in images:
-        if name.endswith(f"_{force}_{v:g}kmh"):
-            return name
-    return ""
-
-
 def build_demo_report(
     result: DemoResult,
     doc: dict[str, Any],
-    images: Mapping[str, tuple[bytes, str]],
+    images: Mapping[str, ReportImage],
     files: list[str] | None = None,
 ) -> str:
     """The demo report as one self-contained HTML page.
@@ -712,9 +700,10 @@ def build_demo_report(
     result : DemoResult
     doc : dict
         Its results document (:func:`tyredamp.studies.document.build_results`).
-    images : mapping of str to (bytes, str)
-        PNG bytes and caption of each figure by name
-        (:func:`tyredamp.report.figures.demo_figures`).
+    images : mapping of str to ReportImage
+        PNG bytes, caption and place of each figure by name, in report order
+        (the plots of :data:`tyredamp.report.plots.PLOTS`); each stands at its
+        place (:data:`~tyredamp.report.plots.PLACES`), one with no place nowhere.
     files : list of str, optional
         Files of the output directory to list; default ``doc["files"]``.
 

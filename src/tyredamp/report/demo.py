@@ -33,8 +33,9 @@ from ..studies.document import build_results
 from ..studies.results import DemoResult
 from ..studies.tyremodel import tyre_model_files
 from ..timedata import TimeData
+from ._cells import ReportImage
 from .build import build_demo_report
-from .figures import demo_figures
+from .plots import demo_figures
 
 __all__ = ["check_output_dir", "save_demo"]
 
@@ -124,11 +125,11 @@ def _save(
                 progress(name, done, total)
             done += 1
 
-        pngs: dict[str, bytes] = {}
-        for name, (fig, _caption) in figs.items():
+        images: dict[str, ReportImage] = {}
+        for name, built in figs.items():
             step(f"figure {name}.png")
-            buf = _png(fig, dpi)
-            pngs[name] = buf
+            buf = _png(built[0], dpi)
+            images[name] = ReportImage(buf, built[1], getattr(built, "section", ""))
             (tmp / "figures").mkdir(exist_ok=True)
             (tmp / "figures" / f"{name}.png").write_bytes(buf)
             written.append(f"figures/{name}.png")
@@ -173,7 +174,7 @@ def _save(
         (tmp / "results.json").write_text(json_text(results), encoding="utf-8")
 
         step("report.html")
-        html = build_demo_report(result, results, {k: (pngs[k], figs[k][1]) for k in figs})
+        html = build_demo_report(result, results, images)
         (tmp / "report.html").write_text(html, encoding="utf-8")
         if progress is not None:
             progress("done", total, total)

@@ -1,13 +1,17 @@
-"""The figures of the demo report, built from a :class:`~tyredamp.studies.demo.DemoResult`.
+"""The builders of the demo report's plots, from a :class:`~tyredamp.studies.demo.DemoResult`.
 
-:func:`demo_figures` returns ``{name: (Figure, caption)}`` in report order;
-names are the PNG file stems (``fig02_real_fit`` ... ``fig15_time_response``;
-the numbers follow the papers' figures where there is one). Only
+Each builder takes the result and returns ``(Figure, caption)`` (or ``None``
+when it has nothing to show; :func:`lateral_frf_figures` returns several
+named figures); :data:`tyredamp.report.plots.PLOTS` lists them with their
+name (the PNG file stem: ``fig02_real_fit`` ... ``fig15_time_response``; the
+numbers follow the papers' figures where there is one) and their place in
+the report, and :func:`tyredamp.report.plots.demo_figures` builds them. Only
 :class:`matplotlib.figure.Figure` objects are used (no pyplot).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -29,12 +33,31 @@ from ..plot.tyremodel import plot_ring_frequencies
 from ..studies.document import time_test_truth
 
 if TYPE_CHECKING:
+    from ..frf import FRF
     from ..lateral.response import ForceKind
     from ..studies.results import DemoResult, LateralCondition
 
-__all__ = ["PAPER_MODELS", "demo_figures"]
+__all__ = [
+    "PAPER_MODELS",
+    "checks_figure",
+    "complex_fit_figure",
+    "corner_frequency_figure",
+    "damping_figure",
+    "discrepancy_figure",
+    "lateral_frf_figures",
+    "mac_figure",
+    "mode_shapes_figure",
+    "pressures_figure",
+    "real_fit_figure",
+    "residual_zoom_figure",
+    "ring_frequencies_figure",
+    "stabilisation_figure",
+    "time_response_figure",
+    "vehicle_figure",
+]
 
-FigureSet = dict[str, tuple[Figure, str]]
+#: What a builder returns: a figure and its caption, or None (nothing to show).
+Built = tuple[Figure, str] | None
 #: The four spring-damper models of the paper (Figures 11-15 show these).
 PAPER_MODELS = ("classic", "maxwell", "viscoplastic", "hysteretic")
 
@@ -51,43 +74,75 @@ def _paper_models(names: Any) -> list[str]:
     return [n for n in PAPER_MODELS if n in names]
 
 
-def _radial(result: DemoResult) -> FigureSet:
-    r = result.radial
-    main = r.main
+@dataclass(frozen=True)
+class _Fits:
+    """What the figures of the fits at the main pressure share."""
+
+    main: Any
+    meas: FRF
+    out_i: int
+    in_i: int
+    lab: str
+    p: str
+
+    @property
+    def rmsd(self) -> tuple[float, float]:
+        """RMSD of the real- and complex-mode fits (eq. [19])."""
+        return self.main.models["real"].meta["rmsd"], self.main.models["complex"].meta["rmsd"]
+
+
+def _fits(result: DemoResult) -> _Fits:
+    main = result.radial.main
     meas = main.fitted_frf
-    real = main.synthesised("real")
-    cplx = main.synthesised("complex")
-    exact = main.exact()
     dp = meas.drive_points()
     out_i, in_i = dp[0] if dp else (0, 0)
     lab = f"{meas.outputs[out_i].label}/{meas.inputs[in_i].label}"
-    p = f"{main.pressure_bar:g} bar"
-    mr, mc = main.models["real"], main.models["complex"]
-    figs: FigureSet = {}
+    return _Fits(main, meas, out_i, in_i, lab, f"{main.pressure_bar:g} bar")
 
-    ax = plot_frf_comparison(meas, {"real-mode fit": real}, out_i, in_i)
-    figs["fig02_real_fit"] = (
+
+def real_fit_figure(result: DemoResult) -> Built:
+    """Paper Fig. 2: the driving-point FRF and the real-mode fit."""
+    c = _fits(result)
+    real = c.main.synthesised("real")
+    ax = plot_frf_comparison(c.meas, {"real-mode fit": real}, c.out_i, c.in_i)
+    return (
         _figure(ax[0]),
-        f"Paper Fig. 2: driving-point accelerance {lab} at {p}, measured (dots) and the "
+        f"Paper Fig. 2: driving-point accelerance {c.lab} at {c.p}, measured (dots) and the "
         f"real-mode fit (eq. [2]/[3]): real part, imaginary part, amplitude, phase. "
-        f"RMSD {mr.meta['rmsd']:.3g} {meas.unit}.",
+        f"RMSD {c.rmsd[0]:.3g} {c.meas.unit}.",
     )
-    ax = plot_frf_comparison(meas, {"complex-mode fit": cplx}, out_i, in_i)
-    figs["fig03_complex_fit"] = (
+
+
+def complex_fit_figure(result: DemoResult) -> Built:
+    """Paper Fig. 3: the driving-point FRF and the complex-mode fit."""
+    c = _fits(result)
+    cplx = c.main.synthesised("complex")
+    ax = plot_frf_comparison(c.meas, {"complex-mode fit": cplx}, c.out_i, c.in_i)
+    return (
         _figure(ax[0]),
         f"Paper Fig. 3: the same FRF and the complex-mode fit (eq. [10]). "
-        f"RMSD {mc.meta['rmsd']:.3g} {meas.unit}.",
+        f"RMSD {c.rmsd[1]:.3g} {c.meas.unit}.",
     )
+
+
+def discrepancy_figure(result: DemoResult) -> Built:
+    """Paper Fig. 4: discrepancy of both fits and of the exact FRF against frequency."""
+    c = _fits(result)
+    meas = c.meas
+    real = c.main.synthesised("real")
+    cplx = c.main.synthesised("complex")
+    exact = c.main.exact()
+    mr, mc = c.rmsd
     ax1 = plot_discrepancy(
         meas,
         {"real-mode fit": real, "complex-mode fit": cplx, "exact FRF (noise level)": exact},
-        {"real-mode fit": mr.meta["rmsd"], "complex-mode fit": mc.meta["rmsd"]},
+        {"real-mode fit": mr, "complex-mode fit": mc},
     )
     plotted = {
         name: float(np.sqrt(np.mean(np.sum(np.abs(fr.H - meas.H) ** 2, axis=(0, 1)))))
         for name, fr in (("real", real), ("complex", cplx))
     }
-    figs["fig04_discrepancy"] = (
+    return (
         _figure(ax1),
         "Paper Fig. 4: discrepancy sqrt(sum_jk |H_fit - H_meas|^2) over the 16 FRFs against "
         "frequency, with the RMSD of eq. [19] in the legend; the exact FRF of the virtual tyre "
@@ -95,42 +150,50 @@ def _radial(result: DemoResult) -> FigureSet:
         f"{meas.n_freq} lines is {plotted['real']:.3g} (real) and {plotted['complex']:.3g} "
         f"(complex) {meas.unit}; eq. [19] divides the root of the same sum by the number of "
         f"values ({meas.H.size}) instead of its root, hence RMSD "
-        f"{mr.meta['rmsd']:.3g} and {mc.meta['rmsd']:.3g}: the same ratio, another scale.",
+        f"{mr:.3g} and {mc:.3g}: the same ratio, another scale.",
     )
-    figs["residual_zoom"] = _residual_zoom(main, meas, real, cplx, out_i, in_i, lab)
 
-    figs["fig05_damping"] = _damping_figure(result)
 
-    ident = main.identification
-    ax2 = plot_stabilisation(ident.poles, ident.flags, meas, mc.frequency_hz)
-    figs["stabilisation"] = (
+def residual_zoom_figure(result: DemoResult) -> Built:
+    """Where the real-mode fit misses: residual against the noise, and a zoom."""
+    c = _fits(result)
+    real = c.main.synthesised("real")
+    cplx = c.main.synthesised("complex")
+    return _residual_zoom(c.main, c.meas, real, cplx, c.out_i, c.in_i, c.lab)
+
+
+def stabilisation_figure(result: DemoResult) -> Built:
+    """The stabilisation diagram of the fit at the main pressure."""
+    c = _fits(result)
+    ident = c.main.identification
+    mc = c.main.models["complex"]
+    ax2 = plot_stabilisation(ident.poles, ident.flags, c.meas, mc.frequency_hz)
+    return (
         _figure(ax2),
-        f"Stabilisation diagram (pLSCF poles of every model order) at {p}; dashed lines: "
+        f"Stabilisation diagram (pLSCF poles of every model order) at {c.p}; dashed lines: "
         "the modes selected automatically; grey curve: summed FRF amplitude.",
     )
-    axs3 = plot_mode_shapes_ring(mc)
+
+
+def mode_shapes_figure(result: DemoResult) -> Built:
+    """The complex mode shapes around the circumference, with the true wave numbers."""
+    main = result.radial.main
+    axs3 = plot_mode_shapes_ring(main.models["complex"])
     vis = main.truth.select("visible")
     wave = {m: int(main.truth.wave_number[vis[t]]) for t, m in main.matches["complex"].matched}
     for j, a in enumerate(axs3):
         if j in wave:
             a.set_title(f"n = {wave[j]}: " + a.get_title(), fontsize="small")
-    figs["mode_shapes"] = (
+    return (
         _figure(axs3[0]),
         "Complex mode shapes around the circumference (16 points): real part of the "
         "second-order shape (solid) and imaginary part (dashed), normalised; n = "
         "circumferential wave number of the matched true mode.",
     )
-    figs["mac"] = _mac_figure(result)
-
-    figs["checks"] = _checks_figure(result)
-    figs["pressures"] = _pressures_figure(result)
-    tm = _ring_frequencies_figure(result)
-    if tm is not None:
-        figs["ring_frequencies"] = tm
-    return figs
 
 
-def _damping_figure(result: DemoResult) -> tuple[Figure, str]:
+def damping_figure(result: DemoResult) -> Built:
+    """Paper Fig. 5: identified and true damping matrices as heat maps."""
     r = result.radial
     p = f"{r.main.pressure_bar:g} bar"
     dm = r.damping
@@ -183,7 +246,8 @@ def _damping_figure(result: DemoResult) -> tuple[Figure, str]:
     )
 
 
-def _checks_figure(result: DemoResult) -> tuple[Figure, str]:
+def checks_figure(result: DemoResult) -> Built:
+    """Linearity and reciprocity: relative difference per line and overall."""
     r = result.radial
     fig = Figure(figsize=(9.0, 3.2), layout="constrained")
     axs = fig.subplots(1, 2)
@@ -208,7 +272,8 @@ def _checks_figure(result: DemoResult) -> tuple[Figure, str]:
     )
 
 
-def _pressures_figure(result: DemoResult) -> tuple[Figure, str]:
+def pressures_figure(result: DemoResult) -> Built:
+    """Frequencies and damping ratios against wave number at every pressure."""
     r = result.radial
     fig = Figure(figsize=(9.0, 3.4), layout="constrained")
     axs = fig.subplots(1, 2)
@@ -245,7 +310,7 @@ def _pressures_figure(result: DemoResult) -> tuple[Figure, str]:
     )
 
 
-def _ring_frequencies_figure(result: DemoResult) -> tuple[Figure, str] | None:
+def ring_frequencies_figure(result: DemoResult) -> Built:
     """Identified against updated-ring frequencies per n and pressure (None: no fit)."""
     res = result.radial.tyre_model.result
     if res is None:
@@ -273,11 +338,10 @@ def _ground_axle(
     return f, meas, preds, truth
 
 
-def _lateral(result: DemoResult) -> FigureSet:
+def corner_frequency_figure(result: DemoResult) -> Built:
+    """Paper Fig. 7: the proposed model's amplitude ratio, asymptotes and corner frequency."""
     lat = result.lateral
-    figs: FigureSet = {}
     ref = lat.reference
-    names = _paper_models(result.settings.lateral_models)
     fig = Figure(figsize=(11.0, 4.0), layout="constrained")
     axs = fig.subplots(1, 2)
     plot_figure7(lat.figure7, ax=axs[0])
@@ -291,14 +355,21 @@ def _lateral(result: DemoResult) -> FigureSet:
         f"C_r {hy.C_r / 1e3:.3g} kN s/m",
         fontsize="small",
     )
-    figs["fig07_corner_frequency"] = (
+    return (
         fig,
         "Paper Fig. 7: amplitude ratio of the proposed model with its low-frequency "
         "(1/(i w C_r)) and high-frequency (1/(K + i h)) asymptotes, the Maxwell model and "
         f"the corner frequency f0 = K/(2 pi C_r) (eq. 38; f0 = {lat.figure7.f0:.4g} Hz and "
         f"{hy.corner_frequency():.3g} Hz).",
     )
-    p_ref = ref.pressure_bar
+
+
+def lateral_frf_figures(result: DemoResult) -> dict[str, tuple[Figure, str]]:
+    """Paper Figs. 11-14: ground-force fits and axle-force predictions at each speed."""
+    lat = result.lateral
+    figs: dict[str, tuple[Figure, str]] = {}
+    names = _paper_models(result.settings.lateral_models)
+    p_ref = lat.reference.pressure_bar
     n = 11
     forces: tuple[tuple[ForceKind, str], ...] = (("ground", "reim"), ("axle", "bode"))
     for force, style in forces:
@@ -325,7 +396,13 @@ def _lateral(result: DemoResult) -> FigureSet:
                 "dotted black: the rig's exact FRF.",
             )
             n += 1
+    return figs
 
+
+def vehicle_figure(result: DemoResult) -> Built:
+    """The single-DOF vehicle on each fitted tyre and on the rig's exact tyre."""
+    lat = result.lateral
+    ref = lat.reference
     veh = lat.vehicle
     f = np.linspace(0.25, 9.0, 500)
     fig = Figure(figsize=(7.5, 5.4), layout="constrained")
@@ -347,7 +424,7 @@ def _lateral(result: DemoResult) -> FigureSet:
     ax.grid(True, which="both", alpha=0.3)
     ax2.grid(True, alpha=0.3)
     ax.legend(fontsize="x-small")
-    figs["vehicle"] = (
+    return (
         fig,
         f"Single-degree-of-freedom vehicle (eq. 41-42): a {veh.body_mass:g} kg body on each "
         f"fitted tyre at {ref.label} and on the rig's exact tyre; body resonance in brackets; "
@@ -355,6 +432,12 @@ def _lateral(result: DemoResult) -> FigureSet:
         "each model's amplitude against the rig's exact one (the gap the log scale hides).",
     )
 
+
+def time_response_figure(result: DemoResult) -> Built:
+    """Paper Fig. 15: the sine test against each fitted model and the exact tyre."""
+    lat = result.lateral
+    ref = lat.reference
+    names = _paper_models(result.settings.lateral_models)
     tt = lat.time_test
     fig = Figure(figsize=(8.0, 5.2), layout="constrained")
     axs = fig.subplots(2, 1, sharex=True)
@@ -375,7 +458,7 @@ def _lateral(result: DemoResult) -> FigureSet:
     axs[1].legend(loc="upper right", fontsize="small")
     axs[1].grid(True, alpha=0.3)
     best = min((k for k in names if k in gaps), key=lambda k: gaps[k], default=None)
-    figs["fig15_time_response"] = (
+    return (
         fig,
         f"Paper Fig. 15: lateral force and body acceleration at {tt.frequency_hz:g} Hz "
         f"({ref.label}), measured against the steady state of each fitted model and of the "
@@ -389,10 +472,9 @@ def _lateral(result: DemoResult) -> FigureSet:
         )
         + ".",
     )
-    return figs
 
 
-def _mac_figure(result: DemoResult) -> tuple[Figure, str]:
+def mac_figure(result: DemoResult) -> Built:
     """Auto-MAC of the identified shapes at the main pressure and MAC across pressures."""
     from ..modal.statistics.indicators import auto_mac, mac
 
@@ -492,8 +574,3 @@ def _residual_zoom(
         f"amplitude zoomed on {lo:.0f}-{f[-1]:.0f} Hz (below), the upper part of the band where "
         "the paper saw the real-mode fit depart.",
     )
-
-
-def demo_figures(result: DemoResult) -> FigureSet:
-    """All demo figures in report order: ``{name: (Figure, caption)}``."""
-    return {**_radial(result), **_lateral(result)}

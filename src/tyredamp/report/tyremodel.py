@@ -12,7 +12,7 @@ from __future__ import annotations
 import html
 from typing import TYPE_CHECKING, Any
 
-from ._cells import _image, _num, _warnings, fmt_pm
+from ._cells import _images, _num, _warnings, fmt_pm
 from .html import HtmlReport
 
 if TYPE_CHECKING:
@@ -124,7 +124,7 @@ def tyre_model_report(
         )
         _warnings(rep, doc, "radial:tyre_model")
         return
-    _image(rep, images, "ring_frequencies")
+    _images(rep, images, "tyre_model")
     fit = tm["fit"]
     rep.table(
         [

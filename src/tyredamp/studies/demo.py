@@ -27,6 +27,12 @@
 * the **damping model** (:func:`.dampmodels.run_dampmodels`): every damping
   model fitted to the rubber tyre's FRFs and ranked, the truth beside it.
 
+Each identification runs a registered step
+(:data:`tyredamp.studies.registry.STEPS`: ``frf``, ``checks``, ``modal``,
+``damping``, ``fit``, ``rolling``), the recipe of the command line and of a
+campaign, with the settings :meth:`DemoSettings.step_settings` makes from
+the demo's own.
+
 :func:`tyredamp.report.demo.save_demo` writes what :func:`run_demo` returned
 into a directory (report, results.json, figures, data, modes and damping
 JSON).
@@ -124,7 +130,8 @@ def _run(s: DemoSettings, progress: ProgressCallback | None) -> DemoResult:
     radial = run_radial(s, st.start)
     lateral = run_lateral(s, st.start)
     st.start("rolling tyre, output-only")
-    rolling = run_rolling((80.0,) if s.quick else (40.0, 80.0), seed=s.seed)
+    speeds = (80.0,) if s.quick else (40.0, 80.0)
+    rolling = run_rolling(speeds, seed=s.seed, settings=s.step_settings()["rolling"])
     st.start("damping model of the rubber tyre")
     damping_models = run_dampmodels(seed=s.seed)
     st.finish()

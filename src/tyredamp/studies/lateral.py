@@ -13,30 +13,24 @@ causal approximation) and :func:`run_lateral`, the whole study of the demo.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from ..exceptions import InputError, PhysicsError
-from ..frf import FRF
+from ..exceptions import PhysicsError
 from ..lateral import (
-    DEFAULT_MODELS,
-    LateralData,
     LateralVehicle,
-    Ranking,
     Resonance,
     causal_error,
     figure7_curves,
     harmonic_response,
-    rank_models,
 )
-from ..lateral.fit import Criterion, Weights
-from ..lateral.response import ForceKind
-from ..virtual.lateral_rig import KMH, VirtualLateralRig
+from ..virtual.lateral_rig import VirtualLateralRig
 from .results import LateralCondition, LateralStudy, TimeTest, VehicleStudy
 from .settings import DemoSettings
+from .steps import LateralFitSettings
+from .steps.lateral_fit import fit_models, lateral_data
 
 __all__ = [
     "fit_models",
@@ -52,66 +46,27 @@ StageCallback = Callable[[str], None]
 
 
 # ---------------------------------------------------------------------------- steps
-def lateral_data(
-    frf: FRF,
-    *,
-    speed_kmh: float | None = None,
-    force: ForceKind | None = None,
-    wheel_mass: float | None = None,
-) -> LateralData:
-    """A lateral measurement from an FRF; conditions not given come from its ``meta``.
-
-    Parameters
-    ----------
-    frf : FRF
-        Lateral acceleration (or displacement, velocity) per lateral force.
-    speed_kmh : float, optional
-        Rolling speed, km/h (> 0).
-    force : {"ground", "axle"}, optional
-        Where the force acts.
-    wheel_mass : float, optional
-        Wheel mass, kg.
-    """
-    if speed_kmh is not None and not (math.isfinite(speed_kmh) and speed_kmh > 0):
-        raise InputError(f"speed: expected a speed > 0 km/h, got {speed_kmh}")
-    return LateralData.from_frf(
-        frf,
-        speed=None if speed_kmh is None else speed_kmh * KMH,
-        force=force,
-        wheel_mass=wheel_mass,
-    )
-
-
-def fit_models(
-    data: LateralData,
-    models: Sequence[str] = DEFAULT_MODELS,
-    *,
-    criterion: Criterion = "bic",
-    band: tuple[float, float] | None = None,
-    weights: Weights | ArrayLike = "auto",
-    channel: tuple[int, int] | None = None,
-) -> Ranking:
-    """Fit every model to the same data and weights and rank them (AIC/BIC).
-
-    See :func:`tyredamp.lateral.fit_model` for ``band``, ``weights`` and ``channel``.
-    """
-    return rank_models(
-        data, models, criterion=criterion, band=band, weights=weights, channel=channel
-    )
-
-
 # --------------------------------------------------------------- on the virtual rig
 def measure_condition(
     rig: VirtualLateralRig,
     pressure_bar: float,
     speed_kmh: float,
-    models: Sequence[str],
+    fit: LateralFitSettings,
     seed: int,
 ) -> LateralCondition:
-    """Ground- and axle-force FRFs of the rig at one condition, every model fitted to the ground."""
+    """Ground- and axle-force FRFs of the rig at one condition, every model fitted to the ground.
+
+    The fit is the registered ``fit`` step
+    (:class:`~tyredamp.studies.steps.LateralFitStep`, the recipe of ``tyredamp
+    lateral fit`` and of a campaign) with the settings ``fit``
+    (the demo's: :meth:`DemoSettings.step_settings`); the speed, force and
+    wheel mass come from the rig's FRF.
+    """
+    from .registry import STEPS
+
     ground = rig.measure(speed_kmh, pressure_bar, "ground", seed)
     axle = rig.measure(speed_kmh, pressure_bar, "axle", seed)
-    ranking = fit_models(ground, models)
+    (ranking, _), _ = STEPS["fit"].run(ground.frf, fit)
     return LateralCondition(
         pressure_bar, speed_kmh, ground, axle, ranking, rig.truth(speed_kmh, pressure_bar)
     )
@@ -198,10 +153,11 @@ def run_lateral(s: DemoSettings, stage: StageCallback | None = None) -> LateralS
             stage(name)
 
     rig = VirtualLateralRig()
+    fit = s.step_settings()["fit"]
     lat: list[LateralCondition] = []
     for p, v in conditions(s):
         start(f"lateral: {len(s.lateral_models)} model fits at {p:g} bar, {v:g} km/h")
-        lat.append(measure_condition(rig, p, v, s.lateral_models, s.seed))
+        lat.append(measure_condition(rig, p, v, fit, s.seed))
     ref_p, ref_v = s.reference_condition
     ref = next(c for c in lat if c.pressure_bar == ref_p and c.speed_kmh == ref_v)
 

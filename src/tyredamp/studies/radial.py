@@ -1,39 +1,38 @@
-"""The radial damping study of paper 000 as named steps.
+"""The radial damping study of paper 000: its functions and the demo's study.
 
-Each step takes typed inputs and returns a typed result; the command line
-(``tyredamp frf``, ``check``, ``modal``, ``damping``), the demo and any batch
-processing call these, so the pipeline exists once::
+The recipe of each step is its registered step
+(:data:`tyredamp.studies.registry.STEPS`: ``frf``, ``checks``, ``modal``,
+``damping``), which the command line, a campaign and the demo run with typed
+settings. The functions here give the same computations to Python with plain
+arguments::
 
     time data --frf_from_time--> FRF --check_linearity/_reciprocity/_quality--> CheckResult
                                  FRF --modes_from_frf--> ModalIdentification (real, complex)
               complex ModalModel --damping_from_modes--> DampingModel
 
 On the virtual tyre (known truth): :func:`virtual_tyre`,
-:func:`run_pressure` (modal test -> FRF -> modes, matched to the true modes
-by :func:`match_modes`), :func:`compare_damping` and :func:`run_radial`, the
-whole study of the demo.
+:func:`run_pressure` (modal test -> the ``frf`` and ``modal`` steps, matched
+to the true modes by :func:`match_modes`), :func:`compare_damping` and
+:func:`run_radial`, the whole study of the demo, whose knobs become the
+steps' settings in one place (:meth:`DemoSettings.step_settings`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
-from ..damping import DampingModel, Method, identify_damping
+from ..damping import DampingModel
 from ..exceptions import InputError
-from ..frf import FRF, Channel
+from ..frf import FRF
 from ..modal.identify import ModalIdentification, ModelChoice, identify_modes
-from ..modal.model import ModalModel
 from ..modal.poles.estimators import PoleEstimator
 from ..modal.statistics.stats import FALSE_ALARM
-from ..signal import CheckResult, linearity_check, quality_check, reciprocity_check
+from ..signal import CheckResult, linearity_check, reciprocity_check
 from ..signal.checks import merge_inputs
-from ..signal.estimators import Estimator, estimate_frf
-from ..signal.estimators import Method as FRFMethod
 from ..timedata import TimeData
 from ..virtual import (
     Cavity,
@@ -44,8 +43,12 @@ from ..virtual import (
     Splice,
     run_modal_test,
 )
+from .registry import STEPS
 from .results import DampingComparison, ModeMatch, PressureRun, RadialStudy
 from .settings import BAR, DemoSettings
+from .steps import QualitySettings, QualityStep
+from .steps.damping import damping_from_modes
+from .steps.frf import frf_from_time
 from .steps.modal import label_wave_numbers
 from .tyremodel import tyre_model_from_runs
 
@@ -69,59 +72,6 @@ StageCallback = Callable[[str], None]
 
 
 # ---------------------------------------------------------------------------- steps
-def frf_from_time(
-    data: TimeData,
-    estimator: Estimator = "H1",
-    *,
-    reference: Sequence[Channel | int | str] | None = None,
-    method: FRFMethod | None = None,
-    segment_samples: int | None = None,
-    period_samples: int | None = None,
-    settle_samples: int | None = None,
-    band: tuple[float, float] | None = None,
-    detect: bool = True,
-) -> FRF:
-    """FRFs with coherence from force and response time data (spec step 2).
-
-    Parameters
-    ----------
-    data : TimeData
-        Force and response channels.
-    estimator : {"H1", "H2", "Hv"}
-        FRF estimator.
-    reference : sequence of Channel, int or str, optional
-        Force channels; default: every force channel.
-    method : {"cyclic", "welch", "transient", "lrm", "lpm"}, optional
-        Averaging method; default chosen from the data's acquisition record
-        or, when ``detect``, from the force itself (cyclic for periodic
-        excitation); see :func:`tyredamp.signal.estimate_frf`.
-    segment_samples : int, optional
-        Segment length of Welch/transient averaging, samples.
-    period_samples : int, optional
-        Excitation period, samples (overrides the acquisition record).
-    settle_samples : int, optional
-        Samples dropped at the start of the record or of each run (start
-        transient); default from the record or detected.
-    band : (float, float), optional
-        Lines to keep, Hz.
-    detect : bool
-        Detect periodicity and the start transient from the data when the
-        acquisition record does not state them
-        (:mod:`tyredamp.signal.periodicity`).
-    """
-    return estimate_frf(
-        data,
-        estimator,
-        reference=list(reference) if reference else None,
-        method=method,
-        segment_samples=segment_samples,
-        period_samples=period_samples,
-        settle_samples=settle_samples,
-        band=band,
-        detect=detect,
-    )
-
-
 def check_linearity(
     frfs: Sequence[FRF], threshold: float = 0.05, band: tuple[float, float] | None = None
 ) -> CheckResult:
@@ -143,14 +93,19 @@ def check_reciprocity(
 def check_quality(
     data: TimeData | FRF,
     *,
-    coherence_min: float = 0.9,
-    max_low_fraction: float = 0.1,
+    coherence_min: float = QualitySettings.coherence_min,
+    max_low_fraction: float = QualitySettings.max_low_fraction,
     band: tuple[float, float] | None = None,
 ) -> CheckResult:
-    """Data quality: clipping, dead channels, low coherence, drive-point passivity."""
-    return quality_check(
-        data, coherence_min=coherence_min, max_low_coherence_fraction=max_low_fraction, band=band
+    """Data quality: clipping, dead channels, low coherence, drive-point passivity.
+
+    The ``checks`` step (:class:`~tyredamp.studies.steps.QualityStep`) with
+    these thresholds (:class:`~tyredamp.studies.steps.QualitySettings`).
+    """
+    settings = QualitySettings(
+        coherence_min=coherence_min, max_low_fraction=max_low_fraction, band=band
     )
+    return QualityStep.run(data, settings)[0]
 
 
 def modes_from_frf(
@@ -191,93 +146,6 @@ def modes_from_frf(
         variance=variance,
         estimator=estimator,
     )
-
-
-def damping_from_modes(
-    models: dict[str, ModalModel],
-    *,
-    model: str = "complex",
-    method: Method = "improved",
-    normalise: bool = True,
-    n_samples: int = 200,
-    seed: int = 0,
-    meta: dict[str, Any] | None = None,
-    modes: Sequence[int] | None = None,
-    band: tuple[float, float] | None = None,
-) -> DampingModel:
-    """The damping matrix in modal and physical coordinates (eq. [14]-[18]).
-
-    The shapes are taken where they are (:func:`tyredamp.damping.modeset.at_shape_points`:
-    at the inputs of a roving-hammer test), the modes chosen by ``modes`` and
-    ``band`` (:func:`~tyredamp.damping.modeset.select_modes`), and unscaled
-    modes are refused (:func:`~tyredamp.damping.modeset.scaling_problem`):
-    without mass-normalised shapes the damping, mass and stiffness matrices
-    have no meaning. ``meta`` of the result records ``modes_used`` (1-based
-    numbers in the file), ``n_modes_available``, ``shape_points``
-    (``"outputs"`` or ``"inputs"``) and ``scaling``.
-
-    Parameters
-    ----------
-    models : dict of str to ModalModel
-        Identified models by name (``"complex"``, ``"real"``).
-    model : str
-        Which of them to use.
-    method, normalise, n_samples, seed, meta
-        See :func:`tyredamp.damping.identify_damping`.
-    modes : sequence of int, optional
-        Mode numbers to use (1-based, in order of frequency); default all.
-    band : (float, float), optional
-        Natural frequency range of the modes to use, Hz.
-
-    Raises
-    ------
-    InputError
-        Unknown model, mode numbers or band that choose nothing, unscaled modes.
-    ShapeError
-        More modes than shape points (the message says how many the points allow).
-    """
-    from ..damping.modeset import (
-        at_shape_points,
-        check_point_count,
-        scaling_problem,
-        select_modes,
-    )
-
-    if model not in models:
-        raise InputError(
-            f"model (--model): the modes file holds the {' and '.join(sorted(models))} model(s), "
-            f"not {model!r}"
-        )
-    full = at_shape_points(models[model])
-    why = scaling_problem(full)
-    if why:
-        src = (meta or {}).get("source") or "the modes"
-        raise InputError(
-            f"{src}: the mode shapes are unscaled ({why}); a damping matrix from them would be "
-            "meaningless. Scale them with a drive-point FRF (an input at the node and direction "
-            "of a response) in the modal fit, or give the modal A (complex modes) or modal mass "
-            "(real modes) with the shapes"
-        )
-    chosen, numbers = select_modes(full, modes, band)
-    check_point_count(chosen, full.n_modes if chosen.n_modes == full.n_modes else None)
-    info = dict(meta or {})
-    info["modes_used"] = numbers
-    info["n_modes_available"] = full.n_modes
-    info["shape_points"] = str(full.meta.get("shapes_from", "outputs"))
-    info["scaling"] = "mass-normalised"
-    dm = identify_damping(
-        chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
-    )
-    if info["shape_points"] == "inputs" and dm.std and "psi_out" not in chosen.std:
-        from dataclasses import replace
-
-        note = (
-            "The shapes at the excitation points carry no standard errors (the fit gives them "
-            "at the responses only): the standard errors of C' and C cover the uncertainty of "
-            "the poles, not of the shapes, and understate the spread."
-        )
-        dm = replace(dm, findings=(*dm.findings, note))
-    return dm
 
 
 # ---------------------------------------------------------------- on the virtual tyre
@@ -355,9 +223,22 @@ def virtual_tyre(
 
 
 def run_pressure(
-    pressure_bar: float, n_periods: int, *, force_rms: float, snr_db: float, seed: int
+    pressure_bar: float,
+    n_periods: int,
+    *,
+    force_rms: float,
+    snr_db: float,
+    seed: int,
+    settings: DemoSettings | None = None,
 ) -> PressureRun:
     """The modal test at one pressure, its FRFs and fits, matched to the true modes.
+
+    The FRF and the modes are the registered steps ``frf`` and ``modal``
+    (:data:`~tyredamp.studies.registry.STEPS`) with the settings the demo
+    gives them (:meth:`DemoSettings.step_settings`): the recipe of ``tyredamp
+    frf``, ``tyredamp modal`` and of a campaign. The verdicts of the ``modal``
+    step are not kept: the demo judges each fit against the true modes
+    (:func:`tyredamp.studies.findings.pressure_verdicts`).
 
     Parameters
     ----------
@@ -371,7 +252,11 @@ def run_pressure(
         Signal-to-noise ratio of every channel, dB.
     seed : int
         Noise seed.
+    settings : DemoSettings, optional
+        The demo's settings (default :class:`DemoSettings`); only the steps'
+        settings are taken from it.
     """
+    steps = (DemoSettings() if settings is None else settings).step_settings()
     test = run_modal_test(
         virtual_tyre(pressure_bar),
         n_periods=n_periods,
@@ -379,8 +264,8 @@ def run_pressure(
         snr_db=snr_db,
         seed=seed,
     )
-    frf = frf_from_time(test.data, "H1")
-    ident = modes_from_frf(frf, model="both")
+    frf, _ = STEPS["frf"].run(test.data, steps["frf"])
+    ident, _ = STEPS["modal"].run(frf, steps["modal"])
     visible = test.truth.frequency_hz[test.truth.select("visible")]
     matches = {k: match_modes(m.frequency_hz, visible) for k, m in ident.models.items()}
     return PressureRun(pressure_bar, test, frf, ident, matches, n_periods)
@@ -448,13 +333,16 @@ def run_radial(s: DemoSettings, stage: StageCallback | None = None) -> RadialStu
         if stage is not None:
             stage(name)
 
+    steps = s.step_settings()
     base = 1000 * s.seed
     runs: list[PressureRun] = []
     for k, p in enumerate(s.radial_pressures_bar):
         start(f"radial: modal test, FRFs, real and complex fits at {p:g} bar")
         n = s.radial_periods if k == 0 else s.radial_side_periods
         runs.append(
-            run_pressure(p, n, force_rms=s.force_levels_n[0], snr_db=s.snr_db, seed=base + 1 + k)
+            run_pressure(
+                p, n, force_rms=s.force_levels_n[0], snr_db=s.snr_db, seed=base + 1 + k, settings=s
+            )
         )
     main = runs[0]
     p0 = s.radial_pressures_bar[0]
@@ -467,9 +355,9 @@ def run_radial(s: DemoSettings, stage: StageCallback | None = None) -> RadialStu
         snr_db=s.snr_db,
         seed=base + 101,
     )
-    frf_high = frf_from_time(high.data, "H1")
+    frf_high, _ = STEPS["frf"].run(high.data, steps["frf"])
     lin = check_linearity([main.frf, frf_high], band=s.check_band_hz)
-    quality = check_quality(main.test.data, band=s.check_band_hz)  # the band of the other checks
+    quality, _ = STEPS["checks"].run(main.test.data, steps["checks"])
 
     start(f"radial: reciprocity check, drive points {s.reciprocity_points}")
     recip_test = run_modal_test(
@@ -479,18 +367,12 @@ def run_radial(s: DemoSettings, stage: StageCallback | None = None) -> RadialStu
         snr_db=s.snr_db,
         seed=base + 102,
     )
-    recip_frf = frf_from_time(recip_test.data, "H1")
+    recip_frf, _ = STEPS["frf"].run(recip_test.data, steps["frf"])
     recip = check_reciprocity([recip_frf], band=s.check_band_hz)
 
     start(f"radial: damping identification ({s.damping_method})")
-    dm = damping_from_modes(
-        main.models,
-        model="complex",
-        method=s.damping_method,  # type: ignore[arg-type]
-        n_samples=s.damping_samples,
-        seed=s.seed,
-        meta={"source": f"demo, virtual truck tyre at {p0:g} bar", "model": "complex"},
-    )
+    meta = {"source": f"demo, virtual truck tyre at {p0:g} bar", "model": "complex"}
+    dm, _ = STEPS["damping"].run(main.models, steps["damping"], meta)
 
     start(f"radial: tyre model (flexible ring, rigid ring) at {len(runs)} pressure(s)")
     tyre_model = tyre_model_from_runs(runs)

@@ -12,7 +12,10 @@ sensors) and in the tyre (the in-tyre sensor).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .steps.rolling import RollingSettings
 
 __all__ = ["RollingSpeed", "RollingStudy", "rolling_section", "run_rolling"]
 
@@ -66,6 +69,7 @@ def run_rolling(
     duration: float = 8.0,
     seed: int = 0,
     band: tuple[float, float] = (0.0, 200.0),
+    settings: RollingSettings | None = None,
 ) -> RollingStudy:
     """Record and identify the rolling virtual tyre at each speed (module docstring).
 
@@ -77,19 +81,28 @@ def run_rolling(
         Seconds per record (512 Hz).
     seed : int
     band : (float, float)
-        Hz: road force and identification.
+        Hz: the band of the road force.
+    settings : RollingSettings, optional
+        Settings of the registered ``rolling`` step
+        (:class:`~tyredamp.studies.steps.rolling.RollingStep`, the recipe of
+        ``tyredamp rolling`` and of a campaign) that identifies each record;
+        default: the demo's (:meth:`DemoSettings.step_settings`, no jackknife
+        standard errors, the recording's band).
 
     Returns
     -------
     RollingStudy
     """
-    from ..oma.rolling import compare_waves, rolling_modes
+    from ..oma.rolling import compare_waves
     from ..virtual import rolling_test
+    from .registry import STEPS
+    from .settings import DemoSettings
 
+    rs = DemoSettings().step_settings()["rolling"] if settings is None else settings
     out = []
     for k, v in enumerate(speeds_kmh):
         test = rolling_test(v, duration=duration, sample_rate=512.0, band=band, seed=seed + k)
-        m = rolling_modes(test.data, uncertainty=False)
+        m, _ = STEPS["rolling"].run(test.data, rs)
         lo, hi = band[0] + 5.0, band[1] - 10.0  # waves away from the band edges
         table = test.truth.table()
         fixed_truth = [r for r in table if lo <= r["fixed_hz"] <= hi]

@@ -3,20 +3,41 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 
 from ..exceptions import InputError
 from ..lateral import DEFAULT_MODELS
 
-__all__ = ["BAR", "LATERAL_MODELS", "DemoSettings"]
+if TYPE_CHECKING:
+    from .steps import (
+        DampingSettings,
+        FrfSettings,
+        LateralFitSettings,
+        ModalSettings,
+        QualitySettings,
+    )
+    from .steps.rolling import RollingSettings
+
+__all__ = ["BAR", "LATERAL_MODELS", "DemoSettings", "DemoSteps"]
 
 #: One bar in Pa.
 BAR = 1.0e5
 #: The six lateral models fitted by the demo: the paper's four, then the
 #: relaxation-length and stretched-string models.
 LATERAL_MODELS: tuple[str, ...] = (*DEFAULT_MODELS, "relaxation", "string")
+
+
+class DemoSteps(TypedDict):
+    """The settings of each registered step the demo runs, by step name."""
+
+    frf: FrfSettings
+    checks: QualitySettings
+    modal: ModalSettings
+    damping: DampingSettings
+    fit: LateralFitSettings
+    rolling: RollingSettings
 
 
 @dataclass(frozen=True)
@@ -119,6 +140,37 @@ class DemoSettings:
             damping_samples=50,
             lateral_pressures_bar=(1.7,),
         )
+
+    def step_settings(self) -> DemoSteps:
+        """The settings of each registered step the demo runs, by step name.
+
+        The demo runs the steps of :data:`tyredamp.studies.registry.STEPS` (the
+        recipe of the command line and of a campaign); this is the one place
+        where its own knobs become theirs: ``checks`` over ``check_band_hz``,
+        ``damping`` with ``damping_method``, ``damping_samples`` and ``seed``,
+        ``fit`` with ``lateral_models``, ``rolling`` without the jackknife
+        standard errors; ``frf`` (H1, averaging method from the data) and
+        ``modal`` (both models) take the steps' defaults.
+        """
+        from .steps import (
+            DampingSettings,
+            FrfSettings,
+            LateralFitSettings,
+            ModalSettings,
+            QualitySettings,
+        )
+        from .steps.rolling import RollingSettings
+
+        return {
+            "frf": FrfSettings(),
+            "checks": QualitySettings(band=self.check_band_hz),
+            "modal": ModalSettings(),
+            "damping": DampingSettings(
+                method=self.damping_method, samples=self.damping_samples, seed=self.seed
+            ),
+            "fit": LateralFitSettings(models=self.lateral_models),
+            "rolling": RollingSettings(uncertainty=False),
+        }
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready copy of the settings."""

@@ -10,14 +10,16 @@ from ...exceptions import InputError
 from ._settings import Band, Boolean, Check, Choice, Integer, StepSettings, knob
 
 if TYPE_CHECKING:
-    from ...damping import DampingModel
+    from collections.abc import Sequence
+
+    from ...damping import DampingModel, Method
     from ...modal.model import ModalModel
 
 #: The estimators of :data:`tyredamp.damping.METHODS` (named here so that the settings
 #: load without the numerical packages; a test keeps the two equal).
 DAMPING_METHODS: tuple[str, ...] = ("first", "improved", "refined")
 
-__all__ = ["DampingSettings", "DampingStep", "ModeNumbers"]
+__all__ = ["DampingSettings", "DampingStep", "ModeNumbers", "damping_from_modes"]
 
 
 #: Most Monte Carlo samples of the damping step (standard errors to about 0.7 %).
@@ -129,8 +131,6 @@ class DampingStep:
     ) -> tuple[DampingModel, dict[str, Any]]:
         """The damping matrix of ``models[settings.model]``; no verdicts of its own
         (its findings are in the result)."""
-        from ..radial import damping_from_modes
-
         s = settings
         dm = damping_from_modes(
             models,
@@ -151,3 +151,91 @@ class DampingStep:
         from ...documents.damping import damping_document
 
         return damping_document(result)
+
+
+def damping_from_modes(
+    models: dict[str, ModalModel],
+    *,
+    model: str = "complex",
+    method: Method = "improved",
+    normalise: bool = True,
+    n_samples: int = 200,
+    seed: int = 0,
+    meta: dict[str, Any] | None = None,
+    modes: Sequence[int] | None = None,
+    band: tuple[float, float] | None = None,
+) -> DampingModel:
+    """The damping matrix in modal and physical coordinates (eq. [14]-[18]).
+
+    The shapes are taken where they are (:func:`tyredamp.damping.modeset.at_shape_points`:
+    at the inputs of a roving-hammer test), the modes chosen by ``modes`` and
+    ``band`` (:func:`~tyredamp.damping.modeset.select_modes`), and unscaled
+    modes are refused (:func:`~tyredamp.damping.modeset.scaling_problem`):
+    without mass-normalised shapes the damping, mass and stiffness matrices
+    have no meaning. ``meta`` of the result records ``modes_used`` (1-based
+    numbers in the file), ``n_modes_available``, ``shape_points``
+    (``"outputs"`` or ``"inputs"``) and ``scaling``.
+
+    Parameters
+    ----------
+    models : dict of str to ModalModel
+        Identified models by name (``"complex"``, ``"real"``).
+    model : str
+        Which of them to use.
+    method, normalise, n_samples, seed, meta
+        See :func:`tyredamp.damping.identify_damping`.
+    modes : sequence of int, optional
+        Mode numbers to use (1-based, in order of frequency); default all.
+    band : (float, float), optional
+        Natural frequency range of the modes to use, Hz.
+
+    Raises
+    ------
+    InputError
+        Unknown model, mode numbers or band that choose nothing, unscaled modes.
+    ShapeError
+        More modes than shape points (the message says how many the points allow).
+    """
+    from ...damping import identify_damping
+    from ...damping.modeset import (
+        at_shape_points,
+        check_point_count,
+        scaling_problem,
+        select_modes,
+    )
+
+    if model not in models:
+        raise InputError(
+            f"model (--model): the modes file holds the {' and '.join(sorted(models))} model(s), "
+            f"not {model!r}"
+        )
+    full = at_shape_points(models[model])
+    why = scaling_problem(full)
+    if why:
+        src = (meta or {}).get("source") or "the modes"
+        raise InputError(
+            f"{src}: the mode shapes are unscaled ({why}); a damping matrix from them would be "
+            "meaningless. Scale them with a drive-point FRF (an input at the node and direction "
+            "of a response) in the modal fit, or give the modal A (complex modes) or modal mass "
+            "(real modes) with the shapes"
+        )
+    chosen, numbers = select_modes(full, modes, band)
+    check_point_count(chosen, full.n_modes if chosen.n_modes == full.n_modes else None)
+    info = dict(meta or {})
+    info["modes_used"] = numbers
+    info["n_modes_available"] = full.n_modes
+    info["shape_points"] = str(full.meta.get("shapes_from", "outputs"))
+    info["scaling"] = "mass-normalised"
+    dm = identify_damping(
+        chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
+    )
+    if info["shape_points"] == "inputs" and dm.std and "psi_out" not in chosen.std:
+        from dataclasses import replace
+
+        note = (
+            "The shapes at the excitation points carry no standard errors (the fit gives them "
+            "at the responses only): the standard errors of C' and C cover the uncertainty of "
+            "the poles, not of the shapes, and understate the spread."
+        )
+        dm = replace(dm, findings=(*dm.findings, note))
+    return dm

@@ -2,14 +2,19 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
-from ...frf import FRF
+from ...frf import FRF, Channel
 from ...timedata import TimeData
 from ._settings import Band, Choice, Integer, Length, Names, StepSettings, knob, samples
 
-__all__ = ["FRF_METHODS", "FrfSettings", "FrfStep"]
+if TYPE_CHECKING:
+    from ...signal.estimators import Estimator
+    from ...signal.estimators import Method as FRFMethod
+
+__all__ = ["FRF_METHODS", "FrfSettings", "FrfStep", "frf_from_time"]
 
 #: The FRF estimators of :data:`tyredamp.signal.estimators.ESTIMATORS` (named here so that
 #: the settings load without SciPy; a test keeps the two equal).
@@ -88,8 +93,6 @@ class FrfStep:
     def run(data: TimeData, settings: FrfSettings, where: str = "") -> tuple[FRF, dict[str, Any]]:
         """FRFs of ``data`` with ``settings``; ``where`` prefixes the names of the
         lengths in messages (``"settings.radial.frf."``; the CLI gives ``"--"``)."""
-        from ..radial import frf_from_time
-
         s = settings
         rate = data.sample_rate
         frf = frf_from_time(
@@ -103,3 +106,58 @@ class FrfStep:
             band=s.band,
         )
         return frf, {}
+
+
+def frf_from_time(
+    data: TimeData,
+    estimator: Estimator = "H1",
+    *,
+    reference: Sequence[Channel | int | str] | None = None,
+    method: FRFMethod | None = None,
+    segment_samples: int | None = None,
+    period_samples: int | None = None,
+    settle_samples: int | None = None,
+    band: tuple[float, float] | None = None,
+    detect: bool = True,
+) -> FRF:
+    """FRFs with coherence from force and response time data (spec step 2).
+
+    Parameters
+    ----------
+    data : TimeData
+        Force and response channels.
+    estimator : {"H1", "H2", "Hv"}
+        FRF estimator.
+    reference : sequence of Channel, int or str, optional
+        Force channels; default: every force channel.
+    method : {"cyclic", "welch", "transient", "lrm", "lpm"}, optional
+        Averaging method; default chosen from the data's acquisition record
+        or, when ``detect``, from the force itself (cyclic for periodic
+        excitation); see :func:`tyredamp.signal.estimate_frf`.
+    segment_samples : int, optional
+        Segment length of Welch/transient averaging, samples.
+    period_samples : int, optional
+        Excitation period, samples (overrides the acquisition record).
+    settle_samples : int, optional
+        Samples dropped at the start of the record or of each run (start
+        transient); default from the record or detected.
+    band : (float, float), optional
+        Lines to keep, Hz.
+    detect : bool
+        Detect periodicity and the start transient from the data when the
+        acquisition record does not state them
+        (:mod:`tyredamp.signal.periodicity`).
+    """
+    from ...signal.estimators import estimate_frf
+
+    return estimate_frf(
+        data,
+        estimator,
+        reference=list(reference) if reference else None,
+        method=method,
+        segment_samples=segment_samples,
+        period_samples=period_samples,
+        settle_samples=settle_samples,
+        band=band,
+        detect=detect,
+    )

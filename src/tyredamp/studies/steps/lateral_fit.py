@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -11,9 +12,14 @@ from ...frf import FRF
 from ._settings import Band, Choice, Names, Number, Pair, StepSettings, knob
 
 if TYPE_CHECKING:
-    from ...lateral.ranking import Ranking
+    from numpy.typing import ArrayLike
 
-__all__ = ["LATERAL_MODELS", "LateralFitSettings", "LateralFitStep"]
+    from ...lateral import LateralData
+    from ...lateral.fit import Criterion, Weights
+    from ...lateral.ranking import Ranking
+    from ...lateral.response import ForceKind
+
+__all__ = ["LATERAL_MODELS", "LateralFitSettings", "LateralFitStep", "fit_models", "lateral_data"]
 
 
 def _model_name(name: str, where: str) -> str:
@@ -120,7 +126,6 @@ class LateralFitStep:
         verdict: :meth:`~tyredamp.lateral.fit.Ranking.check`, which raises when no
         model fits). ``labels`` names the channel and the speed in messages."""
         from ...lateral.models import get_model_class
-        from ..lateral import fit_models, lateral_data
 
         s = settings
         ch = s.channel
@@ -169,3 +174,62 @@ class LateralFitStep:
 
         ranking, data = result
         return lateral_fit_document(ranking, data, source=source, frf_kind=frf_kind)
+
+
+def lateral_data(
+    frf: FRF,
+    *,
+    speed_kmh: float | None = None,
+    force: ForceKind | None = None,
+    wheel_mass: float | None = None,
+) -> LateralData:
+    """A lateral measurement from an FRF; conditions not given come from its ``meta``.
+
+    Parameters
+    ----------
+    frf : FRF
+        Lateral acceleration (or displacement, velocity) per lateral force.
+    speed_kmh : float, optional
+        Rolling speed, km/h (> 0).
+    force : {"ground", "axle"}, optional
+        Where the force acts.
+    wheel_mass : float, optional
+        Wheel mass, kg.
+    """
+    from ...lateral import LateralData
+    from ...virtual.lateral_rig import KMH
+
+    if speed_kmh is not None and not (math.isfinite(speed_kmh) and speed_kmh > 0):
+        raise InputError(f"speed: expected a speed > 0 km/h, got {speed_kmh}")
+    return LateralData.from_frf(
+        frf,
+        speed=None if speed_kmh is None else speed_kmh * KMH,
+        force=force,
+        wheel_mass=wheel_mass,
+    )
+
+
+def fit_models(
+    data: LateralData,
+    models: Sequence[str] | None = None,
+    *,
+    criterion: Criterion = "bic",
+    band: tuple[float, float] | None = None,
+    weights: Weights | ArrayLike = "auto",
+    channel: tuple[int, int] | None = None,
+) -> Ranking:
+    """Fit every model to the same data and weights and rank them (AIC/BIC).
+
+    ``models`` default: :data:`tyredamp.lateral.DEFAULT_MODELS`. See
+    :func:`tyredamp.lateral.fit_model` for ``band``, ``weights`` and ``channel``.
+    """
+    from ...lateral import DEFAULT_MODELS, rank_models
+
+    return rank_models(
+        data,
+        DEFAULT_MODELS if models is None else models,
+        criterion=criterion,
+        band=band,
+        weights=weights,
+        channel=channel,
+    )

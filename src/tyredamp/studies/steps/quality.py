@@ -58,12 +58,12 @@ class QualityStep:
     @staticmethod
     def run(data: TimeData | FRF, settings: QualitySettings) -> tuple[CheckResult, dict[str, Any]]:
         """The quality check of ``data``; the verdict is the result's ``passed``."""
-        from ..radial import check_quality
+        from ...signal import quality_check
 
-        res = check_quality(
+        res = quality_check(
             data,
             coherence_min=settings.coherence_min,
-            max_low_fraction=settings.max_low_fraction,
+            max_low_coherence_fraction=settings.max_low_fraction,
             band=settings.band,
         )
         return res, {"quality": res}
