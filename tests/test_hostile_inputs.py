@@ -582,3 +582,13 @@ def test_archive_refused_before_inflating(tmp_path: Path) -> None:
     finally:
         tracemalloc.stop()
     assert peak < declared / 8  # the archive's directory only, never the members
+
+
+def test_npz_member_header_that_does_not_parse(tmp_path: Path) -> None:
+    """A header cut inside its dict (NumPy's parser raises tokenize's TokenError): one line."""
+    good = hc.npy_bytes(np.zeros(4))
+    cut = good.index(b"}")
+    p = tmp_path / "h.npz"
+    p.write_bytes(hc.zip_bytes({"H.npy": good[:cut].replace(b"{", b"{(") + good[cut:]}))
+    with pytest.raises(FileFormatError, match=r"H\.npy: the array's header is not readable"):
+        read_timedata(p)

@@ -109,12 +109,17 @@ def _check_members(p: os.PathLike[str], max_bytes: int | None = None) -> None:
                     f"{p}: member {info.filename[:60]!r} is not a NumPy array (.npy); a tyredamp "
                     "NPZ file holds arrays only"
                 )
-            with zf.open(info) as fh:
-                version = np.lib.format.read_magic(fh)
-                if version == (1, 0):
-                    shape, _, dtype = np.lib.format.read_array_header_1_0(fh)
-                else:
-                    shape, _, dtype = np.lib.format.read_array_header_2_0(fh)
+            try:
+                with zf.open(info) as fh:
+                    version = np.lib.format.read_magic(fh)
+                    if version == (1, 0):
+                        shape, _, dtype = np.lib.format.read_array_header_1_0(fh)
+                    else:
+                        shape, _, dtype = np.lib.format.read_array_header_2_0(fh)
+            except Exception as exc:  # ValueError, tokenize's TokenError, zlib.error ... on garbage
+                raise FileFormatError(
+                    f"{p}: {info.filename}: the array's header is not readable ({exc})"
+                ) from None
             if dtype.hasobject:
                 raise FileFormatError(f"{p}: {info.filename}: object arrays are not accepted")
             need = int(np.prod(shape, dtype=object)) * dtype.itemsize
