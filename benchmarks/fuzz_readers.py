@@ -140,6 +140,7 @@ def main() -> None:
     parser.add_argument("--cases", type=int, default=400, help="damaged copies per sample")
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--formats", nargs="*", help="sample names (default all)")
+    parser.add_argument("--keep", type=Path, help="copy the files that failed into this folder")
     args = parser.parse_args()
     rng = random.Random(args.seed)
     with tempfile.TemporaryDirectory() as tmp:
@@ -167,6 +168,10 @@ def main() -> None:
             for kind in ("crashes", "internal errors", "hangs"):
                 for line in found[kind][:5]:
                     print(f"    {kind}: {line}")
+                    if args.keep is not None:
+                        bad = Path(line.split()[-1] if kind == "crashes" else line.split()[1])
+                        args.keep.mkdir(parents=True, exist_ok=True)
+                        (args.keep / f"{name}-{bad.name}").write_bytes(bad.read_bytes())
 
 
 if __name__ == "__main__":

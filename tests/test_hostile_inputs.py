@@ -28,7 +28,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 from tyredamp.exceptions import FileFormatError, InputError
-from tyredamp.io import read_frf, read_timedata
+from tyredamp.frf import FRF
+from tyredamp.io import read_frf, read_timedata, write_frf
 from tyredamp.io._guard import axis_scale, check_archive, load_toml, toml_depth
 from tyredamp.io.npz import _check_members
 from tyredamp.io.units import parse_unit
@@ -592,3 +593,17 @@ def test_npz_member_header_that_does_not_parse(tmp_path: Path) -> None:
     p.write_bytes(hc.zip_bytes({"H.npy": good[:cut].replace(b"{", b"{(") + good[cut:]}))
     with pytest.raises(FileFormatError, match=r"H\.npy: the array's header is not readable"):
         read_timedata(p)
+
+
+def test_npz_needing_a_newer_zip_version(tmp_path: Path) -> None:
+    """A member that says it needs zip version 9.1 (zipfile's NotImplementedError): one line."""
+    good = tmp_path / "g.npz"
+    write_frf(FRF(np.linspace(1.0, 10.0, 10), np.ones((1, 1, 10), complex)), good)
+    raw = bytearray(good.read_bytes())
+    for signature, offset in ((b"PK\x03\x04", 4), (b"PK\x01\x02", 6)):  # local, central
+        at = raw.find(signature)
+        raw[at + offset] = 91  # "version needed to extract"
+    p = tmp_path / "v.npz"
+    p.write_bytes(bytes(raw))
+    with pytest.raises(FileFormatError, match=r"v\.npz: not a readable NPZ file \(zip file"):
+        read_frf(p)
