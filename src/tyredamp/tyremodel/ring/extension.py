@@ -184,6 +184,7 @@ def extension_test(
 
 def admit_extension(
     out: dict[str, dict[str, Any]],
+    theta: _Array,
     se: _Array,
     shift: _Array,
     shift_sd: _Array,
@@ -195,8 +196,8 @@ def admit_extension(
     ----------
     out : dict
         Verdicts in parameter order (changed copies are returned).
-    se : ndarray, shape (P,)
-        Standard errors of the reported values.
+    theta, se : ndarray, shape (P,)
+        The reported values and their standard errors.
     shift, shift_sd : ndarray, shape (P,)
         ``q`` and ``sqrt(var q)`` in the parameters' units.
     ext : Extension
@@ -211,9 +212,9 @@ def admit_extension(
         if limited and not w.get("model_limited") and not w["verdict"].startswith("not"):
             w["model_limited"] = True
             w["verdict"] = (
-                f"model-limited (the data see the ring stretch, z = {ext.z:.2g}: "
-                f"the inextensible ring moves it by {abs(q) / max(float(se[i]), 1e-300):.2g} "
-                "standard errors)"
+                f"model-limited (the data see the ring stretch, z = {ext.z:.2g}: a ring that "
+                f"stretches gives {float(theta[i]) + q:.5g}, "
+                f"{abs(q) / max(float(se[i]), 1e-300):.2g} standard errors away)"
             )
         res[name] = w
     return res

@@ -225,12 +225,19 @@ def fit_ring(
     if ext is not None:
         stiff = replace(
             stiff,
-            verdicts=admit_extension(stiff.verdicts, stiff.stderr, ext.shift, ext.shift_sd, ext),
+            verdicts=admit_extension(
+                stiff.verdicts, stiff.theta, stiff.stderr, ext.shift, ext.shift_sd, ext
+            ),
         )
         damp = replace(
             damp,
             verdicts=admit_extension(
-                damp.verdicts, damp.stderr, ext.damping_shift, ext.damping_shift_sd, ext
+                damp.verdicts,
+                damp.values,
+                damp.stderr,
+                ext.damping_shift,
+                ext.damping_shift_sd,
+                ext,
             ),
         )
     return _result(
