@@ -19,7 +19,10 @@ Prints
    (0.01 kg, 2 N s/m), plus Gaussian noise (frequency 0.1 %, shape amplitude 1 %,
    damping ratio 2 %) given to the fit as the modal standard errors; 3c: on
    the modes identified from virtual tests with a new noise seed each (the
-   user's chain), 40 seeds;
+   user's chain), 40 seeds; 3, 3b and 3c also print the test of the
+   inextensible ring against the extensible one (the membrane compliance
+   1/EA found, against the virtual tyre's, and how often the inextensible
+   ring is rejected; ``tyredamp.tyremodel.ring.extension``);
 4. wave numbers of the identified modes and the aliased case (5 bar,
    0-260 Hz: n = 9 seen by 16 points as n = 7);
 5. rigid-ring parameters against the exact modes.
