@@ -147,14 +147,18 @@ def extension_test(
         return np.asarray(problem.residual(v[:-1], float(v[-1]) * c_sc), dtype=np.float64)
 
     v0 = np.concatenate([u, [0.0]])
-    try:
-        res = least_squares(resid, v0, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
-    except (ValueError, np.linalg.LinAlgError):
+    # a step of the search may reach a compliance where the ring has no flexural root
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        try:
+            res = least_squares(resid, v0, method="lm", xtol=1e-14, ftol=1e-14, gtol=1e-14)
+        except (ValueError, np.linalg.LinAlgError):
+            return None
+        if res.status <= 0 or not np.all(np.isfinite(res.x)):
+            return None
+        v = np.asarray(res.x, dtype=float)
+        jac = central_jacobian(resid, v)
+    if not np.all(np.isfinite(jac)):
         return None
-    if res.status <= 0 or not np.all(np.isfinite(res.x)):
-        return None
-    v = np.asarray(res.x, dtype=float)
-    jac = central_jacobian(resid, v)
     sc = np.concatenate([problem.scales, [c_sc]])
     cov_e = np.linalg.pinv(jac.T @ jac, rcond=1e-12) * cov_factor * np.outer(sc, sc)
     theta_e = v[:-1] * problem.scales
