@@ -19,7 +19,10 @@ Prints
    (0.01 kg, 2 N s/m), plus Gaussian noise (frequency 0.1 %, shape amplitude 1 %,
    damping ratio 2 %) given to the fit as the modal standard errors; 3c: on
    the modes identified from virtual tests with a new noise seed each (the
-   user's chain), 40 seeds;
+   user's chain), 40 seeds; 3, 3b and 3c also print the test of the
+   inextensible ring against the extensible one (the membrane compliance
+   1/EA found, against the virtual tyre's, and how often the inextensible
+   ring is rejected; ``tyredamp.tyremodel.ring.extension``);
 4. wave numbers of the identified modes and the aliased case (5 bar,
    0-260 Hz: n = 9 seen by 16 points as n = 7);
 5. rigid-ring parameters against the exact modes.
@@ -48,6 +51,7 @@ from tyredamp.tyremodel import (
     ring_observations,
     wave_number_analysis,
 )
+from tyredamp.tyremodel.ring.extension import Extension
 from tyredamp.virtual import (
     Imperfection,
     MeasurementLayout,
@@ -192,7 +196,7 @@ def coverage(n_seeds: int) -> None:
     )
     print(f"  noise-free data: largest relative error {worst:.2e} (the fit inverts the model)")
     hits: dict[str, list[bool]] = {}
-    scaled = 0
+    scaled = flags = rejected = 0
     for seed in range(n_seeds):
         rng = np.random.default_rng(1000 + seed)
         fit = fit_ring(
@@ -202,13 +206,34 @@ def coverage(n_seeds: int) -> None:
             attachment_damping=C_A,
         )
         scaled += int(fit.scaled_covariance)
+        flags += any(r["model_limited"] for r in fit.table())
+        rejected += int(fit.extension is not None and fit.extension.rejected)
         for name, tv, v, s in recovery_rows(fit):
             hits.setdefault(name, []).append(abs(v - tv) <= s)
     print(f"  covariance scaled by chi2/dof in {scaled} of {n_seeds} fits (p < 0.01)")
+    print(
+        f"  inextensible ring rejected in {rejected} of {n_seeds} fits; a parameter "
+        f"model-limited in {flags}"
+    )
     print(f"  {'parameter':>14} {'coverage %':>11}")
     for name, h in hits.items():
         flag = "" if abs(100 * np.mean(h) - 68.27) <= 7 else "   <- outside 68 +- 7"
         print(f"  {name:>14} {100 * np.mean(h):>11.1f}{flag}")
+
+
+def print_extension(ext: list[Extension | None]) -> None:
+    """The extensibility test over the seeds: compliance 1/EA against the truth, rejections."""
+    got = [e for e in ext if e is not None]
+    if not got:
+        print("  extensibility test: not run (no standard errors)")
+        return
+    c = np.array([e.compliance for e in got])
+    se = np.array([e.compliance_stderr for e in got])
+    print(
+        f"  extensibility: 1/EA median {np.median(c):.3g} 1/N (median se {np.median(se):.2g}; "
+        f"truth {1 / TRUE.membrane_stiffness:.3g}), inextensible ring rejected in "
+        f"{100 * np.mean([e.rejected for e in got]):.0f} % of the seeds"
+    )
 
 
 def coverage_with_model_error(n_seeds: int, rel_f: float, n_ring: int = 64) -> None:
@@ -233,6 +258,7 @@ def coverage_with_model_error(n_seeds: int, rel_f: float, n_ring: int = 64) -> N
     hits: dict[str, list[bool]] = {}
     flagged: dict[str, list[bool]] = {}
     c2 = []
+    ext: list[Extension | None] = []
     for seed in range(n_seeds):
         rng = np.random.default_rng(2000 + seed)
         obs = []
@@ -252,6 +278,7 @@ def coverage_with_model_error(n_seeds: int, rel_f: float, n_ring: int = 64) -> N
             )
         fit = fit_ring(obs, radius=TRUE.radius, attachment_mass=M_A, attachment_damping=C_A)
         c2.append(fit.model_discrepancy()["chi2_per_dof"])
+        ext.append(fit.extension)
         rows = {r["name"]: r for r in fit.table()}
         for name, tv, v, s in recovery_rows(fit):
             if name not in rows:
@@ -260,6 +287,7 @@ def coverage_with_model_error(n_seeds: int, rel_f: float, n_ring: int = 64) -> N
             hits.setdefault(name, []).append(abs(v - tv) <= u)
             flagged.setdefault(name, []).append(bool(rows[name].get("model_limited")))
     print(f"  chi2/dof (worst block): median {np.median(c2):.3g}")
+    print_extension(ext)
     floor = 100 * (0.6827 - 2 * np.sqrt(0.6827 * 0.3173 / n_seeds))
     print(f"  {'parameter':>10} {'coverage %':>11} {'model-limited %':>16}  result")
     for name in hits:
@@ -284,6 +312,7 @@ def coverage_identified(n_seeds: int) -> None:
     flagged: dict[str, list[bool]] = {}
     z: dict[str, list[float]] = {}
     c2 = []
+    ext: list[Extension | None] = []
     t0 = time.perf_counter()
     for seed in range(n_seeds):
         ident = []
@@ -293,6 +322,7 @@ def coverage_identified(n_seeds: int) -> None:
             ident.append((p * BAR, res.models["complex"]))
         fit = fit_ring(ident, radius=TRUE.radius, attachment_mass=M_A, attachment_damping=C_A)
         c2.append(fit.model_discrepancy()["chi2_per_dof"])
+        ext.append(fit.extension)
         rows = {r["name"]: r for r in fit.table()}
         for name, tv, v, s in recovery_rows(fit):
             if name not in rows or name == "T_c":
@@ -303,6 +333,7 @@ def coverage_identified(n_seeds: int) -> None:
             flagged.setdefault(name, []).append(bool(rows[name].get("model_limited")))
     dt = (time.perf_counter() - t0) / n_seeds
     print(f"  chi2/dof (worst block): median {np.median(c2):.3g}; {dt:.1f} s per seed")
+    print_extension(ext)
     floor = 100 * (0.6827 - 2 * np.sqrt(0.6827 * 0.3173 / n_seeds))
     print(f"  {'parameter':>10} {'coverage %':>11} {'mean z':>8} {'model-limited %':>16}  result")
     for name in hits:

@@ -155,7 +155,10 @@ def tyre_model_report(
         "the same fit to the tyre's exact modes (no noise). The virtual tyre is a "
         "finite-difference ring: its discretisation lowers the higher modes a little, which "
         "the continuous ring model reads as less EI even from the exact modes; the rest of a "
-        "gap is the identification's.",
+        "gap is the identification's. A model-limited verdict means the ring model, not the "
+        "noise, limits the value (a misfit beyond the noise, or a belt the data see stretch, "
+        "which the inextensible ring cannot hold); ring.json gives each parameter's "
+        "model-error term, which its interval should include.",
     )
     rows = []
     for pp in tm["per_pressure"]:

@@ -11,7 +11,9 @@ predicts modes and FRFs at other pressures.
 * :mod:`.observations` -- the identified modes the ring describes
   (:func:`ring_observations`).
 * :mod:`.fit` -- :func:`fit_ring`: weighted least squares of the stiffness and
-  mass parameters, then of the damping.
+  mass parameters, then of the damping (:mod:`.damping`).
+* :mod:`.extension` -- the test of the inextensible ring against the
+  extensible one and each parameter's term for it.
 * :mod:`.identifiability` -- covariance scaling, correlations, collinearity
   and the per-parameter verdicts.
 * :mod:`.result` -- :class:`RingFit`: parameters, predictions, FRFs, tables.

@@ -11,15 +11,18 @@ modes) and a linear least-squares solve of eq. (1) for the stiffnesses. The
 parameters are scaled by their "contribution scale" (``T_c`` by the mean
 tension, ``k_rp`` by ``k_r(p_mean)/p_mean`` ...), so the scaled Jacobian
 compares like with like. Damping: weighted linear least squares of eq. (3)
-with ``sigma = 2 omega sigma_zeta``, given the fitted ``EI`` and ``rho A``.
-Uncertainty and verdicts: :mod:`~tyredamp.tyremodel.ring.identifiability`.
+with ``sigma = 2 omega sigma_zeta``, given the fitted ``EI`` and ``rho A``
+(:mod:`~tyredamp.tyremodel.ring.damping`). Uncertainty and verdicts:
+:mod:`~tyredamp.tyremodel.ring.identifiability`; with modal standard errors
+the inextensible ring is tested against the extensible one and every
+parameter carries that model's term (:mod:`~tyredamp.tyremodel.ring.extension`).
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -29,6 +32,8 @@ from scipy.optimize import least_squares
 from ..._validate import check_positive
 from ...exceptions import ConvergenceError, InputError, PhysicsError
 from ...modal.model import ModalModel
+from .damping import DampingFit, damping_target, fit_damping
+from .extension import Extension, admit_extension, extension_test
 from .identifiability import (
     MODEL_LIMITED,
     admit_model_error,
@@ -38,7 +43,13 @@ from .identifiability import (
     correlation,
     verdicts,
 )
-from .model import FoundationLaw, ParameterLayout, damping_columns, ring_frequency
+from .model import (
+    FoundationLaw,
+    ParameterLayout,
+    damping_columns,
+    extensible_ring,
+    ring_frequency,
+)
 from .observations import RingObservation, gather_observations
 from .result import RingFit
 
@@ -74,11 +85,27 @@ class _StiffnessProblem:
     have_std: bool  # sig_f, sig_a are the modal standard errors (else relative weights)
     n_values: int  # frequencies plus amplitudes used
 
-    def model(self, theta: _Array) -> tuple[_Array, _Array]:
-        """Model frequencies (Hz) and amplitudes (1/sqrt(kg)) at the parameters ``theta``."""
+    def model(self, theta: _Array, compliance: float = 0.0) -> tuple[_Array, _Array]:
+        """Model frequencies (Hz) and amplitudes (1/sqrt(kg)) at the parameters ``theta``.
+
+        ``compliance`` ``1/EA`` (1/N) > 0 evaluates the extensible ring
+        (:func:`~tyredamp.tyremodel.ring.model.extensible_ring`) instead of eqs. (1)-(2).
+        """
         x, r = self.x, self.radius
         ei, t0, kr, kt, rho = self.layout.unpack(theta, x.p, r)
         rho = self.rho_fixed if self.rho_fixed is not None else rho
+        if compliance != 0.0:
+            lam, s_r, _ = extensible_ring(
+                x.n,
+                radius=r,
+                bending_stiffness=ei,
+                tension=t0,
+                radial_stiffness=kr,
+                tangential_stiffness=kt,
+                compliance=compliance,
+            )
+            fm_e = np.sqrt(np.clip(lam / rho, 0.0, None) * x.share) / (2 * np.pi)
+            return fm_e, np.sqrt(s_r * x.share / (np.pi * r * rho))
         fm = ring_frequency(
             x.n,
             radius=r,
@@ -92,9 +119,9 @@ class _StiffnessProblem:
         am = np.sqrt(n2 * x.share / (np.pi * r * rho * (1 + n2)))
         return fm, am
 
-    def residual(self, u: _Array) -> _Array:
+    def residual(self, u: _Array, compliance: float = 0.0) -> _Array:
         """Weighted residuals: frequencies, then the amplitudes used for ``rho A``."""
-        fm, am = self.model(u * self.scales)
+        fm, am = self.model(u * self.scales, compliance)
         parts = [(fm - self.x.f) / self.sig_f]
         if self.rho_fixed is None:
             parts.append(((am - self.x.amp) / self.sig_a)[self.x.use_a])
@@ -118,18 +145,8 @@ class _StiffnessFit:
     p_value: float | None
     scaled: bool
     discrepancy: float | None = None
-
-
-@dataclass(frozen=True)
-class _DampingFit:
-    """Fitted damping parameters of eq. (3)."""
-
-    names: tuple[str, ...]
-    units: tuple[str, ...]
-    values: _Array
-    stderr: _Array
-    verdicts: dict[str, dict[str, Any]]
-    fitted_damping_ratio: _Array
+    u: _Array | None = None  # scaled solution
+    cov_factor: float = 1.0  # factor applied to (J^T J)^-1
 
 
 def fit_ring(
@@ -198,7 +215,31 @@ def fit_ring(
     stiff = _fit_stiffness(problem, theta0)
     ei_hat = float(stiff.theta[layout.names.index("EI")])
     rho_hat = float(stiff.theta[layout.names.index("rhoA")]) if rho_fixed is None else rho_fixed
-    damp = _fit_damping(obs, x, ei_hat, rho_hat, r, m_a, c_known, drive_point_damper)
+    tgt = damping_target(obs, x.phi2, x.f, c_known, drive_point_damper)
+    damp = fit_damping(damping_columns(x.n, x.phi2, ei_hat, rho_hat, r, m_a, tgt.with_cd), tgt)
+    ext = None
+    if problem.have_std and stiff.u is not None:
+        ext = extension_test(
+            problem, stiff.theta, stiff.u, stiff.covariance, stiff.cov_factor, damp.values, tgt, m_a
+        )
+    if ext is not None:
+        stiff = replace(
+            stiff,
+            verdicts=admit_extension(
+                stiff.verdicts, stiff.theta, stiff.stderr, ext.shift, ext.shift_sd, ext
+            ),
+        )
+        damp = replace(
+            damp,
+            verdicts=admit_extension(
+                damp.verdicts,
+                damp.values,
+                damp.stderr,
+                ext.damping_shift,
+                ext.damping_shift_sd,
+                ext,
+            ),
+        )
     return _result(
         problem,
         stiff,
@@ -210,6 +251,7 @@ def fit_ring(
         fit_time_s=time.perf_counter() - t_start,
         band_loss_frequency=float(band_loss_frequency),
         foundation_law=foundation_law,
+        extension=ext,
     )
 
 
@@ -373,11 +415,13 @@ def _fit_stiffness(problem: _StiffnessProblem, theta0: _Array) -> _StiffnessFit:
     nf = problem.x.f.size
     dof_f = max(nf - (u.size - (1 if problem.rho_fixed is None else 0)), 1)
     disc = max(rss / dof, float(rvec[:nf] @ rvec[:nf]) / dof_f) if problem.have_std else None
+    factor = 1.0
     if disc is not None and disc > MODEL_LIMITED:
-        cov_u = cov_u * disc  # Birge ratio of the worst block
+        factor = disc  # Birge ratio of the worst block
         scaled = True
     elif scaled:
-        cov_u = cov_u * (rss / dof)
+        factor = rss / dof
+    cov_u = cov_u * factor
     theta = u * scales
     cov = np.asarray(cov_u * np.outer(scales, scales), dtype=np.float64)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
@@ -410,65 +454,8 @@ def _fit_stiffness(problem: _StiffnessProblem, theta0: _Array) -> _StiffnessFit:
         p_value=pval,
         scaled=scaled,
         discrepancy=disc,
-    )
-
-
-# --------------------------------------------------------------------------- damping, eq. (3)
-def _fit_damping(
-    obs: Sequence[RingObservation],
-    x: _Observed,
-    ei_hat: float,
-    rho_hat: float,
-    r: float,
-    m_a: float,
-    c_known: float | None,
-    drive_point_damper: bool,
-) -> _DampingFit:
-    """Weighted linear least squares of eq. (3) given ``EI`` and ``rho A`` (module docstring)."""
-    phi2 = x.phi2
-    zeta = np.array([o.damping_ratio for o in obs])
-    omega = 2 * np.pi * x.f
-    yd = 2 * zeta * omega
-    sz_list = [o.damping_std for o in obs]
-    have_zstd = all(s is not None and s > 0 for s in sz_list)
-    sig_d = 2 * omega * np.array(sz_list, dtype=float) if have_zstd else yd.copy()
-    if c_known is not None:
-        yd = yd - c_known * phi2
-    with_cd = bool(c_known is None and drive_point_damper and np.ptp(phi2) > 0)
-    dmat = damping_columns(x.n, phi2, ei_hat, rho_hat, r, m_a, with_cd)
-    names = ("c_r", "c_t", "eta_b", "c_d")[: dmat.shape[1]]
-    dw = dmat / sig_d[:, None]
-    # columns differ by ~1e9 in scale (eta_b against c_r): solve and invert normalised
-    cn = np.linalg.norm(dw, axis=0)
-    cn = np.where(cn > 0, cn, 1.0)
-    dsol_n, *_ = np.linalg.lstsq(dw / cn, yd / sig_d, rcond=None)
-    dsol = dsol_n / cn
-    dres = yd / sig_d - dw @ dsol
-    drss = float(dres @ dres)
-    ddof = max(x.n.size - dsol.size, 1)
-    dwn = dw / cn
-    dcov = np.asarray(np.linalg.pinv(dwn.T @ dwn, rcond=1e-12) / np.outer(cn, cn), dtype=float)
-    if chi2_scaling(drss, ddof, have_zstd)[1]:
-        dcov = dcov * (drss / ddof)
-    dse = np.sqrt(np.clip(np.diag(dcov), 0.0, None))
-    # verdict scale of each damping term: its value, floored at 1 % of the value that alone
-    # would carry the mean measured 2 zeta omega
-    colmean = np.mean(np.abs(dmat), axis=0)
-    dscale = float(np.mean(np.abs(yd))) / np.where(colmean > 0, colmean, 1.0)
-    dscale = np.maximum(np.abs(dsol), 0.01 * dscale)
-    return _DampingFit(
-        names=names,
-        units=("N s/m^2", "N s/m^2", "s", "N s/m")[: dmat.shape[1]],
-        values=np.asarray(dsol, dtype=float),
-        stderr=dse,
-        verdicts=admit_model_error(
-            verdicts(names, dse / dscale, correlation(dcov), dw),
-            dsol,
-            dse,
-            drss / ddof if have_zstd else None,
-            int(ddof),
-        ),
-        fitted_damping_ratio=(dmat @ dsol + (c_known or 0.0) * phi2) / (2 * omega),
+        u=u,
+        cov_factor=factor,
     )
 
 
@@ -476,7 +463,7 @@ def _fit_damping(
 def _result(
     problem: _StiffnessProblem,
     stiff: _StiffnessFit,
-    damp: _DampingFit,
+    damp: DampingFit,
     *,
     obs: Sequence[RingObservation],
     skipped: Sequence[str],
@@ -485,6 +472,7 @@ def _result(
     fit_time_s: float,
     band_loss_frequency: float,
     foundation_law: FoundationLaw,
+    extension: Extension | None,
 ) -> RingFit:
     """The :class:`RingFit` of the two stages."""
     return RingFit(
@@ -521,4 +509,5 @@ def _result(
         fit_time_s=fit_time_s,
         band_loss_frequency=band_loss_frequency,
         foundation_law=foundation_law,
+        extension=extension,
     )

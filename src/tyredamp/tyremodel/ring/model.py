@@ -37,6 +37,12 @@ tyre (:class:`tyredamp.virtual.RingTyreParameters`):
 
 ``2 zeta_n omega_n = [c_r n^2 + c_t + eta_b EI n^2 (n^2-1)^2/R^4] (1 - m_a phi_d^2)
 / [rho A (1 + n^2)] + c_d phi_d^2``                                      (3)
+
+The inextensible ring is the limit ``EA -> inf`` of the extensible ring
+(:func:`extensible_ring`): a finite membrane stiffness moves a little of
+each mode's motion from the radial to the tangential direction, which
+eqs. (1)-(3) do not hold; :mod:`~tyredamp.tyremodel.ring.extension` tests
+the data for it.
 """
 
 from __future__ import annotations
@@ -53,6 +59,7 @@ __all__ = [
     "FoundationLaw",
     "ParameterLayout",
     "damping_columns",
+    "extensible_ring",
     "ring_amplitude",
     "ring_frequency",
 ]
@@ -148,11 +155,123 @@ def damping_columns(
         and, with ``with_cd``, ``c_d`` (N s/m); their sum is ``2 zeta omega`` in 1/s.
     """
     n2 = n**2
-    fac = (1.0 - m_a * phi2) / (rho_a * (1 + n2))
-    cols = [n2 * fac, fac, ei * n2 * (n2 - 1) ** 2 / radius**4 * fac]
+    s_r = n2 / (1 + n2)
+    return share_columns(
+        s_r, ei * n2 * (n2 - 1) ** 2 / (radius**4 * (1 + n2)), phi2, rho_a, m_a, with_cd
+    )
+
+
+def share_columns(
+    s_r: NDArray[np.float64],
+    bend: NDArray[np.float64],
+    phi2: NDArray[np.float64],
+    rho_a: float,
+    m_a: float,
+    with_cd: bool,
+) -> NDArray[np.float64]:
+    """Design matrix of eq. (3) from each mode's radial share and bending stiffness.
+
+    ``2 zeta omega = [c_r s_r + c_t (1 - s_r) + eta_b bend] (1 - m_a phi_d^2) / rho A
+    + c_d phi_d^2``: the Rayleigh quotient of the sidewall dashpots and the
+    band loss over the ring's kinetic energy ``rho A (a^2 + c^2)`` of the mode
+    ``w = a cos n theta``, ``v = c sin n theta`` (radial share
+    ``s_r = a^2 / (a^2 + c^2)``). The inextensible ring has ``s_r = n^2/(1 + n^2)``
+    and ``bend = EI n^2 (n^2-1)^2 / (R^4 (1 + n^2))``, which is eq. (3).
+
+    Parameters
+    ----------
+    s_r : ndarray, shape (M,)
+        Radial share of each mode's ring kinetic energy (1).
+    bend : ndarray, shape (M,)
+        Bending stiffness quotient ``EI (n^2 a + n c)^2 / (R^4 (a^2 + c^2))`` in N/m^2.
+    phi2 : ndarray, shape (M,)
+        Drive-point ``phi_d^2`` (1/kg).
+    rho_a, m_a : float
+        ``rho A`` (kg/m) and the attachment mass (kg).
+    with_cd : bool
+        Append the column of ``c_d``.
+
+    Returns
+    -------
+    ndarray, shape (M, 3) or (M, 4)
+        Columns multiplying ``c_r``, ``c_t``, ``eta_b`` (, ``c_d``).
+    """
+    fac = (1.0 - m_a * phi2) / rho_a
+    cols = [s_r * fac, (1.0 - s_r) * fac, bend * fac]
     if with_cd:
         cols.append(phi2)
     return np.column_stack(cols)
+
+
+def extensible_ring(
+    n: ArrayLike,
+    *,
+    radius: float,
+    bending_stiffness: ArrayLike,
+    tension: ArrayLike,
+    radial_stiffness: ArrayLike,
+    tangential_stiffness: ArrayLike,
+    compliance: float,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Flexural branch of the extensible ring: stiffness quotient, radial share, bending quotient.
+
+    The 2x2 energy of ``w = a cos n theta``, ``v = c sin n theta`` (Soedel,
+    *Vibrations of Shells and Plates*, 3rd ed., sec. 5.4; spec
+    ``virtual-tyre.md``, the ``q_aa, q_ac, q_cc`` of
+    :func:`tyredamp.virtual.ring_dispersion`) is ``Q = Q_b + kappa u u^T`` with the
+    membrane term ``kappa = (EA + T0)/R^2``, ``u = (1, n)`` and
+    ``Q_b = [[EI n^4/R^4 + T0 (n^2-1)/R^2 + k_r, EI n^3/R^4], [., EI n^2/R^4 + k_t]]``.
+    In the orthonormal basis ``p = (n, -1)/|u|`` (inextensible motion) and
+    ``u/|u|`` the lower eigenvalue ``lambda`` solves
+    ``(Q_pp - lambda)(1 + chi (Q_uu - lambda)) = chi Q_pu^2`` with
+    ``chi = 1/(kappa |u|^2) = C R^2 / ((1 + C T0)(1 + n^2))``, ``C = 1/EA``
+    the membrane compliance; its root that tends to ``Q_pp`` (eq. (1) times
+    ``rho A``) as ``C -> 0`` is taken in the cancellation-free form
+    ``2 c0 / (b + sqrt(b^2 - 4 chi c0))``. The eigenvector has
+    ``t = beta/alpha = -chi Q_pu / (1 + chi (Q_uu - lambda))``.
+
+    Parameters
+    ----------
+    n : array_like, shape (M,)
+        Wave numbers >= 1.
+    radius : float
+        ``R`` in m.
+    bending_stiffness, tension, radial_stiffness, tangential_stiffness : array_like
+        ``EI`` (N m^2), ``T0`` (N), ``k_r``, ``k_t`` (N/m^2), broadcast against ``n``.
+    compliance : float
+        ``C = 1/EA`` in 1/N (0: the inextensible ring).
+
+    Returns
+    -------
+    lam : ndarray, shape (M,)
+        ``rho A omega^2`` in N/m^2.
+    s_r : ndarray, shape (M,)
+        Radial share ``a^2/(a^2 + c^2) = (n + t)^2 / ((1 + t^2)(1 + n^2))``.
+    bend : ndarray, shape (M,)
+        ``EI n^2 (n^2 - 1 + 2 n t)^2 / (R^4 (1 + t^2)(1 + n^2))`` in N/m^2 (for eq. (3)).
+    """
+    s = np.asarray(n, dtype=float)
+    r = float(radius)
+    ei, t0 = np.asarray(bending_stiffness, float), np.asarray(tension, float)
+    qaa = ei * s**4 / r**4 + t0 * (s**2 - 1) / r**2 + np.asarray(radial_stiffness, float)
+    qac = ei * s**3 / r**4
+    qcc = ei * s**2 / r**4 + np.asarray(tangential_stiffness, float)
+    u2 = 1 + s**2
+    qpp = (qaa * s**2 - 2 * qac * s + qcc) / u2
+    qpu = (s * (qaa - qcc) + qac * (s**2 - 1)) / u2
+    quu = (qaa + 2 * qac * s + qcc * s**2) / u2
+    chi = float(compliance) * r**2 / ((1 + float(compliance) * t0) * u2)
+    b = 1 + chi * (quu + qpp)
+    c0 = qpp * (1 + chi * quu) - chi * qpu**2
+    lam = 2 * c0 / (b + np.sqrt(np.clip(b**2 - 4 * chi * c0, 0.0, None)))
+    t = -chi * qpu / (1 + chi * (quu - lam))
+    s_r = (s + t) ** 2 / ((1 + t**2) * u2)
+    bend = ei * s**2 * (s**2 - 1 + 2 * s * t) ** 2 / (r**4 * (1 + t**2) * u2)
+    return (
+        np.asarray(lam, dtype=np.float64),
+        np.asarray(s_r, dtype=np.float64),
+        np.asarray(bend, dtype=np.float64),
+    )
 
 
 class ParameterLayout:

@@ -71,6 +71,11 @@ class RingFit:
         ``omega_ref / 2 pi`` (Hz) for the band loss factor ``eta = eta_b omega_ref``.
     foundation_law : {"linear", "constant"}
         Pressure law of ``k_r``, ``k_t`` used (several pressures).
+    discrepancy_chi2 : float or None
+        The larger of the whole fit's and the frequencies' reduced chi-square.
+    extension : Extension or None
+        The test of the inextensible ring against the extensible one
+        (:mod:`~tyredamp.tyremodel.ring.extension`; None without standard errors).
     """
 
     names: tuple[str, ...]
@@ -106,6 +111,7 @@ class RingFit:
     band_loss_frequency: float = 200.0
     foundation_law: FoundationLaw = "linear"
     discrepancy_chi2: float | None = None
+    extension: Any = None
 
     # ------------------------------------------------------------ parameters
     def param(self, name: str) -> tuple[float, float]:
@@ -390,6 +396,7 @@ class RingFit:
             "p_value": self.p_value,
             "scaled_covariance": self.scaled_covariance,
             "model_discrepancy": self.model_discrepancy(),
+            "extensibility": self.extension.to_dict() if self.extension is not None else None,
             "weights": self.weights,
             "observations": [
                 {
@@ -406,9 +413,13 @@ class RingFit:
 
 
 def _model_error(stderr: float, verdict: dict[str, Any]) -> float:
-    """The model-discrepancy bound ``se sqrt(dof)`` in the parameter's unit (0 when none).
+    """The model-error term in the parameter's unit (0 when none).
 
-    See :func:`~tyredamp.tyremodel.ring.identifiability.admit_model_error`.
+    The root sum of squares of the misfit bound ``se sqrt(dof)``
+    (:func:`~tyredamp.tyremodel.ring.identifiability.admit_model_error`) and
+    the extensible ring's term ``sqrt(q^2 + var q)``
+    (:mod:`~tyredamp.tyremodel.ring.extension`).
     """
     rel, bound = float(verdict.get("relative_se", 0.0)), verdict.get("model_error_bound", 0.0)
-    return stderr * float(bound) / rel if rel > 0 and bound else 0.0
+    misfit = stderr * float(bound) / rel if rel > 0 and bound else 0.0
+    return math.hypot(misfit, float(verdict.get("extension_error", 0.0)))
