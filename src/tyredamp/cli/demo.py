@@ -105,12 +105,20 @@ def _tyre_model_row(tm: dict[str, Any]) -> str:
     return (
         f"flexible ring at {len(tm['pressures_bar'])} pressures, against the virtual tyre: "
         + ", ".join(parts)
-        + (
-            f"; not identified: {', '.join(tm['not_identifiable'])}"
-            if tm["not_identifiable"]
-            else ""
+        + "".join(
+            f"; {what}: {', '.join(names)}" for what, names in _ring_verdicts(tm).items() if names
         )
     )
+
+
+def _ring_verdicts(tm: dict[str, Any]) -> dict[str, list[str]]:
+    """The ring parameters that are not identified, model-limited ones apart."""
+    verdict = {p["name"]: str(p["verdict"]) for p in tm["parameters"]}
+    limited = [n for n in tm["not_identifiable"] if verdict[n].startswith("model-limited")]
+    return {
+        "model-limited": limited,
+        "not identified": [n for n in tm["not_identifiable"] if n not in limited],
+    }
 
 
 def _verdict_rows(doc: dict[str, Any]) -> list[tuple[str, str]]:

@@ -189,9 +189,19 @@ def tyre_model_report(
         caption="Tension and foundation stiffnesses of the updated ring at each test pressure.",
     )
     par = {p["name"]: p for p in tm["parameters"]}
-    if tm["not_identifiable"]:
+    limited = [n for n in tm["not_identifiable"] if _model_limited(par[n])]
+    unknown = [n for n in tm["not_identifiable"] if n not in limited]
+    if limited:
+        rep.paragraph(
+            "Model-limited (the ring model does not hold these modes within their noise; the "
+            "value is given with a model-error term in its uncertainty, and says what the "
+            "updated ring needs, not what the tyre has):"
+        )
+        rep.bullets([f"{n}: {par[n]['verdict']}" for n in limited])
+    if unknown:
         rep.paragraph("Not identified from these modes (reported, not given an arbitrary value):")
-        rep.bullets([f"{n}: {par[n]['verdict']}" for n in tm["not_identifiable"]])
+        rep.bullets([f"{n}: {par[n]['verdict']}" for n in unknown])
+    if tm["not_identifiable"]:
         rep.paragraph(
             "Confounded parameters are determined only in combination: the tension and the "
             "foundation stiffness at each tested pressure (table above) are well determined "
@@ -216,3 +226,8 @@ def tyre_model_report(
         )
         rep.raw(f"<pre>{html.escape(text)}</pre>")
     _warnings(rep, doc, "radial:tyre_model")
+
+
+def _model_limited(row: dict[str, Any]) -> bool:
+    """Is a ring parameter's verdict "model-limited" (a value with a model error)?"""
+    return str(row.get("verdict", "")).startswith("model-limited")
