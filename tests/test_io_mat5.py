@@ -84,3 +84,19 @@ def test_nesting_is_bounded() -> None:
     header = b"MATLAB 5.0 MAT-file".ljust(116) + b"\x00" * 8 + b"\x00\x01IM"
     with pytest.raises(FileFormatError, match="deeper than 32"):
         check_mat5(header + element, "deep.mat")
+
+
+def test_sparse_indices_outside_the_array_are_refused(tmp_path: Path) -> None:
+    """A column pointer changed in a sparse array (SciPy's reader crashed on it)."""
+    p = tmp_path / "s.mat"
+    sio.savemat(p, {"sp": sp.csc_matrix(np.eye(3))})
+    raw = bytearray(p.read_bytes())
+    jc = struct.pack("<4i", 0, 1, 2, 3)  # the column pointers of eye(3)
+    at = raw.index(jc)
+    struct.pack_into("<i", raw, at + 4, 7)  # column 0 ends past the 3 values
+    with pytest.raises(FileFormatError, match="column pointers do not fit"):
+        check_mat5(bytes(raw), "s.mat")
+    struct.pack_into("<i", raw, at + 4, 1)
+    struct.pack_into("<i", raw, at - 8 - 12, 5)  # a row index 5 in a 3 x 3 array
+    with pytest.raises(FileFormatError, match="row indices do not fit 3 rows"):
+        check_mat5(bytes(raw), "s.mat")

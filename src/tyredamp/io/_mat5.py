@@ -11,15 +11,19 @@ packed into the tag; ``miMATRIX`` elements made of array flags, dimensions,
 name and the real and imaginary parts, with cells and structures holding
 ``miMATRIX`` elements of their own; ``miCOMPRESSED`` elements holding one
 zlib-compressed element) and checks that every size fits inside its parent
-and that a numeric array's data hold exactly ``prod(dims)`` values. It reads
-nothing into arrays; what it cannot check (sparse, object, function-handle
-and opaque classes) is only bounded by its parent element.
+and that a numeric array's data hold exactly ``prod(dims)`` values, and a
+sparse array's row indices and column pointers index inside it. It reads
+nothing into arrays but a sparse array's indices; what it cannot check
+(object, function-handle and opaque classes) is only bounded by its parent
+element.
 """
 
 from __future__ import annotations
 
 import struct
 import zlib
+
+import numpy as np
 
 from ..exceptions import FileFormatError
 
@@ -30,7 +34,7 @@ _SIZE = {1: 1, 2: 1, 3: 2, 4: 2, 5: 4, 6: 4, 7: 4, 9: 8, 12: 8, 13: 8, 16: 1, 17
 _MATRIX, _COMPRESSED = 14, 15
 #: Array classes whose data are checked value by value: char (4) and numeric (6-15).
 _CHECKED = {4, *range(6, 16)}
-_CELL, _STRUCT = 1, 2
+_CELL, _STRUCT, _SPARSE = 1, 2, 5
 _MAX_DEPTH = 32
 #: Largest inflated size of one compressed element, a multiple of the file's size.
 _INFLATE_RATIO = 1000
@@ -142,6 +146,8 @@ def _matrix(body: memoryview, order: str, depth: int, file_size: int) -> None:
                     f"an array of {count} values has {n} bytes of data type {kind} in its "
                     f"{part} part"
                 )
+    elif cls == _SPARSE:
+        _sparse(body, pos, order, dims, is_complex)
     elif cls == _CELL:
         for _ in range(count):
             kind, n, start, pos = _tag(body, pos, order)
@@ -161,3 +167,33 @@ def _matrix(body: memoryview, order: str, depth: int, file_size: int) -> None:
             if kind != _MATRIX:
                 raise _Damaged("a structure's field is not an array")
             _element(kind, body[start : start + n], order, depth + 1, file_size)
+
+
+def _sparse(
+    body: memoryview, pos: int, order: str, dims: tuple[int, ...], is_complex: bool
+) -> None:
+    """Row indices ``ir``, column pointers ``jc`` and values of a sparse array
+    (MAT-File Format, "Sparse array"): ``jc`` has ``n + 1`` nondecreasing
+    entries from 0, every row index lies in ``0 .. m - 1`` and the values hold
+    at least ``jc[n]`` entries."""
+    if len(dims) != 2:
+        raise _Damaged(f"a sparse array has {len(dims)} dimensions")
+    index = []
+    for what in ("row indices", "column pointers"):
+        kind, n, start, pos = _tag(body, pos, order)
+        if kind not in (5, 6) or n % 4:
+            raise _Damaged(f"a sparse array's {what} are not 32-bit integers")
+        index.append(
+            np.frombuffer(body[start : start + n], dtype=order + ("i4" if kind == 5 else "u4"))
+        )
+    ir, jc = index
+    rows, cols = dims
+    if jc.size != cols + 1 or jc[0] != 0 or np.any(np.diff(jc.astype(np.int64)) < 0):
+        raise _Damaged(f"a sparse array's {jc.size} column pointers do not fit {cols} columns")
+    nnz = int(jc[-1])
+    if nnz > ir.size or (nnz and (ir[:nnz].min() < 0 or ir[:nnz].max() >= rows)):
+        raise _Damaged(f"a sparse array's row indices do not fit {rows} rows and {nnz} values")
+    for part in ("real", "imaginary")[: 1 + is_complex]:
+        kind, n, start, pos = _tag(body, pos, order)
+        if kind not in _SIZE or n < nnz * _SIZE[kind]:
+            raise _Damaged(f"a sparse array's {part} part holds fewer than its {nnz} values")
