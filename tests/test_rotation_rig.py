@@ -17,7 +17,7 @@ from tyredamp.virtual import (
     rolling_response,
     rolling_test,
 )
-from tyredamp.virtual.rolling_truth import signed_wave_numbers
+from tyredamp.virtual.rolling_truth import RADIAL_OBSERVABLE, RollingTruth, signed_wave_numbers
 
 SPEED = 80.0
 FS = 1024.0
@@ -176,3 +176,21 @@ def test_harmonic_road_force_gives_the_fixed_frame_modal_sum() -> None:
     # 5e-4 of the amplitude: the first-order hold of the moving load, (nu h)^2 / 12 = 2e-4
     scale = np.max(np.abs(want[steady]))
     assert_allclose(out[steady], want[steady], atol=5e-4 * scale)
+
+
+@pytest.mark.parametrize("speed", [0.0, 120.0])
+def test_the_rotation_mode_is_not_radially_observable(speed: float) -> None:
+    """The n = 0 rotation of a symmetric ring is purely tangential at rest (no
+    radial term couples to a uniform tangential displacement); rolling couples
+    it to the radial motion only through the Coriolis forces, weakly."""
+    ring = RotatingRing(speed_kmh=speed)
+    truth = RollingTruth.from_ring(ring, (20.0, 200.0))
+    rows = truth.table()
+    rotation = [r for r in rows if r["wave_number"] == 0]
+    assert len(rotation) == 1
+    (rot,) = rotation
+    assert not rot["radially_observable"]
+    assert rot["radial_share"] < (1e-20 if speed == 0 else RADIAL_OBSERVABLE / 10)
+    # every travelling wave of the band has a large radial part
+    assert all(r["radially_observable"] for r in rows if r["wave_number"] > 0)
+    assert min(r["radial_share"] for r in rows if r["wave_number"] > 0) > 0.3

@@ -26,7 +26,12 @@ from ..exceptions import InputError
 from ..mechanics.gyroscopic import StateModes
 from .rotation import RotatingRing
 
-__all__ = ["RollingTruth", "signed_wave_numbers"]
+__all__ = ["RADIAL_OBSERVABLE", "RollingTruth", "signed_wave_numbers"]
+
+#: Radial share of a wave's shape below which a radial force and radial
+#: sensors leave its response 60 dB or more under that of an all-radial wave
+#: of the same modal mass and damping (the response scales with the share).
+RADIAL_OBSERVABLE = 1e-3
 
 
 def signed_wave_numbers(
@@ -90,6 +95,12 @@ class RollingTruth:
         Share of the shape's power in its harmonic (1 for the perfect ring).
     poles : ndarray, complex, shape (m,)
         Rotating-frame poles in rad/s.
+    radial_share : ndarray, shape (m,)
+        Share of the shape's power in the radial displacements. A radial road
+        force excites a wave in proportion to its radial amplitude and a
+        radial sensor sees it in the same proportion, so the wave's response
+        there scales with this share: the ``n = 0`` rotation (wind-up) mode
+        has none at rest and about 1e-5 at 120 km/h (Coriolis coupling).
     """
 
     speed_kmh: float
@@ -103,6 +114,7 @@ class RollingTruth:
     decay_rate: NDArray[np.float64]
     purity: NDArray[np.float64]
     poles: NDArray[np.complex128]
+    radial_share: NDArray[np.float64]
 
     @classmethod
     def from_modes(
@@ -118,6 +130,8 @@ class RollingTruth:
         f_fix = np.abs(w_fix) / (2 * np.pi)
         keep = ((f_rot >= lo) & (f_rot <= hi)) | ((f_fix >= lo) & (f_fix <= hi))
         order = np.flatnonzero(keep)[np.argsort(f_fix[keep], kind="stable")]
+        rad = np.sum(np.abs(modes.displacement[:n]) ** 2, axis=0)
+        tan = np.sum(np.abs(modes.displacement[n:]) ** 2, axis=0)
         return cls(
             speed_kmh=ring.speed_kmh,
             rotation_hz=ring.rotation_hz,
@@ -130,6 +144,7 @@ class RollingTruth:
             decay_rate=-modes.poles.real[order],
             purity=purity[order],
             poles=modes.poles[order],
+            radial_share=(rad / np.where(rad + tan > 0, rad + tan, 1.0))[order],
         )
 
     @classmethod
@@ -167,7 +182,12 @@ class RollingTruth:
 
         Keys: ``wave_number``, ``direction``, ``rotating_hz``, ``fixed_hz``,
         ``fixed_direction``, ``damping_ratio`` (rotating frame),
-        ``fixed_damping_ratio``, ``decay_rate`` (1/s), ``purity``.
+        ``fixed_damping_ratio``, ``decay_rate`` (1/s), ``purity``,
+        ``radial_share`` and ``radially_observable``: a radial share of at
+        least :data:`RADIAL_OBSERVABLE` (below it the wave's response to a
+        radial force at a radial sensor is 60 dB or more under that of a wave
+        of the same modal mass and damping whose shape is all radial: under
+        the noise of any test here).
         """
         zr, zf = self.damping_ratio, self.fixed_damping_ratio
         return [
@@ -181,6 +201,8 @@ class RollingTruth:
                 "fixed_damping_ratio": float(zf[i]),
                 "decay_rate": float(self.decay_rate[i]),
                 "purity": float(self.purity[i]),
+                "radial_share": float(self.radial_share[i]),
+                "radially_observable": bool(self.radial_share[i] >= RADIAL_OBSERVABLE),
             }
             for i in range(self.n_waves)
         ]
