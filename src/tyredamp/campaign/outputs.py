@@ -58,9 +58,10 @@ from ..io._safety import atomic_path, check_output_dir
 from . import steps
 from .families import FamilyName, ModeWave, family_names, mode_wave
 from .runner import TestRun
+from .series_trend import TrendFit, fit_trend
 from .spec import CONDITIONS, NUMERIC_CONDITIONS, Campaign
 from .status import STEP_COLUMNS, quality_checks, step_rows, summary_entry
-from .tracking import ModeSet, Tracking, TrendFit, fit_trend, track_modes
+from .tracking import ModeSet, Tracking, track_modes
 
 __all__ = [
     "MODE_COLUMNS",
