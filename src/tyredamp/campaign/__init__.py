@@ -7,7 +7,8 @@
 * :mod:`.tracking`: mode families across conditions; :mod:`.series_trend`: their trends;
   :mod:`.excitation`: the doubled modes a shaker layout drives one member of.
 * :mod:`.status`: what happened to each test (step outcomes, skips, quality checks).
-* :mod:`.outputs`: tables, per-test documents and the HTML report.
+* :mod:`.outputs`: the result files, per-test documents and the HTML report; :mod:`.tables`:
+  the tidy tables' columns and rows.
 * :mod:`.virtual`: a virtual campaign with its truth.
 """
 
