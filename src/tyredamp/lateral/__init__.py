@@ -2,8 +2,9 @@
 
 * :mod:`.models` -- the linear models (classic, Maxwell, visco-plastic,
   proposed hysteretic, relaxation length, stretched string) with receptance,
-  mobility and accelerance at the ground or axle force; :mod:`.response` --
-  the algebra they share (wheel mass, axle/ground force, string impedance).
+  mobility and accelerance at the ground or axle force; :mod:`.base` -- the
+  interface they implement and their registry; :mod:`.response` -- the
+  algebra they share (wheel mass, axle/ground force, string impedance).
 * :mod:`.fiala` -- steady-state Fiala/brush force and its non-linear damper form.
 * :mod:`.characteristics` -- corner frequency and the dB differences of
   eq. 38-40, Figure 7 data.
