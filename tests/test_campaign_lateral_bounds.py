@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from tyredamp.campaign.outputs import lateral_trend_rows
+from tyredamp.campaign.tables import lateral_trend_rows
 
 
 def _row(test: str, speed: float, value: float, at_bound: int) -> dict[str, object]:

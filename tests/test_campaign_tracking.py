@@ -8,13 +8,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
+from tyredamp.campaign.excitation import single_member_wave_numbers
+from tyredamp.campaign.series_trend import fit_trend
 from tyredamp.campaign.tracking import (
     MAC_MIN,
     ModeSet,
-    fit_trend,
     group_pairs,
     mode_scatter,
-    single_member_wave_numbers,
     subspace_mac,
     track_modes,
 )

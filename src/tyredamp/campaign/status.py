@@ -14,9 +14,9 @@ from collections.abc import Sequence
 from typing import Any
 
 from . import steps
+from .excitation import single_member_wave_numbers
 from .runner import TestRun
 from .spec import CONDITIONS
-from .tracking import single_member_wave_numbers
 
 __all__ = [
     "STEP_COLUMNS",
@@ -132,7 +132,7 @@ def excitation_layout(run: TestRun, model: str = "complex") -> dict[str, Any] | 
     least three outputs carry an angular position, returns
     ``angles_deg`` (the inputs) and ``single_member`` (the wave numbers up to
     the outputs' spatial Nyquist limit of which only one member of the
-    doubled pair is driven, :func:`~.tracking.single_member_wave_numbers`);
+    doubled pair is driven, :func:`~.excitation.single_member_wave_numbers`);
     None otherwise.
     """
     modal = run.documents.get("modal")

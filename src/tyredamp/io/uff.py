@@ -61,417 +61,43 @@ for forces) or else from the ordinate units label, read by
 An FRF label may hold the whole ratio (``g/N``, ``(m/s^2)/N``,
 ``(1/N)*(m/s²)``) or only the response with the force in the denominator
 label; a label and a data type that disagree are an error.
+
+Modules
+-------
+This module reads; :mod:`tyredamp.io._uff_write` writes (:func:`write_uff` is
+imported from there); :mod:`tyredamp.io._uff_records` holds the record
+conventions both follow (data types, units labels, ID lines);
+:mod:`tyredamp.io._uff_load` loads and checks the data sets through pyuff and
+:mod:`tyredamp.io._uff_meta` holds the metadata record.
 """
 
 from __future__ import annotations
 
-import gc
-import itertools
-import json
 import os
-import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pyuff
 
 from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
-from ._atomic import atomic_path
 from ._channels import timedata_from_channels
-from ._common import check_input_file, meta_to_json, wrap_errors
-from ._uff_load import VARIANCE_ID, load_sets, not_frf_or_time, read_coherence, read_variance
-from ._uff_meta import meta_record
+from ._common import check_input_file, wrap_errors
+from ._uff_load import load_sets, not_frf_or_time, read_coherence, read_variance
+from ._uff_records import (
+    _KIND_QUANTITY,
+    _QUANTITY_KIND,
+    _SDT_QUANTITY,
+    _extras,
+    _rebuild_axis,
+    _tokens,
+)
+from ._uff_write import write_uff
 from .channelmap import ChannelMap
 from .units import frf_units, quantity_units
 
 __all__ = ["read_uff", "uff_contents", "write_uff"]
-
-_MARK = "tyredamp1"
-# specific data types (record 8): 15 pressure, 21 sound pressure, 1 general (volts)
-_SDT = {
-    "displacement": 8,
-    "velocity": 11,
-    "acceleration": 12,
-    "force": 13,
-    "pressure": 15,
-    "voltage": 1,
-}
-_SDT_QUANTITY = {
-    8: "displacement",
-    11: "velocity",
-    12: "acceleration",
-    13: "force",
-    9: "force",
-    15: "pressure",
-    21: "pressure",
-}
-_KIND_QUANTITY = {
-    "receptance": "displacement",
-    "mobility": "velocity",
-    "accelerance": "acceleration",
-}
-_QUANTITY_KIND: dict[str, FRFKind] = {v: k for k, v in _KIND_QUANTITY.items()}  # type: ignore[misc]
-_SI_LABEL = {
-    "displacement": "m",
-    "velocity": "m/s",
-    "acceleration": "m/s^2",
-    "force": "N",
-    "pressure": "Pa",
-    "voltage": "V",
-}
-_AXIS_LABEL = {
-    "displacement": "Displacement",
-    "velocity": "Velocity",
-    "acceleration": "Acceleration",
-    "force": "Force",
-    "pressure": "Pressure",
-    "voltage": "Voltage",
-}
-# (length exponent, force exponent) of each quantity in SI
-_EXP = {
-    "displacement": (1, 0),
-    "velocity": (1, 0),
-    "acceleration": (1, 0),
-    "force": (0, 1),
-    "pressure": (-2, 1),
-    "voltage": (0, 0),
-}
-
-
-# ------------------------------------------------------------------ writing
-def _pair_fields(out: Channel, inp: Channel) -> dict[str, Any]:
-    """The response and reference fields of the data set of one output/input pair."""
-    return {
-        "rsp_node": out.node,
-        "rsp_dir": out.direction,
-        "ref_node": inp.node,
-        "ref_dir": inp.direction,
-        "id4": _extras_line(out),
-        "id5": _extras_line(inp),
-    }
-
-
-def _extras_line(c: Channel) -> str:
-    d: dict[str, Any] = {}
-    if c.name:
-        d["name"] = c.name
-    if c.angle_deg is not None:
-        d["angle_deg"] = float(c.angle_deg)
-    if not d:
-        return "NONE"
-    text = json.dumps(d, separators=(",", ":"), ensure_ascii=True)
-    if len(text) > 80:
-        raise InputError(
-            f"channel {c.label!r}: name and angle need {len(text)} characters, an UFF ID line "
-            "holds 80; shorten the name or write CSV/NPZ"
-        )
-    return text
-
-
-#: Metadata the estimators use: stored first when ``meta`` does not fit an ID line.
-_PRIORITY = (
-    "period_samples",
-    "settle_samples",
-    "record_samples",
-    "run_starts",
-    "band_hz",
-    "n_averages",
-    "excitation",
-    "estimator",
-    "method",
-    "n_averages",
-    "exponential_tau_s",
-    # operating conditions of a lateral rig FRF, readable in the ID lines by other programs
-    "speed_m_s",
-    "force",
-    "wheel_mass_kg",
-    "pressure_bar",
-    "description",
-)
-
-
-def _meta_lines(meta: dict[str, Any], n_lines: int) -> list[str]:
-    """Up to ``n_lines`` JSON objects of <= 80 characters holding as much of ``meta`` as fits.
-
-    Keys the estimators use go first; a key whose value alone needs more than
-    80 characters is left out.
-    """
-    order = [k for k in _PRIORITY if k in meta] + [k for k in meta if k not in _PRIORITY]
-    lines: list[str] = []
-    left = order
-    for _ in range(n_lines):
-        kept: dict[str, Any] = {}
-        rest = []
-        for k in left:
-            trial = {**kept, k: meta[k]}
-            if len(meta_to_json(trial)) <= 80:
-                kept = trial
-            else:
-                rest.append(k)
-        lines.append(meta_to_json(kept) if kept else "NONE")
-        left = rest
-    return lines
-
-
-def _meta_fits(meta: dict[str, Any], lines: list[str]) -> bool:
-    """True when the ID ``lines`` written by :func:`_meta_lines` hold every key of ``meta``."""
-    kept: dict[str, Any] = {}
-    for line in lines:
-        kept.update(_extras(line))
-    return all(k in kept for k in meta)
-
-
-def _even_axis(f: np.ndarray) -> str | None:
-    """ID-line tokens that rebuild ``f`` (bit for bit where possible), None if uneven."""
-    n = f.size
-    if n == 1:
-        return f"f0={float(f[0])!r} df=1.0"
-    d0 = (f[-1] - f[0]) / (n - 1)
-    if d0 <= 0 or np.max(np.abs(f[0] + d0 * np.arange(n) - f)) > 1e-9 * d0:
-        return None
-    k0 = round(f[0] / d0)
-    if abs(f[0] / d0 - k0) < 1e-6:
-        for d in (f[-1] / (k0 + n - 1), d0, f[1] - f[0]):
-            if np.array_equal((k0 + np.arange(n)) * d, f):
-                return f"k0={k0} df={float(d)!r}"
-    return f"f0={float(f[0])!r} df={float(d0)!r}"
-
-
-def _rebuild_axis(tokens: dict[str, str], n: int) -> np.ndarray | None:
-    try:
-        df = float(tokens["df"])
-        if "k0" in tokens:
-            return (int(tokens["k0"]) + np.arange(n)) * df
-        if "f0" in tokens:
-            return float(tokens["f0"]) + df * np.arange(n)
-    except (KeyError, ValueError):
-        return None
-    return None
-
-
-def _base_set(binary: bool, quantity: str, id1: str, id2: str, id3: str) -> dict[str, Any]:
-    le, fe = _EXP[quantity]
-    return {
-        "type": 58,
-        "binary": int(binary),
-        "id1": id1[:80] or "NONE",
-        "id2": id2,
-        "id3": id3,
-        "load_case_id": 0,
-        "ver_num": 0,
-        "rsp_ent_name": "NONE",
-        "ref_ent_name": "NONE",
-        "ordinate_spec_data_type": _SDT[quantity],
-        "ordinate_len_unit_exp": le,
-        "ordinate_force_unit_exp": fe,
-        "ordinate_temp_unit_exp": 0,
-        "ordinate_axis_lab": _AXIS_LABEL[quantity],
-        "ordinate_axis_units_lab": _SI_LABEL[quantity],
-        "orddenom_spec_data_type": 0,
-        "z_axis_spec_data_type": 0,
-    }
-
-
-def write_uff(obj: FRF | TimeData, path: str | os.PathLike[str], binary: bool = True) -> None:
-    """Write an FRF or TimeData as UFF 58 data sets (atomically).
-
-    Parameters
-    ----------
-    obj : FRF or TimeData
-    path : path-like
-    binary : bool
-        58b binary (lossless, default) or ASCII 58 (12 significant digits).
-
-    Raises
-    ------
-    InputError
-        ASCII with an uneven frequency axis; channel names too long for an ID
-        line; metadata that is not JSON-compatible.
-    """
-    if isinstance(obj, FRF):
-        sets = _frf_sets(obj, binary)
-        id_lines = [sets[0]["id3"]]
-    elif isinstance(obj, TimeData):
-        sets = _timedata_sets(obj, binary)
-        id_lines = [sets[0]["id3"], sets[0]["id5"]]  # time data: ID line 5 continues them
-    else:
-        raise InputError(f"obj: expected FRF or TimeData, got {type(obj).__name__}")
-    if not _meta_fits(obj.meta, id_lines):
-        sets = [*meta_record(obj.meta), *sets]
-    with atomic_path(path) as tmp, warnings.catch_warnings():
-        # pyuff's 58b writer reopens the file and leaves that handle to the garbage
-        # collector: silence the ResourceWarning and collect inside this block
-        warnings.simplefilter("ignore", ResourceWarning)
-        uff = pyuff.UFF(str(tmp))
-        try:
-            # "add" to the empty temporary file: pyuff truncates binary sets in "overwrite"
-            uff.write_sets(sets, mode="add", force_double=True)
-        except Exception as exc:  # pyuff raises bare Exception
-            raise FileFormatError(f"{path}: pyuff could not write the data sets ({exc})") from exc
-        finally:
-            gc.collect()
-
-
-def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
-    """The UFF 58 data sets of an FRF: H per pair, coherence per output, variance per pair."""
-    sets: list[dict[str, Any]] = []
-    q = _KIND_QUANTITY[obj.kind]
-    axis = _even_axis(obj.frequency)
-    if not binary and axis is None:
-        raise InputError(
-            "frf: ASCII UFF keeps an uneven frequency axis to 6 digits only; write binary "
-            "UFF (uff58b), CSV or NPZ"
-        )
-    id1 = str(obj.meta.get("description", f"tyredamp FRF {obj.kind}"))
-    # binary: uneven abscissa, every frequency stored as a float64 (pyuff needs
-    # two abscissa values, so a single line goes the even way with ID-line 2)
-    uneven = binary and obj.n_freq > 1
-    id2 = f"{_MARK} frf {obj.kind}" + ("" if uneven else f" {axis}")
-    (id3,) = _meta_lines(obj.meta, 1)
-    x = obj.frequency
-    fid = 0
-    for o, co in enumerate(obj.outputs):
-        for i, ci in enumerate(obj.inputs):
-            fid += 1
-            d = _base_set(binary, q, id1, id2, id3)
-            d.update(
-                func_type=4,
-                func_id=fid,
-                **_pair_fields(co, ci),
-                orddenom_spec_data_type=13,
-                orddenom_len_unit_exp=0,
-                orddenom_force_unit_exp=1,
-                orddenom_temp_unit_exp=0,
-                orddenom_axis_lab="Force",
-                orddenom_axis_units_lab="N",
-                data=np.array(obj.H[o, i], dtype=complex),
-            )
-            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
-    if obj.coherence is not None:
-        ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
-        for o, co in enumerate(obj.outputs):
-            fid += 1
-            d = _base_set(
-                binary,
-                q,
-                "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence",
-                id2,
-                id3,
-            )
-            d.update(
-                func_type=6,
-                func_id=fid,
-                rsp_node=co.node,
-                rsp_dir=co.direction,
-                ref_node=ref.node,
-                ref_dir=ref.direction,
-                id4=_extras_line(co),
-                id5=_extras_line(ref),
-                ordinate_spec_data_type=0,
-                ordinate_len_unit_exp=0,
-                ordinate_force_unit_exp=0,
-                ordinate_axis_lab="Coherence",
-                ordinate_axis_units_lab="NONE",
-                data=np.array(obj.coherence[o], dtype=float),
-            )
-            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
-    if obj.variance is not None:
-        for o, co in enumerate(obj.outputs):
-            for i, ci in enumerate(obj.inputs):
-                fid += 1
-                d = _base_set(binary, q, VARIANCE_ID, id2, id3)
-                d.update(
-                    func_type=0,
-                    func_id=fid,
-                    **_pair_fields(co, ci),
-                    ordinate_spec_data_type=0,
-                    ordinate_len_unit_exp=0,
-                    ordinate_force_unit_exp=0,
-                    ordinate_axis_lab="Variance of H",
-                    ordinate_axis_units_lab=f"({obj.unit})^2"[:20],
-                    data=np.array(obj.variance[o, i], dtype=float),
-                )
-                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
-    return sets
-
-
-def _timedata_sets(obj: TimeData, binary: bool) -> list[dict[str, Any]]:
-    """The UFF 58 data sets of time data: one per channel, the acquisition record on ID lines."""
-    sets: list[dict[str, Any]] = []
-    id1 = str(obj.meta.get("description", "tyredamp time data"))
-    # time data: ID line 5 continues the metadata; the acquisition fields go first
-    acq = _compact_acquisition(obj.acquisition.to_dict())
-    id3, id5 = _meta_lines({**acq, **obj.meta}, 2)
-    stored = {**_extras(id3), **_extras(id5)}
-    lost = [k for k in acq if k not in stored]
-    if lost:
-        raise InputError(
-            f"timedata.acquisition: {', '.join(lost)} do not fit the 80-character UFF ID "
-            "lines with the other fields; write NPZ or CSV (a dropped field would change "
-            "how the FRF is estimated)"
-        )
-    t = obj.time
-    for k, (c, q) in enumerate(zip(obj.channels, obj.quantities, strict=True)):
-        d = _base_set(binary, q, id1, f"{_MARK} time {q} fs={obj.sample_rate!r}", id3)
-        d.update(
-            func_type=1,
-            func_id=k + 1,
-            rsp_node=c.node,
-            rsp_dir=c.direction,
-            ref_node=0,
-            ref_dir=0,
-            id4=_extras_line(c),
-            id5=id5,
-            data=np.array(obj.data[k], dtype=float),
-        )
-        sets.append(_abscissa(d, t, False, 17, "Time", "s"))
-    return sets
-
-
-def _abscissa(
-    d: dict[str, Any], x: np.ndarray, uneven: bool, sdt: int, lab: str, unit: str
-) -> dict[str, Any]:
-    xs = np.array(x, dtype=float)
-    if xs.size == 1 and not uneven:  # pyuff reads the increment from x[1]
-        xs = np.array([xs[0], xs[0] + 1.0])
-    d.update(
-        x=xs,
-        abscissa_spacing=0 if uneven else 1,
-        abscissa_spec_data_type=sdt,
-        abscissa_len_unit_exp=0,
-        abscissa_force_unit_exp=0,
-        abscissa_temp_unit_exp=0,
-        abscissa_axis_lab=lab,
-        abscissa_axis_units_lab=unit,
-    )
-    return d
-
-
-# ------------------------------------------------------------------ reading
-def _tokens(s: dict[str, Any]) -> dict[str, str] | None:
-    parts = str(s.get("id2", "")).split()
-    if not parts or parts[0] != _MARK:
-        return None
-    out = {"_what": parts[1] if len(parts) > 1 else "", "_q": parts[2] if len(parts) > 2 else ""}
-    for tok in parts[3:]:
-        if "=" in tok:
-            k, v = tok.split("=", 1)
-            out[k] = v
-    return out
-
-
-def _extras(line: Any) -> dict[str, Any]:
-    text = str(line or "").strip()
-    if not text.startswith("{"):
-        return {}
-    try:
-        d = json.loads(text)
-    except (json.JSONDecodeError, RecursionError):
-        return {}
-    return d if isinstance(d, dict) else {}
 
 
 def _channel(node: Any, direction: Any, extras: dict[str, Any], where: str) -> Channel:
@@ -576,17 +202,6 @@ def read_uff(
         if what == "timedata":
             return _read_time(p, sets, channel_map)
     raise InputError(f"what: expected 'frf' or 'timedata', got {what!r}")
-
-
-def _compact_acquisition(acq: dict[str, Any]) -> dict[str, Any]:
-    """Evenly spaced ``run_starts`` as ``run_every`` (fits an ID line for many runs)."""
-    runs = acq.get("run_starts")
-    if runs is not None and len(runs) > 2:
-        step = runs[1] - runs[0]
-        if all(b - a == step for a, b in itertools.pairwise(runs)):
-            acq = {k: v for k, v in acq.items() if k != "run_starts"}
-            acq["run_every"] = [int(step), len(runs)]
-    return acq
 
 
 def _meta(s: dict[str, Any], tok: dict[str, str] | None) -> dict[str, Any]:

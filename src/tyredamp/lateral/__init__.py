@@ -2,8 +2,9 @@
 
 * :mod:`.models` -- the linear models (classic, Maxwell, visco-plastic,
   proposed hysteretic, relaxation length, stretched string) with receptance,
-  mobility and accelerance at the ground or axle force; :mod:`.response` --
-  the algebra they share (wheel mass, axle/ground force, string impedance).
+  mobility and accelerance at the ground or axle force; :mod:`.base` -- the
+  interface they implement and their registry; :mod:`.response` -- the
+  algebra they share (wheel mass, axle/ground force, string impedance).
 * :mod:`.fiala` -- steady-state Fiala/brush force and its non-linear damper form.
 * :mod:`.characteristics` -- corner frequency and the dB differences of
   eq. 38-40, Figure 7 data.
@@ -12,14 +13,16 @@
   across speeds.
 * :mod:`.vehicle` -- the single-degree-of-freedom vehicle (eq. 41-44).
 * :mod:`.timedomain` -- exact harmonic/periodic steady states, impulse
-  response and non-causal precursor, causal generalised-Maxwell approximation
-  and exact state-space transients.
+  response and non-causal precursor, and exact state-space transients;
+  :mod:`.prony` -- the causal generalised-Maxwell approximation of the
+  hysteretic tyre; :mod:`.causality` -- its error against the ideal model.
 
 The virtual rolling-tyre rig is :mod:`tyredamp.virtual.lateral_rig`.
 """
 
 from __future__ import annotations
 
+from .causality import CausalError, causal_error
 from .characteristics import (
     CornerDifferences,
     Figure7Curves,
@@ -43,13 +46,10 @@ from .models import (
     ViscoPlasticModel,
     get_model_class,
 )
+from .prony import GeneralizedMaxwellTyre, fit_generalized_maxwell
 from .ranking import Ranking, rank_models
 from .response import attach_mass, axle_from_ground_accelerance, ground_from_axle_accelerance
 from .timedomain import (
-    CausalError,
-    GeneralizedMaxwellTyre,
-    causal_error,
-    fit_generalized_maxwell,
     harmonic_response,
     impulse_response,
     periodic_response,

@@ -19,18 +19,16 @@ from numpy.typing import ArrayLike
 
 from ..exceptions import InputError
 from ._lsq import Problem
+from .data import LateralData, Weights, _prepare
 from .fit import (
     _LOG_SPAN,
     FloatArray,
-    LateralData,
     LateralFit,
-    Weights,
     _conditions,
     _covariance,
     _fit_prepared,
     _information,
     _lateral_fit,
-    _prepare,
 )
 from .models import LateralModel, get_model_class
 

@@ -26,21 +26,23 @@ Two routes:
 included) and :func:`precursor` gives the size of the part before ``t = 0``
 (about 2 % of the peak for the 260 kN/m, 600 kg, ``h/K = 0.077``
 oscillator of spec eq. 43).
+
+The generalised Maxwell tyre and its fit are :mod:`tyredamp.lateral.prony`;
+:func:`causal_error` is :mod:`tyredamp.lateral.causality`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar, Literal, Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import nnls
 from scipy.signal import StateSpace, lsim
 
-from .._validate import as_band, as_finite, check_positive
-from ..exceptions import InputError, PhysicsError
+from .._validate import as_finite, check_positive
+from ..exceptions import InputError
 from .models import (
     ClassicModel,
     HystereticModel,
@@ -49,18 +51,14 @@ from .models import (
     RelaxationLengthModel,
     ViscoPlasticModel,
 )
-from .response import as_freq
+from .prony import GeneralizedMaxwellTyre, fit_generalized_maxwell
 from .vehicle import LateralVehicle
 
 __all__ = [
-    "CausalError",
-    "GeneralizedMaxwellTyre",
     "ImpulseResponse",
     "Output",
     "Precursor",
     "TransientResponse",
-    "causal_error",
-    "fit_generalized_maxwell",
     "harmonic_response",
     "impulse_response",
     "periodic_response",
@@ -312,163 +310,6 @@ def precursor(
     return Precursor(ratio=float(a[i] / peak), time_of_max=float(ir.time[i]), peak=peak, impulse=ir)
 
 
-# ------------------------------------------------------------------ causal approximation
-@dataclass(frozen=True)
-class GeneralizedMaxwellTyre(LateralModel):
-    """Causal tyre: damper ``C_r`` in series with a generalised Maxwell carcass.
-
-    Carcass dynamic stiffness
-    ``Z_c = k0 + sum_j k_j i omega tau_j / (1 + i omega tau_j)`` (N/m): a spring
-    ``k0`` parallel to Maxwell arms (spring ``k_j``, damper ``k_j tau_j``).
-    Mobility ``i omega / Z_c + 1/C_r``. Built by
-    :func:`fit_generalized_maxwell` as the causal stand-in for
-    :class:`~tyredamp.lateral.models.HystereticModel`; not a fitting model.
-
-    Parameters
-    ----------
-    k0 : float
-        Equilibrium (static) stiffness, N/m (> 0).
-    stiffness : tuple of float
-        Arm stiffnesses ``k_j``, N/m (>= 0).
-    tau : tuple of float
-        Arm relaxation times ``tau_j``, s (> 0).
-    C_r : float
-        Road damper, N s/m (> 0, ``inf`` for none).
-    """
-
-    k0: float
-    stiffness: tuple[float, ...]
-    tau: tuple[float, ...]
-    C_r: float
-
-    name: ClassVar[str] = "generalized_maxwell"
-    label: ClassVar[str] = "causal generalised Maxwell carcass + road damper"
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "k0", check_positive(self.k0, "k0"))
-        ks = tuple(check_positive(k, "stiffness", allow_zero=True) for k in self.stiffness)
-        ts = tuple(check_positive(t, "tau") for t in self.tau)
-        if len(ks) != len(ts):
-            raise InputError(f"stiffness, tau: expected equal lengths, got {len(ks)} and {len(ts)}")
-        object.__setattr__(self, "stiffness", ks)
-        object.__setattr__(self, "tau", ts)
-        c = float(self.C_r)
-        if math.isnan(c) or c <= 0:
-            raise InputError(f"C_r: expected a value > 0 (or inf), got {c:g}")
-        object.__setattr__(self, "C_r", c)
-
-    def carcass_stiffness(self, freq_hz: ArrayLike) -> ComplexArray:
-        """``Z_c`` in N/m at ``freq_hz`` (Hz, >= 0)."""
-        w = 2.0 * np.pi * as_freq(freq_hz)
-        return self._zc(w)
-
-    def _zc(self, w: FloatArray) -> ComplexArray:
-        z = np.full(np.shape(w), self.k0, dtype=complex)
-        for k, t in zip(self.stiffness, self.tau, strict=True):
-            z = z + k * (1j * w * t) / (1.0 + 1j * w * t)
-        return z
-
-    def _mobility(self, omega: FloatArray) -> ComplexArray:
-        road = 0.0 if math.isinf(self.C_r) else 1.0 / self.C_r
-        return np.asarray(1j * omega / self._zc(omega) + road, dtype=complex)
-
-    def _static_compliance(self) -> float:
-        return 1.0 / self.k0 if math.isinf(self.C_r) else math.inf
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "model": self.name,
-            "params": {
-                "k0": self.k0,
-                "stiffness": list(self.stiffness),
-                "tau": list(self.tau),
-                "C_r": self.C_r,
-            },
-            "units": {"k0": "N/m", "stiffness": "N/m", "tau": "s", "C_r": "N s/m"},
-            "conditions": {},
-        }
-
-
-def fit_generalized_maxwell(
-    model: HystereticModel,
-    band: tuple[float, float],
-    per_decade: int = 3,
-    f_ref: float | None = None,
-    n_points: int = 400,
-) -> GeneralizedMaxwellTyre:
-    """Causal generalised-Maxwell approximation of the hysteretic carcass ``K + i h``.
-
-    A constant loss ``h`` over a band forces the storage stiffness of any
-    causal model to rise with frequency (Kramers-Kronig: about
-    ``(2 h/pi) ln(f2/f1)`` between ``f1`` and ``f2``), so ``K + i h`` cannot be
-    matched everywhere. This approximation keeps what governs a resonance:
-
-    * the loss ``Im Z_c = sum_j k_j omega tau_j / (1 + (omega tau_j)^2)`` matches
-      ``h`` on ``n_points`` log-spaced frequencies of ``band`` (non-negative
-      least squares, :func:`scipy.optimize.nnls`; relaxation times
-      ``tau_j = 1/(2 pi f_j)`` log-spaced with ``per_decade`` per decade from
-      half a decade below to half a decade above the band);
-    * the storage equals ``K`` at ``f_ref``: ``k0 = K - sum_j k_j (w tau_j)^2/(1 + (w tau_j)^2)``.
-
-    All ``k_j >= 0`` and ``k0 > 0``, so the model is passive and causal.
-
-    Parameters
-    ----------
-    model : HystereticModel
-        The ideal model (its ``C_r`` is kept).
-    band : (float, float)
-        Frequency band in Hz, ``0 < lo < hi``.
-    per_decade : int
-        Maxwell arms per decade (>= 1).
-    f_ref : float, optional
-        Frequency where the storage stiffness equals ``K``, Hz (default the
-        geometric centre of ``band``; use the resonance of the system).
-    n_points : int
-        Fit frequencies (>= 10).
-
-    Returns
-    -------
-    GeneralizedMaxwellTyre
-
-    Raises
-    ------
-    PhysicsError
-        The band is so wide that ``k0`` would not be positive.
-    """
-    if not isinstance(model, HystereticModel):
-        raise InputError(f"model: expected a HystereticModel, got {type(model).__name__}")
-    lo, hi = as_band(band, positive=True)  # log-spaced arms
-    if int(per_decade) < 1 or int(n_points) < 10:
-        raise InputError(
-            f"per_decade >= 1 and n_points >= 10 expected, got {per_decade}, {n_points}"
-        )
-    fr = math.sqrt(lo * hi) if f_ref is None else check_positive(f_ref, "f_ref")
-    if model.h == 0:
-        return GeneralizedMaxwellTyre(k0=model.K, stiffness=(), tau=(), C_r=model.C_r)
-    dec = math.log10(hi / lo)
-    n_arms = math.ceil((dec + 1.0) * int(per_decade)) + 1
-    f_arm = np.logspace(math.log10(lo) - 0.5, math.log10(hi) + 0.5, n_arms)
-    tau = 1.0 / (2.0 * np.pi * f_arm)
-    w = 2.0 * np.pi * np.logspace(math.log10(lo), math.log10(hi), int(n_points))
-    wt = w[:, None] * tau[None, :]
-    loss = wt / (1.0 + wt**2)
-    coef, _ = nnls(loss / model.h, np.ones(w.size), maxiter=50 * tau.size)
-    wr = 2.0 * np.pi * fr * tau
-    k0 = model.K - float(np.sum(coef * wr**2 / (1.0 + wr**2)))
-    if k0 <= 0:
-        raise PhysicsError(
-            f"band: [{lo:g}, {hi:g}] Hz is too wide for h/K = {model.loss_factor:.3g}; the "
-            f"static stiffness k0 = {k0:.3g} N/m would not be positive"
-        )
-    keep = coef > 0
-    return GeneralizedMaxwellTyre(
-        k0=k0,
-        stiffness=tuple(float(x) for x in coef[keep]),
-        tau=tuple(float(x) for x in tau[keep]),
-        C_r=model.C_r,
-    )
-
-
 # --------------------------------------------------------------------------- state space
 _OUTPUTS = ("displacement", "velocity", "acceleration", "tyre_force")
 
@@ -660,131 +501,4 @@ def transient_response(
         y = y.T
     return TransientResponse(
         time=t, displacement=y[0], velocity=y[1], acceleration=y[2], tyre_force=y[3], tyre=veh.tyre
-    )
-
-
-# ---------------------------------------------------------------------------- error report
-@dataclass(frozen=True, eq=False)
-class CausalError:
-    """Error of a causal approximation of a hysteretic vehicle against the ideal model.
-
-    Attributes
-    ----------
-    band : (float, float)
-        Approximation band, Hz.
-    n_arms : int
-        Maxwell arms used.
-    stiffness_error : float
-        ``max |Z_c - (K + i h)| / |K + i h|`` over the band.
-    frf_error : float
-        ``max |Y_causal - Y_ideal| / |Y_ideal|`` of the body receptance over the band.
-    impulse_error : float
-        ``max_{t >= 0} |x_causal - x_ideal| / max |x_ideal|`` of the displacement
-        impulse responses (ideal by FFT, causal by the state-space model).
-    precursor_ratio : float
-        Precursor of the ideal model (:func:`precursor`).
-    sine_error : float
-        After ``settle`` s of a sine switched on at ``t = 0``: max error of the
-        causal transient against the exact steady state, relative to the
-        steady-state amplitude (acceleration).
-    sine_frequency : float
-        Hz.
-    tyre : GeneralizedMaxwellTyre
-        The approximation.
-    """
-
-    band: tuple[float, float]
-    n_arms: int
-    stiffness_error: float
-    frf_error: float
-    impulse_error: float
-    precursor_ratio: float
-    sine_error: float
-    sine_frequency: float
-    tyre: GeneralizedMaxwellTyre
-
-
-def causal_error(
-    vehicle: LateralVehicle,
-    band: tuple[float, float],
-    *,
-    per_decade: int = 3,
-    f_ref: float | None = None,
-    sine_frequency: float = 2.73,
-    sample_rate: float = 500.0,
-    duration: float = 64.0,
-    settle: float = 30.0,
-) -> CausalError:
-    """Compare the causal approximation of a hysteretic body-on-tyre model with the ideal one.
-
-    Parameters
-    ----------
-    vehicle : LateralVehicle
-        Body on a :class:`~tyredamp.lateral.models.HystereticModel` tyre.
-    band : (float, float)
-        Approximation band, Hz.
-    per_decade : int
-        Maxwell arms per decade.
-    f_ref : float, optional
-        Frequency where the storage stiffness is matched, Hz (default the
-        body resonance, or the band centre if there is none).
-    sine_frequency : float
-        Frequency of the switched-on sine test, Hz (default 2.73, the paper's).
-    sample_rate : float
-        Hz, for the impulse and sine simulations.
-    duration : float
-        Impulse-response window, s.
-    settle : float
-        Time after which the sine transient is compared, s (the sine lasts
-        ``settle + 5`` s).
-
-    Returns
-    -------
-    CausalError
-    """
-    if not isinstance(vehicle.tyre, HystereticModel):
-        raise InputError("vehicle: expected a body on a HystereticModel tyre")
-    if f_ref is None:
-        try:
-            f_ref = vehicle.resonance(band).frequency
-        except PhysicsError:
-            f_ref = None
-    causal = _causal_vehicle(vehicle, band, per_decade, f_ref)
-    gm = causal.tyre
-    assert isinstance(gm, GeneralizedMaxwellTyre)
-    f = np.logspace(math.log10(band[0]), math.log10(band[1]), 400)
-    target = vehicle.tyre.K + 1j * vehicle.tyre.h
-    st_err = float(np.max(np.abs(gm.carcass_stiffness(f) - target)) / abs(target))
-    yi, yc = vehicle.receptance(f), causal.receptance(f)
-    frf_err = float(np.max(np.abs(yc - yi) / np.abs(yi)))
-    pre = precursor(vehicle, sample_rate, duration, "displacement")
-    ir = pre.impulse
-    pos = ir.time >= 0
-    tpos = ir.time[pos]
-    sys = state_space(causal)
-    x0 = np.asarray(sys.B[:, 0], dtype=float)  # a unit impulse sets the state to B
-    _, yimp, _ = lsim(sys, np.zeros(tpos.size), tpos, X0=x0)
-    yimp = np.atleast_2d(np.asarray(yimp, dtype=float))
-    if yimp.shape[0] != 4:
-        yimp = yimp.T
-    imp_err = float(np.max(np.abs(yimp[0] - ir.response[pos])) / pre.peak)
-    fs = check_positive(sample_rate, "sample_rate")
-    fsin = check_positive(sine_frequency, "sine_frequency")
-    t = np.arange(round((settle + 5.0) * fs)) / fs
-    force = np.sin(2.0 * np.pi * fsin * t)
-    tr = transient_response(causal, force, fs)
-    exact = harmonic_response(vehicle, fsin, 1.0, t, "acceleration", phase=-np.pi / 2)
-    late = t >= settle
-    amp = float(np.max(np.abs(exact[late])))
-    sine_err = float(np.max(np.abs(tr.acceleration[late] - exact[late])) / amp)
-    return CausalError(
-        band=(float(band[0]), float(band[1])),
-        n_arms=len(gm.stiffness),
-        stiffness_error=st_err,
-        frf_error=frf_err,
-        impulse_error=imp_err,
-        precursor_ratio=pre.ratio,
-        sine_error=sine_err,
-        sine_frequency=fsin,
-        tyre=gm,
     )
