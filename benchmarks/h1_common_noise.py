@@ -48,7 +48,7 @@ def _tmax(E: np.ndarray, V: np.ndarray, f: np.ndarray) -> tuple[float, complex]:
 
 
 def main() -> None:
-    from tyredamp.campaign.virtual import _tyre, tyre_parameters
+    from tyredamp.campaign.virtual import campaign_tyre, tyre_parameters
     from tyredamp.modal.fit.fit import ModalFitter
     from tyredamp.modal.problem.problem import build_problem
     from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold, span_threshold
@@ -59,7 +59,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--draws", type=int, default=3)
     args = ap.parse_args()
-    tyre = _tyre(tyre_parameters(0, 0), 9.0, 20000.0, (1, 5))
+    tyre = campaign_tyre(tyre_parameters(0, 0), 9.0, 20000.0, (1, 5))
     clean = run_modal_test(tyre, n_periods=4, seed=3, snr_db=None).data
     h0 = estimate_frf(clean, "H1")
     sel = (h0.frequency >= 30) & (h0.frequency <= 180)
