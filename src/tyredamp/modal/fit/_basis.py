@@ -257,10 +257,13 @@ def residual_blocks(
     poles: NDArray[np.complex128],
     residues: NDArray[np.complex128],
     terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    n_col: int = 0,
 ) -> Iterator[tuple[slice, NDArray[np.complex128]]]:
     """The weighted residual ``H - H^`` (line weights applied), (n_out, n_in, lines),
-    block by block with its lines (arguments as :func:`residual_power`)."""
-    for sl in blocks(fitter, 2 * poles.size + 2 * fitter.n_in):
+    block by block with its lines (arguments as :func:`residual_power`); ``n_col``:
+    the real columns per line the caller forms with each block, when more than
+    the model's (:func:`blocks`)."""
+    for sl in blocks(fitter, max(2 * poles.size + 2 * fitter.n_in, n_col)):
         yield sl, residual_lines(fitter, poles, residues, terms, sl)
 
 
@@ -272,7 +275,12 @@ def residual_lines(
     sl: slice,
 ) -> NDArray[np.complex128]:
     """The weighted residual ``H - H^`` of the lines ``sl`` (arguments as
-    :func:`residual_power`), (n_out, n_in, lines)."""
+    :func:`residual_power`), (n_out, n_in, lines).
+
+    Only the result grows with the lines: the model's columns are formed for
+    blocks of at most :func:`blocks` lines (each line's value is the same
+    product of the same numbers whatever the block).
+    """
     n_out, n_in, m = residues.shape
     upper, lower = terms
     # the model of every FRF as one real product: R a + conj(R) b = Re R (a + b) +
@@ -283,25 +291,48 @@ def residual_lines(
     coef = [np.stack([residues.real, residues.imag], axis=3).reshape(n_out * n_in, 2 * m)]
     coef += [np.asarray(t, np.float64).reshape(-1, 1) for t in (upper, lower) if t is not None]
     rr = np.concatenate(coef, axis=1)
-    s, kap, kap_low = factors(fitter, sl)
-    h = fitter.H[:, :, sl]
-    e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
-    if rr.shape[1]:
-        cols = np.empty((rr.shape[1], s.size), complex)
-        put_pair(
-            cols[: 2 * m, None, :],
-            0,
-            2,
-            (kap / (s - poles[:, None]))[:, None, :],
-            (kap / (s - np.conj(poles)[:, None]))[:, None, :],
-        )
-        c = 2 * m
-        for t, kk in ((upper, kap), (lower, kap_low)):
-            if t is not None:
-                cols[c] = kk
-                c += 1
-        e -= (rr @ cols.view(np.float64)).view(np.complex128).reshape(e.shape)
+    idx = range(*sl.indices(fitter.n_f))
+    e = np.empty((n_out, n_in, len(idx)), complex)
+    nb = blocks(fitter, rr.shape[1])[0].stop
+    for k in range(0, len(idx), nb):
+        part = idx[k : k + nb]
+        sb = slice(part.start, part.stop, part.step)
+        eb = e[:, :, k : k + len(part)]
+        h = fitter.H[:, :, sb]
+        if fitter.line_weights is not None:
+            np.multiply(h, fitter.line_weights[sb], out=eb)
+        else:
+            eb[...] = h
+        if rr.shape[1]:
+            eb -= _model_block(fitter, poles, rr, terms, sb).reshape(eb.shape)
     return e
+
+
+def _model_block(
+    fitter: FitterState,
+    poles: NDArray[np.complex128],
+    rr: NDArray[np.float64],
+    terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    sb: slice,
+) -> NDArray[np.complex128]:
+    """The weighted model ``rr`` times the columns of the lines ``sb`` (one block),
+    (n_out n_in, lines) complex (:func:`residual_lines`)."""
+    m = poles.size
+    s, kap, kap_low = factors(fitter, sb)
+    cols = np.empty((rr.shape[1], s.size), complex)
+    put_pair(
+        cols[: 2 * m, None, :],
+        0,
+        2,
+        (kap / (s - poles[:, None]))[:, None, :],
+        (kap / (s - np.conj(poles)[:, None]))[:, None, :],
+    )
+    c = 2 * m
+    for t, kk in zip(terms, (kap, kap_low), strict=True):
+        if t is not None:
+            cols[c] = kk
+            c += 1
+    return (rr @ cols.view(np.float64)).view(np.complex128)
 
 
 def basis_ek(
