@@ -125,3 +125,33 @@ def test_out_of_band_scan_in_small_blocks_is_that_of_one_block(
     assert many is not None
     assert many == one  # the best grid point of the same statistic, summed in other blocks
     assert 5.0 <= abs(one.imag) / (2 * np.pi) <= 20.0  # in the range asked for
+
+
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_ml_refine_in_small_blocks_is_that_of_one_block(
+    kind: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the maximum-likelihood stage sums its Gram matrices and residuals over blocks
+    # of lines when the basis of every line is more than one block: blocks of a few
+    # lines must give the fit of one block (the basis whole) to round-off
+    from tyredamp.modal.fit.ml import ml_refine
+
+    poles, _, h = _data(4)
+    rng = np.random.default_rng(2)
+    v = (1e-4 + 1e-2 * np.abs(h) ** 2) * rng.uniform(0.5, 2.0, size=h.shape)
+    v[0, 1, 5] = 0.0  # an exact entry: the output's smallest variance stands for it
+    part = np.ones((3, 2), complex)
+    fit = ModalFitter(F, h, 0, kind, [(0, 0)])
+    wls = fit.fit(poles, part)
+    one = ml_refine(fit, wls, v, tol=1e-10)
+    monkeypatch.setattr(basis_mod, "BLOCK_BYTES", 1)
+    monkeypatch.setattr(basis_mod, "MIN_BLOCK_LINES", 41)  # 18 blocks, the last short
+    many = ml_refine(ModalFitter(F, h, 0, kind, [(0, 0)]), wls, v, tol=1e-10)
+    assert one.status == many.status
+    # the same optimum; the sums in another order: round-off, amplified by the
+    # iteration's stopping point (measured below 1e-12)
+    assert_allclose(many.poles, one.poles, rtol=1e-10)
+    assert_allclose(many.cost, one.cost, rtol=1e-10)
+    assert_allclose(many.model, one.model, rtol=0, atol=1e-9 * np.abs(one.model).max())
+    assert_allclose(many.psi_out, one.psi_out, rtol=0, atol=1e-9 * np.abs(one.psi_out).max())
+    assert_allclose(many.std_frequency_hz, one.std_frequency_hz, rtol=1e-8)
