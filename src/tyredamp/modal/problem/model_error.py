@@ -215,15 +215,16 @@ def with_model_error(
     if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
         return first, 0.0
     problem = build_problem(frf, first.band_hz, variance=variance)
-    lines = problem.lines
+    lines, f_band = problem.lines, problem.frequency
     H = np.asarray(frf.H)[:, :, lines]
-    floor = noise_floor(frf, problem, _model_band(first.models[kind], problem, frf.kind) - H)
+    floor = noise_floor(frf, problem, _model_band(first.models[kind], f_band, frf.kind) - H)
+    del problem  # its normalised copy of the data is not held through the passes
     V = floor.variance[:, :, lines]
 
     def eps_of(res: R) -> float:
         m = res.models[kind]
         dof = m.quality.dof if m.quality is not None else 0
-        return relative_model_error(H, _model_band(m, problem, frf.kind), V, dof)
+        return relative_model_error(H, _model_band(m, f_band, frf.kind), V, dof)
 
     eps, res = eps_of(first), first
     if eps <= 0.0:
@@ -249,8 +250,7 @@ def with_model_error(
     return res, eps
 
 
-def _model_band(m: ModalModel, problem: FitProblem, kind: FRFKind) -> NDArray[np.complex128]:
-    """The model ``m`` synthesised on the band's lines of ``problem``, in the FRF ``kind``."""
-    f = problem.frequency
+def _model_band(m: ModalModel, f: NDArray[np.float64], kind: FRFKind) -> NDArray[np.complex128]:
+    """The model ``m`` synthesised on the band's lines ``f`` (Hz), in the FRF ``kind``."""
     h: NDArray[np.complex128] = m.receptance(f) * kind_factor(2 * np.pi * f, kind)
     return h
