@@ -250,7 +250,16 @@ def with_model_error(
     return res, eps
 
 
+#: lines per block of the synthesised model (:func:`_model_band`): the modal sum's
+#: per-mode temporaries do not grow with the lines
+_SYNTH_BLOCK = 1 << 15
+
+
 def _model_band(m: ModalModel, f: NDArray[np.float64], kind: FRFKind) -> NDArray[np.complex128]:
-    """The model ``m`` synthesised on the band's lines ``f`` (Hz), in the FRF ``kind``."""
-    h: NDArray[np.complex128] = m.receptance(f) * kind_factor(2 * np.pi * f, kind)
+    """The model ``m`` synthesised on the band's lines ``f`` (Hz), in the FRF ``kind``,
+    in blocks of :data:`_SYNTH_BLOCK` lines."""
+    h = np.empty((m.psi_out.shape[0], m.psi_in.shape[0], f.size), np.complex128)
+    for a in range(0, f.size, _SYNTH_BLOCK):
+        fb = f[a : a + _SYNTH_BLOCK]
+        h[:, :, a : a + fb.size] = m.receptance(fb) * kind_factor(2 * np.pi * fb, kind)
     return h
