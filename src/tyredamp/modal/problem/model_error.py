@@ -147,7 +147,11 @@ def relative_model_error(
     ok = (V > 0) | (P > 0)
     if dof <= 0 or not np.any(ok):
         return 0.0
-    r2, P, V = r2[ok], P[ok], V[ok]
+    if ok.all():  # every entry counts: the same entries in the same order, no copies
+        r2, P, V = r2.ravel(), P.ravel(), V.ravel()
+    else:
+        r2, P, V = r2[ok], P[ok], V[ok]
+    del ok
 
     def excess(log_eps: float) -> float:
         return float(np.sum(2.0 * r2 / (V + math.exp(2.0 * log_eps) * P))) - dof
