@@ -88,7 +88,8 @@ class NoiseFloor:
     Attributes
     ----------
     variance : ndarray, shape (n_out, n_in, n_freq)
-        ``V`` of eq. (1), units of ``H`` squared.
+        ``V`` of eq. (1), units of ``H`` squared (read-only; one level per FRF
+        is a view along the lines).
     what : str
         Where it comes from, for people.
     """
@@ -109,12 +110,12 @@ def noise_floor(
     few lines near sharp peaks where the model errs; the residual's median also holds
     noise that adjacent lines share (a window's leakage), which second differences
     cancel."""
-    full = np.empty(frf.H.shape)
     s2 = difference_noise(problem.H, per_input=True) * problem.scale**2  # (n_out, n_in)
     if residual is not None and residual.size:
         r2 = residual.real**2 + residual.imag**2
         s2 = np.fmax(s2, np.median(r2, axis=2) / math.log(2.0))
-    full[:] = s2[:, :, None]
+    # one level per FRF: a read-only view along the lines, not an array of them
+    full = np.broadcast_to(s2[:, :, None], frf.H.shape)
     return NoiseFloor(full, "the noise of the fit's residual (a median over lines)")
 
 
