@@ -155,3 +155,37 @@ def test_ml_refine_in_small_blocks_is_that_of_one_block(
     assert_allclose(many.model, one.model, rtol=0, atol=1e-9 * np.abs(one.model).max())
     assert_allclose(many.psi_out, one.psi_out, rtol=0, atol=1e-9 * np.abs(one.psi_out).max())
     assert_allclose(many.std_frequency_hz, one.std_frequency_hz, rtol=1e-8)
+
+
+def test_model_receptance_in_small_blocks_is_the_modal_sum(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # ModalModel.receptance synthesises in blocks of lines: with blocks of 7 lines
+    # it is eq. [10] plus the residual modes and terms, written out term by term
+    import tyredamp.modal.model as model_mod
+    from tyredamp.modal import ModalModel
+
+    poles, _, _ = _data(6)
+    rng = np.random.default_rng(6)
+    po = rng.normal(size=(2, 3)) + 1j * rng.normal(size=(2, 3))
+    pi = rng.normal(size=(2, 3)) + 1j * rng.normal(size=(2, 3))
+    extra = ModalModel(np.array([-30.0 + 600.0j]), np.ones((2, 1)) + 0.5j, np.ones((2, 1)))
+    upper = rng.normal(size=(2, 2))
+    lower = rng.normal(size=(2, 2))
+    m = ModalModel(poles, po, pi, upper_residual=upper, lower_residual=lower, residual_modes=extra)
+    monkeypatch.setattr(model_mod, "SYNTH_BLOCK", 7)
+    got = m.receptance(F)
+    s = 2j * np.pi * F
+    want = upper[:, :, None] + lower[:, :, None] / s**2
+    for p, a, b in zip(
+        np.r_[poles, extra.poles],
+        np.c_[po, extra.psi_out].T,
+        np.c_[pi, extra.psi_in].T,
+        strict=True,
+    ):
+        r = np.outer(a, b)[:, :, None]
+        want = want + r / (s - p) + np.conj(r) / (s - np.conj(p))
+    # the same sums in another order: round-off of the largest term
+    assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
+    with pytest.raises(ValueError, match="0 Hz"):
+        m.receptance(np.r_[0.0, F])
