@@ -105,17 +105,24 @@ def main() -> None:
         f"{'lines':>10} {'modes':>5} {'order':>5} {'time [s]':>9} {'peak above data [MB]':>21} "
         f"{'B/line above data':>18}"
     )
+    done: list[tuple[int, int]] = []  # (lines, peak above the data in bytes)
     for n in args.lines:
         r = run(n, None, args.model)
         if "error" in r:
             print(f"{int(n):>10} failed: {r['error']}")
             continue
         extra = r["peak"] - r["base"]
+        done.append((int(r["n"]), int(extra)))
         how = "" if r["hwm"] else "  (lifetime peak ru_maxrss: a lower bound)"
         print(
             f"{int(r['n']):>10} {int(r['modes']):>5} {int(r['order']):>5} {r['time']:>9.2f} "
             f"{extra / 1e6:>21.1f} {extra / r['n']:>18.0f}{how}"
         )
+    # the slope between the two largest sizes: what one more line costs
+    if len(done) >= 2:
+        (n1, e1), (n2, e2) = sorted(done)[-2:]
+        if n2 > n1:
+            print(f"slope {n1}-{n2} lines: {(e2 - e1) / (n2 - n1):.0f} B/line above the data")
     if args.long <= 0:
         return
     print(f"\nnarrow band of a long FRF ({args.long:.0e} lines)")

@@ -575,6 +575,7 @@ def final_complex(
             continue
         span = residual_span(cfit, res) if test is not None else None
         thr = local_thresholds(cfit, span, res.poles[:m], threshold, test)
+        del span  # its per-line sums are not held through the refits and the ML stage
         refitted = np.zeros(m, bool)
         if refine and m > 1 and not np.any(t <= thr):
             # the held-pole statistic passes: the likelihood ratio with the

@@ -25,6 +25,10 @@ from .statistics.quality import FitQuality
 
 __all__ = ["ModalModel", "ModeKind"]
 
+#: lines per block of :meth:`ModalModel.receptance` (the modal sum's per-mode
+#: columns of a block, not of every line)
+SYNTH_BLOCK = 1 << 15
+
 ModeKind = Literal["complex", "real"]
 
 
@@ -246,24 +250,38 @@ class ModalModel:
 
     # ---------------------------------------------------------- synthesis
     def receptance(self, frequency: ArrayLike) -> NDArray[np.complex128]:
-        """Receptance matrix (eq. [10] plus residuals), shape (n_out, n_in, n_freq)."""
+        """Receptance matrix (eq. [10] plus residuals), shape (n_out, n_in, n_freq).
+
+        Synthesised in blocks of :data:`SYNTH_BLOCK` lines: besides the result,
+        the memory does not grow with the lines (the modal sum forms a column
+        per mode and line).
+        """
         f = as_frequency(frequency)
+        if self.lower_residual is not None and np.any(f == 0):
+            raise InputError("frequency: the lower residual L/s^2 is undefined at 0 Hz")
+        if f.size <= SYNTH_BLOCK:
+            return self._receptance_block(f)
+        h = np.empty((self.psi_out.shape[0], self.psi_in.shape[0], f.size), np.complex128)
+        for a in range(0, f.size, SYNTH_BLOCK):
+            h[:, :, a : a + SYNTH_BLOCK] = self._receptance_block(f[a : a + SYNTH_BLOCK])
+        return h
+
+    def _receptance_block(self, f: NDArray[np.float64]) -> NDArray[np.complex128]:
+        """:meth:`receptance` of the lines ``f`` (Hz) at once."""
         h = modal_sum_receptance(f, self.poles, self.psi_out, self.psi_in)
         if self.residual_modes is not None:
-            h = h + self.residual_modes.receptance(f)
+            h += self.residual_modes.receptance(f)
         if self.upper_residual is not None:
-            h = h + self.upper_residual[:, :, None]
+            h += self.upper_residual[:, :, None]
         if self.lower_residual is not None:
-            s2 = (2j * np.pi * f) ** 2
-            if np.any(s2 == 0):
-                raise InputError("frequency: the lower residual L/s^2 is undefined at 0 Hz")
-            h = h + self.lower_residual[:, :, None] / s2
+            h += self.lower_residual[:, :, None] / (2j * np.pi * f) ** 2
         return h
 
     def frf(self, frequency: ArrayLike, kind: FRFKind = "receptance") -> FRF:
         """Synthesised :class:`FRF` of this model at ``frequency`` (Hz)."""
         f = as_frequency(frequency)
-        h = self.receptance(f) * kind_factor(2 * np.pi * f, kind)
+        h = self.receptance(f)
+        h *= kind_factor(2 * np.pi * f, kind)
         return FRF(
             f,
             h,

@@ -257,10 +257,13 @@ def residual_blocks(
     poles: NDArray[np.complex128],
     residues: NDArray[np.complex128],
     terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    n_col: int = 0,
 ) -> Iterator[tuple[slice, NDArray[np.complex128]]]:
     """The weighted residual ``H - H^`` (line weights applied), (n_out, n_in, lines),
-    block by block with its lines (arguments as :func:`residual_power`)."""
-    for sl in blocks(fitter, 2 * poles.size + 2 * fitter.n_in):
+    block by block with its lines (arguments as :func:`residual_power`); ``n_col``:
+    the real columns per line the caller forms with each block, when more than
+    the model's (:func:`blocks`)."""
+    for sl in blocks(fitter, max(2 * poles.size + 2 * fitter.n_in, n_col)):
         yield sl, residual_lines(fitter, poles, residues, terms, sl)
 
 
@@ -272,7 +275,12 @@ def residual_lines(
     sl: slice,
 ) -> NDArray[np.complex128]:
     """The weighted residual ``H - H^`` of the lines ``sl`` (arguments as
-    :func:`residual_power`), (n_out, n_in, lines)."""
+    :func:`residual_power`), (n_out, n_in, lines).
+
+    Only the result grows with the lines: the model's columns are formed for
+    blocks of at most :func:`blocks` lines (each line's value is the same
+    product of the same numbers whatever the block).
+    """
     n_out, n_in, m = residues.shape
     upper, lower = terms
     # the model of every FRF as one real product: R a + conj(R) b = Re R (a + b) +
@@ -283,25 +291,48 @@ def residual_lines(
     coef = [np.stack([residues.real, residues.imag], axis=3).reshape(n_out * n_in, 2 * m)]
     coef += [np.asarray(t, np.float64).reshape(-1, 1) for t in (upper, lower) if t is not None]
     rr = np.concatenate(coef, axis=1)
-    s, kap, kap_low = factors(fitter, sl)
-    h = fitter.H[:, :, sl]
-    e = h * fitter.line_weights[sl] if fitter.line_weights is not None else h.copy()
-    if rr.shape[1]:
-        cols = np.empty((rr.shape[1], s.size), complex)
-        put_pair(
-            cols[: 2 * m, None, :],
-            0,
-            2,
-            (kap / (s - poles[:, None]))[:, None, :],
-            (kap / (s - np.conj(poles)[:, None]))[:, None, :],
-        )
-        c = 2 * m
-        for t, kk in ((upper, kap), (lower, kap_low)):
-            if t is not None:
-                cols[c] = kk
-                c += 1
-        e -= (rr @ cols.view(np.float64)).view(np.complex128).reshape(e.shape)
+    idx = range(*sl.indices(fitter.n_f))
+    e = np.empty((n_out, n_in, len(idx)), complex)
+    nb = blocks(fitter, rr.shape[1])[0].stop
+    for k in range(0, len(idx), nb):
+        part = idx[k : k + nb]
+        sb = slice(part.start, part.stop, part.step)
+        eb = e[:, :, k : k + len(part)]
+        h = fitter.H[:, :, sb]
+        if fitter.line_weights is not None:
+            np.multiply(h, fitter.line_weights[sb], out=eb)
+        else:
+            eb[...] = h
+        if rr.shape[1]:
+            eb -= _model_block(fitter, poles, rr, terms, sb).reshape(eb.shape)
     return e
+
+
+def _model_block(
+    fitter: FitterState,
+    poles: NDArray[np.complex128],
+    rr: NDArray[np.float64],
+    terms: tuple[NDArray[np.float64] | None, NDArray[np.float64] | None],
+    sb: slice,
+) -> NDArray[np.complex128]:
+    """The weighted model ``rr`` times the columns of the lines ``sb`` (one block),
+    (n_out n_in, lines) complex (:func:`residual_lines`)."""
+    m = poles.size
+    s, kap, kap_low = factors(fitter, sb)
+    cols = np.empty((rr.shape[1], s.size), complex)
+    put_pair(
+        cols[: 2 * m, None, :],
+        0,
+        2,
+        (kap / (s - poles[:, None]))[:, None, :],
+        (kap / (s - np.conj(poles)[:, None]))[:, None, :],
+    )
+    c = 2 * m
+    for t, kk in zip(terms, (kap, kap_low), strict=True):
+        if t is not None:
+            cols[c] = kk
+            c += 1
+    return (rr @ cols.view(np.float64)).view(np.complex128)
 
 
 def basis_ek(
@@ -342,11 +373,8 @@ def basis_ek(
     q = fitter.n_cols(m)
     s1, kap1, kap_low = factors(fitter, lines) if fac is None else fac
     if fitter.kind == "real":
-        phi, D = basis_real(fitter, poles, part, ref, derivatives, lines)
-        B = np.empty((phi.shape[0], q + D.shape[1]), order="F")
-        B[:, :q] = phi
-        B[:, q:] = D
-        return B, poles
+        rt = real_rows(fitter, poles, part, ref, derivatives, (s1, kap1, kap_low))
+        return rt.reshape(rt.shape[0], -1).view(np.float64).T, poles
     nin, nf = fitter.n_in, s1.size
     ne = 2 * nin * m if derivatives else 0
     # rows: columns of B, complex (real and imaginary part interleaved as in Y)
@@ -412,44 +440,71 @@ def basis_real(
     lines: slice | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``Phi`` and ``D`` of the real-mode model (columns of :meth:`_layout`)."""
-    s, kap, kap_low = factors(fitter, lines)
+    bt = real_rows(fitter, poles, part, ref, derivatives, factors(fitter, lines))
+    q = fitter.n_cols(poles.size)
+    rows = bt.reshape(bt.shape[0], -1).view(np.float64).T
+    return rows[:, :q], rows[:, q:]
+
+
+def real_rows(
+    fitter: FitterState,
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    ref: NDArray[np.intp],
+    derivatives: bool,
+    fac: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]],
+) -> NDArray[np.complex128]:
+    """The columns ``[Phi | D]`` of the real-mode model as complex rows (q + n_d, n_in,
+    lines) (:func:`basis_real`; ``fac``: :func:`factors` of the lines).
+
+    Mode ``n`` (``sigma``, ``Omega``, participation ``L``): ``Phi`` column ``L kappa /
+    d`` with ``d = s^2 + 2 sigma s + sigma^2 + Omega^2``; derivative columns ``L sigma
+    (-kappa (2 s + 2 sigma) / d^2)`` (``x1``, ``sigma = e^x1``), ``L w_ref (-kappa 2
+    Omega / d^2)`` (``x2``) and ``kappa / d`` at input ``k`` for each free
+    participation entry (``k != ref[n]``). Each column is written in place into
+    one array (no per-mode temporaries of the lines).
+    """
+    s, kap, kap_low = fac
     nin, nf = fitter.n_in, s.size
     m = poles.size
     q = fitter.n_cols(m)
-    cols = np.zeros((q, nin, nf), complex)
-    dl: list[NDArray[np.complex128]] = []
+    npm = 2 + (nin - 1)
+    bt = np.zeros((q + (npm * m if derivatives else 0), nin, nf), complex)
+    if m:
+        s2, two_s, nkap = s**2, 2 * s, -kap
+        den, base, tmp = np.empty_like(s), np.empty_like(s), np.empty_like(s)
     for n in range(m):
         p = poles[n]
         sig, om = -p.real, p.imag
-        L = part[n]
-        den = s**2 + 2 * sig * s + sig**2 + om**2
-        base = kap / den
-        cols[n] = L.real[:, None] * base[None, :]
+        lr = part[n].real[:, None]
+        np.multiply(2 * sig, s, out=den)
+        np.add(s2, den, out=den)
+        den += sig**2
+        den += om**2
+        np.divide(kap, den, out=base)
+        np.multiply(lr, base[None, :], out=bt[n])
         if not derivatives:
             continue
-        d_sig = -kap * (2 * s + 2 * sig) / den**2
-        d_om = -kap * (2 * om) / den**2
-        dl += [L.real[:, None] * (d_sig * sig)[None, :]]
-        dl += [L.real[:, None] * (d_om * fitter.w_ref)[None, :]]
-        for k in range(nin):
-            if k == ref[n]:
-                continue
-            a_ = np.zeros((nin, nf), complex)
-            a_[k] = base
-            dl.append(a_)
+        den2 = den**2
+        r = q + npm * n
+        np.add(two_s, 2 * sig, out=tmp)
+        np.multiply(nkap, tmp, out=tmp)
+        np.divide(tmp, den2, out=tmp)
+        np.multiply(tmp, sig, out=tmp)
+        np.multiply(lr, tmp[None, :], out=bt[r])
+        np.multiply(nkap, 2 * om, out=tmp)
+        np.divide(tmp, den2, out=tmp)
+        np.multiply(tmp, fitter.w_ref, out=tmp)
+        np.multiply(lr, tmp[None, :], out=bt[r + 1])
+        for j, k in enumerate(k for k in range(nin) if k != ref[n]):
+            bt[r + 2 + j, k] = base
     c0 = m
-    if fitter.use_upper:
-        for k in range(nin):
-            cols[c0, k] = kap
-            c0 += 1
-    if fitter.use_lower:
-        for k in range(nin):
-            cols[c0, k] = kap_low
-            c0 += 1
-    phi = cols.reshape(q, nin * nf).view(np.float64).T
-    if not derivatives or not dl:
-        return phi, np.zeros((phi.shape[0], 0))
-    return phi, np.stack(dl).reshape(len(dl), nin * nf).view(np.float64).T
+    for use, kk in ((fitter.use_upper, kap), (fitter.use_lower, kap_low)):
+        if use:
+            for k in range(nin):
+                bt[c0, k] = kk
+                c0 += 1
+    return bt
 
 
 # ---------------------------------------------------- variable projection

@@ -50,6 +50,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.linalg import solve_triangular
 
+from . import _basis
 from ._linalg import _gram_chol, _levenberg_marquardt
 from ._scaling import pole_std
 from .fit import FitResult, ModalFitter, pole_bounds
@@ -218,8 +219,8 @@ def ml_refine(
         residual terms, model, cost (``L``) and Fisher standard errors of the
         frequencies, damping ratios and poles (module docstring).
     """
-    om = line_weights_full(variance)
-    if om is None:
+    floor = _floor(variance)
+    if floor is None:
         return res
     m_all = int(res.poles.size)
     part = np.asarray(res.participation, complex)
@@ -230,9 +231,16 @@ def ml_refine(
     q = fitter.n_cols(m_all)
     n_obs = fitter.n_rows * fitter.n_out
     dof = max(n_obs - q * fitter.n_out - n_par, 1)
+    parts = _basis.blocks(fitter, q + int(fitter._layout(m_all).ecol.max(initial=-1)) + 1)
+    om = line_weights_full(variance) if len(parts) == 1 else None
+    wts = (variance, floor, parts)
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         th, nfev, ok, sol = _levenberg_marquardt(
-            lambda x: _evaluate(fitter, x, m_all, ref, om),
+            lambda x: (
+                _evaluate(fitter, x, m_all, ref, om)
+                if om is not None
+                else _evaluate_blocks(fitter, x, m_all, ref, wts)
+            ),
             np.clip(th0, lb + 1e-9, ub - 1e-9),
             lb,
             ub,
@@ -241,9 +249,122 @@ def ml_refine(
             tol=tol,
         )
     C = sol["C"]
-    cost = float(np.sum((om * (fitter.Y - sol["phi"] @ C)) ** 2))
+    if om is not None:  # one block: the basis of every line is at hand
+        cost = float(np.sum((om * (fitter.Y - sol["phi"] @ C)) ** 2))
+        hw = np.ascontiguousarray((sol["phi"] @ C).T)  # (n_out, n_rows), re/im interleaved
+        model = hw.view(np.complex128).reshape(fitter.n_out, fitter.n_in, fitter.n_f)
+    else:
+        cost, model = _model_blocks(fitter, th, m_all, ref, C, wts)
     cth = fisher_scale(noise_dof, cost, dof) * np.linalg.pinv(sol["jtj"], hermitian=True)
-    return _as_result(fitter, res, th, ref, C, sol["phi"], cth, cost, nfev, ok)
+    return _as_result(fitter, res, th, ref, C, model, cth, cost, nfev, ok)
+
+
+#: the weights of the blocked evaluation: the variance, each output's floor and the blocks
+_Weights = tuple[NDArray[np.float64], NDArray[np.float64], list[slice]]
+
+
+def _floor(variance: NDArray[np.float64]) -> NDArray[np.float64] | None:
+    """Each output's smallest positive variance (the global one for an output with
+    none), the variance of entries without one (:func:`line_weights_full`); None
+    when every variance is zero."""
+    n_out = variance.shape[0]
+    v = np.asarray(variance, dtype=float).reshape(n_out, -1)
+    low = np.array([np.min(r, where=r > 0, initial=np.inf) for r in v])
+    if not np.isfinite(low).any():
+        return None
+    return np.where(np.isfinite(low), low, np.min(low))
+
+
+def _rows_weights(wts: _Weights, sl: slice) -> NDArray[np.float64]:
+    """The rows of :func:`line_weights_full` of the lines ``sl`` (2 n_in lines, n_out)."""
+    variance, floor, _ = wts
+    n_out = variance.shape[0]
+    v = np.asarray(variance[:, :, sl], dtype=float).reshape(n_out, -1)
+    v = np.where(v > 0, v, floor[:, None])
+    return np.repeat(1.0 / np.sqrt(v / 2.0), 2, axis=1).T.copy()
+
+
+def _evaluate_blocks(
+    fitter: ModalFitter,
+    th: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    wts: _Weights,
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64], dict[str, Any]]:
+    """:func:`_evaluate` with the Gram matrices and the residual summed over the
+    blocks of lines of ``wts`` (no array of every line): a first pass sums each
+    output's Gram matrix of ``W_j [Phi | E]`` and ``W_j [Phi | E]^T W_j y_j``, the
+    coefficients follow from their Cholesky factors, and a second pass forms the
+    residual ``r_j`` block by block for the cost and ``E^T W_j r_j`` (the same
+    quantities as :func:`_evaluate`, summed in another order). An output whose
+    basis is too ill-conditioned for the Gram route sends the evaluation to
+    :func:`_evaluate` on every line at once (its Householder QR)."""
+    q = fitter.n_cols(m)
+    lay = fitter._layout(m)
+    poles = fitter.unpack(th, m, ref)[0]
+    coef = fitter._coef(lay, poles)
+    n_par, n_out, parts = th.size, fitter.n_out, wts[2]
+    G: list[Any] = [0.0] * n_out
+    py: list[Any] = [0.0] * n_out
+    for sl in parts:
+        B = fitter._basis_ek(th, m, ref, True, sl)[0]
+        om, Y = _rows_weights(wts, sl), _basis.ydata(fitter, sl)
+        for j in range(n_out):
+            bw = B * om[:, j, None]
+            G[j] = G[j] + bw.T @ bw
+            py[j] = py[j] + bw.T @ (Y[:, j] * om[:, j])
+    C = np.zeros((q, n_out))
+    ges = []
+    for j in range(n_out):
+        fac = _gram_chol(G[j][:q, :q])
+        om_all = line_weights_full(wts[0]) if fac is None else None
+        if om_all is not None:  # the QR route needs the basis whole
+            return _evaluate(fitter, th, m, ref, om_all)
+        if fac is None:
+            raise ValueError("variance: every entry is zero")  # _floor said otherwise
+        rs, d = fac
+        R = rs * d[None, :]
+        C[:, j] = solve_triangular(R, solve_triangular(R, py[j][:q], trans="T"))
+        X = solve_triangular(R, G[j][:q, q:], trans="T")
+        ges.append(G[j][q:, q:] - X.T @ X)  # E^T W P W E
+    cost, etr = 0.0, np.zeros((B.shape[1] - q, n_out))
+    for sl in parts:
+        B = fitter._basis_ek(th, m, ref, True, sl)[0]
+        om, Y = _rows_weights(wts, sl), _basis.ydata(fitter, sl)
+        for j in range(n_out):
+            bw = B * om[:, j, None]
+            r = Y[:, j] * om[:, j] - bw[:, :q] @ C[:, j]  # the residual itself
+            cost += float(r @ r)
+            etr[:, j] += bw[:, q:].T @ r
+    jtj = np.zeros((n_par, n_par))
+    jtr = np.zeros(n_par)
+    for j in range(n_out):
+        S = np.zeros((n_par, etr.shape[0]))
+        np.add.at(S, (lay.dpar, lay.ecol), coef * C[lay.dcol, j])
+        jtj += S @ ges[j] @ S.T
+        jtr -= S @ etr[:, j]
+    return cost, 0.5 * (jtj + jtj.T), jtr, {"C": C, "jtj": jtj}
+
+
+def _model_blocks(
+    fitter: ModalFitter,
+    th: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    C: NDArray[np.float64],
+    wts: _Weights,
+) -> tuple[float, NDArray[np.complex128]]:
+    """The weighted cost ``sum (W (Y - Phi C))^2`` and the model ``Phi C`` (n_out,
+    n_in, n_f) complex, block by block (:func:`_evaluate_blocks`)."""
+    model = np.empty((fitter.n_out, fitter.n_in, fitter.n_f), complex)
+    cost = 0.0
+    for sl in wts[2]:
+        mb = fitter._basis_ek(th, m, ref, False, sl)[0] @ C  # (rows, n_out)
+        cost += float(np.sum((_rows_weights(wts, sl) * (_basis.ydata(fitter, sl) - mb)) ** 2))
+        model[:, :, sl] = (
+            np.ascontiguousarray(mb.T).view(np.complex128).reshape(fitter.n_out, fitter.n_in, -1)
+        )
+    return cost, model
 
 
 def _as_result(
@@ -252,7 +373,7 @@ def _as_result(
     th: NDArray[np.float64],
     ref: NDArray[np.intp],
     C: NDArray[np.float64],
-    phi: NDArray[np.float64],
+    model: NDArray[np.complex128],
     cth: NDArray[np.float64],
     cost: float,
     nfev: int,
@@ -273,8 +394,6 @@ def _as_result(
         off += fitter.n_in
     if fitter.use_lower:
         lower = C[off : off + fitter.n_in].T.copy()
-    hw = np.ascontiguousarray((phi @ C).T)  # (n_out, n_rows), rows re/im interleaved
-    model = hw.view(np.complex128).reshape(fitter.n_out, fitter.n_in, fitter.n_f)
     phi2 = res.drive_phi2
     if didx.size:
         kin = np.array([k for _, k in fitter.drive], dtype=np.intp)

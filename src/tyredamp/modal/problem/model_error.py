@@ -87,7 +87,8 @@ class NoiseFloor:
     Attributes
     ----------
     variance : ndarray, shape (n_out, n_in, n_freq)
-        ``V`` of eq. (1), units of ``H`` squared.
+        ``V`` of eq. (1), units of ``H`` squared (read-only; one level per FRF
+        is a view along the lines).
     what : str
         Where it comes from, for people.
     """
@@ -108,12 +109,12 @@ def noise_floor(
     few lines near sharp peaks where the model errs; the residual's median also holds
     noise that adjacent lines share (a window's leakage), which second differences
     cancel."""
-    full = np.empty(frf.H.shape)
     s2 = difference_noise(problem.H, per_input=True) * problem.scale**2  # (n_out, n_in)
     if residual is not None and residual.size:
         r2 = residual.real**2 + residual.imag**2
         s2 = np.fmax(s2, np.median(r2, axis=2) / math.log(2.0))
-    full[:] = s2[:, :, None]
+    # one level per FRF: a read-only view along the lines, not an array of them
+    full = np.broadcast_to(s2[:, :, None], frf.H.shape)
     return NoiseFloor(full, "the noise of the fit's residual (a median over lines)")
 
 
@@ -146,7 +147,11 @@ def relative_model_error(
     ok = (V > 0) | (P > 0)
     if dof <= 0 or not np.any(ok):
         return 0.0
-    r2, P, V = r2[ok], P[ok], V[ok]
+    if ok.all():  # every entry counts: the same entries in the same order, no copies
+        r2, P, V = r2.ravel(), P.ravel(), V.ravel()
+    else:
+        r2, P, V = r2[ok], P[ok], V[ok]
+    del ok
 
     def excess(log_eps: float) -> float:
         return float(np.sum(2.0 * r2 / (V + math.exp(2.0 * log_eps) * P))) - dof
@@ -222,15 +227,16 @@ def with_model_error(
     if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
         return first, 0.0
     problem = build_problem(frf, first.band_hz, variance=variance)
-    lines = problem.lines
+    lines, f_band = problem.lines, problem.frequency
     H = np.asarray(frf.H)[:, :, lines]
-    floor = noise_floor(frf, problem, _model_band(first.models[kind], problem, frf.kind) - H)
+    floor = noise_floor(frf, problem, _model_band(first.models[kind], f_band, frf.kind) - H)
+    del problem  # its normalised copy of the data is not held through the passes
     V = floor.variance[:, :, lines]
 
     def eps_of(res: R) -> float:
         m = res.models[kind]
         dof = m.quality.dof if m.quality is not None else 0
-        return relative_model_error(H, _model_band(m, problem, frf.kind), V, dof)
+        return relative_model_error(H, _model_band(m, f_band, frf.kind), V, dof)
 
     eps, res = eps_of(first), first
     if eps <= 0.0:
@@ -256,8 +262,16 @@ def with_model_error(
     return res, eps
 
 
-def _model_band(m: ModalModel, problem: FitProblem, kind: FRFKind) -> NDArray[np.complex128]:
-    """The model ``m`` synthesised on the band's lines of ``problem``, in the FRF ``kind``."""
-    f = problem.frequency
-    h: NDArray[np.complex128] = m.receptance(f) * kind_factor(2 * np.pi * f, kind)
+#: lines per block of the synthesised model (:func:`_model_band`): the modal sum's
+#: per-mode temporaries do not grow with the lines
+_SYNTH_BLOCK = 1 << 15
+
+
+def _model_band(m: ModalModel, f: NDArray[np.float64], kind: FRFKind) -> NDArray[np.complex128]:
+    """The model ``m`` synthesised on the band's lines ``f`` (Hz), in the FRF ``kind``,
+    in blocks of :data:`_SYNTH_BLOCK` lines."""
+    h = np.empty((m.psi_out.shape[0], m.psi_in.shape[0], f.size), np.complex128)
+    for a in range(0, f.size, _SYNTH_BLOCK):
+        fb = f[a : a + _SYNTH_BLOCK]
+        h[:, :, a : a + fb.size] = m.receptance(fb) * kind_factor(2 * np.pi * fb, kind)
     return h

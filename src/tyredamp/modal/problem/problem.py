@@ -203,7 +203,7 @@ def check_uniform(f: NDArray[np.float64]) -> None:
 
 
 def _line_variance(
-    frf: FRF, lines: NDArray[np.intp], H: NDArray[np.complex128], variance: ArrayLike | None
+    frf: FRF, lines: slice, H: NDArray[np.complex128], variance: ArrayLike | None
 ) -> tuple[NoiseSource, NDArray[np.float64] | None]:
     """Variance of each line of ``lines`` (data units ``H``) and where it comes from.
 
@@ -324,7 +324,7 @@ def build_problem(
     i0, i1, empty = _without_empty_lines(frf.H, fa, i0, i1)
     if empty:
         lo, hi = max(lo, float(fa[i0])), min(hi, float(fa[i1 - 1]))
-    lines = np.arange(i0, i1)
+    lines = slice(i0, i1)  # views of the band, not copies
     f = np.ascontiguousarray(fa[i0:i1])
     check_uniform(f)
     Hb = np.asarray(frf.H[:, :, i0:i1])
@@ -346,7 +346,8 @@ def build_problem(
         source, v, nu = "residual", None, None
     sig = lw = vn = None
     if v is not None:
-        vn = v / peak**2 / rms**2
+        vn = v / peak**2
+        vn /= rms**2  # in place: one copy of the band's variance
         sep = _separable(vn)
         if sep is None:
             source, vn = "residual", None
@@ -367,7 +368,7 @@ def build_problem(
         sigma_out=sig,
         line_weights=lw,
         variance=vn,
-        lines=slice(i0, i1),
+        lines=lines,
         noise_dof=nu if source != "residual" else None,
         n_averages=None if n_avg is None else int(n_avg),
         noise_note=noise_note if source == "variance" else "",

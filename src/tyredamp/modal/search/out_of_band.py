@@ -177,12 +177,14 @@ def _scan_start(
     # residual of a long axis with many FRFs is never held whole)
     m = np.zeros((fitter.n_out * fitter.n_in, pg.size), complex)
     nrm2 = np.zeros(pg.size)
-    for sl, e in residual_blocks(fitter, poles, residues, terms):
+    # blocks sized for the SCAN_CHUNK complex trial columns formed with each
+    for sl, e in residual_blocks(fitter, poles, residues, terms, 2 * SCAN_CHUNK):
         eb = (e * inv[:, None, None]).reshape(-1, e.shape[-1])
         s, kap, _ = factors(fitter, sl)
         for c0 in range(0, pg.size, SCAN_CHUNK):
             g = slice(c0, c0 + SCAN_CHUNK)
-            a = kap[None, :] / (s[None, :] - pg[g, None])
+            a = s[None, :] - pg[g, None]
+            np.divide(kap[None, :], a, out=a)
             m[:, g] += eb @ a.conj().T
             nrm2[g] += np.sum(a.real**2 + a.imag**2, axis=1)
     t = rank_one_statistic(m, nrm2, fitter.n_out, fitter.n_in)

@@ -77,25 +77,34 @@ def noise_mean(pw: NDArray[np.float64], k_terms: int) -> float:
 
 
 def _window_sums(
-    c: NDArray[np.float64], half: NDArray[np.intp]
+    c: NDArray[np.float64], half: NDArray[np.intp], i0: int = 0
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Sums of the series whose cumulative sum (with a leading 0) is ``c`` over
-    ``[i - half_i, i + half_i]`` (clipped to the lines), and the window lengths."""
+    ``[i - half_i, i + half_i]`` (clipped to the lines) for the lines ``i = i0,
+    i0 + 1, ...`` (one per entry of ``half``), and the window lengths."""
     n = c.size - 1
-    i = np.arange(n)
+    i = np.arange(i0, i0 + half.size)
     a = np.clip(i - half, 0, n)
     b = np.clip(i + half + 1, 0, n)
     return c[b] - c[a], (b - a).astype(np.float64)
 
 
 def _peaks(score: NDArray[np.float64]) -> NDArray[np.intp]:
-    """Local maxima of ``score`` where it is finite, best first."""
+    """Local maxima of ``score`` where it is finite, best first (a line is one when
+    it exceeds its left neighbour and is not below its right one; the ends count
+    their missing neighbour as ``-inf``)."""
     fin = np.isfinite(score)
     sc = np.where(fin, score, -1e300)
-    left = np.concatenate([[-np.inf], sc[:-1]])
-    right = np.concatenate([sc[1:], [-np.inf]])
-    peak = np.flatnonzero(fin & (sc > left) & (sc >= right))
-    return np.asarray(peak[np.argsort(-sc[peak])], dtype=np.intp)
+    peak = fin
+    peak[1:] &= sc[1:] > sc[:-1]
+    peak[:-1] &= sc[:-1] >= sc[1:]
+    idx = np.flatnonzero(peak)
+    return np.asarray(idx[np.argsort(-sc[idx])], dtype=np.intp)
+
+
+#: lines per block of the matched-window score of :func:`residual_peaks` (its
+#: temporaries do not grow with the lines)
+PEAK_BLOCK = 1 << 16
 
 
 def residual_peaks(
@@ -128,21 +137,10 @@ def residual_peaks(
     # narrow: 5 lines over the median
     k = min(5, pw.size)
     sm = np.convolve(pw, np.ones(k) / k, mode="same")
-    narrow = np.where(k * (sm - np.median(sm)) > SHARE * threshold, sm, -np.inf)
-    # broad: matched windows, excess over the noise mean (no bias in wide sums)
-    mu = noise_mean(pw, k_terms)
-    # the noise variance of one line's power, robustly: var of chi2(2K)/2 scaled as mu
-    var_line = mu**2 / max(int(k_terms), 1)
-    c = np.concatenate([[0.0], np.cumsum(pw - mu)])
-    dfl = np.gradient(f) if f.size > 1 else np.ones(1)
-    score = np.full(pw.size, -np.inf)
-    for s in SCALES:
-        half = np.maximum(np.round(s * zeta0 * f / np.maximum(dfl, 1e-300)), MIN_HALF)
-        e, n = _window_sums(c, half.astype(np.intp))
-        z = e / np.sqrt(n * var_line)
-        zz = np.where((z > Z_NOISE) & (e > SHARE * threshold), z, -np.inf)
-        score = np.maximum(score, zz)
-    lists = [list(_peaks(narrow)), list(_peaks(score))]
+    sm[~(k * (sm - np.median(sm)) > SHARE * threshold)] = -np.inf
+    narrow = list(_peaks(sm))
+    del sm
+    lists = [narrow, list(_peaks(_broad_score(f, pw, k_terms, zeta0, threshold)))]
     out: list[float] = []
     while (lists[0] or lists[1]) and len(out) < n_max:
         for lst in lists:
@@ -152,6 +150,39 @@ def residual_peaks(
                     out.append(fi)
                     break
     return ResidualPeaks(np.asarray(out[:n_max]), pw - np.median(pw))
+
+
+def _broad_score(
+    f: NDArray[np.float64],
+    pw: NDArray[np.float64],
+    k_terms: int,
+    zeta0: float,
+    threshold: float,
+) -> NDArray[np.float64]:
+    """The standardised excess over the matched windows of :func:`residual_peaks`
+    (``-inf`` where it is not significant), (n,), in blocks of :data:`PEAK_BLOCK` lines."""
+    # broad: matched windows, excess over the noise mean (no bias in wide sums)
+    mu = noise_mean(pw, k_terms)
+    # the noise variance of one line's power, robustly: var of chi2(2K)/2 scaled as mu
+    var_line = mu**2 / max(int(k_terms), 1)
+    n = pw.size
+    c = np.empty(n + 1)
+    c[0] = 0.0
+    np.cumsum(pw - mu, out=c[1:])
+    score = np.full(n, -np.inf)
+    for a in range(0, n, PEAK_BLOCK):
+        b = min(a + PEAK_BLOCK, n)
+        # np.gradient of the block with its neighbours: the same differences as of all lines
+        lo, hi = max(a - 1, 0), min(b + 1, n)
+        fb = f[a:b]
+        dfl = np.gradient(f[lo:hi])[a - lo : a - lo + b - a] if n > 1 else np.ones(1)
+        sb = score[a:b]
+        for s in SCALES:
+            half = np.maximum(np.round(s * zeta0 * fb / np.maximum(dfl, 1e-300)), MIN_HALF)
+            e, w = _window_sums(c, half.astype(np.intp), a)
+            z = e / np.sqrt(w * var_line)
+            np.maximum(sb, np.where((z > Z_NOISE) & (e > SHARE * threshold), z, -np.inf), out=sb)
+    return score
 
 
 def room(f: NDArray[np.float64], excess: NDArray[np.float64], p: complex) -> float:

@@ -125,8 +125,12 @@ def span_noise(
     output).
     """
     n_out, n_in, n_f = fitter.H.shape
-    a = np.ones(n_f)
-    b = np.ones(n_f)
+    # the per-line powers are written after a leading 0 and summed in place: their
+    # cumulative sums, with no other array of the lines
+    ca = np.ones(n_f + 1)
+    cb = np.ones(n_f + 1)
+    ca[0] = cb[0] = 0.0
+    a, b = ca[1:], cb[1:]
     if n_out > n_in:
         isd = 1.0 / np.sqrt(s2)
         lw = fitter.line_weights
@@ -139,11 +143,12 @@ def span_noise(
             # s2 is the variance of a real row: a complex entry holds 2 s2
             a[sl] = e_in / (2 * n_in**2)
             b[sl] = np.maximum(e_all - e_in, 0.0) / (2 * (n_out - n_in) * n_in)
-    zero = np.zeros(1)
+    np.cumsum(a, out=a)
+    np.cumsum(b, out=b)
     return SpanNoise(
         np.asarray(fitter.f, dtype=np.float64),
-        np.concatenate([zero, np.cumsum(a)]),
-        np.concatenate([zero, np.cumsum(b)]),
+        ca,
+        cb,
         int(n_in),
         int(n_out),
     )
