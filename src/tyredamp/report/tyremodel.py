@@ -188,6 +188,28 @@ def tyre_model_report(
         rows,
         caption="Tension and foundation stiffnesses of the updated ring at each test pressure.",
     )
+    _not_identified(rep, tm)
+    _tyre_model_rigid(rep, tm, doc)
+    res = result.radial.tyre_model.result
+    if res is not None:
+        name, text = next(iter(res.tir_files().items()))
+        rep.paragraph(
+            f"The in-plane .tir fragment at {tm['pressures_bar'][0]:g} bar ({name}; one "
+            "file per pressure in tyre_model/), with each value's uncertainty budget and "
+            "assumptions; a simulation needs it merged into a complete property file of the "
+            "tyre (tyredamp tyre-model --merge-into BASE.tir):"
+        )
+        rep.raw(f"<pre>{html.escape(text)}</pre>")
+    _warnings(rep, doc, "radial:tyre_model")
+
+
+def _model_limited(row: dict[str, Any]) -> bool:
+    """Is a ring parameter's verdict "model-limited" (a value with a model error)?"""
+    return str(row.get("verdict", "")).startswith("model-limited")
+
+
+def _not_identified(rep: Any, tm: dict[str, Any]) -> None:
+    """The ring parameters flagged model-limited, and those not identified."""
     par = {p["name"]: p for p in tm["parameters"]}
     limited = [n for n in tm["not_identifiable"] if _model_limited(par[n])]
     unknown = [n for n in tm["not_identifiable"] if n not in limited]
@@ -214,20 +236,3 @@ def tyre_model_report(
             "of its scale, no confounded combination). What a radial test cannot give at all "
             "(wind-up, lateral, footprint) is listed with the rigid ring below."
         )
-    _tyre_model_rigid(rep, tm, doc)
-    res = result.radial.tyre_model.result
-    if res is not None:
-        name, text = next(iter(res.tir_files().items()))
-        rep.paragraph(
-            f"The in-plane .tir fragment at {tm['pressures_bar'][0]:g} bar ({name}; one "
-            "file per pressure in tyre_model/), with each value's uncertainty budget and "
-            "assumptions; a simulation needs it merged into a complete property file of the "
-            "tyre (tyredamp tyre-model --merge-into BASE.tir):"
-        )
-        rep.raw(f"<pre>{html.escape(text)}</pre>")
-    _warnings(rep, doc, "radial:tyre_model")
-
-
-def _model_limited(row: dict[str, Any]) -> bool:
-    """Is a ring parameter's verdict "model-limited" (a value with a model error)?"""
-    return str(row.get("verdict", "")).startswith("model-limited")
