@@ -67,6 +67,7 @@ MODAL_TOP = {
     "starts": "pipeline",
     "mode_count": "pipeline",
     "final": "pipeline",
+    "assemble": "pipeline",
 }
 
 MAX_FUNCTION_LINES = 120

@@ -91,7 +91,8 @@ from numpy.typing import ArrayLike, NDArray
 from .._blas import blas_threads as blas_limit
 from ..exceptions import InputError
 from ..frf import FRF
-from .final import ModelContext, final_complex, fit_real, to_model
+from .assemble import ModelContext, to_model
+from .final import final_complex, fit_real
 from .fit.fit import ModalFitter
 from .mode_count import (
     _COMPRESS_FINAL,
