@@ -379,7 +379,8 @@ def _timed_names(module: ModuleType, names: Sequence[str], acc: list[float]) -> 
             setattr(module, n, fn)
 
 
-#: the pole stage as :mod:`tyredamp.modal.identify` calls it: the automatic order
+#: the pole stage as :mod:`tyredamp.modal.identify` (and its start,
+#: :mod:`tyredamp.modal.starts`) calls it: the automatic order
 #: and its diagram (:func:`~tyredamp.modal.poles.order.settle_order`: pLSCF, the flags,
 #: the clusters) and the picking of given frequencies
 POLE_STAGE = ("settle_order", "plscf", "stability_flags", "cluster_poles", "_pick_frequencies")
@@ -390,14 +391,15 @@ def run_tyredamp(case: Case, max_order: int | None = None, **options: Any) -> Ru
 
     The pole stage is the time spent in pLSCF, the stability flags, the
     clustering and the frequency picking (``POLE_STAGE``, found by wrapping
-    those functions in :mod:`tyredamp.modal.identify` for the duration of the
-    call); the rest of the call (LSFD, refinement, residual modes, standard
+    those functions in :mod:`tyredamp.modal.identify` and :mod:`tyredamp.modal.starts`
+    for the duration of the call); the rest of the call (LSFD, refinement, residual modes, standard
     errors, indicators) counts as residue fitting.
     """
     import tyredamp.modal.identify as ident
+    import tyredamp.modal.starts as starts
 
     acc = [0.0]
-    with _timed_names(ident, POLE_STAGE, acc):
+    with _timed_names(ident, POLE_STAGE, acc), _timed_names(starts, POLE_STAGE, acc):
         c0, t0 = time.process_time(), time.perf_counter()
         res = identify_modes(
             case.frf, band=case.band, model="complex", max_order=max_order, **options

@@ -56,7 +56,7 @@ STAGES = (
     ("  trial evaluations, one block (solve_one)", "_added.py", "solve_one"),
     ("  trial evaluations, blocks (solve_blocks)", "_added.py", "solve_blocks"),
     ("  trial evaluations, Q_r kept (solve_all)", "_added.py", "solve_all"),
-    ("  joint refits (_joint)", "search.py", "_joint"),
+    ("  joint refits (_joint)", "joint.py", "_joint"),
     ("final fit and drop rule (final_complex)", "final.py", "final_complex"),
     ("  maximum-likelihood stage", "final.py", "maximum_likelihood"),
     ("all fits (ModalFitter.fit)", "fit.py", "fit"),

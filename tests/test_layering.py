@@ -61,7 +61,14 @@ MODAL_FLOORS: tuple[tuple[str, ...], ...] = (
 MODAL_FLOOR = {name: i for i, names in enumerate(MODAL_FLOORS) for name in names}
 #: Modules at the top of :mod:`tyredamp.modal` and their group (the package itself,
 #: ``tyredamp.modal``, is the pipeline's: it names the public API of every group).
-MODAL_TOP = {"model": "model", "identify": "pipeline", "final": "pipeline"}
+MODAL_TOP = {
+    "model": "model",
+    "identify": "pipeline",
+    "starts": "pipeline",
+    "mode_count": "pipeline",
+    "final": "pipeline",
+    "assemble": "pipeline",
+}
 
 MAX_FUNCTION_LINES = 120
 MAX_MODULE_LINES = 800

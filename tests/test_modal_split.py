@@ -1,4 +1,4 @@
-"""A mode that stands for a close pair is split in two (issue 16, ``search._split``).
+"""A mode that stands for a close pair is split in two (issue 16, ``search.joint._split``).
 
 A residual-search trial refines one added mode with the others held, so it
 cannot move the mode that took a pair's place; the pair search replaces a
@@ -17,8 +17,9 @@ from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel
 from tyredamp.modal.fit.fit import FitResult, ModalFitter
 from tyredamp.modal.problem.problem import build_problem
+from tyredamp.modal.search.joint import _split
 from tyredamp.modal.search.residual_peaks import power_of
-from tyredamp.modal.search.search import ModeSet, ModeTest, _split
+from tyredamp.modal.search.search import ModeSet, ModeTest
 from tyredamp.modal.statistics.stats import mode_parameters, mode_threshold
 
 F_TRUE = np.array([20.0, 41.0, 41.5, 80.0])

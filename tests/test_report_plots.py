@@ -104,9 +104,10 @@ def test_every_place_is_in_the_report() -> None:
     import inspect
 
     import tyredamp.report.build as build
+    import tyredamp.report.lateral as lateral
     import tyredamp.report.tyremodel as tyremodel
 
-    source = inspect.getsource(build) + inspect.getsource(tyremodel)
+    source = inspect.getsource(build) + inspect.getsource(lateral) + inspect.getsource(tyremodel)
     for place in PLACES:
         assert f'_images(rep, images, "{place}")' in source
     assert {p.section for p in plots.PLOTS.values()} == set(PLACES)

@@ -11,8 +11,8 @@ from numpy.testing import assert_allclose
 from tyredamp.exceptions import InputError
 from tyredamp.virtual import MeasurementLayout, RingTyre, RingTyreParameters
 from tyredamp.virtual.cavity import Cavity, cavity_dispersion
+from tyredamp.virtual.dispersion import difference_symbol
 from tyredamp.virtual.microphone import microphone_row, pressure_frf
-from tyredamp.virtual.ring import difference_symbol
 
 N = 32
 BARE = MeasurementLayout(attachment_mass=0.0, attachment_damping=0.0)

@@ -13,13 +13,16 @@ is :mod:`tyredamp.documents.modes`.
 Map of the package (one group per step of the method; a group imports only
 from the groups below it; the layering test of the package enforces it):
 
-``identify.py``, ``final.py`` (top)
-    The pipeline: :func:`identify_modes` runs the steps below in order and
-    ``final`` turns the last fit into a :class:`ModalModel` with its quality
-    (maximum-likelihood stage, intervals, goodness of fit).
+``identify.py``, ``starts.py``, ``mode_count.py``, ``final.py``, ``assemble.py`` (top)
+    The pipeline: :func:`identify_modes` runs the steps below in order (the
+    modes it starts from in ``starts``, the mode count in ``mode_count``),
+    ``final`` makes the last fit (maximum-likelihood stage, likelihood
+    intervals) and ``assemble`` turns it into a :class:`ModalModel` with its
+    quality (intervals, goodness of fit).
 ``search/``
     Which modes the data hold: the mode test and the residual search on one
-    fitter (``search``), its mode set (``modeset``), out-of-band residual
+    fitter (``search``), the joint refit of a trial mode and the split of a
+    mode in two (``joint``), its mode set (``modeset``), out-of-band residual
     modes (``out_of_band``), where trials start (``search_starts``,
     ``residual_peaks``), each mode's threshold (``thresholds``,
     ``span_noise``), poles narrower than the lines (``narrow``,
@@ -32,8 +35,8 @@ from the groups below it; the layering test of the package enforces it):
     (``estimators``), stability flags and clusters (``selection``), the model
     order (``order``). ``fit/``: residues and poles fitted to the FRFs for a
     given set of modes: :class:`ModalFitter` (``fit``) with its basis,
-    linear algebra, scaling and added-mode projection (``_basis``,
-    ``_linalg``, ``_scaling``, ``_added``, ``_state``), the
+    linear algebra, scaling, added-mode projection and result (``_basis``,
+    ``_linalg``, ``_scaling``, ``_added``, ``_results``, ``_state``), the
     maximum-likelihood refinement (``ml``) and likelihood intervals
     (``profile``). A diagram never fits residues and a fit never builds a
     diagram: the two methods split here.

@@ -89,39 +89,35 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._blas import blas_threads as blas_limit
-from .._validate import as_finite
 from ..exceptions import InputError
 from ..frf import FRF
-from ..mechanics.modal_sum import pole_from_frequency_damping
-from .final import ModelContext, final_complex, fit_real, to_model
-from .fit.fit import FitResult, ModalFitter
+from .assemble import ModelContext, to_model
+from .final import final_complex, fit_real
+from .fit.fit import ModalFitter
+from .mode_count import (
+    _COMPRESS_FINAL,
+    _Fitters,
+    _mode_test,
+    _noise_per_output,
+    _select,
+    _threshold,
+)
 from .model import ModalModel
 from .poles.estimators import PoleEstimator, get_estimator
 from .poles.lscf import PoleSet, plscf
-from .poles.order import Diagram, SelectionRules, default_order, modes_shown, settle_order
+from .poles.order import SelectionRules, default_order, settle_order
 from .poles.selection import Cluster, StabilityFlags
-from .problem.compress import _compress, combine_outputs
+from .problem.compress import combine_outputs
 from .problem.model_error import with_model_error
-from .problem.problem import SET_ASIDE, FitProblem, build_problem, max_modes
-from .search.out_of_band import search_helpers
-from .search.search import (
-    FixedParts,
-    ModeSet,
-    ModeTest,
-    reject_by_test,
-    rejected,
-    residual_search,
-)
+from .problem.problem import SET_ASIDE, FitProblem, build_problem
+from .search.search import ModeSet
+from .starts import _check_counts, _start_modes
 from .statistics.quality import RejectedMode, merge_rejected
-from .statistics.stats import FALSE_ALARM, mode_parameters, mode_threshold
+from .statistics.stats import FALSE_ALARM
 
 __all__ = ["ModalIdentification", "ModelChoice", "identify_modes"]
 
 ModelChoice = Literal["real", "complex", "both"]
-#: output compression (fit.compress_outputs) of the search when n_out > 1.5 rank,
-#: and of the final refinement when n_out > 4 rank (module docstring of identify)
-_COMPRESS_SEARCH = 1.5
-_COMPRESS_FINAL = 4.0
 _METHOD = (
     "pole estimator {est}, automatic selection, mode count by a likelihood-ratio test, "
     "residual search, maximum-likelihood refinement (variable projection)"
@@ -377,251 +373,8 @@ def _identify(
     )
 
 
-def _threshold(problem: FitProblem, kind: str, false_alarm: float) -> float:
-    """Threshold of the mode test for ``kind`` modes on ``problem`` (:func:`mode_threshold`)."""
-    n_out, n_in, n_f = problem.shape
-    k = mode_parameters(n_out, n_in, kind)
-    # the rank-one law of a residue (complex or real, :func:`rank_one_sf`)
-    return mode_threshold(k, n_f, false_alarm, problem.weight_dof, (n_out, n_in), kind)
-
-
-def _mode_test(problem: FitProblem, false_alarm: float) -> ModeTest:
-    """What each complex mode's own threshold needs
-    (:class:`~tyredamp.modal.search.thresholds.ModeTest`)."""
-    n_out, n_in, n_f = problem.shape
-    return ModeTest(mode_parameters(n_out, n_in, "complex"), n_f, false_alarm)
-
-
-def _start_modes(
-    problem: FitProblem,
-    dg: Diagram,
-    fr: NDArray[np.float64] | None,
-    n_modes: int | None,
-    min_fraction: float,
-    warnings: list[str],
-) -> tuple[ModeSet, list[RejectedMode]]:
-    """The modes to start from (chosen clusters, then others as residual modes)."""
-    rej = [
-        rejected(c.pole, f"present in {c.fraction:.0%} of orders < {min_fraction:.0%}")
-        for c in dg.weak
-    ]
-    n_shown = modes_shown(problem) if fr is None and n_modes is None and not dg.kept else None
-    cand, extra, rej = _candidates(dg, fr, n_modes, rej, warnings, n_shown)
-    if not cand:
-        lo, hi = problem.band
-        raise InputError(
-            f"no stable mode found in [{lo:g}, {hi:g}] Hz up to order {dg.order}; raise "
-            "--max-order, widen the band or give --frequencies"
-        )
-    n_in = problem.shape[1]
-    modes = ModeSet(
-        np.array([c.pole for c in cand]),
-        np.array([c.participation for c in cand]).reshape(len(cand), n_in),
-        np.array([c.pole for c in extra], dtype=complex),
-        np.array([c.participation for c in extra], dtype=complex).reshape(len(extra), n_in),
-        n_free=len(extra),
-    )
-    return modes, rej
-
-
 def _asked(fr: NDArray[np.float64] | None) -> str:
     return "asked for (near a given frequency)" if fr is not None else "asked for (mode count)"
-
-
-def _check_counts(
-    problem: FitProblem, n_modes: int | None, frequencies: ArrayLike | None
-) -> NDArray[np.float64] | None:
-    """Validate ``n_modes`` (bounded by the data) and ``frequencies`` (inside the band)."""
-    n_out, n_in, n_f = problem.shape
-    lo, hi = problem.band
-    cap = max_modes(n_out, n_in, n_f)
-    if n_modes is not None:
-        if isinstance(n_modes, bool) or int(n_modes) != n_modes or n_modes < 1:
-            raise InputError(f"n_modes: expected a positive integer, got {n_modes!r}")
-        if n_modes > cap:
-            raise InputError(
-                f"n_modes: {n_modes} modes cannot be identified from {n_f} lines x {n_out} "
-                f"output(s) x {n_in} input(s) in [{lo:g}, {hi:g}] Hz; at most {cap}"
-            )
-    if frequencies is None:
-        return None
-    fr = np.sort(as_finite(frequencies, "frequencies", ndim=1))
-    if np.any((fr < lo) | (fr > hi)):
-        raise InputError(f"frequencies: expected values inside the band [{lo:g}, {hi:g}] Hz")
-    if fr.size > cap:
-        raise InputError(
-            f"frequencies: {fr.size} modes cannot be identified from the band's data; at most {cap}"
-        )
-    return fr
-
-
-def _candidates(
-    dg: Diagram,
-    fr: NDArray[np.float64] | None,
-    n_modes: int | None,
-    rej: list[RejectedMode],
-    warnings: list[str],
-    n_shown: int | None = None,
-) -> tuple[list[Cluster], list[Cluster], list[RejectedMode]]:
-    """Modes to fit and other persistent modes to fit as in-band residual modes;
-    ``n_shown``: the peaks the data show (:func:`~.poles.order.modes_shown`), for the
-    start of an automatic count whose diagram kept no cluster."""
-    if fr is not None:
-        cand = _pick_frequencies(fr, dg.kept + dg.weak, dg.poles, dg.flags)
-    else:
-        n_pick = n_modes
-        if n_pick is None:
-            if dg.kept or not dg.weak or n_shown is None:
-                return list(dg.kept), [], rej
-            # no cluster persists (few orders of many inputs, noisy data): the most
-            # persistent ones, as many as the peaks the data show (at least one),
-            # start the fit; the mode test decides on them and the residual search,
-            # from the other clusters and the residual, on the rest
-            n_pick = max(1, n_shown)
-        pool = sorted(dg.kept + dg.weak, key=lambda c: -c.fraction)
-        if n_modes is not None and len(pool) < n_modes:
-            warnings.append(f"n_modes: asked for {n_modes}, only {len(pool)} stable clusters")
-        cand = sorted(pool[: int(n_pick)], key=lambda c: c.frequency_hz)
-        chosen = {id(c) for c in cand}
-        rej = [r for r, c in zip(rej, dg.weak, strict=True) if id(c) not in chosen]
-    # modes the user did not ask for still shape the FRFs: keep the persistent
-    # clusters that are not chosen (and not within 1 % of a chosen one) as
-    # residual modes, so that the refinement does not pull the chosen poles
-    extra = [c for c in dg.kept if all(abs(c.pole - d.pole) > 0.01 * abs(d.pole) for d in cand)]
-    return cand, extra, rej
-
-
-@dataclass(frozen=True)
-class _Fitters:
-    """The fitters of one identification (stateless; built once per problem).
-
-    ``cfit`` fits every output; ``sfit`` is the search's (``cfit`` or one on
-    principal output combinations when there are many outputs, with their
-    ``patterns``); ``rank`` the compression rank.
-    """
-
-    cfit: ModalFitter
-    sfit: ModalFitter
-    patterns: NDArray[np.float64] | None
-    rank: int
-
-    @classmethod
-    def build(
-        cls, problem: FitProblem, residuals: bool, modes: ModeSet, max_helpers: int
-    ) -> _Fitters:
-        n_out, n_in, _ = problem.shape
-        f, H, pw, lw = problem.frequency, problem.H, problem.power, problem.line_weights
-        cfit = ModalFitter(
-            f, H, pw, "complex", problem.drive, upper=residuals, lower=residuals, line_weights=lw
-        )
-        # the searches refit many times: with more outputs than 1.5 times ``rank``
-        # they run on principal output combinations; so does the final refinement
-        # with more than 4 times ``rank``, whose residues, standard errors and
-        # model then use every output
-        rank = 2 * (modes.m + modes.hp.size + max_helpers + 2 * n_in) + 16
-        if n_out <= _COMPRESS_SEARCH * rank:
-            return cls(cfit, cfit, None, rank)
-        h_comb, patterns = _compress(H, rank)
-        sfit = ModalFitter(
-            f,
-            h_comb,
-            pw,
-            "complex",
-            [],
-            upper=residuals,
-            lower=residuals,
-            unit_weights=True,
-            line_weights=lw,
-        )
-        return cls(cfit, sfit, patterns, rank)
-
-
-def _select(
-    fitters: _Fitters,
-    modes: ModeSet,
-    dg: Diagram,
-    rej: list[RejectedMode],
-    thresholds: tuple[float, ModeTest],
-    auto: bool,
-    refine: bool,
-    max_helpers: int,
-    min_contribution: float,
-    search: bool,
-    problem_band: tuple[float, float],
-) -> tuple[FitResult | None, ModeSet, list[RejectedMode]]:
-    """Step 3: refine, add out-of-band residual modes, decide the mode count.
-
-    ``thresholds``: the mode test's threshold and what each in-band mode's own
-    threshold needs (raised where the noise lies along the response,
-    :func:`~tyredamp.modal.search.thresholds.local_thresholds`)."""
-    thr, test = thresholds
-    sfit = fitters.sfit
-    band = (float(sfit.f[0]), float(sfit.f[-1]))
-    out: list[RejectedMode] = []
-    last: FitResult | None = None
-    fixed = FixedParts(sfit)  # the trials' fixed parts, shared by the stages
-    if refine and max_helpers > 0:
-        last, modes, dropped = search_helpers(
-            sfit, modes, problem_band, band, max_helpers, thr, fixed
-        )
-        out += dropped
-    if not auto:
-        return last, modes, out
-    last, modes, dropped = reject_by_test(
-        sfit,
-        modes,
-        problem_band,
-        thr,
-        refine,
-        min_contribution,
-        test=test,
-        start=last,
-        max_damping=dg.max_damping,
-    )
-    out += dropped
-    if search and refine:
-        cands = [(c.pole, c.participation) for c in dg.weak] + [
-            (_pole_of(r), np.ones(sfit.n_in, complex)) for r in rej + out
-        ]
-        last, modes, tried = residual_search(
-            sfit,
-            last,
-            modes,
-            cands,
-            problem_band,
-            thr,
-            dg.max_damping,
-            test=test,
-            fixed=fixed,
-            max_helpers=max_helpers,
-        )
-        out += tried
-    return last, modes, out
-
-
-def _pole_of(r: RejectedMode) -> complex:
-    """The start pole of a rejected candidate (damping ratio clipped to [1e-4, 0.5])."""
-    z = min(max(r.damping_ratio, 1e-4), 0.5)
-    return complex(pole_from_frequency_damping(r.frequency_hz, z))
-
-
-def _noise_per_output(
-    problem: FitProblem,
-    fitters: _Fitters,
-    modes: ModeSet,
-    last: FitResult | None,
-    refine: bool,
-) -> NDArray[np.float64] | None:
-    """Noise RMS per output for the final fit's weights: known, or from the residual
-    of the latest search fit when it ran on every output, else from a linear fit."""
-    if problem.sigma_out is not None:
-        return np.asarray(problem.sigma_out)
-    if not refine:
-        return None
-    if last is not None and fitters.sfit is fitters.cfit:
-        return last.sigma_out
-    p0, l0 = modes.all()
-    return fitters.cfit.fit(p0, l0, refine=False, uncertainty=False).sigma_out
 
 
 def _final_models(
@@ -709,38 +462,3 @@ def _combined(
         unit_weights=True,
         line_weights=problem.line_weights,
     )
-
-
-def _pick_frequencies(
-    fr: NDArray[np.float64], clusters: list[Cluster], ps: PoleSet, flags: StabilityFlags
-) -> list[Cluster]:
-    """The cluster (or, failing that, the admissible pole) nearest to each frequency."""
-    out: list[Cluster] = []
-    used: set[int] = set()
-    adm = np.flatnonzero(flags.admissible)
-    for fi in fr:
-        best = None
-        if clusters:
-            d = np.array([abs(c.frequency_hz - fi) / fi for c in clusters])
-            for i in np.argsort(d):
-                if d[i] <= 0.05 and int(i) not in used:
-                    best = clusters[int(i)]
-                    used.add(int(i))
-                    break
-        if best is None:
-            if adm.size == 0:
-                raise InputError(f"frequencies: no admissible pole near {fi:g} Hz")
-            top = ps.order[adm].max()
-            cand = adm[ps.order[adm] >= top - 2]
-            j = cand[np.argmin(np.abs(ps.frequency_hz[cand] - fi))]
-            if abs(ps.frequency_hz[j] - fi) > 0.1 * fi:
-                raise InputError(f"frequencies: no admissible pole within 10 % of {fi:g} Hz")
-            best = Cluster(
-                pole=complex(ps.poles[j]),
-                participation=ps.participation[j],
-                members=np.array([j]),
-                fraction=0.0,
-                spread_frequency=0.0,
-            )
-        out.append(best)
-    return out

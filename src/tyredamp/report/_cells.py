@@ -29,6 +29,12 @@ def _num(v: Any, spec: str = ".4g") -> str:
     return format(v, spec)
 
 
+def _pct(v: Any, digits: str = ".3g") -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    return f"{100 * v:{digits}} %"
+
+
 class ReportImage(NamedTuple):
     """A rendered plot of the demo report: PNG bytes, caption and place
     (a key of :data:`tyredamp.report.plots.PLACES`; empty: shown nowhere)."""

@@ -42,19 +42,17 @@ from __future__ import annotations
 from .assembly import Splice
 from .cavity import Cavity
 from .contact import ContactPatch
+from .dispersion import (
+    analytic_ring_frequencies,
+    difference_symbol,
+    ring_dispersion,
+    staggered_weights,
+)
 from .excitation import hadamard_drive_matrix, schroeder_multisine
 from .lateral_rig import KMH, AgriculturalTyre, VirtualLateralRig, ViscoelasticStringTyre
 from .modal_rig import VirtualModalTest, periodic_initial_state, run_modal_test
 from .parameters import Imperfection, MeasurementLayout, RingTyreParameters
-from .ring import (
-    RingConvergence,
-    RingTyre,
-    analytic_ring_frequencies,
-    difference_symbol,
-    ring_convergence,
-    ring_dispersion,
-    staggered_weights,
-)
+from .ring import RingConvergence, RingTyre, ring_convergence
 from .rolling_rig import ContactLoad, PointContact, RollingTest, rolling_response, rolling_test
 from .rolling_truth import RollingTruth
 from .rotation import (

@@ -69,8 +69,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..exceptions import InputError
 from ..mechanics.gyroscopic import GyroscopicSystem
+from .dispersion import difference_symbol
 from .parameters import MeasurementLayout, RingTyreParameters
-from .ring import RingTyre, _operators, difference_symbol
+from .ring import RingTyre, _operators
 
 __all__ = [
     "KMH_PER_MS",
@@ -266,7 +267,7 @@ def inextensible_rotating_frequencies(
     ndarray, shape (k, 2)
         Columns forward, backward, in Hz (rotating frame).
     """
-    from .ring import analytic_ring_frequencies
+    from .dispersion import analytic_ring_frequencies
 
     nn = _wave_numbers(n, None)
     omega = spin_rate(speed_kmh, params.radius)

@@ -1,7 +1,8 @@
 """What the helpers of :class:`~tyredamp.modal.fit.fit.ModalFitter` read of it.
 
-The basis (:mod:`._basis`), the scaling (:mod:`._scaling`) and the projection
-of an added mode (:mod:`._added`) are functions of a fitter that
+The basis (:mod:`._basis`), the scaling (:mod:`._scaling`), the projection
+of an added mode (:mod:`._added`) and the result at the optimum
+(:mod:`._results`) are functions of a fitter that
 :mod:`.fit` itself imports, so they cannot import the class; they take a
 :class:`FitterState`, the protocol that names exactly the attributes and
 methods they use. :class:`~tyredamp.modal.fit.fit.ModalFitter` satisfies it
@@ -77,6 +78,14 @@ class FitterState(Protocol):
         """Reference angular frequency of the pole parameters, rad/s."""
 
     @property
+    def data_ss(self) -> float:
+        """Sum of squares of all unweighted data rows."""
+
+    @property
+    def noise_floor(self) -> NDArray[np.float64]:
+        """Noise floor (n_out,) of the mode statistics, units of the data."""
+
+    @property
     def _w1(self) -> NDArray[np.float64]:
         """Weights (n_out,) of a first pass: 1 / RMS per output."""
 
@@ -102,6 +111,11 @@ class FitterState(Protocol):
         given: tuple[Any, Any] | None = None,
     ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
         """Basis and derivative columns of the lines (:func:`._basis.basis_ek`)."""
+
+    def _normal(
+        self, sol: dict[str, Any], n_par: int
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Kaufman ``J^T J`` and ``J^T r`` of the projected residual."""
 
     def _ydata(self, lines: slice | None = None) -> NDArray[np.float64]:
         """Weighted data rows of the lines (:func:`._basis.ydata`)."""

@@ -79,7 +79,7 @@ frequencies, damping ratios and mode-shape entries by the delta method.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
@@ -87,8 +87,9 @@ from numpy.typing import NDArray
 
 from ...exceptions import InputError
 from ..problem.compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
-from . import _added, _basis, _scaling
-from ._linalg import _extra_ss, _levenberg_marquardt, _vp_solve, at_rest
+from . import _added, _basis, _results, _scaling
+from ._linalg import _levenberg_marquardt, _vp_solve, at_rest
+from ._results import FitResult
 
 __all__ = ["FitResult", "ModalFitter", "combine_outputs", "compress_outputs"]
 
@@ -99,48 +100,6 @@ ModelKind = Literal["complex", "real"]
 #: double-precision FRFs and the fit's arithmetic carry 1e-13..1e-11); without
 #: it, noise-free data would make structure at the level of rounding "significant"
 NOISE_FLOOR = 1e-10
-
-
-@dataclass
-class FitResult:
-    """Outcome of one fit (internal layout; :mod:`identify` turns it into a ModalModel).
-
-    All shapes refer to ``m`` modes, ``n_out`` outputs and ``n_in`` inputs.
-    """
-
-    poles: NDArray[np.complex128]
-    psi_out: NDArray[np.complex128]
-    psi_in: NDArray[np.complex128]
-    upper: NDArray[np.float64] | None
-    lower: NDArray[np.float64] | None
-    std_frequency_hz: NDArray[np.float64]
-    std_damping_ratio: NDArray[np.float64]
-    std_psi_out: NDArray[np.float64]
-    std_pole: NDArray[np.complex128]
-    model: NDArray[np.complex128]  # fitted FRFs in the data's kind (empty for intermediate fits)
-    sigma_out: NDArray[np.float64]
-    cost: float
-    n_iter: int
-    status: str
-    warnings: list[str] = field(default_factory=list)
-    contribution: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-    #: extra-sum-of-squares statistic of each mode (:func:`_extra_ss` / s^2)
-    significance: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-    #: number of (weighted) real observations and of fitted parameters
-    n_obs: int = 0
-    n_par: int = 0
-    theta: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
-    participation: NDArray[np.complex128] = field(default_factory=lambda: np.zeros((0, 0), complex))
-    drive_phi2: NDArray[np.complex128] = field(default_factory=lambda: np.zeros(0, complex))
-    #: not filled any more (the fits keep no per-line array); kept for compatibility
-    projection: tuple[Any, ...] | None = None
-    #: ``(weights, tol)`` of an intermediate one-pass refinement that stopped at
-    #: rest here: the same refinement started at this result stops at once
-    #: (``ModalFitter.fit(..., start=this)``); None when not known to be at rest
-    rest: tuple[NDArray[np.float64], float] | None = None
-    #: 95 % intervals of the in-band modes' f and zeta (fit order;
-    #: :class:`~tyredamp.modal.fit.profile.Intervals`), set by the final stage
-    intervals: Any = None
 
 
 def pole_bounds(m: int, n_par: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -671,130 +630,6 @@ class ModalFitter:
     _scale = _scaling.scale
     _scale_jacobian = _scaling.scale_jacobian
     _shape_std = _scaling.shape_std
-
-    def _pole_std(
-        self,
-        th: NDArray[np.float64],
-        m: int,
-        ref: NDArray[np.intp],
-        w: NDArray[np.float64],
-        sol: dict[str, Any],
-        s2: float,
-        shapes: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.intp]],
-        uncertainty: bool,
-    ) -> tuple[
-        NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64]
-    ]:
-        """Standard errors of f, zeta, the pole and the shapes (NaN without ``uncertainty``):
-        Gauss-Newton covariance ``s^2 (J^T J)^-1`` at the optimum and the delta method."""
-        b, u, didx = shapes
-        n_par = th.size
-        nan = np.full(m, np.nan)
-        std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
-        std_psi = np.full((self.n_out, m), np.nan)
-        if uncertainty:
-            jtj = sol["jtj"] if "jtj" in sol else self._normal(sol, n_par)[0]
-            cth = s2 * np.linalg.pinv(jtj, hermitian=True)
-            std_f, std_z, std_pole = _scaling.pole_std(self.w_ref, th, m, cth)
-            std_psi = self._shape_std(th, m, ref, w, sol, cth, s2, b, u, didx)
-        return std_f, std_z, std_pole, std_psi
-
-    def _result(
-        self,
-        th: NDArray[np.float64],
-        m: int,
-        ref: NDArray[np.intp],
-        w: NDArray[np.float64],
-        sol: dict[str, Any],
-        sig_out: NDArray[np.float64],
-        nit: int,
-        status: str,
-        warn: list[str],
-        uncertainty: bool = True,
-    ) -> FitResult:
-        n_par = th.size
-        C = sol["C"]
-        q = C.shape[0]
-        Cu = C / w[None, :]
-        poles, _ = self.unpack(th, m, ref)
-        didx = np.array([j for j, _ in self.drive], dtype=np.intp)
-        wd = w[didx]
-        b, psi_in, a2r = self._scale(th, m, ref, C[:, didx].T, wd)
-        u = (
-            Cu[0 : 2 * m : 2].T + 1j * Cu[1 : 2 * m : 2].T
-            if self.kind == "complex"
-            else Cu[:m].T + 0j
-        )
-        psi_out = u * b[None, :]
-        off = (2 if self.kind == "complex" else 1) * m
-        upper = lower = None
-        if self.use_upper:
-            upper = Cu[off : off + self.n_in].T.copy()
-            off += self.n_in
-        if self.use_lower:
-            lower = Cu[off : off + self.n_in].T.copy()
-        if didx.size == 0:
-            warn.append("no drive point (output at an input): shapes are not mass-normalised")
-            phi2 = np.full(m, np.nan + 0j)
-        else:
-            kin = np.array([k for _, k in self.drive], dtype=np.intp)
-            # 2 i Omega_n R_kkn at the drive points (= phi_kn^2 for a real mode, eq. [3])
-            phi2 = np.mean(2j * poles.imag[None, :] * psi_out[didx] * psi_in[kin], axis=0)
-        for n in range(m):
-            f_n = abs(poles[n]) / (2 * np.pi)
-            if didx.size and self.kind == "real" and a2r[n] <= 0:
-                warn.append(
-                    f"mode at {f_n:.2f} Hz: drive-point residue gives phi^2 = 2 i Omega R_kk "
-                    "<= 0 (not real positive); shape scaled with |phi^2|"
-                )
-            if didx.size and self.kind == "complex" and phi2[n].real <= 0:
-                warn.append(
-                    f"mode at {f_n:.2f} Hz: drive-point residue has Re(2 i Omega R_kk) <= 0 "
-                    "(negative modal mass); check the drive point and the mode"
-                )
-        # ---- uncertainty (Gauss-Newton at the optimum + delta method)
-        n_obs = self.n_rows * self.n_out
-        dof = max(n_obs - q * self.n_out - n_par, 1)
-        s2 = sol["cost"] / dof
-        std_f, std_z, std_pole, std_psi = self._pole_std(
-            th, m, ref, w, sol, s2, (b, u, didx), uncertainty
-        )
-        # ---- model (final fits only), contributions
-        model = np.zeros((0, self.n_in, self.n_f), complex)
-        if uncertainty:
-            model = _basis.synth(self, th, m, ref, Cu)
-        per = 2 if self.kind == "complex" else 1
-        data_ss = self.data_ss
-        # ||Phi_n C_n||^2 per output from the (per x per) Gram block of each mode's
-        # columns, a diagonal block of Phi^T Phi = R^T R: no (n_rows x n_out) array
-        rb = sol["R"][:, : per * m].reshape(-1, m, per)
-        gram = np.matmul(rb.transpose(1, 2, 0), rb.transpose(1, 0, 2))  # (m, per, per)
-        cb = C[: per * m].reshape(m, per, self.n_out)
-        ss = np.sum(cb * np.matmul(gram, cb), axis=1)  # (m, n_out)
-        contrib = np.sqrt(np.sum(ss / w[None, :] ** 2, axis=1) / max(data_ss, 1e-300))
-        s2_floor = float(np.mean((w * self.noise_floor) ** 2))
-        signif = _extra_ss(sol["R"], C, per, m) / max(s2, s2_floor, 1e-300)
-        return FitResult(
-            poles=poles,
-            psi_out=psi_out,
-            psi_in=psi_in,
-            upper=upper,
-            lower=lower,
-            std_frequency_hz=std_f,
-            std_damping_ratio=std_z,
-            std_psi_out=std_psi,
-            std_pole=std_pole,
-            model=model,
-            sigma_out=sig_out,
-            cost=float(sol["cost"]),
-            n_iter=nit,
-            status=status,
-            warnings=warn,
-            contribution=contrib,
-            significance=signif,
-            n_obs=n_obs,
-            n_par=q * self.n_out + n_par,
-            theta=th,
-            participation=self.unpack(th, m, ref)[1],
-            drive_phi2=phi2,
-        )
+    # the standard errors and the result at the optimum (functions of the fitter, in _results)
+    _pole_std = _results.pole_and_shape_std
+    _result = _results.assemble

@@ -16,12 +16,12 @@ from ...mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
 from ..fit._basis import factors, residual_blocks
 from ..fit.fit import FitResult, ModalFitter
 from ..statistics.quality import RejectedMode
+from .joint import SEARCH_TOL
 from .modeset import outside_side, with_residual
 from .residual_peaks import model_of, rank_one_statistic
 from .search import (
     FIRST_NFEV,
     MIN_LOW_LINES,
-    SEARCH_TOL,
     FixedParts,
     ModeSet,
     _trial,

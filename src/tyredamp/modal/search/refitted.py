@@ -37,7 +37,8 @@ from numpy.typing import NDArray
 from ...exceptions import ConvergenceError
 from ..fit._linalg import _gn_point
 from ..fit.fit import FitResult, ModalFitter
-from .search import JOINT_NFEV, SEARCH_TOL, ModeSet
+from .joint import JOINT_NFEV, SEARCH_TOL
+from .search import ModeSet
 
 __all__ = ["OVERLAP", "REFIT_NFEV", "overlapping", "refit_candidates", "refitted_statistics"]
 

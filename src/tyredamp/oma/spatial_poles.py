@@ -1,0 +1,181 @@
+"""The wave-number route of rolling OMA: each wave number's channel identified apart.
+
+With fixed sensors equally spaced around the circumference, the spatial DFT
+splits their records into one channel per wave number ``n`` and direction of
+travel in space (:mod:`.spatial`); :func:`spatial_poles` identifies each channel
+on its own (:func:`~tyredamp.oma.identify.oma`) and records, for each pole, the
+power of its channel and of the opposite direction over the median of all
+channels and how far the channel's spectrum rises at the pole;
+:func:`select_spatial_poles` keeps the poles that sensor noise alone would pass
+with probability at most ``ALPHA`` per test. The kept poles become waves of the
+rolling tyre in :func:`~tyredamp.oma.rolling.rolling_modes`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .identify import oma
+from .spatial import (
+    peak_contrast,
+    power_threshold,
+    spatial_spectra,
+    travelling_channels,
+    welch_dof,
+)
+
+__all__ = ["ALPHA", "SpatialPole", "select_spatial_poles", "spatial_poles"]
+
+
+ALPHA = 1e-3
+"""Probability that sensor noise alone passes each test of :func:`select_spatial_poles`."""
+
+
+@dataclass(frozen=True)
+class SpatialPole:
+    """One pole of one wave-number channel, before the selection.
+
+    Attributes
+    ----------
+    wave_number : int
+    direction : str
+        As a fixed observer sees it: ``"backward"``, ``"forward"`` or ``"standing"``.
+    frequency_hz, damping_ratio, std_frequency_hz, std_damping_ratio : float
+        As identified from the channel's 2-channel record (Hz; NaN without errors).
+    ratio, other : float
+        Power of this channel and of the opposite direction at the pole's
+        frequency over the median of all channels there.
+    contrast : float
+        How far the channel's spectrum rises at the pole above its flanks
+        (:func:`~tyredamp.oma.spatial.peak_contrast`).
+    orders : int
+        Model orders the pole persisted over in its channel's stabilisation.
+    """
+
+    wave_number: int
+    direction: str
+    frequency_hz: float
+    damping_ratio: float
+    std_frequency_hz: float
+    std_damping_ratio: float
+    ratio: float
+    other: float
+    contrast: float
+    orders: int
+
+
+def spatial_poles(
+    y: Any, fs: float, angles: list[float], kw: dict[str, Any]
+) -> tuple[list[SpatialPole], float, float]:
+    """Every pole of each wave-number channel ``n = 0 .. (K - 1) // 2``, the
+    backward and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`).
+
+    Parameters
+    ----------
+    y : array_like, shape (K, n_samples)
+        The fixed sensors, equally spaced.
+    fs : float
+        Hz.
+    angles : list of float
+        Their angles, deg.
+    kw : dict
+        Options of :func:`~tyredamp.oma.identify.oma`.
+
+    Returns
+    -------
+    poles : list of SpatialPole
+    resolution : float
+        Hz, the bin of the channel spectra.
+    dof : float
+        Degrees of freedom of each bin of those spectra (:func:`.spatial.welch_dof`).
+    """
+    out: list[SpatialPole] = []
+    K = len(angles)
+    nperseg = 1024
+    fs_, S = spatial_spectra(y, fs, angles, nperseg)
+    floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
+    for n in range(0, (K - 1) // 2 + 1):
+        if n == 0:
+            parts = [("standing", oma(travelling_channels(y, angles, 0)[0], fs, **kw))]
+        else:
+            bwd, fwd = travelling_channels(y, angles, n)
+            parts = [("backward", oma(bwd, fs, **kw)), ("forward", oma(fwd, fs, **kw))]
+        for d, r in parts:
+            c = int(d == "forward")
+            for j in range(r.n_modes):
+                f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
+                k = int(np.argmin(np.abs(fs_ - f)))
+                ratio = float(S[c, n, k] / floor[k])
+                other = float(S[1 - c, n, k] / floor[k]) if n > 0 else ratio
+                out.append(SpatialPole(n, d, f, z, float(r.std_frequency_hz[j]),
+                                       float(r.std_damping_ratio[j]), ratio, other,
+                                       peak_contrast(S[c, n], fs_, f, z),
+                                       int(r.n_orders[j])))  # fmt: skip
+    return out, float(fs_[1] - fs_[0]), welch_dof(np.shape(y)[-1], nperseg)
+
+
+def select_spatial_poles(
+    poles: list[SpatialPole],
+    band: tuple[float, float],
+    resolution: float,
+    dof: float,
+    floor_ratio: float | None = None,
+    alpha: float = ALPHA,
+) -> list[SpatialPole]:
+    """The poles of :func:`spatial_poles` taken for waves.
+
+    With ``q`` the ratio two PSD estimates of one level exceed with
+    probability ``alpha`` (:func:`.spatial.power_threshold`), a pole is kept
+    when (i) its channel holds ``q`` times (or ``floor_ratio`` times, when
+    given) the median power of all channels at its frequency: sensor noise
+    spreads evenly over the wave numbers, so the median is the noise level;
+    (ii) the channel's spectrum rises at the pole ``q`` times above its flanks
+    at ``f -+ max(2 zeta f, 3 bins)`` (:func:`.spatial.peak_contrast`; a
+    resonance gives about 5, the skirt of a stronger one less than 1); (iii)
+    those flanks lie inside ``band``: a peak the band cuts may be the band's
+    edge (the filter's transition), not a mode; and (iv) no pole of the same
+    channel that persisted over more model orders (on a tie: with more power)
+    lies within the sum
+    of their half-power half-bandwidths ``zeta_1 f_1 + zeta_2 f_2`` (one
+    channel holds one wave per resonance: two poles closer than that are one
+    resonance the fit split, and the one stable over more orders is the
+    better fit; the half-power points of a mode lie at ``f (1 -+ zeta)``,
+    Ewins, Modal Testing, 2nd ed. 2000, sec. 2.2).
+
+    Parameters
+    ----------
+    poles : list of SpatialPole
+    band : (float, float)
+        Hz, the band of the identification.
+    resolution : float
+        Hz, the bin of the spectra.
+    dof : float
+        Degrees of freedom of each bin.
+    floor_ratio : float, optional
+        A fixed threshold for (i) instead of ``q`` (the benchmark compares values).
+    alpha : float
+        False-pass probability of each test for noise alone.
+
+    Returns
+    -------
+    list of SpatialPole
+        Most stable first.
+    """
+    lo, hi = band
+    q = power_threshold(dof, alpha)
+    floor = q if floor_ratio is None else float(floor_ratio)
+    keep: list[SpatialPole] = []
+    for p in sorted(poles, key=lambda x: (-x.orders, -x.ratio)):
+        f, z = p.frequency_hz, p.damping_ratio
+        off = max(2 * abs(z) * f, 3 * resolution)
+        if p.ratio < floor or p.contrast < q or f + off > hi or (lo > 0 and f - off < lo):
+            continue
+        if any(x.wave_number == p.wave_number and x.direction == p.direction
+               and abs(x.frequency_hz - f) <= x.damping_ratio * x.frequency_hz + z * f
+               for x in keep):  # fmt: skip
+            continue
+        keep.append(p)
+    return keep
