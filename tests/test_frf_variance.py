@@ -13,7 +13,7 @@ from tyredamp import InputError, ShapeError
 from tyredamp.frf import FRF
 from tyredamp.io import read_frf, write_frf
 from tyredamp.signal import estimate_frf
-from tyredamp.signal.cyclic_variance import smoothing_lines
+from tyredamp.signal.cyclic_variance import _line_average, cyclic_frf_variance, smoothing_lines
 from tyredamp.timedata import TimeData
 
 B, A = [0.5, 0.3, -0.2, 0.1], [1.0, -0.5, 0.3]  # a digital test system
@@ -191,3 +191,44 @@ def test_smoothing_lines_is_the_fewest_odd_count_for_the_target() -> None:
     assert got == [11, 5, 5, 3, 1, 1]
     assert smoothing_lines(2, 8) == 7  # capped by the lines there are, kept odd
     assert smoothing_lines(2, 1) == 1
+
+
+def test_cyclic_variance_matches_the_sample_covariance_of_the_periods() -> None:
+    """The spectra-based algebra equals the first-order variance from np.cov of the periods.
+
+    ``var(H) = [-H 1] C [-H 1]^H / (n |Xbar|^2)`` with ``C`` the sample
+    covariance (``n - 1``) of ``[X_k, Y_k]``, computed here directly; 12
+    periods give ``L = 1`` (no line averaging). Same arithmetic in another
+    order: rtol 1e-10.
+    """
+    rng = np.random.default_rng(3)
+    n, n_f, c = 12, 5, 0.37
+    xk = 2.0 + 0.1 * (rng.normal(size=(n, n_f)) + 1j * rng.normal(size=(n, n_f)))
+    yk = (1 - 2j) * xk + 0.2 * (rng.normal(size=(n, n_f)) + 1j * rng.normal(size=(n, n_f)))
+    h = (np.mean(yk * xk.conj(), axis=0) / np.mean(np.abs(xk) ** 2, axis=0))[None, None, :]
+    got = cyclic_frf_variance(
+        c * np.mean(np.abs(xk) ** 2, axis=0),
+        c * np.mean(yk * xk.conj(), axis=0)[:, None],
+        c * np.mean(np.abs(yk) ** 2, axis=0)[:, None],
+        (xk.mean(axis=0), yk.mean(axis=0)[:, None]),
+        np.full(n_f, c),
+        h,
+        n,
+    )
+    assert got is not None
+    var, dof = got
+    assert dof == 2.0 * (n - 1)
+    want = np.empty(n_f)
+    for f in range(n_f):
+        cov = np.cov(np.vstack([xk[:, f], yk[:, f]]))  # rows: variables; n - 1
+        v = np.array([-h[0, 0, f], 1.0])
+        want[f] = np.real(v.conj() @ cov.T @ v) / (n * abs(xk[:, f].mean()) ** 2)
+    assert_allclose(var[0, 0], want, rtol=1e-10)
+
+
+def test_line_average_is_a_moving_mean_shifted_inside_the_axis() -> None:
+    a = np.arange(10.0) ** 2
+    got = _line_average(a, 3)
+    assert_allclose(got[1:-1], np.convolve(a, np.ones(3) / 3, mode="valid"), rtol=1e-14)
+    assert got[0] == pytest.approx(np.mean(a[:3]), rel=1e-14)  # shifted, not shortened
+    assert got[-1] == pytest.approx(np.mean(a[-3:]), rel=1e-14)
