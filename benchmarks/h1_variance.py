@@ -15,6 +15,14 @@ distributed: median ``d (2^(2/d) - 1) / 2``, mean ``d / (d - 2)``.
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/h1_variance.py [N_SEEDS]``
 (default 3 seeds; 2, 4, 8 and 16 periods).
+
+``... h1_variance.py --process``: the limitation of the line averaging. A
+lightly damped digital resonance (pole radius 0.995 at 20/256 cycles per
+sample) driven by a periodic multisine plus force fluctuations that excite it
+(5 % of the force, measured), 0.2 % measurement noise on both channels, 40
+runs: the mean of ``|H - H_exact|^2 / variance`` within 3 lines of the
+resonance and elsewhere, with the variance of the cyclic estimate
+(``periods, lines``) and with the per-line H1 residual (``per line``).
 """
 
 from __future__ import annotations
@@ -22,8 +30,11 @@ from __future__ import annotations
 import sys
 
 import numpy as np
+import scipy.signal
 from threadpoolctl import threadpool_limits
 
+import tyredamp.signal.estimators as est
+from tyredamp.signal import estimate_frf
 from tyredamp.studies.radial import frf_from_time
 from tyredamp.timedata import TimeData
 from tyredamp.virtual import RingTyre, run_modal_test
@@ -50,7 +61,8 @@ def _ratios(frf, ref: np.ndarray, sel: np.ndarray) -> np.ndarray:
 
 
 def main() -> None:
-    n_seeds = int(sys.argv[1]) if len(sys.argv) > 1 else 3
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    n_seeds = int(args[0]) if args else 3
     tyre = RingTyre()
     print("ratio |H - H_ref|^2 / variance over 10-95 Hz; F: the F(2, dof) value it should have")
     print(
@@ -94,6 +106,42 @@ def main() -> None:
             )
 
 
+def process_noise() -> None:
+    """Ratios near and away from a sharp resonance under measured force fluctuations."""
+    a, b, period = [1.0, -2 * 0.995 * np.cos(2 * np.pi * 20 / 256), 0.995**2], [1.0], 256
+    rng = np.random.default_rng(1)
+    spec = np.zeros(period // 2 + 1, complex)
+    spec[1:-1] = np.exp(2j * np.pi * rng.random(period // 2 - 1))
+    one = np.fft.irfft(spec, period)
+    one /= one.std()
+    band = (0.5 / period, (period // 2 - 0.5) / period)
+    cyclic = est.cyclic_variance_on_lines
+    for n in (2, 4, 8):
+        for name, hook in (("per line", lambda *_a, **_k: None), ("periods, lines", cyclic)):
+            est.cyclic_variance_on_lines = hook  # type: ignore[assignment]
+            rr = np.random.default_rng(7)
+            ratios = []
+            for _ in range(40):
+                xa = np.tile(one, n + 30) + 0.05 * rr.standard_normal(period * (n + 30))
+                y = scipy.signal.lfilter(b, a, xa)[-period * n :]
+                x = xa[-period * n :] + 0.002 * rr.standard_normal(period * n)
+                y = y + 0.002 * np.std(y) * rr.standard_normal(period * n)
+                td = TimeData(np.vstack([x, y]), 1.0, [1, 2], ["force", "displacement"])
+                frf = estimate_frf(td, method="cyclic", period_samples=period, band=band)
+                _, h = scipy.signal.freqz(b, a, worN=2 * np.pi * frf.frequency)
+                ratios.append(np.abs(frf.H[0, 0] - h) ** 2 / frf.variance[0, 0])
+            r = np.array(ratios)
+            near = np.abs(frf.frequency - 20 / 256) <= 3.5 / period
+            print(
+                f"{n:2d} periods, {name:15s}: mean ratio within 3 lines of the resonance "
+                f"{np.mean(r[:, near]):.2f}, elsewhere {np.mean(r[:, ~near]):.2f}"
+            )
+    est.cyclic_variance_on_lines = cyclic
+
+
 if __name__ == "__main__":
     with threadpool_limits(1):
-        main()
+        if "--process" in sys.argv:
+            process_noise()
+        else:
+            main()

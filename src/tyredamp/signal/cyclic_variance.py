@@ -30,6 +30,14 @@ variance of ``H``, which follows ``|H|^2`` across a resonance) is averaged over
 :data:`TARGET_DOF` real degrees of freedom, ``2 (n - 1) L`` (the periods'
 white-noise lines are independent under the rectangular window of cyclic
 averaging). From 11 periods on ``L = 1``: the variance of every line is its own.
+
+Limitation: force fluctuations that *excite* the structure (shaker noise
+measured by the force transducer) are no error of ``H`` (``dY = H dX``), and
+line by line the formula gives them no variance; averaged over ``L`` lines
+across a sharp resonance, where ``H`` changes within the window, they leave
+``|H(f') - H(f)|^2`` of them: the variance is then too large (conservative)
+near the resonance. Measurement noise on either channel, the usual case and
+the virtual rigs', is what the averaging assumes.
 """
 
 from __future__ import annotations

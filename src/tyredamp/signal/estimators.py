@@ -350,7 +350,9 @@ def frf_variance(
     (``(1 - gamma^2) / (2 n gamma^2)``) since the complex variance counts the
     magnitude and the phase direction. For cyclic averaging the residual is
     the period-to-period spread of ``Y - H X``. It is the variance of H1 (and
-    a first-order one of H2 and Hv with noise on the outputs).
+    a first-order one of H2 and Hv with noise on the outputs). Cyclic
+    estimates of one input get the errors-in-variables variance of
+    :mod:`.cyclic_variance` from :func:`estimate_frf` instead.
 
     Parameters
     ----------
