@@ -571,18 +571,12 @@ def estimate_frf(
     Returns
     -------
     FRF
-        ``H`` of shape (n_out, n_in, n_lines), the multiple coherence as
-        ``coherence``, the variance of each estimate as ``variance`` (None
-        with too few averages), and ``meta`` with ``estimator``, ``method``,
-        ``n_averages``, ``segment_samples``, ``sample_rate``, ``window``,
-        ``overlap``, ``variance_dof`` (the variance's real degrees of
-        freedom). Cyclic averaging of one input (one run): the
-        errors-in-variables variance from the period-to-period noise of the
-        force and the responses, averaged over neighbouring lines
-        (:mod:`~tyredamp.signal.cyclic_variance`, ``variance_dof`` ``2 (n - 1)
-        L`` >= 20 from two periods on); otherwise :func:`frf_variance`,
-        ``variance_dof`` ``2 (n_eff - n_in)``, ``n_eff`` the averages net of
-        overlap.
+        ``H`` (n_out, n_in, n_lines), the multiple coherence, the variance
+        of each line (cyclic with one input and run:
+        :mod:`~tyredamp.signal.cyclic_variance`, else :func:`frf_variance`;
+        None with too few averages), and ``meta`` with ``estimator``,
+        ``method``, ``n_averages``, ``segment_samples``, ``sample_rate``,
+        ``window``, ``overlap``, ``variance_dof`` (its real degrees of freedom).
 
     Raises
     ------
