@@ -44,6 +44,7 @@ def main() -> None:
     print(" seed   rel f      rel zeta   rel I      z_f    z_zeta  z_I    split  s")
     rel: dict[str, list[float]] = {"f": [], "z": [], "I": []}
     cover: dict[str, list[bool]] = {"f": [], "z": [], "I": []}
+    zall: dict[str, list[float]] = {"f": [], "z": [], "I": []}
     splits = 0
     for seed in range(1, n_seeds + 1):
         t0 = time.perf_counter()
@@ -72,6 +73,7 @@ def main() -> None:
             rel[k].append(got[k] / truth[k] - 1)
             zs[k] = (got[k] - truth[k]) / std[k] if std[k] > 0 else np.nan
             cover[k].append(bool(abs(zs[k]) <= 1))
+            zall[k].append(zs[k])
         print(
             f" {seed:4d} {rel['f'][-1]:+.2e}  {rel['z'][-1]:+.2e}  {rel['I'][-1]:+.2e}  "
             f"{zs['f']:+6.2f} {zs['z']:+6.2f} {zs['I']:+6.2f}  {'yes' if split else 'no':5s}"
@@ -81,7 +83,8 @@ def main() -> None:
         r = np.abs(rel[k])
         print(
             f"{name:12s} largest |relative error| {r.max():.2e}, median {np.median(r):.2e}; "
-            f"1-sigma statistical interval covers the truth in {100 * np.mean(cover[k]):.0f} %"
+            f"1-sigma statistical interval covers the truth in {100 * np.mean(cover[k]):.0f} %, "
+            f"rms z {np.sqrt(np.nanmean(np.square(zall[k]))):.2f}"
         )
     print(f"fits that split the rotation into two poles: {splits} of {n_seeds}")
 

@@ -54,6 +54,7 @@ from .._validate import as_band, as_count, as_finite, check_positive
 from ..exceptions import InputError, ShapeError
 from ..frf import FRF, Channel, FRFKind
 from ..timedata import TimeData
+from .cyclic_variance import cyclic_variance_on_lines
 from .lrm import local_method_frf
 from .segmenting import (
     METHODS,
@@ -349,7 +350,9 @@ def frf_variance(
     (``(1 - gamma^2) / (2 n gamma^2)``) since the complex variance counts the
     magnitude and the phase direction. For cyclic averaging the residual is
     the period-to-period spread of ``Y - H X``. It is the variance of H1 (and
-    a first-order one of H2 and Hv with noise on the outputs).
+    a first-order one of H2 and Hv with noise on the outputs). Cyclic
+    estimates of one input get the errors-in-variables variance of
+    :mod:`.cyclic_variance` from :func:`estimate_frf` instead.
 
     Parameters
     ----------
@@ -568,12 +571,12 @@ def estimate_frf(
     Returns
     -------
     FRF
-        ``H`` of shape (n_out, n_in, n_lines), the multiple coherence as
-        ``coherence``, the variance of each estimate as ``variance`` (see
-        :func:`frf_variance`; None with too few averages), and ``meta``
-        with ``estimator``, ``method``, ``n_averages``, ``segment_samples``,
-        ``sample_rate``, ``window``, ``overlap``, ``variance_dof`` (segment
-        methods: ``2 (n_eff - n_in)``, ``n_eff`` the averages net of overlap).
+        ``H`` (n_out, n_in, n_lines), the multiple coherence, the variance
+        of each line (cyclic with one input and run:
+        :mod:`~tyredamp.signal.cyclic_variance`, else :func:`frf_variance`;
+        None with too few averages), and ``meta`` with ``estimator``,
+        ``method``, ``n_averages``, ``segment_samples``, ``sample_rate``,
+        ``window``, ``overlap``, ``variance_dof`` (its real degrees of freedom).
 
     Raises
     ------
@@ -663,12 +666,13 @@ def _segmented_frf(
     ref_idx, out_idx, kind = io
     chans = timedata.channels
     seg = plan.segment_samples
+    starts = plan_starts(timedata, choice, plan)
     spectra = cross_spectra(
         timedata.data[ref_idx],
         timedata.data[out_idx],
         timedata.sample_rate,
         seg,
-        starts=plan_starts(timedata, choice, plan),
+        starts=starts,
         window=plan.window_values,
         input_window=plan.input_window,
         detrend=plan.detrend,
@@ -684,6 +688,13 @@ def _segmented_frf(
     n_eff = spectra.n_averages / _overlap_factor(
         plan.window_values, plan.step_samples, spectra.n_averages
     )
+    variance, dof = frf_variance(spectra, coh, n_eff), 2.0 * (n_eff - len(ref_idx))
+    if choice.method == "cyclic" and len(ref_idx) == 1 and len(timedata.acquisition.run_starts) < 2:
+        sig = (timedata.data[ref_idx], timedata.data[out_idx])
+        wins = segment_windows(plan.window_values, plan.input_window, seg)
+        eiv = cyclic_variance_on_lines(sig, starts, wins, plan.detrend, spectra, h)
+        if eiv is not None:  # the period-to-period noise of force and responses
+            variance, dof = eiv
     win = plan.window
     meta_out: dict[str, Any] = {
         "estimator": estimator,
@@ -694,8 +705,8 @@ def _segmented_frf(
         "window": win if isinstance(win, str) else list(win),
         "overlap": plan.overlap,
         "settle_samples": choice.settle_samples,
-        # real degrees of freedom of ``variance`` (frf_variance): 2 (n_eff - n_in)
-        "variance_dof": 2.0 * (n_eff - len(ref_idx)),
+        # real degrees of freedom of ``variance``
+        "variance_dof": dof,
         **plan.info,
     }
     if choice.detection is not None:
@@ -708,7 +719,7 @@ def _segmented_frf(
         inputs=[chans[i] for i in ref_idx],
         coherence=coh,
         meta=meta_out,
-        variance=frf_variance(spectra, coh, n_eff),
+        variance=variance,
     )
 
 
