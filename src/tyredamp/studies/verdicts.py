@@ -359,7 +359,8 @@ def modal_fit_verdict(
         The lines of ``measured`` the model was fitted on (default: every line).
     kind : {"receptance", "mobility", "accelerance"}, optional
         The kind of FRF the model was fitted to (default ``measured.kind``):
-        ``measured`` is converted block by block.
+        ``measured`` is converted block by block (a 0 Hz line, which a
+        conversion that divides by the frequency drops, must not be in ``lines``).
     block : int
         Lines per block of the statistics (:func:`floor_test_blocks`,
         :func:`noise_test_blocks`): the memory they take beyond the data does
@@ -569,17 +570,17 @@ def _noise_cautions(
 
 
 def _rejected_in(model: Any, f: NDArray[np.float64], excess: NDArray[np.float64]) -> str:
-    """The candidates the identification rejected where the excess residual
-    ``|e|^2 - var`` (shape (..., n_freq)) concentrates: at least a fifth of it within
-    two half-power bandwidths (at least 1.5 line spacings, at most a twentieth of the
-    band) of the candidate. The likely cause of the miss, with why each was
-    rejected."""
+    """The candidates the identification rejected where the excess residual per line
+    ``excess`` (``(|e|^2 - var)+`` summed over the FRFs, shape (n_freq,)) concentrates:
+    at least a fifth of it within two half-power bandwidths (at least 1.5 line
+    spacings, at most a twentieth of the band) of the candidate. The likely cause of
+    the miss, with why each was rejected."""
     q = getattr(model, "quality", None)
     if q is None or not q.rejected or f.size < 2:
         return ""
     from ..modal.statistics.quality import short_reason, strongest_rejected
 
-    ex = np.clip(excess, 0.0, None).reshape(-1, f.size).sum(axis=0)
+    ex = excess
     total = float(ex.sum())
     if not total > 0:
         return ""
