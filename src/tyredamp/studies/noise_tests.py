@@ -7,7 +7,10 @@ implies, :func:`frf_noise_variance`), and without coherence
 :func:`floor_test` judges it against the noise floor the data themselves
 show (:func:`adjacent_line_variance`: differences of adjacent lines, a
 running median) and the structure of the residual across lines
-(:func:`residual_correlation`, outlying lines).
+(:func:`residual_correlation`, outlying lines). :func:`noise_test_blocks`
+and :func:`floor_test_blocks` are the same tests on a block of lines at a
+time, for the verdicts of long FRFs: their memory beyond the data is a block's
+and 8-16 bytes per line.
 """
 
 from __future__ import annotations
@@ -433,8 +436,9 @@ def noise_test_blocks(
     frequency : ndarray, shape (n_freq,)
         Hz.
     lines : callable
-        ``lines(a, b)`` gives ``(measured, fitted, variance)`` of the lines
-        ``a <= f < b``, each of shape (..., b - a), as :func:`noise_test` takes them.
+        ``lines(a, b)`` gives ``(measured, fitted, variance)`` of the lines of
+        index ``a`` to ``b - 1``, each of shape (..., b - a), as :func:`noise_test`
+        takes them.
     noise_dof_factor, alpha
         As :func:`noise_test`.
     block : int
@@ -486,8 +490,8 @@ def floor_test_blocks(
     frequency : ndarray, shape (n_freq,)
         Hz, adjacent lines.
     measured, fitted : callable
-        ``measured(a, b)``, ``fitted(a, b)``: the values of the lines
-        ``a <= f < b``, complex, shape (..., b - a).
+        ``measured(a, b)``, ``fitted(a, b)``: the values of the lines of index
+        ``a`` to ``b - 1``, complex, shape (..., b - a).
     alpha : float
         Significance level.
     block : int
@@ -495,11 +499,13 @@ def floor_test_blocks(
 
     Returns
     -------
-    test, cautions
+    test : NoiseTest
         As :func:`floor_test` (its sums taken block by block: equal to rounding).
     excess : ndarray, shape (n_freq,)
         ``(|e|^2 - var)+`` of each line of the scaled data summed over the FRFs
         (:func:`floor_test`'s ``excess`` clipped at 0 and summed over the FRFs).
+    cautions : list of str
+        As :func:`floor_test`.
     """
     f = np.asarray(frequency, dtype=float)
     if not 0 < alpha < 1:
