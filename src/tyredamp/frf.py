@@ -313,9 +313,15 @@ class FRF:
 
     # --------------------------------------------------------------- slicing
     def select_lines(self, index: slice | NDArray[Any] | Sequence[int]) -> FRF:
-        """Return the FRF on a subset of frequency lines (kept in order)."""
-        idx = np.arange(self.n_freq)[index]
-        if idx.size == 0:
+        """Return the FRF on a subset of frequency lines (kept in order).
+
+        A slice is taken as such (the memory of the lines it holds, not of every
+        line); other indices as an integer array.
+        """
+        idx: Any = np.arange(self.n_freq)[index] if not isinstance(index, slice) else index
+        if isinstance(idx, slice) and len(range(self.n_freq)[idx]) == 0:
+            raise InputError("select_lines: the selection holds no frequency line")
+        if not isinstance(idx, slice) and idx.size == 0:
             raise InputError("select_lines: the selection holds no frequency line")
         coh = None if self.coherence is None else self.coherence[:, idx]
         var = None if self.variance is None else self.variance[:, :, idx]

@@ -103,17 +103,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import InputError
-from ..frf import FRF
+from ..frf import FRF, FRFKind
 from ..modal.identify import ModalIdentification
 from .noise_tests import (
     _MIN_LINES,
     ALPHA,
+    BLOCK_LINES,
     NoiseTest,
+    _fitted_span,
     _num,
     adjacent_line_variance,
     floor_test,
+    floor_test_blocks,
     frf_noise_variance,
     noise_test,
+    noise_test_blocks,
     residual_correlation,
 )
 
@@ -321,6 +325,9 @@ def modal_fit_verdict(
     better: FitVerdict | None = None,
     alpha: float = ALPHA,
     model_error: float = 0.0,
+    lines: slice | None = None,
+    kind: FRFKind | None = None,
+    block: int = BLOCK_LINES,
 ) -> FitVerdict:
     """Verdict on a modal model fitted to ``measured`` (module docstring).
 
@@ -348,26 +355,49 @@ def modal_fit_verdict(
         Relative model error the identification included in its noise
         (``ModalIdentification.model_error``; 0: none): said in the verdict,
         which tests against the noise without it.
+    lines : slice, optional
+        The lines of ``measured`` the model was fitted on (default: every line).
+    kind : {"receptance", "mobility", "accelerance"}, optional
+        The kind of FRF the model was fitted to (default ``measured.kind``):
+        ``measured`` is converted block by block (a 0 Hz line, which a
+        conversion that divides by the frequency drops, must not be in ``lines``).
+    block : int
+        Lines per block of the statistics (:func:`floor_test_blocks`,
+        :func:`noise_test_blocks`): the memory they take beyond the data does
+        not grow with the lines but for 8-16 bytes per line.
     """
-    f = measured.frequency
+    span = slice(0, measured.n_freq) if lines is None else lines
+    lo, hi, _ = span.indices(measured.n_freq)
+    f = measured.frequency[lo:hi]
     band_meta = model.meta.get("band_hz")
     band = (
         (float(band_meta[0]), float(band_meta[1]))
         if band_meta is not None
         else (float(f[0]), float(f[-1]))
     )
-    synth = model.frf(f, measured.kind).H
+    to = kind or measured.kind
+
+    def part(a: int, b: int) -> FRF:  # the measured lines [a, b) of the fit, as fitted
+        p = measured.select_lines(slice(lo + a, lo + b))
+        return p if p.kind == to else p.to(to)
+
     reasons: list[str] = []
     cautions: list[str] = []
-    noise = frf_noise_variance(measured)
+    noise = frf_noise_variance(part(0, 1))
     test = None
     form = False
     excess: NDArray[np.float64] | None = None
     if noise is not None:
-        test = noise_test(f, measured.H, synth, noise[0], noise[1], alpha)
-        excess = np.abs(synth - measured.H) ** 2 - noise[0]
+
+        def with_noise(a: int, b: int) -> tuple[NDArray[Any], NDArray[Any], NDArray[Any]]:
+            p = part(a, b)
+            return p.H, model.frf(p.frequency, to).H, frf_noise_variance(p)[0]  # type: ignore[index]
+
+        test, excess = noise_test_blocks(f, with_noise, noise[1], alpha, block)
     elif f.size >= _MIN_LINES:
-        test, excess, notes = floor_test(f, measured.H, synth, alpha)
+        test, excess, notes = floor_test_blocks(
+            f, lambda a, b: part(a, b).H, lambda a, b: model.frf(f[a:b], to).H, alpha, block
+        )
         cautions += notes
     if test is not None and not test.passed:
         # another model of the same band within the noise refutes a missing mode
@@ -540,17 +570,17 @@ def _noise_cautions(
 
 
 def _rejected_in(model: Any, f: NDArray[np.float64], excess: NDArray[np.float64]) -> str:
-    """The candidates the identification rejected where the excess residual
-    ``|e|^2 - var`` (shape (..., n_freq)) concentrates: at least a fifth of it within
-    two half-power bandwidths (at least 1.5 line spacings, at most a twentieth of the
-    band) of the candidate. The likely cause of the miss, with why each was
-    rejected."""
+    """The candidates the identification rejected where the excess residual per line
+    ``excess`` (``(|e|^2 - var)+`` summed over the FRFs, shape (n_freq,)) concentrates:
+    at least a fifth of it within two half-power bandwidths (at least 1.5 line
+    spacings, at most a twentieth of the band) of the candidate. The likely cause of
+    the miss, with why each was rejected."""
     q = getattr(model, "quality", None)
     if q is None or not q.rejected or f.size < 2:
         return ""
     from ..modal.statistics.quality import short_reason, strongest_rejected
 
-    ex = np.clip(excess, 0.0, None).reshape(-1, f.size).sum(axis=0)
+    ex = excess
     total = float(ex.sum())
     if not total > 0:
         return ""
@@ -723,27 +753,33 @@ def lateral_family_verdicts(
     return out
 
 
-def modal_verdicts(frf: FRF, res: ModalIdentification) -> dict[str, FitVerdict]:
+def modal_verdicts(
+    frf: FRF, res: ModalIdentification, *, block: int = BLOCK_LINES
+) -> dict[str, FitVerdict]:
     """Verdict of each fitted model of ``res`` against the noise of the fitted lines of ``frf``.
 
     The complex-mode fit is judged first; the real-mode fit is judged with it
     as the better model (:func:`modal_fit_verdict`). ``tyredamp modal`` and
-    the campaign store these as ``meta["verdict"]`` of each model.
+    the campaign store these as ``meta["verdict"]`` of each model. The fitted
+    lines are read from ``frf`` in blocks of ``block`` lines (a band of its
+    lines is not copied).
     """
-    keep = np.flatnonzero(np.isin(frf.frequency, res.frequency))
-    meas = frf.select_lines(keep).to(res.frf_kind)  # type: ignore[arg-type]
+    kind = res.frf_kind
+    span = _fitted_span(frf, res.frequency, kind)
+    if span is None:  # lines that are no band of the FRF's: their copy
+        keep = np.flatnonzero(np.isin(frf.frequency, res.frequency))
+        meas, span = frf.select_lines(keep).to(kind), None  # type: ignore[arg-type]
+    else:
+        meas = frf
     out: dict[str, FitVerdict] = {}
     eps = float(getattr(res, "model_error", 0.0))
+    common: dict[str, Any] = {"model_error": eps, "lines": span, "kind": kind, "block": block}
     if "complex" in res.models:
         out["complex"] = modal_fit_verdict(
-            res.models["complex"], meas, subject="complex-mode fit", model_error=eps
+            res.models["complex"], meas, subject="complex-mode fit", **common
         )
     if "real" in res.models:
         out["real"] = modal_fit_verdict(
-            res.models["real"],
-            meas,
-            subject="real-mode fit",
-            better=out.get("complex"),
-            model_error=eps,
+            res.models["real"], meas, subject="real-mode fit", better=out.get("complex"), **common
         )
     return out
