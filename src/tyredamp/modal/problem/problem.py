@@ -28,8 +28,8 @@ when the estimator states them (:func:`~tyredamp.signal.estimators.estimate_frf`
 ``2 (n_eff - n_in)`` with ``n_eff`` the averages reduced for overlapping
 windows; for cyclic one-force FRFs, whose variance comes from the
 period-to-period noise averaged over ``L`` neighbouring lines,
-``2 (n - 1) L``: :mod:`tyredamp.signal.cyclic_variance`), else ``2 (n_averages - n_in)`` from ``meta["n_averages"]`` (the
-residual of the least-squares H1 over the averages, no overlap correction),
+``2 (n - 1) L``: :mod:`tyredamp.signal.cyclic_variance`), else
+``2 (n_averages - n_in)`` from ``meta["n_averages"]`` (the residual of the least-squares H1 over the averages, no overlap correction),
 else unknown: taken as known. The local methods (LRM/LPM, ``n_averages =
 1``) state the local fit's ``2 (2 n + 1 - n_par)``
 (:func:`~tyredamp.signal.lrm.local_variance_dof`). The goodness of fit
