@@ -23,17 +23,17 @@ and states the noise model of the fit:
 Degrees of freedom of the variance (``FitProblem.noise_dof``). A variance
 passed as ``variance=`` is taken as known (the goodness of fit is then
 chi-square). One carried by the FRF or derived from its coherence is an
-estimate: its real degrees of freedom ``nu`` are ``meta["variance_dof"]``
-when the estimator states them (:func:`~tyredamp.signal.estimators.estimate_frf`:
+estimate: its real degrees of freedom ``nu`` are ``meta["variance_dof"]`` when
+the estimator states them (:func:`~tyredamp.signal.estimators.estimate_frf`:
 ``2 (n_eff - n_in)`` with ``n_eff`` the averages reduced for overlapping
 windows; for cyclic one-force FRFs, whose variance comes from the
-period-to-period noise averaged over ``L`` neighbouring lines,
-``2 (n - 1) L``: :mod:`tyredamp.signal.cyclic_variance`), else
-``2 (n_averages - n_in)`` from ``meta["n_averages"]`` (the residual of the least-squares H1 over the averages, no overlap correction),
-else unknown: taken as known. The local methods (LRM/LPM, ``n_averages =
-1``) state the local fit's ``2 (2 n + 1 - n_par)``
-(:func:`~tyredamp.signal.lrm.local_variance_dof`). The goodness of fit
-corrects for them (:mod:`tyredamp.modal.statistics.stats`).
+period-to-period noise averaged over ``L`` neighbouring lines, ``2 (n - 1) L``:
+:mod:`tyredamp.signal.cyclic_variance`), else ``2 (n_averages - n_in)`` from
+``meta["n_averages"]`` (the residual of the least-squares H1 over the averages,
+no overlap correction), else unknown: taken as known. The local methods
+(LRM/LPM, ``n_averages = 1``) state the local fit's ``2 (2 n + 1 - n_par)``
+(:func:`~tyredamp.signal.lrm.local_variance_dof`). The goodness of fit corrects
+for them (:mod:`tyredamp.modal.statistics.stats`).
 
 A known variance ``V_jkf`` enters the fit as a separable model ``sigma_j^2
 g_f`` (``sigma_j^2`` the mean variance of output ``j``, ``g_f`` the mean of
