@@ -8,13 +8,12 @@ import pytest
 from tyredamp import Channel
 from tyredamp.frf import FRF
 from tyredamp.modal.model import ModalModel
+from tyredamp.studies.lateral_verdicts import lateral_family_verdicts, lateral_fit_verdict
 from tyredamp.studies.verdicts import (
     CAUSE_MODEL_FORM,
     CAUSE_NON_PROPORTIONAL,
     CAUSE_OUTSIDE_FAMILY,
     frf_noise_variance,
-    lateral_family_verdicts,
-    lateral_fit_verdict,
     modal_fit_verdict,
     noise_test,
 )

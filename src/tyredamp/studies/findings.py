@@ -27,7 +27,8 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
-from .verdicts import CAUSE_MEANING, FitVerdict, lateral_family_verdicts, modal_fit_verdict
+from .lateral_verdicts import lateral_family_verdicts
+from .verdicts import CAUSE_MEANING, FitVerdict, modal_fit_verdict
 
 if TYPE_CHECKING:
     from .results import DemoResult, LateralCondition, PressureRun

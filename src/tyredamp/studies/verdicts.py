@@ -96,13 +96,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..exceptions import InputError
 from ..frf import FRF, FRFKind
 from ..modal.identify import ModalIdentification
 from .noise_tests import (
@@ -132,8 +131,6 @@ __all__ = [
     "adjacent_line_variance",
     "floor_test",
     "frf_noise_variance",
-    "lateral_family_verdicts",
-    "lateral_fit_verdict",
     "modal_fit_verdict",
     "modal_verdicts",
     "noise_test",
@@ -614,143 +611,6 @@ def _form_cause(model: Any, better: FitVerdict) -> tuple[str, str]:
         f"the {better.subject} of the same band is within the noise, so this model's "
         "form cannot hold the data: an identification result, not a failure of the fit"
     )
-
-
-def lateral_fit_verdict(
-    fit: Any, frf: FRF, *, subject: str = "", alpha: float = ALPHA
-) -> FitVerdict:
-    """Verdict on a lateral model fitted to the FRF ``frf`` (module docstring).
-
-    Parameters
-    ----------
-    fit : LateralFit
-        Its ``frequency``, ``measured`` and ``fitted`` (accelerance at the
-        data's force) are tested.
-    frf : FRF
-        The measured FRF the fit was made on (1x1; without coherence the fit is
-        judged against the noise floor of adjacent lines, :func:`floor_test`).
-    """
-    name = subject or f"{fit.name} fit"
-    noise = frf_noise_variance(frf)
-    cautions: list[str] = []
-    if noise is None:
-        if np.size(fit.frequency) < _MIN_LINES:
-            return FitVerdict(
-                name,
-                "not judged",
-                cautions=(
-                    f"no coherence and only {np.size(fit.frequency)} line(s): too few to "
-                    "judge against the noise",
-                ),
-            )
-        # no coherence: the noise floor of adjacent lines (module docstring)
-        test, _, cautions = floor_test(fit.frequency, fit.measured, fit.fitted, alpha)
-        cautions.insert(
-            0,
-            "no coherence: judged against the noise floor of the data themselves "
-            "(differences of adjacent lines) and the structure of the residual across lines",
-        )
-    else:
-        keep = np.flatnonzero(np.isin(frf.frequency, fit.frequency))
-        if keep.size != fit.frequency.size:
-            raise InputError("frf: does not hold every line of the fit")
-        acc = frf.to("accelerance").H[0, 0, keep]
-        rel_var = noise[0][0, 0, keep] / np.abs(frf.H[0, 0, keep]) ** 2
-        var = rel_var * np.abs(acc) ** 2
-        test = noise_test(fit.frequency, fit.measured, fit.fitted, var, noise[1], alpha)
-    reasons: list[str] = []
-    if not test.passed:
-        floor = "" if test.noise_from == "coherence" else " floor of adjacent lines"
-        reasons.append(
-            f"the residual is {math.sqrt(test.ratio):.3g}x the noise{floor} level "
-            f"({_p(test.p_value)})"
-        )
-        where = (
-            ""
-            if test.misfit_hz is None
-            else f" at {test.misfit_hz[0]:.3g}-{test.misfit_hz[1]:.3g} Hz"
-        )
-        reasons.append(
-            f"the model form misses the measured tyre{where} (noise does not explain it)"
-        )
-    return FitVerdict(
-        name, "ok" if not reasons else "failed", tuple(reasons), tuple(cautions), test
-    )
-
-
-def _converged(fit: Any) -> bool:
-    """True when the lateral fit's optimiser ran and did not stop on its evaluation limit."""
-    return (
-        int(getattr(fit, "nfev", 1)) > 0
-        and "maximum" not in str(getattr(fit, "message", "")).lower()
-    )
-
-
-def lateral_family_verdicts(
-    fits: Sequence[Any], frf: FRF, *, label: str = "", alpha: float = ALPHA
-) -> dict[str, FitVerdict]:
-    """Verdicts of every lateral model fitted to one FRF, a miss classified by the others.
-
-    Each fit is judged alone (:func:`lateral_fit_verdict`); a fit that misses
-    the noise is then an *expected* outcome (module docstring) when
-
-    * another model of the same FRF is within the noise: this model's form
-      does not hold the tyre (``"model form"``), or
-    * every one of two or more models misses and every fit converged: the
-      measured tyre is none of the models, and the ranking names the closest
-      (``"tyre outside the model family"``).
-
-    A fit whose optimiser did not converge, and a single model fitted alone,
-    keep the outcome ``"failed"``.
-
-    Parameters
-    ----------
-    fits : sequence of LateralFit
-        The fits of one FRF (one per model).
-    frf : FRF
-        The measured FRF they were fitted to (1x1, with coherence).
-    label : str
-        Condition label for the subjects (``"hysteretic fit at 1.7 bar, 5 km/h"``).
-    alpha : float
-        Significance level of the test against the noise.
-
-    Returns
-    -------
-    dict of str to FitVerdict
-        By model name, in the order of ``fits``.
-    """
-    at = f" at {label}" if label else ""
-    out = {
-        f.name: lateral_fit_verdict(f, frf, subject=f"{f.name} fit{at}", alpha=alpha) for f in fits
-    }
-    conv = {f.name: _converged(f) for f in fits}
-    within = [n for n, v in out.items() if v.status == "ok"]
-    missed = [n for n, v in out.items() if v.status == "failed"]
-    if within:
-        names = ", ".join(within)
-        for n in missed:
-            if conv[n]:
-                out[n] = replace(
-                    out[n],
-                    expected_cause=CAUSE_MODEL_FORM,
-                    expected_why=(
-                        f"the {names} fit{'s' if len(within) > 1 else ''} of the same FRF "
-                        f"{'are' if len(within) > 1 else 'is'} within the noise, so this "
-                        "model's form does not hold the measured tyre: a result of the model "
-                        "comparison, not a failure of the fit"
-                    ),
-                )
-    elif len(fits) >= 2 and len(missed) == len(fits) and all(conv.values()):
-        r = [math.sqrt(v.test.ratio) for v in out.values() if v.test is not None]
-        why = (
-            f"none of the {len(fits)} models fitted holds the measured tyre within the noise "
-            f"(residuals {min(r):.3g}-{max(r):.3g}x the noise) although every fit converged: "
-            "the tyre is none of these models, and the ranking names the closest: a result "
-            "of the model comparison, not a failure of the fit"
-        )
-        for n in missed:
-            out[n] = replace(out[n], expected_cause=CAUSE_OUTSIDE_FAMILY, expected_why=why)
-    return out
 
 
 def modal_verdicts(
