@@ -17,7 +17,8 @@ Run::
     python benchmarks/gallery.py --make-references   # needs sdypy-EMA (extra "bench")
 
 The rows (:data:`ROWS`) are the single definition of the table:
-``tests/test_real_data.py`` runs the same rows under pytest.
+``tests/test_real_data.py`` runs the same rows under pytest (the ``long`` ones with
+``pytest -m long``).
 """
 
 from __future__ import annotations
@@ -167,7 +168,9 @@ class Row:
     ``run`` performs the user's commands and returns the :class:`Check`;
     ``xfail`` is the reason why the current code is known not to meet the
     reference (the test then expects the failure, strictly); ``subprocess``
-    marks the rows the test also runs through a real subprocess.
+    marks the rows the test also runs through a real subprocess; ``long`` the
+    rows whose identification takes half a minute or more, which the test
+    suite runs on request (``pytest -m long``) and this script always.
     """
 
     id: str
@@ -179,6 +182,7 @@ class Row:
     xfail: str = ""
     subprocess: bool = False
     needs_references: bool = False
+    long: bool = False
 
 
 # --------------------------------------------------------------------------- helpers
@@ -686,6 +690,7 @@ def _rows() -> list[Row]:
             subprocess=True,
             needs_references=True,
             xfail=IMPACT_GAP,
+            long=True,
         ),
         Row(
             "impact-lvm-no-map",
@@ -1132,7 +1137,8 @@ def markdown(results: list[dict[str, Any]], real: Path) -> str:
         "",
         "The peer-tool references are stored in `benchmarks/results/gallery_references.json`",
         f"with the command that made them (`{REFERENCES_COMMAND}`, needs",
-        '`pip install "tyredamp[bench]"`); `tests/test_real_data.py` runs the same rows.',
+        '`pip install "tyredamp[bench]"`); `tests/test_real_data.py` runs the same rows '
+        "(a row whose identification takes half a minute or more with `pytest -m long`).",
         "",
         "| row | file | what it is | source (licence) | command run | outcome | reference "
         "| agreement |",

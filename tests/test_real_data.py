@@ -52,6 +52,8 @@ def _params(use_subprocess: bool) -> list[Any]:
         if row.subprocess != use_subprocess:  # each row runs once, one way or the other
             continue
         marks = [pytest.mark.xfail(strict=True, reason=row.xfail)] if row.xfail else []
+        if row.long:  # a modal identification of half a minute or more: `pytest -m long`
+            marks.append(pytest.mark.long)
         out.append(pytest.param(row, id=row.id, marks=marks))
     return out
 
