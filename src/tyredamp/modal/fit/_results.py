@@ -92,6 +92,41 @@ def pole_and_shape_std(
     return std_f, std_z, std_pole, std_psi
 
 
+def coefficient_parts(
+    fitter: FitterState, C: NDArray[np.float64], m: int
+) -> tuple[NDArray[np.complex128], NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """The unscaled output shapes ``u`` (n_out, m) and the upper and lower
+    residual terms (n_out, n_in, or None when not fitted) from the linear
+    coefficients ``C`` (n_col, n_out) of the projection: per mode the real and
+    imaginary parts of its column (complex modes) or its real column (real
+    modes), then the residual terms' columns."""
+    complex_modes = fitter.kind == "complex"
+    u = C[0 : 2 * m : 2].T + 1j * C[1 : 2 * m : 2].T if complex_modes else C[:m].T + 0j
+    off = (2 if complex_modes else 1) * m
+    upper = lower = None
+    if fitter.use_upper:
+        upper = C[off : off + fitter.n_in].T.copy()
+        off += fitter.n_in
+    if fitter.use_lower:
+        lower = C[off : off + fitter.n_in].T.copy()
+    return np.asarray(u, dtype=np.complex128), upper, lower
+
+
+def drive_phi2(
+    fitter: FitterState,
+    poles: NDArray[np.complex128],
+    psi_out: NDArray[np.complex128],
+    psi_in: NDArray[np.complex128],
+) -> NDArray[np.complex128]:
+    """``2 i Omega_n R_kkn`` (m,) averaged over the drive points (output ``j`` at
+    input ``k`` of ``fitter.drive``): ``phi_kn^2`` for a real mode (eq. [3])."""
+    out = np.array([j for j, _ in fitter.drive], dtype=np.intp)
+    kin = np.array([k for _, k in fitter.drive], dtype=np.intp)
+    return np.asarray(
+        np.mean(2j * poles.imag[None, :] * psi_out[out] * psi_in[kin], axis=0), np.complex128
+    )
+
+
 def assemble(
     fitter: FitterState,
     th: NDArray[np.float64],
@@ -115,26 +150,13 @@ def assemble(
     didx = np.array([j for j, _ in fitter.drive], dtype=np.intp)
     wd = w[didx]
     b, psi_in, a2r = _scaling.scale(fitter, th, m, ref, C[:, didx].T, wd)
-    u = (
-        Cu[0 : 2 * m : 2].T + 1j * Cu[1 : 2 * m : 2].T
-        if fitter.kind == "complex"
-        else Cu[:m].T + 0j
-    )
+    u, upper, lower = coefficient_parts(fitter, Cu, m)
     psi_out = u * b[None, :]
-    off = (2 if fitter.kind == "complex" else 1) * m
-    upper = lower = None
-    if fitter.use_upper:
-        upper = Cu[off : off + fitter.n_in].T.copy()
-        off += fitter.n_in
-    if fitter.use_lower:
-        lower = Cu[off : off + fitter.n_in].T.copy()
     if didx.size == 0:
         warn.append("no drive point (output at an input): shapes are not mass-normalised")
         phi2 = np.full(m, np.nan + 0j)
     else:
-        kin = np.array([k for _, k in fitter.drive], dtype=np.intp)
-        # 2 i Omega_n R_kkn at the drive points (= phi_kn^2 for a real mode, eq. [3])
-        phi2 = np.mean(2j * poles.imag[None, :] * psi_out[didx] * psi_in[kin], axis=0)
+        phi2 = drive_phi2(fitter, poles, psi_out, psi_in)
     for n in range(m):
         f_n = abs(poles[n]) / (2 * np.pi)
         if didx.size and fitter.kind == "real" and a2r[n] <= 0:

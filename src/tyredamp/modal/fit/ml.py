@@ -52,6 +52,7 @@ from scipy.linalg import solve_triangular
 
 from . import _basis
 from ._linalg import _gram_chol, _levenberg_marquardt
+from ._results import coefficient_parts, drive_phi2
 from ._scaling import pole_std
 from .fit import FitResult, ModalFitter, pole_bounds
 
@@ -384,20 +385,9 @@ def _as_result(
     poles, part = fitter.unpack(th, m, ref)
     didx = np.array([j for j, _ in fitter.drive], dtype=np.intp)
     b, psi_in, _ = fitter._scale(th, m, ref, C[:, didx].T, np.ones(didx.size))
-    per = 2 if fitter.kind == "complex" else 1
-    u = C[0 : 2 * m : 2].T + 1j * C[1 : 2 * m : 2].T if per == 2 else C[:m].T + 0j
+    u, upper, lower = coefficient_parts(fitter, C, m)
     psi_out = u * b[None, :]
-    off = per * m
-    upper = lower = None
-    if fitter.use_upper:
-        upper = C[off : off + fitter.n_in].T.copy()
-        off += fitter.n_in
-    if fitter.use_lower:
-        lower = C[off : off + fitter.n_in].T.copy()
-    phi2 = res.drive_phi2
-    if didx.size:
-        kin = np.array([k for _, k in fitter.drive], dtype=np.intp)
-        phi2 = np.mean(2j * poles.imag[None, :] * psi_out[didx] * psi_in[kin], axis=0)
+    phi2 = drive_phi2(fitter, poles, psi_out, psi_in) if didx.size else res.drive_phi2
     std_f, std_z, std_p = pole_std(fitter.w_ref, th, m, cth)
     status = "maximum likelihood" + ("" if ok else " (evaluation limit)")
     return dataclasses.replace(
