@@ -71,6 +71,16 @@ def step_coefficients(
     return phi, e0, e1
 
 
+def _minv_block(
+    system: MCKSystem, inputs: NDArray[np.intp], outputs: NDArray[np.intp]
+) -> NDArray[np.float64]:
+    """The (outputs x inputs) block of ``M^-1``: the direct term of the acceleration
+    (``sum_n p_n psi_n psi_n^T + c.c. = M^-1``), without forming the whole inverse."""
+    unit = np.zeros((system.n_dof, inputs.size))
+    unit[inputs, np.arange(inputs.size)] = 1.0
+    return np.asarray(sla.cho_solve(sla.cho_factor(system.M), unit)[outputs], np.float64)
+
+
 def time_response(
     system: MCKSystem,
     force: ArrayLike,
@@ -156,12 +166,7 @@ def time_response(
         disp += 2 * np.real(ps @ q)
         vel += 2 * np.real((ps * pp) @ q)
         acc += 2 * np.real((ps * pp**2) @ q)
-    # direct term of the acceleration: sum_n p_n psi_n psi_n^T + c.c. = M^-1
-    # only the (outputs x inputs) block of M^-1 is needed
-    unit = np.zeros((n, ii.size))
-    unit[ii, np.arange(ii.size)] = 1.0
-    minv_block = sla.cho_solve(sla.cho_factor(system.M), unit)[oi]
-    acc += minv_block @ f
+    acc += _minv_block(system, ii, oi) @ f
     return TimeResponse(
         time=np.arange(ns, dtype=float) * h, displacement=disp, velocity=vel, acceleration=acc
     )
@@ -239,8 +244,5 @@ def periodic_response_lines(
     transfer = ((e0 - e1)[:, None] + e1[:, None] * z) / (z - phi[:, None])
     q = transfer * (psi[ii].T @ force)  # (2m, lines)
     disp = psi[oi] @ q
-    unit = np.zeros((system.n_dof, ii.size))
-    unit[ii, np.arange(ii.size)] = 1.0
-    minv_block = sla.cho_solve(sla.cho_factor(system.M), unit)[oi]
-    acc = (psi[oi] * p**2) @ q + minv_block @ force
+    acc = (psi[oi] * p**2) @ q + _minv_block(system, ii, oi) @ force
     return disp, acc
