@@ -90,6 +90,8 @@ def demo_summary_rows(result: DemoResult, doc: dict[str, Any]) -> list[tuple[str
 
 def _tyre_model_row(tm: dict[str, Any]) -> str:
     """EI and the tension and k_r at the first pressure beside the truth, or FAILED and why."""
+    from ..studies.tyremodel import ring_verdict_groups
+
     if tm["status"] != "ok":
         return f"FAILED: {tm['error']}"
     par = {p["name"]: p for p in tm["parameters"]}
@@ -106,19 +108,11 @@ def _tyre_model_row(tm: dict[str, Any]) -> str:
         f"flexible ring at {len(tm['pressures_bar'])} pressures, against the virtual tyre: "
         + ", ".join(parts)
         + "".join(
-            f"; {what}: {', '.join(names)}" for what, names in _ring_verdicts(tm).items() if names
+            f"; {what}: {', '.join(names)}"
+            for what, names in ring_verdict_groups(tm).items()
+            if names
         )
     )
-
-
-def _ring_verdicts(tm: dict[str, Any]) -> dict[str, list[str]]:
-    """The ring parameters that are not identified, model-limited ones apart."""
-    verdict = {p["name"]: str(p["verdict"]) for p in tm["parameters"]}
-    limited = [n for n in tm["not_identifiable"] if verdict[n].startswith("model-limited")]
-    return {
-        "model-limited": limited,
-        "not identified": [n for n in tm["not_identifiable"] if n not in limited],
-    }
 
 
 def _verdict_rows(doc: dict[str, Any]) -> list[tuple[str, str]]:

@@ -203,16 +203,13 @@ def tyre_model_report(
     _warnings(rep, doc, "radial:tyre_model")
 
 
-def _model_limited(row: dict[str, Any]) -> bool:
-    """Is a ring parameter's verdict "model-limited" (a value with a model error)?"""
-    return str(row.get("verdict", "")).startswith("model-limited")
-
-
 def _not_identified(rep: Any, tm: dict[str, Any]) -> None:
     """The ring parameters flagged model-limited, and those not identified."""
+    from ..studies.tyremodel import ring_verdict_groups
+
     par = {p["name"]: p for p in tm["parameters"]}
-    limited = [n for n in tm["not_identifiable"] if _model_limited(par[n])]
-    unknown = [n for n in tm["not_identifiable"] if n not in limited]
+    groups = ring_verdict_groups(tm)
+    limited, unknown = groups["model-limited"], groups["not identified"]
     if limited:
         rep.paragraph(
             "Model-limited (the ring model does not hold these modes within their noise; the "

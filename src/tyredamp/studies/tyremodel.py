@@ -47,6 +47,7 @@ __all__ = [
     "TYRE_MODEL_DIR",
     "TyreModelStudy",
     "ring_truth",
+    "ring_verdict_groups",
     "tyre_model_files",
     "tyre_model_from_runs",
     "tyre_model_section",
@@ -322,3 +323,13 @@ def tyre_model_section(study: TyreModelStudy) -> dict[str, Any]:
         }
     )
     return base
+
+
+def ring_verdict_groups(section: dict[str, Any]) -> dict[str, list[str]]:
+    """The ring parameters of a :func:`tyre_model_section` that are not
+    identified, split by verdict: ``"model-limited"`` (a value with a
+    model-error term) and ``"not identified"`` (the others), in their order."""
+    verdict = {p["name"]: str(p["verdict"]) for p in section["parameters"]}
+    names = section["not_identifiable"]
+    limited = [n for n in names if verdict[n].startswith("model-limited")]
+    return {"model-limited": limited, "not identified": [n for n in names if n not in limited]}
