@@ -221,6 +221,14 @@ def damping_from_modes(
         )
     chosen, numbers = select_modes(full, modes, band)
     check_point_count(chosen, full.n_modes if chosen.n_modes == full.n_modes else None)
+    why = scaling_problem(chosen, per_mode=True)
+    if why:
+        src = (meta or {}).get("source") or "the modes"
+        raise InputError(
+            f"{src}: {why}; a damping matrix from them would be meaningless. Choose other "
+            "modes with --modes or --band, or measure a drive-point FRF (the response at the "
+            "excitation point, in its direction)"
+        )
     info = dict(meta or {})
     info["modes_used"] = numbers
     info["n_modes_available"] = full.n_modes
@@ -229,6 +237,15 @@ def damping_from_modes(
     dm = identify_damping(
         chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
     )
+    from ...damping.diagnostics import not_determined
+
+    why = not_determined(dm.diagnostics, dm.proportional)
+    if why:
+        src = (meta or {}).get("source") or "the modes"
+        raise InputError(
+            f"{src}: these modes do not determine a damping matrix: {why}. Use the modes' "
+            "damping ratios (modal damping), or measure them with finer lines or at more points"
+        )
     if info["shape_points"] == "inputs" and dm.std and "psi_out" not in chosen.std:
         from dataclasses import replace
 
