@@ -769,13 +769,13 @@ def row_tir(rel: str, keys: dict[str, float]) -> Callable[[Context], Check]:
 
 
 IMPACT_GAP = (
-    "modal finds all 8 modes of sdypy-EMA (within 0.16 %) and 21 more in its band; 14 of these are found "
-    "again in each of the two hits identified alone (independent data: modes of the structure "
-    "that the reference, which keeps the poles at the FRF's peaks, does not list), 7 are not. "
-    "Their mode test holds them significant against the noise plus a model error of about 10 "
-    "% of the response, but with two hits and a coherence below 0.9 at 11 % of the lines the "
-    "data do not settle whether they are weak modes that only both hits together resolve or "
-    "artefacts of the fit"
+    "modal finds all 8 modes of sdypy-EMA (within 0.16 %) and 21 more in its band; 14 of "
+    "these are found again in each of the two hits identified alone (independent data: "
+    "modes of the structure that the reference, which keeps the poles at the FRF's peaks, "
+    "does not list), 7 are not. Their mode test holds them significant against the noise "
+    "plus a model error of about 10 % of the response, but with two hits and a coherence "
+    "below 0.9 at 11 % of the lines the data do not settle whether they are weak modes that "
+    "only both hits together resolve or artefacts of the fit"
 )
 
 

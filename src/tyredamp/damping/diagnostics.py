@@ -277,6 +277,12 @@ def findings(
             "construction: non-proportional damping cannot be identified from real modes. "
             "Use the complex-mode fit to identify damping coupling between modes."
         )
+    why = not_determined(d, proportional)
+    if why:
+        out.append(
+            f"C' is not determined by these modes: {why}. Use the modes' damping ratios "
+            "(modal damping) rather than this matrix."
+        )
     out += _collinear_findings(d)
     out += _symmetry_findings(d, real)
     out += _definiteness_findings(d)

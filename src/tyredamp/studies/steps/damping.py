@@ -200,6 +200,7 @@ def damping_from_modes(
     from ...damping.modeset import (
         at_shape_points,
         check_point_count,
+        negative_mass_modes,
         scaling_problem,
         select_modes,
     )
@@ -220,6 +221,19 @@ def damping_from_modes(
             "(real modes) with the shapes"
         )
     chosen, numbers = select_modes(full, modes, band)
+    left_out = ""
+    bad, point = negative_mass_modes(chosen)
+    if bad and modes is None and band is None:
+        # nobody chose these modes: leave out those whose shapes cannot be scaled
+        keep = [k for k, f in enumerate(chosen.frequency_hz) if float(f) not in bad]
+        if keep:
+            chosen, numbers = select_modes(full, [numbers[k] for k in keep])
+            left_out = (
+                f"The mode(s) at {', '.join(f'{f:.4g}' for f in bad)} Hz were left out: the "
+                f"drive point {point} gives them a negative modal mass, so their shapes cannot "
+                "be mass-normalised (the response is not at the drive point for them, or they "
+                "are not physical). Choose modes with --modes to change this."
+            )
     check_point_count(chosen, full.n_modes if chosen.n_modes == full.n_modes else None)
     why = scaling_problem(chosen, per_mode=True)
     if why:
@@ -237,15 +251,10 @@ def damping_from_modes(
     dm = identify_damping(
         chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
     )
-    from ...damping.diagnostics import not_determined
+    if left_out:
+        from dataclasses import replace
 
-    why = not_determined(dm.diagnostics, dm.proportional)
-    if why:
-        src = (meta or {}).get("source") or "the modes"
-        raise InputError(
-            f"{src}: these modes do not determine a damping matrix: {why}. Use the modes' "
-            "damping ratios (modal damping), or measure them with finer lines or at more points"
-        )
+        dm = replace(dm, findings=(left_out, *dm.findings))
     if info["shape_points"] == "inputs" and dm.std and "psi_out" not in chosen.std:
         from dataclasses import replace
 
