@@ -286,7 +286,7 @@ def findings(
     out += _collinear_findings(d)
     out += _symmetry_findings(d, real)
     out += _definiteness_findings(d)
-    out += _proportionality_findings(d, real, proportional)
+    out += _proportionality_findings(d, real, proportional, determined=not why)
     out += _truncation_findings(d, real)
     out += _theory_findings(d, real, method)
     if std_modal is not None and c_modal is not None and d.n_modes > 1:
@@ -401,11 +401,14 @@ def _definiteness_findings(d: DampingDiagnostics) -> list[str]:
     return out
 
 
-def _proportionality_findings(d: DampingDiagnostics, real: bool, proportional: Any) -> list[str]:
-    """Proportional damping and the best Rayleigh model."""
+def _proportionality_findings(
+    d: DampingDiagnostics, real: bool, proportional: Any, determined: bool = True
+) -> list[str]:
+    """Proportional damping and the best Rayleigh model (the share of C' off its
+    diagonal only for a C' that the modes determine, :func:`not_determined`)."""
     out: list[str] = []
     # --- proportionality
-    if not real and d.n_modes > 1:
+    if not real and determined and d.n_modes > 1:
         pct = _pct(d.non_proportionality)
         kind = (
             "close to proportional" if d.non_proportionality < 0.1 else "clearly non-proportional"
