@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from typing import Any
 
 import numpy as np
 import pytest
@@ -294,3 +295,26 @@ def test_modes_the_points_cannot_tell_apart_are_named() -> None:
     assert pairs[0][2] == pytest.approx(1 / 1.04, rel=1e-12)
     assert pairs[0][2] > COLLINEAR_MAC
     assert collinear_pairs(np.column_stack([a, b])) == ()
+
+
+def test_not_determined_needs_both_an_indefinite_c_and_a_worse_reproduction() -> None:
+    """C' is called undetermined only when it is indefinite *and* the modal system
+    with it reproduces its own modes worse than the system with its diagonal."""
+    from types import SimpleNamespace
+
+    from tyredamp.damping.diagnostics import not_determined
+
+    def diag(definiteness: str) -> Any:
+        return SimpleNamespace(
+            definiteness_modal=definiteness,
+            eigenvalues_modal=np.array([-5.0, 2.0, 9.0]),
+            max_damping_ratio=0.0002,
+        )
+
+    worse = SimpleNamespace(frf_error_full=0.3, frf_error_modal=0.01)
+    better = SimpleNamespace(frf_error_full=0.001, frf_error_modal=0.01)
+    assert "indefinite" in not_determined(diag("indefinite"), worse)
+    assert "0.02 %" in not_determined(diag("indefinite"), worse)  # largest damping ratio
+    assert not_determined(diag("indefinite"), better) == ""  # coupling that explains the modes
+    assert not_determined(diag("positive definite"), worse) == ""
+    assert not_determined(diag("indefinite"), None) == ""

@@ -26,7 +26,7 @@ from tyredamp.damping.modeset import (
     shape_side,
 )
 from tyredamp.documents.modes import modes_document, read_modes, write_modes_json
-from tyredamp.exceptions import FileFormatError, InputError, ShapeError
+from tyredamp.exceptions import FileFormatError, InputError
 from tyredamp.frf import FRF, Channel
 from tyredamp.geometry import Geometry
 from tyredamp.io.uff55 import read_uff55
@@ -512,18 +512,30 @@ def test_roving_hammer_shapes_at_the_inputs(beam_models: dict[str, ModalModel]) 
 
 
 def test_roving_hammer_damping_at_the_hammer_points(beam_models: dict[str, ModalModel]) -> None:
-    with pytest.raises(ShapeError, match="at most 3 modes"):
-        damping_from_modes(beam_models, n_samples=0)
-    dm = damping_from_modes(beam_models, modes=[1, 2, 3], n_samples=0)
+    # the beam's response is not at hammer point 1 for every mode: the even modes
+    # (and the weak 900.9 Hz one) have a negative modal mass there, so their shapes
+    # cannot be mass-normalised; chosen by hand they are refused, by default left out
+    refusal = r"1\+Z gives the mode\(s\) at 142\.2.*negative modal mass"
+    with pytest.raises(InputError, match=refusal):
+        damping_from_modes(beam_models, modes=[1, 2, 3], n_samples=0)
+    auto = damping_from_modes(beam_models, n_samples=0)
+    assert auto.meta["modes_used"] == [1, 3, 5]
+    assert "were left out" in auto.findings[0]
+    # modes 1, 3 and 5 are scaled, but their shapes' phases (zeta 0.02 %) are below
+    # what the fit resolves: C' indefinite and further from the modes than diag C'
+    assert auto.diagnostics.definiteness_modal == "indefinite"
+    assert any(f.startswith("C' is not determined by these modes") for f in auto.findings)
+    dm = damping_from_modes(beam_models, modes=[1], n_samples=0)
     assert [c.node for c in dm.points] == [1, 2, 3]
     assert dm.meta["shape_points"] == "inputs"
-    assert not any("excitation points carry no standard errors" in f for f in dm.findings)
-    with_std = damping_from_modes(beam_models, modes=[1, 2, 3], n_samples=20)
-    assert any("excitation points carry no standard errors" in f for f in with_std.findings)
-    assert dm.meta["modes_used"] == [1, 2, 3]
-    # eq. [15]: C'_nn = -2 Re p_n, here of modes 1-3 of the file (not of any others)
+    assert dm.meta["modes_used"] == [1]
+    # the fit gives the shapes at the hammer points their standard errors
+    with_std = damping_from_modes(beam_models, modes=[1], n_samples=20)
+    assert not any("excitation points carry no standard errors" in f for f in with_std.findings)
+    assert np.all(np.isfinite(with_std.std["modal"]))
+    # eq. [15]: C'_nn = -2 Re p_n, here of mode 1 of the file (not of any other)
     m = beam_models["complex"]
-    assert_allclose(np.diag(dm.modal), -2 * m.poles.real[:3], rtol=1e-9)  # rounding
+    assert_allclose(np.diag(dm.modal), -2 * m.poles.real[:1], rtol=1e-9)  # rounding
 
 
 def test_roving_hammer_without_drive_point_is_refused(beam_frf: FRF) -> None:
@@ -550,7 +562,7 @@ def test_roving_hammer_report_and_cli(
     assert "against the point" in html
     assert "around the circumference" not in html
     out = tmp_path / "d.json"
-    code, text = run("damping", str(js), "-o", str(out), "--modes", "1-3", "--samples", "0")
+    code, text = run("damping", str(js), "-o", str(out), "--modes", "1", "--samples", "0")
     assert code == 0, text
     assert "points: the inputs (1+Z, 2+Z, 3+Z)" in text
     doc = json.loads(out.read_text())

@@ -24,7 +24,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["COLLINEAR_MAC", "DampingDiagnostics", "collinear_pairs", "definiteness", "findings"]
+__all__ = [
+    "COLLINEAR_MAC",
+    "DampingDiagnostics",
+    "collinear_pairs",
+    "definiteness",
+    "findings",
+    "not_determined",
+]
 
 #: Relative asymmetry below which C' counts as symmetric (measured data).
 SYMMETRY_OK = 0.05
@@ -270,15 +277,50 @@ def findings(
             "construction: non-proportional damping cannot be identified from real modes. "
             "Use the complex-mode fit to identify damping coupling between modes."
         )
+    why = not_determined(d, proportional)
+    if why:
+        out.append(
+            f"C' is not determined by these modes: {why}. Use the modes' damping ratios "
+            "(modal damping) rather than this matrix."
+        )
     out += _collinear_findings(d)
     out += _symmetry_findings(d, real)
     out += _definiteness_findings(d)
-    out += _proportionality_findings(d, real, proportional)
+    out += _proportionality_findings(d, real, proportional, determined=not why)
     out += _truncation_findings(d, real)
     out += _theory_findings(d, real, method)
     if std_modal is not None and c_modal is not None and d.n_modes > 1:
         out += _uncertainty_findings(d, std_modal, c_modal)
     return out
+
+
+def not_determined(d: DampingDiagnostics, proportional: Any) -> str:
+    """Why the damping matrix is not determined by the modes it came from, or "".
+
+    Two facts together: ``C'`` is indefinite (a passive structure has no
+    combination of modes that gains energy), and the modal system ``(I, C',
+    diag omega^2)`` reproduces the complex-mode FRFs at the points *worse*
+    than the same system with ``C'``'s diagonal alone
+    (:class:`~tyredamp.damping.proportional.ProportionalComparison`). The
+    off-diagonal terms exist to explain the modes' complexity; when adding
+    them both breaks passivity and moves the model away from the modes they
+    were computed from, they are what the errors of the shapes' small phases
+    made of them, not damping coupling (typical of lightly damped modes
+    whose phases the fit barely resolves).
+    """
+    if proportional is None or d.definiteness_modal != "indefinite":
+        return ""
+    full, modal = float(proportional.frf_error_full), float(proportional.frf_error_modal)
+    if not full > modal:
+        return ""
+    lo, hi = float(d.eigenvalues_modal[0]), float(d.eigenvalues_modal[-1])
+    return (
+        f"C' is indefinite (eigenvalues {lo:.3g} to {hi:.3g} 1/s; a passive structure has "
+        f"none below 0) and reproduces the FRFs of the modes it came from worse ({_pct(full)} "
+        f"%) than their modal damping alone ({_pct(modal)} %): its off-diagonal terms come "
+        f"from errors in the small phases of the shapes (largest damping ratio "
+        f"{100 * d.max_damping_ratio:.3g} %), not from damping coupling"
+    )
 
 
 def _collinear_findings(d: DampingDiagnostics) -> list[str]:
@@ -359,11 +401,14 @@ def _definiteness_findings(d: DampingDiagnostics) -> list[str]:
     return out
 
 
-def _proportionality_findings(d: DampingDiagnostics, real: bool, proportional: Any) -> list[str]:
-    """Proportional damping and the best Rayleigh model."""
+def _proportionality_findings(
+    d: DampingDiagnostics, real: bool, proportional: Any, determined: bool = True
+) -> list[str]:
+    """Proportional damping and the best Rayleigh model (the share of C' off its
+    diagonal only for a C' that the modes determine, :func:`not_determined`)."""
     out: list[str] = []
     # --- proportionality
-    if not real and d.n_modes > 1:
+    if not real and determined and d.n_modes > 1:
         pct = _pct(d.non_proportionality)
         kind = (
             "close to proportional" if d.non_proportionality < 0.1 else "clearly non-proportional"

@@ -38,6 +38,7 @@ __all__ = [
     "ShapeSide",
     "at_shape_points",
     "check_point_count",
+    "negative_mass_modes",
     "parse_mode_numbers",
     "scaling_problem",
     "select_modes",
@@ -69,7 +70,11 @@ def _transposed(model: ModalModel) -> ModalModel:
     def t(r: Any) -> Any:
         return None if r is None else np.asarray(r).T
 
-    std: dict[str, Any] = {k: v for k, v in model.std.items() if k != "psi_out"}
+    std: dict[str, Any] = {k: v for k, v in model.std.items() if k not in ("psi_out", "psi_in")}
+    if "psi_in" in model.std:  # the shapes' errors go with the shapes
+        std["psi_out"] = model.std["psi_in"]
+    if "psi_out" in model.std:
+        std["psi_in"] = model.std["psi_out"]
     rm = model.residual_modes
     return ModalModel(
         model.poles,
@@ -95,9 +100,9 @@ def at_shape_points(model: ModalModel) -> ModalModel:
     channels, residual terms transposed (the receptance of the result is the
     transpose of the model's, equal to it by reciprocity), with
     ``meta["shapes_from"] = "inputs"`` (and ``meta["shapes_at"] = "outputs"``,
-    so that a second call changes nothing). Standard errors of the shapes, given
-    only at the outputs, are not carried over (the modes' frequency and
-    damping errors are).
+    so that a second call changes nothing). The standard errors go with what they
+    belong to: those of the shapes at the inputs become those at the outputs and
+    the other way round; the modes' frequency and damping errors are kept.
     """
     if shape_side(model) == "outputs":
         return model
@@ -111,15 +116,71 @@ def at_shape_points(model: ModalModel) -> ModalModel:
     return out
 
 
-def scaling_problem(model: ModalModel) -> str:
+def negative_mass_modes(model: ModalModel) -> tuple[list[float], str]:
+    """The modes to which a drive point of ``model`` gives a negative modal mass.
+
+    With the eq. [10] scaling the residue of mode ``n`` at a drive point
+    (output ``k`` at the node of input ``j``) is ``R_kjn = psi_out[k, n]
+    psi_in[j, n]``, and ``2 i Omega_n R_kjn = phi_k phi_j`` (spec eq. [3];
+    the complex modes' ``1 / a_n`` in eq. [10]) is the inverse modal mass
+    seen at that point: ``phi_k^2 > 0`` for every mode of a passive structure
+    when the response is measured at the excitation point and in its
+    direction (a direction of the opposite sense turns every sign). A mode
+    with ``Re(2 i Omega_n R_kjn) <= 0`` at a drive point therefore says that
+    the point is not one, for that mode (the response is beside the
+    excitation, on a node line of the mode's neighbour, or across the
+    structure), or that the mode is not physical; the drive-point scaling
+    of its shape is then meaningless. A mode set whose drive points were not
+    stated (``meta["drive_points_stated"] is False``: a UFF 55 file of another
+    program, every point taken as an input) has no measured drive point to
+    test.
+
+    Returns
+    -------
+    frequencies : list of float
+        Natural frequencies (Hz) of those modes, ascending.
+    point : str
+        The drive point that shows it (e.g. ``"1+Z"``), ``""`` when none.
+    """
+    if model.meta.get("drive_points_stated") is False:  # inputs assumed, not measured
+        return [], ""
+    names = {1: "X", 2: "Y", 3: "Z", 4: "RX", 5: "RY", 6: "RZ"}
+    omega = np.abs(np.asarray(model.poles).imag)
+    for k, co in enumerate(model.outputs):
+        for j, ci in enumerate(model.inputs):
+            if co.node != ci.node or abs(co.direction) != abs(ci.direction) or not co.direction:
+                continue
+            sense = 1.0 if co.direction * ci.direction > 0 else -1.0
+            a = sense * np.real(2j * omega * model.psi_out[k] * model.psi_in[j])
+            bad = np.flatnonzero(~(a > 0))
+            if bad.size:
+                where = f"{co.node}{'+' if co.direction > 0 else '-'}"
+                where += names.get(abs(co.direction), str(abs(co.direction)))
+                return sorted(float(x) for x in model.frequency_hz[bad]), where
+    return [], ""
+
+
+def scaling_problem(model: ModalModel, per_mode: bool = False) -> str:
     """Why the shapes of ``model`` are not mass-normalised, or ``""`` when they are.
 
     Unscaled are the modes of a UFF 55 file without modal A (complex modes) or
     modal mass (real modes), ``meta["scaled"] is False``, and the modes fitted
     to FRFs without a drive point (no input at the node and direction of an
     output, so no residue fixes the scale). A model that states
-    ``meta["scaled"] is True`` is scaled.
+    ``meta["scaled"] is True`` is scaled. With ``per_mode`` the modes to which
+    the drive point gives a negative modal mass (:func:`negative_mass_modes`)
+    are unscaled too.
     """
+    if per_mode:
+        bad, point = negative_mass_modes(model)
+        if bad:
+            hz = ", ".join(f"{f:.4g}" for f in bad)
+            return (
+                f"the drive point {point} gives the mode(s) at {hz} Hz a negative modal mass, "
+                "which a response measured at the excitation point and in its direction never "
+                "does: for these modes the response is not at the drive point (or the modes are "
+                "not physical), so their shapes cannot be mass-normalised"
+            )
     scaled = model.meta.get("scaled")
     if scaled is True:
         return ""

@@ -63,6 +63,7 @@ def unscale(res: FitResult, c: float, drive: bool) -> FitResult:
         psi_out=res.psi_out * so,
         psi_in=res.psi_in * si,
         std_psi_out=res.std_psi_out * so,
+        std_psi_in=res.std_psi_in * si,
         upper=None if res.upper is None else res.upper * c,
         lower=None if res.lower is None else res.lower * c,
         sigma_out=res.sigma_out * c,
@@ -218,6 +219,9 @@ def _intervals_95(
         "damping_ratio": np.where(lik, np.max(half_z, axis=1) / Z95, sd_z * inflate),
         "psi_out": u.std_psi_out[:, o] * inflate[None, :],
     }
+    sin = u.std_psi_in
+    if sin.ndim == 2 and sin.shape[1] == u.std_psi_out.shape[1] and np.isfinite(sin[:, o]).all():
+        std["psi_in"] = sin[:, o] * inflate[None, :]
     f_lo, f_hi = f_hat - half_f[:, 0], f_hat + half_f[:, 1]
     meta: dict[str, object] = {
         "interval_frequency_hz": np.stack([f_lo, f_hi], axis=1),

@@ -304,7 +304,8 @@ class ModalModel:
                         "shape": [[re, im] per output]  (eq. [10] scaling),
                         "participation": [[re, im] per input],
                         "std": {"frequency_hz", "damping_ratio",
-                                "shape": [per output] (optional)}}, ...],
+                                "shape": [per output] (optional),
+                                "participation": [per input] (optional)}}, ...],
              "lower_residual": [[[re, im] per input] per output] | null,
              "upper_residual": ... | null,
              "meta": {...},
@@ -326,6 +327,8 @@ class ModalModel:
                     std[key] = float(self.std[key][n])
             if "psi_out" in self.std:
                 std["shape"] = np.asarray(self.std["psi_out"])[:, n].tolist()
+            if "psi_in" in self.std:
+                std["participation"] = np.asarray(self.std["psi_in"])[:, n].tolist()
             modes.append(
                 {
                     "frequency_hz": float(self.frequency_hz[n]),
@@ -390,6 +393,8 @@ class ModalModel:
                     std[key] = [md["std"][key] for md in modes]
             if m and all("shape" in md.get("std", {}) for md in modes):
                 std["psi_out"] = np.array([md["std"]["shape"] for md in modes], float).T
+            if m and all("participation" in md.get("std", {}) for md in modes):
+                std["psi_in"] = np.array([md["std"]["participation"] for md in modes], float).T
             lr = d.get("lower_residual")
             ur = d.get("upper_residual")
             rm = d.get("residual_modes")

@@ -61,6 +61,9 @@ class FitResult:
     #: rest here: the same refinement started at this result stops at once
     #: (``ModalFitter.fit(..., start=this)``); None when not known to be at rest
     rest: tuple[NDArray[np.float64], float] | None = None
+    #: standard errors of ``psi_in`` (n_in, m; magnitude of the complex error),
+    #: empty when not computed
+    std_psi_in: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 0)))
     #: 95 % intervals of the in-band modes' f and zeta (fit order;
     #: :class:`~tyredamp.modal.fit.profile.Intervals`), set by the final stage
     intervals: Any = None
@@ -76,20 +79,29 @@ def pole_and_shape_std(
     s2: float,
     shapes: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.intp]],
     uncertainty: bool,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.complex128], NDArray[np.float64]]:
-    """Standard errors of f, zeta, the pole and the shapes (NaN without ``uncertainty``):
-    Gauss-Newton covariance ``s^2 (J^T J)^-1`` at the optimum and the delta method."""
+) -> tuple[
+    NDArray[np.float64],
+    NDArray[np.float64],
+    NDArray[np.complex128],
+    NDArray[np.float64],
+    NDArray[np.float64],
+]:
+    """Standard errors of f, zeta, the pole and the shapes at the outputs and at
+    the inputs (NaN without ``uncertainty``): Gauss-Newton covariance ``s^2
+    (J^T J)^-1`` at the optimum and the delta method."""
     b, u, didx = shapes
     n_par = th.size
     nan = np.full(m, np.nan)
     std_f, std_z, std_pole = nan, nan.copy(), nan + 0j
     std_psi = np.full((fitter.n_out, m), np.nan)
+    std_in = np.full((fitter.n_in, m), np.nan)
     if uncertainty:
         jtj = sol["jtj"] if "jtj" in sol else fitter._normal(sol, n_par)[0]
         cth = s2 * np.linalg.pinv(jtj, hermitian=True)
         std_f, std_z, std_pole = _scaling.pole_std(fitter.w_ref, th, m, cth)
         std_psi = _scaling.shape_std(fitter, th, m, ref, w, sol, cth, s2, b, u, didx)
-    return std_f, std_z, std_pole, std_psi
+        std_in = _scaling.input_shape_std(fitter, th, m, ref, w, sol, cth, s2, b, didx)
+    return std_f, std_z, std_pole, std_psi, std_in
 
 
 def coefficient_parts(
@@ -173,7 +185,7 @@ def assemble(
     n_obs = fitter.n_rows * fitter.n_out
     dof = max(n_obs - q * fitter.n_out - n_par, 1)
     s2 = sol["cost"] / dof
-    std_f, std_z, std_pole, std_psi = pole_and_shape_std(
+    std_f, std_z, std_pole, std_psi, std_in = pole_and_shape_std(
         fitter, th, m, ref, w, sol, s2, (b, u, didx), uncertainty
     )
     # ---- model (final fits only), contributions
@@ -201,6 +213,7 @@ def assemble(
         std_damping_ratio=std_z,
         std_psi_out=std_psi,
         std_pole=std_pole,
+        std_psi_in=std_in,
         model=model,
         sigma_out=sig_out,
         cost=float(sol["cost"]),

@@ -173,17 +173,8 @@ def shape_std(
         return np.asarray(np.sqrt(np.maximum(term1, 0.0)))
     # global quantities G = [theta, C_D (n_d * q)] and d b / d G
     beta = scale_jacobian(fitter, th, m, ref, C[:, didx].T, w[didx])
-    ng = beta.shape[0]
     MD = M[didx]  # (nd, q, n_par)
-    # Sigma_GG
-    sgg = np.zeros((ng, ng))
-    sgg[:n_par, :n_par] = cth
-    cdt = MC[didx]  # Cov(C_D, theta): (nd, q, n_par)
-    sgg[n_par:, :n_par] = cdt.reshape(nd * q, n_par)
-    sgg[:n_par, n_par:] = sgg[n_par:, :n_par].T
-    dd = cdt.reshape(nd * q, n_par) @ MD.reshape(nd * q, n_par).T  # MD cth MD^T
-    dd += s2 * np.kron(np.eye(nd), F)
-    sgg[n_par:, n_par:] = dd
+    sgg = _global_cov(cth, MC[didx], MD, s2, F)
     v3 = np.real(np.sum(beta.conj() * (sgg @ beta), axis=0))
     term3 = np.abs(u) ** 2 * v3[None, :]
     # cross_jn = sum_g Sigma_cG_j[a_n, g] beta[g, n] with Sigma_cG_j = [MC_j,
@@ -206,6 +197,93 @@ def shape_std(
         cross += sign * part_
     term2 = 2 * np.real(np.conj(b)[None, :] / w[:, None] * u * cross)
     return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))
+
+
+def _global_cov(
+    cth: NDArray[np.float64],
+    cdt: NDArray[np.float64],
+    MD: NDArray[np.float64],
+    s2: float,
+    F: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Covariance of ``G = [theta, C_D]``: the parameters and the drive outputs'
+    coefficients (``cdt = Cov(C_D, theta)`` and ``MD = -Phi^+ dPhi/dtheta C_D``,
+    each (n_d, q, n_par); ``F = (Phi^T Phi)^-1``)."""
+    nd, q, n_par = cdt.shape
+    ng = n_par + nd * q
+    sgg = np.zeros((ng, ng))
+    sgg[:n_par, :n_par] = cth
+    sgg[n_par:, :n_par] = cdt.reshape(nd * q, n_par)
+    sgg[:n_par, n_par:] = sgg[n_par:, :n_par].T
+    dd = cdt.reshape(nd * q, n_par) @ MD.reshape(nd * q, n_par).T  # MD cth MD^T
+    dd += s2 * np.kron(np.eye(nd), F)
+    sgg[n_par:, n_par:] = dd
+    return sgg
+
+
+def input_shape_std(
+    fitter: FitterState,
+    th: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    w: NDArray[np.float64],
+    sol: dict[str, Any],
+    cth: NDArray[np.float64],
+    s2: float,
+    b: NDArray[np.complex128],
+    didx: NDArray[np.intp],
+) -> NDArray[np.float64]:
+    """``sqrt(E|d psi_in|^2)`` per entry (n_in, m) by the delta method.
+
+    ``psi_in[k, n] = l_kn c_n`` with the participation ``l`` (parameters of
+    ``theta``; the reference input's is 1) and the scale ``c_n = 1 / b_n``
+    (complex modes) or ``1 / (b_n 2 i Omega_n)`` (real modes, ``psi = phi /
+    sqrt(2 i Omega)``), :func:`scale`. Over ``G = [theta, C_D]`` (the drive
+    outputs' coefficients fix ``b``, :func:`scale_jacobian`):
+    ``d psi_in[k, n] = c_n (d l_kn - l_kn (d b_n / b_n + d Omega_n / Omega_n))``
+    (the last term for real modes only) and ``E|d psi|^2 = Re(g^H Sigma_GG g)``.
+    Without a drive point ``c_n = 1`` (complex) and only ``theta`` counts.
+    """
+    n_par = th.size
+    poles, part = fitter.unpack(th, m, ref)
+    cplx = fitter.kind == "complex"
+    if didx.size:
+        C, Rq = sol["C"], sol["R"]
+        q = C.shape[0]
+        rinv = lapack.dtrtri(Rq)[0]
+        F = rinv @ rinv.T
+        lay = sol["lay"]
+        E = rinv @ (sol["QtE"][:, lay.ecol] * sol["coef"][None, :])
+        ec = E[None, :, :] * C[lay.dcol][:, didx].T[:, None, :]  # (nd, q, n_d)
+        MD = -(ec.reshape(didx.size * q, -1) @ lay.A).reshape(didx.size, q, n_par)
+        MC = (MD.reshape(-1, n_par) @ cth).reshape(MD.shape)
+        sgg = _global_cov(cth, MC, MD, s2, F)
+        beta = scale_jacobian(fitter, th, m, ref, C[:, didx].T, w[didx])
+        bb = np.where(b == 0, 1.0, b)
+    else:
+        sgg, beta, bb = cth, np.zeros((n_par, m), complex), np.ones(m, complex)
+    omega = poles.imag
+    c = 1.0 / bb if cplx else 1.0 / (bb * 2j * omega)
+    if not didx.size:
+        c = np.ones(m, complex) if cplx else 1.0 / np.sqrt(2j * omega)
+    out = np.zeros((fitter.n_in, m))
+    idx = 2 * m
+    for n in range(m):
+        ln = part[n]
+        dlog = -beta[:, n] / bb[n]
+        if not cplx:  # d ln Omega of 1 / (2 i Omega), or of 1 / sqrt(2 i Omega) without b
+            dlog[2 * n + 1] -= (1.0 if didx.size else 0.5) * fitter.w_ref / omega[n]
+        for k in range(fitter.n_in):
+            g = ln[k] * dlog
+            if k != ref[n]:
+                g[idx] += 1.0
+                idx += 1
+                if cplx:
+                    g[idx] += 1j
+                    idx += 1
+            g = c[n] * g
+            out[k, n] = np.sqrt(max(float(np.real(np.conj(g) @ (sgg @ g))), 0.0))
+    return out
 
 
 def pole_std(

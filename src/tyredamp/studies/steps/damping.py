@@ -200,6 +200,7 @@ def damping_from_modes(
     from ...damping.modeset import (
         at_shape_points,
         check_point_count,
+        negative_mass_modes,
         scaling_problem,
         select_modes,
     )
@@ -220,7 +221,28 @@ def damping_from_modes(
             "(real modes) with the shapes"
         )
     chosen, numbers = select_modes(full, modes, band)
+    left_out = ""
+    bad, point = negative_mass_modes(chosen)
+    if bad and modes is None and band is None:
+        # nobody chose these modes: leave out those whose shapes cannot be scaled
+        keep = [k for k, f in enumerate(chosen.frequency_hz) if float(f) not in bad]
+        if keep:
+            chosen, numbers = select_modes(full, [numbers[k] for k in keep])
+            left_out = (
+                f"The mode(s) at {', '.join(f'{f:.4g}' for f in bad)} Hz were left out: the "
+                f"drive point {point} gives them a negative modal mass, so their shapes cannot "
+                "be mass-normalised (the response is not at the drive point for them, or they "
+                "are not physical). Choose modes with --modes to change this."
+            )
     check_point_count(chosen, full.n_modes if chosen.n_modes == full.n_modes else None)
+    why = scaling_problem(chosen, per_mode=True)
+    if why:
+        src = (meta or {}).get("source") or "the modes"
+        raise InputError(
+            f"{src}: {why}; a damping matrix from them would be meaningless. Choose other "
+            "modes with --modes or --band, or measure a drive-point FRF (the response at the "
+            "excitation point, in its direction)"
+        )
     info = dict(meta or {})
     info["modes_used"] = numbers
     info["n_modes_available"] = full.n_modes
@@ -229,6 +251,10 @@ def damping_from_modes(
     dm = identify_damping(
         chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
     )
+    if left_out:
+        from dataclasses import replace
+
+        dm = replace(dm, findings=(left_out, *dm.findings))
     if info["shape_points"] == "inputs" and dm.std and "psi_out" not in chosen.std:
         from dataclasses import replace
 
