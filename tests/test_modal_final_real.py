@@ -3,6 +3,7 @@ against the refinement without the stop (the old path), and its evaluations."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -96,3 +97,22 @@ def test_accepted_real_refinement_is_unchanged(monkeypatch: pytest.MonkeyPatch) 
     _same(new, old)
     assert new.meta["refinement"] != "lsfd"
     assert count[0] == count[1] > 0
+
+
+def test_pole_at_its_frequency_bound_is_out_of_the_band() -> None:
+    # lines from 0.0002 Hz (1e6 lines to 200 Hz): the bound Omega = 1e-6 w_ref
+    # (0.0002 Hz, plus the 1e-9 w_ref a refinement starts inside it) is in the band,
+    # yet a pole held there is refused; one just above the floor is in the band
+    f = np.array([2e-4, 100.0, 200.0])
+    fitter = ModalFitter(f, np.ones((1, 1, 3), complex), 2, "real", [(0, 0)])
+    floor = final._floor_hz(fitter)
+    # the bound's frequency (1e-6 of the highest line) and the start margin, closed form
+    assert floor == pytest.approx((1e-6 + 2e-9) * 200.0, rel=1e-12)  # rounding only
+    band = (2e-4, 200.0)
+    at = SimpleNamespace(poles=2j * np.pi * np.array([50.0, 1e-6 * 200.0]) - 1.0)
+    above = SimpleNamespace(poles=2j * np.pi * np.array([50.0, 2 * floor]) - 1.0)
+    assert final._problem(at, 2, 0, band) == ("", -1)  # the band alone: accepted
+    why, bad = final._problem(at, 2, 0, band, floor)
+    assert bad == 1
+    assert "band edge (0.00 Hz)" in why
+    assert final._problem(above, 2, 0, band, floor) == ("", -1)

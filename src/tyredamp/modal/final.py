@@ -55,12 +55,27 @@ __all__ = ["fit_real", "goodness", "to_model", "unscale"]
 FINAL_TOL = 1e-4
 
 
-def _problem(res: FitResult, m: int, n_free: int, band: tuple[float, float]) -> tuple[str, int]:
+def _floor_hz(fitter: ModalFitter) -> float:
+    """The highest damped frequency (Hz) of a pole held at the lower bound of its
+    frequency in a refinement of ``fitter``: ``Omega = 1e-6 w_ref``
+    (:func:`~tyredamp.modal.fit.fit.pole_bounds`), which a refinement starts at
+    most 1e-9 ``w_ref`` above (``ModalFitter._refine``)."""
+    return float((pole_bounds(1, 2)[0][1] + 2e-9) * fitter.w_ref / (2.0 * np.pi))
+
+
+def _problem(
+    res: FitResult, m: int, n_free: int, band: tuple[float, float], floor: float = 0.0
+) -> tuple[str, int]:
     """Why a fit is not acceptable ("" when it is: a mode crossed a band edge, or
-    two merged) and the index of the mode concerned (-1 when none)."""
+    two merged) and the index of the mode concerned (-1 when none).
+
+    A pole at or below ``floor`` Hz (:func:`_floor_hz`: held at the lower bound of
+    its frequency, 0 Hz) is out of the band even where the band's first line is
+    below it (``1e6`` lines from 0 Hz): a pole at its bound is no estimate (the
+    cost would fall further beyond it) and no mode of the band."""
     p = res.poles
     fd = p.imag / (2 * np.pi)
-    inb = (fd >= band[0]) & (fd <= band[1])
+    inb = (fd >= band[0]) & (fd <= band[1]) & (fd > floor)
     free = np.zeros(len(p) - m, bool)
     free[:n_free] = True
     wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
@@ -83,50 +98,46 @@ class _PoleAtZero(Exception):
 
 
 class _RealFitter(ModalFitter):
-    """The real-mode fitter of :func:`fit_real`: while :attr:`watch` is set
-    (``(m, f_lo)``: the in-band modes come first, the band starts at ``f_lo`` Hz),
-    a refinement stops (:class:`_PoleAtZero`) as soon as the best point it has
-    evaluated in its pass holds an in-band mode's pole at the lower bound of its
-    frequency (``Omega = 1e-6 w_ref``, :func:`~tyredamp.modal.fit.fit.pole_bounds`)
-    when that bound lies below the band (a pole there fails :func:`_problem`'s test;
-    with lines down to ``1e-6`` of the highest, the bound is in the band and the
-    refinement runs as before).
+    """The real-mode fitter of :func:`fit_real`: while :attr:`watch` is set (``m``,
+    the in-band modes coming first), a refinement stops (:class:`_PoleAtZero`)
+    as soon as the best point it has evaluated in its pass holds an in-band
+    mode's pole at the lower bound of its frequency (``Omega = 1e-6 w_ref``,
+    :func:`~tyredamp.modal.fit.fit.pole_bounds`, :func:`_floor_hz`), where
+    :func:`_problem` would refuse the fit.
 
     Such a pole is at 0 Hz: the real-mode model uses it for what real modes
     cannot hold (the out-of-phase part of complex residues, a lower residual
-    term), not for a mode of the band. The bounded Levenberg-Marquardt iteration
-    holds a parameter at its bound while the cost rises inwards and never
-    accepts a point of higher cost, so the pole comes back into the band only if
-    the other parameters turn its gradient round and the cost falls further on
-    the way; on the tyre cases, the package's tests and the real-data gallery no
-    refinement that passed through 0 Hz came back (``benchmarks/README.md``,
-    "--model both against --model complex"), while those that ended there took
-    the whole evaluation budget (100 per pass) to be rejected. The best point is
-    the lowest cost evaluated with the pass's weights: the iteration's current
-    point (it moves only to lower costs) but for steps of too small a gain.
+    term), not for a mode of the band. The bounded Levenberg-Marquardt
+    iteration (:func:`~tyredamp.modal.fit._linalg._levenberg_marquardt`) holds a
+    parameter at its bound while its gradient points out and never accepts a
+    point of higher cost, so the pole comes back only if the other parameters
+    turn its gradient round with the cost still falling: not excluded in
+    general, so checked (``benchmarks/README.md``, "--model both against
+    --model complex": on the tyre cases, the package's tests and the real-data
+    gallery no refinement's best point held a pole there, while the synthetic
+    complex-mode cases that did took most or all of their budget, 100
+    evaluations per pass, to end rejected with the same model). The best point
+    is the lowest cost evaluated with the pass's weights: the iteration's
+    current point (it moves only to lower costs) but after steps of too small a
+    gain.
     """
 
-    watch: tuple[int, float] | None = None
+    watch: int | None = None
     _best: tuple[bytes, float] | None = None
 
     def _solve(self, th: Any, m: int, ref: Any, w: Any, *args: Any, **kw: Any) -> dict[str, Any]:
         sol = super()._solve(th, m, ref, w, *args, **kw)
-        if self.watch is None or not kw.get("gradient", True) or m < self.watch[0]:
+        if self.watch is None or not kw.get("gradient", True) or m < self.watch:
             return sol
-        n_band, f_lo = self.watch
+        n_band = self.watch
         key, cost = w.tobytes(), float(sol["cost"])
         if self._best is not None and self._best[0] == key and not cost <= self._best[1]:
             return sol
         self._best = (key, cost)
-        # a refinement starts at most 1e-9 inside the bounds (ModalFitter._refine);
-        # where the band reaches down to that frequency, a pole there is in the band
-        top = pole_bounds(m, th.size)[0][1] + 2e-9
-        if not top * self.w_ref / (2.0 * np.pi) < f_lo:
-            return sol
-        om = th[1 : 2 * n_band : 2]
-        at = np.flatnonzero(om <= top)
+        f = th[1 : 2 * n_band : 2] * self.w_ref / (2.0 * np.pi)
+        at = np.flatnonzero(f <= _floor_hz(self))
         if at.size:
-            raise _PoleAtZero(int(at[0]), float(om[at[0]] * self.w_ref / (2.0 * np.pi)))
+            raise _PoleAtZero(int(at[0]), float(f[at[0]]))
         return sol
 
 
@@ -207,7 +218,7 @@ def fit_real(
         )
         if not why:
             ml = maximum_likelihood(problem, fitter, res)
-            if not _problem(ml, m, nf, problem.band)[0]:
+            if not _problem(ml, m, nf, problem.band, _floor_hz(fitter))[0]:
                 res = ml
             # likelihood intervals where the linearised ones would be too short
             res.intervals = fit_intervals(fitter, res, m, sigma0)
@@ -241,7 +252,7 @@ def _watched(
     Hz (:class:`_RealFitter`), and why it is not acceptable with the mode concerned
     (:func:`_problem`). A stopped refinement returns the start (its result is
     rejected and not used)."""
-    fitter.watch, fitter._best = (m, float(band[0])), None
+    fitter.watch, fitter._best = m, None
     try:
         res = fitter.fit(poles, part, **options)
     except _PoleAtZero as stop:
@@ -252,7 +263,7 @@ def _watched(
         )
     finally:
         fitter.watch, fitter._best = None, None
-    return (res, *_problem(res, m, n_free, band))
+    return (res, *_problem(res, m, n_free, band, _floor_hz(fitter)))
 
 
 def noise_along_response(
