@@ -155,9 +155,11 @@ def fit_real(
     is not acceptable (a pole crosses a band edge or two merge: real modes
     that cannot describe strongly complex data), the poles are kept at the
     complex-mode values, only the real residues are fitted, and a warning
-    says so. ``search``: the compressed search fitter (a pre-fit on the
-    output combinations) or None. ``start``: poles and participation of all
-    modes (in-band first) and the mode set they belong to. ``sigma0``: the
+    says so; a refinement whose best point holds an in-band pole at 0 Hz stops
+    there with that outcome (:class:`_RealFitter`). ``search``: the compressed
+    search fitter (a pre-fit on the output combinations) or None. ``start``:
+    poles and participation of all modes (in-band first) and the mode set they
+    belong to. ``sigma0``: the
     noise per output of the final fits; with it, the modes whose linearised
     intervals would be too short get likelihood intervals
     (:func:`~tyredamp.modal.fit.profile.fit_intervals`), as in the complex model.
