@@ -23,13 +23,14 @@ units with its quality, is assembled by :mod:`~tyredamp.modal.assemble`.
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError
 from .assemble import goodness, local_dispersion, to_model, unscale  # noqa: F401 (re-exported)
-from .fit.fit import FitResult, ModalFitter
+from .fit.fit import FitResult, ModalFitter, pole_bounds
 from .fit.ml import ml_refine
 from .fit.profile import fit_intervals
 from .problem.problem import FitProblem
@@ -54,12 +55,27 @@ __all__ = ["fit_real", "goodness", "to_model", "unscale"]
 FINAL_TOL = 1e-4
 
 
-def _problem(res: FitResult, m: int, n_free: int, band: tuple[float, float]) -> tuple[str, int]:
+def _floor_hz(fitter: ModalFitter) -> float:
+    """The highest damped frequency (Hz) of a pole held at the lower bound of its
+    frequency in a refinement of ``fitter``: ``Omega = 1e-6 w_ref``
+    (:func:`~tyredamp.modal.fit.fit.pole_bounds`), which a refinement starts at
+    most 1e-9 ``w_ref`` above (``ModalFitter._refine``)."""
+    return float((pole_bounds(1, 2)[0][1] + 2e-9) * fitter.w_ref / (2.0 * np.pi))
+
+
+def _problem(
+    res: FitResult, m: int, n_free: int, band: tuple[float, float], floor: float = 0.0
+) -> tuple[str, int]:
     """Why a fit is not acceptable ("" when it is: a mode crossed a band edge, or
-    two merged) and the index of the mode concerned (-1 when none)."""
+    two merged) and the index of the mode concerned (-1 when none).
+
+    A pole at or below ``floor`` Hz (:func:`_floor_hz`: held at the lower bound of
+    its frequency, 0 Hz) is out of the band even where the band's first line is
+    below it (``1e6`` lines from 0 Hz): a pole at its bound is no estimate (the
+    cost would fall further beyond it) and no mode of the band."""
     p = res.poles
     fd = p.imag / (2 * np.pi)
-    inb = (fd >= band[0]) & (fd <= band[1])
+    inb = (fd >= band[0]) & (fd <= band[1]) & (fd > floor)
     free = np.zeros(len(p) - m, bool)
     free[:n_free] = True
     wrong = np.flatnonzero(np.concatenate([~inb[:m], inb[m:] & ~free]))
@@ -71,6 +87,58 @@ def _problem(res: FitResult, m: int, n_free: int, band: tuple[float, float]) -> 
         i, j = np.unravel_index(np.argmin(d), d.shape)
         return "two poles merged", int(max(i, j))
     return "", -1
+
+
+class _PoleAtZero(Exception):
+    """An in-band mode's pole reached 0 Hz in a real-mode refinement (:class:`_RealFitter`)."""
+
+    def __init__(self, index: int, freq: float) -> None:
+        super().__init__(index, freq)
+        self.index, self.freq = index, freq
+
+
+class _RealFitter(ModalFitter):
+    """The real-mode fitter of :func:`fit_real`: while :attr:`watch` is set (``m``,
+    the in-band modes coming first), a refinement stops (:class:`_PoleAtZero`)
+    as soon as the best point it has evaluated in its pass holds an in-band
+    mode's pole at the lower bound of its frequency (``Omega = 1e-6 w_ref``,
+    :func:`~tyredamp.modal.fit.fit.pole_bounds`, :func:`_floor_hz`), where
+    :func:`_problem` would refuse the fit.
+
+    Such a pole is at 0 Hz: the real-mode model uses it for what real modes
+    cannot hold (the out-of-phase part of complex residues, a lower residual
+    term), not for a mode of the band. The bounded Levenberg-Marquardt
+    iteration (:func:`~tyredamp.modal.fit._linalg._levenberg_marquardt`) holds a
+    parameter at its bound while its gradient points out and never accepts a
+    point of higher cost, so the pole comes back only if the other parameters
+    turn its gradient round with the cost still falling: not excluded in
+    general, so checked (``benchmarks/README.md``, "--model both against
+    --model complex": on the tyre cases, the package's tests and the real-data
+    gallery no refinement's best point held a pole there, while the synthetic
+    complex-mode cases that did took most or all of their budget, 100
+    evaluations per pass, to end rejected with the same model). The best point
+    is the lowest cost evaluated with the pass's weights: the iteration's
+    current point (it moves only to lower costs) but after steps of too small a
+    gain.
+    """
+
+    watch: int | None = None
+    _best: tuple[bytes, float] | None = None
+
+    def _solve(self, th: Any, m: int, ref: Any, w: Any, *args: Any, **kw: Any) -> dict[str, Any]:
+        sol = super()._solve(th, m, ref, w, *args, **kw)
+        if self.watch is None or not kw.get("gradient", True) or m < self.watch:
+            return sol
+        n_band = self.watch
+        key, cost = w.tobytes(), float(sol["cost"])
+        if self._best is not None and self._best[0] == key and not cost <= self._best[1]:
+            return sol
+        self._best = (key, cost)
+        f = th[1 : 2 * n_band : 2] * self.w_ref / (2.0 * np.pi)
+        at = np.flatnonzero(f <= _floor_hz(self))
+        if at.size:
+            raise _PoleAtZero(int(at[0]), float(f[at[0]]))
+        return sol
 
 
 def fit_real(
@@ -87,9 +155,11 @@ def fit_real(
     is not acceptable (a pole crosses a band edge or two merge: real modes
     that cannot describe strongly complex data), the poles are kept at the
     complex-mode values, only the real residues are fitted, and a warning
-    says so. ``search``: the compressed search fitter (a pre-fit on the
-    output combinations) or None. ``start``: poles and participation of all
-    modes (in-band first) and the mode set they belong to. ``sigma0``: the
+    says so; a refinement whose best point holds an in-band pole at 0 Hz stops
+    there with that outcome (:class:`_RealFitter`). ``search``: the compressed
+    search fitter (a pre-fit on the output combinations) or None. ``start``:
+    poles and participation of all modes (in-band first) and the mode set they
+    belong to. ``sigma0``: the
     noise per output of the final fits; with it, the modes whose linearised
     intervals would be too short get likelihood intervals
     (:func:`~tyredamp.modal.fit.profile.fit_intervals`), as in the complex model.
@@ -98,7 +168,7 @@ def fit_real(
     """
     p0, l0, modes = start
     m, nf = modes.m, modes.n_free
-    fitter = ModalFitter(
+    fitter = _RealFitter(
         problem.frequency,
         problem.H,
         problem.power,
@@ -117,7 +187,7 @@ def fit_real(
     why, bad = "", -1
     if search is not None:
         # real modes start far from the complex optimum: pre-fit on the combinations
-        pre = ModalFitter(
+        pre_fit = _RealFitter(
             search.f,
             search.H,
             problem.power,
@@ -127,8 +197,8 @@ def fit_real(
             lower=residuals,
             unit_weights=True,
             line_weights=problem.line_weights,
-        ).fit(p0, l0, passes=1)
-        why, bad = _problem(pre, m, nf, problem.band)
+        )
+        pre, why, bad = _watched(pre_fit, p0, l0, m, nf, problem.band, passes=1)
         start_p, start_l = pre.poles, pre.participation
     # an out-of-band residual mode that real modes cannot hold is dropped (it only
     # shapes the band's edges); an in-band mode that crosses ends the refinement
@@ -136,11 +206,21 @@ def fit_real(
         if why:
             break
         # the evaluation limit bounds the time spent on data that real modes cannot fit
-        res = fitter.fit(start_p, start_l, max_nfev=100, tol=FINAL_TOL, sigma=sigma, passes=passes)
-        why, bad = _problem(res, m, nf, problem.band)
+        res, why, bad = _watched(
+            fitter,
+            start_p,
+            start_l,
+            m,
+            nf,
+            problem.band,
+            max_nfev=100,
+            tol=FINAL_TOL,
+            sigma=sigma,
+            passes=passes,
+        )
         if not why:
             ml = maximum_likelihood(problem, fitter, res)
-            if not _problem(ml, m, nf, problem.band)[0]:
+            if not _problem(ml, m, nf, problem.band, _floor_hz(fitter))[0]:
                 res = ml
             # likelihood intervals where the linearised ones would be too short
             res.intervals = fit_intervals(fitter, res, m, sigma0)
@@ -159,6 +239,33 @@ def fit_real(
         ],
         noise_along_response(fitter, res, m),
     )
+
+
+def _watched(
+    fitter: _RealFitter,
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    m: int,
+    n_free: int,
+    band: tuple[float, float],
+    **options: Any,
+) -> tuple[FitResult, str, int]:
+    """``fitter.fit(poles, part, **options)`` stopped once an in-band pole reaches 0
+    Hz (:class:`_RealFitter`), and why it is not acceptable with the mode concerned
+    (:func:`_problem`). A stopped refinement returns the start (its result is
+    rejected and not used)."""
+    fitter.watch, fitter._best = m, None
+    try:
+        res = fitter.fit(poles, part, **options)
+    except _PoleAtZero as stop:
+        return (
+            fitter.fit(poles, part, refine=False, uncertainty=False),
+            f"a pole crossed the band edge ({stop.freq:.2f} Hz)",
+            stop.index,
+        )
+    finally:
+        fitter.watch, fitter._best = None, None
+    return (res, *_problem(res, m, n_free, band, _floor_hz(fitter)))
 
 
 def noise_along_response(

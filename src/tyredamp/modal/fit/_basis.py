@@ -457,12 +457,16 @@ def real_rows(
     """The columns ``[Phi | D]`` of the real-mode model as complex rows (q + n_d, n_in,
     lines) (:func:`basis_real`; ``fac``: :func:`factors` of the lines).
 
-    Mode ``n`` (``sigma``, ``Omega``, participation ``L``): ``Phi`` column ``L kappa /
-    d`` with ``d = s^2 + 2 sigma s + sigma^2 + Omega^2``; derivative columns ``L sigma
-    (-kappa (2 s + 2 sigma) / d^2)`` (``x1``, ``sigma = e^x1``), ``L w_ref (-kappa 2
-    Omega / d^2)`` (``x2``) and ``kappa / d`` at input ``k`` for each free
-    participation entry (``k != ref[n]``). Each column is written in place into
-    one array (no per-mode temporaries of the lines).
+    Mode ``n`` (``sigma``, ``Omega``, participation ``L``), ``t = s + sigma`` and ``d =
+    t^2 + Omega^2 = (s - p_n)(s - conj p_n)`` (the denominator of spec eq. [2]):
+    ``Phi`` column ``L kappa / d``; derivative columns ``L sigma (-2 t kappa / d^2)``
+    (``x1``, ``sigma = w_ref e^x1``: ``d d / d sigma = 2 t``), ``L w_ref (-2 Omega
+    kappa / d^2)`` (``x2``, ``Omega = w_ref x2``: ``d d / d Omega = 2 Omega``) and
+    ``kappa / d`` at input ``k`` for each free participation entry (``k !=
+    ref[n]``). Every mode at once: ``1 / d = conj(d) / |d|^2`` from the real and
+    imaginary parts of ``d`` (``Re d = (Re t^2 + Omega^2) - Im t^2``, the positive
+    terms summed first), then ``kappa / d`` and ``kappa / d^2`` by two complex
+    products (no complex division); written in place into one array.
     """
     s, kap, kap_low = fac
     nin, nf = fitter.n_in, s.size
@@ -471,33 +475,7 @@ def real_rows(
     npm = 2 + (nin - 1)
     bt = np.zeros((q + (npm * m if derivatives else 0), nin, nf), complex)
     if m:
-        s2, two_s, nkap = s**2, 2 * s, -kap
-        den, base, tmp = np.empty_like(s), np.empty_like(s), np.empty_like(s)
-    for n in range(m):
-        p = poles[n]
-        sig, om = -p.real, p.imag
-        lr = part[n].real[:, None]
-        np.multiply(2 * sig, s, out=den)
-        np.add(s2, den, out=den)
-        den += sig**2
-        den += om**2
-        np.divide(kap, den, out=base)
-        np.multiply(lr, base[None, :], out=bt[n])
-        if not derivatives:
-            continue
-        den2 = den**2
-        r = q + npm * n
-        np.add(two_s, 2 * sig, out=tmp)
-        np.multiply(nkap, tmp, out=tmp)
-        np.divide(tmp, den2, out=tmp)
-        np.multiply(tmp, sig, out=tmp)
-        np.multiply(lr, tmp[None, :], out=bt[r])
-        np.multiply(nkap, 2 * om, out=tmp)
-        np.divide(tmp, den2, out=tmp)
-        np.multiply(tmp, fitter.w_ref, out=tmp)
-        np.multiply(lr, tmp[None, :], out=bt[r + 1])
-        for j, k in enumerate(k for k in range(nin) if k != ref[n]):
-            bt[r + 2 + j, k] = base
+        _real_mode_rows(fitter, bt, poles, part, ref, derivatives, s, kap)
     c0 = m
     for use, kk in ((fitter.use_upper, kap), (fitter.use_lower, kap_low)):
         if use:
@@ -505,6 +483,54 @@ def real_rows(
                 bt[c0, k] = kk
                 c0 += 1
     return bt
+
+
+def _real_mode_rows(
+    fitter: FitterState,
+    bt: NDArray[np.complex128],
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    ref: NDArray[np.intp],
+    derivatives: bool,
+    s: NDArray[np.complex128],
+    kap: NDArray[np.complex128],
+) -> None:
+    """The modes' rows of :func:`real_rows`, written into ``bt`` (zeros there).
+
+    Mode by mode (arrays of one mode's lines stay in cache): ``t = s + sigma``, ``d = t
+    t + Omega^2``, one complex reciprocal ``r = 1 / d``, then ``kappa r`` and ``kappa
+    r^2`` by products (the columns of three complex divisions before)."""
+    nin, m = fitter.n_in, poles.size
+    q, npm = fitter.n_cols(m), 2 + (nin - 1)
+    nf = s.size
+    t, r, base, u = (np.empty(nf, complex) for _ in range(4))
+    rows = bt[q:].reshape(m, npm, nin, nf) if derivatives else None
+    for n in range(m):
+        sig, om = -poles[n].real, poles[n].imag
+        lr = part[n].real[:, None]
+        one = nin == 1 and lr[0, 0] == 1.0  # L = 1: the columns themselves
+        np.add(s, sig, out=t)
+        np.multiply(t, t, out=r)
+        r += om * om  # d = t^2 + Omega^2
+        np.reciprocal(r, out=r)
+        np.multiply(kap, r, out=base)  # kappa / d
+        if one:
+            bt[n, 0] = base
+        else:
+            np.multiply(lr, base[None, :], out=bt[n])
+        if rows is None:
+            continue
+        np.multiply(base, r, out=u)  # kappa / d^2
+        t *= u
+        t *= -2.0 * sig  # sigma (-2 t kappa / d^2)
+        u *= -2.0 * fitter.w_ref * om  # w_ref (-2 Omega kappa / d^2)
+        for j, col in enumerate((t, u)):
+            if one:
+                rows[n, j, 0] = col
+            else:
+                np.multiply(lr, col[None, :], out=rows[n, j])
+        for j, k in enumerate(k for k in range(nin) if k != ref[n]):
+            rows[n, 2 + j, k] = base
 
 
 # ---------------------------------------------------- variable projection
