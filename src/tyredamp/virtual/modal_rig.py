@@ -412,12 +412,8 @@ def run_modal_test(
     periods = (int(settle_periods), int(n_periods), keep_settle)
     run_len = n_keep * p_samples
     n_runs = drive.shape[0]
-    runs = [drive[run][:, None] * exc.signal[None, :] for run in range(n_runs)]
-    if initial_state == "periodic":
-        clean = _steady_state_runs(tyre, np.stack(runs), (fs * r, r), n_keep, mic)
-    else:
-        sim = ((fs * r, r), periods, mic)
-        clean = np.concatenate([_rest_start_run(tyre, f, *sim) for f in runs], axis=1)
+    runs = drive[:, :, None] * exc.signal[None, None, :]  # (n_runs, n_in, P r)
+    clean = _record(tyre, runs, (fs * r, r), initial_state, periods, mic)
     measured, noise_std = _add_noise(clean, snr_db, rng)
     meta = _notes(tyre, drive, drive_mode, exc, lines, (f_rms, snr_db, noise_std), seed, r)
     meta["initial_state"] = initial_state
@@ -541,6 +537,21 @@ def _checked_options(
         if not (snr > -300.0):  # NaN, -inf (infinite noise) or noise 1e15 x the signal
             raise InputError(f"snr_db: expected a ratio in dB > -300 (inf: no noise), got {snr:g}")
     return tyre, fs, p_samples, f_rms
+
+
+def _record(
+    tyre: RingTyre,
+    runs: NDArray[np.float64],
+    rates: tuple[float, int],
+    initial_state: str,
+    periods: tuple[int, int, bool],
+    mic: NDArray[np.float64] | None,
+) -> NDArray[np.float64]:
+    """The noise-free record of all runs (``runs``: one period of each run's forces)."""
+    if initial_state == "periodic":
+        n_keep = periods[1] + (periods[0] if periods[2] else 0)
+        return _steady_state_runs(tyre, runs, rates, n_keep, mic)
+    return np.concatenate([_rest_start_run(tyre, f, rates, periods, mic) for f in runs], axis=1)
 
 
 def _measured_dofs(
