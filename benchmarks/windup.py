@@ -24,6 +24,11 @@ the share of seeds where it was found, the mean error in standard errors
 and the error of the same fit on the exact FRF (``test.truth.frf``, weighted
 with the noisy test's FRF variance): the fit's own model error, in standard
 errors.
+
+``--noise force`` or ``--noise responses`` (either mode): the test is run
+without noise and the 40 dB noise added to the force channel only or to the
+accelerations only (``h1_variance.noisy``), to tell which noise the
+intervals miss.
 """
 
 from __future__ import annotations
@@ -70,6 +75,22 @@ def exact_fit(tyre: RingTyre, test, frf: FRF) -> None:
         )
 
 
+#: Channels that get the 40 dB noise: "both" (the rig's own), "force" or "responses".
+NOISE = "both"
+
+
+def tested(seed: int, **options: object):
+    """``run_modal_test(seed=seed, **options)`` with the noise on :data:`NOISE`'s channels."""
+    from dataclasses import replace
+
+    from h1_variance import noisy
+
+    if NOISE == "both":
+        return run_modal_test(seed=seed, **options)  # type: ignore[arg-type]
+    test = run_modal_test(seed=seed, snr_db=None, **options)  # type: ignore[arg-type]
+    return replace(test, data=noisy(test.data, NOISE, np.random.default_rng(seed), 40.0))
+
+
 def main() -> None:
     n_seeds = int(sys.argv[1]) if len(sys.argv) > 1 else 20
     n_periods = int(sys.argv[2]) if len(sys.argv) > 2 else 2
@@ -82,17 +103,17 @@ def main() -> None:
         f"BELT_IYY {truth['I']:.5f} kg m^2 (tested with the tip: {wt.frequency_hz:.5f} Hz, "
         f"zeta {wt.damping_ratio:.6f})"
     )
-    print(" seed   rel f      rel zeta   rel I      z_f    z_zeta  z_I    split  s")
+    print(" seed   rel f      rel zeta   rel I      z_f    z_zeta  z_I    split along  s")
     rel: dict[str, list[float]] = {"f": [], "z": [], "I": []}
     cover: dict[str, list[bool]] = {"f": [], "z": [], "I": []}
     zall: dict[str, list[float]] = {"f": [], "z": [], "I": []}
     splits = 0
     for seed in range(1, n_seeds + 1):
         t0 = time.perf_counter()
-        test = run_modal_test(
-            tyre,
+        test = tested(
+            seed,
+            tyre=tyre,
             direction="tangential",
-            seed=seed,
             n_periods=n_periods,
             band=(0.0, 100.0),
             oversample=4,
@@ -120,7 +141,7 @@ def main() -> None:
         print(
             f" {seed:4d} {rel['f'][-1]:+.2e}  {rel['z'][-1]:+.2e}  {rel['I'][-1]:+.2e}  "
             f"{zs['f']:+6.2f} {zs['z']:+6.2f} {zs['I']:+6.2f}  {'yes' if split else 'no':5s}"
-            f"  {time.perf_counter() - t0:.1f}"
+            f" {_along(mdl, w.index):5.2f}  {time.perf_counter() - t0:.1f}"
         )
     for k, name in (("f", "FREQ_WINDUP"), ("z", "DAMP_WINDUP"), ("I", "BELT_IYY")):
         r = np.abs(rel[k])
@@ -130,6 +151,12 @@ def main() -> None:
             f"rms z {np.sqrt(np.nanmean(np.square(zall[k]))):.2f}"
         )
     print(f"fits that split the rotation into two poles: {splits} of {n_seeds}")
+
+
+def _along(model, k: int) -> float:
+    """The fit's noise along the response of mode ``k`` (1: not significant, not used)."""
+    along = model.meta.get("noise_along_response")
+    return float(along[k]) if along is not None else float("nan")
 
 
 def _matched(model, truth_f: np.ndarray, truth_z: np.ndarray) -> list[int | None]:
@@ -157,7 +184,7 @@ def radial(n_seeds: int, n_periods: int) -> None:
     truth = None
     for seed in range(1, n_seeds + 1):
         t0 = time.perf_counter()
-        test = run_modal_test(seed=seed, n_periods=n_periods)
+        test = tested(seed, n_periods=n_periods)
         truth = test.truth
         vis = truth.select("visible")
         tf, tz = truth.frequency_hz[vis], truth.damping_ratio[vis]
@@ -208,6 +235,10 @@ def radial(n_seeds: int, n_periods: int) -> None:
 
 if __name__ == "__main__":
     with threadpool_limits(1):
+        if "--noise" in sys.argv:
+            i = sys.argv.index("--noise")
+            NOISE = sys.argv[i + 1]
+            del sys.argv[i : i + 2]
         if "--radial" in sys.argv:
             sys.argv.remove("--radial")
             radial(
