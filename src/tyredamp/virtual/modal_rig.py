@@ -49,7 +49,9 @@ structure, and ideal anti-alias filters, the same on every channel, keep the
 harmonics below ``sample_rate / 2`` of force and responses before both are
 sampled at ``sample_rate``. In the periodic steady state the noise-free
 cyclic FRF is therefore the exact FRF, ``A(f)`` of ``test.truth.frf`` at
-every line, to rounding (checked in the tests).
+every line, to rounding (checked in the tests). ``force_rms`` is the RMS of
+the force samples; the recorded force's is about ``sinc^2(pi f_max /
+fs_sim)`` of it (0.9995 for the defaults, ``f_max`` the band's top).
 
 With ``initial_state="rest"`` the response is the sampled output of the
 time stepping at ``fs_sim`` and the force channel its samples; the filter is
