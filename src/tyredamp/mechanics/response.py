@@ -310,9 +310,9 @@ def continuous_periodic_lines(
     piecewise-linear force of :func:`time_response`: the force gauge sees
     the continuous force, whose harmonics are :func:`foh_fourier_lines`, and
     the response in the periodic steady state is, harmonic by harmonic, the
-    receptance times the force (spec eq. [1]; computed by
-    :func:`_receptance_balanced`, equal to the direct solution at each line
-    to about 1e-10 of its largest value):
+    receptance times the force (spec eq. [1]; from the eigenvalues of the
+    balanced first-order form, ``_receptance_balanced``, equal to the direct
+    solution at each line to about 1e-10 of its largest value):
 
     ``X_l = H(omega_l) F_l``, ``A_l = -omega_l^2 X_l``,
     ``omega_l = 2 pi l sample_rate / N``.

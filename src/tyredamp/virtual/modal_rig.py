@@ -24,9 +24,9 @@ Steady state
 ------------
 By default the record is the exact periodic steady state of the continuous
 system driven by the continuous force: at each harmonic ``l`` of the period
-the force's Fourier coefficient times the receptance (solved directly,
-``(K - omega_l^2 M + i omega_l C) X_l = F_l``, spec eq. [1]) is the
-response's (:func:`~tyredamp.mechanics.continuous_periodic_lines`). The
+the force's Fourier coefficient times the receptance
+``(K - omega_l^2 M + i omega_l C)^-1`` (spec eq. [1]) is the response's
+(:func:`~tyredamp.mechanics.continuous_periodic_lines`). The
 noise-free record is exactly periodic, so it is that period repeated, plus
 independent noise.
 ``initial_state="rest"`` instead simulates every period from rest with
