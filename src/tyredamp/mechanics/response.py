@@ -266,9 +266,10 @@ def foh_fourier_lines(force_period: ArrayLike, n_lines: int) -> NDArray[np.compl
 
     ``c_l = (1/T) int_0^T f(t) e^{-i omega_l t} dt = X_l sinc^2(pi l / N) / N``
 
-    with ``X_l`` the DFT of the samples (Oppenheim & Schafer, *Discrete-Time
-    Signal Processing*, 3rd ed., 2010, eq. (4.98): the triangle as the
-    reconstruction filter of linear interpolation). The function returns
+    with ``X_l`` the DFT of the samples (the triangle's transform: Bracewell,
+    *The Fourier Transform and Its Applications*, 3rd ed., 2000, pictorial
+    dictionary, ``Lambda(x) <-> sinc^2(s)``; the periodic sum gives ``X_l``;
+    checked against a dense Fourier integral in the tests). The function returns
     ``N c_l = X_l sinc^2(pi l / N)``, in the ``numpy.fft.rfft`` convention of
     the samples.
 
