@@ -7,10 +7,13 @@ settings of ``tests/test_tyremodel_windup.py``), the H1 FRFs are fitted
 (``identify_modes``, complex modes, 5-100 Hz) and ``windup_from_modes``
 (attachment removed) is compared with the exact rotation mode
 (``windup_truth``: bare frequency and damping, belt inertia). Prints per
-seed the relative errors and the errors in units of the statistical
-standard errors, then the largest relative errors, the share of seeds whose
-1-sigma statistical interval covers the truth and the share whose fit split
-the rotation into two poles (noted by ``windup_from_modes``).
+seed the relative errors, the errors in units of the statistical
+standard errors and the fit's noise along the response of the mode
+(``noise_along_response``, 1 where not significant), then the largest
+relative errors, the share of seeds whose 1-sigma statistical interval
+covers the truth and the share whose fit split
+the rotation into two poles (noted by ``windup_from_modes``). First it
+prints the same fit on the exact FRF (seed 1's FRF variance as weights).
 
 Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/windup.py [N_SEEDS] [N_PERIODS]``
 (default 20 seeds, 2 periods).
@@ -57,13 +60,17 @@ def exact_fit(tyre: RingTyre, test, frf: FRF) -> None:
     ex = FRF(frf.frequency, exact.H, kind=frf.kind, outputs=frf.outputs, inputs=frf.inputs)
     mdl = modes_from_frf(ex, band=(5.0, 100.0), model="complex", variance=frf.variance)
     mdl = mdl.models["complex"]
-    for label, (m_a, c_a), (f0, z0) in (
+    for label, (m_a, c_a), (f0, z0, i0) in (
         (
             "tip removed, bare truth",
             (lay.attachment_mass, lay.attachment_damping),
-            (wt.bare_frequency_hz, wt.bare_damping_ratio),
+            (wt.bare_frequency_hz, wt.bare_damping_ratio, wt.inertia),
         ),
-        ("tip kept, tested mode", (0.0, 0.0), (wt.frequency_hz, wt.damping_ratio)),
+        (
+            "tip kept, tested mode",
+            (0.0, 0.0),
+            (wt.frequency_hz, wt.damping_ratio, wt.modal_inertia),
+        ),
     ):
         w = windup_from_modes(
             mdl, radius=tyre.params.radius, attachment_mass=m_a, attachment_damping=c_a
@@ -72,6 +79,7 @@ def exact_fit(tyre: RingTyre, test, frf: FRF) -> None:
             f"exact FRF, {label}: rel f {w.freq_windup / f0 - 1:+.2e} "
             f"({(w.freq_windup - f0) / w.freq_windup_std:+.2f} se), rel zeta "
             f"{w.damp_windup / z0 - 1:+.2e} ({(w.damp_windup - z0) / w.damp_windup_std:+.2f} se)"
+            f", rel I {w.belt_iyy / i0 - 1:+.2e}"
         )
 
 
