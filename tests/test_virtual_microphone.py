@@ -93,9 +93,9 @@ def test_rig_records_the_microphone_pressure() -> None:
     sel = (f > 20) & (f < 190)
     h = x[-1, sel] / x[0, sel]
     exact = pressure_frf(tyre, f[sel], 0.0)[0]
-    # one steady-state period, no noise: the first-order hold and the ideal anti-alias
-    # filter change a receptance-like FRF by (pi f / fs_sim)^2 / 3 < 1e-4 below 200 Hz
-    assert_allclose(h, exact, rtol=1e-3)
+    # one steady-state period, no noise: the continuous force and the exact response,
+    # filtered alike, give the exact FRF to rounding (measured 1.2e-13)
+    assert_allclose(h, exact, rtol=1e-10)
 
 
 def test_microphone_determines_the_band_air_damping_term() -> None:

@@ -27,7 +27,14 @@ from .proportional import (
     rayleigh_damping,
     rayleigh_damping_ratios,
 )
-from .response import TimeResponse, periodic_response_lines, step_coefficients, time_response
+from .response import (
+    TimeResponse,
+    continuous_periodic_lines,
+    foh_fourier_lines,
+    periodic_response_lines,
+    step_coefficients,
+    time_response,
+)
 from .system import ComplexModes, MCKSystem, UndampedModes, normalisation_constants
 
 __all__ = [
@@ -40,6 +47,8 @@ __all__ = [
     "TimeResponse",
     "UndampedModes",
     "alpha_coefficients",
+    "continuous_periodic_lines",
+    "foh_fourier_lines",
     "kind_factor",
     "modal_damping_matrix",
     "modal_sum_receptance",

@@ -5,9 +5,10 @@ point(s) by a periodic chirp and the radial accelerations at the measured
 points are recorded together with the forces, with independent Gaussian
 noise on every channel (``direction="tangential"``: driven and measured
 along the circumference, :mod:`~tyredamp.virtual.tangential`, the test that
-sees the belt's wind-up mode). The response is computed with
-:func:`tyredamp.mechanics.time_response` (exact modal integration with a
-first-order hold of the sampled force).
+sees the belt's wind-up mode). The response is the exact steady state of
+the continuous system (or, started at rest, the exact modal integration of
+:func:`tyredamp.mechanics.time_response`) to the linearly interpolated
+force samples.
 
 Excitation
 ----------
@@ -21,39 +22,45 @@ period inside ``band``.
 
 Steady state
 ------------
-By default the record is the exact periodic steady state. For each complex
-mode, ``q' = p q + psi^T f`` (spec eq. [10]) with the one-step coefficients of
-``time_response`` (:func:`~tyredamp.mechanics.step_coefficients`) is a
-recursion whose periodic solution has, at each DFT line of the period, the
-closed form of :func:`~tyredamp.mechanics.periodic_response_lines`; the lines
-the acquisition keeps are formed there and transformed back, which equals
-simulating one period with ``time_response`` from the periodic initial state
-(:func:`periodic_initial_state`, ``q*(0) = q_P / (1 - e^{p T})`` with ``q_P``
-one period propagated from rest) to rounding, without stepping through the
-samples. The noise-free steady-state response is exactly periodic, so the
-record is that period repeated, plus independent noise.
-``initial_state="rest"`` instead simulates
-every period from rest (the transient decays with the slowest mode, about
+By default the record is the exact periodic steady state of the continuous
+system driven by the continuous force: at each harmonic ``l`` of the period
+the force's Fourier coefficient times the receptance
+``(K - omega_l^2 M + i omega_l C)^-1`` (spec eq. [1]) is the response's
+(:func:`~tyredamp.mechanics.continuous_periodic_lines`). The
+noise-free record is exactly periodic, so it is that period repeated, plus
+independent noise.
+``initial_state="rest"`` instead simulates every period from rest with
+:func:`~tyredamp.mechanics.time_response` (exact modal integration of the
+first-order-hold force; the transient decays with the slowest mode, about
 ``1 / sigma_min`` s) and drops ``settle_periods`` leading periods, or keeps
 them and says so in ``data.acquisition.settle_samples``.
+(:func:`periodic_initial_state` gives the state from which that time
+stepping starts periodic.)
 
 Sampling
 --------
 The force is generated ``oversample`` times faster than ``sample_rate``
-(``fs_sim``) and the response simulated at that rate. The acquisition then
-applies an ideal anti-alias filter (all DFT lines of the simulated period at
-or above ``sample_rate / 2`` removed, on every channel alike, like a DAQ with
-matched filters) and keeps every ``oversample``-th sample. For the periodic
-steady state the filter is exact; in ``initial_state="rest"`` it is applied
-per period and smears the (discarded) transient slightly.
+(``fs_sim``) and interpolated linearly between those samples (first-order
+hold): the shaker's force is the piecewise-linear signal, whose Fourier
+coefficients are the DFT of the samples times ``sinc^2(pi l / N)``
+(:func:`~tyredamp.mechanics.foh_fourier_lines`). The acquisition acts like
+an ideal laboratory: the force gauge measures that continuous force at the
+structure, and ideal anti-alias filters, the same on every channel, keep the
+harmonics below ``sample_rate / 2`` of force and responses before both are
+sampled at ``sample_rate``. In the periodic steady state the noise-free
+cyclic FRF is therefore the exact FRF, ``A(f)`` of ``test.truth.frf`` at
+every line, to rounding (checked in the tests). ``force_rms`` is the RMS of
+the force samples; the recorded force's is about ``sinc^2(pi f_max /
+fs_sim)`` of it (0.9995 for the defaults, ``f_max`` the band's top).
 
-The first-order hold interprets the force as piecewise linear between the
-``fs_sim`` samples, so for the band-limited multisine the cyclic FRF of the
-noise-free data is exactly ``sum_m A(f + m fs_sim) sinc^2(f / fs_sim + m)``
-(``A`` the true accelerance; checked in the tests), which differs from
-``A(f)`` by about ``(pi f / fs_sim)^2 / 3 * |A(f) - M^-1|`` plus folded
-extensional resonances: 5e-4 at 200 Hz for the defaults, below 1 % of
-``|A|`` at every line of the default test.
+With ``initial_state="rest"`` the response is the sampled output of the
+time stepping at ``fs_sim`` and the force channel its samples; the filter is
+applied per simulated period (it smears the discarded transient slightly),
+and sampling folds the response's harmonics above ``fs_sim / 2``: once
+settled, the noise-free cyclic FRF is ``sum_m A(f + m fs_sim)
+sinc^2(f / fs_sim + m)``, which differs from ``A(f)`` by about
+``(pi f / fs_sim)^2 / 3 * |A(f) - M^-1|`` plus folded extensional
+resonances (below 1 % of ``|A|`` at every line of the default test).
 
 Several drive points
 --------------------
@@ -86,7 +93,7 @@ from ..mechanics import (
     ComplexModes,
     MCKSystem,
     TimeResponse,
-    periodic_response_lines,
+    continuous_periodic_lines,
     step_coefficients,
     time_response,
 )
@@ -233,6 +240,18 @@ def _acquire(x: NDArray[np.float64], r: int) -> NDArray[np.float64]:
     spec = np.fft.rfft(x, axis=1)[:, : p // 2 + 1]
     if p % 2 == 0:
         spec[:, p // 2] = 0.0
+    return np.fft.irfft(spec, n=p, axis=1) / r
+
+
+def _band_limited(lines: NDArray[np.complex128], p: int, r: int) -> NDArray[np.float64]:
+    """``P`` samples of the signal whose lines ``0 <= l < P/2`` are ``lines / r``.
+
+    ``lines`` are in the rfft scaling of the ``P r`` simulated samples; the
+    signal of those lines alone (an ideal anti-alias filter) sampled ``P``
+    times per period has the rfft ``lines / r``.
+    """
+    spec = np.zeros((lines.shape[0], p // 2 + 1), dtype=complex)
+    spec[:, : lines.shape[1]] = lines
     return np.fft.irfft(spec, n=p, axis=1) / r
 
 
@@ -395,9 +414,8 @@ def run_modal_test(
     periods = (int(settle_periods), int(n_periods), keep_settle)
     run_len = n_keep * p_samples
     n_runs = drive.shape[0]
-    runs = [drive[run][:, None] * exc.signal[None, :] for run in range(n_runs)]
-    sim = ((fs * r, r), initial_state, periods, mic)
-    clean = np.concatenate([_simulate_run(tyre, f, *sim) for f in runs], axis=1)
+    runs = drive[:, :, None] * exc.signal[None, None, :]  # (n_runs, n_in, P r)
+    clean = _record(tyre, runs, (fs * r, r), initial_state, periods, mic)
     measured, noise_std = _add_noise(clean, snr_db, rng)
     meta = _notes(tyre, drive, drive_mode, exc, lines, (f_rms, snr_db, noise_std), seed, r)
     meta["initial_state"] = initial_state
@@ -475,7 +493,7 @@ def _notes(
         "seed": int(seed) if isinstance(seed, int | np.integer) else None,
         "oversample": r,
         "hold": "foh",
-        "anti_alias": "ideal low-pass at sample_rate/2 (per simulated period)",
+        "anti_alias": "ideal low-pass at sample_rate/2 on every channel",
         "pressure_pa": tyre.params.pressure,
         "nonproportionality": tyre.nonproportionality,
         "n_ring": tyre.n_ring,
@@ -523,29 +541,85 @@ def _checked_options(
     return tyre, fs, p_samples, f_rms
 
 
-def _simulate_run(
+def _record(
     tyre: RingTyre,
-    force_sim: NDArray[np.float64],
+    runs: NDArray[np.float64],
     rates: tuple[float, int],
     initial_state: str,
     periods: tuple[int, int, bool],
+    mic: NDArray[np.float64] | None,
+) -> NDArray[np.float64]:
+    """The noise-free record of all runs (``runs``: one period of each run's forces)."""
+    if initial_state == "periodic":
+        n_keep = periods[1] + (periods[0] if periods[2] else 0)
+        return _steady_state_runs(tyre, runs, rates, n_keep, mic)
+    return np.concatenate([_rest_start_run(tyre, f, rates, periods, mic) for f in runs], axis=1)
+
+
+def _measured_dofs(
+    tyre: RingTyre, mic: NDArray[np.float64] | None
+) -> tuple[list[int], list[int], NDArray[np.intp]]:
+    """Drive DOFs, response DOFs (points, then the microphone's DOFs) and the latter."""
+    extra = np.array([], dtype=np.intp) if mic is None else np.flatnonzero(mic)
+    return tyre.drive_dofs.tolist(), tyre.point_dofs.tolist() + extra.tolist(), extra
+
+
+def _steady_state_runs(
+    tyre: RingTyre,
+    force_sim: NDArray[np.float64],
+    rates: tuple[float, int],
+    n_keep: int,
     mic: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
-    """Forces, accelerations (and the microphone's pressure) of one run, at ``fs_sim / r``.
+    """Forces, accelerations (and pressure) of every run in the steady state, at ``fs_sim / r``.
+
+    ``force_sim`` (n_runs, n_in, P r) is one period of each run's drive
+    forces at the simulation rate ``rates = (fs_sim, r)``. The lines below
+    ``sample_rate / 2`` of the continuous force and of the exact continuous
+    response (:func:`~tyredamp.mechanics.continuous_periodic_lines`) are
+    sampled ``P`` times per period (module docstring, "Sampling") and every
+    run holds ``n_keep`` copies of its period; ``mic`` the pressure row (Pa
+    per DOF) of a microphone, or None.
+    """
+    fs_sim, r = rates
+    inputs, outputs, extra = _measured_dofs(tyre, mic)
+    n_pts = tyre.point_dofs.size
+    p = force_sim.shape[2] // r
+    kept = p // 2 + p % 2  # the lines below sample_rate / 2
+    f_lines, disp, acc_lines = continuous_periodic_lines(
+        tyre.system, force_sim, fs_sim, inputs, outputs, kept
+    )
+    blocks = []
+    for run in range(force_sim.shape[0]):
+        rows = acc_lines[run, :n_pts]
+        if mic is not None:
+            rows = np.vstack([rows, mic[extra] @ disp[run, n_pts:]])
+        one = np.vstack([_band_limited(f_lines[run], p, r), _band_limited(rows, p, r)])
+        blocks.append(np.tile(one, (1, n_keep)))
+    return np.concatenate(blocks, axis=1)
+
+
+def _rest_start_run(
+    tyre: RingTyre,
+    force_sim: NDArray[np.float64],
+    rates: tuple[float, int],
+    periods: tuple[int, int, bool],
+    mic: NDArray[np.float64] | None = None,
+) -> NDArray[np.float64]:
+    """Forces, accelerations (and pressure) of one run started at rest, at ``fs_sim / r``.
 
     ``force_sim`` (n_in, P r) is one period of the drive forces at the
     simulation rate ``rates = (fs_sim, r)``; ``periods`` = (settle periods,
     recorded periods, keep the settle periods); ``mic`` the pressure row
-    (Pa per DOF) of a microphone, or None.
+    (Pa per DOF) of a microphone, or None. Simulated by ``time_response``
+    and sampled (module docstring, "Sampling").
     """
     fs_sim, r = rates
     settle_periods, n_periods, keep_settle = periods
     n_keep = n_periods + (settle_periods if keep_settle else 0)
     system = tyre.system
-    inputs = tyre.drive_dofs.tolist()
+    inputs, outputs, extra = _measured_dofs(tyre, mic)
     n_pts = tyre.point_dofs.size
-    extra = np.array([], dtype=np.intp) if mic is None else np.flatnonzero(mic)
-    outputs = tyre.point_dofs.tolist() + extra.tolist()
 
     def channels(resp: TimeResponse) -> NDArray[np.float64]:
         acc = resp.acceleration[:n_pts]
@@ -553,29 +627,18 @@ def _simulate_run(
             return acc
         return np.vstack([acc, mic[extra] @ resp.displacement[n_pts:]])
 
-    if initial_state == "periodic":
-        p = force_sim.shape[1] // r
-        kept = p // 2 + p % 2  # the lines _acquire keeps: 0 <= l < p / 2
-        disp, acc_lines = periodic_response_lines(system, force_sim, fs_sim, inputs, outputs, kept)
-        rows = acc_lines[:n_pts]
-        if mic is not None:
-            rows = np.vstack([rows, mic[extra] @ disp[n_pts:]])
-        spec = np.zeros((rows.shape[0], p // 2 + 1), dtype=complex)
-        spec[:, :kept] = rows
-        acc = np.tile(np.fft.irfft(spec, n=p, axis=1) / r, (1, n_keep))
-    else:
-        cm = system.complex_modes()
-        blocks = []
-        q = np.zeros(cm.poles.size, dtype=complex)
-        ext = np.concatenate([force_sim, force_sim[:, :1]], axis=1)
-        psi_in = cm.psi[inputs]
-        for k in range(settle_periods + n_periods):
-            x0, v0 = _modal_to_physical(cm, q)
-            resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
-            if k >= settle_periods or keep_settle:
-                blocks.append(_acquire(channels(resp), r))
-            q = _modal_propagate(cm, psi_in, ext, 1.0 / fs_sim, q)
-        acc = np.concatenate(blocks, axis=1)
+    cm = system.complex_modes()
+    blocks = []
+    q = np.zeros(cm.poles.size, dtype=complex)
+    ext = np.concatenate([force_sim, force_sim[:, :1]], axis=1)
+    psi_in = cm.psi[inputs]
+    for k in range(settle_periods + n_periods):
+        x0, v0 = _modal_to_physical(cm, q)
+        resp = time_response(system, force_sim, fs_sim, inputs, outputs, x0=x0, v0=v0)
+        if k >= settle_periods or keep_settle:
+            blocks.append(_acquire(channels(resp), r))
+        q = _modal_propagate(cm, psi_in, ext, 1.0 / fs_sim, q)
+    acc = np.concatenate(blocks, axis=1)
     force = np.tile(_acquire(force_sim, r), (1, n_keep))
     return np.concatenate([force, acc], axis=0)
 
