@@ -424,3 +424,49 @@ def test_plscf_cholesky_fallback_gives_the_same_poles(monkeypatch: pytest.Monkey
     # singular normal equations (no signal): least squares, then no pole at all
     with pytest.raises(InputError, match="no pole"):
         plscf(F, np.zeros((2, 1, F.size), complex), 4)
+
+
+def test_det_coefficients_equal_the_two_by_two_determinant() -> None:
+    """``det A(z) = a11 a22 - a12 a21`` of a 2 x 2 matrix polynomial, the products of
+    polynomials by ``np.convolve`` (an independent route)."""
+    from tyredamp.modal.poles.lscf import _det_coefficients
+
+    rng = np.random.default_rng(4)
+    p = 7
+    alpha = rng.normal(size=(p * 2, 2))
+    a = np.concatenate([alpha.reshape(p, 2, 2), np.eye(2)[None]])  # a[r] = alpha_r
+    exact = np.convolve(a[:, 0, 0], a[:, 1, 1]) - np.convolve(a[:, 0, 1], a[:, 1, 0])
+    # FFT interpolation: round-off of the largest value on the unit circle
+    assert_allclose(_det_coefficients(alpha, 2), exact, rtol=0, atol=1e-12 * np.abs(exact).max())
+
+
+@pytest.mark.parametrize("n_in", [2, 3])
+def test_plscf_aberth_orders_equal_eigenvalue_orders_several_inputs(
+    monkeypatch: pytest.MonkeyPatch, n_in: int
+) -> None:
+    """With several inputs the sweeps on ``det A(z)`` find the block companion's
+    eigenvalues: every pole of every order the same to round-off."""
+    import tyredamp.modal.poles.lscf as lscf_mod
+
+    rng = np.random.default_rng(8)
+    h = chain_system().frf(F, inputs=list(range(n_in))).H
+    h = h + 0.01 * np.abs(h).mean() * (rng.normal(size=h.shape) + 1j * rng.normal(size=h.shape))
+    monkeypatch.setattr(lscf_mod, "_ABERTH_MIN_ORDER", 10**9)
+    ref = plscf(F, h, 40, min_order=10, order_step=2)
+    monkeypatch.setattr(lscf_mod, "_ABERTH_MIN_ORDER", 16)
+    calls = []
+    aberth = lscf_mod._aberth
+    monkeypatch.setattr(lscf_mod, "_aberth", lambda c, g: calls.append(1) or aberth(c, g))
+    got = plscf(F, h, 40, min_order=10, order_step=2)
+    assert len(calls) > 5  # the sweeps ran (not the eigenvalue fallback alone)
+    assert got.poles.size == ref.poles.size
+    for p in ref.orders:
+        ia, ib = ref.at_order(p), got.at_order(p)
+        oa, ob = np.argsort(ref.poles[ia]), np.argsort(got.poles[ib])  # same order
+        a, b = ref.poles[ia][oa], got.poles[ib][ob]
+        # roots to ~1e-13 relative; poles (log of z) as those of one input's test
+        assert_allclose(b, a, rtol=1e-9)
+        # participation from the same A(z) at roots equal to ~1e-13: its null
+        # vector moves by that over the gap of the two singular values
+        pa, pb = ref.participation[ia][oa], got.participation[ib][ob]
+        assert_allclose(pb, pa, atol=1e-6)

@@ -3,6 +3,8 @@ data show, and the blocked linear algebra of the fits equals the dense one."""
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
@@ -12,7 +14,7 @@ from tyredamp.modal import ModalModel, identify_modes
 from tyredamp.modal.fit._linalg import _fixed_range, _qr_blocks
 from tyredamp.modal.poles.estimators import PoleEstimator
 from tyredamp.modal.poles.lscf import PoleSet
-from tyredamp.modal.poles.order import modes_shown, order_cap
+from tyredamp.modal.poles.order import Diagram, modes_shown, order_cap, shown_order
 from tyredamp.modal.problem.problem import build_problem
 
 FN = np.array([25.0, 48.0, 71.0, 96.0, 123.0, 152.0])
@@ -230,3 +232,38 @@ def test_prominent_peaks_are_those_of_scipy_find_peaks() -> None:
         assert_array_equal(prominent_peaks(r, prom), ref)
     assert prominent_peaks(np.array([1.0, 2.0]), 0.0).size == 0
     assert prominent_peaks(np.array([0.0, 1.0, 1.0, 1.0, 0.0]), 0.5).tolist() == [2]
+
+
+def test_shown_order_is_the_sizing_of_the_modes_the_peaks_can_hold() -> None:
+    # ceil(4 (n_in M + 2) / n_in): half the cap's roots
+    assert shown_order(1, 10) == 48
+    assert shown_order(2, 20) == 84
+    assert shown_order(3, 19) == 79
+    for n_in, m in [(1, 7), (2, 17), (3, 5)]:
+        assert 2 * shown_order(n_in, m) >= order_cap(n_in, 10**6, 2, m) >= shown_order(n_in, m)
+
+
+def _diagram_with(order: int, n_kept: int, share: float) -> Diagram:
+    """A stand-in diagram: ``n_kept`` persistent clusters of one stable pole each and
+    stable poles outside them so that the persistent share is ``share``."""
+    n_stable = round(n_kept / share)
+    flags = SimpleNamespace(stable=np.ones(n_stable, bool))
+    kept = [SimpleNamespace(members=np.array([i])) for i in range(n_kept)]
+    return Diagram(order, None, flags, kept, [])  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("n_kept", "share", "kept"),
+    [(20, 0.9, True), (20, 0.4, False), (10, 0.9, False), (12, 0.6, False)],
+)
+def test_peaks_trial_is_kept_only_with_more_clusters_and_a_larger_share(
+    monkeypatch: pytest.MonkeyPatch, n_kept: int, share: float, kept: bool
+) -> None:
+    import tyredamp.modal.poles.order as order_mod
+
+    cur = _diagram_with(30, 12, 0.5)
+    trial = _diagram_with(84, n_kept, share)
+    monkeypatch.setattr(order_mod, "diagram", lambda *a: trial)
+    got = order_mod._peaks_trial(None, None, None, cur, 84)  # type: ignore[arg-type]
+    assert got is (trial if kept else cur)
+    assert order_mod._peaks_trial(None, None, None, cur, 30) is cur  # type: ignore[arg-type]

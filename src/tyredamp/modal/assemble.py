@@ -27,7 +27,12 @@ from .search.narrow import unresolved_damping
 from .search.residual_peaks import local_ratio
 from .statistics.indicators import mean_phase_deviation, modal_phase_collinearity
 from .statistics.quality import FitQuality, RejectedMode, threshold_text
-from .statistics.stats import GoodnessOfFit, difference_noise, goodness_of_fit
+from .statistics.stats import (
+    DIFFERENCE_INFLATION,
+    GoodnessOfFit,
+    difference_noise,
+    goodness_of_fit,
+)
 
 __all__ = ["ModelContext", "goodness", "local_dispersion", "to_model", "unscale"]
 
@@ -81,7 +86,8 @@ def goodness(
     :mod:`tyredamp.modal.statistics.stats` (one with ``nu <= 4``, too few averages for the
     cost to have a variance, is set aside by
     :func:`~tyredamp.modal.problem.problem.build_problem`); none: the second-difference
-    noise of each FRF.
+    noise of each FRF, estimated from the lines the cost sums (the scaled chi-square
+    of eq. (GoF-1) of :mod:`tyredamp.modal.statistics.stats`).
     """
     n_obs = 2 * sq.size
     nu = problem.noise_dof
@@ -112,11 +118,18 @@ def goodness(
         return goodness_of_fit(
             float("nan"), n_obs - n_par, "unknown", n_rejected=n_rejected, false_alarm=false_alarm
         )
-    # |e|^2 / (s^2 / 2) per real and imaginary part: chi-square with 2 dof per entry
+    # |e|^2 / (s^2 / 2) per real and imaginary part: 2 dof per entry; the noise is
+    # estimated from the same lines: the cost's variance is DIFFERENCE_INFLATION
+    # times the chi-square's (eq. (GoF-1) of modal.statistics.stats)
     chi2 = 2.0 * float(np.einsum("okf,ok->", sq, 1.0 / var))
     label = "from second differences of adjacent lines"
     return goodness_of_fit(
-        chi2, n_obs - n_par, label, n_rejected=n_rejected, false_alarm=false_alarm
+        chi2,
+        n_obs - n_par,
+        label,
+        n_rejected=n_rejected,
+        false_alarm=false_alarm,
+        inflation=DIFFERENCE_INFLATION,
     )
 
 

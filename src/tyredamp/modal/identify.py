@@ -39,6 +39,11 @@ roots; ``limit = 2 n_freq / (n_in + 1) - 2``):
   higher order only adds noise poles to a resolved band, so the share falls.
   Otherwise order ``p`` and its diagram are kept as they were and the
   search stops.
+* *several inputs*: a settled diagram can meet the sizing rule with few of
+  the modes resolved (20 modes, 2 inputs, order 30: 8-15 persistent
+  clusters); one more trial at the order the sizing rule asks for the modes
+  the peaks shown can hold, ``ceil(4 (n M + 2) / n)`` (``M`` below), is kept
+  on the same rule (more persistent clusters and a larger share).
 
 No order exceeds ``limit``, nor the cap set by the modes the data show:
 ``max(p_start, ceil(8 (M + 2) / n))`` with ``M`` the resonance peaks of the

@@ -28,8 +28,11 @@ elimination is one triangular solve (BLAS ``dtrsm``, in place) and a rank
 update per order (``dsyrk``); the reduced equations of each order are solved
 by Cholesky (``dposv``), with LU and least squares as fallbacks. The roots
 of each order are the eigenvalues of the companion matrix (``dgeev``), or,
-for one input and high orders, Aberth-Ehrlich sweeps started at the previous
-order's roots (the same roots to round-off, fewer operations).
+from ``p n_in = 64`` roots on, Aberth-Ehrlich sweeps started at the previous
+order's roots (the same roots to round-off, fewer operations) on the
+denominator's polynomial (one input) or on the determinant of the matrix
+polynomial (several inputs, its coefficients by FFT interpolation on the unit
+circle).
 """
 
 from __future__ import annotations
@@ -48,9 +51,10 @@ from ..problem.problem import check_uniform
 
 __all__ = ["PoleSet", "plscf"]
 
-#: from this order on (one input) the roots come from Aberth-Ehrlich sweeps started
-#: at the previous order's roots instead of the companion eigenvalues (same roots
-#: to ~1e-13; faster for the large orders of many-mode bands)
+#: from this number of roots ``p n_in`` on the roots come from Aberth-Ehrlich sweeps
+#: started at the previous order's roots instead of the companion eigenvalues (same
+#: roots to ~1e-13; faster for the large orders of many-mode bands); with several
+#: inputs on the determinant of the matrix polynomial (:func:`_det_coefficients`)
 _ABERTH_MIN_ORDER = 64
 #: convergence tolerances of :func:`_aberth` on ``|w| / |z|``, chosen by the
 #: shrink ratio ``|w| / |w_last|`` of the correction (edges ``_SHRINK``)
@@ -292,8 +296,9 @@ def _roots_of_orders(
                 sol = np.linalg.lstsq(m11, m12, rcond=None)[0]
         alpha = np.asarray(-sol, dtype=float)  # (p n_in, n_in): alpha_0..alpha_{p-1}
         zall = None
-        if n_in == 1 and p >= _ABERTH_MIN_ORDER and prev_roots is not None:
-            zall = _aberth(np.append(alpha[:, 0], 1.0), prev_roots)
+        if p * n_in >= _ABERTH_MIN_ORDER and prev_roots is not None:
+            c = np.append(alpha[:, 0], 1.0) if n_in == 1 else _det_coefficients(alpha, n_in)
+            zall = _aberth(c, prev_roots)
         if zall is None:
             zall = _companion_eigvals(alpha, n_in)
         prev_roots = zall
@@ -498,6 +503,31 @@ def _companion_eigvals(alpha: NDArray[np.float64], n_in: int) -> NDArray[np.comp
         if info == 0:
             return np.asarray(wr + 1j * wi)
     return np.asarray(np.linalg.eigvals(_companion(alpha, n_in)), dtype=complex)
+
+
+def _det_coefficients(alpha: NDArray[np.float64], n_in: int) -> NDArray[np.float64]:
+    """Coefficients ``c_0..c_N`` (ascending, ``c_N = 1``, ``N = p n_in``) of ``det A(z)``,
+    ``A(z) = sum_r alpha_r z^r`` with ``alpha_p = I`` (its roots are the eigenvalues of
+    the block companion matrix, :func:`_companion_eigvals`).
+
+    Evaluation and interpolation at the ``M >= N + 1`` roots of unity (the product
+    of polynomials by the discrete Fourier transform, Aho, Hopcroft & Ullman 1974,
+    sec. 7.2): the ``n_in x n_in`` blocks ``A(w^-j) = sum_r alpha_r w^-jr``, ``w =
+    exp(2 pi i / M)``, are one FFT over ``r``; their determinants are the values of
+    a polynomial of degree ``N < M``, whose coefficients are their inverse FFT
+    (exactly, up to round-off of the order of ``1e-16`` times the largest value on
+    the unit circle, where the roots that are modes lie).
+    """
+    p = alpha.shape[0] // n_in
+    n = p * n_in
+    m = 1 << n.bit_length()  # M > N, a power of 2
+    blocks = np.zeros((m, n_in, n_in))
+    blocks[:p] = alpha.reshape(p, n_in, n_in)
+    blocks[p] = np.eye(n_in)
+    det = np.linalg.det(np.fft.fft(blocks, axis=0))
+    c = np.fft.ifft(det).real[: n + 1]
+    c[n] = 1.0  # monic: alpha_p = I (its round-off dropped)
+    return np.asarray(c)
 
 
 def _companion(alpha: NDArray[np.float64], n_in: int) -> NDArray[np.float64]:

@@ -344,7 +344,9 @@ def _rank_one_off_fitted(
         hmat = beta[:, :, None] * l_near.conj()[None, :, :]  # (G, m, n_in)
         cmat = np.linalg.solve(gram, hmat)
         # y[g, j, n] = sum_k conj(l_nk) <b_n, e_jk> over window g (prefix sums)
-        w = np.einsum("nk,jkt->njt", l_near.conj(), e) * b.conj()[:, None, :]
+        # (one matrix product over the inputs: einsum's loop was 8 times slower)
+        w = (l_near.conj() @ e.transpose(1, 0, 2).reshape(n_in, -1)).reshape(-1, n_out, e.shape[-1])
+        w *= b.conj()[:, None, :]
         y = _sums_over_windows(w, lo, hi) * own[:, :, None]  # (G, m, n_out)
         z = x - np.einsum("gnk,gnj->gjk", cmat.conj(), y)
         nmat = nrm2[:, None, None] * eye_in - np.einsum("gnk,gnl->gkl", hmat.conj(), cmat)
