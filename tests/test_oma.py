@@ -11,7 +11,7 @@ from tyredamp.mechanics import MCKSystem, time_response
 from tyredamp.oma import correlations, oma, resolve_rotating, wave_content
 from tyredamp.oma.harmonics import band_kurtosis, detect_wheel_speed, harmonic_tests
 from tyredamp.oma.selection import otsu_threshold
-from tyredamp.oma.ssi import block_toeplitz, ssi_cov
+from tyredamp.oma.ssi import ShiftProjection, block_toeplitz, poles_at_order, ssi_cov
 from tyredamp.oma.uncertainty import jackknife_variance
 
 
@@ -70,6 +70,22 @@ def test_ssi_exact_correlations_give_exact_poles() -> None:
     R = np.array([(C * mu**k) @ G for k in range(30)]).real
     op, _ = ssi_cov(R, fs, 10, [4])
     assert_allclose(np.sort_complex(op.poles), np.sort_complex(lam), rtol=1e-8)  # exact data
+
+
+def test_shift_projection_equals_least_squares_at_every_order() -> None:
+    # the QR shared by all orders against one least squares per order (eq. 19 of
+    # Peeters & De Roeck 1999, computed independently by lstsq)
+    rng = np.random.default_rng(3)
+    T = rng.standard_normal((60, 40))
+    U, s, _ = np.linalg.svd(T, full_matrices=False)
+    proj = ShiftProjection(U, 30, 3)
+    for n in (4, 11, 30):
+        lam, sh = proj.poles(n, 50.0)
+        lam0, sh0 = poles_at_order(U, s, n, 3, 50.0)
+        i, i0 = np.argsort(lam.imag + 1e-3 * lam.real), np.argsort(lam0.imag + 1e-3 * lam0.real)
+        assert_allclose(lam[i], lam0[i0], rtol=1e-8)  # the same matrix up to similarity
+        mac = np.abs(np.sum(np.conj(sh[:, i]) * sh0[:, i0], axis=0)) ** 2
+        assert_allclose(mac, 1.0, atol=1e-8)  # unit shapes, equal up to a phase
 
 
 def test_ssi_chain_modes(chain_record: tuple[np.ndarray, float, MCKSystem]) -> None:

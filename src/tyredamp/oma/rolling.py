@@ -45,7 +45,7 @@ from ..exceptions import InputError
 from ..timedata import TimeData
 from .identify import OMAResult, oma
 from .spatial import equally_spaced
-from .spatial_poles import ALPHA, SpatialPole, select_spatial_poles, spatial_poles
+from .spatial_poles import ALPHA, SpatialPole, select_spatial_poles, spatial_poles, spatial_route
 from .waves import wave_content
 
 __all__ = [
@@ -474,9 +474,9 @@ def rolling_modes(
                 f"every {360 / len(ang):g} deg around the tyre, got {got} deg"
             )
         if spatial:
-            poles, res, dof = spatial_poles(data.data[fix], data.sample_rate, ang, kw)
             edges = bnd if bnd is not None else (0.0, 0.45 * data.sample_rate)
-            kept = select_spatial_poles(poles, edges, res, dof)
+            kept, dropped = spatial_route(data.data[fix], data.sample_rate, ang, kw, edges)
+            notes.extend(dropped)
             fixed = _spatial_waves(kept, len(ang), fw)
             notes.append(f"fixed sensors: each wave number 0..{(len(fix) - 1) // 2} identified "
                          "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
