@@ -10,6 +10,7 @@ from tyredamp.exceptions import InputError
 from tyredamp.mechanics import MCKSystem, time_response
 from tyredamp.oma import correlations, oma, resolve_rotating, wave_content
 from tyredamp.oma.harmonics import band_kurtosis, detect_wheel_speed, harmonic_tests
+from tyredamp.oma.identify import oma_deferred
 from tyredamp.oma.selection import otsu_threshold
 from tyredamp.oma.ssi import ShiftProjection, block_toeplitz, poles_at_order, ssi_cov
 from tyredamp.oma.uncertainty import jackknife_variance
@@ -106,6 +107,24 @@ def test_ssi_chain_modes(chain_record: tuple[np.ndarray, float, MCKSystem]) -> N
             np.vdot(phi[:, j], phi[:, j]).real * np.vdot(res.shapes[:, j], res.shapes[:, j]).real
         )
         assert mac > 0.99  # acceleration shapes = displacement shapes up to a factor
+
+
+def test_deferred_errors_equal_the_jackknife_of_oma(
+    chain_record: tuple[np.ndarray, float, MCKSystem],
+) -> None:
+    y, fs, _ = chain_record
+    y = y[:, :40000]
+    res = oma(y, fs)
+    r2, later = oma_deferred(y, fs)
+    # the same modes, and those oma dropped for their jackknife scatter (left to the caller)
+    idx = [int(np.argmin(np.abs(r2.frequency_hz - f))) for f in res.frequency_hz]
+    assert_allclose(r2.frequency_hz[idx], res.frequency_hz, rtol=1e-12)  # identical: round-off
+    assert np.all(np.isnan(r2.std_frequency_hz))
+    sf, sz = later.std(idx)
+    assert_allclose(sf, res.std_frequency_hz, rtol=1e-10)  # the same jackknife, run later
+    assert_allclose(sz, res.std_damping_ratio, rtol=1e-10)
+    sf1, _ = later.std(idx[-1:])
+    assert_allclose(sf1, res.std_frequency_hz[-1:], rtol=1e-10)  # one mode alone: the same
 
 
 def test_plscf_chain_modes(chain_record: tuple[np.ndarray, float, MCKSystem]) -> None:

@@ -44,8 +44,15 @@ from numpy.typing import ArrayLike
 from ..exceptions import InputError
 from ..timedata import TimeData
 from .identify import OMAResult, oma
-from .spatial import equally_spaced
-from .spatial_poles import ALPHA, SpatialPole, select_spatial_poles, spatial_poles, spatial_route
+from .spatial import equally_spaced, peak_test_has_power, welch_dof
+from .spatial_poles import (
+    ALPHA,
+    SEGMENT,
+    SpatialPole,
+    select_spatial_poles,
+    spatial_poles,
+    spatial_route,
+)
 from .waves import wave_content
 
 __all__ = [
@@ -395,6 +402,20 @@ def _split_channels(
     return fix, rot
 
 
+def _default_route(angles: list[float], n_samples: int) -> tuple[bool, str]:
+    """The wave-number route when the sensors are equally spaced and the record
+    long enough for its peak test (:func:`.spatial.peak_test_has_power`), and why."""
+    if not equally_spaced(angles):
+        return False, ("fixed sensors not equally spaced: all identified together, each mode "
+                       "split into waves afterwards")  # fmt: skip
+    dof = welch_dof(n_samples, SEGMENT)
+    if not peak_test_has_power(dof, ALPHA):
+        return False, (f"record too short for the wave-number route ({dof:.0f} degrees of "
+                       "freedom in its channel spectra): all fixed sensors identified "
+                       "together")  # fmt: skip
+    return True, ""
+
+
 def rolling_modes(
     data: TimeData,
     wheel_speed_hz: float | None = None,
@@ -407,7 +428,7 @@ def rolling_modes(
     tol: float = 0.01,
     n_groups: int = 16,
     uncertainty: bool = True,
-    spatial: bool = False,
+    spatial: bool | None = None,
 ) -> RollingModes:
     """Travelling waves of a rolling tyre from fixed and in-tyre output-only records.
 
@@ -434,12 +455,14 @@ def rolling_modes(
         Jackknife segments of the SSI (fixed sensors).
     uncertainty : bool
         Jackknife standard errors of the fixed-sensor modes (slower).
-    spatial : bool
-        Identify each wave number and direction apart from the spatial DFT of
-        the fixed sensors (:mod:`.spatial`; they must be equally spaced around
-        the circumference), its poles kept by :func:`select_spatial_poles`.
-        Default: all fixed sensors together, each mode split into waves
-        afterwards (any layout).
+    spatial : bool, optional
+        ``True``: identify each wave number and direction apart from the
+        spatial DFT of the fixed sensors (:mod:`.spatial`; they must be
+        equally spaced around the circumference), its poles kept by
+        :func:`select_spatial_poles` (the wave-number route). ``False``: all
+        fixed sensors together, each mode split into waves afterwards (any
+        layout). Default: the wave-number route when the fixed sensors are
+        equally spaced, the other otherwise (said in the notes).
 
     Returns
     -------
@@ -467,6 +490,9 @@ def rolling_modes(
             raise InputError("angles: the fixed channels carry no angles; give angles_deg")
         kw: dict[str, Any] = {"band": bnd, "n_groups": n_groups, "uncertainty": uncertainty,
                               "wheel_speed_hz": fw if fw > 0 else None}  # fmt: skip
+        if spatial is None:
+            spatial, why = _default_route(ang, np.shape(data.data)[-1])
+            notes.extend([why] if why else [])
         if spatial and not equally_spaced(ang):
             got = ", ".join(f"{a:g}" for a in ang)
             raise InputError(

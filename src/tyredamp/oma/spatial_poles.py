@@ -40,6 +40,9 @@ __all__ = [
 ALPHA = 1e-3
 """Probability that sensor noise alone passes each test of :func:`select_spatial_poles`."""
 
+SEGMENT = 1024
+"""Welch segment (samples) of the channel spectra the selection tests use."""
+
 CHANNEL_ORDER = 40
 """Largest SSI model order of one wave-number channel (unless given).
 
@@ -93,7 +96,7 @@ def _channel_poles(
     out: list[SpatialPole] = []
     later: dict[int, tuple[DeferredErrors, int]] = {}
     K = len(angles)
-    nperseg = 1024
+    nperseg = SEGMENT
     fs_, S = spatial_spectra(y, fs, angles, nperseg)
     floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
     opts = {k: v for k, v in kw.items() if k != "uncertainty"}
