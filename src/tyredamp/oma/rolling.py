@@ -286,6 +286,34 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
+def _within_band(
+    waves: list[RollingWave], band: tuple[float, float]
+) -> tuple[list[RollingWave], list[str]]:
+    """The waves whose flanks ``f -+ 2 zeta f`` lie inside ``band``, and a note for each
+    mode left out.
+
+    A pole whose resonance the band cuts off is not a mode the band determines:
+    near the edge of the excitation or of the anti-alias filter the spectra fall
+    off like the flank of a peak, and SSI fits poles there. The flanks of a
+    mode, where its response has fallen to a fifth of the peak (the frequency
+    response of one mode, Ewins, Modal Testing, 2nd ed. 2000, sec. 2.2; the
+    same rule as test (iii) of :func:`select_spatial_poles`), must lie inside.
+    """
+    lo, hi = band
+    keep: list[RollingWave] = []
+    notes: list[str] = []
+    for w in waves:
+        off = 2 * abs(w.damping_ratio) * w.fixed_hz
+        if w.fixed_hz + off > hi or (lo > 0 and w.fixed_hz - off < lo):
+            note = (f"{w.fixed_hz:.4g} Hz left out: its resonance (+- {off:.2g} Hz) is cut off by "
+                    f"the band edge ({lo:g}-{hi:g} Hz)")  # fmt: skip
+            if note not in notes:
+                notes.append(note)
+            continue
+        keep.append(w)
+    return keep, notes
+
+
 def _spatial_waves(poles: list[SpatialPole], K: int, fw: float) -> list[RollingWave]:
     """The selected poles as waves, with their channel and power in the reason."""
     out: list[RollingWave] = []
@@ -508,7 +536,9 @@ def rolling_modes(
                          "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
         else:
             r_fix = oma(data.data[fix], data.sample_rate, **kw)
-            fixed = _fixed_waves(r_fix, ang, fw)
+            edges = r_fix.band_hz
+            fixed, edge = _within_band(_fixed_waves(r_fix, ang, fw), edges)
+            notes.extend(edge)
         fixed = sorted(fixed, key=lambda w: w.fixed_hz)
     else:
         notes.append(f"{len(fix)} fixed sensor(s): at least 3 are needed for wave numbers")
