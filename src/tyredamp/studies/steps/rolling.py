@@ -121,7 +121,9 @@ class RollingStep:
                     }
                 )
         else:
-            for j in range(r.n_modes):
+            # the modes that gave a wave (not those the band edge cut off)
+            waved = {w.fixed_hz for w in result.fixed}
+            for j in (j for j in range(r.n_modes) if float(r.frequency_hz[j]) in waved):
                 sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
                 modes.append(
                     {
