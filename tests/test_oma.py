@@ -89,6 +89,22 @@ def test_shift_projection_equals_least_squares_at_every_order() -> None:
         assert_allclose(mac, 1.0, atol=1e-8)  # unit shapes, equal up to a phase
 
 
+def test_shift_projection_falls_back_where_the_shift_is_rank_deficient() -> None:
+    # a singular vector living in the last block row only makes U_up rank-deficient:
+    # the minimum-norm least squares (lstsq, computed independently) takes over
+    rng = np.random.default_rng(4)
+    U = np.linalg.qr(rng.standard_normal((30, 6)))[0]
+    U[:, 5] = 0.0
+    U[-3:, 5] = [1.0, 0.0, 0.0]
+    proj = ShiftProjection(U, 6, 3)
+    lam, _ = proj.poles(6, 10.0)
+    O = U[:, :6]
+    mu = np.linalg.eigvals(np.linalg.lstsq(O[:-3], O[3:], rcond=None)[0])
+    lam0 = np.log(mu[mu.imag > 0]) * 10.0
+    assert np.all(np.isfinite(lam))
+    assert_allclose(np.sort_complex(lam), np.sort_complex(lam0), rtol=1e-8)  # the same solve
+
+
 def test_ssi_chain_modes(chain_record: tuple[np.ndarray, float, MCKSystem]) -> None:
     y, fs, s = chain_record
     truth = s.complex_modes().poles

@@ -154,6 +154,7 @@ class ShiftProjection:
     def __init__(self, U: NDArray[np.float64], n_hi: int, n_out: int) -> None:
         Un = np.asarray(U, float)[:, :n_hi]
         self._C = Un[:n_out]
+        self._U, self._l = Un, int(n_out)
         Q, self._R = np.linalg.qr(Un[:-n_out])
         self._M = Q.T @ Un[n_out:]
         self.n_hi = int(n_hi)
@@ -162,9 +163,13 @@ class ShiftProjection:
         self, n: int, sample_rate: float
     ) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
         """Poles (``Im > 0``, rad/s) and unit shapes (n_out, m) of order ``n <= n_hi``."""
-        X: NDArray[np.float64] = sla.solve_triangular(
-            self._R[:n, :n], self._M[:n, :n], check_finite=False
-        )
+        R = self._R[:n, :n]
+        d = np.abs(np.diag(R))
+        if d.size and d.min() <= 1e-12 * d.max():  # rank-deficient: the minimum-norm solution
+            up, down = self._U[: -self._l, :n], self._U[self._l :, :n]
+            X = np.asarray(np.linalg.lstsq(up, down, rcond=None)[0], float)
+        else:
+            X = np.asarray(sla.solve_triangular(R, self._M[:n, :n], check_finite=False), float)
         return _eig_poles(X, self._C[:, :n], sample_rate)
 
 
