@@ -29,8 +29,9 @@ a peak of the in-tyre sensor alone does not: each ``(n, direction)`` gives
 another ``f_fixed`` from (1), and only a fixed-frame mode with that ``n`` and
 direction at that frequency resolves it. Without fixed sensors the candidates
 are listed and the peak is reported unresolved. With fixed sensors equally
-spaced around the circumference each wave number can also be identified apart
-(the wave-number route, :mod:`.spatial_poles`).
+spaced around the circumference each wave number is identified apart (the
+wave-number route, :mod:`.spatial_poles`), the default where the record is
+long enough for its tests.
 """
 
 from __future__ import annotations

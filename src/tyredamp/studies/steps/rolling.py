@@ -48,7 +48,7 @@ class RollingSettings(StepSettings):
     spatial: bool = knob(
         False,
         "Identify each wave number and direction apart (fixed sensors equally spaced "
-        "around the tyre; the default for such sensors).",
+        "around the tyre; the default for such sensors and a long enough record).",
         Boolean(),
         "--spatial",
     )
