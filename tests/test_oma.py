@@ -10,8 +10,9 @@ from tyredamp.exceptions import InputError
 from tyredamp.mechanics import MCKSystem, time_response
 from tyredamp.oma import correlations, oma, resolve_rotating, wave_content
 from tyredamp.oma.harmonics import band_kurtosis, detect_wheel_speed, harmonic_tests
+from tyredamp.oma.identify import oma_deferred
 from tyredamp.oma.selection import otsu_threshold
-from tyredamp.oma.ssi import block_toeplitz, ssi_cov
+from tyredamp.oma.ssi import ShiftProjection, block_toeplitz, poles_at_order, ssi_cov
 from tyredamp.oma.uncertainty import jackknife_variance
 
 
@@ -72,6 +73,38 @@ def test_ssi_exact_correlations_give_exact_poles() -> None:
     assert_allclose(np.sort_complex(op.poles), np.sort_complex(lam), rtol=1e-8)  # exact data
 
 
+def test_shift_projection_equals_least_squares_at_every_order() -> None:
+    # the QR shared by all orders against one least squares per order (eq. 19 of
+    # Peeters & De Roeck 1999, computed independently by lstsq)
+    rng = np.random.default_rng(3)
+    T = rng.standard_normal((60, 40))
+    U, s, _ = np.linalg.svd(T, full_matrices=False)
+    proj = ShiftProjection(U, 30, 3)
+    for n in (4, 11, 30):
+        lam, sh = proj.poles(n, 50.0)
+        lam0, sh0 = poles_at_order(U, s, n, 3, 50.0)
+        i, i0 = np.argsort(lam.imag + 1e-3 * lam.real), np.argsort(lam0.imag + 1e-3 * lam0.real)
+        assert_allclose(lam[i], lam0[i0], rtol=1e-8)  # the same matrix up to similarity
+        mac = np.abs(np.sum(np.conj(sh[:, i]) * sh0[:, i0], axis=0)) ** 2
+        assert_allclose(mac, 1.0, atol=1e-8)  # unit shapes, equal up to a phase
+
+
+def test_shift_projection_falls_back_where_the_shift_is_rank_deficient() -> None:
+    # a singular vector living in the last block row only makes U_up rank-deficient:
+    # the minimum-norm least squares (lstsq, computed independently) takes over
+    rng = np.random.default_rng(4)
+    U = np.linalg.qr(rng.standard_normal((30, 6)))[0]
+    U[:, 5] = 0.0
+    U[-3:, 5] = [1.0, 0.0, 0.0]
+    proj = ShiftProjection(U, 6, 3)
+    lam, _ = proj.poles(6, 10.0)
+    O = U[:, :6]
+    mu = np.linalg.eigvals(np.linalg.lstsq(O[:-3], O[3:], rcond=None)[0])
+    lam0 = np.log(mu[mu.imag > 0]) * 10.0
+    assert np.all(np.isfinite(lam))
+    assert_allclose(np.sort_complex(lam), np.sort_complex(lam0), rtol=1e-8)  # the same solve
+
+
 def test_ssi_chain_modes(chain_record: tuple[np.ndarray, float, MCKSystem]) -> None:
     y, fs, s = chain_record
     truth = s.complex_modes().poles
@@ -90,6 +123,24 @@ def test_ssi_chain_modes(chain_record: tuple[np.ndarray, float, MCKSystem]) -> N
             np.vdot(phi[:, j], phi[:, j]).real * np.vdot(res.shapes[:, j], res.shapes[:, j]).real
         )
         assert mac > 0.99  # acceleration shapes = displacement shapes up to a factor
+
+
+def test_deferred_errors_equal_the_jackknife_of_oma(
+    chain_record: tuple[np.ndarray, float, MCKSystem],
+) -> None:
+    y, fs, _ = chain_record
+    y = y[:, :40000]
+    res = oma(y, fs)
+    r2, later = oma_deferred(y, fs)
+    # the same modes, and those oma dropped for their jackknife scatter (left to the caller)
+    idx = [int(np.argmin(np.abs(r2.frequency_hz - f))) for f in res.frequency_hz]
+    assert_allclose(r2.frequency_hz[idx], res.frequency_hz, rtol=1e-12)  # identical: round-off
+    assert np.all(np.isnan(r2.std_frequency_hz))
+    sf, sz = later.std(idx)
+    assert_allclose(sf, res.std_frequency_hz, rtol=1e-10)  # the same jackknife, run later
+    assert_allclose(sz, res.std_damping_ratio, rtol=1e-10)
+    sf1, _ = later.std(idx[-1:])
+    assert_allclose(sf1, res.std_frequency_hz[-1:], rtol=1e-10)  # one mode alone: the same
 
 
 def test_plscf_chain_modes(chain_record: tuple[np.ndarray, float, MCKSystem]) -> None:

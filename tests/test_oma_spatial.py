@@ -116,7 +116,7 @@ WAVES = [(2, "backward", 20.0, 0.02), (2, "forward", 27.0, 0.015), (3, "forward"
 WHEEL_HZ = 2.0
 
 
-def _rolling_record(seed: int, angles_deg=None, n_samples: int = 2**15):
+def _rolling_record(seed: int, angles_deg=None, n_samples: int = 2**15, waves=None):
     """Eight equally spaced fixed sensors seeing the travelling waves of WAVES, each a
     complex AR(1) of its pole (a random stationary wave), plus 10 % white sensor noise."""
     from tyredamp.frf import Channel
@@ -127,7 +127,7 @@ def _rolling_record(seed: int, angles_deg=None, n_samples: int = 2**15):
     ang = np.arange(K) * 360.0 / K if angles_deg is None else np.asarray(angles_deg, float)
     th = np.deg2rad(ang)
     y = np.zeros((K, n_samples))
-    for n, d, f, z in WAVES:
+    for n, d, f, z in WAVES if waves is None else waves:
         lam = complex(-z * 2 * np.pi * f, 2 * np.pi * f * np.sqrt(1 - z * z))
         e = rng.standard_normal(n_samples + 2000) + 1j * rng.standard_normal(n_samples + 2000)
         x = lfilter([1.0], [1.0, -np.exp(lam / fs)], e)[2000:] * np.sqrt(z)
@@ -232,3 +232,59 @@ def test_select_spatial_poles_rules() -> None:
     # a fixed threshold replaces only the noise test
     got = select_spatial_poles(poles, (0.0, 200.0), 0.5, dof, floor_ratio=0.5 * q)
     assert (80.0, "forward") in {(p.frequency_hz, p.direction) for p in got}
+
+
+CLOSE = [(2, "forward", 40.0, 0.02), (3, "backward", 40.6, 0.02)]
+"""Two waves 0.6 Hz apart, less than their half-power half-bandwidth zeta f = 0.8 Hz."""
+
+
+def test_close_waves_of_two_wave_numbers_resolved_by_default() -> None:
+    from tyredamp.oma.rolling import rolling_modes
+
+    td = _rolling_record(5, waves=CLOSE)
+    m = rolling_modes(td, uncertainty=False)  # equally spaced, 256 s: the wave-number route
+    assert any("identified apart" in n for n in m.notes)
+    for n, d, f, z in CLOSE:
+        got = [w for w in m.fixed if (w.wave_number, w.fixed_direction) == (n, d)]
+        assert len(got) == 1, [(w.wave_number, w.fixed_direction, w.fixed_hz) for w in m.fixed]
+        # 0.5 %: the target; one channel holds one wave, so its neighbour does not pull it
+        assert_allclose(got[0].fixed_hz, f, rtol=5e-3)
+        # 30 %: the damping of one 256 s record of a 2-channel SSI (as above)
+        assert_allclose(got[0].damping_ratio, z, rtol=0.3)
+    assert len(m.fixed) == 2
+    # all sensors together: the two resonances overlap in every channel
+    g = rolling_modes(td, uncertainty=False, spatial=False)
+    assert g.fixed_result is not None
+    assert m.fixed_result is None
+
+
+def test_default_route_follows_the_layout_and_the_record() -> None:
+    from tyredamp.oma.rolling import _default_route, rolling_modes
+
+    even = list(np.arange(8) * 45.0)
+    assert _default_route(even, 2**15) == (True, "")
+    short, why = _default_route(even, 2**12)
+    assert not short
+    assert "too short" in why
+    odd, why = _default_route([0, 40, 90, 135, 180, 225, 270, 315], 2**15)
+    assert not odd
+    assert "not equally spaced" in why
+    td = _rolling_record(0, angles_deg=[0, 40, 90, 135, 180, 225, 270, 315], n_samples=4096)
+    m = rolling_modes(td, uncertainty=False)  # an irregular layout: the general route, no error
+    assert m.fixed_result is not None
+    assert any("not equally spaced" in n for n in m.notes)
+
+
+def test_peak_test_power_against_monte_carlo() -> None:
+    from scipy.stats import f as f_dist
+
+    rng = np.random.default_rng(11)
+    for dof, expect in ((21.0, False), (120.0, True)):
+        q = spatial.power_threshold(dof)
+        # a resonance's contrast estimate: 5 x the ratio of two independent chi2 / dof
+        x = 5 * rng.chisquare(dof, 200_000) / rng.chisquare(dof, 200_000)
+        miss = float(np.mean(x < q))
+        # the closed form of the same probability, F(dof, dof) below q / 5
+        assert_allclose(miss, f_dist.cdf(q / 5, dof, dof), atol=3e-3)  # MC: 4 sigma of 2e5
+        assert spatial.peak_test_has_power(dof) is expect
+        assert (miss <= 0.01) is expect

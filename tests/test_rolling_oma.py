@@ -167,3 +167,43 @@ def test_in_tyre_match_widens_to_three_standard_errors(truth80: RollingTruth) ->
     assert (w.wave_number, w.direction) == (3, "forward")
     (w,) = resolve_in_tyre([row["rotating_hz"]], [tight], fw, n_max=4)
     assert w.wave_number is None
+
+
+def test_a_pole_whose_resonance_the_band_cuts_is_not_a_wave() -> None:
+    from tyredamp.oma.rolling import _within_band
+
+    def wave(f: float, z: float) -> RollingWave:
+        return RollingWave("fixed", 5, "forward", "forward", f, f, z, np.nan, np.nan)
+
+    # flanks f -+ 2 zeta f: 196 + 3.92 = 199.92 Hz inside 200 Hz, 198 + 3.96 beyond it,
+    # 6 - 0.24 = 5.76 Hz below a band from 5.8 Hz
+    waves = [wave(100.0, 0.02), wave(196.0, 0.01), wave(198.0, 0.01), wave(6.0, 0.02)]
+    kept, notes = _within_band(waves, (5.8, 200.0))
+    assert [w.fixed_hz for w in kept] == [100.0, 196.0]
+    assert len(notes) == 2
+    assert "198 Hz left out" in notes[0]
+    kept, _ = _within_band(waves, (0.0, 200.0))  # no lower edge from 0 Hz
+    assert [w.fixed_hz for w in kept] == [100.0, 196.0, 6.0]
+
+
+def test_document_keeps_only_the_modes_that_gave_a_wave() -> None:
+    from types import SimpleNamespace
+
+    from tyredamp.oma.rolling import RollingModes
+    from tyredamp.studies.steps.rolling import RollingStep
+
+    # a general-route result with two modes, the second cut off by the band edge
+    r = SimpleNamespace(
+        n_modes=2,
+        frequency_hz=np.array([100.0, 199.0]),
+        damping_ratio=np.array([0.02, 0.01]),
+        std_frequency_hz=np.array([0.1, 0.1]),
+        std_damping_ratio=np.array([0.001, 0.001]),
+        shapes=np.ones((4, 2), complex),
+    )
+    wave = RollingWave("fixed", 2, "forward", "forward", 100.0, 95.0, 0.02, 0.1, 0.001)
+    res = RollingModes(
+        1.0, [wave], [], r, None, [], (0.0, 90.0, 180.0, 270.0), ("A", "B", "C", "D")
+    )  # type: ignore[arg-type]
+    doc = RollingStep.document(res, "x.npz")
+    assert [m["frequency_hz"] for m in doc["modes"]] == [100.0]

@@ -73,7 +73,7 @@ def rolling_command(file: Path, out: Path, **o: Any) -> None:
             rotating_channels=rot,
             band=settings.band,
             uncertainty=settings.uncertainty,
-            spatial=settings.spatial,
+            spatial=settings.route,
         )
     except InputError as exc:
         raise InputError(f"{file.name}: {exc}") from None

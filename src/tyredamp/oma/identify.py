@@ -19,7 +19,7 @@ from .spectra import half_spectra, plscf_poles, residue_shapes
 from .ssi import OrderPoles, ssi_cov
 from .uncertainty import jackknife_std
 
-__all__ = ["OMAResult", "choose_references", "oma", "preprocess"]
+__all__ = ["DeferredErrors", "OMAResult", "choose_references", "oma", "oma_deferred", "preprocess"]
 
 Method = Literal["ssi", "plscf"]
 
@@ -83,6 +83,36 @@ class OMAResult:
     def n_modes(self) -> int:
         """Number of structural modes."""
         return int(self.frequency_hz.size)
+
+
+@dataclass(frozen=True)
+class DeferredErrors:
+    """What the jackknife of :func:`oma` needs, kept to run it later on some modes only.
+
+    Attributes
+    ----------
+    corr : Correlations
+        With its group sums.
+    block_rows : int
+    orders, poles : list of ndarray
+        Per mode of the result (in its order), the model orders and poles its
+        estimate averages over.
+    shapes : ndarray of complex, shape (m, n_out)
+    """
+
+    corr: Correlations
+    block_rows: int
+    orders: list[NDArray[np.int64]]
+    poles: list[NDArray[np.complex128]]
+    shapes: NDArray[np.complex128]
+
+    def std(self, modes: list[int]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Jackknife standard errors (Hz, -) of the given modes of the result
+        (:func:`~.uncertainty.jackknife_std`); empty arrays for none."""
+        if not modes:
+            return np.zeros(0), np.zeros(0)
+        return jackknife_std(self.corr, self.block_rows, [self.orders[j] for j in modes],
+                             [self.poles[j] for j in modes], self.shapes[modes])  # fmt: skip
 
 
 def preprocess(
@@ -222,7 +252,40 @@ def oma(
     """
     with blas_limit(blas_threads):
         return _oma(data, sample_rate, method, references, band, decimate, block_rows,
-                    max_order, n_groups, wheel_speed_hz, uncertainty)  # fmt: skip
+                    max_order, n_groups, wheel_speed_hz, uncertainty)[0]  # fmt: skip
+
+
+def oma_deferred(
+    data: ArrayLike,
+    sample_rate: float,
+    *,
+    method: Method = "ssi",
+    references: ArrayLike | None = None,
+    band: tuple[float, float] | None = None,
+    decimate: int | None = None,
+    block_rows: int | None = None,
+    max_order: int | None = None,
+    n_groups: int = 16,
+    wheel_speed_hz: float | None = None,
+    blas_threads: int | None = 1,
+) -> tuple[OMAResult, DeferredErrors]:
+    """:func:`oma` without standard errors, and what computes them later.
+
+    For callers that keep only some of the modes (the wave-number route of
+    :mod:`.spatial_poles`): the jackknife, most of the cost, then runs on
+    those alone. The parameters are those of :func:`oma`. The modes returned
+    do not depend on the errors: the rule of :func:`oma` that drops a mode
+    whose jackknife scatter is too large is left to the caller.
+
+    Returns
+    -------
+    result : OMAResult
+        With NaN standard errors.
+    errors : DeferredErrors
+    """
+    with blas_limit(blas_threads):
+        return _oma(data, sample_rate, method, references, band, decimate, block_rows,
+                    max_order, n_groups, wheel_speed_hz, False)  # fmt: skip
 
 
 def _oma(
@@ -237,8 +300,8 @@ def _oma(
     n_groups: int,
     wheel_speed_hz: float | None,
     uncertainty: bool,
-) -> OMAResult:
-    """The body of :func:`oma` (same parameters)."""
+) -> tuple[OMAResult, DeferredErrors]:
+    """The body of :func:`oma` (same parameters) and its deferred errors."""
     y0 = np.asarray(data, dtype=float)
     if y0.ndim == 1:
         y0 = y0[None, :]
@@ -303,7 +366,7 @@ def _finish(
     refs: list[int],
     wheel: float | None,
     uncertainty: bool = True,
-) -> OMAResult:
+) -> tuple[OMAResult, DeferredErrors]:
     """Standard errors, shapes (pLSCF), the harmonic tests and the result."""
     notes: list[str] = []
     # each mode's estimate: the mean over (up to) 5 of its cluster's lowest orders, a
@@ -380,6 +443,11 @@ def _finish(
         )
     if not keep.any():
         notes.append("no structural mode found: no cluster of poles persisted over the orders")
+    kj = np.flatnonzero(keep)
+    sh_k = shapes[kj] if method == "ssi" else np.zeros((0, y.shape[0]), complex)
+    later = DeferredErrors(
+        corr, i, [op.order[sub[j]] for j in kj], [op.poles[sub[j]] for j in kj], sh_k
+    )
     return OMAResult(
         fn[keep],
         zeta[keep],
@@ -401,4 +469,4 @@ def _finish(
         st,
         cut,
         notes,
-    )
+    ), later

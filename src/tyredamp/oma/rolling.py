@@ -29,8 +29,9 @@ a peak of the in-tyre sensor alone does not: each ``(n, direction)`` gives
 another ``f_fixed`` from (1), and only a fixed-frame mode with that ``n`` and
 direction at that frequency resolves it. Without fixed sensors the candidates
 are listed and the peak is reported unresolved. With fixed sensors equally
-spaced around the circumference each wave number can also be identified apart
-(the wave-number route, :mod:`.spatial_poles`).
+spaced around the circumference each wave number is identified apart (the
+wave-number route, :mod:`.spatial_poles`), the default where the record is
+long enough for its tests.
 """
 
 from __future__ import annotations
@@ -44,8 +45,15 @@ from numpy.typing import ArrayLike
 from ..exceptions import InputError
 from ..timedata import TimeData
 from .identify import OMAResult, oma
-from .spatial import equally_spaced
-from .spatial_poles import ALPHA, SpatialPole, select_spatial_poles, spatial_poles
+from .spatial import equally_spaced, peak_test_has_power, welch_dof
+from .spatial_poles import (
+    ALPHA,
+    SEGMENT,
+    SpatialPole,
+    select_spatial_poles,
+    spatial_poles,
+    spatial_route,
+)
 from .waves import wave_content
 
 __all__ = [
@@ -279,6 +287,34 @@ def _fixed_waves(r: OMAResult, angles: list[float], fw: float) -> list[RollingWa
     return out
 
 
+def _within_band(
+    waves: list[RollingWave], band: tuple[float, float]
+) -> tuple[list[RollingWave], list[str]]:
+    """The waves whose flanks ``f -+ 2 zeta f`` lie inside ``band``, and a note for each
+    mode left out.
+
+    A pole whose resonance the band cuts off is not a mode the band determines:
+    near the edge of the excitation or of the anti-alias filter the spectra fall
+    off like the flank of a peak, and SSI fits poles there. The flanks of a
+    mode, where its response has fallen to a fifth of the peak (the frequency
+    response of one mode, Ewins, Modal Testing, 2nd ed. 2000, sec. 2.2; the
+    same rule as test (iii) of :func:`select_spatial_poles`), must lie inside.
+    """
+    lo, hi = band
+    keep: list[RollingWave] = []
+    notes: list[str] = []
+    for w in waves:
+        off = 2 * abs(w.damping_ratio) * w.fixed_hz
+        if w.fixed_hz + off > hi or (lo > 0 and w.fixed_hz - off < lo):
+            note = (f"{w.fixed_hz:.4g} Hz left out: its resonance (+- {off:.2g} Hz) is cut off by "
+                    f"the band edge ({lo:g}-{hi:g} Hz)")  # fmt: skip
+            if note not in notes:
+                notes.append(note)
+            continue
+        keep.append(w)
+    return keep, notes
+
+
 def _spatial_waves(poles: list[SpatialPole], K: int, fw: float) -> list[RollingWave]:
     """The selected poles as waves, with their channel and power in the reason."""
     out: list[RollingWave] = []
@@ -395,6 +431,20 @@ def _split_channels(
     return fix, rot
 
 
+def _default_route(angles: list[float], n_samples: int) -> tuple[bool, str]:
+    """The wave-number route when the sensors are equally spaced and the record
+    long enough for its peak test (:func:`.spatial.peak_test_has_power`), and why."""
+    if not equally_spaced(angles):
+        return False, ("fixed sensors not equally spaced: all identified together, each mode "
+                       "split into waves afterwards")  # fmt: skip
+    dof = welch_dof(n_samples, SEGMENT)
+    if not peak_test_has_power(dof, ALPHA):
+        return False, (f"record too short for the wave-number route ({dof:.0f} degrees of "
+                       "freedom in its channel spectra): all fixed sensors identified "
+                       "together")  # fmt: skip
+    return True, ""
+
+
 def rolling_modes(
     data: TimeData,
     wheel_speed_hz: float | None = None,
@@ -407,7 +457,7 @@ def rolling_modes(
     tol: float = 0.01,
     n_groups: int = 16,
     uncertainty: bool = True,
-    spatial: bool = False,
+    spatial: bool | None = None,
 ) -> RollingModes:
     """Travelling waves of a rolling tyre from fixed and in-tyre output-only records.
 
@@ -434,12 +484,14 @@ def rolling_modes(
         Jackknife segments of the SSI (fixed sensors).
     uncertainty : bool
         Jackknife standard errors of the fixed-sensor modes (slower).
-    spatial : bool
-        Identify each wave number and direction apart from the spatial DFT of
-        the fixed sensors (:mod:`.spatial`; they must be equally spaced around
-        the circumference), its poles kept by :func:`select_spatial_poles`.
-        Default: all fixed sensors together, each mode split into waves
-        afterwards (any layout).
+    spatial : bool, optional
+        ``True``: identify each wave number and direction apart from the
+        spatial DFT of the fixed sensors (:mod:`.spatial`; they must be
+        equally spaced around the circumference), its poles kept by
+        :func:`select_spatial_poles` (the wave-number route). ``False``: all
+        fixed sensors together, each mode split into waves afterwards (any
+        layout). Default: the wave-number route when the fixed sensors are
+        equally spaced, the other otherwise (said in the notes).
 
     Returns
     -------
@@ -467,6 +519,9 @@ def rolling_modes(
             raise InputError("angles: the fixed channels carry no angles; give angles_deg")
         kw: dict[str, Any] = {"band": bnd, "n_groups": n_groups, "uncertainty": uncertainty,
                               "wheel_speed_hz": fw if fw > 0 else None}  # fmt: skip
+        if spatial is None:
+            spatial, why = _default_route(ang, np.shape(data.data)[-1])
+            notes.extend([why] if why else [])
         if spatial and not equally_spaced(ang):
             got = ", ".join(f"{a:g}" for a in ang)
             raise InputError(
@@ -474,15 +529,17 @@ def rolling_modes(
                 f"every {360 / len(ang):g} deg around the tyre, got {got} deg"
             )
         if spatial:
-            poles, res, dof = spatial_poles(data.data[fix], data.sample_rate, ang, kw)
             edges = bnd if bnd is not None else (0.0, 0.45 * data.sample_rate)
-            kept = select_spatial_poles(poles, edges, res, dof)
+            kept, dropped = spatial_route(data.data[fix], data.sample_rate, ang, kw, edges)
+            notes.extend(dropped)
             fixed = _spatial_waves(kept, len(ang), fw)
             notes.append(f"fixed sensors: each wave number 0..{(len(fix) - 1) // 2} identified "
                          "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
         else:
             r_fix = oma(data.data[fix], data.sample_rate, **kw)
-            fixed = _fixed_waves(r_fix, ang, fw)
+            edges = r_fix.band_hz
+            fixed, edge = _within_band(_fixed_waves(r_fix, ang, fw), edges)
+            notes.extend(edge)
         fixed = sorted(fixed, key=lambda w: w.fixed_hz)
     else:
         notes.append(f"{len(fix)} fixed sensor(s): at least 3 are needed for wave numbers")

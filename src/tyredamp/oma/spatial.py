@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 __all__ = [
     "equally_spaced",
     "peak_contrast",
+    "peak_test_has_power",
     "power_threshold",
     "spatial_channels",
     "spatial_spectra",
@@ -187,6 +188,36 @@ def power_threshold(dof: float, alpha: float = 1e-3) -> float:
     from scipy.stats import f as f_dist
 
     return float(f_dist.ppf(1.0 - alpha, dof, dof))
+
+
+def peak_test_has_power(dof: float, alpha: float = 1e-3, miss: float = 0.01) -> bool:
+    """Whether an isolated resonance passes the flank test of the channel spectra.
+
+    A resonance alone rises five times above its flanks at ``f -+ 2 zeta f``
+    (:func:`peak_contrast`); two Welch estimates with ``nu`` degrees of
+    freedom each scatter by ``chi2_nu / nu`` (Bendat & Piersol 2010, sec.
+    8.5), so its estimated contrast is about ``5 F`` with ``F ~ F(nu, nu)``.
+    The test keeps a pole whose contrast exceeds the ``1 - alpha`` quantile of
+    ``F(nu, nu)`` (:func:`power_threshold`, what noise alone passes with
+    probability ``alpha``); this says whether a resonance passes it with
+    probability at least ``1 - miss``: ``5 F_miss(nu, nu) >= F_{1-alpha}(nu, nu)``.
+    Short records (few averages) fail it: their spectra cannot tell a
+    resonance from noise at that confidence.
+
+    Parameters
+    ----------
+    dof : float
+        ``nu`` (:func:`welch_dof`).
+    alpha, miss : float
+        False-pass probability for noise and miss probability for a resonance.
+
+    Returns
+    -------
+    bool
+    """
+    from scipy.stats import f as f_dist
+
+    return bool(5.0 * f_dist.ppf(miss, dof, dof) >= power_threshold(dof, alpha))
 
 
 def peak_contrast(s: ArrayLike, f_axis: ArrayLike, f: float, zeta: float) -> float:

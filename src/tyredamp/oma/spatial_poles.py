@@ -13,12 +13,12 @@ rolling tyre in :func:`~tyredamp.oma.rolling.rolling_modes`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
-from .identify import oma
+from .identify import DeferredErrors, oma_deferred
 from .spatial import (
     peak_contrast,
     power_threshold,
@@ -27,11 +27,44 @@ from .spatial import (
     welch_dof,
 )
 
-__all__ = ["ALPHA", "SpatialPole", "select_spatial_poles", "spatial_poles"]
+__all__ = [
+    "ALPHA",
+    "CHANNEL_ORDER",
+    "SpatialPole",
+    "select_spatial_poles",
+    "spatial_poles",
+    "spatial_route",
+]
 
 
 ALPHA = 1e-3
 """Probability that sensor noise alone passes each test of :func:`select_spatial_poles`."""
+
+SEGMENT = 1024
+"""Welch segment (samples) of the channel spectra the selection tests use."""
+
+CHANNEL_ORDER = 40
+"""Largest SSI model order of one wave-number channel (unless given).
+
+A channel of one wave number and direction holds, in the band, only the
+waves of ``n`` and its aliases ``K -+ n`` travelling that way: a few poles,
+where the record of all sensors holds every wave of the band. Forty states
+(twenty poles) leave room for the noise poles a stabilisation diagram needs
+to tell the physical ones apart; ``benchmarks/README.md`` compares 30, 40,
+60 and 80 on the virtual tyre.
+"""
+
+CHANNEL_BLOCK_ROWS = CHANNEL_ORDER // 2 + 2
+"""SSI block rows of one wave-number channel (unless given): about the fewest
+whose Toeplitz matrix holds :data:`CHANNEL_ORDER` (``2 (i - 1) >= 40`` for the
+channel's two outputs, Peeters & De Roeck 1999, eq. 16-18). Longer lags add
+more of the correlation estimate's noise than information about a channel's
+few waves: on the virtual tyre 100 block rows (the default of
+:func:`~.identify.oma` for a band from 0 Hz) gave larger frequency errors
+and jackknife errors 1.6 times their actual scatter; 22 gave the most waves
+within 0.5 % and 10 % and intervals that cover about as they should
+(``benchmarks/README.md``: 22, 25, 30, 50, 100).
+"""
 
 
 @dataclass(frozen=True)
@@ -67,6 +100,61 @@ class SpatialPole:
     orders: int
 
 
+def _channel_poles(
+    y: Any, fs: float, angles: list[float], kw: dict[str, Any]
+) -> tuple[list[SpatialPole], dict[int, tuple[DeferredErrors, int]], float, float]:
+    """Every pole of every channel without standard errors, with what computes
+    them (keyed by ``id`` of the pole), the spectra's bin (Hz) and dof."""
+    out: list[SpatialPole] = []
+    later: dict[int, tuple[DeferredErrors, int]] = {}
+    K = len(angles)
+    nperseg = SEGMENT
+    fs_, S = spatial_spectra(y, fs, angles, nperseg)
+    floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
+    opts = {k: v for k, v in kw.items() if k != "uncertainty"}
+    opts.setdefault("max_order", CHANNEL_ORDER)
+    if opts["max_order"] is None:
+        opts["max_order"] = CHANNEL_ORDER
+    if opts.get("block_rows") is None:
+        opts["block_rows"] = CHANNEL_BLOCK_ROWS
+    for n in range(0, (K - 1) // 2 + 1):
+        if n == 0:
+            parts = [("standing", oma_deferred(travelling_channels(y, angles, 0)[0], fs, **opts))]
+        else:
+            bwd, fwd = travelling_channels(y, angles, n)
+            parts = [("backward", oma_deferred(bwd, fs, **opts)),
+                     ("forward", oma_deferred(fwd, fs, **opts))]  # fmt: skip
+        for d, (r, err) in parts:
+            c = int(d == "forward")
+            for j in range(r.n_modes):
+                f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
+                k = int(np.argmin(np.abs(fs_ - f)))
+                ratio = float(S[c, n, k] / floor[k])
+                other = float(S[1 - c, n, k] / floor[k]) if n > 0 else ratio
+                p = SpatialPole(n, d, f, z, np.nan, np.nan, ratio, other,
+                                peak_contrast(S[c, n], fs_, f, z), int(r.n_orders[j]))  # fmt: skip
+                out.append(p)
+                later[id(p)] = (err, j)
+    return out, later, float(fs_[1] - fs_[0]), welch_dof(np.shape(y)[-1], nperseg)
+
+
+def _with_errors(
+    poles: list[SpatialPole], later: dict[int, tuple[DeferredErrors, int]]
+) -> list[SpatialPole]:
+    """The poles with their jackknife standard errors, one jackknife per channel."""
+    groups: dict[int, tuple[DeferredErrors, list[int], list[int]]] = {}
+    for i, p in enumerate(poles):
+        err, j = later[id(p)]
+        groups.setdefault(id(err), (err, [], []))[1].append(j)
+        groups[id(err)][2].append(i)
+    out = list(poles)
+    for err, modes, where in groups.values():
+        sf, sz = err.std(modes)
+        for i, a, b in zip(where, sf.tolist(), sz.tolist(), strict=True):
+            out[i] = replace(poles[i], std_frequency_hz=a, std_damping_ratio=b)
+    return out
+
+
 def spatial_poles(
     y: Any, fs: float, angles: list[float], kw: dict[str, Any]
 ) -> tuple[list[SpatialPole], float, float]:
@@ -82,7 +170,10 @@ def spatial_poles(
     angles : list of float
         Their angles, deg.
     kw : dict
-        Options of :func:`~tyredamp.oma.identify.oma`.
+        Options of :func:`~tyredamp.oma.identify.oma` (``max_order`` defaults
+        to :data:`CHANNEL_ORDER`); with ``uncertainty`` every pole gets its
+        jackknife errors (:func:`spatial_route` computes them for the kept
+        poles only).
 
     Returns
     -------
@@ -92,29 +183,57 @@ def spatial_poles(
     dof : float
         Degrees of freedom of each bin of those spectra (:func:`.spatial.welch_dof`).
     """
-    out: list[SpatialPole] = []
-    K = len(angles)
-    nperseg = 1024
-    fs_, S = spatial_spectra(y, fs, angles, nperseg)
-    floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
-    for n in range(0, (K - 1) // 2 + 1):
-        if n == 0:
-            parts = [("standing", oma(travelling_channels(y, angles, 0)[0], fs, **kw))]
-        else:
-            bwd, fwd = travelling_channels(y, angles, n)
-            parts = [("backward", oma(bwd, fs, **kw)), ("forward", oma(fwd, fs, **kw))]
-        for d, r in parts:
-            c = int(d == "forward")
-            for j in range(r.n_modes):
-                f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
-                k = int(np.argmin(np.abs(fs_ - f)))
-                ratio = float(S[c, n, k] / floor[k])
-                other = float(S[1 - c, n, k] / floor[k]) if n > 0 else ratio
-                out.append(SpatialPole(n, d, f, z, float(r.std_frequency_hz[j]),
-                                       float(r.std_damping_ratio[j]), ratio, other,
-                                       peak_contrast(S[c, n], fs_, f, z),
-                                       int(r.n_orders[j])))  # fmt: skip
-    return out, float(fs_[1] - fs_[0]), welch_dof(np.shape(y)[-1], nperseg)
+    poles, later, res, dof = _channel_poles(y, fs, angles, kw)
+    if kw.get("uncertainty", True):
+        poles = _with_errors(poles, later)
+    return poles, res, dof
+
+
+def spatial_route(
+    y: Any, fs: float, angles: list[float], kw: dict[str, Any], band: tuple[float, float]
+) -> tuple[list[SpatialPole], list[str]]:
+    """The waves of the wave-number route: the poles of every channel
+    (:func:`spatial_poles`), those taken for waves (:func:`select_spatial_poles`),
+    and, with ``kw["uncertainty"]``, their jackknife errors, computed for the
+    kept poles only.
+
+    A kept pole whose frequency scatters over the jackknife segments by more
+    than ten times ``sqrt(zeta f / T)`` is left out, as :func:`~.identify.oma`
+    does: the random error of the frequency of a resonance of half-power
+    half-bandwidth ``B = zeta f`` seen for ``T`` seconds is about ``sqrt(B / T)``
+    (Bendat & Piersol, Random Data, 4th ed. 2010, sec. 8.5.4).
+
+    Parameters
+    ----------
+    y, fs, angles, kw
+        As in :func:`spatial_poles`.
+    band : (float, float)
+        Hz, the band of the identification.
+
+    Returns
+    -------
+    kept : list of SpatialPole
+    notes : list of str
+        One per pole left out for its scatter.
+    """
+    poles, later, res, dof = _channel_poles(y, fs, angles, kw)
+    kept = select_spatial_poles(poles, band, res, dof)
+    if not kw.get("uncertainty", True):
+        return kept, []
+    kept = _with_errors(kept, later)
+    T = np.shape(y)[-1] / fs
+    notes: list[str] = []
+    out = []
+    for p in kept:
+        scale = np.sqrt(max(p.damping_ratio, 1e-12) * p.frequency_hz / T)
+        if np.isfinite(p.std_frequency_hz) and p.std_frequency_hz > 10 * scale:
+            notes.append(f"{p.frequency_hz:.4g} Hz (wave number {p.wave_number}, {p.direction}) "
+                         f"left out: its frequency scatters by {p.std_frequency_hz:.2g} Hz over "
+                         f"the segments, {p.std_frequency_hz / scale:.0f} times what a mode of "
+                         "its damping shows in this record")  # fmt: skip
+            continue
+        out.append(p)
+    return out, notes
 
 
 def select_spatial_poles(

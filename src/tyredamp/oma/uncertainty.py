@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .correlation import Correlations
-from .ssi import block_toeplitz, poles_at_order
+from .ssi import ShiftProjection, block_toeplitz
 
 __all__ = ["jackknife_std", "jackknife_variance"]
 
@@ -91,11 +91,12 @@ def jackknife_std(
     n_hi = int(need.max()) if m else 0
     for g in range(G):
         T = block_toeplitz(corr.leave_out(g), block_rows)
-        U, s, _ = np.linalg.svd(T, full_matrices=False)
+        U = np.linalg.svd(T, full_matrices=False)[0]
+        proj = ShiftProjection(U, n_hi, n_out)
         fs_: list[list[float]] = [[] for _ in range(m)]
         zs_: list[list[float]] = [[] for _ in range(m)]
         for n in need:
-            lam, sh = poles_at_order(U[:, :n_hi], s[:n_hi], int(n), n_out, corr.sample_rate)
+            lam, sh = proj.poles(int(n), corr.sample_rate)
             for j in range(m):
                 hit = np.flatnonzero(orders[j] == n)
                 if hit.size == 0:

@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ...exceptions import InputError
 from ...timedata import TimeData
 from ._settings import Band, Boolean, StepSettings, knob
 
@@ -47,10 +48,28 @@ class RollingSettings(StepSettings):
     spatial: bool = knob(
         False,
         "Identify each wave number and direction apart (fixed sensors equally spaced "
-        "around the tyre).",
+        "around the tyre; the default for such sensors and a long enough record).",
         Boolean(),
         "--spatial",
     )
+    general: bool = knob(
+        False,
+        "Identify all fixed sensors together and split each mode into waves afterwards "
+        "(the default for sensors not equally spaced).",
+        Boolean(),
+        "--general",
+    )
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.spatial and self.general:
+            raise InputError("spatial, general: expected one route for the fixed sensors, got both")
+
+    @property
+    def route(self) -> bool | None:
+        """``spatial`` of :func:`~tyredamp.oma.rolling.rolling_modes`: ``True``,
+        ``False`` or ``None`` (its default: by the sensors' layout)."""
+        return True if self.spatial else (False if self.general else None)
 
 
 class RollingStep:
@@ -72,7 +91,7 @@ class RollingStep:
             wheel_speed_hz,
             band=settings.band,
             uncertainty=settings.uncertainty,
-            spatial=settings.spatial,
+            spatial=settings.route,
         )
         return res, []
 
@@ -102,7 +121,9 @@ class RollingStep:
                     }
                 )
         else:
-            for j in range(r.n_modes):
+            # the modes that gave a wave (not those the band edge cut off)
+            waved = {w.fixed_hz for w in result.fixed}
+            for j in (j for j in range(r.n_modes) if float(r.frequency_hz[j]) in waved):
                 sf, sz = float(r.std_frequency_hz[j]), float(r.std_damping_ratio[j])
                 modes.append(
                     {
