@@ -137,7 +137,9 @@ def test_the_passes_neither_hold_the_first_identification_nor_touch_a_given_vari
         return plain
 
     with_model_error(frf, None, held, run)  # type: ignore[arg-type]
-    assert seen and np.all(np.isfinite(seen[0])) and np.all(seen[0] > 0)
+    assert seen
+    assert np.all(np.isfinite(seen[0]))
+    assert np.all(seen[0] > 0)
     v_user = np.full(np.shape(frf.H), 1e-6)
     kept = v_user.copy()
     identify_modes(frf, band=(20.0, 980.0), model="complex", variance=v_user)
