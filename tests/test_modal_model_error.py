@@ -115,3 +115,32 @@ def test_no_pole_within_one_line_of_a_ringing_beam_mode(k: int, band: tuple[floa
     # a pole that close is refused where it arises: by the search (a trial narrower
     # than the lines within one line of a mode, tyredamp.modal.search.narrow) or by the
     # final fit (tyredamp.modal.search.resolution)
+
+
+@pytest.mark.skipif(not BEAM.is_dir(), reason="the real-data gallery is not beside the repository")
+def test_the_passes_neither_hold_the_first_identification_nor_touch_a_given_variance() -> None:
+    """The model error's passes empty the list that hands them the first
+    identification (its arrays are not held through them); the variance made for
+    a pass is normalised in place, but a variance the user gives never is."""
+    from tyredamp.modal.identify import IdentifyOptions, _identify
+    from tyredamp.modal.problem.model_error import with_model_error
+
+    frf = _beam(1)
+    # the first identification (noise from the residual), which leaves structure
+    plain = _identify(frf, (20.0, 980.0), IdentifyOptions(model="complex"), None)
+    held = [plain]
+    seen: list[np.ndarray] = []
+
+    def run(v: object, note: str) -> object:
+        assert not held  # emptied before the pass runs
+        seen.append(np.array(v, copy=True))
+        return plain
+
+    with_model_error(frf, None, held, run)  # type: ignore[arg-type]
+    assert seen
+    assert np.all(np.isfinite(seen[0]))
+    assert np.all(seen[0] > 0)
+    v_user = np.full(np.shape(frf.H), 1e-6)
+    kept = v_user.copy()
+    identify_modes(frf, band=(20.0, 980.0), model="complex", variance=v_user)
+    assert np.array_equal(v_user, kept)  # the user's variance is not normalised in place

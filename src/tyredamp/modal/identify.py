@@ -312,13 +312,17 @@ def identify_modes(
         get_estimator(estimator), search,
     )  # fmt: skip
     with blas_limit(blas_threads):
-        first = _identify(frf, band, o, variance)
+        # the first identification is handed over in a list, which the model-error
+        # passes empty: its arrays are not held through them
+        first = [_identify(frf, band, o, variance)]
+        aside = [w for w in first[0].warnings[:1] if w.startswith(SET_ASIDE)]
         res, eps = with_model_error(
-            frf, variance, first, lambda v, note: _identify(frf, band, o, v, note)
+            frf, variance, first, lambda v, note: _identify(frf, band, o, v, note, owned=True)
         )
-    if res is not first:  # the last pass was given a variance: first's notes on its own
-        res.warnings[:0] = [w for w in first.warnings[:1] if w.startswith(SET_ASIDE)]
-    return res if eps == 0.0 else dataclasses.replace(res, model_error=eps)
+    if eps == 0.0:
+        return res
+    res.warnings[:0] = aside  # the last pass was given a variance: first's notes on its own
+    return dataclasses.replace(res, model_error=eps)
 
 
 def _identify(
@@ -327,12 +331,14 @@ def _identify(
     o: IdentifyOptions,
     variance: ArrayLike | None,
     noise_note: str = "",
+    owned: bool = False,
 ) -> ModalIdentification:
     """The body of :func:`identify_modes` (``noise_note`` says what a given
-    ``variance`` is, :attr:`~tyredamp.modal.problem.problem.FitProblem.noise_note`)."""
+    ``variance`` is, :attr:`~tyredamp.modal.problem.problem.FitProblem.noise_note`;
+    ``owned``: the variance is this call's to normalise in place, one made for it)."""
     if o.model not in ("both", "complex", "real"):
         raise InputError(f"model: expected 'both', 'complex' or 'real', got {o.model!r}")
-    problem = build_problem(frf, band, variance=variance, noise_note=noise_note)
+    problem = build_problem(frf, band, variance=variance, noise_note=noise_note, owned=owned)
     _, n_in, n_f = problem.shape
     lo, hi = problem.band
     fr = _check_counts(problem, o.n_modes, o.frequencies)

@@ -197,7 +197,7 @@ R = TypeVar("R", bound=Identification)
 def with_model_error(
     frf: FRF,
     variance: ArrayLike | None,
-    first: R,
+    first: list[R],
     run: Callable[[ArrayLike | None, str], R],
 ) -> tuple[R, float]:
     """``first`` decided again against eq. (1), when its fit leaves structure beyond
@@ -207,12 +207,13 @@ def with_model_error(
     ----------
     frf : FRF
         The data ``first`` was identified from; ``variance`` the variance it was given.
-    first : identification
-        The identification against the noise alone.
+    first : list of one identification
+        The identification against the noise alone, in a list that is emptied
+        once the passes begin (its arrays are not held through them).
     run : callable
         ``run(variance, note)`` identifies ``frf`` again with a per-line
-        ``variance`` (shape of ``frf.H``, units of ``H`` squared) that ``note``
-        describes.
+        ``variance`` (shape of ``frf.H``, units of ``H`` squared, made for the
+        call: it may normalise it in place) that ``note`` describes.
 
     Returns
     -------
@@ -220,36 +221,40 @@ def with_model_error(
         The last pass (a warning added) and its ``eps``; ``(first, 0.0)`` where
         the noise was measured, the fit passed, or eq. (2) has no root.
     """
-    kind = "complex" if "complex" in first.models else "real"
-    q = first.models[kind].quality
-    if first.noise_source != "residual":
-        return first, 0.0  # a measured noise: a fit that misses it has failed, and says so
+    res = first[0]
+    kind = "complex" if "complex" in res.models else "real"
+    q = res.models[kind].quality
+    if res.noise_source != "residual":
+        return res, 0.0  # a measured noise: a fit that misses it has failed, and says so
     if q is None or q.passed or not math.isfinite(q.chi2) or q.dof <= 0:
-        return first, 0.0
-    problem = build_problem(frf, first.band_hz, variance=variance)
+        return res, 0.0
+    problem = build_problem(frf, res.band_hz, variance=variance)
     lines, f_band = problem.lines, problem.frequency
     H = np.asarray(frf.H)[:, :, lines]
-    floor = noise_floor(frf, problem, _model_band(first.models[kind], f_band, frf.kind) - H)
+    floor = noise_floor(frf, problem, _model_band(res.models[kind], f_band, frf.kind) - H)
     del problem  # its normalised copy of the data is not held through the passes
     V = floor.variance[:, :, lines]
 
-    def eps_of(res: R) -> float:
-        m = res.models[kind]
+    def eps_of(r: R) -> float:
+        m = r.models[kind]
         dof = m.quality.dof if m.quality is not None else 0
         return relative_model_error(H, _model_band(m, f_band, frf.kind), V, dof)
 
-    eps, res = eps_of(first), first
+    eps = eps_of(res)
     if eps <= 0.0:
-        return first, 0.0
+        return res, 0.0
+    first.clear()
     # each pass decides the modes against the eps of the fits before it; a pass
     # whose fit gives back a larger eps (it merged a split, so the model error
     # shows) is followed by one against that eps: the sequence only rises, to the
     # largest eps the fits of the data give back (the fixed point of eq. (2) that
     # holds the fewest modes; a split fit reproduces its own smaller eps too)
     for _ in range(PASSES):
-        v = floor.variance.copy()
-        v[:, :, lines] += eps**2 * np.abs(H) ** 2
-        res = run(v, f"{floor.what} plus a model error of {eps:.2%} of the response")
+        del res  # the pass before is not held through this one
+        res = run(
+            _floor_plus_error(floor, H, lines, eps),
+            f"{floor.what} plus a model error of {eps:.2%} of the response",
+        )
         again = eps_of(res)
         if again <= eps * (1.0 + EPS_TOLERANCE):
             break
@@ -260,6 +265,21 @@ def with_model_error(
         f"against a noise that includes a model error of {eps:.2%} of the response"
     )
     return res, eps
+
+
+def _floor_plus_error(
+    floor: NoiseFloor, H: NDArray[np.complex128], lines: slice, eps: float
+) -> NDArray[np.float64]:
+    """Eq. (1) on the whole axis: the floor plus ``eps^2 |H|^2`` on the band's lines
+    (``H`` the band's data), formed in blocks of lines without full-length
+    temporaries."""
+    v = np.empty(floor.variance.shape)
+    v[...] = floor.variance
+    vb = v[:, :, lines]
+    for a in range(0, H.shape[2], _SYNTH_BLOCK):
+        h = H[:, :, a : a + _SYNTH_BLOCK]
+        vb[:, :, a : a + h.shape[2]] += eps**2 * (h.real**2 + h.imag**2)
+    return v
 
 
 #: lines per block of the synthesised model (:func:`_model_band`): the modal sum's

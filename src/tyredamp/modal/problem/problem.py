@@ -277,6 +277,7 @@ def build_problem(
     *,
     variance: ArrayLike | None = None,
     noise_note: str = "",
+    owned: bool = False,
 ) -> FitProblem:
     """Cut ``frf`` to the band, normalise it and state its noise model.
 
@@ -292,6 +293,9 @@ def build_problem(
         ``meta["n_averages"]``, else none (estimated from the residual).
     noise_note : str
         What a given ``variance`` is (:attr:`FitProblem.noise_note`).
+    owned : bool
+        The given ``variance`` (a float64 array) was made for this call and may be
+        normalised in place (the model error's passes; never a user's array).
 
     Returns
     -------
@@ -348,7 +352,10 @@ def build_problem(
         source, v, nu = "residual", None, None
     sig = lw = vn = None
     if v is not None:
-        vn = v / peak**2
+        # a variance made for this call (``owned``) is normalised in place: no copy
+        vn = v if owned and v.dtype == np.float64 and v.flags.writeable else v / peak**2
+        if vn is v:
+            vn /= peak**2
         vn /= rms**2  # in place: one copy of the band's variance
         sep = _separable(vn)
         if sep is None:
