@@ -148,19 +148,11 @@ def shape_std(
     didx: NDArray[np.intp],
 ) -> NDArray[np.float64]:
     """``sqrt(E|d psi_out|^2)`` per entry (n_out, m) by the delta method."""
-    C, Rq = sol["C"], sol["R"]
-    lay = sol["lay"]
-    q, n_out = C.shape
+    C = sol["C"]
+    q = C.shape[0]
     n_par = th.size
     nd = didx.size
-    rinv = lapack.dtrtri(Rq)[0]
-    F = rinv @ rinv.T  # (Phi^T Phi)^-1
-    E = rinv @ (sol["QtE"][:, lay.ecol] * sol["coef"][None, :])  # Phi^+ D, (q, n_d)
-    A = lay.A
-    # M_j = -Phi^+ dPhi/dtheta C_j: M[j, a, k] = -sum_d E[a, d] C[dcol_d, j] A[d, k]
-    ec = E[None, :, :] * C[lay.dcol].T[:, None, :]  # (n_out, q, n_d)
-    M = -(ec.reshape(n_out * q, -1) @ A).reshape(n_out, q, n_par)
-    MC = (M.reshape(n_out * q, n_par) @ cth).reshape(M.shape)  # Cov(C_j, theta)
+    F, M, MC = _coefficient_sensitivity(sol, cth)
     # Var of the coefficient of mode n for output j
     cov_cc_diag = s2 * np.diag(F)[None, :] + np.einsum("jak,jak->ja", MC, M)
     if fitter.kind == "complex":
@@ -197,6 +189,26 @@ def shape_std(
         cross += sign * part_
     term2 = 2 * np.real(np.conj(b)[None, :] / w[:, None] * u * cross)
     return np.asarray(np.sqrt(np.maximum(term1 + term2 + term3, 0.0)))
+
+
+def _coefficient_sensitivity(
+    sol: dict[str, Any], cth: NDArray[np.float64], rows: NDArray[np.intp] | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``F = (Phi^T Phi)^-1`` (q, q), ``M_j = -Phi^+ dPhi/dtheta C_j`` and
+    ``Cov(C_j, theta) = M_j cth`` (each (n_rows, q, n_par)) of the outputs ``rows``
+    (default all) of the projection's solution ``sol``:
+    ``M[j, a, k] = -sum_d E[a, d] C[dcol_d, j] A[d, k]`` with ``E = Phi^+ D``."""
+    C, lay = sol["C"], sol["lay"]
+    rinv = lapack.dtrtri(sol["R"])[0]
+    F = rinv @ rinv.T
+    E = rinv @ (sol["QtE"][:, lay.ecol] * sol["coef"][None, :])  # Phi^+ D, (q, n_d)
+    cd = C[lay.dcol] if rows is None else C[lay.dcol][:, rows]
+    ec = E[None, :, :] * cd.T[:, None, :]  # (n_rows, q, n_d)
+    n_rows, q = ec.shape[:2]
+    n_par = cth.shape[0]
+    M = -(ec.reshape(n_rows * q, -1) @ lay.A).reshape(n_rows, q, n_par)
+    MC = (M.reshape(n_rows * q, n_par) @ cth).reshape(M.shape)
+    return F, M, MC
 
 
 def _global_cov(
@@ -247,24 +259,15 @@ def input_shape_std(
     n_par = th.size
     poles, part = fitter.unpack(th, m, ref)
     cplx = fitter.kind == "complex"
+    omega = poles.imag
     if didx.size:
-        C, Rq = sol["C"], sol["R"]
-        q = C.shape[0]
-        rinv = lapack.dtrtri(Rq)[0]
-        F = rinv @ rinv.T
-        lay = sol["lay"]
-        E = rinv @ (sol["QtE"][:, lay.ecol] * sol["coef"][None, :])
-        ec = E[None, :, :] * C[lay.dcol][:, didx].T[:, None, :]  # (nd, q, n_d)
-        MD = -(ec.reshape(didx.size * q, -1) @ lay.A).reshape(didx.size, q, n_par)
-        MC = (MD.reshape(-1, n_par) @ cth).reshape(MD.shape)
+        F, MD, MC = _coefficient_sensitivity(sol, cth, didx)
         sgg = _global_cov(cth, MC, MD, s2, F)
-        beta = scale_jacobian(fitter, th, m, ref, C[:, didx].T, w[didx])
+        beta = scale_jacobian(fitter, th, m, ref, sol["C"][:, didx].T, w[didx])
         bb = np.where(b == 0, 1.0, b)
+        c = 1.0 / bb if cplx else 1.0 / (bb * 2j * omega)
     else:
         sgg, beta, bb = cth, np.zeros((n_par, m), complex), np.ones(m, complex)
-    omega = poles.imag
-    c = 1.0 / bb if cplx else 1.0 / (bb * 2j * omega)
-    if not didx.size:
         c = np.ones(m, complex) if cplx else 1.0 / np.sqrt(2j * omega)
     out = np.zeros((fitter.n_in, m))
     idx = 2 * m
