@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._validate import as_band, as_finite, as_frequency
 from .exceptions import InputError, ShapeError
 
-__all__ = ["FRF", "KINDS", "UNITS", "Channel", "FRFKind"]
+__all__ = ["FRF", "KINDS", "UNITS", "Channel", "FRFKind", "drive_pairs"]
 
 FRFKind = Literal["receptance", "mobility", "accelerance"]
 KINDS: tuple[FRFKind, ...] = ("receptance", "mobility", "accelerance")
@@ -90,6 +90,17 @@ class Channel:
     def label(self) -> str:
         """Short text label such as ``"5+Z"`` (or the name when given)."""
         return self.name or f"{self.node}{_DIRECTIONS[self.direction]}"
+
+
+def drive_pairs(outputs: Sequence[Channel], inputs: Sequence[Channel]) -> list[tuple[int, int]]:
+    """Pairs ``(i_out, i_in)`` of an output at the node and direction (either sense)
+    of an input, in the order of the inputs: the drive points."""
+    return [
+        (i, j)
+        for j, ci in enumerate(inputs)
+        for i, co in enumerate(outputs)
+        if co.node == ci.node and abs(co.direction) == abs(ci.direction)
+    ]
 
 
 def _channels(ch: Sequence[Channel | int] | None, n: int, name: str) -> tuple[Channel, ...]:
@@ -372,12 +383,7 @@ class FRF:
 
     def drive_points(self) -> list[tuple[int, int]]:
         """Pairs ``(i_out, i_in)`` where output and input are the same node and direction."""
-        pairs = []
-        for j, ci in enumerate(self.inputs):
-            for i, co in enumerate(self.outputs):
-                if co.node == ci.node and abs(co.direction) == abs(ci.direction):
-                    pairs.append((i, j))
-        return pairs
+        return drive_pairs(self.outputs, self.inputs)
 
     def with_H(self, H: ArrayLike, kind: FRFKind | None = None) -> FRF:
         """A copy with new responses on the same axis and channels (no coherence or variance)."""

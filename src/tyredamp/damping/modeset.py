@@ -32,6 +32,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..exceptions import InputError, ShapeError
+from ..frf import Channel, drive_pairs
 from ..modal.model import ModalModel
 
 __all__ = [
@@ -144,19 +145,17 @@ def negative_mass_modes(model: ModalModel) -> tuple[list[float], str]:
     """
     if model.meta.get("drive_points_stated") is False:  # inputs assumed, not measured
         return [], ""
-    names = {1: "X", 2: "Y", 3: "Z", 4: "RX", 5: "RY", 6: "RZ"}
     omega = np.abs(np.asarray(model.poles).imag)
-    for k, co in enumerate(model.outputs):
-        for j, ci in enumerate(model.inputs):
-            if co.node != ci.node or abs(co.direction) != abs(ci.direction) or not co.direction:
-                continue
-            sense = 1.0 if co.direction * ci.direction > 0 else -1.0
-            a = sense * np.real(2j * omega * model.psi_out[k] * model.psi_in[j])
-            bad = np.flatnonzero(~(a > 0))
-            if bad.size:
-                where = f"{co.node}{'+' if co.direction > 0 else '-'}"
-                where += names.get(abs(co.direction), str(abs(co.direction)))
-                return sorted(float(x) for x in model.frequency_hz[bad]), where
+    for k, j in sorted(drive_pairs(model.outputs, model.inputs)):  # output by output
+        co, ci = model.outputs[k], model.inputs[j]
+        if not co.direction:  # a scalar channel has no sense to compare
+            continue
+        sense = 1.0 if co.direction * ci.direction > 0 else -1.0
+        a = sense * np.real(2j * omega * model.psi_out[k] * model.psi_in[j])
+        bad = np.flatnonzero(~(a > 0))
+        if bad.size:
+            point = Channel(co.node, co.direction).label  # node and direction, not a name
+            return sorted(float(x) for x in model.frequency_hz[bad]), point
     return [], ""
 
 
@@ -189,10 +188,8 @@ def scaling_problem(model: ModalModel, per_mode: bool = False) -> str:
         return str(why) if why else "the modes are not scaled"
     if not model.inputs:
         return "the modes have no drive point to scale them"
-    for ci in model.inputs:
-        for co in model.outputs:
-            if co.node == ci.node and abs(co.direction) == abs(ci.direction):
-                return ""
+    if drive_pairs(model.outputs, model.inputs):
+        return ""
     return (
         "the FRFs have no drive point (no input at the node and direction of an output), "
         "so the fit cannot scale the shapes"
