@@ -352,26 +352,33 @@ def impact_modes(ctx: Context, time_file: str, label: str) -> Check:
     return Check(f"{len(found)} modes: {fmt_hz(found)}", agree, ok)
 
 
-def _hit_frfs(ctx: Context) -> list[Path]:
-    """The impact test's FRF of each hit alone (numpy on lvm_read's data, as the
-    reference's H1 but one hit per file), written as UFF 58 for ``tyredamp modal``."""
+def impact_hit_spectra(real: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """The impact test read by lvm_read, cut into one record per hit: the frequency
+    axis (Hz), the force spectra (hits, lines), the two responses' spectra (hits,
+    lines, 2) and the samples per record (from 20 samples before each hit)."""
     import lvm_read
 
-    from tyredamp.frf import FRF, Channel
-    from tyredamp.io import write_frf
-
-    lvm = lvm_read.read(str(ctx.path(LVM_LONG)), read_from_pickle=False, dump_file=False)
+    lvm = lvm_read.read(str(real / LVM_LONG), read_from_pickle=False, dump_file=False)
     data, dt = lvm[0]["data"], float(lvm[0]["Delta_X"][0])
     force, resp = data[:, 0], data[:, 1:3]
     hits = [int(i) for i in np.flatnonzero(np.abs(force) > 0.5 * np.abs(force).max())]
     starts = sorted({h - 20 for h in hits if all(abs(h - g) > 100 for g in hits if g < h)})
     n = min(data.shape[0] - s for s in starts)
-    f = np.fft.rfftfreq(n, dt)
+    fspec = np.array([np.fft.rfft(force[s : s + n] - np.median(force[:50])) for s in starts])
+    xspec = np.array([np.fft.rfft(resp[s : s + n], axis=0) for s in starts])
+    return np.fft.rfftfreq(n, dt), fspec, xspec, n
+
+
+def _hit_frfs(ctx: Context) -> list[Path]:
+    """The impact test's FRF of each hit alone (numpy on lvm_read's data, as the
+    reference's H1 but one hit per file), written as UFF 58 for ``tyredamp modal``."""
+    from tyredamp.frf import FRF, Channel
+    from tyredamp.io import write_frf
+
+    f, fspec, xspec, _ = impact_hit_spectra(ctx.real)
     band = (f > 0) & (f <= 500.0)
     out = []
-    for k, s0 in enumerate(starts, start=1):
-        fs = np.fft.rfft(force[s0 : s0 + n] - np.median(force[:50]))
-        xs = np.fft.rfft(resp[s0 : s0 + n], axis=0)
+    for k, (fs, xs) in enumerate(zip(fspec, xspec, strict=True), start=1):
         frf = FRF(
             f[band],
             (xs[band] / fs[band, None]).T[:, None, :],
@@ -769,10 +776,10 @@ def row_tir(rel: str, keys: dict[str, float]) -> Callable[[Context], Check]:
 
 
 IMPACT_GAP = (
-    "modal finds all 8 modes of sdypy-EMA (within 0.16 %) and 21 more in its band; 14 of "
+    "modal finds all 8 modes of sdypy-EMA (within 0.16 %) and 21 more in its band; 12 of "
     "these are found again in each of the two hits identified alone (independent data: "
     "modes of the structure that the reference, which keeps the poles at the FRF's peaks, "
-    "does not list), 7 are not. Their mode test holds them significant against the noise "
+    "does not list), 9 are not. Their mode test holds them significant against the noise "
     "plus a model error of about 10 % of the response, but with two hits and a coherence "
     "below 0.9 at 11 % of the lines the data do not settle whether they are weak modes that "
     "only both hits together resolve or artefacts of the fit"
@@ -1139,26 +1146,16 @@ def _sdypy(
 
 def make_references(real: Path) -> dict[str, Any]:
     """Peer-tool and independent references (sdypy-EMA, lvm_read, scipy.io, pyuff)."""
-    import lvm_read
     import pyuff
     import scipy.io
 
     refs: dict[str, Any] = {}
     # the impact test: H1 of the two hits, read by lvm_read, records of 8100 samples
-    lvm = lvm_read.read(str(real / LVM_LONG), read_from_pickle=False, dump_file=False)
-    data = lvm[0]["data"]
-    dt = float(lvm[0]["Delta_X"][0])
-    force, resp = data[:, 0], data[:, 1:3]
-    hits = [int(i) for i in np.flatnonzero(np.abs(force) > 0.5 * np.abs(force).max())]
-    starts = sorted({h - 20 for h in hits if all(abs(h - g) > 100 for g in hits if g < h)})
-    n = min(data.shape[0] - s for s in starts)
-    fspec = np.array([np.fft.rfft(force[s : s + n] - np.median(force[:50])) for s in starts])
-    xspec = np.array([np.fft.rfft(resp[s : s + n], axis=0) for s in starts])
+    f, fspec, xspec, n = impact_hit_spectra(real)
     h1 = (np.conj(fspec)[:, :, None] * xspec).sum(0) / (np.abs(fspec) ** 2).sum(0)[:, None]
-    f = np.fft.rfftfreq(n, dt)
     approx = _peaks(f, h1.T, 5.0, 500.0, 1.0)
     refs["impact"] = {
-        "what": f"H1 of {len(starts)} hits (records of {n} samples from 20 before each), lvm_read",
+        "what": f"H1 of {len(fspec)} hits (records of {n} samples from 20 before each), lvm_read",
         "peaks_hz": [round(x, 3) for x in approx],
         "sdypy_ema": _sdypy(f, h1.T, 5.0, 500.0, approx),
     }
