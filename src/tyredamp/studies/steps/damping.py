@@ -251,13 +251,11 @@ def damping_from_modes(
     dm = identify_damping(
         chosen, method, normalise=normalise, n_samples=n_samples, seed=seed, meta=info
     )
-    if left_out:
-        from dataclasses import replace
+    from dataclasses import replace
 
+    if left_out:
         dm = replace(dm, findings=(left_out, *dm.findings))
     if info["shape_points"] == "inputs" and dm.std and "psi_out" not in chosen.std:
-        from dataclasses import replace
-
         note = (
             "The shapes at the excitation points carry no standard errors (the fit gives them "
             "at the responses only): the standard errors of C' and C cover the uncertainty of "
