@@ -44,8 +44,10 @@ from numpy.typing import ArrayLike
 
 from ..exceptions import InputError
 from ..timedata import TimeData
+from .frames import rotating_frequency, rotating_pole
 from .identify import OMAResult, oma
-from .spatial import equally_spaced, peak_test_has_power, welch_dof
+from .nyquist import nyquist_candidates, resolve_nyquist
+from .spatial import equally_spaced, nyquist_wave_number, peak_test_has_power, welch_dof
 from .spatial_poles import (
     ALPHA,
     SEGMENT,
@@ -69,86 +71,6 @@ __all__ = [
     "select_spatial_poles",
     "spatial_poles",
 ]
-
-
-def rotating_frequency(
-    fixed_hz: float, wave_number: int, fixed_direction: str, wheel_speed_hz: float
-) -> tuple[float, str]:
-    """Rotating-frame frequency and direction on the tyre of a fixed-frame wave.
-
-    Eq. (1) of this module, ``f_rot = f_fixed - s n f_w`` (the Doppler relation
-    between the frames of a rotating ring, from the frame change of Huang &
-    Soedel 1987; derived in the module docstring).
-
-    Parameters
-    ----------
-    fixed_hz : float
-        Frequency at a fixed point, Hz.
-    wave_number : int
-        ``n >= 0``.
-    fixed_direction : {"forward", "backward", "standing"}
-        Direction of travel seen from a fixed point (``"forward"``: with the rotation).
-    wheel_speed_hz : float
-        Wheel rotation frequency ``f_w`` in Hz.
-
-    Returns
-    -------
-    f_rot : float
-        Hz (``>= 0``).
-    direction : str
-        On the tyre: ``"forward"``, ``"backward"`` or ``"standing"`` (``n = 0``
-        or a standing fixed-frame wave, for which ``f_fixed`` is returned).
-    """
-    if wave_number == 0 or fixed_direction == "standing":
-        return float(fixed_hz), "standing"
-    s = 1.0 if fixed_direction == "forward" else -1.0
-    f = float(fixed_hz) - s * wave_number * float(wheel_speed_hz)
-    if f >= 0:
-        return f, fixed_direction
-    return -f, "backward" if fixed_direction == "forward" else "forward"
-
-
-def rotating_pole(
-    fixed_hz: float,
-    damping_ratio: float,
-    wave_number: int,
-    fixed_direction: str,
-    wheel_speed_hz: float,
-) -> tuple[float, float, str]:
-    """Rotating-frame natural frequency and damping ratio of an identified fixed-frame pole.
-
-    An identified pole ``lambda = -sigma + i omega_d`` has the natural frequency
-    ``|lambda| / 2 pi`` and the damping ratio ``sigma / |lambda|``. Eq. (1) of
-    this module moves its *damped* frequency ``omega_d`` by ``-s n Omega`` and
-    keeps its decay rate ``sigma`` (the change of frame multiplies the wave by
-    ``e^{-i s n Omega t}``, Huang & Soedel 1987; :mod:`tyredamp.virtual.rolling_truth`).
-    Applying eq. (1) to the natural frequency instead is off by about
-    ``zeta^2 / 2`` relatively, which grows where the fixed frequency is low.
-
-    Parameters
-    ----------
-    fixed_hz : float
-        Natural frequency ``|lambda| / 2 pi`` at a fixed point, Hz.
-    damping_ratio : float
-        ``sigma / |lambda|`` at a fixed point (0 <= zeta < 1).
-    wave_number, fixed_direction, wheel_speed_hz
-        As in :func:`rotating_frequency`.
-
-    Returns
-    -------
-    f_rot : float
-        ``|lambda_rot| / 2 pi`` in Hz.
-    zeta_rot : float
-        ``sigma / |lambda_rot|``.
-    direction : str
-        On the tyre.
-    """
-    z = float(np.clip(damping_ratio, 0.0, 1.0))
-    sigma = z * float(fixed_hz)  # in Hz units: sigma / 2 pi
-    fd = float(fixed_hz) * np.sqrt(1.0 - z * z)
-    fr, d = rotating_frequency(fd, wave_number, fixed_direction, wheel_speed_hz)
-    mag = float(np.hypot(fr, sigma))
-    return mag, (sigma / mag if mag > 0 else z), d
 
 
 @dataclass(frozen=True)
@@ -315,11 +237,17 @@ def _within_band(
     return keep, notes
 
 
-def _spatial_waves(poles: list[SpatialPole], K: int, fw: float) -> list[RollingWave]:
-    """The selected poles as waves, with their channel and power in the reason."""
+def _spatial_waves(
+    poles: list[SpatialPole], K: int, fw: float, in_tyre: _InTyre | None = None, tol: float = 0.01
+) -> list[RollingWave]:
+    """The selected poles as waves, with their channel and power in the reason; the
+    poles of the Nyquist channel (even ``K``) through :func:`_nyquist_waves`."""
     out: list[RollingWave] = []
+    nyq = nyquist_wave_number(K)
     for p in poles:
         n, d = p.wave_number, p.direction
+        if n == nyq and n > 0:
+            continue
         alias = f" (aliases {K - n}, {K + n})" if n > 0 else ""
         why = (
             f"wave-number channel {'-' if d == 'forward' else '+'}{n}{alias}: power "
@@ -329,6 +257,68 @@ def _spatial_waves(poles: list[SpatialPole], K: int, fw: float) -> list[RollingW
         out.append(RollingWave("fixed", n, dt, d, p.frequency_hz, fr, p.damping_ratio,
                                p.std_frequency_hz, p.std_damping_ratio, float("nan"), [],
                                why))  # fmt: skip
+    others = [w.rotating_hz for w in out]
+    return out + _nyquist_waves([p for p in poles if p.wave_number == nyq and nyq],
+                                K, fw, in_tyre, others, tol)  # fmt: skip
+
+
+@dataclass
+class _InTyre:
+    """The in-tyre sensor's poles for :func:`resolve_nyquist`: those of the in-tyre
+    identification, and, where a hypothesis lies above its band but below
+    0.45 of the sampling rate, those of a second pLSCF up to there (computed once)."""
+
+    record: Any
+    sample_rate: float
+    wheel_speed_hz: float
+    result: OMAResult
+    wide: OMAResult | None = None
+
+    def poles(self, highest_hz: float) -> tuple[Any, Any, Any, tuple[float, float]]:
+        """``(f, zeta, std_f, band)`` of the identification whose band holds ``highest_hz``."""
+        r = self.result
+        top = 0.45 * self.sample_rate
+        if highest_hz > r.band_hz[1] and r.band_hz[1] < top:
+            if self.wide is None:
+                self.wide = oma(self.record, self.sample_rate, method="plscf",
+                                band=(r.band_hz[0], top),
+                                wheel_speed_hz=self.wheel_speed_hz or None)  # fmt: skip
+            r = self.wide
+        return r.frequency_hz, r.damping_ratio, r.std_frequency_hz, r.band_hz
+
+
+def _nyquist_waves(
+    poles: list[SpatialPole],
+    K: int,
+    fw: float,
+    in_tyre: _InTyre | None,
+    others: list[float],
+    tol: float,
+) -> list[RollingWave]:
+    """The poles of the Nyquist channel as waves: at rest both waves (they share
+    the frequency), rolling the direction :func:`resolve_nyquist` finds or none."""
+    out: list[RollingWave] = []
+    for p in poles:
+        n, f, z = p.wave_number, p.frequency_hz, p.damping_ratio
+        sf, sz = p.std_frequency_hz, p.std_damping_ratio
+        head = (f"wave-number channel {n} (the Nyquist channel (-1)^k): power {p.ratio:.3g} x "
+                "the median channel")  # fmt: skip
+        if fw == 0:
+            why = f"{head}; at rest both waves share its frequency"
+            for d in ("forward", "backward"):
+                out.append(RollingWave("fixed", n, d, d, f, f, z, sf, sz, float("nan"), [], why))
+            continue
+        hi = max(c.rotating_hz for c in nyquist_candidates(f, z, n, fw))
+        res = resolve_nyquist(f, z, sf, n, K, fw, None if in_tyre is None else in_tyre.poles(hi),
+                              [o for o in others if np.isfinite(o)], tol)  # fmt: skip
+        c, why = res.candidate, f"{head}; {res.reason}"
+        cands = [(n, x.direction, x.rotating_hz) for x in res.candidates]
+        if c is None:
+            out.append(RollingWave("fixed", n, None, None, f, float("nan"), z, sf, sz,
+                                   float("nan"), cands, why))  # fmt: skip
+        else:
+            out.append(RollingWave("fixed", n, c.direction, c.fixed_direction, f, c.rotating_hz,
+                                   z, sf, sz, float("nan"), [], why))  # fmt: skip
     return out
 
 
@@ -508,6 +498,11 @@ def rolling_modes(
     notes: list[str] = []
     fixed: list[RollingWave] = []
     r_fix = r_rot = None
+    in_tyre = None
+    if rot:
+        r_rot = oma(data.data[rot[:1]], data.sample_rate, method="plscf", band=bnd,
+                    wheel_speed_hz=fw if fw > 0 else None)  # fmt: skip
+        in_tyre = _InTyre(data.data[rot[:1]], data.sample_rate, fw, r_rot)
     ang: list[float] = []
     if len(fix) >= 3:
         ang = (
@@ -532,8 +527,8 @@ def rolling_modes(
             edges = bnd if bnd is not None else (0.0, 0.45 * data.sample_rate)
             kept, dropped = spatial_route(data.data[fix], data.sample_rate, ang, kw, edges)
             notes.extend(dropped)
-            fixed = _spatial_waves(kept, len(ang), fw)
-            notes.append(f"fixed sensors: each wave number 0..{(len(fix) - 1) // 2} identified "
+            fixed = _spatial_waves(kept, len(ang), fw, in_tyre, tol)
+            notes.append(f"fixed sensors: each wave number 0..{len(fix) // 2} identified "
                          "apart (spatial DFT of equally spaced sensors)")  # fmt: skip
         else:
             r_fix = oma(data.data[fix], data.sample_rate, **kw)
@@ -544,9 +539,7 @@ def rolling_modes(
     else:
         notes.append(f"{len(fix)} fixed sensor(s): at least 3 are needed for wave numbers")
     rotating: list[RollingWave] = []
-    if rot:
-        r_rot = oma(data.data[rot[:1]], data.sample_rate, method="plscf", band=bnd,
-                    wheel_speed_hz=fw if fw > 0 else None)  # fmt: skip
+    if r_rot is not None:
         rotating = resolve_in_tyre(
             r_rot.frequency_hz, fixed, fw, damping_ratio=r_rot.damping_ratio,
             std_frequency_hz=r_rot.std_frequency_hz, n_max=n_max, tol=tol,

@@ -21,6 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "equally_spaced",
+    "nyquist_wave_number",
     "peak_contrast",
     "peak_test_has_power",
     "power_threshold",
@@ -119,15 +120,18 @@ def spatial_spectra(
     -------
     f : ndarray, shape (m,)
         Hz, ``0 .. sample_rate / 2``.
-    S : ndarray, shape (2, n_hi + 1, m)
+    S : ndarray, shape (2, K // 2 + 1, m)
         ``S[0, n]`` the two-sided PSD of ``q_n`` at ``+f`` (backward waves),
         ``S[1, n]`` at ``-f`` (forward waves), unit of ``y`` squared per Hz.
+        For ``n = 0`` and, with ``K`` even, the Nyquist wave number ``K / 2``
+        (:func:`nyquist_wave_number`) ``q_n`` is a real record times a
+        constant phase, so both rows hold the same spectrum.
     """
     from scipy.signal import welch
 
     Y = np.asarray(y, float)
     K = Y.shape[0]
-    n_hi = (K - 1) // 2
+    n_hi = K // 2
     q = np.stack([re + 1j * im for re, im in
                   (spatial_channels(Y, angles_deg, n) for n in range(n_hi + 1))])  # fmt: skip
     seg = min(nperseg, Y.shape[1])
@@ -137,6 +141,35 @@ def spatial_spectra(
     pos = P[:, :m]
     neg = P[:, (-np.arange(m)) % seg]
     return f, np.stack([pos, neg]).real
+
+
+def nyquist_wave_number(n_sensors: int) -> int | None:
+    """The wave number whose two directions equally spaced sensors cannot tell apart.
+
+    At ``theta_k = theta_0 + 2 pi k / K`` the two travelling waves
+    ``e^{+-i n theta_k}`` of ``n = K / 2`` (``K`` even) are both
+    ``e^{+-i n theta_0} (-1)^k``: one real pattern, the spatial Nyquist
+    frequency of the sampling of the circumference (the spatial form of the
+    sampling theorem; Kindt, Sas & Desmet, J. Sound Vib. 320 (2009)
+    1049-1068, sec. 3, on the wave numbers a ring of sensors resolves). Its
+    channel ``sum_k (-1)^k y_k`` holds both waves of ``n = K / 2`` (and the
+    aliases ``K / 2 + m K``) at their fixed-frame frequencies, without their
+    direction.
+
+    Parameters
+    ----------
+    n_sensors : int
+        ``K``.
+
+    Returns
+    -------
+    int or None
+        ``K // 2`` for even ``K >= 2``, ``None`` for odd ``K`` (every wave
+        number up to ``(K - 1) / 2`` keeps its direction, and ``K / 2`` is
+        not an integer).
+    """
+    K = int(n_sensors)
+    return K // 2 if K >= 2 and K % 2 == 0 else None
 
 
 def welch_dof(n_samples: int, nperseg: int) -> float:

@@ -20,6 +20,7 @@ import numpy as np
 
 from .identify import DeferredErrors, oma_deferred
 from .spatial import (
+    nyquist_wave_number,
     peak_contrast,
     power_threshold,
     spatial_spectra,
@@ -110,16 +111,19 @@ def _channel_poles(
     K = len(angles)
     nperseg = SEGMENT
     fs_, S = spatial_spectra(y, fs, angles, nperseg)
-    floor = np.median(S.reshape(-1, S.shape[-1]), axis=0)
+    nyq = nyquist_wave_number(K)
+    real = {0} | ({nyq} if nyq is not None else set())
+    rows = [S[c, n] for n in range(S.shape[1]) for c in (0, 1) if c == 0 or n not in real]
+    floor = np.median(np.stack(rows), axis=0)  # one row per independent channel
     opts = {k: v for k, v in kw.items() if k != "uncertainty"}
     opts.setdefault("max_order", CHANNEL_ORDER)
     if opts["max_order"] is None:
         opts["max_order"] = CHANNEL_ORDER
     if opts.get("block_rows") is None:
         opts["block_rows"] = CHANNEL_BLOCK_ROWS
-    for n in range(0, (K - 1) // 2 + 1):
-        if n == 0:
-            parts = [("standing", oma_deferred(travelling_channels(y, angles, 0)[0], fs, **opts))]
+    for n in range(0, K // 2 + 1):
+        if n in real:  # one real channel: the standing pattern at the sensors
+            parts = [("standing", oma_deferred(travelling_channels(y, angles, n)[0], fs, **opts))]
         else:
             bwd, fwd = travelling_channels(y, angles, n)
             parts = [("backward", oma_deferred(bwd, fs, **opts)),
@@ -130,7 +134,7 @@ def _channel_poles(
                 f, z = float(r.frequency_hz[j]), float(r.damping_ratio[j])
                 k = int(np.argmin(np.abs(fs_ - f)))
                 ratio = float(S[c, n, k] / floor[k])
-                other = float(S[1 - c, n, k] / floor[k]) if n > 0 else ratio
+                other = float(S[1 - c, n, k] / floor[k]) if n not in real else ratio
                 p = SpatialPole(n, d, f, z, np.nan, np.nan, ratio, other,
                                 peak_contrast(S[c, n], fs_, f, z), int(r.n_orders[j]))  # fmt: skip
                 out.append(p)
@@ -158,8 +162,11 @@ def _with_errors(
 def spatial_poles(
     y: Any, fs: float, angles: list[float], kw: dict[str, Any]
 ) -> tuple[list[SpatialPole], float, float]:
-    """Every pole of each wave-number channel ``n = 0 .. (K - 1) // 2``, the
-    backward and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`).
+    """Every pole of each wave-number channel ``n = 0 .. K // 2``, the
+    backward and forward wave of each ``n >= 1`` identified apart (:mod:`.spatial`),
+    except the Nyquist wave number ``K / 2`` of an even ``K``, whose one real
+    channel gives ``"standing"`` poles (:func:`.spatial.nyquist_wave_number`;
+    :mod:`.nyquist` resolves their direction where it can).
 
     Parameters
     ----------
