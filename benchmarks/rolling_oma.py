@@ -67,16 +67,24 @@ def _split_errors(waves: list[RollingWave], truth: list[dict]) -> list[float]:
     return out
 
 
-def _test(speed: float, seed: int, duration: float, band: tuple[float, float], cache: str):
+def _test(
+    speed: float,
+    seed: int,
+    duration: float,
+    band: tuple[float, float],
+    cache: str,
+    sample_rate: float = 512.0,
+):
     """The virtual test, simulated or read from ``cache`` (a folder; written there)."""
     import pickle
     from pathlib import Path
 
-    path = Path(cache) / f"rolling_{speed:g}_{seed}_{duration:g}.pkl" if cache else None
+    rate = "" if sample_rate == 512 else f"_{sample_rate:g}Hz"
+    path = Path(cache) / f"rolling_{speed:g}_{seed}_{duration:g}{rate}.pkl" if cache else None
     if path is not None and path.exists():
         with path.open("rb") as fh:
             return pickle.load(fh)
-    test = rolling_test(speed, duration=duration, sample_rate=512, band=band, seed=seed)
+    test = rolling_test(speed, duration=duration, sample_rate=sample_rate, band=band, seed=seed)
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
         with path.open("wb") as fh:
@@ -91,8 +99,9 @@ def _run(
     band: tuple[float, float],
     spatial: bool | None = False,
     cache: str = "",
+    sample_rate: float = 512.0,
 ) -> dict:
-    test = _test(speed, seed, duration, band, cache)
+    test = _test(speed, seed, duration, band, cache, sample_rate)
     t0, c0 = time.perf_counter(), time.process_time()
     m = (
         rolling_modes(test.data, spatial=spatial)
@@ -103,15 +112,17 @@ def _run(
     truth = [r for r in _seen(test) if band[0] + 5 <= r["fixed_hz"] <= band[1] - 10]
     cmp = compare_waves(m.fixed, truth, "fixed")
     false = 0
+    undirected = 0
     for w in m.fixed:  # a wave is false when no exact wave, at any frequency, is near it
         near = [
             r
             for r in _seen(test)
             if r["wave_number"] == w.wave_number
-            and (r["direction"] == w.direction or r["wave_number"] == 0)
+            and (r["direction"] == w.direction or r["wave_number"] == 0 or w.direction is None)
             and abs(r["fixed_hz"] / w.fixed_hz - 1) < 0.02
         ]
         false += not near
+        undirected += bool(near) and w.direction is None  # a Nyquist wave left unresolved
     rot_truth = [r for r in _seen(test) if band[0] + 5 <= r["rotating_hz"] <= band[1] - 10]
     rot = compare_waves(m.rotating, rot_truth, "rotating")
     cover = [
@@ -124,6 +135,21 @@ def _run(
         for c in cmp
         if c["found"] and np.isfinite(c["std_damping_ratio"])
     ]
+    zf = [
+        (c["frequency_hz"] - c["truth"]["fixed_hz"]) / c["std_frequency_hz"]
+        for c in cmp
+        if c["found"] and np.isfinite(c["std_frequency_hz"]) and c["std_frequency_hz"] > 0
+    ]
+    zz = [
+        (c["damping_ratio"] - c["truth"]["fixed_damping_ratio"]) / c["std_damping_ratio"]
+        for c in cmp
+        if c["found"] and np.isfinite(c["std_damping_ratio"]) and c["std_damping_ratio"] > 0
+    ]
+    rel_sz = [
+        c["std_damping_ratio"] / c["damping_ratio"]
+        for c in cmp
+        if c["found"] and np.isfinite(c["std_damping_ratio"]) and c["damping_ratio"] > 0
+    ]
     rot_split = [r for r in _seen(test) if band[0] + 5 <= r["rotating_hz"] <= band[1] - 10]
     return {
         "n": len(cmp),
@@ -131,11 +157,15 @@ def _run(
         "f_ok": sum(c["found"] and abs(c["f_error"]) <= 0.005 for c in cmp),
         "z_ok": sum(c["found"] and abs(c["zeta_error"]) <= 0.10 for c in cmp),
         "false": false,
+        "undirected": undirected,
         "cover": cover,
         "zcover": zcover,
         "split_fixed": _split_errors(m.fixed, rot_split),
         "split_rot": _split_errors(m.rotating, rot_split),
         "zerr": [c["zeta_error"] for c in cmp if c["found"]],
+        "zf": zf,
+        "zz": zz,
+        "rel_sz": rel_sz,
         "rot_n": len(rot),
         "rot_ok": sum(c["found"] and abs(c["f_error"]) <= 0.005 for c in rot),
         "unresolved": sum(w.wave_number is None for w in m.rotating),
@@ -183,6 +213,10 @@ def _thresholds(
     return out
 
 
+def _rms(x: list) -> float:
+    return float(np.sqrt(np.mean(np.square(x)))) if x else float("nan")
+
+
 def _pct(x: list) -> str:
     return f"{100 * np.mean(x):.0f}%" if x else "-"
 
@@ -195,21 +229,27 @@ def main() -> None:
     ap.add_argument("--spatial", action="store_true", help="one identification per wave number")
     ap.add_argument("--general", action="store_true", help="all fixed sensors together")
     ap.add_argument("--cache", default="", help="folder keeping the simulated tests")
+    ap.add_argument("--sample-rate", type=float, default=512.0, help="Hz (default 512)")
     ap.add_argument("--thresholds", default="", help="channel-power thresholds to compare")
     a = ap.parse_args()
     if a.thresholds:
         _threshold_table(a)
         return
     band = (0.0, 200.0)
-    print(f"band {band} Hz, {a.duration:g} s records, 16 fixed + 1 in-tyre sensor, {a.draws} draws")
+    print(f"band {band} Hz, {a.duration:g} s records at {a.sample_rate:g} Hz, 16 fixed + 1 "
+          f"in-tyre sensor, {a.draws} draws")  # fmt: skip
     print(
         "speed  waves  found  f<0.5%  z<10%  med|dz|  false/run  cover f  cover z  "
-        "in-tyre ok  unresolved  split<0.5% fixed  in-tyre  s/run  cpu s/run"
+        "in-tyre ok  unresolved  split<0.5% fixed  in-tyre  no dir  rms f/sd  rms z/sd  "
+        "med sd(z)/z  s/run  cpu s/run"
     )
     for v in [float(s) for s in a.speeds.split(",")]:
         with single_threaded_blas():
             route = True if a.spatial else (False if a.general else None)
-            runs = [_run(v, seed, a.duration, band, route, a.cache) for seed in range(a.draws)]
+            runs = [
+                _run(v, seed, a.duration, band, route, a.cache, a.sample_rate)
+                for seed in range(a.draws)
+            ]
         cov = [c for r in runs for c in r["cover"]]
         zcov = [c for r in runs for c in r["zcover"]]
         sf = [e <= 0.005 for r in runs for e in r["split_fixed"]]
@@ -223,6 +263,10 @@ def main() -> None:
             f"{sum(r['rot_ok'] for r in runs):4d}/{sum(r['rot_n'] for r in runs):<5d}  "
             f"{sum(r['unresolved'] for r in runs):10d}  "
             f"{sum(sf):5d}/{len(sf):<5d}  {sum(sr):5d}/{len(sr):<5d}  "
+            f"{sum(r['undirected'] for r in runs):6d}  "
+            f"{_rms([e for r in runs for e in r['zf']]):8.2f}  "
+            f"{_rms([e for r in runs for e in r['zz']]):8.2f}  "
+            f"{100 * np.median([e for r in runs for e in r['rel_sz']] or [np.nan]):10.1f}%  "
             f"{np.mean([r['time'] for r in runs]):5.1f}  {np.mean([r['cpu'] for r in runs]):9.1f}",
             flush=True,
         )
