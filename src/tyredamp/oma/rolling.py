@@ -84,9 +84,10 @@ class RollingWave:
     wave_number : int or None
         ``n``; ``None`` when the in-tyre peak is not resolved.
     direction : str or None
-        On the tyre: ``"forward"`` (with the rotation), ``"backward"``, ``"standing"``.
+        On the tyre: ``"forward"`` (with the rotation), ``"backward"``, ``"standing"``;
+        ``None`` when not resolved (an in-tyre peak, or a Nyquist wave).
     fixed_direction : str or None
-        As a fixed observer sees it travel.
+        As a fixed observer sees it travel (``None`` when not resolved).
     fixed_hz, rotating_hz : float
         Natural frequency ``|lambda| / 2 pi`` at a fixed point and in the tyre
         (Hz; NaN where not known); a fixed-frame wave's in-tyre frequency is
@@ -100,7 +101,9 @@ class RollingWave:
         the in-tyre sensor).
     candidates : list of (int, str, float)
         For an unresolved in-tyre peak: every ``(n, direction on the tyre,
-        f_fixed)`` it could be.
+        f_fixed)`` it could be. For a fixed-frame wave of the Nyquist wave
+        number whose direction is not resolved (:mod:`.nyquist`): both
+        ``(n, direction on the tyre, f_rot)``.
     reason : str
     """
 
@@ -481,7 +484,10 @@ def rolling_modes(
         :func:`select_spatial_poles` (the wave-number route). ``False``: all
         fixed sensors together, each mode split into waves afterwards (any
         layout). Default: the wave-number route when the fixed sensors are
-        equally spaced, the other otherwise (said in the notes).
+        equally spaced, the other otherwise (said in the notes). With an
+        even number ``K`` of sensors the wave-number route also identifies
+        the Nyquist channel ``n = K / 2`` and takes its waves' direction from
+        the in-tyre sensor where that tells it (:mod:`.nyquist`).
 
     Returns
     -------
