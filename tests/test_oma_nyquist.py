@@ -49,7 +49,7 @@ def test_candidates_follow_the_exact_rolling_ring() -> None:
     assert_allclose(fwd.rotating_hz, np.hypot(f_d, sigma / (2 * np.pi)), rtol=1e-12)  # rounding
 
 
-def _ring(tyre_k: int, f_rot: float, zeta: float, n_samples: int, seed: int):
+def _ring(tyre_k: int, f_rot: float, zeta: float, n_samples: int, seed: int, wheel=WHEEL_HZ):
     """K fixed sensors and one in-tyre sensor seeing one random stationary wave
     ``x(t) e^{i k theta}`` of the tyre (``x`` a complex AR(1) of the rotating-frame pole),
     at material angle ``theta = phi - Omega t``, plus 5 % white sensor noise."""
@@ -62,13 +62,13 @@ def _ring(tyre_k: int, f_rot: float, zeta: float, n_samples: int, seed: int):
     x = lfilter([1.0], [1.0, -np.exp(lam / FS)], e)[2000:]
     t = np.arange(n_samples) / FS
     phi = np.deg2rad(np.arange(K) * 360.0 / K)
-    turn = np.exp(-1j * tyre_k * 2 * np.pi * WHEEL_HZ * t)  # theta = phi - Omega t
+    turn = np.exp(-1j * tyre_k * 2 * np.pi * wheel * t)  # theta = phi - Omega t
     y = np.real(x[None, :] * turn[None, :] * np.exp(1j * tyre_k * phi[:, None]))
     y = np.vstack([y, x.real[None, :]])  # the in-tyre sensor at theta = 0
     y += 0.05 * np.std(y) * rng.standard_normal(y.shape)
     ch = [Channel(k + 1, angle_deg=float(a), name=f"A{k + 1}")
           for k, a in enumerate(np.rad2deg(phi))] + [Channel(101, name="T1")]  # fmt: skip
-    return TimeData(y, FS, ch, ["displacement"] * (K + 1), meta={"rotation_hz": WHEEL_HZ})
+    return TimeData(y, FS, ch, ["displacement"] * (K + 1), meta={"rotation_hz": wheel})
 
 
 #: The same fixed-frame frequency, 30 Hz, both ways: k = +4 (backward on the tyre, 38 Hz
@@ -115,6 +115,19 @@ def test_nyquist_wave_without_an_in_tyre_sensor_is_unresolved() -> None:
     for words in ("no in-tyre sensor", "odd number of sensors", "unequal spacing"):
         assert words in w.reason
     assert w.to_dict()["direction"] is None
+
+
+def test_nyquist_wave_at_rest_stands_for_both_waves() -> None:
+    from tyredamp.oma.rolling import rolling_modes
+
+    m = rolling_modes(_ring(+4, 30.0, 0.02, 2**15, seed=5, wheel=0.0), uncertainty=False,
+                      spatial=True)  # fmt: skip
+    got = sorted((w.direction, w.fixed_direction) for w in m.fixed if w.wave_number == NYQ)
+    # at rest the two waves of n share one frequency: both listed, as for a standing shape
+    assert got == [("backward", "backward"), ("forward", "forward")]
+    for w in m.fixed:
+        assert_allclose(w.fixed_hz, 30.0, rtol=5e-3)  # 0.5 %, as above
+        assert w.rotating_hz == w.fixed_hz
 
 
 def test_resolve_nyquist_rules() -> None:
