@@ -120,13 +120,14 @@ def _supported(
     tol: float,
 ) -> bool:
     """Whether an in-tyre pole lies at ``c`` with the wave's decay rate, nearer to
-    it (in units of the tolerance) than to any other fixed-frame wave's in-tyre frequency."""
+    it (in units of the tolerance) than to any other fixed-frame wave's in-tyre frequency
+    (an undamped wave, ``sigma = 0``, is matched by frequency alone)."""
     sigma = c.rotating_damping_ratio * c.rotating_hz
     for f, z, s in zip(f_in.tolist(), z_in.tolist(), s_in.tolist(), strict=True):
         err = float(np.hypot(s if np.isfinite(s) else 0.0, std_hz if np.isfinite(std_hz) else 0.0))
         t = max(tol * c.rotating_hz, 3.0 * err)
         d = abs(f - c.rotating_hz) / t
-        if d > 1 or not 1 / DECAY_FACTOR <= z * f / sigma <= DECAY_FACTOR:
+        if d > 1 or (sigma > 0 and not 1 / DECAY_FACTOR <= z * f / sigma <= DECAY_FACTOR):
             continue
         if any(abs(f - o) / (tol * o) < d for o in others_hz.tolist() if o > 0):
             continue
