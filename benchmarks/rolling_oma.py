@@ -20,8 +20,15 @@ the waves of the wave-number route found and the false ones when the channel-pow
 :func:`tyredamp.oma.rolling.select_spatial_poles` takes each value (the poles
 identified once per draw).
 
+``no dir`` counts the fixed-frame waves found with the wave number of an
+exact wave within 2 % but no direction (a Nyquist wave whose direction the
+in-tyre sensor does not tell, :mod:`tyredamp.oma.nyquist`); ``rms f/sd`` and
+``rms z/sd`` are the rms errors of the found waves in units of their
+standard errors, ``med sd(z)/z`` the median reported relative standard
+error of the damping ratio. ``--sample-rate`` sets the acquisition rate.
+
 Usage: python benchmarks/rolling_oma.py [--draws 5] [--duration 16] [--spatial | --general]
-       [--thresholds 3,10,30]
+       [--thresholds 3,10,30] [--sample-rate 512] [--cache DIR]
 """
 
 from __future__ import annotations
