@@ -9,7 +9,12 @@ from numpy.testing import assert_allclose
 from tyredamp.exceptions import InputError
 from tyredamp.mechanics import MCKSystem, time_response
 from tyredamp.oma import correlations, oma, resolve_rotating, wave_content
-from tyredamp.oma.harmonics import band_kurtosis, detect_wheel_speed, harmonic_tests
+from tyredamp.oma.harmonics import (
+    band_kurtosis,
+    detect_wheel_speed,
+    harmonic_tests,
+    order_evidence,
+)
 from tyredamp.oma.identify import oma_deferred
 from tyredamp.oma.selection import otsu_threshold
 from tyredamp.oma.ssi import ShiftProjection, block_toeplitz, poles_at_order, ssi_cov
@@ -229,6 +234,16 @@ def test_harmonic_test_tells_orders_from_modes() -> None:
     assert [t.harmonic for t in tests] == [False, False, False, True, True]
     assert [t.wheel_order for t in tests[3:]] == [5, 10]
     assert_allclose(detect_wheel_speed(np.array([20.0, 40.0, 60.0])), 20.0, rtol=1e-12)
+
+
+def test_order_evidence_keeps_the_loss_of_modes_at_the_free_level() -> None:
+    # sparse orders (a 0.1 Hz band around orders every 10 Hz: p = 2 %): the 5 % level,
+    # whose one-sided normal quantile is 1.6449 (tables)
+    assert_allclose(order_evidence(0.1, 10.0), 1.6449, atol=1e-4)  # 4 printed decimals
+    # orders covering the axis (p = 1): the 0.1 % level of a peak anywhere, 3.0902 (tables)
+    assert_allclose(order_evidence(3.0, 4.0), 3.0902, atol=1e-4)  # same
+    # in between, p alpha = 0.1 %: p = 0.4 gives alpha = 0.25 %, quantile 2.8070 (tables)
+    assert_allclose(order_evidence(0.2, 1.0), 2.8070, atol=1e-4)  # same
 
 
 def test_band_kurtosis_sine_and_noise() -> None:

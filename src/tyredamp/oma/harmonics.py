@@ -8,8 +8,17 @@ Brincker, IMAC 2006). The kurtosis of the band-passed record is compared with
 3 under its sampling standard error ``sqrt(24 / N_eff)`` (Kendall & Stuart,
 *The Advanced Theory of Statistics* vol. 1, eq. 10.5 for a normal sample), with
 ``N_eff = 2 B T`` independent samples in a band ``B`` over a record of ``T`` s.
-A mode near a multiple of a given wheel speed needs the weaker one-sided 5 %
-evidence; elsewhere 0.1 %.
+A peak elsewhere is called a harmonic at the one-sided 0.1 % level. A peak
+within ``tol`` of a multiple of a given wheel speed ``f_w`` needs weaker
+evidence, the one-sided level ``alpha = min(5 %, 0.1 % / p)`` with
+``p = 2 tol / f_w`` the share of the frequency axis that lies that close to
+some order: a mode at a random frequency is near an order with probability
+``p`` and then called a harmonic with probability ``alpha``, so at most
+``p alpha <= 0.1 %`` of modes are lost, as away from the orders. Where the
+orders are sparse (low orders, ``p`` small) the order is evidence and 5 %
+suffices; where they are dense (high orders: at order 39 a tolerance of
+0.5 % covers 39 % of the axis) being near one says little, and the level
+tends to 0.1 %.
 """
 
 from __future__ import annotations
@@ -19,11 +28,18 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["HarmonicTest", "band_kurtosis", "detect_wheel_speed", "harmonic_tests"]
+__all__ = [
+    "HarmonicTest",
+    "band_kurtosis",
+    "detect_wheel_speed",
+    "harmonic_tests",
+    "order_evidence",
+]
 
-#: one-sided normal quantiles: a wheel order needs 5 %, any other peak 0.1 %
-_Z_ORDER = 1.645
-_Z_FREE = 3.09
+#: one-sided levels: at most 5 % near a wheel order (module docstring), 0.1 % elsewhere
+_ALPHA_ORDER = 0.05
+_ALPHA_FREE = 0.001
+_Z_FREE = 3.09  # the one-sided normal quantile of _ALPHA_FREE
 
 
 @dataclass(frozen=True)
@@ -46,6 +62,31 @@ class HarmonicTest:
     z: float
     wheel_order: int | None
     harmonic: bool
+
+
+def order_evidence(tol_hz: float, wheel_speed_hz: float) -> float:
+    """The ``z`` a peak within ``tol_hz`` of a wheel order needs to be called a harmonic.
+
+    The one-sided normal quantile of ``alpha = min(5 %, 0.1 % / p)``,
+    ``p = min(1, 2 tol / f_w)`` (module docstring: a mode is lost at most
+    0.1 % of the time, near an order or not).
+
+    Parameters
+    ----------
+    tol_hz : float
+        Half-width (Hz) of "near an order".
+    wheel_speed_hz : float
+        ``f_w > 0``, Hz.
+
+    Returns
+    -------
+    float
+        From 1.645 (sparse orders) to 3.09 (orders covering the axis).
+    """
+    from scipy.stats import norm
+
+    near = min(1.0, 2.0 * float(tol_hz) / float(wheel_speed_hz))
+    return float(norm.isf(min(_ALPHA_ORDER, _ALPHA_FREE / near)))
 
 
 def band_kurtosis(
@@ -101,13 +142,14 @@ def harmonic_tests(
         kurt, n_eff = band_kurtosis(y[ch], sample_rate, float(f0), half)
         z = (3.0 - kurt) / np.sqrt(24.0 / n_eff)
         order = None
+        need = _Z_FREE
         if wheel_speed_hz:
             k = round(f0 / wheel_speed_hz)
             sf = 0.0 if std_frequency_hz is None else float(np.nan_to_num(std_frequency_hz[j]))
             tol = max(3 * sf, 0.005 * f0, 2.0 / T)
             if k >= 1 and abs(f0 - k * wheel_speed_hz) <= tol:
                 order = k
-        need = _Z_ORDER if order is not None else _Z_FREE
+                need = order_evidence(tol, wheel_speed_hz)
         out.append(HarmonicTest(kurt, float(z), order, bool(z > need)))
     return out
 
