@@ -56,7 +56,9 @@ def _false(waves: list[Any], truth: list[dict[str, Any]]) -> int:
     return sum(
         not any(
             r["wave_number"] == w.wave_number
-            and (r["direction"] == w.direction or r["wave_number"] == 0)
+            # a wave whose direction the layout cannot tell (the Nyquist wave number
+            # without an in-tyre sensor) is the truth's wave of either direction
+            and (r["direction"] == w.direction or r["wave_number"] == 0 or w.direction is None)
             and abs(r["fixed_hz"] / w.fixed_hz - 1) < 0.02
             for r in truth
         )
