@@ -31,9 +31,10 @@ from numpy.typing import NDArray
 from ..exceptions import ConvergenceError
 from .assemble import goodness, local_dispersion, to_model, unscale  # noqa: F401 (re-exported)
 from .fit.fit import FitResult, ModalFitter, pole_bounds
-from .fit.ml import ml_refine
+from .fit.ml import fisher_scale, ml_refine
 from .fit.profile import fit_intervals
 from .problem.problem import FitProblem
+from .sandwich import sandwich_ratios
 from .search.refitted import refitted_statistics
 from .search.resolution import unresolved_pair, unresolved_pair_text
 from .search.search import (
@@ -305,7 +306,14 @@ def final_complex(
     combined: ModalFitter | None,
     threshold: float | None = None,
     test: ModeTest | None = None,
-) -> tuple[FitResult, ModeSet, list[RejectedMode], NDArray[np.float64] | None, NDArray[np.float64]]:
+) -> tuple[
+    FitResult,
+    ModeSet,
+    list[RejectedMode],
+    NDArray[np.float64] | None,
+    NDArray[np.float64],
+    NDArray[np.float64] | None,
+]:
     """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
     combinations (many outputs), whose poles then give the residues of every output.
 
@@ -317,11 +325,13 @@ def final_complex(
     e.g. a damping that collapsed) is dropped, the weakest first, and the fit
     repeated. Also returns the threshold applied to each kept in-band mode (fit
     order; None without ``threshold``) and each in-band mode's noise along the
-    response (:func:`noise_along_response`, fit order). When every mode passes with the other
-    poles held, modes beside a stronger one are tested once more with the
-    neighbours' poles refitted (:mod:`~tyredamp.modal.search.refitted`: the likelihood
-    ratio of the maximised models) and dropped, the weakest first, when that
-    fails.
+    response (:func:`noise_along_response`, fit order) and the factors of the
+    variances of its frequency and damping ratio under the noise's structure
+    across outputs (:func:`pole_variance_ratios`; None where not known). When
+    every mode passes with the other poles held, modes beside a stronger one are
+    tested once more with the neighbours' poles refitted
+    (:mod:`~tyredamp.modal.search.refitted`: the likelihood ratio of the
+    maximised models) and dropped, the weakest first, when that fails.
     """
     dropped: list[RejectedMode] = []
     cur = modes
@@ -381,7 +391,8 @@ def final_complex(
         res = maximum_likelihood(problem, cfit, res)
         # likelihood intervals where the linearised ones would be too short
         res.intervals = fit_intervals(cfit, res, cur.m, sigma0)
-    return res, cur, dropped, thr, noise_along_response(cfit, res, cur.m)
+    ratio = pole_variance_ratios(problem, cfit, res, cur.m, sigma0) if refine else None
+    return res, cur, dropped, thr, noise_along_response(cfit, res, cur.m), ratio
 
 
 def _spacing(problem: FitProblem) -> float:
@@ -470,8 +481,19 @@ def maximum_likelihood(problem: FitProblem, fitter: ModalFitter, res: FitResult)
     estimated and :func:`full_weights` says its own weights are the better ones."""
     if problem.variance is None or not full_weights(problem):
         return res
-    nu = problem.noise_dof
-    plain = ModalFitter(
+    try:
+        return ml_refine(
+            _plain(problem, fitter), res, problem.variance, problem.noise_dof, tol=FINAL_TOL
+        )
+    except (np.linalg.LinAlgError, ValueError):
+        res.warnings.append("maximum-likelihood refinement failed: weighted fit kept")
+        return res
+
+
+def _plain(problem: FitProblem, fitter: ModalFitter) -> ModalFitter:
+    """The fitter of the maximum-likelihood stage: ``fitter``'s model on the problem's
+    unweighted data (no line weights)."""
+    return ModalFitter(
         problem.frequency,
         problem.H,
         problem.power,
@@ -480,8 +502,33 @@ def maximum_likelihood(problem: FitProblem, fitter: ModalFitter, res: FitResult)
         upper=fitter.use_upper,
         lower=fitter.use_lower,
     )
-    try:
-        return ml_refine(plain, res, problem.variance, nu, tol=FINAL_TOL)
-    except (np.linalg.LinAlgError, ValueError):
-        res.warnings.append("maximum-likelihood refinement failed: weighted fit kept")
-        return res
+
+
+def pole_variance_ratios(
+    problem: FitProblem,
+    fitter: ModalFitter,
+    res: FitResult,
+    n_band: int,
+    sigma0: NDArray[np.float64] | None,
+) -> NDArray[np.float64] | None:
+    """The factors of the variances of each in-band mode's frequency and damping ratio
+    (n_band, 2; fit order) under the noise's structure across outputs, White's
+    sandwich (:func:`~tyredamp.modal.sandwich.sandwich_ratios`): where the FRF
+    carries its input noise (:attr:`~tyredamp.frf.FRF.input_noise`, the part of
+    the variance common to all outputs) and ``res`` is the maximum-likelihood fit
+    with its per-line variance, or the weighted least-squares fit of ``fitter``
+    (each output weighted by ``1 / sigma0``, its residual RMS without ``sigma0``).
+    None otherwise: the modes' noise along the response
+    (:func:`noise_along_response`) then stands for that structure.
+    """
+    r = problem.frf.input_noise
+    if r is None or problem.variance is None or n_band == 0:
+        return None
+    ml = res.status.startswith("maximum likelihood")
+    fit = _plain(problem, fitter) if ml else fitter
+    # the ML fit reports its inverse information times its Fisher scale (an estimated variance)
+    scale = fisher_scale(problem.noise_dof, 0.0, 1) if ml else 1.0
+    w = None if ml else fitter.weights(res.sigma_out if sigma0 is None else sigma0)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        out = sandwich_ratios(fit, res, w, problem.variance, r[:, problem.lines], n_band, scale)
+    return out if np.isfinite(out).all() else None

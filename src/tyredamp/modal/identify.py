@@ -406,9 +406,9 @@ def _final_models(
     base: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet] = (*modes.all(), modes)
     for kind in kinds:
         extra_warn: list[str] = []
-        thresholds = along = None
+        thresholds = along = ratio = None
         if kind == "complex":
-            res, cur, dropped, thresholds, along = final_complex(
+            res, cur, dropped, thresholds, along, ratio = final_complex(
                 problem,
                 fitters.cfit,
                 modes,
@@ -444,6 +444,7 @@ def _final_models(
             method=ctx["method"],
             thresholds=thresholds,
             along=along,
+            pole_ratio=ratio,
         )
         models[kind], disc[kind] = to_model(res, n_band, c)
     return models, disc
