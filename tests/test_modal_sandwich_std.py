@@ -5,6 +5,8 @@ force and responses."""
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -40,16 +42,21 @@ def _draw(rng: np.random.Generator) -> np.ndarray:
     return H0 + e + H0 * n[None]
 
 
-def _ml(h: np.ndarray) -> tuple[ModalFitter, FitResult]:
-    fit = ModalFitter(F, h, 0, "complex", [], upper=True, lower=True)
+def _ml(
+    h: np.ndarray, kind: Literal["complex", "real"] = "complex"
+) -> tuple[ModalFitter, FitResult]:
+    fit = ModalFitter(F, h, 0, kind, [], upper=True, lower=True)
     return fit, ml_refine(fit, fit.fit(POLES, PI.T.copy()), V)
 
 
-def test_without_common_noise_the_sandwich_is_the_information() -> None:
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_without_common_noise_the_sandwich_is_the_information(
+    kind: Literal["complex", "real"],
+) -> None:
     """``r = 0`` and the weights ``1 / sqrt(V / 2)``: ``B = A`` (module docstring, eq. 3),
     so the sandwich is ``A^-1`` (rounding: rtol 1e-8), and ``A^-1`` gives the ML
     stage's own Fisher errors (known variance; the same J^T J: rtol 1e-6)."""
-    fit, ml = _ml(_draw(np.random.default_rng(1)))
+    fit, ml = _ml(_draw(np.random.default_rng(1)), kind)
     ainv, cov, th = sandwich_covariance(fit, ml, None, V, np.zeros_like(R))
     f0, z0, _ = pole_std(fit.w_ref, th, 2, ainv)
     f1, z1, _ = pole_std(fit.w_ref, th, 2, cov)
@@ -59,13 +66,14 @@ def test_without_common_noise_the_sandwich_is_the_information() -> None:
     assert_allclose(z0, ml.std_damping_ratio, rtol=1e-6)
 
 
-def test_rank_two_updates_equal_the_dense_covariance() -> None:
+@pytest.mark.parametrize("kind", ["complex", "real"])
+def test_rank_two_updates_equal_the_dense_covariance(kind: Literal["complex", "real"]) -> None:
     """``B`` of eq. (3) equals ``J^T W Sigma W J`` with ``Sigma_f = D_f + r_f h_f h_f^H``
     (``D_f = diag(V_f - min(r_f |h_f|^2, V_f))``) assembled as a dense real
     covariance of the (Re, Im) rows of every output at each line (``Cov(Re, Re) =
     Cov(Im, Im) = Re Sigma / 2``, ``Cov(Im, Re) = Im Sigma / 2``). Rounding of sums
     of 161 lines: rtol 1e-8."""
-    fit, ml = _ml(_draw(np.random.default_rng(2)))
+    fit, ml = _ml(_draw(np.random.default_rng(2)), kind)
     ainv, cov, _ = sandwich_covariance(fit, ml, None, V, R)
     th, blocks = _jacobians(fit, ml, lambda sl: _row_weights(V, sl))
     jac = np.stack(next(blocks)[1])  # (n_out, rows, n_par): one block here

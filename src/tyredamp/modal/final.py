@@ -149,7 +149,7 @@ def fit_real(
     search: ModalFitter | None,
     start: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet],
     sigma0: NDArray[np.float64] | None = None,
-) -> tuple[FitResult, int, list[str], NDArray[np.float64]]:
+) -> tuple[FitResult, int, list[str], NDArray[np.float64], NDArray[np.float64] | None]:
     """Real-mode fit (pole-pair optimisation) started from the complex-mode poles.
 
     The real model keeps the modes of the complex model. When its refinement
@@ -165,7 +165,8 @@ def fit_real(
     intervals would be too short get likelihood intervals
     (:func:`~tyredamp.modal.fit.profile.fit_intervals`), as in the complex model.
     Also returns the in-band modes' noise along the response
-    (:func:`noise_along_response`), as :func:`final_complex` does.
+    (:func:`noise_along_response`) and the factors of their poles' variances
+    (:func:`pole_variance_ratios`), as :func:`final_complex` does.
     """
     p0, l0, modes = start
     m, nf = modes.m, modes.n_free
@@ -183,7 +184,7 @@ def fit_real(
     passes = 1 if sigma is not None else 2
     if not refine:
         res = fitter.fit(p0, l0, refine=False, sigma=sigma)
-        return res, m, [], noise_along_response(fitter, res, m)
+        return res, m, [], noise_along_response(fitter, res, m), None
     start_p, start_l = p0, l0
     why, bad = "", -1
     if search is not None:
@@ -225,7 +226,7 @@ def fit_real(
                 res = ml
             # likelihood intervals where the linearised ones would be too short
             res.intervals = fit_intervals(fitter, res, m, sigma0)
-            return res, m, [], noise_along_response(fitter, res, m)
+            return res, m, [], *_along(problem, fitter, res, m, sigma)
         if bad >= m + nf:
             keep = np.arange(start_p.size) != bad
             start_p, start_l, p0, l0 = start_p[keep], start_l[keep], p0[keep], l0[keep]
@@ -239,6 +240,7 @@ def fit_real(
             "values, real residues fitted"
         ],
         noise_along_response(fitter, res, m),
+        None,
     )
 
 
@@ -267,6 +269,19 @@ def _watched(
     finally:
         fitter.watch, fitter._best = None, None
     return (res, *_problem(res, m, n_free, band, _floor_hz(fitter)))
+
+
+def _along(
+    problem: FitProblem,
+    fitter: ModalFitter,
+    res: FitResult,
+    m: int,
+    sigma: NDArray[np.float64] | None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+    """:func:`noise_along_response` and :func:`pole_variance_ratios` of a final fit."""
+    return noise_along_response(fitter, res, m), pole_variance_ratios(
+        problem, fitter, res, m, sigma
+    )
 
 
 def noise_along_response(

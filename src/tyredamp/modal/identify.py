@@ -423,7 +423,7 @@ def _final_models(
             n_band = cur.m
         else:
             compressed = fitters.sfit if fitters.sfit is not fitters.cfit else None
-            res, n_band, extra_warn, along = fit_real(
+            res, n_band, extra_warn, along, ratio = fit_real(
                 problem, residuals, refine, compressed, base, sigma0
             )
         res.warnings.extend(extra_warn)
