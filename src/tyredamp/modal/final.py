@@ -298,7 +298,11 @@ def noise_along_response(
     by up to ``sqrt(n_out)``). ``lambda_in`` over ``n`` lines around the mode holds
     ``2 n_in^2 n`` real units of noise, so under independent outputs ``lambda_in
     nu`` is ``chi2_nu`` with ``nu = 2 n_in^2 n``; it is used where it exceeds that
-    law's upper ``alpha`` quantile over ``nu``.
+    law's upper ``alpha`` quantile over ``nu``. Where the FRF carries its input
+    noise, the frequencies' and damping ratios' standard errors take the
+    sandwich's factors instead (:func:`pole_variance_ratios`): averaged over the
+    window, ``lambda_in`` mixes the lines where the force's noise dominates with
+    those where the responses' does, and scatters from seed to seed.
     """
     out = np.ones(n_band)
     if n_band == 0:
