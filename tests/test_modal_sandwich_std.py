@@ -76,7 +76,7 @@ def test_rank_two_updates_equal_the_dense_covariance(kind: Literal["complex", "r
     fit, ml = _ml(_draw(np.random.default_rng(2)), kind)
     ainv, cov, _ = sandwich_covariance(fit, ml, None, V, R)
     th, blocks = _jacobians(fit, ml, lambda sl: _row_weights(V, sl))
-    jac = np.stack(next(blocks)[1])  # (n_out, rows, n_par): one block here
+    jac = np.stack(list(next(blocks)[1]))  # (n_out, rows, n_par): one block here
     om = line_weights_full(V)[0::2].T  # (n_out, n_f): the weight of each entry
     h = ml.model[:, 0, :]
     b = np.zeros((th.size, th.size))
@@ -138,3 +138,16 @@ def test_pipeline_scales_the_pole_errors_by_the_sandwich(seed: int) -> None:
     assert_allclose(m1.frequency_hz, m0.frequency_hz, rtol=1e-12)  # the estimate is the same
     along = np.asarray(m0.meta["noise_along_response"])
     assert_allclose(np.asarray(m0.meta["pole_variance_ratio"]), np.stack([along, along], 1))
+
+
+def test_blocks_of_lines_give_the_same_covariance(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The Gram matrices and the updates summed block by block (lines of large
+    problems) give the covariance of one block: rounding, rtol 1e-9."""
+    from tyredamp.modal.fit import _basis
+
+    fit, ml = _ml(_draw(np.random.default_rng(4)))
+    one = sandwich_covariance(fit, ml, None, V, R)[1]
+    monkeypatch.setattr(_basis, "BLOCK_BYTES", 1)
+    monkeypatch.setattr(_basis, "MIN_BLOCK_LINES", 40)
+    assert len(_basis.blocks(fit, 10)) == 5
+    assert_allclose(sandwich_covariance(fit, ml, None, V, R)[1], one, rtol=1e-9)

@@ -170,11 +170,12 @@ def sandwich_covariance(
 
 def _jacobians(
     fitter: ModalFitter, res: FitResult, rows: Callable[[slice], NDArray[np.float64]]
-) -> tuple[NDArray[np.float64], Iterator[tuple[slice, list[NDArray[np.float64]]]]]:
+) -> tuple[NDArray[np.float64], Iterator[tuple[slice, Iterator[NDArray[np.float64]]]]]:
     """The parameters ``theta`` of ``res`` and, block by block of lines, Kaufman's
     variable-projection Jacobian ``J_j = P_j W_j E S_j^T`` (rows, n_par) of every
     output (as :func:`~tyredamp.modal.fit.ml._evaluate` forms ``J^T J``), ``rows(sl)``
-    the row weights (rows, n_out) of the lines ``sl``: ``P_j W_j E = W_j (E - Phi
+    the row weights (rows, n_out) of the lines ``sl`` (the outputs' Jacobians of a
+    block one after the other): ``P_j W_j E = W_j (E - Phi
     X_j)`` with ``X_j = G_PhiPhi^-1 G_PhiE`` and the coefficients ``C_j`` from each
     output's Gram matrix of ``W_j [Phi | E]`` (Golub & Pereyra, "The
     differentiation of pseudo-inverses and nonlinear least squares problems whose
@@ -207,17 +208,14 @@ def _jacobians(
         np.add.at(sj, (lay.dpar, lay.ecol), coef * sol[j][lay.dcol, 0])
         s.append(sj)
 
-    def blocks() -> Iterator[tuple[slice, list[NDArray[np.float64]]]]:
-        for sl in parts:
-            bb = fitter._basis_ek(th, m, ref, True, sl)[0]
-            om = rows(sl)
-            out = []
-            for j in range(n_out):
-                bw = bb * om[:, j, None]
-                out.append((bw[:, q:] - bw[:, :q] @ sol[j][:, 1:]) @ s[j].T)
-            yield sl, out
+    def outputs(sl: slice) -> Iterator[NDArray[np.float64]]:
+        bb = fitter._basis_ek(th, m, ref, True, sl)[0]
+        om = rows(sl)
+        for j in range(n_out):  # one output's Jacobian at a time: memory of one
+            bw = bb * om[:, j, None]
+            yield (bw[:, q:] - bw[:, :q] @ sol[j][:, 1:]) @ s[j].T
 
-    return th, blocks()
+    return th, ((sl, outputs(sl)) for sl in parts)
 
 
 def _count(fitter: ModalFitter, sl: slice) -> int:
