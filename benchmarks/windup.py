@@ -8,8 +8,11 @@ settings of ``tests/test_tyremodel_windup.py``), the H1 FRFs are fitted
 (attachment removed) is compared with the exact rotation mode
 (``windup_truth``: bare frequency and damping, belt inertia). Prints per
 seed the relative errors, the errors in units of the statistical
-standard errors and the fit's noise along the response of the mode
-(``noise_along_response``, 1 where not significant), then the largest
+standard errors, the fit's noise along the response of the mode
+(``noise_along_response``, 1 where not significant) and the factor of its
+damping ratio's variance the fit applied (``pole_variance_ratio``: the
+sandwich's where the FRF carries its input noise, else the noise along the
+response), then the largest
 relative errors, the share of seeds whose 1-sigma statistical interval
 covers the truth and the share whose fit split
 the rotation into two poles (noted by ``windup_from_modes``). First it
