@@ -548,6 +548,9 @@ def pole_variance_ratios(
     # the ML fit reports its inverse information times its Fisher scale (an estimated variance)
     scale = fisher_scale(problem.noise_dof, 0.0, 1) if ml else 1.0
     w = None if ml else fitter.weights(res.sigma_out if sigma0 is None else sigma0)
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        out = sandwich_ratios(fit, res, w, problem.variance, r[:, problem.lines], n_band, scale)
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            out = sandwich_ratios(fit, res, w, problem.variance, r[:, problem.lines], n_band, scale)
+    except (np.linalg.LinAlgError, ValueError):  # no covariance: the noise along the response
+        return None
     return out if np.isfinite(out).all() else None
