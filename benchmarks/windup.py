@@ -8,8 +8,11 @@ settings of ``tests/test_tyremodel_windup.py``), the H1 FRFs are fitted
 (attachment removed) is compared with the exact rotation mode
 (``windup_truth``: bare frequency and damping, belt inertia). Prints per
 seed the relative errors, the errors in units of the statistical
-standard errors and the fit's noise along the response of the mode
-(``noise_along_response``, 1 where not significant), then the largest
+standard errors, the fit's noise along the response of the mode
+(``noise_along_response``, 1 where not significant) and the factor of its
+damping ratio's variance the fit applied (``pole_variance_ratio``: the
+sandwich's where the FRF carries its input noise, else the noise along the
+response), then the largest
 relative errors, the share of seeds whose 1-sigma statistical interval
 covers the truth and the share whose fit split
 the rotation into two poles (noted by ``windup_from_modes``). First it
@@ -111,7 +114,7 @@ def main() -> None:
         f"BELT_IYY {truth['I']:.5f} kg m^2 (tested with the tip: {wt.frequency_hz:.5f} Hz, "
         f"zeta {wt.damping_ratio:.6f})"
     )
-    print(" seed   rel f      rel zeta   rel I      z_f    z_zeta  z_I    split along  s")
+    print(" seed   rel f      rel zeta   rel I      z_f    z_zeta  z_I    split along  ratio  s")
     rel: dict[str, list[float]] = {"f": [], "z": [], "I": []}
     cover: dict[str, list[bool]] = {"f": [], "z": [], "I": []}
     zall: dict[str, list[float]] = {"f": [], "z": [], "I": []}
@@ -149,7 +152,8 @@ def main() -> None:
         print(
             f" {seed:4d} {rel['f'][-1]:+.2e}  {rel['z'][-1]:+.2e}  {rel['I'][-1]:+.2e}  "
             f"{zs['f']:+6.2f} {zs['z']:+6.2f} {zs['I']:+6.2f}  {'yes' if split else 'no':5s}"
-            f" {_along(mdl, w.index):5.2f}  {time.perf_counter() - t0:.1f}"
+            f" {_along(mdl, w.index):5.2f}  {_ratio(mdl, w.index):5.2f}"
+            f"  {time.perf_counter() - t0:.1f}"
         )
     for k, name in (("f", "FREQ_WINDUP"), ("z", "DAMP_WINDUP"), ("I", "BELT_IYY")):
         r = np.abs(rel[k])
@@ -165,6 +169,12 @@ def _along(model, k: int) -> float:
     """The fit's noise along the response of mode ``k`` (1: not significant, not used)."""
     along = model.meta.get("noise_along_response")
     return float(along[k]) if along is not None else float("nan")
+
+
+def _ratio(model, k: int) -> float:
+    """The sandwich's factor of the variance of mode ``k``'s damping ratio (NaN: not known)."""
+    ratio = model.meta.get("pole_variance_ratio")
+    return float(ratio[k][1]) if ratio is not None else float("nan")
 
 
 def _matched(model, truth_f: np.ndarray, truth_z: np.ndarray) -> list[int | None]:

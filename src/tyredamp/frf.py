@@ -137,6 +137,16 @@ class FRF:
         Variance ``E|H_est - H|^2`` of each estimate of ``H`` (real, >= 0, in
         the unit of ``H`` squared), as estimated from the measurement noise
         by the FRF estimator; the weights of a maximum-likelihood fit.
+    input_noise : array_like, shape (n_in, n_freq), optional
+        Relative variance ``r`` of the error the input (force) noise makes,
+        common to all outputs (dimensionless, >= 0): the error of column ``k``
+        at a line holds ``-H[:, k] n`` with one complex noise ``n`` of variance
+        ``r[k]`` for every output (errors in variables: Pintelon & Schoukens,
+        *System Identification*, 2nd ed. 2012, sec. 2.5), which ``variance``
+        counts as ``r |H|^2`` on the diagonal only. Given by the cyclic
+        one-input estimate (:mod:`tyredamp.signal.cyclic_variance`); the
+        final modal fit then takes the outputs' correlation into its standard
+        errors (:mod:`tyredamp.modal.sandwich`). Not kept in files.
 
     Examples
     --------
@@ -164,6 +174,7 @@ class FRF:
     coherence: NDArray[np.float64] | None = None
     meta: dict[str, Any] = field(default_factory=dict)
     variance: NDArray[np.float64] | None = None
+    input_noise: NDArray[np.float64] | None = None
 
     def __init__(
         self,
@@ -175,6 +186,7 @@ class FRF:
         coherence: ArrayLike | None = None,
         meta: dict[str, Any] | None = None,
         variance: ArrayLike | None = None,
+        input_noise: ArrayLike | None = None,
     ) -> None:
         f = as_frequency(frequency, "frequency")
         h = as_finite(H, "H", dtype=complex)
@@ -216,6 +228,7 @@ class FRF:
                 raise InputError("variance: expected values >= 0")
             var = var.copy()
             var.setflags(write=False)
+        rin = None if input_noise is None else _input_noise(input_noise, h.shape)
         f = f.copy()
         h = h.copy()
         f.setflags(write=False)
@@ -228,6 +241,7 @@ class FRF:
         object.__setattr__(self, "coherence", coh)
         object.__setattr__(self, "meta", dict(meta or {}))
         object.__setattr__(self, "variance", var)
+        object.__setattr__(self, "input_noise", rin)
 
     # ------------------------------------------------------------------ views
     @property
@@ -271,6 +285,7 @@ class FRF:
             "coherence": self.coherence,
             "meta": self.meta,
             "variance": self.variance,
+            "input_noise": self.input_noise,
         }
         base.update(changes)
         return FRF(**base)
@@ -336,8 +351,13 @@ class FRF:
             raise InputError("select_lines: the selection holds no frequency line")
         coh = None if self.coherence is None else self.coherence[:, idx]
         var = None if self.variance is None else self.variance[:, :, idx]
+        rin = None if self.input_noise is None else self.input_noise[:, idx]
         return self._new(
-            frequency=self.frequency[idx], H=self.H[:, :, idx], coherence=coh, variance=var
+            frequency=self.frequency[idx],
+            H=self.H[:, :, idx],
+            coherence=coh,
+            variance=var,
+            input_noise=rin,
         )
 
     def band(self, f_lo: float, f_hi: float) -> FRF:
@@ -371,6 +391,7 @@ class FRF:
             inputs=[self.inputs[i] for i in ii],
             coherence=coh,
             variance=None if self.variance is None else self.variance[np.ix_(oi, ii)],
+            input_noise=None if self.input_noise is None else self.input_noise[ii],
         )
 
     def output_index(self, node: int, direction: int | None = None) -> int:
@@ -387,7 +408,9 @@ class FRF:
 
     def with_H(self, H: ArrayLike, kind: FRFKind | None = None) -> FRF:
         """A copy with new responses on the same axis and channels (no coherence or variance)."""
-        return self._new(H=H, kind=kind or self.kind, coherence=None, variance=None)
+        return self._new(
+            H=H, kind=kind or self.kind, coherence=None, variance=None, input_noise=None
+        )
 
     # ---------------------------------------------------------------- xarray
     def to_xarray(self) -> Any:
@@ -512,6 +535,24 @@ class FRF:
         from .plot import plot_frf  # type: ignore[attr-defined,unused-ignore]
 
         return plot_frf(self, **kwargs)
+
+
+def _input_noise(values: ArrayLike, shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """The checked, read-only ``input_noise`` (n_in, n_freq) of an FRF of ``H.shape``
+    ``shape`` (:class:`FRF`)."""
+    r = as_finite(values, "input_noise")
+    want = (shape[1], shape[2])
+    if r.shape != want:
+        if r.size != shape[1] * shape[2]:
+            raise ShapeError(
+                f"input_noise: expected shape {want} (inputs, frequency lines), got {r.shape}"
+            )
+        r = r.reshape(want)
+    if np.any(r < 0):
+        raise InputError("input_noise: expected relative variances >= 0")
+    r = r.copy()
+    r.setflags(write=False)
+    return r
 
 
 def _find(chs: tuple[Channel, ...], node: int, direction: int | None, name: str) -> int:

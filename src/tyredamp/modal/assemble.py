@@ -161,6 +161,11 @@ class ModelContext:
     #: each in-band mode's noise along the response over the fit's noise, where it
     #: exceeds its scatter (fit order; :func:`noise_along_response`); None: not measured
     along: NDArray[np.float64] | None = None
+    #: the factors of the variances of each in-band mode's frequency and damping
+    #: ratio under the noise's structure across outputs (n_band, 2; fit order;
+    #: :func:`~tyredamp.modal.final.pole_variance_ratios`); None: not known, ``along``
+    #: stands for it
+    pole_ratio: NDArray[np.float64] | None = None
 
 
 def local_dispersion(
@@ -206,10 +211,11 @@ def _intervals_95(
     u: FitResult,
     o: NDArray[np.intp],
     poles: NDArray[np.complex128],
-    inflate: NDArray[np.float64],
+    inflations: tuple[NDArray[np.float64], NDArray[np.float64]],
 ) -> tuple[dict[str, ArrayLike], dict[str, object]]:
     """The standard errors and 95 % intervals of the in-band modes (sorted by ``o``;
-    ``u`` the unscaled fit, ``inflate`` the square root of each mode's local
+    ``u`` the unscaled fit, ``inflations`` the factors of the shapes (n,) and of the
+    frequencies and damping ratios (n, 2): the square root of each mode's local
     dispersion): the likelihood interval where it was formed
     (:mod:`~tyredamp.modal.fit.profile`), else the linearised one, each half scaled by
     the local dispersion; the standard error of a mode with a likelihood interval
@@ -226,10 +232,11 @@ def _intervals_95(
         fi, zi = np.asarray(iv.frequency_hz)[o], np.asarray(iv.damping_ratio)[o]
         half_f[lik] = np.abs(fi[lik] - f_hat[lik, None])
         half_z[lik] = np.abs(zi[lik] - z_hat[lik, None])
-    half_f, half_z = half_f * inflate[:, None], half_z * inflate[:, None]
+    inflate, fz = inflations
+    half_f, half_z = half_f * fz[:, 0, None], half_z * fz[:, 1, None]
     std: dict[str, ArrayLike] = {
-        "frequency_hz": np.where(lik, np.max(half_f, axis=1) / Z95, sd_f * inflate),
-        "damping_ratio": np.where(lik, np.max(half_z, axis=1) / Z95, sd_z * inflate),
+        "frequency_hz": np.where(lik, np.max(half_f, axis=1) / Z95, sd_f * fz[:, 0]),
+        "damping_ratio": np.where(lik, np.max(half_z, axis=1) / Z95, sd_z * fz[:, 1]),
         "psi_out": u.std_psi_out[:, o] * inflate[None, :],
     }
     sin = u.std_psi_in
@@ -260,6 +267,23 @@ def _holds_other(
     inside = (f_hat[None, :] >= lo[:, None]) & (f_hat[None, :] <= hi[:, None])
     np.fill_diagonal(inside, False)
     return np.asarray(np.any(inside, axis=1))
+
+
+def _inflations(
+    ctx: ModelContext, disp: NDArray[np.float64], o: NDArray[np.intp]
+) -> tuple[NDArray[np.float64], ...]:
+    """The in-band modes' noise along the response (sorted by ``o``), the factors of the
+    variances of their frequencies and damping ratios (n, 2), and the factors of the
+    standard errors of the shapes (n,) and of frequency and damping ratio (n, 2):
+    the square root of the larger of the local dispersion ``disp`` and the noise
+    along the response, or for frequency and damping ratio the sandwich's factor
+    where known (:attr:`ModelContext.pole_ratio`)."""
+    n = o.size
+    along = np.ones(n) if ctx.along is None else np.asarray(ctx.along, dtype=float)[o]
+    ratio = np.repeat(along[:, None], 2, axis=1)
+    if ctx.pole_ratio is not None:
+        ratio = np.asarray(ctx.pole_ratio, dtype=float)[o]
+    return along, ratio, np.sqrt(np.maximum(disp, along)), np.sqrt(np.maximum(disp[:, None], ratio))
 
 
 def to_model(
@@ -293,9 +317,8 @@ def to_model(
     o = np.argsort(u.poles[:n_band].imag)
     poles, psi_out, psi_in = u.poles[o], u.psi_out[:, o], u.psi_in[:, o]
     disp = local_dispersion(pr, res, sq, n_band)[o]
-    along = np.ones(n_band) if ctx.along is None else np.asarray(ctx.along, dtype=float)[o]
-    inflate = np.sqrt(np.maximum(disp, along))
-    std, intervals = _intervals_95(res, u, o, poles, inflate)
+    along, ratio, inflate, inflate_fz = _inflations(ctx, disp, o)
+    std, intervals = _intervals_95(res, u, o, poles, (inflate, inflate_fz))
     n_f = pr.H.shape[-1]
     rmsd = float(c * np.sqrt(sq.sum()) / sq.size)
     rel = float(np.sqrt(sq.sum() / max(float(np.vdot(pr.H, pr.H).real), 1e-300)))
@@ -358,9 +381,11 @@ def to_model(
         "contribution": res.contribution[o],
         "significance": stat,
         "drive_point_phi2": u.drive_phi2[o],
-        "std_pole": res.std_pole[o] * inflate,
+        "std_pole": res.std_pole[o].real * inflate_fz[:, 1]
+        + 1j * res.std_pole[o].imag * inflate_fz[:, 0],
         "local_dispersion": disp,
         "noise_along_response": along,
+        "pole_variance_ratio": ratio,
         **intervals,
         "n_residual_modes": len(res.poles) - n_band,
         "warnings": list(res.warnings) + unresolved,

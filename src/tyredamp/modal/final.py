@@ -31,9 +31,10 @@ from numpy.typing import NDArray
 from ..exceptions import ConvergenceError
 from .assemble import goodness, local_dispersion, to_model, unscale  # noqa: F401 (re-exported)
 from .fit.fit import FitResult, ModalFitter, pole_bounds
-from .fit.ml import ml_refine
+from .fit.ml import fisher_scale, ml_refine
 from .fit.profile import fit_intervals
 from .problem.problem import FitProblem
+from .sandwich import sandwich_ratios
 from .search.refitted import refitted_statistics
 from .search.resolution import unresolved_pair, unresolved_pair_text
 from .search.search import (
@@ -148,7 +149,7 @@ def fit_real(
     search: ModalFitter | None,
     start: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet],
     sigma0: NDArray[np.float64] | None = None,
-) -> tuple[FitResult, int, list[str], NDArray[np.float64]]:
+) -> tuple[FitResult, int, list[str], NDArray[np.float64], NDArray[np.float64] | None]:
     """Real-mode fit (pole-pair optimisation) started from the complex-mode poles.
 
     The real model keeps the modes of the complex model. When its refinement
@@ -164,7 +165,8 @@ def fit_real(
     intervals would be too short get likelihood intervals
     (:func:`~tyredamp.modal.fit.profile.fit_intervals`), as in the complex model.
     Also returns the in-band modes' noise along the response
-    (:func:`noise_along_response`), as :func:`final_complex` does.
+    (:func:`noise_along_response`) and the factors of their poles' variances
+    (:func:`pole_variance_ratios`), as :func:`final_complex` does.
     """
     p0, l0, modes = start
     m, nf = modes.m, modes.n_free
@@ -182,7 +184,7 @@ def fit_real(
     passes = 1 if sigma is not None else 2
     if not refine:
         res = fitter.fit(p0, l0, refine=False, sigma=sigma)
-        return res, m, [], noise_along_response(fitter, res, m)
+        return res, m, [], noise_along_response(fitter, res, m), None
     start_p, start_l = p0, l0
     why, bad = "", -1
     if search is not None:
@@ -224,7 +226,7 @@ def fit_real(
                 res = ml
             # likelihood intervals where the linearised ones would be too short
             res.intervals = fit_intervals(fitter, res, m, sigma0)
-            return res, m, [], noise_along_response(fitter, res, m)
+            return res, m, [], *_along(problem, fitter, res, m, sigma)
         if bad >= m + nf:
             keep = np.arange(start_p.size) != bad
             start_p, start_l, p0, l0 = start_p[keep], start_l[keep], p0[keep], l0[keep]
@@ -238,6 +240,7 @@ def fit_real(
             "values, real residues fitted"
         ],
         noise_along_response(fitter, res, m),
+        None,
     )
 
 
@@ -268,6 +271,19 @@ def _watched(
     return (res, *_problem(res, m, n_free, band, _floor_hz(fitter)))
 
 
+def _along(
+    problem: FitProblem,
+    fitter: ModalFitter,
+    res: FitResult,
+    m: int,
+    sigma: NDArray[np.float64] | None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+    """:func:`noise_along_response` and :func:`pole_variance_ratios` of a final fit."""
+    return noise_along_response(fitter, res, m), pole_variance_ratios(
+        problem, fitter, res, m, sigma
+    )
+
+
 def noise_along_response(
     fitter: ModalFitter, res: FitResult, n_band: int, alpha: float = 0.05
 ) -> NDArray[np.float64]:
@@ -282,7 +298,11 @@ def noise_along_response(
     by up to ``sqrt(n_out)``). ``lambda_in`` over ``n`` lines around the mode holds
     ``2 n_in^2 n`` real units of noise, so under independent outputs ``lambda_in
     nu`` is ``chi2_nu`` with ``nu = 2 n_in^2 n``; it is used where it exceeds that
-    law's upper ``alpha`` quantile over ``nu``.
+    law's upper ``alpha`` quantile over ``nu``. Where the FRF carries its input
+    noise, the frequencies' and damping ratios' standard errors take the
+    sandwich's factors instead (:func:`pole_variance_ratios`): averaged over the
+    window, ``lambda_in`` mixes the lines where the force's noise dominates with
+    those where the responses' does, and scatters from seed to seed.
     """
     out = np.ones(n_band)
     if n_band == 0:
@@ -305,7 +325,14 @@ def final_complex(
     combined: ModalFitter | None,
     threshold: float | None = None,
     test: ModeTest | None = None,
-) -> tuple[FitResult, ModeSet, list[RejectedMode], NDArray[np.float64] | None, NDArray[np.float64]]:
+) -> tuple[
+    FitResult,
+    ModeSet,
+    list[RejectedMode],
+    NDArray[np.float64] | None,
+    NDArray[np.float64],
+    NDArray[np.float64] | None,
+]:
     """The final complex-mode fit; ``combined``: a fitter on the re-weighted output
     combinations (many outputs), whose poles then give the residues of every output.
 
@@ -317,11 +344,13 @@ def final_complex(
     e.g. a damping that collapsed) is dropped, the weakest first, and the fit
     repeated. Also returns the threshold applied to each kept in-band mode (fit
     order; None without ``threshold``) and each in-band mode's noise along the
-    response (:func:`noise_along_response`, fit order). When every mode passes with the other
-    poles held, modes beside a stronger one are tested once more with the
-    neighbours' poles refitted (:mod:`~tyredamp.modal.search.refitted`: the likelihood
-    ratio of the maximised models) and dropped, the weakest first, when that
-    fails.
+    response (:func:`noise_along_response`, fit order) and the factors of the
+    variances of its frequency and damping ratio under the noise's structure
+    across outputs (:func:`pole_variance_ratios`; None where not known). When
+    every mode passes with the other poles held, modes beside a stronger one are
+    tested once more with the neighbours' poles refitted
+    (:mod:`~tyredamp.modal.search.refitted`: the likelihood ratio of the
+    maximised models) and dropped, the weakest first, when that fails.
     """
     dropped: list[RejectedMode] = []
     cur = modes
@@ -381,7 +410,8 @@ def final_complex(
         res = maximum_likelihood(problem, cfit, res)
         # likelihood intervals where the linearised ones would be too short
         res.intervals = fit_intervals(cfit, res, cur.m, sigma0)
-    return res, cur, dropped, thr, noise_along_response(cfit, res, cur.m)
+    ratio = pole_variance_ratios(problem, cfit, res, cur.m, sigma0) if refine else None
+    return res, cur, dropped, thr, noise_along_response(cfit, res, cur.m), ratio
 
 
 def _spacing(problem: FitProblem) -> float:
@@ -470,8 +500,19 @@ def maximum_likelihood(problem: FitProblem, fitter: ModalFitter, res: FitResult)
     estimated and :func:`full_weights` says its own weights are the better ones."""
     if problem.variance is None or not full_weights(problem):
         return res
-    nu = problem.noise_dof
-    plain = ModalFitter(
+    try:
+        return ml_refine(
+            _plain(problem, fitter), res, problem.variance, problem.noise_dof, tol=FINAL_TOL
+        )
+    except (np.linalg.LinAlgError, ValueError):
+        res.warnings.append("maximum-likelihood refinement failed: weighted fit kept")
+        return res
+
+
+def _plain(problem: FitProblem, fitter: ModalFitter) -> ModalFitter:
+    """The fitter of the maximum-likelihood stage: ``fitter``'s model on the problem's
+    unweighted data (no line weights)."""
+    return ModalFitter(
         problem.frequency,
         problem.H,
         problem.power,
@@ -480,8 +521,36 @@ def maximum_likelihood(problem: FitProblem, fitter: ModalFitter, res: FitResult)
         upper=fitter.use_upper,
         lower=fitter.use_lower,
     )
+
+
+def pole_variance_ratios(
+    problem: FitProblem,
+    fitter: ModalFitter,
+    res: FitResult,
+    n_band: int,
+    sigma0: NDArray[np.float64] | None,
+) -> NDArray[np.float64] | None:
+    """The factors of the variances of each in-band mode's frequency and damping ratio
+    (n_band, 2; fit order) under the noise's structure across outputs, White's
+    sandwich (:func:`~tyredamp.modal.sandwich.sandwich_ratios`): where the FRF
+    carries its input noise (:attr:`~tyredamp.frf.FRF.input_noise`, the part of
+    the variance common to all outputs) and ``res`` is the maximum-likelihood fit
+    with its per-line variance, or the weighted least-squares fit of ``fitter``
+    (each output weighted by ``1 / sigma0``, its residual RMS without ``sigma0``).
+    None otherwise: the modes' noise along the response
+    (:func:`noise_along_response`) then stands for that structure.
+    """
+    r = problem.frf.input_noise
+    if r is None or problem.variance is None or n_band == 0:
+        return None
+    ml = res.status.startswith("maximum likelihood")
+    fit = _plain(problem, fitter) if ml else fitter
+    # the ML fit reports its inverse information times its Fisher scale (an estimated variance)
+    scale = fisher_scale(problem.noise_dof, 0.0, 1) if ml else 1.0
+    w = None if ml else fitter.weights(res.sigma_out if sigma0 is None else sigma0)
     try:
-        return ml_refine(plain, res, problem.variance, nu, tol=FINAL_TOL)
-    except (np.linalg.LinAlgError, ValueError):
-        res.warnings.append("maximum-likelihood refinement failed: weighted fit kept")
-        return res
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            out = sandwich_ratios(fit, res, w, problem.variance, r[:, problem.lines], n_band, scale)
+    except (np.linalg.LinAlgError, ValueError):  # no covariance: the noise along the response
+        return None
+    return out if np.isfinite(out).all() else None

@@ -406,9 +406,9 @@ def _final_models(
     base: tuple[NDArray[np.complex128], NDArray[np.complex128], ModeSet] = (*modes.all(), modes)
     for kind in kinds:
         extra_warn: list[str] = []
-        thresholds = along = None
+        thresholds = along = ratio = None
         if kind == "complex":
-            res, cur, dropped, thresholds, along = final_complex(
+            res, cur, dropped, thresholds, along, ratio = final_complex(
                 problem,
                 fitters.cfit,
                 modes,
@@ -423,7 +423,7 @@ def _final_models(
             n_band = cur.m
         else:
             compressed = fitters.sfit if fitters.sfit is not fitters.cfit else None
-            res, n_band, extra_warn, along = fit_real(
+            res, n_band, extra_warn, along, ratio = fit_real(
                 problem, residuals, refine, compressed, base, sigma0
             )
         res.warnings.extend(extra_warn)
@@ -444,6 +444,7 @@ def _final_models(
             method=ctx["method"],
             thresholds=thresholds,
             along=along,
+            pole_ratio=ratio,
         )
         models[kind], disc[kind] = to_model(res, n_band, c)
     return models, disc

@@ -52,6 +52,7 @@ from numpy.typing import NDArray
 __all__ = [
     "TARGET_DOF",
     "cyclic_frf_variance",
+    "cyclic_input_noise",
     "cyclic_variance_on_lines",
     "mean_spectra",
     "smoothing_lines",
@@ -192,6 +193,52 @@ def _line_average(a: NDArray[Any], n_lines: int) -> NDArray[Any]:
     return out
 
 
+def cyclic_input_noise(
+    gxx: NDArray[np.float64],
+    xbar: NDArray[np.complex128],
+    line_scale: NDArray[np.float64],
+    n_periods: int,
+) -> NDArray[np.float64] | None:
+    """Relative variance ``r`` of the error the force noise makes in a one-input cyclic FRF.
+
+    The first-order error of ``H_j = Ybar_j / Xbar`` is ``(dY_j - H_j dX) /
+    Xbar`` (module docstring): its part ``-H_j dX / Xbar`` is one complex noise
+    ``n = dX / Xbar`` times ``H_j``, the same ``n`` for every output, of variance
+    ``r = C_xx / (n |Xbar|^2)`` (the term ``|H_j|^2 C_xx`` of the variance over
+    ``|H_j|^2``; Pintelon & Schoukens 2012, sec. 2.5). ``C_xx`` is averaged over the
+    lines of :func:`smoothing_lines` as in :func:`cyclic_frf_variance`.
+
+    Parameters
+    ----------
+    gxx : ndarray, shape (n_freq,)
+        Input auto spectrum ``c mean_k |X_k|^2``.
+    xbar : ndarray, complex, shape (n_freq,)
+        Mean spectrum of the periods' force (unscaled, :func:`mean_spectra`).
+    line_scale : ndarray, shape (n_freq,)
+        Density scale ``c`` of each line.
+    n_periods : int
+        Number of periods ``n`` averaged.
+
+    Returns
+    -------
+    ndarray, shape (1, n_freq) or None
+        ``r`` (dimensionless, >= 0) per line; None with fewer than two periods
+        or no finite result.
+    """
+    n = int(n_periods)
+    n_f = gxx.shape[0]
+    if n < 2 or n_f == 0:
+        return None
+    c = line_scale
+    cxx = (n / (n - 1.0)) * (gxx - c * np.abs(xbar) ** 2)
+    cxx = _line_average(cxx, smoothing_lines(n, n_f))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.maximum(cxx, 0.0) / (n * c * np.abs(xbar) ** 2)
+    if not np.all(np.isfinite(r)):
+        return None
+    return np.asarray(r[None, :], dtype=float)
+
+
 def cyclic_variance_on_lines(
     signals: tuple[NDArray[Any], NDArray[Any]],
     starts: NDArray[np.intp],
@@ -199,8 +246,10 @@ def cyclic_variance_on_lines(
     detrend: bool,
     spectra: Any,
     h: NDArray[np.complex128],
-) -> tuple[NDArray[np.float64], float] | None:
-    """:func:`cyclic_frf_variance` of a one-input cyclic estimate on its kept lines.
+) -> tuple[NDArray[np.float64], float, NDArray[np.float64] | None] | None:
+    """:func:`cyclic_frf_variance` and :func:`cyclic_input_noise` of a one-input cyclic
+    estimate on its kept lines: the variance, its real degrees of freedom and the
+    relative input-noise variance (1, n_freq) (None where not finite).
 
     Parameters
     ----------
@@ -226,12 +275,10 @@ def cyclic_variance_on_lines(
     # density scale of one segment's line (cross_spectra's, times the averages)
     c = np.full(k.size, 2.0 / (spectra.sample_rate * float(np.sum(w * w))))
     c[(k == 0) | ((seg % 2 == 0) & (k == seg // 2))] /= 2
-    return cyclic_frf_variance(
-        np.real(spectra.Gxx[:, 0, 0]),
-        spectra.Gyx[:, :, 0],
-        spectra.Gyy,
-        (xbar[k, 0], ybar[k]),
-        c,
-        h,
-        spectra.n_averages,
+    gxx = np.real(spectra.Gxx[:, 0, 0])
+    got = cyclic_frf_variance(
+        gxx, spectra.Gyx[:, :, 0], spectra.Gyy, (xbar[k, 0], ybar[k]), c, h, spectra.n_averages
     )
+    if got is None:
+        return None
+    return got[0], got[1], cyclic_input_noise(gxx, xbar[k, 0], c, spectra.n_averages)

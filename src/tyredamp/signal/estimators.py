@@ -689,12 +689,13 @@ def _segmented_frf(
         plan.window_values, plan.step_samples, spectra.n_averages
     )
     variance, dof = frf_variance(spectra, coh, n_eff), 2.0 * (n_eff - len(ref_idx))
+    input_noise = None
     if choice.method == "cyclic" and len(ref_idx) == 1 and len(timedata.acquisition.run_starts) < 2:
         sig = (timedata.data[ref_idx], timedata.data[out_idx])
         wins = segment_windows(plan.window_values, plan.input_window, seg)
         eiv = cyclic_variance_on_lines(sig, starts, wins, plan.detrend, spectra, h)
         if eiv is not None:  # the period-to-period noise of force and responses
-            variance, dof = eiv
+            variance, dof, input_noise = eiv
     win = plan.window
     meta_out: dict[str, Any] = {
         "estimator": estimator,
@@ -720,6 +721,7 @@ def _segmented_frf(
         coherence=coh,
         meta=meta_out,
         variance=variance,
+        input_noise=input_noise,
     )
 
 

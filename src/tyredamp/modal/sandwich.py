@@ -1,0 +1,247 @@
+"""Standard errors of a maximum-likelihood modal fit whose noise is correlated across outputs.
+
+The maximum-likelihood fit (:mod:`~tyredamp.modal.fit.ml`) weights every entry
+of the FRF by its own variance ``V_jkf`` as if the entries' errors were
+independent. The error of an H1 (or cyclic) estimate with a noisy force is
+not: with ``X + N`` measured, the error of column ``k`` holds ``-H_k(f) n_kf``
+with one complex noise ``n_kf = N / X`` shared by every output (errors in
+variables; Pintelon & Schoukens, *System Identification*, 2nd ed. 2012, sec.
+2.5 and 7.2; Bendat & Piersol, *Random Data*, 4th ed. 2010, sec. 9.2), so per
+line and input the covariance of the outputs' errors is::
+
+    Sigma_f = D_f + r_f h_f h_f^H,    D_f = diag(V_f) - r_f diag(|h_f|^2)
+
+(``r_f = E|n_f|^2`` the relative input-noise variance,
+:attr:`~tyredamp.frf.FRF.input_noise`; ``h_f`` the column of ``H``). The
+variance ``V`` counts the common part on the diagonal only. The estimate of the
+weighted fit is then still consistent but its covariance is White's sandwich
+(White, "A heteroskedasticity-consistent covariance matrix estimator",
+*Econometrica* 48(4), 1980, eq. (3); Pintelon & Schoukens 2012, sec. 7.2.4 and
+17.2, the covariance of a weighted least-squares estimate under a noise model
+other than its weighting)::
+
+    Cov(theta) = A^-1 B A^-1,   A = J^T J,   B = J^T W Sigma W J       (1)
+
+with ``J`` the Jacobian of the whitened residual ``W (y - model)`` (the
+variable-projection Jacobian of Kaufman, the linear coefficients profiled out,
+as :mod:`~tyredamp.modal.fit.ml` uses it) and ``W`` the fit's weights ``1 /
+sqrt(V / 2)`` per real row. Since ``W diag(V) W = I``, ``B`` is ``A`` plus, per line
+and input, a rank-two update for the common part and minus the diagonal it
+replaces. Writing ``n = a + i b`` (``a``, ``b`` independent, each of variance
+``r / 2``), the common part adds to ``J^T W e`` the term ``a u_f + b v_f`` with::
+
+    u_f = sum_j w_jf (J_j,re(f) Re h_jf + J_j,im(f) Im h_jf)
+    v_f = sum_j w_jf (J_j,im(f) Re h_jf - J_j,re(f) Im h_jf)              (2)
+
+(``J_j,re(f)``, ``J_j,im(f)`` the rows of output ``j``'s real and imaginary part at
+line ``f``), so::
+
+    B = A + sum_f r_f / 2 (u_f u_f^T + v_f v_f^T)
+          - sum_jf d_jf w_jf^2 / 2 (J_j,re(f)^T J_j,re(f) + J_j,im(f)^T J_j,im(f))   (3)
+
+with ``d_jf = min(r_f |h_jf|^2, V_jf)`` the common part's share of the diagonal
+(``D_f >= 0``). The cost is that of one more evaluation of ``J`` plus
+``O(n_lines n_par^2)`` for the updates. ``h`` is the fitted model (not the noisy
+data). The fit reports ``s A^-1`` (``s`` its Fisher scale for an estimated
+variance, :func:`~tyredamp.modal.fit.ml.fisher_scale`); :func:`sandwich_ratios`
+returns, for the frequency and the damping ratio of each mode, the variance of
+(1) over the variance the fit reports by the delta method, the factor the
+reported variances are multiplied by. The sandwich holds for any weights
+``W``: for the weighted least-squares fit with the separable weights ``1 /
+(sigma_j sqrt(g_f))`` its diagonal part is ``J^T W diag(D) W J`` (not ``A``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.linalg
+from numpy.typing import NDArray
+
+from .fit import _basis
+from .fit._scaling import pole_std
+
+if TYPE_CHECKING:
+    from .fit.fit import FitResult, ModalFitter
+
+__all__ = ["sandwich_covariance", "sandwich_ratios"]
+
+
+def _solve_gram(gram: NDArray[np.float64], rhs: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``gram^-1 rhs`` of a Gram matrix, its columns scaled to unit norm first (Jacobi);
+    a pseudo-inverse where the Cholesky factor fails."""
+    d = 1.0 / np.sqrt(np.maximum(np.diag(gram), 1e-300))
+    g = gram * d[:, None] * d[None, :]
+    b = rhs * d.reshape(-1, *([1] * (rhs.ndim - 1)))
+    try:
+        x = scipy.linalg.cho_solve(scipy.linalg.cho_factor(g), b)
+    except (np.linalg.LinAlgError, ValueError):
+        x = np.linalg.pinv(g, hermitian=True) @ b
+    return np.asarray(x * d.reshape(-1, *([1] * (rhs.ndim - 1))))
+
+
+def _row_weights(variance: NDArray[np.float64], sl: slice) -> NDArray[np.float64]:
+    """``1 / sqrt(V / 2)`` of the real rows of lines ``sl`` (2 n_in lines, n_out), an entry
+    without variance weighted as its output's least noisy line (as the fit does)."""
+    n_out = variance.shape[0]
+    v_all = variance.reshape(n_out, -1)
+    low = np.array([np.min(r, where=r > 0, initial=np.inf) for r in v_all])
+    low = np.where(np.isfinite(low), low, np.min(low))
+    v = np.asarray(variance[:, :, sl], dtype=float).reshape(n_out, -1)
+    v = np.where(v > 0, v, low[:, None])
+    return np.repeat(1.0 / np.sqrt(v / 2.0), 2, axis=1).T
+
+
+def sandwich_covariance(
+    fitter: ModalFitter,
+    res: FitResult,
+    out_weights: NDArray[np.float64] | None,
+    variance: NDArray[np.float64],
+    input_noise: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``A^-1`` and ``A^-1 B A^-1`` of eq. (1) (module docstring) for the fit ``res``.
+
+    Parameters
+    ----------
+    fitter : ModalFitter
+        The fitter of ``res`` (its line weights, if any, are part of its rows).
+    res : FitResult
+        The fit (poles, participation, model).
+    out_weights : ndarray, shape (n_out,), or None
+        The weight of each output's rows in the weighted least-squares fit
+        (``1 / sigma_j``, :meth:`ModalFitter.weights`); None: the fit of ``res`` is the
+        maximum-likelihood one, every real row weighted by ``1 / sqrt(V / 2)``.
+    variance : ndarray, shape (n_out, n_in, n_freq)
+        The variance ``V`` of each entry (units of ``fitter.H`` squared).
+    input_noise : ndarray, shape (n_in, n_freq)
+        Relative input-noise variance ``r`` (dimensionless).
+
+    Returns
+    -------
+    ainv, cov, theta : ndarray, shapes (n_par, n_par), (n_par, n_par), (n_par,)
+        The inverse information, the sandwich covariance (units of the fit's
+        parameters ``theta``, :meth:`ModalFitter.pack`) and ``theta``.
+    """
+    n_out, n_in = fitter.n_out, fitter.n_in
+    v = np.asarray(variance, dtype=float)
+    lw = fitter.line_weights
+
+    def rows(sl: slice) -> NDArray[np.float64]:
+        if out_weights is None:
+            return _row_weights(v, sl)
+        return np.broadcast_to(
+            np.asarray(out_weights, float), (2 * n_in * _count(fitter, sl), n_out)
+        )
+
+    th, blocks = _jacobians(fitter, res, rows)
+    n_par = th.size
+    a = np.zeros((n_par, n_par))
+    b = np.zeros((n_par, n_par))
+    for sl, jac in blocks:
+        nb = _count(fitter, sl)
+        # the weight of each row's noise: the output's and the line's
+        om = rows(sl)[0::2] * (1.0 if lw is None else np.tile(lw[sl], n_in)[:, None])
+        h = np.asarray(res.model[:, :, sl])  # (n_out, n_in, nb)
+        r = np.asarray(input_noise[:, sl], dtype=float)  # (n_in, nb)
+        u = np.zeros((n_in, nb, n_par))
+        w2 = np.zeros((n_in, nb, n_par))
+        for j, jj in enumerate(jac):
+            a += jj.T @ jj
+            jr = jj[0::2].reshape(n_in, nb, n_par)
+            ji = jj[1::2].reshape(n_in, nb, n_par)
+            w = om[:, j].reshape(n_in, nb)
+            hr, hi = h[j].real * w, h[j].imag * w  # (n_in, nb)
+            u += jr * hr[..., None] + ji * hi[..., None]  # eq. (2)
+            w2 += ji * hr[..., None] - jr * hi[..., None]
+            vj = v[j][:, sl]
+            dj = vj - np.minimum(r * np.abs(h[j]) ** 2, vj)  # D_f, the outputs' own noise
+            dd = (dj * w**2 / 2.0).reshape(-1, 1)
+            for x in (jr.reshape(-1, n_par), ji.reshape(-1, n_par)):
+                b += (x * dd).T @ x  # eq. (3), the diagonal D
+        rr = (r / 2.0).reshape(-1, 1)
+        for x in (u.reshape(-1, n_par), w2.reshape(-1, n_par)):
+            b += (x * rr).T @ x  # eq. (3), the common part
+    ainv = np.asarray(np.linalg.pinv(0.5 * (a + a.T), hermitian=True), dtype=np.float64)
+    cov = np.asarray(ainv @ (0.5 * (b + b.T)) @ ainv, dtype=np.float64)
+    return ainv, cov, th
+
+
+def _jacobians(
+    fitter: ModalFitter, res: FitResult, rows: Callable[[slice], NDArray[np.float64]]
+) -> tuple[NDArray[np.float64], Iterator[tuple[slice, Iterator[NDArray[np.float64]]]]]:
+    """The parameters ``theta`` of ``res`` and, block by block of lines, Kaufman's
+    variable-projection Jacobian ``J_j = P_j W_j E S_j^T`` (rows, n_par) of every
+    output (as :func:`~tyredamp.modal.fit.ml._evaluate` forms ``J^T J``), ``rows(sl)``
+    the row weights (rows, n_out) of the lines ``sl`` (the outputs' Jacobians of a
+    block one after the other): ``P_j W_j E = W_j (E - Phi
+    X_j)`` with ``X_j = G_PhiPhi^-1 G_PhiE`` and the coefficients ``C_j`` from each
+    output's Gram matrix of ``W_j [Phi | E]`` (Golub & Pereyra, "The
+    differentiation of pseudo-inverses and nonlinear least squares problems whose
+    variables separate", *SIAM J. Numer. Anal.* 10(2), 1973; Kaufman's
+    approximation, *BIT* 15, 1975)."""
+    m = int(res.poles.size)
+    part = np.asarray(res.participation, complex)
+    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
+    th = fitter.pack(res.poles, part, ref)
+    q, lay = fitter.n_cols(m), fitter._layout(m)
+    coef = fitter._coef(lay, fitter.unpack(th, m, ref)[0])
+    n_out = fitter.n_out
+    parts = _basis.blocks(fitter, q + int(lay.ecol.max(initial=-1)) + 1)
+    gram: list[NDArray[np.float64]] = [np.zeros(0)] * n_out
+    py: list[NDArray[np.float64]] = [np.zeros(0)] * n_out
+    for k, sl in enumerate(parts):
+        bb = fitter._basis_ek(th, m, ref, True, sl)[0]
+        om, yy = rows(sl), _basis.ydata(fitter, sl)
+        for j in range(n_out):
+            bw = bb * om[:, j, None]
+            g, p = bw.T @ bw, bw[:, :q].T @ (yy[:, j] * om[:, j])
+            gram[j], py[j] = (g, p) if k == 0 else (gram[j] + g, py[j] + p)
+    sol = [
+        _solve_gram(g[:q, :q], np.column_stack([p, g[:q, q:]]))
+        for g, p in zip(gram, py, strict=True)
+    ]
+    s = []
+    for j in range(n_out):
+        sj = np.zeros((th.size, gram[j].shape[0] - q))
+        np.add.at(sj, (lay.dpar, lay.ecol), coef * sol[j][lay.dcol, 0])
+        s.append(sj)
+
+    def outputs(sl: slice) -> Iterator[NDArray[np.float64]]:
+        bb = fitter._basis_ek(th, m, ref, True, sl)[0]
+        om = rows(sl)
+        for j in range(n_out):  # one output's Jacobian at a time: memory of one
+            bw = bb * om[:, j, None]
+            yield (bw[:, q:] - bw[:, :q] @ sol[j][:, 1:]) @ s[j].T
+
+    return th, ((sl, outputs(sl)) for sl in parts)
+
+
+def _count(fitter: ModalFitter, sl: slice) -> int:
+    """Lines in the slice ``sl`` of the fitter's lines."""
+    return len(range(fitter.n_f)[sl])
+
+
+def sandwich_ratios(
+    fitter: ModalFitter,
+    res: FitResult,
+    out_weights: NDArray[np.float64] | None,
+    variance: NDArray[np.float64],
+    input_noise: NDArray[np.float64],
+    n_band: int,
+    scale: float = 1.0,
+) -> NDArray[np.float64]:
+    """Variance of the frequency and of the damping ratio of each of the first
+    ``n_band`` modes under the sandwich (1) times ``scale`` over their variance as the
+    fit reports it (``res.std_frequency_hz``, ``res.std_damping_ratio``), shape
+    (n_band, 2), by the delta method (module docstring); arguments as
+    :func:`sandwich_covariance`. NaN where the fit's standard error is zero or
+    not finite."""
+    _, cov, th = sandwich_covariance(fitter, res, out_weights, variance, input_noise)
+    f1, z1, _ = pole_std(fitter.w_ref, th, int(res.poles.size), cov)
+    f0 = np.asarray(res.std_frequency_hz, float)
+    z0 = np.asarray(res.std_damping_ratio, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = scale * np.stack([(f1 / f0) ** 2, (z1 / z0) ** 2], axis=1)[:n_band]
+    return np.where(np.isfinite(out), out, np.nan)
