@@ -146,7 +146,8 @@ class FRF:
         counts as ``r |H|^2`` on the diagonal only. Given by the cyclic
         one-input estimate (:mod:`tyredamp.signal.cyclic_variance`); the
         final modal fit then takes the outputs' correlation into its standard
-        errors (:mod:`tyredamp.modal.sandwich`). Not kept in files.
+        errors (:mod:`tyredamp.modal.sandwich`). Kept in NPZ, CSV and UFF
+        files written by tyredamp.
 
     Examples
     --------

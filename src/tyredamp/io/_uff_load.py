@@ -24,6 +24,8 @@ from ._uff_meta import read_meta_record
 
 #: ID line 1 of the extra data sets (function type 0) holding FRF.variance.
 VARIANCE_ID = "tyredamp FRF variance"
+#: ID line 1 of tyredamp's extra type-0 data sets that hold FRF.input_noise (one per input)
+INPUT_NOISE_ID = "tyredamp FRF input noise"
 
 
 def _markers(raw: bytes) -> int:
@@ -244,3 +246,19 @@ def read_variance(
     if not all((o, i) in found for o in outs for i in ins):
         return None
     return np.array([[found[(o, i)] for i in ins] for o in outs]).reshape(shape)
+
+
+def read_input_noise(
+    sets: list[dict[str, Any]], ins: list[tuple[int, int]], n: int
+) -> np.ndarray | None:
+    """FRF.input_noise from tyredamp's extra type-0 data sets, when every input has one."""
+    found: dict[tuple[int, int], np.ndarray] = {}
+    for s in sets:
+        if int(s["func_type"]) != 0 or str(s.get("id1", "")).strip() != INPUT_NOISE_ID:
+            continue
+        if len(s["data"]) != n:
+            continue
+        found[(int(s["ref_node"]), int(s["ref_dir"]))] = np.real(np.asarray(s["data"], dtype=float))
+    if not all(i in found for i in ins):
+        return None
+    return np.array([found[i] for i in ins])

@@ -19,7 +19,7 @@ from ..exceptions import FileFormatError, InputError
 from ..frf import FRF, Channel
 from ..timedata import TimeData
 from ._atomic import atomic_path
-from ._uff_load import VARIANCE_ID
+from ._uff_load import INPUT_NOISE_ID, VARIANCE_ID
 from ._uff_meta import meta_record
 from ._uff_records import (
     _AXIS_LABEL,
@@ -194,6 +194,22 @@ def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
                     data=np.array(obj.variance[o, i], dtype=float),
                 )
                 sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+    if obj.input_noise is not None:
+        for i, ci in enumerate(obj.inputs):
+            fid += 1
+            d = _base_set(binary, q, INPUT_NOISE_ID, id2, id3)
+            d.update(
+                func_type=0,
+                func_id=fid,
+                **_pair_fields(ci, ci),
+                ordinate_spec_data_type=0,
+                ordinate_len_unit_exp=0,
+                ordinate_force_unit_exp=0,
+                ordinate_axis_lab="Relative input noise",
+                ordinate_axis_units_lab="NONE",
+                data=np.array(obj.input_noise[i], dtype=float),
+            )
+            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
     return sets
 
 

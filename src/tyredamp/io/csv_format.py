@@ -27,7 +27,9 @@ FRF layout::
   kind (``unit`` line: m/N, m/(s N) or m/(s^2 N)).
 * ``coherence[out]``: optional multiple coherence of each output (0..1).
 * ``variance[out/in]``: optional variance of each ``H`` estimate (unit of
-  ``H`` squared), last, for every output (outer) and input (inner).
+  ``H`` squared), for every output (outer) and input (inner).
+* ``input_noise[in]``: optional relative variance of the input (force) noise
+  of each input (dimensionless, :attr:`tyredamp.frf.FRF.input_noise`), last.
 
 Time-data layout::
 
@@ -110,6 +112,9 @@ def write_csv(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
         if obj.variance is not None:
             cols += [f"variance[{co.label}/{ci.label}]" for co in obj.outputs for ci in obj.inputs]
             blocks.append(obj.variance.reshape(-1, obj.n_freq).T)
+        if obj.input_noise is not None:
+            cols += [f"input_noise[{c.label}]" for c in obj.inputs]
+            blocks.append(obj.input_noise.T)
         table = np.hstack(blocks)
     elif isinstance(obj, TimeData):
         head += ["# type: timedata", f"# sample_rate: {obj.sample_rate!r}"]
@@ -224,6 +229,16 @@ def read_csv(path: str | os.PathLike[str], channel_map: ChannelMap | None = None
             if not outs or not ins:
                 raise FileFormatError(f"{p}: expected '# output:' and '# input:' header lines")
             n_h = 2 * len(outs) * len(ins)
+            n_rin = sum(c.startswith("input_noise[") for c in cols)
+            if n_rin not in (0, len(ins)) or any(
+                c.startswith("input_noise[") for c in cols[: len(cols) - n_rin]
+            ):
+                raise FileFormatError(
+                    f"{p}: expected {len(ins)} input_noise columns at the end, got {n_rin}"
+                )
+            rin = table[:, len(cols) - n_rin :].T if n_rin else None
+            cols = cols[: len(cols) - n_rin]
+            table = table[:, : len(cols)]
             n_var = sum(c.startswith("variance[") for c in cols)
             if n_var not in (0, len(outs) * len(ins)) or any(
                 c.startswith("variance[") for c in cols[: len(cols) - n_var]
@@ -254,6 +269,7 @@ def read_csv(path: str | os.PathLike[str], channel_map: ChannelMap | None = None
                 coherence=coh,
                 meta=meta,
                 variance=var,
+                input_noise=rin,
             )
         if typ == "timedata":
             recs = [meta_from_json(v, f"{p}: channel") for v in fields.get("channel", [])]

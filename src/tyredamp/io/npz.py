@@ -12,8 +12,9 @@ Layout (a NumPy ``.npz`` archive, no pickled objects):
     :class:`~tyredamp.timedata.Acquisition`; older files kept them in
     ``meta`` and read the same) and ``meta``.
 ``frequency`` (n_freq,), ``H`` (n_out, n_in, n_freq) complex, optional
-``coherence`` (n_out, n_freq), optional ``variance`` (n_out, n_in, n_freq)
-    FRF arrays, Hz and SI units of the kind.
+``coherence`` (n_out, n_freq), optional ``variance`` (n_out, n_in, n_freq),
+optional ``input_noise`` (n_in, n_freq)
+    FRF arrays, Hz and SI units of the kind (``input_noise`` is dimensionless).
 ``data`` (n_channels, n_samples)
     Time data in SI units.
 
@@ -69,6 +70,8 @@ def write_npz(obj: FRF | TimeData, path: str | os.PathLike[str]) -> None:
             arrays["coherence"] = obj.coherence
         if obj.variance is not None:
             arrays["variance"] = obj.variance
+        if obj.input_noise is not None:
+            arrays["input_noise"] = obj.input_noise
     elif isinstance(obj, TimeData):
         head = {
             "type": "timedata",
@@ -217,6 +220,7 @@ def read_npz(path: str | os.PathLike[str], max_bytes: int | None = None) -> FRF 
                 coherence=arrays.get("coherence"),
                 meta=meta,
                 variance=arrays.get("variance"),
+                input_noise=arrays.get("input_noise"),
             )
         if kind == "timedata":
             if "data" not in arrays:

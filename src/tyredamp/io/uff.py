@@ -84,7 +84,13 @@ from ..frf import FRF, KINDS, Channel, FRFKind
 from ..timedata import TimeData
 from ._channels import timedata_from_channels
 from ._common import check_input_file, wrap_errors
-from ._uff_load import load_sets, not_frf_or_time, read_coherence, read_variance
+from ._uff_load import (
+    load_sets,
+    not_frf_or_time,
+    read_coherence,
+    read_input_noise,
+    read_variance,
+)
 from ._uff_records import (
     _KIND_QUANTITY,
     _QUANTITY_KIND,
@@ -290,6 +296,7 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
             h[a, b] = cells[(ko, ki)]
     coh = read_coherence(sets, list(outs), list(ins), n)
     var = read_variance(sets, list(outs), list(ins), n, h.shape)
+    rin = read_input_noise(sets, list(ins), n)
     meta = _meta(first, tok)
     encodings = sorted({s["_encoding"] for s in frf_sets if "_encoding" in s})
     if encodings:
@@ -303,6 +310,7 @@ def _read_frf(p: Path, sets: list[dict[str, Any]], kind: FRFKind | None) -> FRF:
         coherence=coh,
         meta=meta,
         variance=var,
+        input_noise=rin,
     )
 
 
