@@ -68,6 +68,7 @@ MODAL_TOP = {
     "mode_count": "pipeline",
     "final": "pipeline",
     "assemble": "pipeline",
+    "replicates": "pipeline",
 }
 
 MAX_FUNCTION_LINES = 120
