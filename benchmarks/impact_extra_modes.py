@@ -30,6 +30,25 @@ noise peak, and the two residues then agree within their errors as well). Only
 the free search in each hit alone, with its own threshold over the lines of its
 band, is independent of the joint fit's choice.
 
+What the data say about the nine that the whole-band fit of each hit alone does not
+find again (``tyredamp modal`` defaults; its hits' fits carry a model error of about
+half the response from the cut ringing of the modes near 20 Hz):
+
+* 104.9, 216.0, 255.5, 360.6 and 480.7 Hz: modes; each hit's own search in
+  ``f +- 5 %`` finds them within 0.5 % (104.9 Hz lives in output m_1, where its peak
+  is 1.6 times the mean ``|H|``, in a band where m_1's coherence falls to 0.07).
+* 184.2, 210.6 and 391.1 Hz (damping 2.4, 4.3 and 3.1 %): broad resonances that each
+  hit finds within their half-power band (181-182, 207-208 and 388-396 Hz), not at
+  the joint pole: resonances of the structure whose pole the records place only
+  loosely (210.6 Hz is the weakest: its damping is 4.3 +- 7.2 %, its residue with
+  the poles fixed is not significant in hit 1).
+* 114.1 Hz: undecidable with two hits: hit 1 alone finds it (T 181 against 28),
+  hit 2 does not (its search keeps nothing there); ``tyredamp modal --replicate``
+  marks it so.
+
+None is shown to be an artefact of the mode test: its noise model is not what lets
+them through.
+
 Usage::
 
     python benchmarks/impact_extra_modes.py [--real-data ../shared/real-data]
