@@ -171,6 +171,7 @@ def modal_command(
     Example:
       tyredamp modal tyre_frf.uff --out modes.json --band 0 200
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
+      tyredamp modal frf.uff -o modes.json --replicate hit1.uff --replicate hit2.uff
     """
     from ..documents.jsonfile import write_json  # imported when the command runs
     from ..io import read_frf
