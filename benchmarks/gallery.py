@@ -434,6 +434,7 @@ def impact_hit_confirm(
     zeta = {float(m["frequency_hz"]): float(m["damping_ratio"]) for m in model["modes"]}
     marked = dict(zip(zeta, model["meta"].get("replicates", []), strict=False))
     whole: list[list[float]] = []
+    within = f"within {100 * rel_tol:g} % or the mode's half-power half-width"
 
     def near(modes: Sequence[float], f: float) -> bool:
         tol = max(rel_tol, zeta.get(f, 0.0))
@@ -452,9 +453,9 @@ def impact_hit_confirm(
                 run = ctx.cli("modal", src, "-o", out, "--model", "complex")
                 whole.append(kept_hz(out) if run.code == 0 else [])
         if all(near(hit, f) for hit in whole):
-            return f"found again in each of the {len(hits)} hits alone"
+            return f"found again in each of the {len(hits)} hits alone ({within})"
         if all(near(local(k, src, f), f) for k, src in enumerate(hits, start=1)):
-            return f"found again in each of the {len(hits)} hits alone in the band f +- 5 %"
+            return f"found again in each of the {len(hits)} hits alone in f +- 5 % ({within})"
         rep = marked.get(f)
         if rep is not None and not rep["confirmed"]:
             n = sum(g is not None for g in rep["found_hz"])
