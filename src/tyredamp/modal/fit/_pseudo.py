@@ -1,0 +1,202 @@
+"""Pseudo-lines: the Gram blocks of an added mode on a long record, with a cost
+per evaluation that does not grow with the lines.
+
+An evaluation of :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit_added`
+(:mod:`._added`) needs three sums over the lines ``w_k`` of products of the added
+mode's columns ``b(w)`` (a rational function of ``w`` with its poles at ``w =
+Omega + i sigma`` and ``w = -Omega + i sigma`` for the pole ``p = -sigma + i
+Omega``) with things that do not change between evaluations: the fixed basis
+``Phi_f``, the data ``Y`` and ``b`` itself,
+
+    ``Phi_f^T B1 = sum_k Phi_f(w_k)^T b(w_k)``, ``B1^T Y = sum_k b(w_k)^T y_k``,
+    ``B1^T B1 = sum_k b(w_k)^T b(w_k)``.
+
+The lines are cut into bins of :data:`BIN_LINES` lines. On a bin ``[c - h, c +
+h]`` whose Bernstein ellipse of parameter :data:`RHO_MIN` holds no pole of ``b``,
+``b`` is replaced by its interpolant at :data:`NODES` Chebyshev points ``x_j``
+(``b(w) = sum_j l_j(w) b(x_j)``, ``l_j`` the Lagrange polynomials, barycentric
+form: Berrut & Trefethen, *Barycentric Lagrange interpolation*, SIAM Review 46
+(2004), eqs. (4.2) and (5.3)), so that the sums become sums over the nodes:
+
+    ``sum_k Phi_f(w_k)^T b(w_k) = sum_j Phit_j^T b(x_j)`` with ``Phit_j = sum_k
+    l_j(w_k) Phi_f(w_k)`` (and ``Yt_j`` likewise), and ``sum_k f(w_k) = sum_j W_j
+    f(x_j)`` with ``W_j = sum_k l_j(w_k)`` for ``f = b^T b`` (the real product of
+    two complex columns, ``Re(conj(a) b)``, is on the real axis the analytic
+    function ``(a(w) b~(w) + a~(w) b(w)) / 2``, ``b~(w) = conj(b(conj w))``,
+    whose poles are those of ``b`` and their mirror images, as far from the bin).
+
+``Phit``, ``Yt`` and ``W`` are formed once per fixed part (one pass over the
+lines, :func:`pseudo_lines`); an evaluation forms ``b`` at the nodes of the far
+bins and on the lines of the near ones only (:func:`gram_blocks`). The error
+of the interpolant of a function analytic inside the ellipse ``E_rho`` with
+``|f| <= M`` there is at most ``4 M rho^-n / (rho - 1)`` on the bin (Trefethen,
+*Approximation Theory and Approximation Practice*, 2013, Theorem 8.2): with ``n
+= 32`` nodes and the poles outside ``E_6`` (double poles and the factor ``(i
+w)^power`` of ``b^T b`` included) the sums agree with those over the lines to
+rounding (``tests/test_modal_pseudo.py`` checks them against the sums over the
+lines and a sum of ``1 / (i w_k - p)`` against its closed form by the digamma
+function).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import _basis
+from ._state import FitterState
+
+#: Chebyshev nodes per bin
+NODES = 32
+#: lines per bin (the last bin may be shorter)
+BIN_LINES = 2048
+#: a bin is far from a pole outside its Bernstein ellipse of this parameter
+RHO_MIN = 6.0
+#: fewest bins for pseudo-lines to pay (fewer: the sums over the lines)
+MIN_BINS = 8
+
+
+@dataclass(frozen=True)
+class PseudoLines:
+    """The pseudo-lines of a fixed part (module docstring).
+
+    ``bins``: the lines of each bin; ``centre``, ``half`` (n_bins,): centre and
+    half-width of each bin in rad/s; ``nodes`` (n_bins, NODES): the Chebyshev
+    nodes in rad/s; ``weights`` (n_bins, NODES): ``W_j``; ``phi`` (n_in, n_bins,
+    NODES, 2, q_f) and ``y`` (n_in, n_bins, NODES, 2, n_out): ``Phit`` and ``Yt``
+    (unweighted data), real and imaginary part as the rows of the basis.
+    """
+
+    bins: tuple[slice, ...]
+    centre: NDArray[np.float64]
+    half: NDArray[np.float64]
+    nodes: NDArray[np.float64]
+    weights: NDArray[np.float64]
+    phi: NDArray[np.float64]
+    y: NDArray[np.float64]
+
+
+def applies(fitter: FitterState) -> bool:
+    """Do pseudo-lines apply to this fitter's trials? Complex modes, no line weights,
+    a non-negative power of ``i w``, at least :data:`MIN_BINS` bins."""
+    return (
+        fitter.kind == "complex"
+        and fitter.line_weights is None
+        and fitter.power >= 0
+        and fitter.n_f >= MIN_BINS * BIN_LINES
+    )
+
+
+def _cheb_nodes(n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The ``n`` Chebyshev points of the first kind on [-1, 1], ``x_j = cos((2j + 1) pi /
+    2n)``, and their barycentric weights ``(-1)^j sin((2j + 1) pi / 2n)`` (Berrut &
+    Trefethen 2004, eq. (5.3), common factors dropped)."""
+    t = (2 * np.arange(n) + 1) * np.pi / (2 * n)
+    return np.asarray(np.cos(t), np.float64), np.asarray((-1.0) ** np.arange(n) * np.sin(t))
+
+
+def lagrange(x: NDArray[np.float64], n: int = NODES) -> NDArray[np.float64]:
+    """``l_j(x_k)`` (n, x.size) of the Chebyshev points of :func:`_cheb_nodes`
+    (second barycentric formula, Berrut & Trefethen 2004, eq. (4.2)); a point
+    that falls on a node gets that node's unit row."""
+    xj, wj = _cheb_nodes(n)
+    d = x[None, :] - xj[:, None]
+    hit = d == 0.0
+    d[hit] = 1.0
+    q = wj[:, None] / d
+    out = q / q.sum(axis=0, keepdims=True)
+    cols = np.flatnonzero(hit.any(axis=0))
+    if cols.size:
+        out[:, cols] = hit[:, cols].astype(float)
+    return out
+
+
+def bernstein_rho(z0: NDArray[np.complex128]) -> NDArray[np.float64]:
+    """Parameter ``rho = |z + sqrt(z - 1) sqrt(z + 1)|`` (the larger root) of the
+    Bernstein ellipse through ``z0`` (points of the plane of [-1, 1])."""
+    r = np.sqrt(z0 - 1.0) * np.sqrt(z0 + 1.0)
+    return np.maximum(np.abs(z0 + r), np.abs(z0 - r))
+
+
+def pseudo_lines(fitter: FitterState, phi_rows: Any) -> PseudoLines:
+    """The pseudo-lines of a fixed basis (module docstring); ``phi_rows(sl)``
+    returns the fixed basis's rows of the lines ``sl`` (``(k, f)`` rows, real and
+    imaginary part interleaved, as :func:`~tyredamp.modal.fit._basis.basis_ek`)."""
+    n_f, n_in, n_out = fitter.n_f, fitter.n_in, fitter.n_out
+    bins = tuple(slice(a, min(a + BIN_LINES, n_f)) for a in range(0, n_f, BIN_LINES))
+    w = 2 * np.pi * fitter.f
+    lo = np.array([w[b.start] for b in bins])
+    hi = np.array([w[b.stop - 1] for b in bins])
+    centre, half = (hi + lo) / 2, np.maximum((hi - lo) / 2, 1e-12 * np.maximum(hi, 1.0))
+    xj = _cheb_nodes(NODES)[0]
+    nodes = centre[:, None] + half[:, None] * xj[None, :]
+    weights = np.empty((len(bins), NODES))
+    phis, ys = [], []
+    for i, sl in enumerate(bins):
+        ell = lagrange((w[sl] - centre[i]) / half[i])  # (NODES, nb)
+        weights[i] = ell.sum(axis=1)
+        nb = sl.stop - sl.start
+        p = np.asarray(phi_rows(sl)).reshape(n_in, nb, 2, -1)
+        d = _basis.ydata(fitter, sl).reshape(n_in, nb, 2, n_out)
+        phis.append(np.einsum("jf,kfrc->kjrc", ell, p, optimize=True))
+        ys.append(np.einsum("jf,kfrc->kjrc", ell, d, optimize=True))
+    phi, y = np.stack(phis, axis=1), np.stack(ys, axis=1)
+    for a in (centre, half, nodes, weights, phi, y):
+        a.flags.writeable = False
+    return PseudoLines(bins, centre, half, nodes, weights, phi, y)
+
+
+def near_bins(pl: PseudoLines, pole: complex) -> NDArray[np.bool_]:
+    """Bins (n_bins,) whose ellipse ``E_RHO_MIN`` holds a pole of the added columns:
+    ``w = Omega + i sigma`` or ``-Omega + i sigma`` for ``p = -sigma + i Omega``."""
+    near = np.zeros(pl.centre.size, bool)
+    for wp in (complex(pole.imag, -pole.real), complex(-pole.imag, -pole.real)):
+        near |= bernstein_rho(np.asarray((wp - pl.centre) / pl.half, np.complex128)) < RHO_MIN
+    return near
+
+
+def factors_at(fitter: FitterState, w: NDArray[np.float64]) -> tuple[Any, Any, Any]:
+    """``s = i w``, ``kappa = (i w)^power`` and ``kappa_low`` at the frequencies ``w``
+    (rad/s), as :func:`~tyredamp.modal.fit._basis.factors` (no line weights)."""
+    p = fitter.power
+    i_pow = (1.0 + 0j, 1j, -1.0 + 0j, -1j)
+    s = 1j * w
+    kappa = i_pow[p % 4] * w**p
+    kappa_low = i_pow[(p - 2) % 4] * w ** float(p - 2) if p >= 2 else np.zeros_like(s)
+    return s, kappa, kappa_low
+
+
+def gram_blocks(
+    fitter: FitterState,
+    pl: PseudoLines,
+    cols: Any,
+    fixed_rows: Any,
+    pole: complex,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``Phi_f^T B1`` (q_f, n1), ``B1^T B1`` (n1, n1) and ``B1^T Y`` (n1, n_out, data
+    unweighted) of the added columns, from the pseudo-lines of the far bins and the
+    lines of the near ones (module docstring). ``cols(fac, sl)``: the added columns
+    at the factors ``fac`` (:func:`factors_at`) or, with ``fac`` None, on the lines
+    ``sl``; ``fixed_rows(sl)``: the fixed basis on the lines ``sl``; ``pole``: the
+    added mode's pole (rad/s)."""
+    n_in = fitter.n_in
+    near = near_bins(pl, pole)
+    far = np.flatnonzero(~near)
+    sums: list[tuple[Any, Any, Any]] = []
+    if far.size:
+        wn = pl.nodes[far].ravel()
+        b = np.asarray(cols(factors_at(fitter, wn), None))  # (2 n_in n_nodes, n1)
+        n1 = b.shape[1]
+        bw = b.reshape(n_in, far.size, NODES, 2, n1) * pl.weights[far][None, :, :, None, None]
+        ph = pl.phi[:, far].reshape(-1, pl.phi.shape[-1])
+        yt = pl.y[:, far].reshape(-1, pl.y.shape[-1])
+        sums.append((ph.T @ b, bw.reshape(-1, n1).T @ b, b.T @ yt))
+    for i in np.flatnonzero(near):
+        sl = pl.bins[i]
+        b = np.asarray(cols(None, sl))
+        sums.append((fixed_rows(sl).T @ b, b.T @ b, _basis.rows_t_data(fitter, sl, b)))
+    cross, g0, p0 = (sum(x[j] for x in sums[1:]) + sums[0][j] for j in range(3))
+    return cross, g0, p0
