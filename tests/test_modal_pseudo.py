@@ -102,3 +102,40 @@ def test_trial_same_with_and_without_pseudo_lines(monkeypatch):
         )  # fmt: skip
     assert_allclose(got[0][0], got[1][0], rtol=1e-12)  # the same optimum to rounding
     assert_allclose(got[0][2], got[1][2], rtol=1e-9)  # residual RMS: a difference of sums
+
+
+@pytest.mark.parametrize(("n_in", "power"), [(1, 2), (2, 0)])
+def test_gram_full_equals_sums_over_lines(n_in, power):
+    # every mode and both residual terms; receptance (power 0) puts a pole of the
+    # lower term's column at 0, whose bins are then taken on the lines
+    fit, p = _fitter(n_in, 10 * _pseudo.BIN_LINES, seed=2)
+    fit = ModalFitter(fit.f, fit.H, power, "complex", [], upper=True, lower=True)
+    part = np.ones((p.size, n_in), complex)
+    th, m, ref, _ = fit._fixed_modes(p, part, 0)
+    pl = fit._pseudo_lines()
+    assert pl is not None
+    pp = fit.unpack(th, m, ref)
+    at_zero = [0j] if power < 2 else []
+    G, P = _pseudo.gram_full(
+        fit,
+        pl,
+        lambda fac, sl: fit._basis_ek(th, m, ref, True, sl, (fac, pp))[0],
+        np.concatenate([pp[0], at_zero]),
+    )
+    b = fit._basis_ek(th, m, ref, True)[0]
+    for g, e in ((G, b.T @ b), (P, b.T @ _basis.ydata(fit))):
+        # rounding of sums of 2e4 lines, relative to the largest entry
+        assert_allclose(g, e, rtol=0, atol=1e-12 * np.abs(e).max())
+
+
+def test_fit_same_with_and_without_pseudo_lines(monkeypatch):
+    fit, p = _fitter(2, 10 * _pseudo.BIN_LINES, seed=3)
+    part = np.ones((p.size, 2), complex)
+    got = []
+    for mb in (_pseudo.MIN_BINS, 10**9):
+        monkeypatch.setattr(_pseudo, "MIN_BINS", mb)
+        fit._pl = None
+        got.append(fit.fit(p * (1 + 1e-3), part, passes=1, uncertainty=False, max_nfev=4))
+        assert (fit._pl is not None) == (mb < 10**9)  # the fit went through them
+    assert_allclose(got[0].poles, got[1].poles, rtol=1e-11)  # the same optimum to rounding
+    assert_allclose(got[0].sigma_out, got[1].sigma_out, rtol=1e-9)  # a difference of sums

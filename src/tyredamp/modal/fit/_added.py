@@ -145,7 +145,7 @@ def fixed_part(
     r = tmap.shape[1]
     if phi0 is None and not keep and _pseudo.applies(fitter):
         pseudo = _pseudo.pseudo_lines(
-            fitter, lambda sl: fitter._basis_ek(th_f, m, ref, False, sl)[0]
+            fitter, lambda sl: fitter._basis_ek(th_f, m, ref, False, sl)[0], fitter._pseudo_lines()
         )
     if phi0 is not None and yw is not None:
         qy = np.empty((yw.shape[0], r + yw.shape[1]), order="F")

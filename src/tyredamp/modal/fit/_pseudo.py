@@ -121,29 +121,39 @@ def bernstein_rho(z0: NDArray[np.complex128]) -> NDArray[np.float64]:
     return np.maximum(np.abs(z0 + r), np.abs(z0 - r))
 
 
-def pseudo_lines(fitter: FitterState, phi_rows: Any) -> PseudoLines:
-    """The pseudo-lines of a fixed basis (module docstring); ``phi_rows(sl)``
-    returns the fixed basis's rows of the lines ``sl`` (``(k, f)`` rows, real and
-    imaginary part interleaved, as :func:`~tyredamp.modal.fit._basis.basis_ek`)."""
+def pseudo_lines(
+    fitter: FitterState, phi_rows: Any = None, base: PseudoLines | None = None
+) -> PseudoLines:
+    """The pseudo-lines of the data and, with ``phi_rows``, of a fixed basis (module
+    docstring; ``phi`` has no column without it). ``phi_rows(sl)`` returns the fixed
+    basis's rows of the lines ``sl`` (``(k, f)`` rows, real and imaginary part
+    interleaved, as :func:`~tyredamp.modal.fit._basis.basis_ek`); ``base``: the
+    fitter's pseudo-lines of the data, whose bins, weights and ``Yt`` are reused."""
     n_f, n_in, n_out = fitter.n_f, fitter.n_in, fitter.n_out
-    bins = tuple(slice(a, min(a + BIN_LINES, n_f)) for a in range(0, n_f, BIN_LINES))
+    if base is None:
+        bins = tuple(slice(a, min(a + BIN_LINES, n_f)) for a in range(0, n_f, BIN_LINES))
+        w0 = 2 * np.pi * fitter.f
+        lo = np.array([w0[b.start] for b in bins])
+        hi = np.array([w0[b.stop - 1] for b in bins])
+        centre, half = (hi + lo) / 2, np.maximum((hi - lo) / 2, 1e-12 * np.maximum(hi, 1.0))
+        nodes = centre[:, None] + half[:, None] * _cheb_nodes(NODES)[0][None, :]
+    else:
+        bins, centre, half, nodes = base.bins, base.centre, base.half, base.nodes
     w = 2 * np.pi * fitter.f
-    lo = np.array([w[b.start] for b in bins])
-    hi = np.array([w[b.stop - 1] for b in bins])
-    centre, half = (hi + lo) / 2, np.maximum((hi - lo) / 2, 1e-12 * np.maximum(hi, 1.0))
-    xj = _cheb_nodes(NODES)[0]
-    nodes = centre[:, None] + half[:, None] * xj[None, :]
     weights = np.empty((len(bins), NODES))
     phis, ys = [], []
     for i, sl in enumerate(bins):
         ell = lagrange((w[sl] - centre[i]) / half[i])  # (NODES, nb)
         weights[i] = ell.sum(axis=1)
         nb = sl.stop - sl.start
-        p = np.asarray(phi_rows(sl)).reshape(n_in, nb, 2, -1)
-        d = _basis.ydata(fitter, sl).reshape(n_in, nb, 2, n_out)
-        phis.append(np.einsum("jf,kfrc->kjrc", ell, p, optimize=True))
-        ys.append(np.einsum("jf,kfrc->kjrc", ell, d, optimize=True))
-    phi, y = np.stack(phis, axis=1), np.stack(ys, axis=1)
+        if phi_rows is not None:
+            p = np.asarray(phi_rows(sl)).reshape(n_in, nb, 2, -1)
+            phis.append(np.einsum("jf,kfrc->kjrc", ell, p, optimize=True))
+        if base is None:
+            d = _basis.ydata(fitter, sl).reshape(n_in, nb, 2, n_out)
+            ys.append(np.einsum("jf,kfrc->kjrc", ell, d, optimize=True))
+    phi = np.stack(phis, axis=1) if phis else np.zeros((n_in, len(bins), NODES, 2, 0))
+    y = np.stack(ys, axis=1) if base is None else base.y
     for a in (centre, half, nodes, weights, phi, y):
         a.flags.writeable = False
     return PseudoLines(bins, centre, half, nodes, weights, phi, y)
@@ -165,8 +175,55 @@ def factors_at(fitter: FitterState, w: NDArray[np.float64]) -> tuple[Any, Any, A
     i_pow = (1.0 + 0j, 1j, -1.0 + 0j, -1j)
     s = 1j * w
     kappa = i_pow[p % 4] * w**p
-    kappa_low = i_pow[(p - 2) % 4] * w ** float(p - 2) if p >= 2 else np.zeros_like(s)
+    kappa_low = i_pow[(p - 2) % 4] * w ** float(p - 2)
     return s, kappa, kappa_low
+
+
+def gram_full(
+    fitter: FitterState,
+    pl: PseudoLines,
+    cols: Any,
+    poles: NDArray[np.complex128],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``B^T B`` and ``B^T Y`` (data unweighted) of the columns ``B`` of a full fit
+    (every mode and the residual terms), from the pseudo-lines of the bins far from
+    every pole in ``poles`` (rad/s; include 0 for a column in negative powers of
+    ``i w``) and the lines of the others (module docstring; ``cols`` as in
+    :func:`gram_blocks`)."""
+    near = np.zeros(pl.centre.size, bool)
+    for p in np.asarray(poles, complex).ravel():
+        near |= near_bins(pl, complex(p))
+    got = _sums(fitter, pl, cols, near, None)
+    return got[1], got[2]
+
+
+def _sums(
+    fitter: FitterState, pl: PseudoLines, cols: Any, near: NDArray[np.bool_], fixed_rows: Any
+) -> tuple[Any, NDArray[np.float64], NDArray[np.float64]]:
+    """``Phi_f^T B`` (None without ``fixed_rows``), ``B^T B`` and ``B^T Y`` over the
+    pseudo-lines of the bins not ``near`` and the lines of the others."""
+    n_in = fitter.n_in
+    far = np.flatnonzero(~near)
+    sums: list[tuple[Any, Any, Any]] = []
+    if far.size:
+        wn = pl.nodes[far].ravel()
+        b = np.asarray(cols(factors_at(fitter, wn), None))  # (2 n_in n_nodes, n1)
+        n1 = b.shape[1]
+        bw = b.reshape(n_in, far.size, NODES, 2, n1) * pl.weights[far][None, :, :, None, None]
+        yt = pl.y[:, far].reshape(-1, pl.y.shape[-1])
+        cross = None
+        if fixed_rows is not None:
+            cross = pl.phi[:, far].reshape(-1, pl.phi.shape[-1]).T @ b
+        sums.append((cross, bw.reshape(-1, n1).T @ b, b.T @ yt))
+    for i in np.flatnonzero(near):
+        sl = pl.bins[i]
+        b = np.asarray(cols(None, sl))
+        cross = None if fixed_rows is None else fixed_rows(sl).T @ b
+        sums.append((cross, b.T @ b, _basis.rows_t_data(fitter, sl, b)))
+    g0 = sum(x[1] for x in sums[1:]) + sums[0][1]
+    p0 = sum(x[2] for x in sums[1:]) + sums[0][2]
+    cross = None if fixed_rows is None else sum(x[0] for x in sums[1:]) + sums[0][0]
+    return cross, g0, p0
 
 
 def gram_blocks(
@@ -182,21 +239,5 @@ def gram_blocks(
     at the factors ``fac`` (:func:`factors_at`) or, with ``fac`` None, on the lines
     ``sl``; ``fixed_rows(sl)``: the fixed basis on the lines ``sl``; ``pole``: the
     added mode's pole (rad/s)."""
-    n_in = fitter.n_in
-    near = near_bins(pl, pole)
-    far = np.flatnonzero(~near)
-    sums: list[tuple[Any, Any, Any]] = []
-    if far.size:
-        wn = pl.nodes[far].ravel()
-        b = np.asarray(cols(factors_at(fitter, wn), None))  # (2 n_in n_nodes, n1)
-        n1 = b.shape[1]
-        bw = b.reshape(n_in, far.size, NODES, 2, n1) * pl.weights[far][None, :, :, None, None]
-        ph = pl.phi[:, far].reshape(-1, pl.phi.shape[-1])
-        yt = pl.y[:, far].reshape(-1, pl.y.shape[-1])
-        sums.append((ph.T @ b, bw.reshape(-1, n1).T @ b, b.T @ yt))
-    for i in np.flatnonzero(near):
-        sl = pl.bins[i]
-        b = np.asarray(cols(None, sl))
-        sums.append((fixed_rows(sl).T @ b, b.T @ b, _basis.rows_t_data(fitter, sl, b)))
-    cross, g0, p0 = (sum(x[j] for x in sums[1:]) + sums[0][j] for j in range(3))
+    cross, g0, p0 = _sums(fitter, pl, cols, near_bins(pl, pole), fixed_rows)
     return cross, g0, p0
