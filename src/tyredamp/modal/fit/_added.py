@@ -132,6 +132,14 @@ def fixed_part(
     rows = _Rows(fitter, None, parts, keep)
     yw = np.asarray(fitter._ydata(parts[0]) * w) if one else None
     phi0 = rows.basis(th_f, m, ref, 0) if one else None
+    pseudo = sums = None
+    if phi0 is None and not keep and _pseudo.applies(fitter):
+        # a long record: the pseudo-lines of the fixed basis, and its Gram blocks
+        # summed in the same pass over the lines
+        pseudo, gf, pf = _pseudo.fixed_lines(
+            fitter, lambda sl: fitter._basis_ek(th_f, m, ref, False, sl)[0], fitter._pseudo_lines()
+        )
+        sums = None if gf is None or pf is None else (gf, pf * w)
     # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
     # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
     tmap, qty, yyp = _fixed_range(
@@ -140,13 +148,10 @@ def fixed_part(
         fitter._yss * w**2,
         (phi0, yw) if phi0 is not None and yw is not None else None,
         fitter.n_rows,
+        sums,
     )
-    qy = qr = pseudo = None
+    qy = qr = None
     r = tmap.shape[1]
-    if phi0 is None and not keep and _pseudo.applies(fitter):
-        pseudo = _pseudo.pseudo_lines(
-            fitter, lambda sl: fitter._basis_ek(th_f, m, ref, False, sl)[0], fitter._pseudo_lines()
-        )
     if phi0 is not None and yw is not None:
         qy = np.empty((yw.shape[0], r + yw.shape[1]), order="F")
         np.subtract(yw, np.matmul(phi0, tmap, out=qy[:, :r]) @ qty, out=qy[:, r:])

@@ -129,6 +129,17 @@ def pseudo_lines(
     basis's rows of the lines ``sl`` (``(k, f)`` rows, real and imaginary part
     interleaved, as :func:`~tyredamp.modal.fit._basis.basis_ek`); ``base``: the
     fitter's pseudo-lines of the data, whose bins, weights and ``Yt`` are reused."""
+    return fixed_lines(fitter, phi_rows, base)[0]
+
+
+def fixed_lines(
+    fitter: FitterState, phi_rows: Any = None, base: PseudoLines | None = None
+) -> tuple[PseudoLines, NDArray[np.float64] | None, NDArray[np.float64] | None]:
+    """:func:`pseudo_lines`, and the Gram blocks ``Phi_f^T Phi_f`` and ``Phi_f^T Y``
+    (unweighted data) of the fixed basis summed over the lines in the same pass
+    (None without ``phi_rows``). Groups of bins of equal length share one product
+    with their Lagrange rows, which bins of uniformly spaced lines share
+    (:func:`_bin_lagrange`)."""
     n_f, n_in, n_out = fitter.n_f, fitter.n_in, fitter.n_out
     if base is None:
         bins = tuple(slice(a, min(a + BIN_LINES, n_f)) for a in range(0, n_f, BIN_LINES))
@@ -139,24 +150,84 @@ def pseudo_lines(
         nodes = centre[:, None] + half[:, None] * _cheb_nodes(NODES)[0][None, :]
     else:
         bins, centre, half, nodes = base.bins, base.centre, base.half, base.nodes
-    w = 2 * np.pi * fitter.f
-    weights = np.empty((len(bins), NODES))
-    phis, ys = [], []
-    for i, sl in enumerate(bins):
-        ell = lagrange((w[sl] - centre[i]) / half[i])  # (NODES, nb)
-        weights[i] = ell.sum(axis=1)
-        nb = sl.stop - sl.start
+    ells = _bin_lagrange(2 * np.pi * fitter.f, bins, centre, half)
+    sums: dict[int, NDArray[np.float64]] = {}
+    weights = np.stack([sums.setdefault(id(e), e.sum(axis=1)) for e in ells])
+    phi = y = gf = pf = None
+    if base is not None:
+        y = base.y
+    for i0, i1 in _groups(bins, ells, 16 * n_in * (n_out + 64)):
+        sl = slice(bins[i0].start, bins[i1 - 1].stop)
         if phi_rows is not None:
-            p = np.asarray(phi_rows(sl)).reshape(n_in, nb, 2, -1)
-            phis.append(np.einsum("jf,kfrc->kjrc", ell, p, optimize=True))
+            rows = np.asarray(phi_rows(sl))
+            g1, p1 = rows.T @ rows, _basis.rows_t_data(fitter, sl, rows)
+            gf, pf = (g1, p1) if gf is None or pf is None else (gf + g1, pf + p1)
+            if phi is None:
+                phi = np.empty((n_in, len(bins), NODES, 2, rows.shape[1]))
+            phi[:, i0:i1] = _moments(ells[i0], rows, n_in, i1 - i0)
         if base is None:
-            d = _basis.ydata(fitter, sl).reshape(n_in, nb, 2, n_out)
-            ys.append(np.einsum("jf,kfrc->kjrc", ell, d, optimize=True))
-    phi = np.stack(phis, axis=1) if phis else np.zeros((n_in, len(bins), NODES, 2, 0))
-    y = np.stack(ys, axis=1) if base is None else base.y
+            if y is None:
+                y = np.empty((n_in, len(bins), NODES, 2, n_out))
+            y[:, i0:i1] = _moments(ells[i0], _basis.ydata(fitter, sl), n_in, i1 - i0)
+    if phi is None:
+        phi = np.zeros((n_in, len(bins), NODES, 2, 0))
+    assert y is not None
     for a in (centre, half, nodes, weights, phi, y):
         a.flags.writeable = False
-    return PseudoLines(bins, centre, half, nodes, weights, phi, y)
+    return PseudoLines(bins, centre, half, nodes, weights, phi, y), gf, pf
+
+
+def _moments(
+    ell: NDArray[np.float64], rows: NDArray[np.float64], n_in: int, n_bins: int
+) -> NDArray[np.float64]:
+    """``sum_k l_j(w_k) x_k`` of the rows (``(k, f)``, parts interleaved) of ``n_bins``
+    bins of equal length that share the Lagrange rows ``ell`` (NODES, nb), as
+    (n_in, n_bins, NODES, 2, c)."""
+    nb = ell.shape[1]
+    c = rows.shape[1]
+    x = rows.reshape(n_in, n_bins, nb, 2 * c)
+    return np.matmul(ell, x).reshape(n_in, n_bins, NODES, 2, c)
+
+
+def _bin_lagrange(
+    w: NDArray[np.float64],
+    bins: tuple[slice, ...],
+    centre: NDArray[np.float64],
+    half: NDArray[np.float64],
+) -> list[NDArray[np.float64]]:
+    """The Lagrange rows (NODES, nb) of each bin: one array shared by the bins whose
+    lines lie, to rounding, at the same relative places (uniformly spaced lines:
+    ``(w_k - c) / h`` equal to ``-1 + 2 k / (nb - 1)`` to 64 ulp of ``max(|c| / h,
+    1)``, the rounding of the lines themselves), else the bin's own."""
+    shared: dict[int, NDArray[np.float64]] = {}
+    out = []
+    for i, sl in enumerate(bins):
+        x = (w[sl] - centre[i]) / half[i]
+        nb = x.size
+        grid = np.linspace(-1.0, 1.0, nb) if nb > 1 else np.zeros(1)
+        tol = 64 * np.finfo(float).eps * max(abs(centre[i]) / half[i], 1.0)
+        if np.max(np.abs(x - grid)) <= tol:
+            if nb not in shared:
+                shared[nb] = lagrange(grid)
+            out.append(shared[nb])
+        else:
+            out.append(lagrange(x))
+    return out
+
+
+def _groups(
+    bins: tuple[slice, ...], ells: list[NDArray[np.float64]], bytes_per_line: int
+) -> list[tuple[int, int]]:
+    """Runs ``[i0, i1)`` of consecutive bins that share their Lagrange rows, of at most
+    :data:`~tyredamp.modal.fit._basis.BLOCK_BYTES` of rows (at least one bin)."""
+    most = max(1, _basis.BLOCK_BYTES // max(bytes_per_line * BIN_LINES, 1))
+    out = []
+    i0 = 0
+    for i in range(1, len(bins) + 1):
+        if i == len(bins) or ells[i] is not ells[i0] or i - i0 >= most:
+            out.append((i0, i))
+            i0 = i
+    return out
 
 
 def near_bins(pl: PseudoLines, pole: complex) -> NDArray[np.bool_]:
