@@ -139,3 +139,21 @@ def test_fit_same_with_and_without_pseudo_lines(monkeypatch):
         assert (fit._pl is not None) == (mb < 10**9)  # the fit went through them
     assert_allclose(got[0].poles, got[1].poles, rtol=1e-11)  # the same optimum to rounding
     assert_allclose(got[0].sigma_out, got[1].sigma_out, rtol=1e-9)  # a difference of sums
+
+
+def test_scan_sums_equal_sums_over_lines():
+    # a scan's inner products with smooth values (a residual's moments stand for it
+    # on far bins) against the sums over the lines, poles beyond and inside the band
+    fit, _p = _fitter(1, 10 * _pseudo.BIN_LINES, seed=4)
+    pl = fit._pseudo_lines()
+    assert pl is not None
+    rng = np.random.default_rng(5)
+    v = rng.normal(size=(3, fit.n_f)) + 1j * rng.normal(size=(3, fit.n_f))  # noise-like
+    pg = pole_from_frequency_damping(np.array([201.0, 230.0, 300.0, 120.0]), 0.01)
+    cols = lambda s, kap, p: kap[None, :] / (s[None, :] - p[:, None])  # noqa: E731
+    m, n2 = _pseudo.scan_sums(fit, pl, lambda sl: v[:, sl], cols, pg, chunk=2)
+    s, kap, _ = _basis.factors(fit)
+    c = cols(s, kap, pg)
+    # rounding of sums of 2e4 lines, relative to the largest entry
+    assert_allclose(m, v @ c.conj().T, rtol=0, atol=1e-12 * np.abs(v @ c.conj().T).max())
+    assert_allclose(n2, np.sum(np.abs(c) ** 2, axis=1), rtol=1e-12)

@@ -67,7 +67,8 @@ class PseudoLines:
     half-width of each bin in rad/s; ``nodes`` (n_bins, NODES): the Chebyshev
     nodes in rad/s; ``weights`` (n_bins, NODES): ``W_j``; ``phi`` (n_in, n_bins,
     NODES, 2, q_f) and ``y`` (n_in, n_bins, NODES, 2, n_out): ``Phit`` and ``Yt``
-    (unweighted data), real and imaginary part as the rows of the basis.
+    (unweighted data), real and imaginary part as the rows of the basis; ``ells``:
+    each bin's Lagrange rows (:func:`_bin_lagrange`).
     """
 
     bins: tuple[slice, ...]
@@ -77,6 +78,7 @@ class PseudoLines:
     weights: NDArray[np.float64]
     phi: NDArray[np.float64]
     y: NDArray[np.float64]
+    ells: tuple[NDArray[np.float64], ...] = ()
 
 
 def applies(fitter: FitterState) -> bool:
@@ -174,7 +176,8 @@ def fixed_lines(
     assert y is not None
     for a in (centre, half, nodes, weights, phi, y):
         a.flags.writeable = False
-    return PseudoLines(bins, centre, half, nodes, weights, phi, y), gf, pf
+    got = PseudoLines(bins, centre, half, nodes, weights, phi, y, tuple(ells))
+    return got, gf, pf
 
 
 def _moments(
@@ -312,3 +315,61 @@ def gram_blocks(
     added mode's pole (rad/s)."""
     cross, g0, p0 = _sums(fitter, pl, cols, near_bins(pl, pole), fixed_rows)
     return cross, g0, p0
+
+
+def scan_sums(
+    fitter: FitterState,
+    pl: PseudoLines,
+    vals: Any,
+    cols: Any,
+    poles: NDArray[np.complex128],
+    chunk: int = 64,
+) -> tuple[NDArray[np.complex128], NDArray[np.float64]]:
+    """``sum_k v_k conj(c_g(w_k))`` (r, G) and ``sum_k |c_g(w_k)|^2`` (G,) of complex
+    values ``v`` and the columns ``c_g`` of the trial poles ``poles`` (G,): the inner
+    products of a scan of a residual, from the pseudo-lines of the bins far from
+    every trial pole (module docstring: ``v`` by its moments ``sum_k l_j(w_k) v_k``,
+    ``|c|^2`` by the weights ``W_j``) and the lines of the others.
+
+    ``vals(sl)``: the values (r, lines) of the lines ``sl`` (called once per line);
+    ``cols(s, kappa, p)``: the columns (len(p), n) of the poles ``p`` at ``s = i w``
+    and ``kappa`` (:func:`factors_at`), formed for ``chunk`` poles at a time."""
+    near = np.zeros((pl.centre.size, poles.size), bool)
+    for k, p in enumerate(np.asarray(poles, complex).ravel()):
+        near[:, k] = near_bins(pl, complex(p))
+    ells = pl.ells or tuple(_bin_lagrange(2 * np.pi * fitter.f, pl.bins, pl.centre, pl.half))
+    m = np.zeros((0, poles.size), complex)
+    nrm2 = np.zeros(poles.size)
+    vt = []
+    for i0, i1 in _groups(pl.bins, list(ells), 16 * (fitter.n_out * fitter.n_in + 2)):
+        sl = slice(pl.bins[i0].start, pl.bins[i1 - 1].stop)
+        v = np.asarray(vals(sl))
+        if not m.size:
+            m = np.zeros((v.shape[0], poles.size), complex)
+        nb = ells[i0].shape[1]
+        vt.append(np.matmul(v.reshape(v.shape[0], i1 - i0, nb), ells[i0].T))
+        for i in range(i0, i1):
+            gn = np.flatnonzero(near[i])
+            if gn.size:  # the lines of a bin near some of the poles, for those
+                b = pl.bins[i]
+                s_, k_, _ = _basis.factors(fitter, b)
+                c = np.asarray(cols(s_, k_, poles[gn]))
+                m[:, gn] += v[:, b.start - sl.start : b.stop - sl.start] @ c.conj().T
+                nrm2[gn] += np.sum(c.real**2 + c.imag**2, axis=1)
+    v_all = np.concatenate(vt, axis=1)  # (r, n_bins, NODES)
+    for c0 in range(0, poles.size, chunk):
+        g = np.arange(c0, min(c0 + chunk, poles.size))
+        far = np.flatnonzero(~near[:, g].any(axis=1))  # far from every pole of the chunk
+        part = near[:, g].any(axis=1) & ~near[:, g].all(axis=1)
+        for ib in np.flatnonzero(part):  # near some poles of the chunk: the others here
+            gi = g[~near[ib, g]]
+            s_, k_, _ = factors_at(fitter, pl.nodes[ib])
+            c = np.asarray(cols(s_, k_, poles[gi]))
+            m[:, gi] += v_all[:, ib] @ c.conj().T
+            nrm2[gi] += (c.real**2 + c.imag**2) @ pl.weights[ib]
+        if far.size:
+            s_, k_, _ = factors_at(fitter, pl.nodes[far].ravel())
+            c = np.asarray(cols(s_, k_, poles[g]))
+            m[:, g] += v_all[:, far].reshape(v_all.shape[0], -1) @ c.conj().T
+            nrm2[g] += (c.real**2 + c.imag**2) @ pl.weights[far].ravel()
+    return m, nrm2
