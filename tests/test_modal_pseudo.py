@@ -157,3 +157,21 @@ def test_scan_sums_equal_sums_over_lines():
     # rounding of sums of 2e4 lines, relative to the largest entry
     assert_allclose(m, v @ c.conj().T, rtol=0, atol=1e-12 * np.abs(v @ c.conj().T).max())
     assert_allclose(n2, np.sum(np.abs(c) ** 2, axis=1), rtol=1e-12)
+
+
+@pytest.mark.parametrize("n_in", [1, 2])
+def test_fixed_far_equals_moments_over_lines(n_in):
+    # the fixed basis's moments, Gram blocks and products with the data from its
+    # values at the nodes (far bins) against those summed over every line
+    fit, p = _fitter(n_in, 10 * _pseudo.BIN_LINES, seed=6)
+    th, m, ref, _ = fit._fixed_modes(p, np.ones((p.size, n_in), complex), 0)
+    base = fit._pseudo_lines()
+    assert base is not None
+    rows = lambda sl: fit._basis_ek(th, m, ref, False, sl)[0]  # noqa: E731
+    exact = _pseudo.fixed_lines(fit, rows, base)
+    got = _pseudo.fixed_far(
+        fit, base, rows, lambda fac: fit._basis_ek(th, m, ref, False, None, (fac, None))[0], p
+    )
+    for g, e in ((got[0].phi, exact[0].phi), (got[1], exact[1]), (got[2], exact[2])):
+        # rounding of sums of 2e4 lines, relative to the largest entry
+        assert_allclose(g, e, rtol=0, atol=1e-12 * np.abs(e).max())

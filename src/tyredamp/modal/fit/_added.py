@@ -136,10 +136,17 @@ def fixed_part(
     if phi0 is None and not keep and _pseudo.applies(fitter):
         # a long record: the pseudo-lines of the fixed basis, and its Gram blocks
         # summed in the same pass over the lines
-        pseudo, gf, pf = _pseudo.fixed_lines(
-            fitter, lambda sl: fitter._basis_ek(th_f, m, ref, False, sl)[0], fitter._pseudo_lines()
+        base = fitter._pseudo_lines()
+        assert base is not None
+        at_zero = [0j] if fitter.use_lower and fitter.power < 2 else []
+        pseudo, gf, pf = _pseudo.fixed_far(
+            fitter,
+            base,
+            lambda sl: fitter._basis_ek(th_f, m, ref, False, sl)[0],
+            lambda fac: fitter._basis_ek(th_f, m, ref, False, None, (fac, None))[0],
+            np.concatenate([fitter.unpack(th_f, m, ref)[0], at_zero]),
         )
-        sums = None if gf is None or pf is None else (gf, pf * w)
+        sums = (gf, pf * w)
     # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
     # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
     tmap, qty, yyp = _fixed_range(

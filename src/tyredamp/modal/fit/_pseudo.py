@@ -180,6 +180,56 @@ def fixed_lines(
     return got, gf, pf
 
 
+def fixed_far(
+    fitter: FitterState,
+    base: PseudoLines,
+    phi_rows: Any,
+    phi_at: Any,
+    poles: NDArray[np.complex128],
+) -> tuple[PseudoLines, NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`fixed_lines` of a fixed basis whose columns are smooth away from
+    ``poles`` (rad/s; 0 for a column in negative powers of ``i w``), on the
+    fitter's pseudo-lines of the data ``base``: on the bins far from every pole
+    the basis too is its interpolant at the nodes, so that ``Phit_j = sum_i M_ji
+    Phi_f(x_i)`` with ``M = L L^T`` (``L`` the bin's Lagrange rows), ``Phi_f^T Phi_f
+    = sum_i W_i Phi_f(x_i)^T Phi_f(x_i)`` and ``Phi_f^T Y = sum_i Phi_f(x_i)^T Yt_i``
+    (module docstring); the near bins from their lines. ``phi_rows(sl)``: the basis
+    on the lines ``sl``; ``phi_at(fac)``: at the factors ``fac``
+    (:func:`factors_at`)."""
+    n_in, n_out = fitter.n_in, fitter.n_out
+    near = np.zeros(base.centre.size, bool)
+    for p in np.asarray(poles, complex).ravel():
+        near |= near_bins(base, complex(p))
+    ells = base.ells or tuple(
+        _bin_lagrange(2 * np.pi * fitter.f, base.bins, base.centre, base.half)
+    )
+    far = np.flatnonzero(~near)
+    pn = np.asarray(phi_at(factors_at(fitter, base.nodes[far].ravel())))
+    qf = pn.shape[1]
+    mass: dict[int, NDArray[np.float64]] = {}
+    mm = np.stack(
+        [mass.setdefault(id(ells[i]), ells[i] @ ells[i].T) for i in far]
+        or [np.zeros((NODES, NODES))]
+    )[: far.size]
+    phi = np.empty((n_in, base.centre.size, NODES, 2, qf))
+    x = pn.reshape(n_in, far.size, NODES, 2 * qf)
+    phi[:, far] = np.matmul(mm[None], x).reshape(n_in, far.size, NODES, 2, qf)
+    wr = np.broadcast_to(base.weights[far][None, :, :, None], (n_in, far.size, NODES, 2))
+    gf = (pn * wr.reshape(-1, 1)).T @ pn
+    pf = pn.T @ base.y[:, far].reshape(-1, n_out)
+    for i in np.flatnonzero(near):
+        sl = base.bins[i]
+        rows = np.asarray(phi_rows(sl))
+        gf += rows.T @ rows
+        pf += _basis.rows_t_data(fitter, sl, rows)
+        phi[:, i : i + 1] = _moments(ells[i], rows, n_in, 1)
+    phi.flags.writeable = False
+    got = PseudoLines(
+        base.bins, base.centre, base.half, base.nodes, base.weights, phi, base.y, ells
+    )
+    return got, gf, pf
+
+
 def _moments(
     ell: NDArray[np.float64], rows: NDArray[np.float64], n_in: int, n_bins: int
 ) -> NDArray[np.float64]:

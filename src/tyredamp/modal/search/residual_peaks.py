@@ -23,6 +23,7 @@ carry no bias.
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -140,12 +141,14 @@ def residual_peaks(
     sm[~(k * (sm - np.median(sm)) > SHARE * threshold)] = -np.inf
     narrow = list(_peaks(sm))
     del sm
-    lists = [narrow, list(_peaks(_broad_score(f, pw, k_terms, zeta0, threshold)))]
+    # taken from the front (deques: a list's pop(0) moves the rest, quadratic in the
+    # peaks of a long record)
+    lists = [deque(narrow), deque(_peaks(_broad_score(f, pw, k_terms, zeta0, threshold)))]
     out: list[float] = []
     while (lists[0] or lists[1]) and len(out) < n_max:
         for lst in lists:
             while lst:
-                fi = float(f[lst.pop(0)])
+                fi = float(f[lst.popleft()])
                 if all(abs(fi - g) > 0.01 * g for g in out):
                     out.append(fi)
                     break
