@@ -105,9 +105,11 @@ def test_trial_same_with_and_without_pseudo_lines(monkeypatch):
 
 
 @pytest.mark.parametrize(("n_in", "power"), [(1, 2), (2, 0)])
-def test_gram_full_equals_sums_over_lines(n_in, power):
+def test_gram_full_equals_sums_over_lines(n_in, power, monkeypatch):
     # every mode and both residual terms; receptance (power 0) puts a pole of the
-    # lower term's column at 0, whose bins are then taken on the lines
+    # lower term's column at 0, whose bins are then taken on the lines; the far
+    # bins in several pieces
+    monkeypatch.setattr(_pseudo, "FAR_BINS", 3)
     fit, p = _fitter(n_in, 10 * _pseudo.BIN_LINES, seed=2)
     fit = ModalFitter(fit.f, fit.H, power, "complex", [], upper=True, lower=True)
     part = np.ones((p.size, n_in), complex)
@@ -141,9 +143,10 @@ def test_fit_same_with_and_without_pseudo_lines(monkeypatch):
     assert_allclose(got[0].sigma_out, got[1].sigma_out, rtol=1e-9)  # a difference of sums
 
 
-def test_scan_sums_equal_sums_over_lines():
+def test_scan_sums_equal_sums_over_lines(monkeypatch):
     # a scan's inner products with smooth values (a residual's moments stand for it
     # on far bins) against the sums over the lines, poles beyond and inside the band
+    monkeypatch.setattr(_pseudo, "FAR_BINS", 3)
     fit, _p = _fitter(1, 10 * _pseudo.BIN_LINES, seed=4)
     pl = fit._pseudo_lines()
     assert pl is not None
@@ -160,9 +163,11 @@ def test_scan_sums_equal_sums_over_lines():
 
 
 @pytest.mark.parametrize("n_in", [1, 2])
-def test_fixed_far_equals_moments_over_lines(n_in):
+def test_fixed_far_equals_moments_over_lines(n_in, monkeypatch):
     # the fixed basis's moments, Gram blocks and products with the data from its
-    # values at the nodes (far bins) against those summed over every line
+    # values at the nodes (far bins, in several pieces) against those summed over
+    # every line
+    monkeypatch.setattr(_pseudo, "FAR_BINS", 3)
     fit, p = _fitter(n_in, 10 * _pseudo.BIN_LINES, seed=6)
     th, m, ref, _ = fit._fixed_modes(p, np.ones((p.size, n_in), complex), 0)
     base = fit._pseudo_lines()

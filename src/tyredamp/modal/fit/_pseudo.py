@@ -57,6 +57,14 @@ BIN_LINES = 2048
 RHO_MIN = 6.0
 #: fewest bins for pseudo-lines to pay (fewer: the sums over the lines)
 MIN_BINS = 8
+#: most far bins whose nodes are formed at once (the columns at the nodes of this many
+#: bins take about the memory of one bin of lines: no array grows with the record)
+FAR_BINS = 64
+
+
+def _chunks(idx: NDArray[np.intp]) -> list[NDArray[np.intp]]:
+    """``idx`` in pieces of at most :data:`FAR_BINS`."""
+    return [idx[a : a + FAR_BINS] for a in range(0, idx.size, FAR_BINS)]
 
 
 @dataclass(frozen=True)
@@ -203,26 +211,30 @@ def fixed_far(
     ells = base.ells or tuple(
         _bin_lagrange(2 * np.pi * fitter.f, base.bins, base.centre, base.half)
     )
-    far = np.flatnonzero(~near)
-    pn = np.asarray(phi_at(factors_at(fitter, base.nodes[far].ravel())))
-    qf = pn.shape[1]
     mass: dict[int, NDArray[np.float64]] = {}
-    mm = np.stack(
-        [mass.setdefault(id(ells[i]), ells[i] @ ells[i].T) for i in far]
-        or [np.zeros((NODES, NODES))]
-    )[: far.size]
-    phi = np.empty((n_in, base.centre.size, NODES, 2, qf))
-    x = pn.reshape(n_in, far.size, NODES, 2 * qf)
-    phi[:, far] = np.matmul(mm[None], x).reshape(n_in, far.size, NODES, 2, qf)
-    wr = np.broadcast_to(base.weights[far][None, :, :, None], (n_in, far.size, NODES, 2))
-    gf = (pn * wr.reshape(-1, 1)).T @ pn
-    pf = pn.T @ base.y[:, far].reshape(-1, n_out)
+    phi = gf = pf = None
+    for far in _chunks(np.flatnonzero(~near)):
+        pn = np.asarray(phi_at(factors_at(fitter, base.nodes[far].ravel())))
+        qf = pn.shape[1]
+        mm = np.stack([mass.setdefault(id(ells[i]), ells[i] @ ells[i].T) for i in far])
+        if phi is None:
+            phi = np.empty((n_in, base.centre.size, NODES, 2, qf))
+        x = pn.reshape(n_in, far.size, NODES, 2 * qf)
+        phi[:, far] = np.matmul(mm[None], x).reshape(n_in, far.size, NODES, 2, qf)
+        wr = np.broadcast_to(base.weights[far][None, :, :, None], (n_in, far.size, NODES, 2))
+        g1, p1 = (pn * wr.reshape(-1, 1)).T @ pn, pn.T @ base.y[:, far].reshape(-1, n_out)
+        gf, pf = (g1, p1) if gf is None or pf is None else (gf + g1, pf + p1)
     for i in np.flatnonzero(near):
         sl = base.bins[i]
         rows = np.asarray(phi_rows(sl))
-        gf += rows.T @ rows
-        pf += _basis.rows_t_data(fitter, sl, rows)
+        g1, p1 = rows.T @ rows, _basis.rows_t_data(fitter, sl, rows)
+        gf, pf = (g1, p1) if gf is None or pf is None else (gf + g1, pf + p1)
+        if phi is None:
+            phi = np.empty((n_in, base.centre.size, NODES, 2, rows.shape[1]))
         phi[:, i : i + 1] = _moments(ells[i], rows, n_in, 1)
+    assert phi is not None
+    assert gf is not None
+    assert pf is not None
     phi.flags.writeable = False
     got = PseudoLines(
         base.bins, base.centre, base.half, base.nodes, base.weights, phi, base.y, ells
@@ -327,9 +339,8 @@ def _sums(
     """``Phi_f^T B`` (None without ``fixed_rows``), ``B^T B`` and ``B^T Y`` over the
     pseudo-lines of the bins not ``near`` and the lines of the others."""
     n_in = fitter.n_in
-    far = np.flatnonzero(~near)
     sums: list[tuple[Any, Any, Any]] = []
-    if far.size:
+    for far in _chunks(np.flatnonzero(~near)):
         wn = pl.nodes[far].ravel()
         b = np.asarray(cols(factors_at(fitter, wn), None))  # (2 n_in n_nodes, n1)
         n1 = b.shape[1]
@@ -417,9 +428,9 @@ def scan_sums(
             c = np.asarray(cols(s_, k_, poles[gi]))
             m[:, gi] += v_all[:, ib] @ c.conj().T
             nrm2[gi] += (c.real**2 + c.imag**2) @ pl.weights[ib]
-        if far.size:
-            s_, k_, _ = factors_at(fitter, pl.nodes[far].ravel())
+        for fc in _chunks(far):
+            s_, k_, _ = factors_at(fitter, pl.nodes[fc].ravel())
             c = np.asarray(cols(s_, k_, poles[g]))
-            m[:, g] += v_all[:, far].reshape(v_all.shape[0], -1) @ c.conj().T
-            nrm2[g] += (c.real**2 + c.imag**2) @ pl.weights[far].ravel()
+            m[:, g] += v_all[:, fc].reshape(v_all.shape[0], -1) @ c.conj().T
+            nrm2[g] += (c.real**2 + c.imag**2) @ pl.weights[fc].ravel()
     return m, nrm2
