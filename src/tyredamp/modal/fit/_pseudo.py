@@ -62,6 +62,15 @@ MIN_BINS = 8
 FAR_BINS = 64
 
 
+def _cached(memo: dict[int, Any], ell: NDArray[np.float64], fn: Any) -> Any:
+    """``fn(ell)``, computed once per array ``ell`` (bins of uniformly spaced lines
+    share theirs, :func:`_bin_lagrange`)."""
+    key = id(ell)
+    if key not in memo:
+        memo[key] = fn(ell)
+    return memo[key]
+
+
 def _chunks(idx: NDArray[np.intp]) -> list[NDArray[np.intp]]:
     """``idx`` in pieces of at most :data:`FAR_BINS`."""
     return [idx[a : a + FAR_BINS] for a in range(0, idx.size, FAR_BINS)]
@@ -162,7 +171,7 @@ def fixed_lines(
         bins, centre, half, nodes = base.bins, base.centre, base.half, base.nodes
     ells = _bin_lagrange(2 * np.pi * fitter.f, bins, centre, half)
     sums: dict[int, NDArray[np.float64]] = {}
-    weights = np.stack([sums.setdefault(id(e), e.sum(axis=1)) for e in ells])
+    weights = np.stack([_cached(sums, e, lambda e: e.sum(axis=1)) for e in ells])
     phi = y = gf = pf = None
     if base is not None:
         y = base.y
@@ -216,7 +225,7 @@ def fixed_far(
     for far in _chunks(np.flatnonzero(~near)):
         pn = np.asarray(phi_at(factors_at(fitter, base.nodes[far].ravel())))
         qf = pn.shape[1]
-        mm = np.stack([mass.setdefault(id(ells[i]), ells[i] @ ells[i].T) for i in far])
+        mm = np.stack([_cached(mass, ells[i], lambda e: e @ e.T) for i in far])
         if phi is None:
             phi = np.empty((n_in, base.centre.size, NODES, 2, qf))
         x = pn.reshape(n_in, far.size, NODES, 2 * qf)
@@ -344,12 +353,17 @@ def _sums(
         wn = pl.nodes[far].ravel()
         b = np.asarray(cols(factors_at(fitter, wn), None))  # (2 n_in n_nodes, n1)
         n1 = b.shape[1]
-        bw = b.reshape(n_in, far.size, NODES, 2, n1) * pl.weights[far][None, :, :, None, None]
+        wf = pl.weights[far][None, :, :, None, None]
         yt = pl.y[:, far].reshape(-1, pl.y.shape[-1])
         cross = None
         if fixed_rows is not None:
             cross = pl.phi[:, far].reshape(-1, pl.phi.shape[-1]).T @ b
-        sums.append((cross, bw.reshape(-1, n1).T @ b, b.T @ yt))
+        if np.all(wf > 0):  # B^T W B as X^T X, X = W^1/2 B: one symmetric product
+            bw = (b.reshape(n_in, far.size, NODES, 2, n1) * np.sqrt(wf)).reshape(-1, n1)
+            g1 = bw.T @ bw
+        else:
+            g1 = (b.reshape(n_in, far.size, NODES, 2, n1) * wf).reshape(-1, n1).T @ b
+        sums.append((cross, g1, b.T @ yt))
     for i in np.flatnonzero(near):
         sl = pl.bins[i]
         b = np.asarray(cols(None, sl))
