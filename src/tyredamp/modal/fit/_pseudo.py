@@ -1,5 +1,5 @@
-"""Pseudo-lines: the Gram blocks of an added mode on a long record, with a cost
-per evaluation that does not grow with the lines.
+"""Pseudo-lines: the Gram blocks of the fits on a long record, with a cost per
+evaluation that does not grow with the lines.
 
 An evaluation of :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit_added`
 (:mod:`._added`) needs three sums over the lines ``w_k`` of products of the added
@@ -25,17 +25,25 @@ form: Berrut & Trefethen, *Barycentric Lagrange interpolation*, SIAM Review 46
     function ``(a(w) b~(w) + a~(w) b(w)) / 2``, ``b~(w) = conj(b(conj w))``,
     whose poles are those of ``b`` and their mirror images, as far from the bin).
 
-``Phit``, ``Yt`` and ``W`` are formed once per fixed part (one pass over the
-lines, :func:`pseudo_lines`); an evaluation forms ``b`` at the nodes of the far
-bins and on the lines of the near ones only (:func:`gram_blocks`). The error
-of the interpolant of a function analytic inside the ellipse ``E_rho`` with
-``|f| <= M`` there is at most ``4 M rho^-n / (rho - 1)`` on the bin (Trefethen,
-*Approximation Theory and Approximation Practice*, 2013, Theorem 8.2): with ``n
-= 32`` nodes and the poles outside ``E_6`` (double poles and the factor ``(i
-w)^power`` of ``b^T b`` included) the sums agree with those over the lines to
-rounding (``tests/test_modal_pseudo.py`` checks them against the sums over the
-lines and a sum of ``1 / (i w_k - p)`` against its closed form by the digamma
-function).
+``Yt`` and ``W`` are formed once per fitter (:meth:`ModalFitter._pseudo_lines
+<tyredamp.modal.fit.fit.ModalFitter._pseudo_lines>`), ``Phit`` once per fixed part
+(:func:`fixed_far`: on the far bins from ``Phi_f`` at the nodes, ``Phit = M
+Phi_f(x)`` with ``M = L L^T``, ``L`` the bin's Lagrange rows, since ``Phi_f`` too
+is smooth away from its poles; the near bins from their lines); an evaluation
+forms ``b`` at the nodes of the far bins and on the lines of the near ones only
+(:func:`gram_blocks`). The same sums give the Gram blocks of a full fit
+(:func:`gram_full`: every mode's columns, the bins far from every pole) and the
+inner products of a scan of the residual against trial columns
+(:func:`scan_sums`). The error of the interpolant of a function analytic
+inside the ellipse ``E_rho`` with ``|f| <= M`` there is at most ``4 M rho^-n /
+(rho - 1)`` on the bin (Trefethen, *Approximation Theory and Approximation
+Practice*, 2013, Theorem 8.2, stated for Chebyshev points of the second kind;
+its aliasing argument, chapter 4 there, bounds the interpolant in points of the
+first kind alike): with ``n = 32`` nodes and the poles outside ``E_6`` (double
+poles and the factor ``(i w)^power`` of ``b^T b`` included) the sums agree with
+those over the lines to rounding (``tests/test_modal_pseudo.py`` checks them
+against the sums over the lines and a sum of ``1 / (i w_k - p)`` against its
+closed form by the digamma function).
 """
 
 from __future__ import annotations
