@@ -93,7 +93,9 @@ class PseudoLines:
     nodes in rad/s; ``weights`` (n_bins, NODES): ``W_j``; ``phi`` (n_in, n_bins,
     NODES, 2, q_f) and ``y`` (n_in, n_bins, NODES, 2, n_out): ``Phit`` and ``Yt``
     (unweighted data), real and imaginary part as the rows of the basis; ``ells``:
-    each bin's Lagrange rows (:func:`_bin_lagrange`).
+    each bin's Lagrange rows (:func:`_bin_lagrange`) when kept (the functions here
+    form them again when needed: a few milliseconds, and no memory held between
+    the fits).
     """
 
     bins: tuple[slice, ...]
@@ -201,7 +203,7 @@ def fixed_lines(
     assert y is not None
     for a in (centre, half, nodes, weights, phi, y):
         a.flags.writeable = False
-    got = PseudoLines(bins, centre, half, nodes, weights, phi, y, tuple(ells))
+    got = PseudoLines(bins, centre, half, nodes, weights, phi, y)  # ells formed again
     return got, gf, pf
 
 
@@ -253,9 +255,7 @@ def fixed_far(
     assert gf is not None
     assert pf is not None
     phi.flags.writeable = False
-    got = PseudoLines(
-        base.bins, base.centre, base.half, base.nodes, base.weights, phi, base.y, ells
-    )
+    got = PseudoLines(base.bins, base.centre, base.half, base.nodes, base.weights, phi, base.y)
     return got, gf, pf
 
 

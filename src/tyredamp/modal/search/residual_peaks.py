@@ -570,9 +570,9 @@ def residual_view(
     inv = 1.0 / np.sqrt(np.maximum(s2, 1e-300))
     whole = _whole(fitter, (poles, residues, terms), inv)
     grid = coherent_scan(fitter, (poles, residues, terms), s2, zeta0, whole)
-    pw = np.einsum("jkf,jkf->f", whole.real, whole.real)
-    pw += np.einsum("jkf,jkf->f", whole.imag, whole.imag)
-    return grid, pw
+    # |e|^2 summed over the FRFs from the interleaved parts: one array of the lines
+    parts = whole.reshape(-1, fitter.n_f).view(np.float64).reshape(-1, fitter.n_f, 2)
+    return grid, np.einsum("jfr,jfr->f", parts, parts)
 
 
 def _whole(fitter: ModalFitter, model: Any, inv: NDArray[np.float64]) -> NDArray[np.complex128]:

@@ -116,6 +116,12 @@ class FixedParts:
         self.modes: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
         self.value: FixedPart | None = None
 
+    def release(self) -> None:
+        """Drop the fixed part held (formed again at the next trial): a long record's
+        holds pseudo-lines of its basis, not to be held while the residual of every
+        line is (:func:`residual_search`)."""
+        self.modes = self.value = None
+
     def of(self, p_all: NDArray[np.complex128], l_all: NDArray[np.complex128]) -> FixedPart | None:
         """The fixed part of these modes (None when it cannot be formed)."""
         held = self.modes
@@ -402,6 +408,8 @@ def residual_search(
         # the residual's peaks first (where the structure is), then the diagram's;
         # when they add nothing, the coherent scan's poles (one round per mode set)
         if view_of is not res:
+            if fitter._pseudo_lines() is not None:
+                fixed.release()  # no pseudo-lines held beside the residual of every line
             view, view_of = residual_view(fitter, res, zeta0), res
         starts, screened = round_starts(
             fitter, res, view, pending, threshold, zeta0, test, scan_next
