@@ -388,21 +388,19 @@ def basis_ek(
     bt = np.empty((q + ne, nin, nf), complex)
     s, kap = s1[None, :], kap1[None, :]
     if nin == 1:
-        # three arrays of (m, nf) temporaries: t, 1 / d (then t^2 - Omega^2) and h
         sig = (-poles.real)[:, None] + 0j  # complex factors: no casts in the loops
         mom = -poles.imag[:, None] + 0j
-        t = s + sig
-        r = np.multiply(t, t)
-        r += mom * mom  # d = (s - p)(s - conj p) = t^2 + Omega^2
-        np.reciprocal(r, out=r)
+        den = s - poles[:, None]
+        den *= s - np.conj(poles)[:, None]  # d = (s - p)(s - conj p)
+        r = np.reciprocal(den)
         h = 2.0 * kap * r  # 2 kappa / d
+        t = s + sig
         np.multiply(t, h, out=bt[0 : 2 * m : 2, 0])
         np.multiply(h, mom, out=bt[1 : 2 * m : 2, 0])
         if derivatives:
             h *= r  # 2 kappa / d^2
-            np.multiply(t, t, out=r)
-            r -= mom * mom  # t^2 - Omega^2
-            np.multiply(r, h, out=bt[q::2, 0])
+            den -= 2.0 * mom * mom  # t^2 - Omega^2
+            np.multiply(den, h, out=bt[q::2, 0])
             o = bt[q + 1 :: 2, 0]
             np.multiply(t, h, out=o)
             o *= 2.0 * mom
