@@ -1,7 +1,8 @@
 """tyredamp against sdypy-EMA (LSCF + LSFD): speed and accuracy on the same FRFs.
 
-Run: ``python benchmarks/perf_compare.py [--quick] [--blas-threads 1] [--set all|tyre|random|long|million]
-[--json PATH]`` (needs the ``bench`` extra: ``pip install -e ".[bench]"``).
+Run: ``python benchmarks/perf_compare.py [--quick] [--blas-threads 1]
+[--set all|tyre|random|long|million] [--json PATH]`` (needs the ``bench`` extra:
+``pip install -e ".[bench]"``).
 
 For each case both tools get the same FRFs, the same band and the same
 highest polynomial order (tyredamp ``max_order = 2 P``, sdypy-EMA
