@@ -353,16 +353,21 @@ def parse_tir_plain(path: Path) -> dict[str, float]:
 def impact_modes(ctx: Context, time_file: str, label: str) -> Check:
     """``frf`` with the hammer named, then ``modal``, against sdypy-EMA on an independent H1.
 
-    The LVM's two hits are also given to ``modal`` one by one as replicates
-    (``--replicate``): a mode the reference does not list must be found again
-    in each hit (:func:`impact_hit_confirm`) or be marked undecidable by ``modal``.
+    The LVM's two hits are also written one by one by ``frf --each-record`` and
+    given to ``modal`` as replicates (``--replicate``): a mode the reference does
+    not list must be found again in each hit (:func:`impact_hit_confirm`) or be
+    marked undecidable by ``modal``.
     """
     frf = ctx.tmp / f"{label}_frf.uff"
     cmap = IMPACT_MAP if time_file.endswith((".lvm", ".mf4")) else IMPACT_MAP_FULL
-    succeeded(ctx.cli("frf", ctx.path(time_file), "-o", frf, *cmap))
+    each = ["--each-record"] if time_file == LVM_LONG else []
+    succeeded(ctx.cli("frf", ctx.path(time_file), "-o", frf, *cmap, *each))
     modes = ctx.tmp / f"{label}_modes.json"
-    hits = _hit_frfs(ctx) if time_file == LVM_LONG else []
-    succeeded(ctx.cli("modal", frf, "-o", modes, *[a for h in hits for a in ("--replicate", h)]))
+    # the replicates modal takes are tyredamp frf's own records of the hits; the
+    # confirmation below reads the hits independently (lvm_read and numpy)
+    records = sorted(ctx.tmp.glob(f"{label}_frf.record*.uff")) if each else []
+    hits = _hit_frfs(ctx) if each else []
+    succeeded(ctx.cli("modal", frf, "-o", modes, *[a for h in records for a in ("--replicate", h)]))
     found = modes_hz(modes)
     ref = ctx.references["impact"]["sdypy_ema"]["frequency_hz"]
     confirm = impact_hit_confirm(ctx, hits, modes) if hits else None
