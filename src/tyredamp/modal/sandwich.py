@@ -299,6 +299,20 @@ def _common(
     return xr * hr[..., None] + xi * hi[..., None], xi * hr[..., None] - xr * hi[..., None]
 
 
+def _rank_two(
+    u1: NDArray[np.float64],
+    v1: NDArray[np.float64],
+    u2: NDArray[np.float64],
+    v2: NDArray[np.float64],
+    rr: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """``sum_f r_f / 2 (u1_f u2_f^T + v1_f v2_f^T)`` (eq. (3), the common part) of the
+    projections ``u``, ``v`` (n_in, nb, k) of eq. (2); ``rr = r / 2`` (n_in, nb, 1)."""
+    k, n = u1.shape[-1], u2.shape[-1]
+    a = (u1 * rr).reshape(-1, k).T @ u2.reshape(-1, n)
+    return np.asarray(a + (v1 * rr).reshape(-1, k).T @ v2.reshape(-1, n))
+
+
 class _Sums(NamedTuple):
     """The sums of :func:`_shape_sums` (raw: before ``A^-1`` is applied)."""
 
@@ -356,15 +370,15 @@ def _shape_sums(
             u1, v1 = _common(z, h[j].real * w, h[j].imag * w)
             ug += u1
             vg += v1
-        bg += np.einsum("fgk,fgl->kl", ug * rr, ug) + np.einsum("fgk,fgl->kl", vg * rr, vg)
+        bg += _rank_two(ug, vg, ug, vg, rr)
         for j, (jac, x) in enumerate(_outputs(fitter, pr, rows, sl, True)):
             w = om[:, j].reshape(n_in, nb)
             xm, z = x[:, :p], scores(j, jac, x)
             own[j] += (xm * dd[j]).T @ xm
             cross[j] += (xm * dd[j]).T @ z
             u1, v1 = _common(xm, h[j].real * w, h[j].imag * w)
-            own[j] += np.einsum("fgk,fgl->kl", u1 * rr, u1) + np.einsum("fgk,fgl->kl", v1 * rr, v1)
-            cross[j] += np.einsum("fgk,fgl->kl", u1 * rr, ug) + np.einsum("fgk,fgl->kl", v1 * rr, vg)
+            own[j] += _rank_two(u1, v1, u1, v1, rr)
+            cross[j] += _rank_two(u1, v1, ug, vg, rr)
     return _Sums(a, bg, own, cross)
 
 
