@@ -57,7 +57,7 @@ def test_without_common_noise_the_shapes_errors_are_the_delta_method(
     u = c[0 : 2 * m : 2].T + 1j * c[1 : 2 * m : 2].T if kind == "complex" else c[:m].T + 0j
     out0 = _scaling.shape_std(fit, th, m, ref, w, sol, ainv, 1.0, b, u, didx)
     in0 = _scaling.input_shape_std(fit, th, m, ref, w, sol, ainv, 1.0, b, didx)
-    cov, out1, in1 = sandwich_shapes(fit, res, w, vs, np.zeros_like(R))
+    cov, out1, in1, _ = sandwich_shapes(fit, res, w, vs, np.zeros_like(R))
     assert_allclose(cov, ainv, rtol=1e-9, atol=1e-12 * np.abs(ainv).max())
     assert_allclose(out1, out0, rtol=1e-9)
     assert_allclose(in1, in0, rtol=1e-9, atol=1e-12 * in0.max())
@@ -73,7 +73,7 @@ def test_shape_errors_equal_the_dense_covariance(kind: Literal["complex", "real"
     and (3) (rounding of sums of 161 lines: rtol 1e-8)."""
     fit = ModalFitter(F, _draw(np.random.default_rng(2)), 0, kind, DRIVE, upper=True, lower=True)
     ml = ml_refine(fit, fit.fit(POLES, PI.T.copy()), V)
-    _, std, _ = sandwich_shapes(fit, ml, None, V, R)
+    _, std, _, _ = sandwich_shapes(fit, ml, None, V, R)
 
     def rows(sl: slice) -> np.ndarray:
         return _row_weights(V, sl)
@@ -121,9 +121,12 @@ def test_shape_errors_match_the_scatter_with_noise_on_force_and_responses() -> N
     sandwich's standard error (at the fit of the exact FRF) to 10 % (the rms of 200
     draws scatters by 5 %; measured 2-10 %, 1-4 % over 1000 draws), while the errors
     without the common part miss it by more than 20 % for some entry (the test can
-    fail). The pipeline (``identify_modes`` on an FRF carrying its input noise)
-    reports the sandwich's errors: within 15 % of the scatter (its own fit and
-    residual terms, the local dispersion)."""
+    fail). The shape's amplitude along itself (eq. (S3)) scatters ``kappa`` times its
+    variance with the entries taken independent: to 25 % (a variance of 200 draws
+    scatters by 10 %; measured 4-12 % over 400), ``kappa`` about 2 here. The pipeline
+    (``identify_modes`` on an FRF carrying its input noise) reports the sandwich's
+    errors times ``sqrt(kappa)``: within 15 % of the scatter so scaled (its own fit
+    and residual terms, the local dispersion)."""
     from tyredamp.modal import identify_modes
 
     po, pi = [], []
@@ -135,18 +138,23 @@ def test_shape_errors_match_the_scatter_with_noise_on_force_and_responses() -> N
         pi.append(ml.psi_in)
     fit = ModalFitter(F, H0, 0, "complex", DRIVE, upper=True, lower=True)
     ml = ml_refine(fit, fit.fit(POLES, PI.T.copy()), V)
-    _, s_out, s_in = sandwich_shapes(fit, ml, None, V, R)
-    _, s0_out, _ = sandwich_shapes(fit, ml, None, V, np.zeros_like(R))
-    sc_out = np.sqrt(np.mean(np.abs(po - np.mean(po, axis=0)) ** 2, axis=0))
+    _, s_out, s_in, kappa = sandwich_shapes(fit, ml, None, V, R)
+    _, s0_out, _, _ = sandwich_shapes(fit, ml, None, V, np.zeros_like(R))
+    err = np.asarray(po) - np.mean(po, axis=0)
+    sc_out = np.sqrt(np.mean(np.abs(err) ** 2, axis=0))
     sc_in = np.sqrt(np.mean(np.abs(pi - np.mean(pi, axis=0)) ** 2, axis=0))
     assert_allclose(s_out, sc_out, rtol=0.10)
     assert_allclose(s_in, sc_in, rtol=0.10)
     assert np.max(np.abs(s0_out / sc_out - 1.0)) > 0.2
+    info = np.sum(np.abs(ml.psi_out) ** 2 / s_out**2, axis=0)  # 1 / Var_ind(a_n)
+    amp = np.einsum("jn,sjn->sn", np.conj(ml.psi_out) / s_out**2 / info, err)
+    assert_allclose(kappa, np.mean(np.abs(amp) ** 2, axis=0) * info, rtol=0.25)
+    assert np.all(kappa > 1.3)
     h = _draw(np.random.default_rng(100))
     frf = FRF(F, h, variance=V, input_noise=R, outputs=[1, 2, 3, 4], inputs=[1])
     mdl = identify_modes(frf, model="complex", n_modes=2).models["complex"]
     assert mdl.meta["pole_variance_ratio"] is not None
-    assert_allclose(np.asarray(mdl.std["psi_out"]), sc_out, rtol=0.15)
+    assert_allclose(np.asarray(mdl.std["psi_out"]), sc_out * np.sqrt(kappa), rtol=0.15)
 
 
 def test_without_input_noise_the_shapes_keep_the_noise_along_the_response() -> None:

@@ -564,9 +564,12 @@ def sandwiched(
     m = int(res.poles.size)
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            cov, s_out, s_in = sandwich_shapes(
+            cov, s_out, s_in, kappa = sandwich_shapes(
                 fit, res, w, problem.variance, r[:, problem.lines], scale
             )
+            # the entries' errors as a consumer that takes them independent needs them
+            # for the shape's amplitude (eq. (S3) of modal.sandwich)
+            s_out = s_out * np.sqrt(np.maximum(kappa, 1.0))[None, :]
             f1, z1, _ = pole_std(fit.w_ref, fit.pack(*_start(res)), m, cov)
             f0 = np.asarray(res.std_frequency_hz, float)
             z0 = np.asarray(res.std_damping_ratio, float)

@@ -54,7 +54,7 @@ reported variances are multiplied by. The sandwich holds for any weights
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import scipy.linalg
@@ -319,6 +319,7 @@ class _Sums(NamedTuple):
     a: NDArray[np.float64]  # J^T J (n_par, n_par)
     bg: NDArray[np.float64]  # Cov(z) of the scores z = [J^T W e, K_D W e_D] (n_g, n_g)
     own: NDArray[np.float64]  # Cov(o_j) of each output's own mode coefficients (n_out, p, p)
+    own_d: NDArray[np.float64]  # the part of the outputs' own noise D in it (n_out, p, p)
     cross: NDArray[np.float64]  # Cov(o_j, z) (n_out, p, n_g)
 
 
@@ -342,6 +343,7 @@ def _shape_sums(
     v = np.asarray(variance, dtype=float)
     a, bg = np.zeros((n_par, n_par)), np.zeros((ng, ng))
     own, cross = np.zeros((n_out, p, p)), np.zeros((n_out, p, ng))
+    own_d = np.zeros((n_out, p, p))
     model = np.asarray(res_model)
 
     def scores(j: int, jac: NDArray[np.float64], x: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -374,12 +376,13 @@ def _shape_sums(
         for j, (jac, x) in enumerate(_outputs(fitter, pr, rows, sl, True)):
             w = om[:, j].reshape(n_in, nb)
             xm, z = x[:, :p], scores(j, jac, x)
+            own_d[j] += (xm * dd[j]).T @ xm
             own[j] += (xm * dd[j]).T @ xm
             cross[j] += (xm * dd[j]).T @ z
             u1, v1 = _common(xm, h[j].real * w, h[j].imag * w)
             own[j] += _rank_two(u1, v1, u1, v1, rr)
             cross[j] += _rank_two(u1, v1, ug, vg, rr)
-    return _Sums(a, bg, own, cross)
+    return _Sums(a, bg, own, own_d, cross)
 
 
 def _model(fitter: ModalFitter, res: FitResult, pr: _Projection) -> NDArray[np.complex128]:
@@ -447,7 +450,8 @@ def sandwich_shapes(
 
     pr = _project(fitter, res, rows)
     didx = np.array([j for j, _ in fitter.drive], dtype=np.intp)
-    sums = _shape_sums(fitter, pr, rows, v, input_noise, didx, _model(fitter, res, pr))
+    model = _model(fitter, res, pr)
+    sums = _shape_sums(fitter, pr, rows, v, input_noise, didx, model)
     th, ref, q, m = pr.th, pr.ref, pr.q, len(pr.ref)
     n_par, nd = th.size, didx.size
     ainv = np.asarray(np.linalg.pinv(0.5 * (sums.a + sums.a.T), hermitian=True), np.float64)
@@ -464,23 +468,74 @@ def sandwich_shapes(
     if nd == 0:  # the scale of real modes' shapes, 1 / sqrt(2 i Omega), held
         beta = np.zeros((n_par, m), complex)
     cplx = fitter.kind == "complex"
-    std = np.zeros((n_out, m))
+    alpha = np.zeros((m, sums.own.shape[1]), complex)  # b_n (e_re + i e_im) or b_n e_n
+    ar = np.arange(m)
+    if cplx:
+        alpha[ar, 2 * ar], alpha[ar, 2 * ar + 1] = b, 1j * b
+    else:
+        alpha[ar, ar] = b
+    crs = scale * sums.cross @ t.T  # Cov(o_j, G) (n_out, p, n_g)
+    g = u[:, :, None] * beta.T[None, :, :]  # g_jn of eq. (S1) (n_out, m, n_g)
     for j in range(n_out):
-        crs = scale * sums.cross[j] @ t.T  # Cov(o_j, G) (p, n_g)
-        for n in range(m):
-            alpha = np.zeros(sums.own.shape[1], complex)
-            if cplx:
-                alpha[2 * n], alpha[2 * n + 1] = b[n], 1j * b[n]
-                mrow = mj[j][2 * n] + 1j * mj[j][2 * n + 1]
-            else:
-                alpha[n], mrow = b[n], mj[j][n] + 0j
-            g = u[j, n] * beta[:, n]
-            g[:n_par] += b[n] * mrow
-            var = (
-                scale * np.real(np.conj(alpha) @ sums.own[j] @ alpha)
-                + np.real(np.conj(g) @ cov_g @ g)
-                + 2.0 * np.real(np.conj(alpha) @ crs @ g)
-            )
-            std[j, n] = np.sqrt(max(float(var), 0.0))
+        mrow = mj[j][0 : 2 * m : 2] + 1j * mj[j][1 : 2 * m : 2] if cplx else mj[j][:m] + 0j
+        g[j, :, :n_par] += b[:, None] * mrow
+    var = (
+        scale * np.real(np.einsum("np,jpk,nk->jn", alpha.conj(), sums.own, alpha))
+        + np.real(np.einsum("jnk,kl,jnl->jn", g.conj(), cov_g, g))
+        + 2.0 * np.real(np.einsum("np,jpk,jnk->jn", alpha.conj(), crs, g))
+    )
+    std = np.sqrt(np.maximum(var, 0.0))
+    psi = u * b[None, :]
+    kappa = _amplitude_ratio(
+        fitter, pr, rows, (v, input_noise, didx, model), sums, (psi, std, alpha, g, crs, cov_g)
+    )
+    kappa = scale * kappa[0] + kappa[1]  # the own part's E|Q|^2 was summed unscaled
     std_in = input_std_given(fitter, th, m, ref, cov_g, beta, b, bool(nd))
-    return np.asarray(cov_g[:n_par, :n_par]), std, std_in
+    return np.asarray(cov_g[:n_par, :n_par]), std, std_in, np.asarray(kappa)
+
+
+def _amplitude_ratio(
+    fitter: ModalFitter,
+    pr: _Projection,
+    rows: Callable[[slice], NDArray[np.float64]],
+    noise: tuple[Any, ...],
+    sums: _Sums,
+    entries: tuple[NDArray[Any], ...],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The two parts of ``E|a_n|^2 / Var_ind(a_n)`` (own, global; their sum after the
+    own part is scaled) for each mode's amplitude along its shape (eq. (S3),
+    :func:`sandwich_shapes`): a third pass over the lines for the own parts' common
+    noise summed over the outputs. ``noise`` = (V, r, drive outputs, model h);
+    ``entries`` = (psi, std, alpha, g, Cov(o_j, G), Cov(G)) of eq. (S1)-(S2)."""
+    _, input_noise, _, model = noise
+    psi, std, alpha, g, crs, cov_g = entries
+    n_in = fitter.n_in
+    m = psi.shape[1]
+    lw = fitter.line_weights
+    with np.errstate(divide="ignore", invalid="ignore"):
+        info = np.abs(psi) ** 2 / std**2
+        info = np.where(np.isfinite(info), info, 0.0)
+        tot = np.sum(info, axis=0)
+        lam = np.where(std > 0, np.conj(psi) / std**2, 0.0) / np.where(tot > 0, tot, 1.0)
+    c = lam[:, :, None] * alpha[None, :, :]  # c_jn = lambda_jn alpha_n (n_out, m, p)
+    y = np.concatenate([c.real, c.imag], axis=1)  # (n_out, 2m, p): Re Q_n and Im Q_n
+    own = np.einsum("jap,jpk,jak->a", y, sums.own_d, y)  # the outputs' own noise D
+    for sl in pr.parts:
+        nb = _count(fitter, sl)
+        om = rows(sl)[0::2] * (1.0 if lw is None else np.tile(lw[sl], n_in)[:, None])
+        h = model[:, :, sl]
+        rr = (np.asarray(input_noise[:, sl], dtype=float) / 2.0)[..., None]
+        uq, vq = np.zeros((n_in, nb, 2 * m)), np.zeros((n_in, nb, 2 * m))
+        for j, (_, x) in enumerate(_outputs(fitter, pr, rows, sl, True)):
+            w = om[:, j].reshape(n_in, nb)
+            u1, v1 = _common(x[:, : y.shape[2]] @ y[j].T, h[j].real * w, h[j].imag * w)
+            uq += u1
+            vq += v1
+        own += np.sum(rr * (uq**2 + vq**2), axis=(0, 1))  # eq. (3), the common part
+    own_q = own[:m] + own[m:]  # E|Q_n|^2 (unscaled)
+    gam = np.einsum("jn,jnk->nk", lam, g)  # Gamma_n = sum_j lambda_jn g_jn (m, n_g)
+    glob = np.real(np.einsum("nk,kl,nl->n", gam.conj(), cov_g, gam))
+    glob = glob + 2.0 * np.real(np.einsum("jnp,jpk,nk->n", c.conj(), crs, gam))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ind = np.where(tot > 0, 1.0 / tot, np.nan)  # Var_ind(a_n)
+        return np.asarray(own_q / ind), np.asarray(glob / ind)
