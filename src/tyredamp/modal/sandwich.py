@@ -401,7 +401,7 @@ def sandwich_shapes(
     variance: NDArray[np.float64],
     input_noise: NDArray[np.float64],
     scale: float = 1.0,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The sandwich covariance of ``theta`` and the standard errors of the shapes at the
     outputs and at the inputs under ``Sigma_f = D_f + r_f h_f h_f^H`` (module docstring).
 
@@ -431,12 +431,28 @@ def sandwich_shapes(
     :func:`sandwich_covariance`; ``scale`` multiplies every covariance (the fit's
     Fisher scale).
 
+    The common part of the noise lies along the mode's shape: the entries' errors
+    are correlated across outputs, which a consumer that takes them independent
+    (a harmonic fit of the shape, a modal mass from its amplitude) does not see.
+    For the shape's amplitude along itself, the weighted least-squares projection
+    ``a_n = sum_j lambda_jn d psi_jn`` with ``lambda_jn = conj(psi_jn) / s_jn^2 /
+    sum_k |psi_kn|^2 / s_kn^2`` (``s`` the standard errors of (S2)), the ratio::
+
+        kappa_n = E|a_n|^2 / Var_ind(a_n),   Var_ind(a_n) = 1 / sum_j |psi_jn|^2 / s_jn^2   (S3)
+
+    is the factor of its variance over the one the independent entries give
+    (``E|a_n|^2`` from the same second moments, the own parts' common noise summed
+    over the outputs in a third pass over the lines; the generalised least-squares
+    variance of a weighted mean, Seber & Lee, *Linear Regression Analysis*, 2nd ed.
+    2003, sec. 3.10).
+
     Returns
     -------
-    cov, std_psi_out, std_psi_in : ndarray, shapes (n_par, n_par), (n_out, m), (n_in, m)
-        The covariance of ``theta`` (:func:`sandwich_covariance` times ``scale``) and
-        ``sqrt(E|d psi|^2)`` of each entry (units of the fit's data over the square
-        root of a modal mass with a drive point; of the data without).
+    cov, std_psi_out, std_psi_in, kappa : ndarray
+        The covariance of ``theta`` (n_par, n_par; :func:`sandwich_covariance` times
+        ``scale``), ``sqrt(E|d psi|^2)`` of each entry (n_out, m) and (n_in, m) (units
+        of the fit's data over the square root of a modal mass with a drive point; of
+        the data without) and ``kappa`` of (S3) (m,).
     """
     n_out, n_in = fitter.n_out, fitter.n_in
     v = np.asarray(variance, dtype=float)
@@ -486,10 +502,10 @@ def sandwich_shapes(
     )
     std = np.sqrt(np.maximum(var, 0.0))
     psi = u * b[None, :]
-    kappa = _amplitude_ratio(
+    k_own, k_glob = _amplitude_ratio(
         fitter, pr, rows, (v, input_noise, didx, model), sums, (psi, std, alpha, g, crs, cov_g)
     )
-    kappa = scale * kappa[0] + kappa[1]  # the own part's E|Q|^2 was summed unscaled
+    kappa = scale * k_own + k_glob  # the own part's E|Q|^2 was summed unscaled
     std_in = input_std_given(fitter, th, m, ref, cov_g, beta, b, bool(nd))
     return np.asarray(cov_g[:n_par, :n_par]), std, std_in, np.asarray(kappa)
 
