@@ -569,7 +569,8 @@ def sandwiched(
             )
             # the entries' errors as a consumer that takes them independent needs them
             # for the shape's amplitude (eq. (S3) of modal.sandwich)
-            s_out = s_out * np.sqrt(np.maximum(kappa, 1.0))[None, :]
+            kappa = np.where(np.isfinite(kappa), np.maximum(kappa, 1.0), 1.0)
+            s_out = s_out * np.sqrt(kappa)[None, :]
             f1, z1, _ = pole_std(fit.w_ref, fit.pack(*_start(res)), m, cov)
             f0 = np.asarray(res.std_frequency_hz, float)
             z0 = np.asarray(res.std_damping_ratio, float)
