@@ -49,6 +49,13 @@ returns, for the frequency and the damping ratio of each mode, the variance of
 reported variances are multiplied by. The sandwich holds for any weights
 ``W``: for the weighted least-squares fit with the separable weights ``1 /
 (sigma_j sqrt(g_f))`` its diagonal part is ``J^T W diag(D) W J`` (not ``A``).
+:func:`sandwich_shapes` extends it to the shapes (the residues are linear given
+the poles: their errors under ``Sigma_f`` plus the poles' part, eq. (S1)-(S2) of
+its docstring) and gives the factor (S3) by which the common part raises the
+variance of each shape's amplitude along itself; the final stage
+(:func:`~tyredamp.modal.final.sandwiched`) uses these in place of
+:func:`sandwich_ratios` (the same factors of frequency and damping ratio, from the
+covariance of ``theta`` that :func:`sandwich_shapes` returns too).
 """
 
 from __future__ import annotations
