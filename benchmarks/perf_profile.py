@@ -63,8 +63,10 @@ STAGES = (
     ("  trial fits (fit_added)", "fit.py", "fit_added"),
     ("  Levenberg-Marquardt (all refinements)", "_linalg.py", "_levenberg_marquardt"),
     ("  basis and derivative columns (basis_ek)", "_basis.py", "basis_ek"),
-    ("  result assembly (_result)", "fit.py", "_result"),
-    ("model object and indicators (to_model)", "final.py", "to_model"),
+    ("  long records: pseudo-line sums (_sums, scan_sums)", "_pseudo.py", "_sums|scan_sums"),
+    ("  long records: fixed parts' pseudo-lines (fixed_far)", "_pseudo.py", "fixed_far"),
+    ("  result assembly (_results.assemble)", "_results.py", "assemble"),
+    ("model object and indicators (to_model)", "assemble.py", "to_model"),
 )
 
 
@@ -75,7 +77,11 @@ def check_stages() -> None:
 
     root = Path(tyredamp.modal.__file__).parent
     for label, file, funcs in STAGES:
-        text = (root / file).read_text(encoding="utf-8")
+        # the stages' modules sit in the subpackages of tyredamp.modal (poles/, fit/, ...)
+        found = sorted(root.rglob(file))
+        if len(found) != 1:
+            raise SystemExit(f"perf_profile: stage {label.strip()!r}: {len(found)} files {file}")
+        text = found[0].read_text(encoding="utf-8")
         for fn in funcs.split("|"):
             if f"def {fn}(" not in text:
                 raise SystemExit(f"perf_profile: stage {label.strip()!r}: no {fn}() in {file}")

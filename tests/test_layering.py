@@ -69,6 +69,7 @@ MODAL_TOP = {
     "final": "pipeline",
     "assemble": "pipeline",
     "sandwich": "pipeline",
+    "replicates": "pipeline",
 }
 
 MAX_FUNCTION_LINES = 120

@@ -109,3 +109,22 @@ def test_every_catalogue_file_has_a_row() -> None:
         f for f in files if f.startswith("pyOMA-dev_pyOMA/tests/files/") and f.endswith(".txt")
     }
     assert files - covered - skipped == set()
+
+
+def test_kept_hz_leaves_out_a_mode_that_fails_its_test(tmp_path: Path) -> None:
+    """A hit's confirmation counts only modes that pass their test: a model keeps one
+    mode when none passes ("the only mode left, not significant"), which confirms nothing."""
+    doc = {
+        "models": {
+            "complex": {
+                "modes": [
+                    {"frequency_hz": 114.2, "test": {"statistic": 181.0, "threshold": 27.6}},
+                    {"frequency_hz": 112.9, "test": {"statistic": 15.6, "threshold": 27.6}},
+                    {"frequency_hz": 50.0},  # asked for: no test
+                ]
+            }
+        }
+    }
+    path = tmp_path / "m.json"
+    path.write_text(gallery.json.dumps(doc), encoding="utf-8")
+    assert gallery.kept_hz(path) == [50.0, 114.2]

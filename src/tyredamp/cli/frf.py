@@ -11,7 +11,7 @@ import numpy as np
 from ..exceptions import InputError
 from ..frf import FRF
 from ..io import format_of, read_timedata, write_frf
-from ..io._safety import check_output_file
+from ..io._safety import atomic_paths, check_output_file
 from ..studies.steps import FrfSettings, FrfStep, samples
 from ..timedata import TimeData
 from ._common import (
@@ -77,7 +77,16 @@ def _refuse_dependent_forces(td: TimeData) -> None:
 @settings_options(FrfSettings)
 @format_option("Output format; default from the extension (.uff/.unv: binary UFF 58b).")
 @channel_map_options
-def frf_command(time_file: Path, out: Path, fmt: str | None, **options: Any) -> None:
+@click.option(
+    "--each-record",
+    is_flag=True,
+    help="Also write one FRF per record it averages (each hit of an impact test alone), "
+    "as OUT's name with .record1, .record2, ... before the extension: independent "
+    "measurements for tyredamp modal --replicate.",
+)
+def frf_command(
+    time_file: Path, out: Path, fmt: str | None, each_record: bool, **options: Any
+) -> None:
     """Estimate FRFs (with coherence) from TIME_FILE and write them to --out.
 
     TIME_FILE holds force and response channels (UFF 58 function type 1,
@@ -97,6 +106,7 @@ def frf_command(time_file: Path, out: Path, fmt: str | None, **options: Any) -> 
       tyredamp frf rig.npz --out frf.csv --reference 1+Z --method welch --segment 4096
       tyredamp frf daq.unv --out frf.nc --period 0.5s --settle 2s
       tyredamp frf impact.tdms -o frf.uff --channel F=force:N --channel 2=acceleration:m/s^2
+      tyredamp frf impact.lvm -o frf.uff --channel F=force:N --each-record
     """
     check_output_file(out, [time_file])
     out_format = format_of(out, fmt)
@@ -107,8 +117,25 @@ def frf_command(time_file: Path, out: Path, fmt: str | None, **options: Any) -> 
     td.require_response("an FRF", time_file)
     if not settings.reference and len(td.force_indices) > 1:
         _refuse_dependent_forces(td)
-    frf, _ = FrfStep.run(td, settings, "--")
-    write_frf(frf, out, out_format)
+    if not each_record:
+        frf, _ = FrfStep.run(td, settings, "--")
+        write_frf(frf, out, out_format)
+        for row in frf_summary(frf):
+            click.echo(row)
+        click.echo(f"wrote {out} ({out_format})")
+        return
+    frf, records = FrfStep.records(td, settings, "--")
+    paths = [out.with_name(f"{out.stem}.record{k}{out.suffix}") for k in range(1, len(records) + 1)]
+    for p in paths:
+        check_output_file(p, [time_file], "--each-record")
+    # every file or none: a failure leaves no new file and every replaced one as it was
+    with atomic_paths([out, *paths]) as tmps:
+        for obj, tmp in zip([frf, *records], tmps, strict=True):
+            write_frf(obj, tmp, out_format)
     for row in frf_summary(frf):
         click.echo(row)
     click.echo(f"wrote {out} ({out_format})")
+    click.echo(
+        f"wrote {len(paths)} records, one FRF each: {paths[0].name} ... {paths[-1].name} "
+        f"(for tyredamp modal {out.name} --replicate {paths[0].name} ...)"
+    )

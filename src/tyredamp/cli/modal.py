@@ -91,6 +91,20 @@ def _likelihood_rows(model: ModalModel) -> list[str]:
     ]
 
 
+def _replicate(path: Path, frf: FRF, frf_file: Path) -> FRF:
+    """A replicate's FRFs, refused unless they have the channels of the FRF file."""
+    from ..io import read_frf
+
+    rep = read_frf(path, channel_map=channel_map())
+    if (rep.n_out, rep.n_in, rep.kind) != (frf.n_out, frf.n_in, frf.kind):
+        raise InputError(
+            f"--replicate: {path} holds {rep.n_out} output(s) x {rep.n_in} input(s) of "
+            f"{rep.kind}; a replicate of {frf_file.name} has its {frf.n_out} output(s) x "
+            f"{frf.n_in} input(s) of {frf.kind}"
+        )
+    return rep
+
+
 def _with_geometry(frf: FRF, path: Path) -> FRF:
     """The FRF with channel angles from the geometry when its points lie on a circle."""
     from dataclasses import replace
@@ -124,9 +138,24 @@ def _with_geometry(frf: FRF, path: Path) -> FRF:
     help="UFF geometry (nodes 15/2411, trace lines 82, systems 18/2420): every channel's node "
     "must be in it; points on a circle get their angles from it (ring views).",
 )
+@click.option(
+    "--replicate",
+    "replicate_files",
+    type=click.Path(dir_okay=False, path_type=Path),
+    multiple=True,
+    help="An independent measurement of the same FRFs (one hit of an impact test, one "
+    "repeat of the test), identified alone: each mode is marked as found again in each "
+    "replicate or as undecidable. Repeat for each replicate.",
+)
 @settings_options(ModalSettings, only=("estimator",))
 @channel_map_options
-def modal_command(frf_file: Path, out: Path, geometry_file: Path | None, **options: Any) -> None:
+def modal_command(
+    frf_file: Path,
+    out: Path,
+    geometry_file: Path | None,
+    replicate_files: tuple[Path, ...] = (),
+    **options: Any,
+) -> None:
     """Identify real and complex modes of the FRFs in FRF_FILE.
 
     Poles come from a poly-reference LSCF stabilisation diagram with automatic
@@ -142,14 +171,16 @@ def modal_command(frf_file: Path, out: Path, geometry_file: Path | None, **optio
     Example:
       tyredamp modal tyre_frf.uff --out modes.json --band 0 200
       tyredamp modal tyre_frf.npz -o modes.json --model complex --modes 6
+      tyredamp modal frf.uff -o modes.json --replicate hit1.uff --replicate hit2.uff
     """
     from ..documents.jsonfile import write_json  # imported when the command runs
     from ..io import read_frf
     from ..io._safety import check_output_file
 
     settings = settings_from_options(ModalSettings, options)
-    check_output_file(out, [frf_file])
+    check_output_file(out, [frf_file, *replicate_files])
     frf = read_frf(frf_file, channel_map=channel_map())
+    replicates = [_replicate(p, frf, frf_file) for p in replicate_files]
     if geometry_file is not None:
         frf = _with_geometry(frf, geometry_file)
     try:
@@ -160,6 +191,7 @@ def modal_command(frf_file: Path, out: Path, geometry_file: Path | None, **optio
             if msg.startswith(arg):
                 raise InputError(opt + msg[len(arg) :]) from None
         raise
+    support = ModalStep.replicates(res, replicates, settings) if replicates else []
     write_json(ModalStep.document(res, verdicts, source=frf_file.name), out)
     click.echo(
         f"FRF {frf_file.name}: {frf.n_out} output(s) x {frf.n_in} input(s), {res.frf_kind}, "
@@ -177,6 +209,15 @@ def modal_command(frf_file: Path, out: Path, geometry_file: Path | None, **optio
         click.echo(f"RMSD real / complex = {ratio:.3g}")
     for w in res.warnings:
         click.echo(f"warning: {w}")
+    for sup in support:
+        if not sup.confirmed:
+            click.echo(f"warning: mode at {sup.frequency_hz:.5g} Hz: {sup.text()}")
+    if support:
+        n = sum(sup.confirmed for sup in support)
+        click.echo(
+            f"replicates: {n} of {len(support)} modes found again in each of the "
+            f"{len(replicates)} replicates"
+        )
     for v in verdicts.values():
         click.echo(f"verdict: {v.summary()}")
         for c in v.cautions:

@@ -13,12 +13,14 @@ is :mod:`tyredamp.documents.modes`.
 Map of the package (one group per step of the method; a group imports only
 from the groups below it; the layering test of the package enforces it):
 
-``identify.py``, ``starts.py``, ``mode_count.py``, ``final.py``, ``assemble.py`` (top)
+``identify.py``, ``starts.py``, ``mode_count.py``, ``final.py``, ``assemble.py``,
+``replicates.py`` (top)
     The pipeline: :func:`identify_modes` runs the steps below in order (the
     modes it starts from in ``starts``, the mode count in ``mode_count``),
     ``final`` makes the last fit (maximum-likelihood stage, likelihood
     intervals) and ``assemble`` turns it into a :class:`ModalModel` with its
-    quality (intervals, goodness of fit).
+    quality (intervals, goodness of fit); ``replicates`` finds each mode
+    again in independent measurements identified alone.
 ``search/``
     Which modes the data hold: the mode test and the residual search on one
     fitter (``search``), the joint refit of a trial mode and the split of a

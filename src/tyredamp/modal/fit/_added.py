@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _basis
+from . import _basis, _pseudo
 from ._linalg import _PROJ_TOL, _fixed_range, _vp_solve
 from ._state import FitterState
 
@@ -53,7 +53,10 @@ class FixedPart:
     several blocks), so that an evaluation needs one product ``B1^T [Q_r | P_f Y]``;
     ``src``: the poles and participation it was formed from, when given; ``qr``:
     with several blocks and ``keep``, the rows of ``Q_r`` of every line (no larger
-    than the data), so that an evaluation needs no fixed basis.
+    than the data), so that an evaluation needs no fixed basis; ``pseudo``: with
+    several blocks, neither kept, and a long record, the pseudo-lines of the fixed
+    basis and the data (:mod:`._pseudo`), so that an evaluation's cost does not
+    grow with the lines.
     """
 
     th: NDArray[np.float64]
@@ -69,6 +72,7 @@ class FixedPart:
     qy: NDArray[np.float64] | None = None
     src: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
     qr: NDArray[np.float64] | None = None
+    pseudo: _pseudo.PseudoLines | None = None
 
     def matches(self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp]) -> bool:
         """Is this the fixed part of the modes ``th`` (``m``, ``ref``)?"""
@@ -128,6 +132,21 @@ def fixed_part(
     rows = _Rows(fitter, None, parts, keep)
     yw = np.asarray(fitter._ydata(parts[0]) * w) if one else None
     phi0 = rows.basis(th_f, m, ref, 0) if one else None
+    pseudo = sums = None
+    if phi0 is None and not keep and _pseudo.applies(fitter):
+        # a long record: the pseudo-lines of the fixed basis, and its Gram blocks
+        # summed in the same pass over the lines
+        base = fitter._pseudo_lines()
+        assert base is not None
+        at_zero = [0j] if fitter.use_lower and fitter.power < 2 else []
+        pseudo, gf, pf = _pseudo.fixed_far(
+            fitter,
+            base,
+            lambda sl: fitter._basis_ek(th_f, m, ref, False, sl)[0],
+            lambda fac: fitter._basis_ek(th_f, m, ref, False, None, (fac, None))[0],
+            np.concatenate([fitter.unpack(th_f, m, ref)[0], at_zero]),
+        )
+        sums = (gf, pf * w)
     # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
     # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
     tmap, qty, yyp = _fixed_range(
@@ -136,6 +155,7 @@ def fixed_part(
         fitter._yss * w**2,
         (phi0, yw) if phi0 is not None and yw is not None else None,
         fitter.n_rows,
+        sums,
     )
     qy = qr = None
     r = tmap.shape[1]
@@ -151,7 +171,9 @@ def fixed_part(
     for a in (th_f, ref, phi0, yw, tmap, qty, yyp, qy, qr, *(src or ())):
         if a is not None:
             a.flags.writeable = False
-    return FixedPart(th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr)
+    return FixedPart(
+        th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr, pseudo
+    )
 
 
 def _no_larger(fitter: FitterState, n_col: int) -> bool:
@@ -227,15 +249,26 @@ def added_solver(
 
     def solve_blocks(th: NDArray[np.float64]) -> dict[str, Any]:
         # the same, the Gram blocks of the added columns summed over blocks of lines
+        # (or over the pseudo-lines of a long record, _pseudo)
         pp1 = one.unpack(th, 1, ref1)
-        cross = np.zeros((qf, n1))
-        g0 = np.zeros((n1, n1))
-        p0 = np.zeros((n1, fitter.n_out))
-        for i, sl in enumerate(fx.parts):
-            b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
-            cross += rows.basis(th_f, m_f, ref_f, i).T @ b1
-            g0 += b1.T @ b1
-            p0 += _basis.rows_t_data(fitter, sl, b1) * w  # no data rows formed
+        if fx.pseudo is not None:
+            cross, g0, p0 = _pseudo.gram_blocks(
+                fitter,
+                fx.pseudo,
+                lambda fac, sl: one._basis_ek(th, 1, ref1, True, sl, (fac, pp1))[0],
+                lambda sl: fitter._basis_ek(th_f, m_f, ref_f, False, sl)[0],
+                complex(pp1[0][0]),
+            )
+            p0 = p0 * w
+        else:
+            cross = np.zeros((qf, n1))
+            g0 = np.zeros((n1, n1))
+            p0 = np.zeros((n1, fitter.n_out))
+            for i, sl in enumerate(fx.parts):
+                b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
+                cross += rows.basis(th_f, m_f, ref_f, i).T @ b1
+                g0 += b1.T @ b1
+                p0 += _basis.rows_t_data(fitter, sl, b1) * w  # no data rows formed
         qb = fx.tmap.T @ cross
         G = g0 - qb.T @ qb
         P = p0 - qb.T @ fx.qty

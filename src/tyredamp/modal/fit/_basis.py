@@ -316,20 +316,27 @@ def _model_block(
     sb: slice,
 ) -> NDArray[np.complex128]:
     """The weighted model ``rr`` times the columns of the lines ``sb`` (one block),
-    (n_out n_in, lines) complex (:func:`residual_lines`)."""
+    (n_out n_in, lines) complex (:func:`residual_lines`).
+
+    The columns ``a + b`` and ``i (a - b)`` of mode ``n`` (``a = kappa / (s - p_n)``,
+    ``b = kappa / (s - conj p_n)``) are ``2 t kappa / d`` and ``-2 Omega_n kappa / d``
+    with ``t = s + sigma_n`` and ``d = (s - p_n)(s - conj p_n) = t^2 + Omega_n^2``, as
+    in :func:`basis_ek`: one complex reciprocal per line and mode instead of two
+    divisions."""
     m = poles.size
     s, kap, kap_low = factors(fitter, sb)
     cols = np.empty((rr.shape[1], s.size), complex)
-    put_pair(
-        cols[: 2 * m, None, :],
-        0,
-        2,
-        (kap / (s - poles[:, None]))[:, None, :],
-        (kap / (s - np.conj(poles)[:, None]))[:, None, :],
-    )
+    if m:
+        t = s[None, :] + (-poles.real)[:, None]
+        h = np.multiply(t, t)
+        h += (poles.imag**2)[:, None]
+        np.reciprocal(h, out=h)
+        h *= 2.0 * kap[None, :]  # 2 kappa / d
+        np.multiply(t, h, out=cols[0 : 2 * m : 2])
+        np.multiply(h, (-poles.imag)[:, None], out=cols[1 : 2 * m : 2])
     c = 2 * m
-    for t, kk in zip(terms, (kap, kap_low), strict=True):
-        if t is not None:
+    for t_, kk in zip(terms, (kap, kap_low), strict=True):
+        if t_ is not None:
             cols[c] = kk
             c += 1
     return (rr @ cols.view(np.float64)).view(np.complex128)

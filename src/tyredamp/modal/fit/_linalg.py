@@ -43,6 +43,7 @@ def _fixed_range(
     yy: NDArray[np.float64],
     one: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
     n_rows: int | None = None,
+    sums: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The range of a fixed basis ``Phi``; ``blocks()`` returns its row blocks ``(Phi_b,
     Y_b)`` with those of the data (called again when a second pass is needed).
@@ -56,16 +57,20 @@ def _fixed_range(
     (:func:`_qr_blocks`) and the SVD ``R = U S V^T`` (``r`` singular values above
     ``1e-13`` times the largest): ``Q_r = Q U_r = Phi V_r S_r^-1``, so ``T = V_r
     S_r^-1`` and ``Q_r^T Y = U_r^T Q^T Y`` (a rank-deficient ``Phi`` included).
-    ``one = (Phi, Y)`` when they are one block. An ill-conditioned ``Phi`` of full
+    ``one = (Phi, Y)`` when they are one block; ``sums``: ``(Phi^T Phi, Phi^T Y)``
+    when the caller summed them already (no first pass). An ill-conditioned ``Phi`` of full
     rank (condition estimate up to :data:`_MAX_CQR2_COND`) is orthogonalised by
     CholeskyQR2 first, block by block (:func:`_cholqr2`: ``T = D^-1 R_1^-1
     R_2^-1``, ``Q^T Y = R_2^-T Q_1^T Y``), with the same cancellation test.
     """
-    G = np.zeros((q, q))
-    P = np.zeros((q, yy.size))
-    for Pb, Yb in blocks():
-        G += Pb.T @ Pb
-        P += Pb.T @ Yb
+    if sums is not None:
+        G, P = sums
+    else:
+        G = np.zeros((q, q))
+        P = np.zeros((q, yy.size))
+        for Pb, Yb in blocks():
+            G += Pb.T @ Pb
+            P += Pb.T @ Yb
     fac = _gram_chol(G)
     if fac is not None:
         rs, d = fac

@@ -101,6 +101,9 @@ class FitterState(Protocol):
     ) -> tuple[NDArray[np.complex128], NDArray[np.complex128]]:
         """Poles (m,) and participation (m, n_in) from the parameter vector."""
 
+    def _pseudo_lines(self) -> Any:
+        """The pseudo-lines of the data (:mod:`._pseudo`) or None."""
+
     def _basis_ek(
         self,
         th: NDArray[np.float64],

@@ -87,7 +87,7 @@ from numpy.typing import NDArray
 
 from ...exceptions import InputError
 from ..problem.compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
-from . import _added, _basis, _results, _scaling
+from . import _added, _basis, _pseudo, _results, _scaling
 from ._linalg import _levenberg_marquardt, _vp_solve, at_rest
 from ._results import FitResult
 
@@ -208,8 +208,18 @@ class ModalFitter:
             if unit_weights
             else 1.0 / np.where(self._rms > 0, self._rms, 1.0)
         )
+        # the pseudo-lines of the data of a long record (_pseudo), formed at first use
+        self._pl: _pseudo.PseudoLines | None = None
         # the fitter of fit_added's one added mode (formed once: settings never change)
         self._added_one = self._make_added_one()
+
+    def _pseudo_lines(self) -> _pseudo.PseudoLines | None:
+        """The pseudo-lines of the data (:mod:`._pseudo`) when they apply to this
+        fitter (a long record), formed at the first call and kept (about 1 % of the
+        data's memory); else None."""
+        if self._pl is None and _pseudo.applies(self):
+            self._pl = _pseudo.pseudo_lines(self)
+        return self._pl
 
     @property
     def Y(self) -> NDArray[np.float64]:
@@ -343,6 +353,17 @@ class ModalFitter:
 
             def explicit() -> Any:
                 return iter(kept)
+        elif not residual and (pl := self._pseudo_lines()) is not None:
+            # a long record: the Gram blocks from the pseudo-lines of the bins far
+            # from every pole (the lower residual term's at 0 for a negative power)
+            at_zero = [0j] if self.use_lower and self.power < 2 else []
+            G, P = _pseudo.gram_full(
+                self,
+                pl,
+                lambda fac, sl: self._basis_ek(th, m, ref, derivatives, sl, (fac, pp))[0],
+                np.concatenate([pp[0], at_zero]),
+            )
+            P = P * w
         else:
             G = np.zeros((n_col, n_col))
             P = np.zeros((n_col, self.n_out))

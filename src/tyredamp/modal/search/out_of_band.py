@@ -8,12 +8,15 @@ above and below the band while they pass the mode test
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ...exceptions import ConvergenceError
 from ...mechanics.modal_sum import pole_from_frequency_damping, pole_quantities
-from ..fit._basis import factors, residual_blocks
+from ..fit import _pseudo
+from ..fit._basis import factors, residual_blocks, residual_lines
 from ..fit.fit import FitResult, ModalFitter
 from ..statistics.quality import RejectedMode
 from .joint import SEARCH_TOL
@@ -173,6 +176,11 @@ def _scan_start(
     pg = np.concatenate(grids)
     poles, residues, terms, s2 = model_of(fitter, res)
     inv = 1.0 / np.sqrt(s2)
+    pl = fitter._pseudo_lines()
+    if pl is not None:  # a long record: the sums from pseudo-lines (fit._pseudo)
+        m, nrm2 = _pseudo_scan(fitter, pl, pg, (poles, residues, terms), inv)
+        t = rank_one_statistic(m, nrm2, fitter.n_out, fitter.n_in)
+        return complex(pg[int(np.argmax(t))])
     # the inner products <a_g, e_jk> and ||a_g||^2, summed over blocks of lines (the
     # residual of a long axis with many FRFs is never held whole)
     m = np.zeros((fitter.n_out * fitter.n_in, pg.size), complex)
@@ -195,3 +203,30 @@ def _took_tail(r: RejectedMode) -> RejectedMode:
     """An in-band mode that a residual mode's refit moved out of the band: it stood
     for the tail of the modes outside the band, which the residual mode now holds."""
     return replace(r, reason=f"{r.reason}, once a residual mode outside the band held the tails")
+
+
+def _pseudo_scan(
+    fitter: ModalFitter,
+    pl: _pseudo.PseudoLines,
+    pg: NDArray[np.complex128],
+    model: tuple[Any, Any, Any],
+    inv: NDArray[np.float64],
+) -> tuple[NDArray[np.complex128], NDArray[np.float64]]:
+    """The inner products of :func:`_scan_start` (``<a_g, e_jk>``, ``||a_g||^2``) on a
+    long record, from the pseudo-lines of the bins far from every grid pole
+    (:func:`~tyredamp.modal.fit._pseudo.scan_sums`, ``SCAN_CHUNK`` grid poles at a
+    time)."""
+    poles, residues, terms = model
+
+    def vals(sl: slice) -> Any:
+        e = residual_lines(fitter, poles, residues, terms, sl) * inv[:, None, None]
+        return e.reshape(-1, e.shape[-1])
+
+    return _pseudo.scan_sums(
+        fitter,
+        pl,
+        vals,
+        lambda s, kap, p: kap[None, :] / (s[None, :] - p[:, None]),
+        pg,
+        SCAN_CHUNK,
+    )

@@ -23,8 +23,10 @@ carry no bias.
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -140,12 +142,14 @@ def residual_peaks(
     sm[~(k * (sm - np.median(sm)) > SHARE * threshold)] = -np.inf
     narrow = list(_peaks(sm))
     del sm
-    lists = [narrow, list(_peaks(_broad_score(f, pw, k_terms, zeta0, threshold)))]
+    # taken from the front (deques: a list's pop(0) moves the rest, quadratic in the
+    # peaks of a long record)
+    lists = [deque(narrow), deque(_peaks(_broad_score(f, pw, k_terms, zeta0, threshold)))]
     out: list[float] = []
     while (lists[0] or lists[1]) and len(out) < n_max:
         for lst in lists:
             while lst:
-                fi = float(f[lst.pop(0)])
+                fi = float(f[lst.popleft()])
                 if all(abs(fi - g) > 0.01 * g for g in out):
                     out.append(fi)
                     break
@@ -444,6 +448,7 @@ def coherent_scan(
     ],
     s2: NDArray[np.float64],
     zeta0: float,
+    whole: NDArray[np.complex128] | None = None,
 ) -> ScanGrid:
     """Where the residual holds a resonance coherent across the FRFs.
 
@@ -462,7 +467,9 @@ def coherent_scan(
     several inputs as the model holds them, rank-one with their participation
     held, :func:`_rank_one_off_fitted`: freeing every input's coefficient took up
     most of a weak mode's share between two strong ones). ``model`` is the
-    fit's ``(poles, residues (n_out, n_in, m), (upper, lower))``.
+    fit's ``(poles, residues (n_out, n_in, m), (upper, lower))``; ``whole``: the
+    residual of every line in units of the noise when the caller formed it
+    (:func:`residual_view`).
     """
     fit = fitter
     f = np.asarray(fit.f, dtype=np.float64)
@@ -471,9 +478,8 @@ def coherent_scan(
         return empty
     poles, residues, terms = model
     inv = 1.0 / np.sqrt(np.maximum(np.asarray(s2, dtype=np.float64), 1e-300))
-    whole = None
-    if fit.n_out * fit.n_in * f.size <= SCAN_ENTRIES:
-        whole = residual_lines(fit, poles, residues, terms, slice(0, f.size)) * inv[:, None, None]
+    if whole is None and fit.n_out * fit.n_in * f.size <= SCAN_ENTRIES:
+        whole = _whole(fit, model, inv)
 
     def resid(sl: slice) -> NDArray[np.complex128]:
         if whole is not None:
@@ -555,5 +561,24 @@ def residual_view(
 ) -> tuple[ScanGrid, NDArray[np.float64]]:
     """The coherent scan of a fit's residual (:func:`scan_of`) and its residual power
     per line (n_f,) in units of each output's noise (:func:`power_of`): what one
-    round of the residual search reads, formed once per fit."""
-    return scan_of(fitter, res, zeta0), power_of(fitter, res)
+    round of the residual search reads, formed once per fit. When the scan holds
+    the residual of every line (``SCAN_ENTRIES``), the power is summed from it
+    (one pass of the model over the lines instead of two)."""
+    if fitter.n_out * fitter.n_in * fitter.n_f > SCAN_ENTRIES:
+        return scan_of(fitter, res, zeta0), power_of(fitter, res)
+    poles, residues, terms, s2 = model_of(fitter, res)
+    inv = 1.0 / np.sqrt(np.maximum(s2, 1e-300))
+    whole = _whole(fitter, (poles, residues, terms), inv)
+    grid = coherent_scan(fitter, (poles, residues, terms), s2, zeta0, whole)
+    # |e|^2 summed over the FRFs from the interleaved parts: one array of the lines
+    parts = whole.reshape(-1, fitter.n_f).view(np.float64).reshape(-1, fitter.n_f, 2)
+    return grid, np.einsum("jfr,jfr->f", parts, parts)
+
+
+def _whole(fitter: ModalFitter, model: Any, inv: NDArray[np.float64]) -> NDArray[np.complex128]:
+    """The residual of every line in units of each output's noise (``inv = 1 /
+    sigma``), (n_out, n_in, n_f)."""
+    poles, residues, terms = model
+    e = residual_lines(fitter, poles, residues, terms, slice(0, fitter.n_f))
+    e *= inv[:, None, None]
+    return e

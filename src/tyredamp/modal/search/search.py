@@ -116,6 +116,13 @@ class FixedParts:
         self.modes: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
         self.value: FixedPart | None = None
 
+    def release(self) -> None:
+        """Drop the fixed part held when it holds pseudo-lines of its basis (a long
+        record's; formed again at the next trial), not to be held while the residual
+        of every line is (:func:`residual_search`)."""
+        if self.value is not None and self.value.pseudo is not None:
+            self.modes = self.value = None
+
     def of(self, p_all: NDArray[np.complex128], l_all: NDArray[np.complex128]) -> FixedPart | None:
         """The fixed part of these modes (None when it cannot be formed)."""
         held = self.modes
@@ -354,11 +361,11 @@ def residual_search(
     another mode's misfit: it is kept only when its tails hold evidence beyond
     those on both sides, away from the ends of the lines and from the other
     modes (:func:`~tyredamp.modal.search.narrow.narrow_refusal`; poles up to 3 lines
-    wide against a spike and a step), in the trial and again in the joint
-    refit. A trial mode that passes
-    is refitted with all modes (:func:`_joint`) and kept when it stays in the
-    band, merges with no mode, is still admissible and every mode still passes
-    the test; a trial mode that alone crosses a band edge in the joint refit,
+    wide against a spike and a step), in the trial and again in the joint refit.
+    A trial mode that passes is refitted with all modes (:func:`_joint`) and
+    kept when it stays in the band, merges with no mode, is still admissible and
+    every mode still passes the test; a trial mode that alone crosses a band edge
+    in the joint refit,
     to an admissible pole within a factor 2 of the edge that passes the test, is
     a mode outside the band whose tail the data hold: it is kept as a residual
     mode while fewer than ``max_helpers`` lie on that side (the limit of
@@ -370,8 +377,8 @@ def residual_search(
     toward a band edge that a trial crossed (it runs toward the same structure
     outside the band).
 
-    ``candidates`` are starting poles and participation vectors from the
-    diagram; each round adds the peaks of the current residual. Every candidate
+    ``candidates`` are starting poles and participation vectors from the diagram;
+    each round adds the peaks of the current residual. Every candidate
     of the diagram gets a record: not tried (too little residual power in its
     half-power band, the same pole as a mode or an earlier start, the round's
     ``MAX_TRIALS`` reached), where its trial mode went and why it was rejected,
@@ -382,8 +389,7 @@ def residual_search(
     refit, raised where the noise of that fit's residual (the mode in it: a
     true mode's signal does not count as noise) lies along the response
     (:func:`local_thresholds`). ``fixed``: the trials' fixed parts
-    (:class:`FixedParts`; shared with :func:`search_helpers` by the caller, or
-    new).
+    (:class:`FixedParts`; shared with :func:`search_helpers` by the caller, or new).
     """
     df = float(fitter.f[1] - fitter.f[0]) if fitter.f.size > 1 else 0.0
     tried: list[RejectedMode] = []
@@ -402,6 +408,7 @@ def residual_search(
         # the residual's peaks first (where the structure is), then the diagram's;
         # when they add nothing, the coherent scan's poles (one round per mode set)
         if view_of is not res:
+            fixed.release()  # a long record's, not held beside the residual of every line
             view, view_of = residual_view(fitter, res, zeta0), res
         starts, screened = round_starts(
             fitter, res, view, pending, threshold, zeta0, test, scan_next

@@ -93,19 +93,36 @@ class FrfStep:
     def run(data: TimeData, settings: FrfSettings, where: str = "") -> tuple[FRF, dict[str, Any]]:
         """FRFs of ``data`` with ``settings``; ``where`` prefixes the names of the
         lengths in messages (``"settings.radial.frf."``; the CLI gives ``"--"``)."""
+        frf = frf_from_time(data, **FrfStep._arguments(data, settings, where))
+        return frf, {}
+
+    @staticmethod
+    def records(data: TimeData, settings: FrfSettings, where: str = "") -> tuple[FRF, list[FRF]]:
+        """The FRF of :meth:`run` and one FRF per record it averages (each hit of an
+        impact test alone, on the same lines: :mod:`tyredamp.signal.records`)."""
+        from ...signal.records import estimate_record_frfs
+
+        kw = FrfStep._arguments(data, settings, where)
+        return estimate_record_frfs(data, kw.pop("estimator"), **kw)
+
+    @staticmethod
+    def _arguments(data: TimeData, settings: FrfSettings, where: str) -> dict[str, Any]:
+        """The estimator's arguments from the step's settings (lengths in samples)."""
         s = settings
         rate = data.sample_rate
-        frf = frf_from_time(
-            data,
-            s.estimator,  # type: ignore[arg-type]
-            reference=list(s.reference) if s.reference else None,
-            method=None if s.method == "auto" else s.method,  # type: ignore[arg-type]
-            segment_samples=s.segment,
-            period_samples=None if s.period is None else samples(s.period, rate, where + "period"),
-            settle_samples=None if s.settle is None else samples(s.settle, rate, where + "settle"),
-            band=s.band,
-        )
-        return frf, {}
+        return {
+            "estimator": s.estimator,
+            "reference": list(s.reference) if s.reference else None,
+            "method": None if s.method == "auto" else s.method,
+            "segment_samples": s.segment,
+            "period_samples": None
+            if s.period is None
+            else samples(s.period, rate, where + "period"),
+            "settle_samples": None
+            if s.settle is None
+            else samples(s.settle, rate, where + "settle"),
+            "band": s.band,
+        }
 
 
 def frf_from_time(

@@ -9,6 +9,7 @@ the verdicts into the modes document (``meta.verdict`` of each model,
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -150,6 +151,71 @@ class ModalStep:
         for mdl in res.models.values():
             label_wave_numbers(mdl)
         return res, dict(modal_verdicts(frf, res))
+
+    @staticmethod
+    def replicates(
+        result: ModalIdentification, replicates: Sequence[FRF], settings: ModalSettings
+    ) -> list[Any]:
+        """Find each mode again in each replicate (``tyredamp modal --replicate``).
+
+        Each replicate is identified alone with ``settings`` (complex modes, the
+        mode count its own), over the fit's band and then over a mode's own band
+        (:func:`tyredamp.modal.replicates.replicate_support`); the finding of
+        each mode goes into ``meta["replicates"]`` of the complex model (the real
+        one when there is none) and is returned, one
+        :class:`~tyredamp.modal.replicates.ReplicateSupport` per mode.
+        """
+        from dataclasses import replace
+
+        import numpy as np
+
+        from ...modal.replicates import replicate_support
+
+        name = "complex" if "complex" in result.models else "real"
+        model = result.models[name]
+        cache: dict[tuple[int, float, float], np.ndarray] = {}
+
+        def identify(k: int, band: tuple[float, float]) -> np.ndarray:
+            key = (k, round(band[0], 9), round(band[1], 9))
+            if key not in cache:
+                sub = replace(settings, band=band, model="complex", n_modes=None, frequencies=None)
+                try:
+                    found = ModalStep.run_modes(replicates[k], sub)
+                except InputError:  # too few lines in a mode's own band: nothing found there
+                    found = np.empty(0, dtype=complex)
+                cache[key] = found
+            return cache[key]
+
+        df = float(np.median(np.diff(result.frequency))) if result.frequency.size > 1 else 0.0
+        support = replicate_support(
+            model,
+            len(replicates),
+            identify,
+            band=(float(result.band_hz[0]), float(result.band_hz[1])),
+            df=df,
+        )
+        model.meta["replicates"] = [s.to_dict() for s in support]
+        return support
+
+    @staticmethod
+    def run_modes(frf: FRF, settings: ModalSettings) -> Any:
+        """The poles (rad/s) of the modes of ``frf`` that the mode test keeps."""
+        from ...modal.identify import identify_modes
+        from ...modal.replicates import kept_poles
+
+        s = settings
+        res = identify_modes(
+            frf,
+            band=s.band,
+            model="complex",
+            max_order=s.max_order,
+            order_step=s.order_step,
+            residuals=s.residuals,
+            false_alarm=s.false_alarm,
+            search=s.search,
+            estimator=_estimators()[s.estimator],
+        )
+        return kept_poles(res.models["complex"])
 
     @staticmethod
     def document(
