@@ -163,8 +163,8 @@ class ModelContext:
     along: NDArray[np.float64] | None = None
     #: the factors of the variances of each in-band mode's frequency and damping
     #: ratio under the noise's structure across outputs (n_band, 2; fit order;
-    #: :func:`~tyredamp.modal.final.pole_variance_ratios`); None: not known, ``along``
-    #: stands for it
+    #: :func:`~tyredamp.modal.final.sandwiched`, whose fit then holds the shapes'
+    #: errors under it too); None: not known, ``along`` stands for it
     pole_ratio: NDArray[np.float64] | None = None
 
 
@@ -276,14 +276,18 @@ def _inflations(
     variances of their frequencies and damping ratios (n, 2), and the factors of the
     standard errors of the shapes (n,) and of frequency and damping ratio (n, 2):
     the square root of the larger of the local dispersion ``disp`` and the noise
-    along the response, or for frequency and damping ratio the sandwich's factor
-    where known (:attr:`ModelContext.pole_ratio`)."""
+    along the response; where the sandwich is known (:attr:`ModelContext.pole_ratio`)
+    the sandwich's factor for frequency and damping ratio, and for the shapes, whose
+    errors are then the sandwich's own (:func:`~tyredamp.modal.final.sandwiched`), the
+    square root of the local dispersion alone."""
     n = o.size
     along = np.ones(n) if ctx.along is None else np.asarray(ctx.along, dtype=float)[o]
     ratio = np.repeat(along[:, None], 2, axis=1)
+    shapes = np.sqrt(np.maximum(disp, along))
     if ctx.pole_ratio is not None:
         ratio = np.asarray(ctx.pole_ratio, dtype=float)[o]
-    return along, ratio, np.sqrt(np.maximum(disp, along)), np.sqrt(np.maximum(disp[:, None], ratio))
+        shapes = np.sqrt(disp)
+    return along, ratio, shapes, np.sqrt(np.maximum(disp[:, None], ratio))
 
 
 def to_model(

@@ -30,11 +30,12 @@ from numpy.typing import NDArray
 
 from ..exceptions import ConvergenceError
 from .assemble import goodness, local_dispersion, to_model, unscale  # noqa: F401 (re-exported)
+from .fit._scaling import pole_std
 from .fit.fit import FitResult, ModalFitter, pole_bounds
 from .fit.ml import fisher_scale, ml_refine
 from .fit.profile import fit_intervals
 from .problem.problem import FitProblem
-from .sandwich import sandwich_ratios
+from .sandwich import sandwich_shapes
 from .search.refitted import refitted_statistics
 from .search.resolution import unresolved_pair, unresolved_pair_text
 from .search.search import (
@@ -166,7 +167,8 @@ def fit_real(
     (:func:`~tyredamp.modal.fit.profile.fit_intervals`), as in the complex model.
     Also returns the in-band modes' noise along the response
     (:func:`noise_along_response`) and the factors of their poles' variances
-    (:func:`pole_variance_ratios`), as :func:`final_complex` does.
+    (:func:`sandwiched`, whose shapes' errors the returned fit then holds), as
+    :func:`final_complex` does.
     """
     p0, l0, modes = start
     m, nf = modes.m, modes.n_free
@@ -226,7 +228,8 @@ def fit_real(
                 res = ml
             # likelihood intervals where the linearised ones would be too short
             res.intervals = fit_intervals(fitter, res, m, sigma0)
-            return res, m, [], *_along(problem, fitter, res, m, sigma)
+            res, ratio = sandwiched(problem, fitter, res, m, sigma)
+            return res, m, [], noise_along_response(fitter, res, m), ratio
         if bad >= m + nf:
             keep = np.arange(start_p.size) != bad
             start_p, start_l, p0, l0 = start_p[keep], start_l[keep], p0[keep], l0[keep]
@@ -271,19 +274,6 @@ def _watched(
     return (res, *_problem(res, m, n_free, band, _floor_hz(fitter)))
 
 
-def _along(
-    problem: FitProblem,
-    fitter: ModalFitter,
-    res: FitResult,
-    m: int,
-    sigma: NDArray[np.float64] | None,
-) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-    """:func:`noise_along_response` and :func:`pole_variance_ratios` of a final fit."""
-    return noise_along_response(fitter, res, m), pole_variance_ratios(
-        problem, fitter, res, m, sigma
-    )
-
-
 def noise_along_response(
     fitter: ModalFitter, res: FitResult, n_band: int, alpha: float = 0.05
 ) -> NDArray[np.float64]:
@@ -299,8 +289,8 @@ def noise_along_response(
     ``2 n_in^2 n`` real units of noise, so under independent outputs ``lambda_in
     nu`` is ``chi2_nu`` with ``nu = 2 n_in^2 n``; it is used where it exceeds that
     law's upper ``alpha`` quantile over ``nu``. Where the FRF carries its input
-    noise, the frequencies' and damping ratios' standard errors take the
-    sandwich's factors instead (:func:`pole_variance_ratios`): averaged over the
+    noise, the standard errors of the frequencies, damping ratios and shapes are
+    the sandwich's instead (:func:`sandwiched`): averaged over the
     window, ``lambda_in`` mixes the lines where the force's noise dominates with
     those where the responses' does, and scatters from seed to seed.
     """
@@ -410,7 +400,9 @@ def final_complex(
         res = maximum_likelihood(problem, cfit, res)
         # likelihood intervals where the linearised ones would be too short
         res.intervals = fit_intervals(cfit, res, cur.m, sigma0)
-    ratio = pole_variance_ratios(problem, cfit, res, cur.m, sigma0) if refine else None
+    ratio = None
+    if refine:
+        res, ratio = sandwiched(problem, cfit, res, cur.m, sigma0)
     return res, cur, dropped, thr, noise_along_response(cfit, res, cur.m), ratio
 
 
@@ -532,25 +524,67 @@ def pole_variance_ratios(
 ) -> NDArray[np.float64] | None:
     """The factors of the variances of each in-band mode's frequency and damping ratio
     (n_band, 2; fit order) under the noise's structure across outputs, White's
-    sandwich (:func:`~tyredamp.modal.sandwich.sandwich_ratios`): where the FRF
-    carries its input noise (:attr:`~tyredamp.frf.FRF.input_noise`, the part of
-    the variance common to all outputs) and ``res`` is the maximum-likelihood fit
-    with its per-line variance, or the weighted least-squares fit of ``fitter``
-    (each output weighted by ``1 / sigma0``, its residual RMS without ``sigma0``).
-    None otherwise: the modes' noise along the response
-    (:func:`noise_along_response`) then stands for that structure.
+    sandwich (:func:`sandwiched`); None where it is not formed."""
+    return sandwiched(problem, fitter, res, n_band, sigma0)[1]
+
+
+def sandwiched(
+    problem: FitProblem,
+    fitter: ModalFitter,
+    res: FitResult,
+    n_band: int,
+    sigma0: NDArray[np.float64] | None,
+) -> tuple[FitResult, NDArray[np.float64] | None]:
+    """The fit with the shapes' standard errors of White's sandwich, and the factors of
+    the variances of each in-band mode's frequency and damping ratio (n_band, 2; fit
+    order) under it, over the variances the fit reports
+    (:func:`~tyredamp.modal.sandwich.sandwich_shapes`; for f and zeta by the delta
+    method of :func:`~tyredamp.modal.fit._scaling.pole_std`).
+
+    Formed where the FRF carries its input noise (:attr:`~tyredamp.frf.FRF.input_noise`,
+    the part of the variance common to all outputs) and ``res`` is the
+    maximum-likelihood fit with its per-line variance, or the weighted least-squares
+    fit of ``fitter`` (each output weighted by ``1 / sigma0``, its residual RMS
+    without ``sigma0``); ``std_psi_out`` and ``std_psi_in`` of the returned fit are
+    then the sandwich's (the standard errors of a known or estimated variance, the
+    latter times the Fisher scale :func:`~tyredamp.modal.fit.ml.fisher_scale`), which
+    replace the fit's errors inflated by the noise along the response. Otherwise
+    (or where the sandwich is not finite) ``res`` unchanged and None: the modes'
+    noise along the response (:func:`noise_along_response`) then stands for that
+    structure.
     """
     r = problem.frf.input_noise
     if r is None or problem.variance is None or n_band == 0:
-        return None
+        return res, None
     ml = res.status.startswith("maximum likelihood")
     fit = _plain(problem, fitter) if ml else fitter
     # the ML fit reports its inverse information times its Fisher scale (an estimated variance)
     scale = fisher_scale(problem.noise_dof, 0.0, 1) if ml else 1.0
     w = None if ml else fitter.weights(res.sigma_out if sigma0 is None else sigma0)
+    m = int(res.poles.size)
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            out = sandwich_ratios(fit, res, w, problem.variance, r[:, problem.lines], n_band, scale)
+            cov, s_out, s_in, kappa = sandwich_shapes(
+                fit, res, w, problem.variance, r[:, problem.lines], scale
+            )
+            # the entries' errors as a consumer that takes them independent needs them
+            # for the shape's amplitude (eq. (S3) of modal.sandwich)
+            kappa = np.where(np.isfinite(kappa), np.maximum(kappa, 1.0), 1.0)
+            s_out = s_out * np.sqrt(kappa)[None, :]
+            f1, z1, _ = pole_std(fit.w_ref, fit.pack(*_start(res)), m, cov)
+            f0 = np.asarray(res.std_frequency_hz, float)
+            z0 = np.asarray(res.std_damping_ratio, float)
+            out = np.stack([(f1 / f0) ** 2, (z1 / z0) ** 2], axis=1)[:n_band]
     except (np.linalg.LinAlgError, ValueError):  # no covariance: the noise along the response
-        return None
-    return out if np.isfinite(out).all() else None
+        return res, None
+    if not (np.isfinite(out).all() and np.isfinite(s_out).all() and np.isfinite(s_in).all()):
+        return res, None
+    return dataclasses.replace(res, std_psi_out=s_out, std_psi_in=s_in), out
+
+
+def _start(
+    res: FitResult,
+) -> tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.intp]]:
+    """Poles, participation and reference inputs of ``res`` as the sandwich packs them."""
+    part = np.asarray(res.participation, complex)
+    return res.poles, part, np.argmax(np.abs(part), axis=1).astype(np.intp)

@@ -257,17 +257,36 @@ def input_shape_std(
     Without a drive point ``c_n = 1`` (complex) and only ``theta`` counts.
     """
     n_par = th.size
-    poles, part = fitter.unpack(th, m, ref)
-    cplx = fitter.kind == "complex"
-    omega = poles.imag
     if didx.size:
         F, MD, MC = _coefficient_sensitivity(sol, cth, didx)
         sgg = _global_cov(cth, MC, MD, s2, F)
         beta = scale_jacobian(fitter, th, m, ref, sol["C"][:, didx].T, w[didx])
+    else:
+        sgg, beta = cth, np.zeros((n_par, m), complex)
+    return input_std_given(fitter, th, m, ref, sgg, beta, b, bool(didx.size))
+
+
+def input_std_given(
+    fitter: FitterState,
+    th: NDArray[np.float64],
+    m: int,
+    ref: NDArray[np.intp],
+    sgg: NDArray[np.float64],
+    beta: NDArray[np.complex128],
+    b: NDArray[np.complex128],
+    drive: bool,
+) -> NDArray[np.float64]:
+    """``sqrt(E|d psi_in|^2)`` (n_in, m) of :func:`input_shape_std` from a given covariance
+    ``sgg`` of ``G = [theta, C_D]`` (or of ``theta`` alone without a drive point, then
+    ``beta`` is zero) and ``beta = d b / d G`` (:func:`scale_jacobian`)."""
+    poles, part = fitter.unpack(th, m, ref)
+    cplx = fitter.kind == "complex"
+    omega = poles.imag
+    if drive:
         bb = np.where(b == 0, 1.0, b)
         c = 1.0 / bb if cplx else 1.0 / (bb * 2j * omega)
     else:
-        sgg, beta, bb = cth, np.zeros((n_par, m), complex), np.ones(m, complex)
+        bb = np.ones(m, complex)
         c = np.ones(m, complex) if cplx else 1.0 / np.sqrt(2j * omega)
     out = np.zeros((fitter.n_in, m))
     idx = 2 * m
@@ -275,7 +294,7 @@ def input_shape_std(
         ln = part[n]
         dlog = -beta[:, n] / bb[n]
         if not cplx:  # d ln Omega of 1 / (2 i Omega), or of 1 / sqrt(2 i Omega) without b
-            dlog[2 * n + 1] -= (1.0 if didx.size else 0.5) * fitter.w_ref / omega[n]
+            dlog[2 * n + 1] -= (1.0 if drive else 0.5) * fitter.w_ref / omega[n]
         for k in range(fitter.n_in):
             g = ln[k] * dlog
             if k != ref[n]:
