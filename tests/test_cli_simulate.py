@@ -86,7 +86,11 @@ def test_simulate_radial_writes_uff58(radial_files: dict[str, Path]) -> None:
     # metadata record (data sets 151) before them
     data = [s for s in sets if s["type"] == 58]
     assert {s["func_type"] for s in data} == {0, 4, 6}
-    assert {s["id1"].strip() for s in data if s["func_type"] == 0} == {"tyredamp FRF variance"}
+    # the variance per pair and the force noise's relative variance per input
+    assert {s["id1"].strip() for s in data if s["func_type"] == 0} == {
+        "tyredamp FRF variance",
+        "tyredamp FRF input noise",
+    }
     frf = read_frf(radial_files["frf"])
     assert frf.H.shape[:2] == (16, 1)
     assert frf.kind == "accelerance"
