@@ -149,67 +149,47 @@ def _frf_sets(obj: FRF, binary: bool) -> list[dict[str, Any]]:
                 data=np.array(obj.H[o, i], dtype=complex),
             )
             sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+
+    def real_set(
+        id1_: str, fid_: int, ftype: int, pair: dict[str, Any], lab: str, unit: str, data: Any
+    ) -> dict[str, Any]:
+        """One data set of real values per line (coherence, variance, input noise)."""
+        d = _base_set(binary, q, id1_, id2, id3)
+        d.update(
+            func_type=ftype,
+            func_id=fid_,
+            **pair,
+            ordinate_spec_data_type=0,
+            ordinate_len_unit_exp=0,
+            ordinate_force_unit_exp=0,
+            ordinate_axis_lab=lab,
+            ordinate_axis_units_lab=unit,
+            data=np.array(data, dtype=float),
+        )
+        return _abscissa(d, x, uneven, 18, "Frequency", "Hz")
+
     if obj.coherence is not None:
         ref = obj.inputs[0] if obj.n_in == 1 else Channel(node=0, direction=0)
+        name = "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence"
         for o, co in enumerate(obj.outputs):
             fid += 1
-            d = _base_set(
-                binary,
-                q,
-                "tyredamp coherence" if obj.n_in == 1 else "tyredamp multiple coherence",
-                id2,
-                id3,
+            sets.append(
+                real_set(name, fid, 6, _pair_fields(co, ref), "Coherence", "NONE", obj.coherence[o])
             )
-            d.update(
-                func_type=6,
-                func_id=fid,
-                rsp_node=co.node,
-                rsp_dir=co.direction,
-                ref_node=ref.node,
-                ref_dir=ref.direction,
-                id4=_extras_line(co),
-                id5=_extras_line(ref),
-                ordinate_spec_data_type=0,
-                ordinate_len_unit_exp=0,
-                ordinate_force_unit_exp=0,
-                ordinate_axis_lab="Coherence",
-                ordinate_axis_units_lab="NONE",
-                data=np.array(obj.coherence[o], dtype=float),
-            )
-            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
     if obj.variance is not None:
+        unit = f"({obj.unit})^2"[:20]
         for o, co in enumerate(obj.outputs):
             for i, ci in enumerate(obj.inputs):
                 fid += 1
-                d = _base_set(binary, q, VARIANCE_ID, id2, id3)
-                d.update(
-                    func_type=0,
-                    func_id=fid,
-                    **_pair_fields(co, ci),
-                    ordinate_spec_data_type=0,
-                    ordinate_len_unit_exp=0,
-                    ordinate_force_unit_exp=0,
-                    ordinate_axis_lab="Variance of H",
-                    ordinate_axis_units_lab=f"({obj.unit})^2"[:20],
-                    data=np.array(obj.variance[o, i], dtype=float),
-                )
-                sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+                pair = _pair_fields(co, ci)
+                var = obj.variance[o, i]
+                sets.append(real_set(VARIANCE_ID, fid, 0, pair, "Variance of H", unit, var))
     if obj.input_noise is not None:
         for i, ci in enumerate(obj.inputs):
             fid += 1
-            d = _base_set(binary, q, INPUT_NOISE_ID, id2, id3)
-            d.update(
-                func_type=0,
-                func_id=fid,
-                **_pair_fields(ci, ci),
-                ordinate_spec_data_type=0,
-                ordinate_len_unit_exp=0,
-                ordinate_force_unit_exp=0,
-                ordinate_axis_lab="Relative input noise",
-                ordinate_axis_units_lab="NONE",
-                data=np.array(obj.input_noise[i], dtype=float),
-            )
-            sets.append(_abscissa(d, x, uneven, 18, "Frequency", "Hz"))
+            pair = _pair_fields(ci, ci)
+            lab, rin = "Relative input noise", obj.input_noise[i]
+            sets.append(real_set(INPUT_NOISE_ID, fid, 0, pair, lab, "NONE", rin))
     return sets
 
 
