@@ -336,7 +336,7 @@ def final_complex(
     order; None without ``threshold``) and each in-band mode's noise along the
     response (:func:`noise_along_response`, fit order) and the factors of the
     variances of its frequency and damping ratio under the noise's structure
-    across outputs (:func:`pole_variance_ratios`; None where not known). When
+    across outputs (:func:`sandwiched`; None where not known). When
     every mode passes with the other poles held, modes beside a stronger one are
     tested once more with the neighbours' poles refitted
     (:mod:`~tyredamp.modal.search.refitted`: the likelihood ratio of the
@@ -513,19 +513,6 @@ def _plain(problem: FitProblem, fitter: ModalFitter) -> ModalFitter:
         upper=fitter.use_upper,
         lower=fitter.use_lower,
     )
-
-
-def pole_variance_ratios(
-    problem: FitProblem,
-    fitter: ModalFitter,
-    res: FitResult,
-    n_band: int,
-    sigma0: NDArray[np.float64] | None,
-) -> NDArray[np.float64] | None:
-    """The factors of the variances of each in-band mode's frequency and damping ratio
-    (n_band, 2; fit order) under the noise's structure across outputs, White's
-    sandwich (:func:`sandwiched`); None where it is not formed."""
-    return sandwiched(problem, fitter, res, n_band, sigma0)[1]
 
 
 def sandwiched(

@@ -43,19 +43,18 @@ with ``d_jf = min(r_f |h_jf|^2, V_jf)`` the common part's share of the diagonal
 (``D_f >= 0``). The cost is that of one more evaluation of ``J`` plus
 ``O(n_lines n_par^2)`` for the updates. ``h`` is the fitted model (not the noisy
 data). The fit reports ``s A^-1`` (``s`` its Fisher scale for an estimated
-variance, :func:`~tyredamp.modal.fit.ml.fisher_scale`); :func:`sandwich_ratios`
-returns, for the frequency and the damping ratio of each mode, the variance of
-(1) over the variance the fit reports by the delta method, the factor the
-reported variances are multiplied by. The sandwich holds for any weights
-``W``: for the weighted least-squares fit with the separable weights ``1 /
-(sigma_j sqrt(g_f))`` its diagonal part is ``J^T W diag(D) W J`` (not ``A``).
+variance, :func:`~tyredamp.modal.fit.ml.fisher_scale`); the final stage
+(:func:`~tyredamp.modal.final.sandwiched`) takes, for the frequency and the
+damping ratio of each mode, the variance of (1) over the variance the fit
+reports by the delta method, the factor the reported variances are multiplied
+by. The sandwich holds for any weights ``W``: for the weighted least-squares
+fit with the separable weights ``1 / (sigma_j sqrt(g_f))`` its diagonal part
+is ``J^T W diag(D) W J`` (not ``A``).
 :func:`sandwich_shapes` extends it to the shapes (the residues are linear given
 the poles: their errors under ``Sigma_f`` plus the poles' part, eq. (S1)-(S2) of
 its docstring) and gives the factor (S3) by which the common part raises the
-variance of each shape's amplitude along itself; the final stage
-(:func:`~tyredamp.modal.final.sandwiched`) uses these in place of
-:func:`sandwich_ratios` (the same factors of frequency and damping ratio, from the
-covariance of ``theta`` that :func:`sandwich_shapes` returns too).
+variance of each shape's amplitude along itself; the final stage takes the
+covariance of ``theta`` it returns too.
 """
 
 from __future__ import annotations
@@ -69,12 +68,12 @@ from numpy.typing import NDArray
 
 from .fit import _basis
 from .fit._results import coefficient_parts
-from .fit._scaling import input_std_given, pole_std
+from .fit._scaling import input_std_given
 
 if TYPE_CHECKING:
     from .fit.fit import FitResult, ModalFitter
 
-__all__ = ["sandwich_covariance", "sandwich_ratios", "sandwich_shapes"]
+__all__ = ["sandwich_covariance", "sandwich_shapes"]
 
 
 def _solve_gram(gram: NDArray[np.float64], rhs: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -100,6 +99,43 @@ def _row_weights(variance: NDArray[np.float64], sl: slice) -> NDArray[np.float64
     v = np.asarray(variance[:, :, sl], dtype=float).reshape(n_out, -1)
     v = np.where(v > 0, v, low[:, None])
     return np.repeat(1.0 / np.sqrt(v / 2.0), 2, axis=1).T
+
+
+def _rows(
+    fitter: ModalFitter, variance: NDArray[np.float64], out_weights: NDArray[np.float64] | None
+) -> Callable[[slice], NDArray[np.float64]]:
+    """The row weights (rows, n_out) of the lines ``sl`` as the fit weights them: each
+    real row by ``1 / sqrt(V / 2)`` (``out_weights`` None: the maximum-likelihood fit)
+    or each output by its ``out_weights`` (the weighted least-squares fit)."""
+    n_out, n_in = fitter.n_out, fitter.n_in
+
+    def rows(sl: slice) -> NDArray[np.float64]:
+        if out_weights is None:
+            return _row_weights(variance, sl)
+        return np.broadcast_to(
+            np.asarray(out_weights, float), (2 * n_in * _count(fitter, sl), n_out)
+        )
+
+    return rows
+
+
+def _noise_weights(
+    fitter: ModalFitter, rows: Callable[[slice], NDArray[np.float64]], sl: slice
+) -> NDArray[np.float64]:
+    """The weight ``w_jf`` of each line's noise (n_in nb, n_out): the output's row weight
+    times the fitter's line weight."""
+    lw = fitter.line_weights
+    return rows(sl)[0::2] * (1.0 if lw is None else np.tile(lw[sl], fitter.n_in)[:, None])
+
+
+def _own_noise(
+    vj: NDArray[np.float64], r: NDArray[np.float64], hj: NDArray[Any], w: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """``D_f w^2 / 2`` of one output per real row (2 n_in nb, 1): its own noise, the
+    variance ``vj`` less the common part's share ``min(r |h|^2, V)`` (eq. (3)), each
+    of the (n_in, nb) entries twice (real and imaginary row)."""
+    dj = vj - np.minimum(r * np.abs(hj) ** 2, vj)
+    return np.repeat((dj * w**2 / 2.0).reshape(-1), 2)[:, None]
 
 
 def sandwich_covariance(
@@ -132,45 +168,27 @@ def sandwich_covariance(
         The inverse information, the sandwich covariance (units of the fit's
         parameters ``theta``, :meth:`ModalFitter.pack`) and ``theta``.
     """
-    n_out, n_in = fitter.n_out, fitter.n_in
+    n_in = fitter.n_in
     v = np.asarray(variance, dtype=float)
-    lw = fitter.line_weights
-
-    def rows(sl: slice) -> NDArray[np.float64]:
-        if out_weights is None:
-            return _row_weights(v, sl)
-        return np.broadcast_to(
-            np.asarray(out_weights, float), (2 * n_in * _count(fitter, sl), n_out)
-        )
-
+    rows = _rows(fitter, v, out_weights)
     th, blocks = _jacobians(fitter, res, rows)
     n_par = th.size
     a = np.zeros((n_par, n_par))
     b = np.zeros((n_par, n_par))
     for sl, jac in blocks:
         nb = _count(fitter, sl)
-        # the weight of each row's noise: the output's and the line's
-        om = rows(sl)[0::2] * (1.0 if lw is None else np.tile(lw[sl], n_in)[:, None])
+        om = _noise_weights(fitter, rows, sl)
         h = np.asarray(res.model[:, :, sl])  # (n_out, n_in, nb)
         r = np.asarray(input_noise[:, sl], dtype=float)  # (n_in, nb)
-        u = np.zeros((n_in, nb, n_par))
-        w2 = np.zeros((n_in, nb, n_par))
+        u, w2 = np.zeros((n_in, nb, n_par)), np.zeros((n_in, nb, n_par))
         for j, jj in enumerate(jac):
             a += jj.T @ jj
-            jr = jj[0::2].reshape(n_in, nb, n_par)
-            ji = jj[1::2].reshape(n_in, nb, n_par)
             w = om[:, j].reshape(n_in, nb)
-            hr, hi = h[j].real * w, h[j].imag * w  # (n_in, nb)
-            u += jr * hr[..., None] + ji * hi[..., None]  # eq. (2)
-            w2 += ji * hr[..., None] - jr * hi[..., None]
-            vj = v[j][:, sl]
-            dj = vj - np.minimum(r * np.abs(h[j]) ** 2, vj)  # D_f, the outputs' own noise
-            dd = (dj * w**2 / 2.0).reshape(-1, 1)
-            for x in (jr.reshape(-1, n_par), ji.reshape(-1, n_par)):
-                b += (x * dd).T @ x  # eq. (3), the diagonal D
-        rr = (r / 2.0).reshape(-1, 1)
-        for x in (u.reshape(-1, n_par), w2.reshape(-1, n_par)):
-            b += (x * rr).T @ x  # eq. (3), the common part
+            u1, v1 = _common(jj, h[j].real * w, h[j].imag * w)  # eq. (2)
+            u += u1
+            w2 += v1
+            b += (jj * _own_noise(v[j][:, sl], r, h[j], w)).T @ jj  # eq. (3), the diagonal D
+        b += _rank_two(u, w2, u, w2, (r / 2.0)[..., None])  # eq. (3), the common part
     ainv = np.asarray(np.linalg.pinv(0.5 * (a + a.T), hermitian=True), dtype=np.float64)
     cov = np.asarray(ainv @ (0.5 * (b + b.T)) @ ainv, dtype=np.float64)
     return ainv, cov, th
@@ -271,30 +289,6 @@ def _count(fitter: ModalFitter, sl: slice) -> int:
     return len(range(fitter.n_f)[sl])
 
 
-def sandwich_ratios(
-    fitter: ModalFitter,
-    res: FitResult,
-    out_weights: NDArray[np.float64] | None,
-    variance: NDArray[np.float64],
-    input_noise: NDArray[np.float64],
-    n_band: int,
-    scale: float = 1.0,
-) -> NDArray[np.float64]:
-    """Variance of the frequency and of the damping ratio of each of the first
-    ``n_band`` modes under the sandwich (1) times ``scale`` over their variance as the
-    fit reports it (``res.std_frequency_hz``, ``res.std_damping_ratio``), shape
-    (n_band, 2), by the delta method (module docstring); arguments as
-    :func:`sandwich_covariance`. NaN where the fit's standard error is zero or
-    not finite."""
-    _, cov, th = sandwich_covariance(fitter, res, out_weights, variance, input_noise)
-    f1, z1, _ = pole_std(fitter.w_ref, th, int(res.poles.size), cov)
-    f0 = np.asarray(res.std_frequency_hz, float)
-    z0 = np.asarray(res.std_damping_ratio, float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = scale * np.stack([(f1 / f0) ** 2, (z1 / z0) ** 2], axis=1)[:n_band]
-    return np.where(np.isfinite(out), out, np.nan)
-
-
 def _common(
     x: NDArray[np.float64], hr: NDArray[np.float64], hi: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -346,7 +340,6 @@ def _shape_sums(
     n_par, m = pr.th.size, len(pr.ref)
     p = 2 * m if fitter.kind == "complex" else m
     ng = n_par + didx.size * q
-    lw = fitter.line_weights
     v = np.asarray(variance, dtype=float)
     a, bg = np.zeros((n_par, n_par)), np.zeros((ng, ng))
     own, cross = np.zeros((n_out, p, p)), np.zeros((n_out, p, ng))
@@ -362,7 +355,7 @@ def _shape_sums(
 
     for sl in pr.parts:
         nb = _count(fitter, sl)
-        om = rows(sl)[0::2] * (1.0 if lw is None else np.tile(lw[sl], n_in)[:, None])
+        om = _noise_weights(fitter, rows, sl)
         h = model[:, :, sl]
         r = np.asarray(input_noise[:, sl], dtype=float)
         rr = (r / 2.0)[..., None]
@@ -371,9 +364,7 @@ def _shape_sums(
         for j, (jac, x) in enumerate(_outputs(fitter, pr, rows, sl, True)):
             a += jac.T @ jac
             w = om[:, j].reshape(n_in, nb)
-            vj = v[j][:, sl]
-            dj = vj - np.minimum(r * np.abs(h[j]) ** 2, vj)  # D_f, the outputs' own noise
-            dd.append(np.repeat((dj * w**2 / 2.0).reshape(-1), 2)[:, None])  # per real row
+            dd.append(_own_noise(v[j][:, sl], r, h[j], w))  # D_f, the outputs' own noise
             z = scores(j, jac, x)
             bg += (z * dd[j]).T @ z  # eq. (3), the diagonal D
             u1, v1 = _common(z, h[j].real * w, h[j].imag * w)
@@ -461,16 +452,9 @@ def sandwich_shapes(
         of the fit's data over the square root of a modal mass with a drive point; of
         the data without) and ``kappa`` of (S3) (m,).
     """
-    n_out, n_in = fitter.n_out, fitter.n_in
+    n_out = fitter.n_out
     v = np.asarray(variance, dtype=float)
-
-    def rows(sl: slice) -> NDArray[np.float64]:
-        if out_weights is None:
-            return _row_weights(v, sl)
-        return np.broadcast_to(
-            np.asarray(out_weights, float), (2 * n_in * _count(fitter, sl), n_out)
-        )
-
+    rows = _rows(fitter, v, out_weights)
     pr = _project(fitter, res, rows)
     didx = np.array([j for j, _ in fitter.drive], dtype=np.intp)
     model = _model(fitter, res, pr)
@@ -534,7 +518,6 @@ def _amplitude_ratio(
     psi, std, alpha, g, crs, cov_g = entries
     n_in = fitter.n_in
     m = psi.shape[1]
-    lw = fitter.line_weights
     with np.errstate(divide="ignore", invalid="ignore"):
         info = np.abs(psi) ** 2 / std**2
         info = np.where(np.isfinite(info), info, 0.0)
@@ -545,7 +528,7 @@ def _amplitude_ratio(
     own = np.einsum("jap,jpk,jak->a", y, sums.own_d, y)  # the outputs' own noise D
     for sl in pr.parts:
         nb = _count(fitter, sl)
-        om = rows(sl)[0::2] * (1.0 if lw is None else np.tile(lw[sl], n_in)[:, None])
+        om = _noise_weights(fitter, rows, sl)
         h = model[:, :, sl]
         rr = (np.asarray(input_noise[:, sl], dtype=float) / 2.0)[..., None]
         uq, vq = np.zeros((n_in, nb, 2 * m)), np.zeros((n_in, nb, 2 * m))
