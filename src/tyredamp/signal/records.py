@@ -25,7 +25,7 @@ from ..exceptions import InputError
 from ..frf import FRF, Channel
 from ..timedata import TimeData
 from .estimators import Estimator, _resolve_io, cross_spectra, estimate_frf, frf_from_spectra
-from .segmenting import Method, choose_method, plan_starts, segment_plan
+from .segmenting import Method, SegmentPlan, choose_method, plan_starts, segment_plan
 
 __all__ = ["estimate_record_frfs"]
 
@@ -110,7 +110,7 @@ def _record(
     frf: FRF,
     io: tuple[list[int], list[int]],
     estimator: Estimator,
-    plan: Any,
+    plan: SegmentPlan,
     start: int,
     k: int,
 ) -> FRF:

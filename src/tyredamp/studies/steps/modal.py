@@ -131,23 +131,9 @@ class ModalStep:
         (:func:`label_wave_numbers`); the verdicts are returned, not stored in
         the models (:meth:`document` stores them).
         """
-        from ...modal.identify import identify_modes
         from ..verdicts import modal_verdicts
 
-        s = settings
-        res = identify_modes(
-            frf,
-            band=s.band,
-            model=s.model,  # type: ignore[arg-type]
-            n_modes=s.n_modes,
-            frequencies=s.frequencies,
-            max_order=s.max_order,
-            order_step=s.order_step,
-            residuals=s.residuals,
-            false_alarm=s.false_alarm,
-            search=s.search,
-            estimator=_estimators()[s.estimator],
-        )
+        res = ModalStep._identify(frf, settings)
         for mdl in res.models.values():
             label_wave_numbers(mdl)
         return res, dict(modal_verdicts(frf, res))
@@ -178,9 +164,8 @@ class ModalStep:
         def identify(k: int, band: tuple[float, float]) -> np.ndarray:
             key = (k, round(band[0], 9), round(band[1], 9))
             if key not in cache:
-                sub = replace(settings, band=band, model="complex", n_modes=None, frequencies=None)
                 try:
-                    found = ModalStep.run_modes(replicates[k], sub)
+                    found = ModalStep.run_modes(replicates[k], replace(settings, band=band))
                 except InputError:  # too few lines in a mode's own band: nothing found there
                     found = np.empty(0, dtype=complex)
                 cache[key] = found
@@ -199,23 +184,32 @@ class ModalStep:
 
     @staticmethod
     def run_modes(frf: FRF, settings: ModalSettings) -> Any:
-        """The poles (rad/s) of the modes of ``frf`` that the mode test keeps."""
-        from ...modal.identify import identify_modes
+        """The poles (rad/s) of the complex modes of ``frf`` that the mode test keeps, the
+        mode count the data's own (``settings``' model, mode count and frequencies not used)."""
         from ...modal.replicates import kept_poles
 
-        s = settings
-        res = identify_modes(
-            frf,
-            band=s.band,
-            model="complex",
-            max_order=s.max_order,
-            order_step=s.order_step,
-            residuals=s.residuals,
-            false_alarm=s.false_alarm,
-            search=s.search,
-            estimator=_estimators()[s.estimator],
-        )
+        res = ModalStep._identify(frf, settings, model="complex", n_modes=None, frequencies=None)
         return kept_poles(res.models["complex"])
+
+    @staticmethod
+    def _identify(frf: FRF, settings: ModalSettings, **override: Any) -> ModalIdentification:
+        """``identify_modes`` of ``frf`` with ``settings``, some arguments overridden."""
+        from ...modal.identify import identify_modes
+
+        s = settings
+        kw: dict[str, Any] = {
+            "band": s.band,
+            "model": s.model,
+            "n_modes": s.n_modes,
+            "frequencies": s.frequencies,
+            "max_order": s.max_order,
+            "order_step": s.order_step,
+            "residuals": s.residuals,
+            "false_alarm": s.false_alarm,
+            "search": s.search,
+            "estimator": _estimators()[s.estimator],
+        }
+        return identify_modes(frf, **{**kw, **override})
 
     @staticmethod
     def document(
