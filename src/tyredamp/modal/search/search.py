@@ -109,12 +109,18 @@ class FixedParts:
     formed at the first trial against a mode set and passed to every trial
     against the same modes (equal poles and participation), across the search
     stages. Owned by the caller of the stages; the fitter keeps nothing.
+    ``at_edge``: the sides of the band (+1 above, -1 below) whose residual-mode
+    trials all ran into the band edge
+    (:func:`~tyredamp.modal.search.out_of_band.search_helpers`: in-band structure
+    at the edge, a missed mode there), searched again by :func:`residual_search`
+    once it adds an in-band mode.
     """
 
     def __init__(self, fitter: ModalFitter) -> None:
         self.fitter = fitter
         self.modes: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
         self.value: FixedPart | None = None
+        self.at_edge: set[float] = set()
 
     def release(self) -> None:
         """Drop the fixed part held when it holds pseudo-lines of its basis (a long
@@ -441,7 +447,8 @@ def residual_search(
             if isinstance(got, RejectedMode) or got is None:
                 tried += start_records(got, p0, complex(p0) in from_diagram)
                 continue
-            res, cur = got
+            res, cur, more = _edges_again(fitter, got, cur.m, fixed, band, threshold, max_helpers)
+            tried += more
             added, refused, crossed, scanned = True, [], set(), False
             if complex(p0) in from_diagram:
                 tried.append(rejected(p0, KEPT))
@@ -451,11 +458,36 @@ def residual_search(
             )
             if got2 is None:
                 break
-            res, cur = got2
+            res, cur, more = _edges_again(fitter, got2, cur.m, fixed, band, threshold, max_helpers)
+            tried += more
             refused, crossed, scanned = [], set(), False
         elif not added:
             scan_next = True
     return res, cur, tried
+
+
+def _edges_again(
+    fitter: ModalFitter,
+    got: tuple[FitResult, ModeSet],
+    m_was: int,
+    fixed: FixedParts,
+    band: tuple[float, float],
+    threshold: float,
+    max_helpers: int,
+) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
+    """The fit and modes ``got`` of :func:`residual_search`, with residual modes added
+    on the sides whose helper trials ran into the band edge (``fixed.at_edge``,
+    :func:`~tyredamp.modal.search.out_of_band.more_helpers`) when ``got`` holds more
+    in-band modes than ``m_was``: the structure at the edge may have been the mode
+    just added, which hid the tails of the modes outside. Also returns the in-band
+    modes those refits moved out of the band."""
+    res, cur = got
+    if not fixed.at_edge or cur.m <= m_was:
+        return res, cur, []
+    from .out_of_band import more_helpers  # out_of_band builds on this module
+
+    sides = sorted(fixed.at_edge, reverse=True)
+    return more_helpers(fitter, got, fixed, band, sides, threshold, max_helpers)
 
 
 def _try_start(
