@@ -150,30 +150,13 @@ def _helper(
     threshold: float,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]] | str | None:
     """A helper trial on ``side`` (+1 above the band, -1 below) of
-    :func:`search_helpers`: the refit with it, "lost" when the joint refit lost
-    it (into the band, or merged), ``EDGE`` when every trial stopped at the band
-    edge, None when it failed otherwise (not significant, at the far limit, or
-    moved out of its range). The trials start at the scan's maxima
-    (:func:`_scan_starts`), the next when one fails; the first that passes is
-    refitted with all modes."""
-    lo, hi = band
-    edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
-    w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
-    at_edge, found = 0, None
-    starts = _scan_starts(fitter, res, edge, side, zeta0, threshold)
-    ones = np.ones(fitter.n_in, complex)
-    for ph in starts:
-        got = _trial(fitter, res, cur, fixed, ph, ones, w_lim, strict=False)
-        if got is None:
-            continue
-        stop = _toward(got[0], w_lim)
-        if stop == -side:
-            at_edge += 1  # in-band structure at the edge: no mode outside
-        elif stop == 0 and got[2] >= threshold:
-            found = got
-            break
-    if found is None:
-        return EDGE if starts and at_edge == len(starts) else None
+    :func:`search_helpers` (:func:`helper_trial`): the refit with it, "lost" when
+    the joint refit lost it (into the band, or merged), ``EDGE`` when every trial
+    stopped at the band edge, None when it failed otherwise (not significant, at
+    the far limit, or moved out of its range)."""
+    found = helper_trial(fitter, res, cur, fixed, band, side, zeta0, threshold)
+    if found is None or isinstance(found, str):
+        return found
     p_t, l_t, _ = found
     try:
         trial, new, lost = fit_checked(
@@ -192,6 +175,40 @@ def _helper(
     # the helper must stay on its side of the band, within a factor 2 of the edge
     on_side = outside_side(new.hp[-1].imag / (2 * np.pi), band) == side
     return (trial, new, lost) if on_side else None
+
+
+def helper_trial(
+    fitter: ModalFitter,
+    res: FitResult,
+    cur: ModeSet,
+    fixed: FixedParts,
+    band: tuple[float, float],
+    side: float,
+    zeta0: float,
+    threshold: float,
+) -> tuple[complex, NDArray[np.complex128], float] | str | None:
+    """The trial of a residual mode on ``side`` (+1 above the band, -1 below) against
+    the fit ``res`` of the modes ``cur``, refined alone within a factor 2 of the
+    band edge: its pole, participation and statistic ``T``. The trials start at the
+    scan's maxima (:func:`_scan_starts`), the next when one stops at a limit of its
+    range or does not pass ``threshold``. ``EDGE`` when every trial stopped at the
+    band edge (the residual there is in-band structure), else None when none passes."""
+    lo, hi = band
+    edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
+    w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
+    at_edge = 0
+    starts = _scan_starts(fitter, res, edge, side, zeta0, threshold)
+    ones = np.ones(fitter.n_in, complex)
+    for ph in starts:
+        got = _trial(fitter, res, cur, fixed, ph, ones, w_lim, strict=False)
+        if got is None:
+            continue
+        stop = _toward(got[0], w_lim)
+        if stop == -side:
+            at_edge += 1  # in-band structure at the edge: no mode outside
+        elif stop == 0 and got[2] >= threshold:
+            return got
+    return EDGE if starts and at_edge == len(starts) else None
 
 
 #: damping ratios of the scan for a residual mode's start, relative to the modes'
