@@ -20,19 +20,21 @@ from ..fit._basis import factors, residual_blocks, residual_lines
 from ..fit.fit import FitResult, ModalFitter
 from ..statistics.quality import RejectedMode
 from .joint import SEARCH_TOL
-from .modeset import outside_side, with_residual
+from .modeset import ModeSet, fit_checked, outside_side, with_residual
 from .residual_peaks import model_of, rank_one_statistic
-from .search import (
-    FIRST_NFEV,
-    MIN_LOW_LINES,
-    FixedParts,
-    ModeSet,
-    _toward,
-    _trial,
-    fit_checked,
-)
+from .trials import FixedParts, _toward, _trial
 
-__all__ = ["search_helpers"]
+__all__ = ["FIRST_NFEV", "MIN_LOW_LINES", "more_helpers", "search_helpers"]
+
+#: evaluation limit of the search's first joint fit: before the residual modes are
+#: found, the modes near a band edge absorb the out-of-band ones and converge slowly
+#: (linearly) to that biased optimum; one Gauss-Newton step takes most of the gain
+#: from the estimator's poles, the later joint fits and the final fit do the rest
+FIRST_NFEV = 2
+#: a residual mode below the band (damped frequency in [f_lo / 2, f_lo]) shapes the
+#: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
+#: starts at the first lines) it cannot be told from the lower residual term
+MIN_LOW_LINES = 10
 
 
 def search_helpers(

@@ -21,7 +21,7 @@ rad/s: where one resonance's pole can take up the other's response) or an
 overlapping residual mode, the model without it (every pole free, from the
 final fit's values), and takes ``T`` as the drop of the residual power when
 the mode is added to that refitted model, in units of each output's noise (as
-the search's trials, :func:`~tyredamp.modal.search.search._trial`). Modes without
+the search's trials, :func:`~tyredamp.modal.search.trials._trial`). Modes without
 such a neighbour keep ``T`` (their neighbours' poles do not move), so a band
 of separated modes costs no refit; a mode whose ``T`` stays above its
 threshold with twice the Gauss-Newton decrement of the model without it taken

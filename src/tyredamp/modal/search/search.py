@@ -42,7 +42,6 @@ from numpy.typing import NDArray
 
 from ...exceptions import ConvergenceError
 from ...mechanics.modal_sum import pole_quantities
-from ..fit._added import FixedPart
 from ..fit.fit import FitResult, ModalFitter
 from ..statistics.quality import KEPT, RejectedMode, threshold_text
 from .joint import SEARCH_TOL, _inadmissible, _joint, _split
@@ -55,6 +54,7 @@ from .modeset import (
     too_damped,
 )
 from .narrow import narrow_refusal, too_narrow
+from .out_of_band import more_helpers
 from .residual_peaks import (
     residual_view,
 )
@@ -68,6 +68,7 @@ from .search_starts import (
 )
 from .span_noise import SpanNoise
 from .thresholds import ModeTest, local_thresholds, residual_span
+from .trials import FixedParts, _toward, _trial, sigma_bound
 
 __all__ = [
     "FixedParts",
@@ -77,124 +78,15 @@ __all__ = [
     "reject_by_test",
     "residual_search",
     "residual_span",
+    "sigma_bound",
 ]
 
-#: convergence threshold of a trial mode, in units of the residual variance s^2
-#: (ModalFitter.fit_added ``tol``): a trial stops when a further step would lower the
-#: cost by less than 1 s^2; like SEARCH_TOL (:mod:`.joint`) it only chooses the modes.
-TRIAL_TOL = 1.0
-#: evaluation limit of the search's first joint fit: before the residual modes are
-#: found, the modes near a band edge absorb the out-of-band ones and converge slowly
-#: (linearly) to that biased optimum; one Gauss-Newton step takes most of the gain
-#: from the estimator's poles, the later joint fits and the final fit do the rest
-FIRST_NFEV = 2
-#: a residual mode below the band (damped frequency in [f_lo / 2, f_lo]) shapes the
-#: FRFs mainly near f_lo; with fewer lines than this in [f_lo, 2 f_lo] (a band that
-#: starts at the first lines) it cannot be told from the lower residual term
-MIN_LOW_LINES = 10
 #: residual search: most rounds (they go on while one adds a mode; this only bounds them)
 MAX_ROUNDS = 50
 #: residual search: a candidate's frequency stays within this factor of its start
 TRIAL_SPAN = 0.03
-#: evaluation limit of a trial mode (a mode that is there converges in a few steps)
-TRIAL_NFEV = 30
 #: times a trial stopped at its window's limit is continued beyond it (_follow)
 FOLLOW = 3
-
-
-class FixedParts:
-    """The fixed parts of the trials of one identification: each trial refines
-    an added mode against the current modes (:meth:`ModalFitter.fit_added`),
-    whose fixed part (:meth:`ModalFitter.fixed_part`, an immutable value) is
-    formed at the first trial against a mode set and passed to every trial
-    against the same modes (equal poles and participation), across the search
-    stages. Owned by the caller of the stages; the fitter keeps nothing.
-    ``at_edge``: the sides of the band (+1 above, -1 below) whose residual-mode
-    trials all ran into the band edge
-    (:func:`~tyredamp.modal.search.out_of_band.search_helpers`: in-band structure
-    at the edge, a missed mode there), searched again by :func:`residual_search`
-    once it adds an in-band mode.
-    """
-
-    def __init__(self, fitter: ModalFitter) -> None:
-        self.fitter = fitter
-        self.modes: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
-        self.value: FixedPart | None = None
-        self.at_edge: set[float] = set()
-
-    def release(self) -> None:
-        """Drop the fixed part held when it holds pseudo-lines of its basis (a long
-        record's; formed again at the next trial), not to be held while the residual
-        of every line is (:func:`residual_search`)."""
-        if self.value is not None and self.value.pseudo is not None:
-            self.modes = self.value = None
-
-    def of(self, p_all: NDArray[np.complex128], l_all: NDArray[np.complex128]) -> FixedPart | None:
-        """The fixed part of these modes (None when it cannot be formed)."""
-        held = self.modes
-        if held is None or not (np.array_equal(held[0], p_all) and np.array_equal(held[1], l_all)):
-            self.modes = (p_all.copy(), l_all.copy())
-            try:
-                self.value = self.fitter.fixed_part(p_all, l_all)
-            except (np.linalg.LinAlgError, ValueError):
-                self.value = None
-        return self.value
-
-
-def _trial(
-    fitter: ModalFitter,
-    res: FitResult,
-    modes: ModeSet,
-    fixed: FixedParts,
-    pole: complex,
-    part: NDArray[np.complex128],
-    w_lim: tuple[float, float],
-    strict: bool = True,
-    max_damping: float | None = None,
-) -> tuple[complex, NDArray[np.complex128], float] | None:
-    """Refine one added mode alone against ``modes`` (their fixed part from
-    ``fixed``); its statistic ``T``. ``strict``: None when it stopped at a limit
-    of ``w_lim`` (an out-of-band residual mode that runs into the band edge is
-    not there); otherwise the limit only localises the trial. ``max_damping``:
-    the trial's decay rate is bounded by that damping ratio at the window's upper
-    limit (:func:`sigma_bound`), so that a trial that would be refused for its
-    damping stops at the bound instead of running on (None: no bound)."""
-    p_all, l_all = modes.all()
-    fx = fixed.of(p_all, l_all)
-    if fx is None:
-        return None
-    try:
-        p_t, l_t, sig_t = fitter.fit_added(
-            p_all,
-            l_all,
-            pole,
-            part,
-            omega_bounds=w_lim,
-            tol=TRIAL_TOL,
-            fixed=fx,
-            max_nfev=TRIAL_NFEV,
-            sigma_max=None if max_damping is None else sigma_bound(max_damping, w_lim[1]),
-        )
-    except (np.linalg.LinAlgError, ValueError):
-        return None
-    tol = 1e-4 * (w_lim[1] - w_lim[0])
-    if strict and not (w_lim[0] + tol < p_t.imag < w_lim[1] - tol):
-        return None  # a trial pole stopped at a limit did not find a mode there
-    n_all = p_all.size
-    dof0 = max(fitter.n_rows - fitter.n_cols(n_all), 1)
-    dof1 = max(fitter.n_rows - fitter.n_cols(n_all + 1), 1)
-    s2a = np.maximum(sig_t**2, np.maximum(fitter.noise_floor**2, 1e-300))
-    s2b = np.maximum(res.sigma_out**2, s2a)
-    t = float(np.sum((s2b * dof0 - s2a * dof1) / s2a))
-    return p_t, l_t, t
-
-
-def sigma_bound(max_damping: float, omega: float) -> float:
-    """The decay rate ``sigma = -Re p`` (rad/s) of damping ratio ``max_damping`` at the
-    damped natural frequency ``omega`` (rad/s): ``zeta = sigma / |p|`` with ``|p|^2
-    = sigma^2 + omega^2`` gives ``sigma = zeta omega / sqrt(1 - zeta^2)``. A pole
-    with ``Im p <= omega`` and a larger decay rate has a larger damping ratio."""
-    return float(max_damping * omega / np.sqrt(1.0 - max_damping**2))
 
 
 def reject_by_test(
@@ -332,16 +224,6 @@ def _follow(
     return (got, w_lim) if got is not None else None
 
 
-def _toward(p: complex, w_lim: tuple[float, float]) -> int:
-    """The side (+1 up, -1 down, 0 none) of the window ``w_lim`` (rad/s) at whose
-    limit a trial pole ``p`` stopped: it found no optimum inside its window and
-    runs toward structure beyond it."""
-    tol = 1e-4 * (w_lim[1] - w_lim[0])
-    if p.imag >= w_lim[1] - tol:
-        return 1
-    return -1 if p.imag <= w_lim[0] + tol else 0
-
-
 def residual_search(
     fitter: ModalFitter,
     res: FitResult,
@@ -447,8 +329,7 @@ def residual_search(
             if isinstance(got, RejectedMode) or got is None:
                 tried += start_records(got, p0, complex(p0) in from_diagram)
                 continue
-            res, cur, more = _edges_again(fitter, got, cur.m, fixed, band, threshold, max_helpers)
-            tried += more
+            res, cur = _edges_again(got, cur.m, fixed, band, (threshold, max_helpers), tried)
             added, refused, crossed, scanned = True, [], set(), False
             if complex(p0) in from_diagram:
                 tried.append(rejected(p0, KEPT))
@@ -458,8 +339,7 @@ def residual_search(
             )
             if got2 is None:
                 break
-            res, cur, more = _edges_again(fitter, got2, cur.m, fixed, band, threshold, max_helpers)
-            tried += more
+            res, cur = _edges_again(got2, cur.m, fixed, band, (threshold, max_helpers), tried)
             refused, crossed, scanned = [], set(), False
         elif not added:
             scan_next = True
@@ -467,27 +347,28 @@ def residual_search(
 
 
 def _edges_again(
-    fitter: ModalFitter,
     got: tuple[FitResult, ModeSet],
     m_was: int,
     fixed: FixedParts,
     band: tuple[float, float],
-    threshold: float,
-    max_helpers: int,
-) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
-    """The fit and modes ``got`` of :func:`residual_search`, with residual modes added
-    on the sides whose helper trials ran into the band edge (``fixed.at_edge``,
-    :func:`~tyredamp.modal.search.out_of_band.more_helpers`) when ``got`` holds more
+    limits: tuple[float, int],
+    tried: list[RejectedMode],
+) -> tuple[FitResult, ModeSet]:
+    """The fit and modes ``got`` of :func:`residual_search` (on ``fixed.fitter``), with
+    residual modes added on the sides whose helper trials ran into the band edge
+    (``fixed.at_edge``, :func:`~tyredamp.modal.search.out_of_band.more_helpers`)
+    when ``got`` holds more
     in-band modes than ``m_was``: the structure at the edge may have been the mode
-    just added, which hid the tails of the modes outside. Also returns the in-band
-    modes those refits moved out of the band."""
+    just added, which hid the tails of the modes outside. ``limits``: the mode
+    test's threshold and the most residual modes a side; ``tried`` gets the records
+    of the in-band modes those refits moved out of the band."""
     res, cur = got
     if not fixed.at_edge or cur.m <= m_was:
-        return res, cur, []
-    from .out_of_band import more_helpers  # out_of_band builds on this module
-
+        return res, cur
     sides = sorted(fixed.at_edge, reverse=True)
-    return more_helpers(fitter, got, fixed, band, sides, threshold, max_helpers)
+    res, cur, lost = more_helpers(fixed.fitter, got, fixed, band, sides, limits[0], limits[1])
+    tried += lost
+    return res, cur
 
 
 def _try_start(
