@@ -14,7 +14,8 @@ The system, in order of construction
    with designed ``omega`` (the same mass and mode shapes, other natural
    frequencies: the spectral form of a symmetric positive definite pencil,
    ``Phi^T K Phi = diag(omega^2)``). ``n_modes - 1`` in-band slots in
-   0.04-0.92 ``f_hi`` at least 6 % apart, one of them a close pair (below);
+   0.04-0.92 ``f_hi``, roughly evenly spread but at least 6 % apart, one of
+   them a close pair (below);
    the remaining modes above the band, from 1.1-1.3 ``f_hi`` up with the
    network's own frequency ratios (at most 8 ``f_hi``).
 3. Measured points: ``n_out`` random DOFs (the others unmeasured); the
@@ -125,14 +126,25 @@ def _network(n: int, rng: np.random.Generator) -> tuple[NDArray[np.float64], NDA
 def _slots(n_slots: int, f_hi: float, rng: np.random.Generator) -> NDArray[np.float64]:
     """``n_slots`` ascending frequencies (Hz) in ``[BAND_LO, BAND_HI] f_hi``, ratios >= MIN_RATIO.
 
-    The log-gaps are ``ln MIN_RATIO`` plus a Dirichlet share of the rest of the range.
+    ``f_(i+1) = MIN_RATIO f_i + e_i`` from ``f_0`` in 1-1.5 ``BAND_LO f_hi`` to
+    ``f_N`` in 0.92-1 ``BAND_HI f_hi``, the increments ``e_i >= 0`` in
+    proportion to Dirichlet shares ``d_i``, scaled so that the last lands on
+    ``f_N`` (``sum_i e_i MIN_RATIO^(N-1-i) = f_N - f_0 MIN_RATIO^N``): a
+    roughly even density in frequency, as a one-dimensional structure has,
+    and no two slots closer than the ratio.
     """
-    span = np.log(BAND_HI / BAND_LO)
-    g = np.log(MIN_RATIO)
-    if (n_slots - 1) * g > span:
+    n = n_slots - 1
+    lo = BAND_LO * f_hi * rng.uniform(1.0, 1.5)
+    hi = BAND_HI * f_hi * rng.uniform(0.92, 1.0)
+    budget = hi - lo * MIN_RATIO**n
+    if budget < 0:
         raise ValueError(f"n_modes: {n_slots + 1} modes do not fit in the band {MIN_RATIO} apart")
-    gaps = g + (span - (n_slots - 1) * g) * rng.dirichlet(np.ones(n_slots))
-    return np.asarray(BAND_LO * f_hi * np.exp(np.concatenate([[0.0], np.cumsum(gaps[:-1])])))
+    d = rng.dirichlet(np.ones(n))
+    e = budget * d / np.sum(d * MIN_RATIO ** (n - 1 - np.arange(n)))
+    f = [lo]
+    for step in e:
+        f.append(MIN_RATIO * f[-1] + step)
+    return np.asarray(f)
 
 
 def _above(
