@@ -345,7 +345,8 @@ def physical_case(
     (Popov & Geng eq. [10], the exact state-space FRF of eq. [4]-[9]), noise
     as :func:`add_noise`. ``meta["physics"]``: the structure's figures
     (:func:`perf_physical.describe`) and each in-band mode's peak over the
-    noise (``peak_snr_db``, :func:`perf_physical.mode_peak_snr_db`).
+    noise (``peak_snr_db``, :func:`perf_physical.mode_peak_snr_db`; the weak
+    mode's ``weak_peak_snr_db``).
     """
     from perf_physical import mode_peak_snr_db, physical_system
 
@@ -360,6 +361,7 @@ def physical_case(
     psi_in = cm.psi[ps.inputs][:, ps.in_band]
     physics = dict(ps.info)
     physics["peak_snr_db"] = mode_peak_snr_db(poles, psi, psi_in, np.asarray(ex.H), snr_db)
+    physics["weak_peak_snr_db"] = float(physics["peak_snr_db"][ps.weak])
     physics["outputs"], physics["inputs"] = ps.outputs + 1, ps.inputs + 1
     return Case(
         name=f"physical {n_out} x {n_in}, {n_lines} lines, {n_modes} modes, {snr_db:g} dB",

@@ -178,7 +178,8 @@ def print_physics(res: dict[str, Any]) -> None:
         f"MPC median {p['mpc_median']:.4f} (min {p['mpc_min']:.3f}), off-diagonal share of "
         f"C' {p['offdiag_share']:.2f}; close pair {p['pair_hz'][0]:.1f}/{p['pair_hz'][1]:.1f} Hz "
         f"{p['pair_bandwidths']:.2f} half-power bandwidths apart; weak mode {p['weak_hz']:.1f} Hz "
-        f"{p['weak_below_median_db']:.1f} dB below the median peak; peaks over the noise "
+        f"{p['weak_below_median_db']:.1f} dB below the median peak and "
+        f"{p['weak_peak_snr_db']:.0f} dB over the noise; peaks over the noise "
         f"{snr.min():.0f}-{snr.max():.0f} dB",
         flush=True,
     )
