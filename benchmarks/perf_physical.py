@@ -339,18 +339,19 @@ def physical_system(
 ) -> PhysicalSystem:
     """A random non-proportionally damped structure with ``n_modes`` modes below ``f_hi``.
 
-    Construction in the module docstring: network, tuning, Rayleigh damping
-    plus dashpots, a close pair, drive points, a weak mode.
+    Construction in the module docstring: network, tuning, drive points,
+    Rayleigh damping plus dashpots, a weak mode, a close pair, corrections.
 
     Parameters
     ----------
     n_out : int
         Measured DOFs (>= 1); the structure has ``max(n_out + max(2, n_out // 4),
-        n_modes + n_in + 4)`` DOFs, the rest unmeasured.
+        n_modes + n_in + 2 n_dash + 4)`` DOFs with ``n_dash = 2 + n_modes // 10``
+        dashpots, the rest unmeasured.
     n_in : int
         Drive points, among the outputs (1 <= n_in <= n_out).
     n_modes : int
-        Modes in ``(0, f_hi]`` (4-45 fit the band's slots).
+        Modes in ``(0, f_hi]``, 4 to 47 (the band's slots 6 % apart).
     seed : int
         Seed of everything drawn.
     f_hi : float
