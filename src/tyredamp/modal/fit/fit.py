@@ -87,7 +87,7 @@ from numpy.typing import NDArray
 
 from ...exceptions import InputError
 from ..problem.compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
-from . import _added, _basis, _pseudo, _results, _scaling
+from . import _added, _basis, _gram_lines, _pseudo, _results, _scaling
 from ._linalg import _levenberg_marquardt, _vp_solve, at_rest
 from ._results import FitResult
 
@@ -345,7 +345,20 @@ class ModalFitter:
 
         explicit = rows
         one = None
-        if len(parts) == 1:  # one block: formed once, kept for the QR route
+        pl = None if len(parts) == 1 or residual else self._pseudo_lines()
+        if pl is None and _gram_lines.applies(self):
+            # complex modes, several inputs: the Gram blocks from per-line sums of
+            # the atoms (_gram_lines), the basis formed only for the QR route
+            G, P = _gram_lines.gram(self, pp, ref, derivatives, parts)
+            P = P * w
+            if len(parts) == 1:  # formed at most once, kept for the QR route's passes
+                kept: list[Any] = []
+
+                def explicit() -> Any:
+                    if not kept:
+                        kept.extend(rows())
+                    return iter(kept)
+        elif len(parts) == 1:  # one block: formed once, kept for the QR route
             kept = list(rows())
             B, Yb = kept[0]
             G, P = B.T @ B, B.T @ Yb
@@ -353,7 +366,7 @@ class ModalFitter:
 
             def explicit() -> Any:
                 return iter(kept)
-        elif not residual and (pl := self._pseudo_lines()) is not None:
+        elif pl is not None:
             # a long record: the Gram blocks from the pseudo-lines of the bins far
             # from every pole (the lower residual term's at 0 for a negative power)
             at_zero = [0j] if self.use_lower and self.power < 2 else []
