@@ -10,7 +10,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from tyredamp.frf import FRF
-from tyredamp.modal.fit import _basis, _gram_lines
+from tyredamp.modal.fit import _added, _basis, _gram_lines
 from tyredamp.modal.fit.fit import ModalFitter
 from tyredamp.modal.identify import identify_modes
 
@@ -144,3 +144,44 @@ def test_identify_modes_finds_the_same_modes_by_either_route(
     # the same refinements from sums equal to rounding: the same optimum to 1e-9
     assert_allclose(f1, f0, rtol=1e-9)
     assert_allclose(z1, z0, rtol=1e-9)
+
+
+@pytest.mark.parametrize(("n_in", "weights", "same_pole"), [(2, True, False), (3, False, True)])
+def test_fit_added_is_the_same_by_either_route(
+    n_in: int, weights: bool, same_pole: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # several blocks of lines (the per-line route of fit_added needs them)
+    monkeypatch.setattr(_basis, "BLOCK_BYTES", 20_000)
+    rng = np.random.default_rng(5)
+    f = np.linspace(5.0, 200.0, 600)
+    H = rng.normal(size=(4, n_in, f.size)) + 1j * rng.normal(size=(4, n_in, f.size))
+    lw = rng.uniform(0.5, 2.0, f.size) if weights else None
+    fit = ModalFitter(f, H, 2, "complex", [(0, 0), (1, 1)], line_weights=lw)
+    poles = 2 * np.pi * np.array([20.0, 70.0, 130.0]) * (-0.02 + 1j)
+    part = rng.normal(size=(3, n_in)) + 1j * rng.normal(size=(3, n_in))
+    # a trial mode next to a fixed one (2e-4 of its frequency): its columns lie nearly
+    # in the fixed basis's span, which takes the QR route of the projected rows
+    p1 = poles[1] * (1 + 2e-4j) if same_pole else 2 * np.pi * 100.0 * (-0.02 + 1j)
+    l1 = part[1] if same_pole else rng.normal(size=n_in) + 1j * rng.normal(size=n_in)
+    one, lay1, _ = fit._added_fitter()
+    ref1 = np.array([int(np.argmax(np.abs(l1)))], np.intp)
+    th1 = one.pack(np.array([p1]), l1[None, :], ref1)
+    got = []
+    for use in (False, True):
+        monkeypatch.setattr(_gram_lines, "USE", use)
+        fx = fit.fixed_part(poles, part)
+        assert len(fx.parts) > 1
+        assert (fx.atoms is not None) == use
+        sol = _added.added_solver(fit, one, fx, ref1, lay1)(th1)
+        got.append((sol, fit.fit_added(poles, part, p1, l1, fixed=fx)))
+    (a, ra), (b, rb) = got
+    assert a["qr"] == b["qr"] == same_pole
+    # sums equal to rounding, projected as before: the projection to 1e-10 (relative
+    # to the largest entry; the QR route's rows are the same numbers)
+    for key in ("GE", "Etr", "C"):
+        assert_allclose(b[key], a[key], rtol=0, atol=1e-10 * np.abs(a[key]).max())
+    assert_allclose(b["cost"], a["cost"], rtol=1e-12)  # a sum of squares of the residual
+    # the refined added mode: the same optimum to 1e-9
+    assert_allclose(rb[0], ra[0], rtol=1e-9)
+    assert_allclose(rb[1], ra[1], rtol=1e-9)
+    assert_allclose(rb[2], ra[2], rtol=1e-9)

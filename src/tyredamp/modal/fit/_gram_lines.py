@@ -62,6 +62,7 @@ def coefficients(
     part: NDArray[np.complex128],
     ref: NDArray[np.intp],
     derivatives: bool,
+    residual: bool = True,
 ) -> tuple[NDArray[np.intp], NDArray[np.float64], int]:
     """The real coefficients of every column of ``B = [Phi | E]`` on the atoms.
 
@@ -75,6 +76,9 @@ def coefficients(
         Input of each mode's fixed participation entry.
     derivatives : bool
         Include the columns ``E`` (and the atoms ``u'``, ``v'``).
+    residual : bool
+        Include the residual terms the fitter uses (False: none, as the added
+        mode's columns of ``fit_added``).
 
     Returns
     -------
@@ -90,7 +94,8 @@ def coefficients(
     """
     m, nin = part.shape
     na = 4 if derivatives else 2
-    q = fitter.n_cols(m)
+    terms = (fitter.use_upper, fitter.use_lower) if residual else (False, False)
+    q = 2 * m + nin * sum(terms)
     nc = q + (2 * nin * m if derivatives else 0)
     idx = np.zeros((nin, nc, 2), np.intp)
     val = np.zeros((nin, nc, 2))
@@ -106,7 +111,7 @@ def coefficients(
         val[:, cols + 1, 0], val[:, cols + 1, 1] = lr, -li
     n_phi = na * m
     c0 = 2 * m
-    for use in (fitter.use_upper, fitter.use_lower):
+    for use in terms:
         if use:
             ins = np.arange(nin)
             idx[ins, c0 + ins, 0] = n_phi
@@ -129,11 +134,13 @@ def atoms(
     poles: NDArray[np.complex128],
     derivatives: bool,
     fac: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]],
+    residual: bool = True,
 ) -> NDArray[np.complex128]:
     """The atoms of the lines as rows (n_phi, lines), complex (module docstring).
 
     ``fac``: :func:`~tyredamp.modal.fit._basis.factors` of the lines (``s``,
-    ``kappa``, ``kappa_low``, line weights included). Per mode one complex
+    ``kappa``, ``kappa_low``, line weights included); ``residual``: with the
+    residual terms' atoms the fitter uses. Per mode one complex
     reciprocal ``r = 1 / d`` (``d = t^2 + Omega^2``, ``t = s + sigma``), as
     :func:`~tyredamp.modal.fit._basis.basis_ek` with one input: ``u = t h``, ``v =
     -Omega h`` with ``h = 2 kappa r``, ``u' = (d - 2 Omega^2) h r``, ``v' = -2 Omega t h
@@ -142,7 +149,8 @@ def atoms(
     s, kap, kap_low = fac
     m, nf = poles.size, s.size
     na = 4 if derivatives else 2
-    n_phi = na * m + int(fitter.use_upper) + int(fitter.use_lower)
+    terms = (fitter.use_upper, fitter.use_lower) if residual else (False, False)
+    n_phi = na * m + sum(terms)
     ft = np.empty((n_phi, nf), complex)
     if m:
         om = poles.imag[:, None]
@@ -161,7 +169,7 @@ def atoms(
             np.multiply(t, h, out=o)
             o *= -2.0 * om
     c = na * m
-    for use, kk in ((fitter.use_upper, kap), (fitter.use_lower, kap_low)):
+    for use, kk in zip(terms, (kap, kap_low), strict=True):
         if use:
             ft[c] = kk
             c += 1
@@ -210,31 +218,113 @@ def gram(
     """
     poles, part = pp
     idx, val, n_phi = coefficients(fitter, part, ref, derivatives)
-    n_out, nin = fitter.n_out, fitter.n_in
     gam = np.zeros((n_phi, n_phi))
-    z = np.zeros((n_out * nin, n_phi))
-    lw = fitter.line_weights
+    z = np.zeros((fitter.n_out * fitter.n_in, n_phi))
     for sl in parts:
         ft = atoms(fitter, poles, derivatives, _basis.factors(fitter, sl))
         fr = ft.view(np.float64)  # (n_phi, 2 lines): the atoms as real rows
         gam += fr @ fr.T
-        if lw is not None:
-            fr = (ft * lw[sl][None, :]).view(np.float64)
-        hb = np.asarray(fitter.H[:, :, sl], np.complex128).reshape(n_out * nin, -1)
-        if hb.strides[-1] != hb.itemsize:
-            hb = np.ascontiguousarray(hb)
-        z += hb.view(np.float64) @ fr.T  # Re(Y_k^T conj(F)), rows (j, k)
-    zk = z.reshape(n_out, nin, n_phi)
-    nc = idx.shape[1]
-    G = np.zeros((nc, nc))
-    P = np.zeros((nc, n_out))
-    for k in range(nin):
-        i0, i1 = idx[k, :, 0], idx[k, :, 1]
-        v0, v1 = val[k, :, 0], val[k, :, 1]
-        gm = gam[:, i0] * v0 + gam[:, i1] * v1  # Re(F^H F) M_k
-        G += v0[:, None] * gm[i0] + v1[:, None] * gm[i1]
-        zt = zk[:, k, :].T  # Re(F^H Y_k), (n_phi, n_out)
-        P += v0[:, None] * zt[i0] + v1[:, None] * zt[i1]
+        z += data_rows(fitter, sl) @ _weighted(fitter, ft, sl).T
+    G = products(gam, (idx, val), (idx, val))
     G += G.T
     G *= 0.5
-    return G, P
+    return G, data_products(z, (idx, val))
+
+
+def added_sums(
+    fitter: FitterState,
+    pp1: tuple[NDArray[np.complex128], NDArray[np.complex128]],
+    ref1: NDArray[np.intp],
+    fixed: tuple[NDArray[np.complex128], tuple[NDArray[np.intp], NDArray[np.float64]]],
+    parts: tuple[slice, ...],
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``Phi_f^T B1``, ``B1^T B1`` and ``B1^T Y`` of one added mode against fixed modes.
+
+    Parameters
+    ----------
+    fitter : FitterState
+        The fitter (complex modes, ``n_in >= 2``; :func:`applies`).
+    pp1 : (ndarray, ndarray)
+        Pole (1,) in rad/s and participation (1, n_in) of the added mode, whose
+        columns ``B1 = [Phi_1 | E_1]`` have no residual terms.
+    ref1 : ndarray of int, shape (1,)
+        Input of its fixed participation entry.
+    fixed : (ndarray, (ndarray, ndarray))
+        The atoms of the fixed basis ``Phi_f`` (fixed modes and residual terms, no
+        derivatives) as rows (n_phi_f, n_f) of every line (:func:`atoms`), and
+        its coefficient tables (:func:`coefficients`).
+    parts : tuple of slice
+        Blocks of lines to sum over.
+
+    Returns
+    -------
+    cross : ndarray, shape (q_f, n_1)
+        ``Phi_f^T B1 = sum_k M_fk^T Re(F_f^H F_1) M_1k`` (module docstring).
+    g0 : ndarray, shape (n_1, n_1)
+        ``B1^T B1``, exactly symmetric.
+    p0 : ndarray, shape (n_1, n_out)
+        ``B1^T Y`` (line weights, no output weights).
+    """
+    ff, tab_f = fixed
+    idx1, val1, n1 = coefficients(fitter, pp1[1], ref1, True, residual=False)
+    one = (idx1, val1)
+    g11 = np.zeros((n1, n1))
+    gf1 = np.zeros((ff.shape[0], n1))
+    z = np.zeros((fitter.n_out * fitter.n_in, n1))
+    for sl in parts:
+        f1 = atoms(fitter, pp1[0], True, _basis.factors(fitter, sl), residual=False)
+        fr = f1.view(np.float64)
+        g11 += fr @ fr.T
+        gf1 += ff[:, sl].view(np.float64) @ fr.T
+        z += data_rows(fitter, sl) @ _weighted(fitter, f1, sl).T
+    g0 = products(g11, one, one)
+    g0 += g0.T
+    g0 *= 0.5
+    return products(gf1, tab_f, one), g0, data_products(z, one)
+
+
+def data_rows(fitter: FitterState, sl: slice) -> NDArray[np.float64]:
+    """The data of the lines ``sl`` as real rows (n_out n_in, 2 lines), rows ``(j, k)``
+    (real and imaginary part interleaved; a view of ``fitter.H`` when it allows)."""
+    hb = np.asarray(fitter.H[:, :, sl], np.complex128).reshape(fitter.n_out * fitter.n_in, -1)
+    if hb.strides[-1] != hb.itemsize:
+        hb = np.ascontiguousarray(hb)
+    return hb.view(np.float64)
+
+
+def _weighted(fitter: FitterState, ft: NDArray[np.complex128], sl: slice) -> NDArray[np.float64]:
+    """Atoms of the lines ``sl`` (rows) times the line weights, as real rows: their
+    product with :func:`data_rows` is ``Re(F^H Y_k)`` (``Y`` carries the weights too)."""
+    lw = fitter.line_weights
+    return (ft if lw is None else ft * lw[sl][None, :]).view(np.float64)
+
+
+def products(
+    gam: NDArray[np.float64],
+    left: tuple[NDArray[np.intp], NDArray[np.float64]],
+    right: tuple[NDArray[np.intp], NDArray[np.float64]],
+) -> NDArray[np.float64]:
+    """``sum_k L_k^T gam R_k`` of the coefficient tables ``left`` and ``right``
+    (:func:`coefficients`; at most two entries per column: gathers, no products
+    with the zeros)."""
+    (il, vl), (ir, vr) = left, right
+    out = np.zeros((il.shape[1], ir.shape[1]))
+    for k in range(il.shape[0]):
+        gm = gam[:, ir[k, :, 0]] * vr[k, :, 0] + gam[:, ir[k, :, 1]] * vr[k, :, 1]  # gam R_k
+        out += vl[k, :, 0, None] * gm[il[k, :, 0]] + vl[k, :, 1, None] * gm[il[k, :, 1]]
+    return out
+
+
+def data_products(
+    z: NDArray[np.float64], table: tuple[NDArray[np.intp], NDArray[np.float64]]
+) -> NDArray[np.float64]:
+    """``sum_k M_k^T Re(F^H Y_k)`` (n_cols, n_out) from ``z`` (n_out n_in, n_phi), the
+    products of :func:`data_rows` with the weighted atoms (rows ``(j, k)``)."""
+    idx, val = table
+    nin = idx.shape[0]
+    zk = z.reshape(-1, nin, z.shape[1])
+    out = np.zeros((idx.shape[1], zk.shape[0]))
+    for k in range(nin):
+        zt = zk[:, k, :].T  # Re(F^H Y_k), (n_phi, n_out)
+        out += val[k, :, 0, None] * zt[idx[k, :, 0]] + val[k, :, 1, None] * zt[idx[k, :, 1]]
+    return out
