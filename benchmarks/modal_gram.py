@@ -12,9 +12,14 @@ time of one evaluation (``_solve`` with derivatives and gradient, the
 refinement's) by each route (``_gram_lines.USE`` False, then True), their
 ratio, and the largest difference of ``G`` and ``P`` relative to
 ``sqrt(G_ii G_jj)`` and ``sqrt(G_ii ||Y_j||^2)``. ``--identify`` also runs
-``identify_modes`` by each route and prints its time and the largest relative
-difference of the frequencies and damping ratios found (one BLAS thread; the
-machine is shared, so medians and ratios count, not single times).
+``identify_modes`` by each route (``USE`` covers ``fit_added``'s sums too;
+the three cases and, when
+``../shared/real-data`` is there, ladisk/pyuff's measured accelerances of one
+response to three roving-hammer references) and prints its time and the
+largest difference of the frequencies and damping ratios found, relative and
+in units of the damping ratio's standard error. Times are CPU times of the
+process (one BLAS thread; the machine is shared, so medians and ratios count,
+not single times).
 """
 
 from __future__ import annotations
@@ -22,10 +27,12 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 from perf_common import limit_blas, mimo_case
 
+from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
 from tyredamp.modal.fit import _basis, _gram_lines
 from tyredamp.modal.fit.fit import ModalFitter
@@ -51,9 +58,9 @@ def _evaluation(spec: tuple[int, int, int, int, float], repeat: int) -> None:
     for r in range(repeat):
         for use in (False, True) if r % 2 == 0 else (True, False):
             _gram_lines.USE = use
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             fitter._solve(th, m, ref, w, residual=False)
-            times[use].append(time.perf_counter() - t0)
+            times[use].append(time.process_time() - t0)
     pp = fitter.unpack(th, m, ref)
     n_col = fitter.n_cols(m) + 2 * n_in * m
     parts = _basis.blocks(fitter, n_col)
@@ -74,22 +81,38 @@ def _evaluation(spec: tuple[int, int, int, int, float], repeat: int) -> None:
     )
 
 
-def _identify(spec: tuple[int, int, int, int, float]) -> None:
-    case = mimo_case(*spec)
+def _identify(name: str, frf: FRF, band: tuple[float, float]) -> None:
     out = {}
     for use in (False, True):
         _gram_lines.USE = use
-        t0 = time.perf_counter()
-        res = identify_modes(case.frf, band=case.band, model="complex")
-        dt = time.perf_counter() - t0
+        t0 = time.process_time()
+        res = identify_modes(frf, band=band, model="complex")
+        dt = time.process_time() - t0
         mm = res.models["complex"]
         o = np.argsort(mm.frequency_hz)
-        out[use] = (dt, np.asarray(mm.frequency_hz)[o], np.asarray(mm.damping_ratio)[o])
-    (ta, fa, za), (tb, fb, zb) = out[False], out[True]
+        z_std = np.asarray(mm.std["damping_ratio"])[o]
+        out[use] = (dt, np.asarray(mm.frequency_hz)[o], np.asarray(mm.damping_ratio)[o], z_std)
+    (ta, fa, za, sa), (tb, fb, zb, _) = out[False], out[True]
     same = fa.shape == fb.shape
     df = float(np.max(np.abs(fb / fa - 1))) if same else np.nan
     dz = float(np.max(np.abs(zb / za - 1))) if same else np.nan
-    print(f"{case.name:<44} {fa.size:>3} {ta:8.2f} {tb:8.2f} {ta / tb:6.2f} {df:9.1e} {dz:9.1e}")
+    dzs = float(np.max(np.abs(zb - za) / sa)) if same else np.nan
+    print(
+        f"{name:<44} {fa.size:>3} {ta:8.2f} {tb:8.2f} {ta / tb:6.2f} {df:9.1e} {dz:10.1e} "
+        f"{dzs:9.1e}"
+    )
+
+
+def _real_case() -> tuple[str, FRF, tuple[float, float]] | None:
+    """ladisk/pyuff's measured accelerances of response node 1 to references 1, 2, 3
+    (``/work/shared/real-data``, CATALOGUE.md; roving hammer): 1 output x 3 inputs."""
+    d = Path(__file__).resolve().parents[2] / "shared" / "real-data" / "ladisk_pyuff" / "data"
+    if not d.is_dir():
+        return None
+    h = [np.genfromtxt(d / f"meas_point_{i}.txt", dtype=complex)[1:] for i in (1, 2, 3)]
+    f = np.arange(1.0, 1001.0)
+    frf = FRF(f, np.stack(h)[None], kind="accelerance")
+    return "pyuff meas_point_1-3: 1 out x 3 in (real)", frf, (20.0, 950.0)
 
 
 def main() -> None:
@@ -106,9 +129,13 @@ def main() -> None:
     if a.identify:
         print("identify_modes, s")
         head = f"{'case':<44} {'m':>3} {'basis':>8} {'lines':>8} {'ratio':>6}"
-        print(f"{head} {'df/f':>9} {'dzeta/zeta':>9}")
+        print(f"{head} {'df/f':>9} {'dzeta/zeta':>10} {'dzeta/std':>9}")
         for spec in CASES:
-            _identify(spec)
+            case = mimo_case(*spec)
+            _identify(case.name, case.frf, case.band)
+        real = _real_case()
+        if real is not None:
+            _identify(*real)
     _gram_lines.USE = True
     del pool
 

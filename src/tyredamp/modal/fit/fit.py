@@ -33,7 +33,10 @@ per complex mode the pole derivatives are ``-sigma [S]``, ``-sigma [i T]``,
 per free participation entry ``[g]``, ``[i g']``, ``[i g']``, ``-[g]``. An evaluation
 therefore needs only the Gram blocks of ``B = [Phi | E]`` and ``B^T Y`` (one
 symmetric rank-k update and one matrix product with the data, ``O(n_in n_freq
-(q + n_e) (q + n_e + n_out))``): with the Cholesky factor ``R`` of ``Phi^T Phi``
+(q + n_e) (q + n_e + n_out))``; with complex modes and several inputs they are
+summed from the modes' per-line functions without forming ``B``,
+``O(n_freq n_phi (n_phi + n_in n_out))`` with ``n_phi = 4 m + 2``:
+:mod:`~tyredamp.modal.fit._gram_lines`): with the Cholesky factor ``R`` of ``Phi^T Phi``
 (``Phi = Q R``) follow ``Q^T E``, ``Q^T Y``, the coefficients, the cost
 ``||Y||^2 - ||Q^T Y||^2``, ``E^T P E`` and ``E^T r`` (``P`` the projector on the
 complement of the basis, ``r`` the residual), and from them ``J^T J`` and
