@@ -1,8 +1,10 @@
 """The Gram blocks of the complex-mode basis with several inputs, from per-line sums.
 
 The real basis ``B = [Phi | E]`` of :func:`~tyredamp.modal.fit._basis.basis_ek`
-(complex modes, ``n_in >= 2``) has ``2 n_in n_f`` rows: every column is, at
-input ``k``, a complex function of the line times real numbers. With the
+(complex modes, spec eq. [10], the model in the docstring of
+:mod:`~tyredamp.modal.fit.fit`; ``n_in >= 2``) has ``2 n_in n_f`` rows: every
+column is, at input ``k``, a complex function of the line times real numbers.
+With the
 per-line functions ("atoms") of mode ``n`` (``t = s + sigma_n``, ``d = (s -
 p_n)(s - conj p_n) = t^2 + Omega_n^2``, ``g = kappa / (s - p_n)``, ``gb = kappa /
 (s - conj p_n)``)::
