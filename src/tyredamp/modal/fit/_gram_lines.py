@@ -4,10 +4,9 @@ The real basis ``B = [Phi | E]`` of :func:`~tyredamp.modal.fit._basis.basis_ek`
 (complex modes, spec eq. [10], the model in the docstring of
 :mod:`~tyredamp.modal.fit.fit`; ``n_in >= 2``) has ``2 n_in n_f`` rows: every
 column is, at input ``k``, a complex function of the line times real numbers.
-With the
-per-line functions ("atoms") of mode ``n`` (``t = s + sigma_n``, ``d = (s -
-p_n)(s - conj p_n) = t^2 + Omega_n^2``, ``g = kappa / (s - p_n)``, ``gb = kappa /
-(s - conj p_n)``)::
+With the per-line functions ("atoms") of mode ``n`` (``t = s + sigma_n``, ``d =
+(s - p_n)(s - conj p_n) = t^2 + Omega_n^2``, ``g = kappa / (s - p_n)``, ``gb =
+kappa / (s - conj p_n)``)::
 
     u_n  = g + gb                      = 2 t kappa / d
     v_n  = i (g - gb)                  = -2 Omega_n kappa / d
