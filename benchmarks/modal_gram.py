@@ -10,8 +10,9 @@ For each case (:func:`perf_common.mimo_case`, its true poles and participation,
 the upper and lower residual terms, first-pass weights) this prints the median
 time of one evaluation (``_solve`` with derivatives and gradient, the
 refinement's) by each route (``_gram_lines.USE`` False, then True), their
-ratio, and the largest difference of ``G`` and ``P`` relative to
-``sqrt(G_ii G_jj)`` and ``sqrt(G_ii ||Y_j||^2)``. ``--identify`` also runs
+ratio, the largest difference of ``G`` and ``P`` relative to ``sqrt(G_ii
+G_jj)`` and ``sqrt(G_ii ||Y_j||^2)``, and the same times of one evaluation of
+``fit_added`` (the last mode refined with the others fixed). ``--identify`` also runs
 ``identify_modes`` by each route (``USE`` covers ``fit_added``'s sums too;
 the three cases and, when
 ``../shared/real-data`` is there, ladisk/pyuff's measured accelerances of one
@@ -34,7 +35,7 @@ from perf_common import limit_blas, mimo_case
 
 from tyredamp.frf import FRF
 from tyredamp.modal import identify_modes
-from tyredamp.modal.fit import _basis, _gram_lines
+from tyredamp.modal.fit import _added, _basis, _gram_lines
 from tyredamp.modal.fit.fit import ModalFitter
 
 CASES = [(16, 2, 3000, 20, 35.0), (32, 2, 4000, 20, 50.0), (64, 3, 8000, 20, 30.0)]
@@ -75,10 +76,34 @@ def _evaluation(spec: tuple[int, int, int, int, float], repeat: int) -> None:
     sums["G"] = float(np.max(np.abs(G1 - G0) / np.outer(d, d)))
     sums["P"] = float(np.max(np.abs(P1 - P0) / np.outer(d, np.sqrt(fitter._yss))))
     t0, t1 = statistics.median(times[False]), statistics.median(times[True])
+    a0, a1 = _added_times(fitter, case.poles, part, repeat)
     print(
         f"{case.name:<44} {len(parts):>6} {1e3 * t0:9.1f} {1e3 * t1:9.1f} {t0 / t1:6.2f} "
-        f"{sums['G']:9.1e} {sums['P']:9.1e}"
+        f"{sums['G']:9.1e} {sums['P']:9.1e} {1e3 * a0:9.2f} {1e3 * a1:9.2f} {a0 / a1:6.2f}"
     )
+
+
+def _added_times(
+    fitter: ModalFitter, poles: np.ndarray, part: np.ndarray, repeat: int
+) -> tuple[float, float]:
+    """Median CPU time of one evaluation of ``fit_added`` (the last mode added to the
+    others, held fixed) by each route."""
+    one, lay1, _ = fitter._added_fitter()
+    ref1 = np.array([int(np.argmax(np.abs(part[-1])))], np.intp)
+    th1 = one.pack(poles[-1:], part[-1:], ref1)
+    solvers = {}
+    for use in (False, True):
+        _gram_lines.USE = use
+        fixed = fitter.fixed_part(poles[:-1], part[:-1])
+        solvers[use] = _added.added_solver(fitter, one, fixed, ref1, lay1)
+    times: dict[bool, list[float]] = {False: [], True: []}
+    for r in range(3 * repeat):
+        for use in (False, True) if r % 2 == 0 else (True, False):
+            _gram_lines.USE = use
+            t0 = time.process_time()
+            solvers[use](th1)
+            times[use].append(time.process_time() - t0)
+    return statistics.median(times[False]), statistics.median(times[True])
 
 
 def _identify(name: str, frf: FRF, band: tuple[float, float]) -> None:
@@ -121,9 +146,9 @@ def main() -> None:
     ap.add_argument("--identify", action="store_true")
     a = ap.parse_args()
     pool = limit_blas(1)
-    print("one evaluation (_solve), ms")
+    print("one evaluation of _solve and of fit_added (basis, per-line sums), ms")
     head = f"{'case':<44} {'blocks':>6} {'basis':>9} {'lines':>9} {'ratio':>6}"
-    print(f"{head} {'dG':>9} {'dP':>9}")
+    print(f"{head} {'dG':>9} {'dP':>9} {'added':>9} {'lines':>9} {'ratio':>6}")
     for spec in CASES:
         _evaluation(spec, a.repeat)
     if a.identify:
