@@ -146,15 +146,20 @@ def test_identify_modes_finds_the_same_modes_by_either_route(
     assert_allclose(z1, z0, rtol=1e-9)
 
 
-@pytest.mark.parametrize(("n_in", "weights", "same_pole"), [(2, True, False), (3, False, True)])
+@pytest.mark.parametrize(
+    ("n_in", "n_out", "weights", "same_pole"),
+    [(2, 4, True, False), (3, 4, False, True), (2, 16, False, False), (2, 16, True, True)],
+)
 def test_fit_added_is_the_same_by_either_route(
-    n_in: int, weights: bool, same_pole: bool, monkeypatch: pytest.MonkeyPatch
+    n_in: int, n_out: int, weights: bool, same_pole: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # several blocks of lines (the per-line route of fit_added needs them)
+    # several blocks of lines (the per-line route of fit_added needs them); with 16
+    # outputs the fixed basis is no larger than the data and the fixed part keeps its
+    # orthonormal rows of every line (FixedPart.qr: the basis route's evaluations)
     monkeypatch.setattr(_basis, "BLOCK_BYTES", 20_000)
     rng = np.random.default_rng(5)
     f = np.linspace(5.0, 200.0, 600)
-    H = rng.normal(size=(4, n_in, f.size)) + 1j * rng.normal(size=(4, n_in, f.size))
+    H = rng.normal(size=(n_out, n_in, f.size)) + 1j * rng.normal(size=(n_out, n_in, f.size))
     lw = rng.uniform(0.5, 2.0, f.size) if weights else None
     fit = ModalFitter(f, H, 2, "complex", [(0, 0), (1, 1)], line_weights=lw)
     poles = 2 * np.pi * np.array([20.0, 70.0, 130.0]) * (-0.02 + 1j)
@@ -172,6 +177,7 @@ def test_fit_added_is_the_same_by_either_route(
         fx = fit.fixed_part(poles, part)
         assert len(fx.parts) > 1
         assert (fx.atoms is not None) == use
+        assert (fx.qr is not None) == (n_out == 16)
         sol = _added.added_solver(fit, one, fx, ref1, lay1)(th1)
         got.append((sol, fit.fit_added(poles, part, p1, l1, fixed=fx)))
     (a, ra), (b, rb) = got

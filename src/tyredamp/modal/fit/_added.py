@@ -152,6 +152,11 @@ def fixed_part(
             np.concatenate([fitter.unpack(th_f, m, ref)[0], at_zero]),
         )
         sums = (gf, pf * w)
+    atoms = None if one or pseudo is not None else _fixed_atoms(fitter, th_f, m, ref, parts)
+    if atoms is not None:  # the Gram blocks of the fixed basis from its atoms
+        ff = atoms[0]
+        gf, pf = _gram_lines.gram_of(fitter, lambda sl: ff[:, sl], (*atoms[1], ff.shape[0]), parts)
+        sums = (gf, pf * w)
     # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
     # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
     tmap, qty, yyp = _fixed_range(
@@ -173,7 +178,6 @@ def fixed_part(
             qr[line_rows(fitter, sl)] = rows.basis(th_f, m, ref, i) @ tmap
     if src is not None:
         src = (np.array(src[0], complex), np.array(src[1], complex))
-    atoms = None if one or pseudo is not None else _fixed_atoms(fitter, th_f, m, ref, parts)
     extra = () if atoms is None else (atoms[0], *atoms[1])
     for a in (th_f, ref, phi0, yw, tmap, qty, yyp, qy, qr, *(src or ()), *extra):
         if a is not None:

@@ -42,6 +42,8 @@ exactly as ``B^T B`` and ``B^T Y`` do, equal to them up to rounding.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -219,10 +221,27 @@ def gram(
     """
     poles, part = pp
     idx, val, n_phi = coefficients(fitter, part, ref, derivatives)
+    return gram_of(
+        fitter,
+        lambda sl: atoms(fitter, poles, derivatives, _basis.factors(fitter, sl)),
+        (idx, val, n_phi),
+        parts,
+    )
+
+
+def gram_of(
+    fitter: FitterState,
+    block_atoms: Callable[[slice], NDArray[np.complex128]],
+    table: tuple[NDArray[np.intp], NDArray[np.float64], int],
+    parts: Sequence[slice],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`gram` of the atoms ``block_atoms(sl)`` (n_phi, lines) of each block of
+    lines and the coefficient tables ``table`` (:func:`coefficients`)."""
+    idx, val, n_phi = table
     gam = np.zeros((n_phi, n_phi))
     z = np.zeros((fitter.n_out * fitter.n_in, n_phi))
     for sl in parts:
-        ft = atoms(fitter, poles, derivatives, _basis.factors(fitter, sl))
+        ft = block_atoms(sl)
         fr = ft.view(np.float64)  # (n_phi, 2 lines): the atoms as real rows
         gam += fr @ fr.T
         z += data_rows(fitter, sl) @ _weighted(fitter, ft, sl).T
