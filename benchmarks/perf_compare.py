@@ -1,7 +1,7 @@
 """tyredamp against sdypy-EMA (LSCF + LSFD): speed and accuracy on the same FRFs.
 
 Run: ``python benchmarks/perf_compare.py [--quick] [--blas-threads 1]
-[--set all|tyre|random|long|million] [--json PATH]`` (needs the ``bench`` extra:
+[--set all|tyre|random|physical|long|million] [--json PATH]`` (needs the ``bench`` extra:
 ``pip install -e ".[bench]"``).
 
 For each case both tools get the same FRFs, the same band and the same
@@ -46,6 +46,7 @@ from perf_common import (
     limit_blas,
     machine_info,
     mimo_case,
+    physical_case,
     print_table,
     run_sdypy,
     run_tyredamp,
@@ -56,16 +57,55 @@ from perf_common import (
     write_json,
 )
 
+from tyredamp.exceptions import TyredampError
+
 #: random MIMO cases (n_out, n_in, n_lines, n_modes, SNR dB) of --set random
 RANDOM = [(4, 1, 1000, 10, 60.0), (16, 2, 3000, 20, 35.0), (32, 2, 4000, 20, 50.0)]
 #: larger random cases of --set long, with their orders: many outputs and inputs,
 #: and a long record (a million lines)
 LONG = [((64, 3, 8000, 20, 30.0), 80), ((4, 1, 1_000_000, 10, 40.0), 40)]
 
+#: random physical structures (n_out, n_in, n_lines, n_modes, SNR dB) of --set physical
+#: (perf_common.physical_case), with their orders (four per mode, at least 40)
+PHYSICAL = [
+    ((4, 1, 1000, 8, 60.0), 40),
+    ((8, 1, 2000, 12, 50.0), 48),
+    ((16, 2, 3000, 20, 40.0), 80),
+    ((32, 2, 4000, 24, 35.0), 96),
+    ((64, 3, 8000, 30, 30.0), 120),
+]
+
 TOOLS = ("tyredamp", "tyredamp no search", "tyredamp lscf+lsfd", "sdypy-EMA")
 
 
+def _failed(tool: str, case: Case, error: Exception) -> RunResult:
+    """A run that raised: no modes, a zero model, no time; the message in ``extra["error"]``."""
+    f = case.frf.frequency
+    lines = np.flatnonzero((f >= case.band[0]) & (f <= case.band[1]))
+    nan = float("nan")
+    return RunResult(
+        tool=tool,
+        t_poles=nan,
+        t_residues=nan,
+        poles=np.zeros(0, dtype=complex),
+        shapes=np.zeros((case.frf.n_out, 0), dtype=complex),
+        reconstruction=np.zeros((case.frf.n_out, case.frf.n_in, lines.size), dtype=complex),
+        lines=lines,
+        extra={"error": f"{type(error).__name__}: {error}"},
+    )
+
+
 def _run(tool: str, case: Case, order: int) -> RunResult:
+    """One run of ``tool``; a tyredamp error (e.g. a given frequency without a pole) is recorded."""
+    if tool.startswith("tyredamp"):
+        try:
+            return _run_tyredamp(tool, case, order)
+        except TyredampError as e:
+            return _failed(tool, case, e)
+    return run_sdypy(case, pol_order_high=order // 2)
+
+
+def _run_tyredamp(tool: str, case: Case, order: int) -> RunResult:
     if tool == "tyredamp":
         return run_tyredamp(case, max_order=order)
     if tool == "tyredamp no search":
@@ -78,7 +118,7 @@ def _run(tool: str, case: Case, order: int) -> RunResult:
         )
         r.tool = tool
         return r
-    return run_sdypy(case, pol_order_high=order // 2)
+    raise ValueError(f"unknown tool {tool!r}")
 
 
 def compare_case(case: Case, order: int, repeats: int, tools: tuple[str, ...]) -> dict[str, Any]:
@@ -99,6 +139,8 @@ def compare_case(case: Case, order: int, repeats: int, tools: tuple[str, ...]) -
         "repeats": repeats,
         "tools": {},
     }
+    if "physics" in case.meta:
+        out["physics"] = case.meta["physics"]
     for tool, rs in runs.items():
         acc = accuracy(case, rs[0])
         out["tools"][tool] = {
@@ -125,7 +167,26 @@ def better_or_equal(a: dict[str, Any], b: dict[str, Any]) -> dict[str, bool]:
     }
 
 
+def print_physics(res: dict[str, Any]) -> None:
+    """One line on the structure of a physical case (``perf_physical.describe``)."""
+    p = res.get("physics")
+    if not p:
+        return
+    snr = np.asarray(p["peak_snr_db"], dtype=float)
+    print(
+        f"\n{p['n_dof']} DOF, damping {100 * p['zeta_min']:.2g}-{100 * p['zeta_max']:.2g} %, "
+        f"MPC median {p['mpc_median']:.4f} (min {p['mpc_min']:.3f}), off-diagonal share of "
+        f"C' {p['offdiag_share']:.2f}; close pair {p['pair_hz'][0]:.1f}/{p['pair_hz'][1]:.1f} Hz "
+        f"{p['pair_bandwidths']:.2f} half-power bandwidths apart; weak mode {p['weak_hz']:.1f} Hz "
+        f"{p['weak_below_median_db']:.1f} dB below the median peak and "
+        f"{p['weak_peak_snr_db']:.0f} dB over the noise; peaks over the noise "
+        f"{snr.min():.0f}-{snr.max():.0f} dB",
+        flush=True,
+    )
+
+
 def print_case(res: dict[str, Any]) -> None:
+    print_physics(res)
     ref = res["tools"].get("sdypy-EMA")
     rows = []
     for tool, d in res["tools"].items():
@@ -171,6 +232,9 @@ def print_case(res: dict[str, Any]) -> None:
             f"{res['band_hz'][1]:g} Hz, order {res['max_order']}, median of {res['repeats']}"
         ),
     )
+    for tool, d in res["tools"].items():
+        if "error" in d["extra"]:
+            print(f"{tool} raised: {d['extra']['error']}", flush=True)
 
 
 def main(argv: list[str] | None = None) -> dict[str, Any]:
@@ -180,9 +244,10 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--json", default=str(RESULTS_DIR / "compare.json"), help="output JSON")
     ap.add_argument(
         "--set",
-        choices=("all", "tyre", "random", "long", "million"),
+        choices=("all", "tyre", "random", "physical", "long", "million"),
         default="all",
-        help="the tyre and 128-output cases, the random MIMO cases, or both; long: "
+        help="the tyre and 128-output cases, the random MIMO cases, or both; physical: "
+        "random physical structures (M, C, K; 4-64 outputs, 1-3 inputs, 8-30 modes); long: "
         "64 outputs x 3 inputs x 8000 lines and 4 outputs x 1e6 lines; million: the 1e6-line "
         "record alone, tyredamp's default and sdypy-EMA only",
     )
@@ -214,6 +279,9 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
             (functools.partial(mimo_case, *spec), order, rep)
             for spec, order in zip(RANDOM, (40, 80, 80), strict=True)
         ]
+    if a.set == "physical":
+        # random physical structures (perf_common.physical_case): sdypy-EMA sees the first input
+        specs += [(functools.partial(physical_case, *spec), order, rep) for spec, order in PHYSICAL]
     results = []
     for make, order, n in specs:
         case = make()

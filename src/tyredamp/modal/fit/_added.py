@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from . import _basis, _pseudo
+from . import _basis, _gram_lines, _pseudo
 from ._linalg import _PROJ_TOL, _fixed_range, _vp_solve
 from ._state import FitterState
 
@@ -56,7 +56,11 @@ class FixedPart:
     than the data), so that an evaluation needs no fixed basis; ``pseudo``: with
     several blocks, neither kept, and a long record, the pseudo-lines of the fixed
     basis and the data (:mod:`._pseudo`), so that an evaluation's cost does not
-    grow with the lines.
+    grow with the lines; ``atoms``: with complex modes, several inputs and several
+    blocks (no pseudo-lines), the atoms of ``Phi_f`` of every line and their
+    coefficient tables (:mod:`._gram_lines`; no larger than the data or one
+    block), so that an evaluation sums the Gram blocks of the added columns from
+    per-line sums without forming them.
     """
 
     th: NDArray[np.float64]
@@ -73,6 +77,7 @@ class FixedPart:
     src: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
     qr: NDArray[np.float64] | None = None
     pseudo: _pseudo.PseudoLines | None = None
+    atoms: tuple[NDArray[np.complex128], tuple[NDArray[np.intp], NDArray[np.float64]]] | None = None
 
     def matches(self, th: NDArray[np.float64], m: int, ref: NDArray[np.intp]) -> bool:
         """Is this the fixed part of the modes ``th`` (``m``, ``ref``)?"""
@@ -147,6 +152,11 @@ def fixed_part(
             np.concatenate([fitter.unpack(th_f, m, ref)[0], at_zero]),
         )
         sums = (gf, pf * w)
+    atoms = None if one or pseudo is not None else _fixed_atoms(fitter, th_f, m, ref, parts)
+    if atoms is not None:  # the Gram blocks of the fixed basis from its atoms
+        ff = atoms[0]
+        gf, pf = _gram_lines.gram_of(fitter, lambda sl: ff[:, sl], (*atoms[1], ff.shape[0]), parts)
+        sums = (gf, pf * w)
     # Q_r^T X = T^T Phi_f^T X on an orthonormal basis Q_r of the range of Phi_f,
     # Q_r^T Y and ||P_f Y||^2 once (_fixed_range)
     tmap, qty, yyp = _fixed_range(
@@ -168,12 +178,32 @@ def fixed_part(
             qr[line_rows(fitter, sl)] = rows.basis(th_f, m, ref, i) @ tmap
     if src is not None:
         src = (np.array(src[0], complex), np.array(src[1], complex))
-    for a in (th_f, ref, phi0, yw, tmap, qty, yyp, qy, qr, *(src or ())):
+    extra = () if atoms is None else (atoms[0], *atoms[1])
+    for a in (th_f, ref, phi0, yw, tmap, qty, yyp, qy, qr, *(src or ()), *extra):
         if a is not None:
             a.flags.writeable = False
     return FixedPart(
-        th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr, pseudo
+        th_f, m, ref, tuple(parts), keep, phi0, yw, tmap, qty, yyp, qy, src, qr, pseudo, atoms
     )
+
+
+def _fixed_atoms(
+    fitter: FitterState, th_f: NDArray[np.float64], m: int, ref: NDArray[np.intp], parts: Any
+) -> tuple[NDArray[np.complex128], tuple[NDArray[np.intp], NDArray[np.float64]]] | None:
+    """The atoms of the fixed basis of every line (n_phi_f, n_f) and its coefficient
+    tables (:mod:`._gram_lines`), when they apply (complex modes, several inputs)
+    and are no larger than the data or one block of the fits; else None."""
+    if not _gram_lines.applies(fitter):
+        return None
+    poles, part = fitter.unpack(th_f, m, ref)
+    idx, val, n_phi = _gram_lines.coefficients(fitter, part, ref, False)
+    size = 16 * n_phi * fitter.n_f
+    if n_phi > fitter.n_out * fitter.n_in and size > _basis.BLOCK_BYTES:
+        return None
+    ff = np.empty((n_phi, fitter.n_f), complex)
+    for sl in parts:
+        ff[:, sl] = _gram_lines.atoms(fitter, poles, False, _basis.factors(fitter, sl))
+    return ff, (idx, val)
 
 
 def _no_larger(fitter: FitterState, n_col: int) -> bool:
@@ -305,4 +335,38 @@ def added_solver(
 
     if fx.qy is not None:
         return solve_one
+    if fx.atoms is not None and _gram_lines.USE:
+        return _atoms_solver(fitter, one, fx, ref1, solution)
     return solve_all if fac_all is not None else solve_blocks
+
+
+def _atoms_solver(
+    fitter: FitterState, one: FitterState, fx: FixedPart, ref1: NDArray[np.intp], solution: Any
+) -> Any:
+    """The projection at the added mode's parameters with the Gram blocks of the added
+    columns from per-line sums (:func:`~tyredamp.modal.fit._gram_lines.added_sums`,
+    ``fx.atoms``); the QR route's rows as :func:`added_solver`'s."""
+    w = fitter._w1
+    rows = _Rows(fitter, fx, fx.parts, fx.keep)
+    assert fx.atoms is not None
+
+    def solve_atoms(th: NDArray[np.float64]) -> dict[str, Any]:
+        pp1 = one.unpack(th, 1, ref1)
+        assert fx.atoms is not None
+        cross, g0, p0 = _gram_lines.added_sums(fitter, pp1, ref1, fx.atoms, fx.parts)
+        qb = fx.tmap.T @ cross  # Q_r^T B1
+        G = g0 - qb.T @ qb
+        P = p0 * w - qb.T @ fx.qty
+
+        def projected() -> Any:
+            for i, sl in enumerate(fx.parts):
+                b1 = one._basis_ek(th, 1, ref1, True, sl, (None, pp1))[0]
+                if fx.qr is not None:
+                    pt = fx.qr[line_rows(fitter, sl)]
+                else:
+                    pt = rows.basis(fx.th, fx.m, fx.ref, i) @ fx.tmap  # Q_r rows
+                yield b1 - pt @ qb, rows.data(fx.yw, i, w) - pt @ fx.qty
+
+        return solution(g0, G, P, projected, pp1)
+
+    return solve_atoms

@@ -33,7 +33,10 @@ per complex mode the pole derivatives are ``-sigma [S]``, ``-sigma [i T]``,
 per free participation entry ``[g]``, ``[i g']``, ``[i g']``, ``-[g]``. An evaluation
 therefore needs only the Gram blocks of ``B = [Phi | E]`` and ``B^T Y`` (one
 symmetric rank-k update and one matrix product with the data, ``O(n_in n_freq
-(q + n_e) (q + n_e + n_out))``): with the Cholesky factor ``R`` of ``Phi^T Phi``
+(q + n_e) (q + n_e + n_out))``; with complex modes and several inputs they are
+summed from the modes' per-line functions without forming ``B``,
+``O(n_freq n_phi (n_phi + n_in n_out))`` with ``n_phi = 4 m + 2``:
+:mod:`~tyredamp.modal.fit._gram_lines`): with the Cholesky factor ``R`` of ``Phi^T Phi``
 (``Phi = Q R``) follow ``Q^T E``, ``Q^T Y``, the coefficients, the cost
 ``||Y||^2 - ||Q^T Y||^2``, ``E^T P E`` and ``E^T r`` (``P`` the projector on the
 complement of the basis, ``r`` the residual), and from them ``J^T J`` and
@@ -87,7 +90,7 @@ from numpy.typing import NDArray
 
 from ...exceptions import InputError
 from ..problem.compress import _compress, combine_outputs, compress_outputs  # noqa: F401 (re-exported)
-from . import _added, _basis, _pseudo, _results, _scaling
+from . import _added, _basis, _gram_lines, _pseudo, _results, _scaling
 from ._linalg import _levenberg_marquardt, _vp_solve, at_rest
 from ._results import FitResult
 
@@ -345,7 +348,20 @@ class ModalFitter:
 
         explicit = rows
         one = None
-        if len(parts) == 1:  # one block: formed once, kept for the QR route
+        pl = None if len(parts) == 1 or residual else self._pseudo_lines()
+        if pl is None and _gram_lines.applies(self):
+            # complex modes, several inputs: the Gram blocks from per-line sums of
+            # the atoms (_gram_lines), the basis formed only for the QR route
+            G, P = _gram_lines.gram(self, pp, ref, derivatives, parts)
+            P = P * w
+            if len(parts) == 1:  # formed at most once, kept for the QR route's passes
+                kept: list[Any] = []
+
+                def explicit() -> Any:
+                    if not kept:
+                        kept.extend(rows())
+                    return iter(kept)
+        elif len(parts) == 1:  # one block: formed once, kept for the QR route
             kept = list(rows())
             B, Yb = kept[0]
             G, P = B.T @ B, B.T @ Yb
@@ -353,7 +369,7 @@ class ModalFitter:
 
             def explicit() -> Any:
                 return iter(kept)
-        elif not residual and (pl := self._pseudo_lines()) is not None:
+        elif pl is not None:
             # a long record: the Gram blocks from the pseudo-lines of the bins far
             # from every pole (the lower residual term's at 0 for a negative power)
             at_zero = [0j] if self.use_lower and self.power < 2 else []
