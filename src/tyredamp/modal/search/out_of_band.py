@@ -71,7 +71,8 @@ def search_helpers(
     edge (the residual there is in-band structure, a missed or misfitted mode
     near the edge, not a mode outside) is recorded in ``fixed.at_edge``:
     :func:`~tyredamp.modal.search.search.residual_search` searches it again
-    (:func:`more_helpers`) once it adds an in-band mode. ``fixed``: the trials'
+    (:func:`more_helpers`) once it adds an in-band mode nearer that edge than
+    every fitted one. ``fixed``: the trials'
     fixed parts (:class:`FixedParts`, new when None).
     """
     res, cur, dropped = fit_checked(

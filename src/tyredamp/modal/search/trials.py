@@ -40,7 +40,7 @@ class FixedParts:
     (:func:`~tyredamp.modal.search.out_of_band.search_helpers`: in-band structure
     at the edge, a missed mode there), searched again by
     :func:`~tyredamp.modal.search.search.residual_search`
-    once it adds an in-band mode.
+    once it adds an in-band mode nearer that edge than every fitted one.
     """
 
     def __init__(self, fitter: ModalFitter) -> None:
