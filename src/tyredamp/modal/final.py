@@ -428,7 +428,14 @@ def _final_fit(
     try:
         if combined is not None and sigma0 is not None:
             r0, cur, dropped = fit_checked(
-                combined, modes, True, problem.band, passes=1, tol=FINAL_TOL, uncertainty=False
+                combined,
+                modes,
+                True,
+                problem.band,
+                in_band_only=True,
+                passes=1,
+                tol=FINAL_TOL,
+                uncertainty=False,
             )
             res = cfit.fit(r0.poles, r0.participation, refine=False, sigma=sigma0)
             res.status, res.n_iter = r0.status, r0.n_iter
@@ -438,6 +445,7 @@ def _final_fit(
             modes,
             refine,
             problem.band,
+            in_band_only=True,
             passes=1 if sigma0 is not None else 2,
             sigma=sigma0,
             tol=FINAL_TOL,

@@ -516,6 +516,40 @@ def at_rest(
     return point is None or point[4] <= max(tol * cost / dof, 1e-24 * max(cost, 1e-300))
 
 
+def interest_decrement(
+    free: NDArray[np.intp] | None,
+    An: NDArray[np.float64],
+    gn: NDArray[np.float64],
+    interest: NDArray[np.intp],
+) -> float:
+    """The Gauss-Newton decrement of the parameters ``interest`` alone, the others
+    (nuisance) profiled out: ``s_1^T (C_11)^-1 s_1`` with ``s = -A^-1 g`` the full
+    Gauss-Newton step and ``C = A^-1`` (``An``, ``gn``: the scaled ``A`` and ``g``
+    of the free parameters ``free`` of :func:`_gn_point`; None: all free).
+
+    It equals the decrement ``g_1'^T S^-1 g_1'`` of the profile cost (the cost
+    minimised over the nuisance parameters) in the quadratic model, with ``S =
+    A_11 - A_12 A_22^-1 A_21`` (the Schur complement, ``= C_11^-1``) and ``g_1' =
+    g_1 - A_12 A_22^-1 g_2``: the squared distance, in units of the noise, of the
+    parameters of interest from their Gauss-Newton optimum. It never exceeds the
+    full decrement (a marginal Mahalanobis distance is at most the joint one;
+    e.g. Seber & Wild, *Nonlinear Regression*, 1989, sec. 2.2 on the profile
+    cost). Held parameters of interest count as converged (0 when every one is
+    held)."""
+    sel = interest if free is None else np.flatnonzero(np.isin(free, interest))
+    if sel.size == 0:
+        return 0.0
+    a = _plus_diag(An, 1e-12)
+    try:
+        c = np.linalg.inv(a)
+    except np.linalg.LinAlgError:
+        return math.inf
+    s1 = -(c @ gn)[sel]
+    c11 = np.ascontiguousarray(c[np.ix_(sel, sel)], np.float64)
+    x, info = _lu_solve(c11, s1)
+    return float(s1 @ x) if info == 0 else math.inf
+
+
 def _levenberg_marquardt(
     evaluate: Any,
     x0: NDArray[np.float64],
@@ -524,6 +558,7 @@ def _levenberg_marquardt(
     max_nfev: int,
     dof: int,
     tol: float = 1e-6,
+    interest: NDArray[np.intp] | None = None,
 ) -> tuple[NDArray[np.float64], int, bool, Any]:
     """Bounded Levenberg-Marquardt on the normal equations of a least-squares cost.
 
@@ -542,7 +577,14 @@ def _levenberg_marquardt(
     variance -- with the default ``tol = 1e-6`` the remaining step is about
     1e-3 standard deviations of the parameters, far below their uncertainty --
     or below ``1e-24`` times the starting cost (noise-free data), or when no
-    step reduces the cost any more (round-off).
+    step reduces the cost any more (round-off). With ``interest`` (indices of
+    the parameters whose values matter; the others are nuisance parameters) it
+    also stops when the decrement of those parameters alone, the nuisance ones
+    profiled out (:func:`interest_decrement`), is below ``tol s^2``: they are
+    then within ``sqrt(tol)`` standard deviations of their Gauss-Newton optimum
+    whatever the nuisance parameters still do (a residual mode far outside the
+    band whose damping the data hardly hold can creep along a flat valley for
+    hundreds of steps while the modes of the band stand still).
 
     Returns the parameters, the number of evaluations, whether it converged
     and the by-product of ``evaluate`` at the returned parameters.
@@ -563,7 +605,10 @@ def _levenberg_marquardt(
             if point is None:
                 return x, nfev, True, aux
             free, d_f, An, gn, decrement = point
-            if decrement <= max(tol * cost / dof, 1e-24 * cost0):
+            limit = max(tol * cost / dof, 1e-24 * cost0)
+            if decrement <= limit:
+                return x, nfev, True, aux
+            if interest is not None and interest_decrement(free, An, gn, interest) <= limit:
                 return x, nfev, True, aux
             new_point = False
         step_n, info = _lu_solve(_plus_diag(An, lam), -gn)

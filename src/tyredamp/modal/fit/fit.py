@@ -440,6 +440,7 @@ class ModalFitter:
         tol: float = 1e-6,
         uncertainty: bool = True,
         start: FitResult | None = None,
+        n_interest: int | None = None,
     ) -> FitResult:
         """Fit from initial poles (m,) and participation (m, n_in).
 
@@ -451,6 +452,12 @@ class ModalFitter:
         ``tol`` is the convergence threshold of the refinement in units of the
         residual variance (:func:`_levenberg_marquardt`); ``uncertainty=False``
         skips the standard errors (left at NaN), for intermediate fits.
+
+        ``n_interest``: the refinement may stop once the poles and participation
+        of the first ``n_interest`` modes (the band's; the rest residual modes
+        outside it, nuisance parameters) have converged, whatever the others
+        still do (:func:`~tyredamp.modal.fit._linalg.interest_decrement`);
+        default None: every parameter must converge.
 
         ``start``: a previous result of this fitter whose poles and
         participation are ``poles`` and ``part``. When it is an intermediate
@@ -487,7 +494,10 @@ class ModalFitter:
         warn: list[str] = []
         for ip in range(max(1, passes if refine else 1)):
             if refine:
-                th, nfev, status, sol = self._refine(th, m, ref, w, max_nfev, tol=tol)
+                keep = None if n_interest is None else self.interest(m, n_interest)
+                th, nfev, status, sol = self._refine(
+                    th, m, ref, w, max_nfev, tol=tol, interest=keep
+                )
                 nit += nfev
             else:
                 sol = self._solve(
@@ -502,6 +512,17 @@ class ModalFitter:
         if once and status == "converged" and self._at_rest(th, sol):
             res.rest = (w.copy(), float(tol))
         return res
+
+    def interest(self, m: int, n: int) -> NDArray[np.intp] | None:
+        """Indices into a parameter vector of ``m`` modes (:meth:`pack` layout) of
+        the poles and free participation entries of its first ``n`` modes (None
+        when that is every parameter)."""
+        if n >= m:
+            return None
+        per = (self.n_in - 1) * (2 if self.kind == "complex" else 1)
+        poles = np.arange(2 * n)
+        part = 2 * m + np.arange(per * n)  # mode-major: the first n modes' entries
+        return np.concatenate([poles, part]).astype(np.intp)
 
     def weights(self, sigma: NDArray[np.float64] | None) -> NDArray[np.float64]:
         """Row weights of each output (n_out,) for a noise RMS per output ``sigma``
@@ -627,6 +648,7 @@ class ModalFitter:
         solve: Any = None,
         box: tuple[float, float, float] | None = None,
         tol: float = 1e-6,
+        interest: NDArray[np.intp] | None = None,
     ) -> tuple[NDArray[np.float64], int, str, dict[str, Any]]:
         n_par = th0.size
         lb, ub = pole_bounds(m, n_par)
@@ -649,7 +671,7 @@ class ModalFitter:
         dof = max(n_obs - n_lin * self.n_out - n_par, 1)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             x, nfev, ok, sol = _levenberg_marquardt(
-                evaluate, th0, lb, ub, max_nfev, dof=dof, tol=tol
+                evaluate, th0, lb, ub, max_nfev, dof=dof, tol=tol, interest=interest
             )
         sol["lm"] = (lb, ub, dof, tol)  # the iteration's settings (_at_rest)
         return x, nfev, "converged" if ok else "maxfev", sol

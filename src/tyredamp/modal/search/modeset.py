@@ -150,13 +150,16 @@ def fit_checked(
     refine: bool,
     band: tuple[float, float],
     start: FitResult | None = None,
+    in_band_only: bool = False,
     **fit_kw: object,
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Fit the modes; drop any that left its side of the band or merged, and refit.
 
     ``fit_kw`` go to :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit`, ``start`` (the
-    fit the modes come from, if any) to its first fit. Returns the fit, the
-    modes at the fit's values and the dropped ones.
+    fit the modes come from, if any) to its first fit. ``in_band_only``: a
+    refinement may stop once the in-band modes have converged, the residual modes
+    outside the band being nuisance parameters (``n_interest`` of ``fit``).
+    Returns the fit, the modes at the fit's values and the dropped ones.
     """
     dropped: list[RejectedMode] = []
     cur = modes
@@ -164,7 +167,8 @@ def fit_checked(
         m = cur.m
         p0, l0 = cur.all()
         first = start if cur is modes else None
-        res = fitter.fit(p0, l0, refine=refine, start=first, **fit_kw)  # type: ignore[arg-type]
+        n_int = m if in_band_only else None
+        res = fitter.fit(p0, l0, refine=refine, start=first, n_interest=n_int, **fit_kw)  # type: ignore[arg-type]
         fd = res.poles.imag / (2 * np.pi)
         wrong, why = lost_modes(res, cur, band)
         if not wrong.size:
