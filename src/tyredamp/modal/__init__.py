@@ -25,11 +25,11 @@ from the groups below it; the layering test of the package enforces it):
     Which modes the data hold: the mode test and the residual search on one
     fitter (``search``), the joint refit of a trial mode and the split of a
     mode in two (``joint``), its mode set (``modeset``), out-of-band residual
-    modes (``out_of_band``), where trials start (``search_starts``,
-    ``residual_peaks``), each mode's threshold (``thresholds``,
-    ``span_noise``), poles narrower than the lines (``narrow``,
-    ``resolution``) and the statistic with the neighbours refitted
-    (``refitted``). Its own group because it decides the mode count from
+    modes (``out_of_band``), a trial mode against fixed ones (``trials``),
+    where trials start (``search_starts``, ``residual_peaks``), each mode's
+    threshold (``thresholds``, ``span_noise``), poles narrower than the lines
+    (``narrow``, ``resolution``) and the statistic with the neighbours
+    refitted (``refitted``). Its own group because it decides the mode count from
     fits: it uses the fitter and the diagram's poles, neither uses it.
 ``poles/`` and ``fit/`` (side by side, independent of each other)
     ``poles/``: the stabilisation diagram, from the FRFs to candidate poles
