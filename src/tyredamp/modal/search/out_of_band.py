@@ -67,13 +67,8 @@ def search_helpers(
     residual mode on the other side is added: the residual it failed on has
     changed (the tail of a strong mode just below the band is fitted better by
     a broad pole far above it than by the mode just above the edge, until a
-    residual mode below holds it). A side where every trial ran into the band
-    edge (the residual there is in-band structure, a missed or misfitted mode
-    near the edge, not a mode outside) is recorded in ``fixed.at_edge``:
-    :func:`~tyredamp.modal.search.search.residual_search` searches it again
-    (:func:`more_helpers`) once it adds an in-band mode nearer that edge than
-    every fitted one. ``fixed``: the trials'
-    fixed parts (:class:`FixedParts`, new when None).
+    residual mode below holds it). ``fixed``: the trials' fixed parts
+    (:class:`FixedParts`, new when None).
     """
     res, cur, dropped = fit_checked(
         fitter,
@@ -103,9 +98,8 @@ def more_helpers(
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]]:
     """Add residual modes on ``sides`` (+1 above the band, -1 below) to the fit and
     modes ``current`` while their trials pass (:func:`search_helpers`), up to
-    ``max_helpers`` outside the band on each side. Sets ``fixed.at_edge`` to the
-    sides whose last trials all ran into the band edge. Returns the fit, the modes
-    and the in-band modes the helpers' refits moved out of the band."""
+    ``max_helpers`` outside the band on each side. Returns the fit, the modes and
+    the in-band modes the helpers' refits moved out of the band."""
     res, cur = current
     zeta0 = float(np.clip(np.median(pole_quantities(cur.poles)[1]), 0.005, 0.1))
     dropped: list[RejectedMode] = []
@@ -126,11 +120,7 @@ def more_helpers(
                     # failed, or the joint refit lost it (into the band): the same
                     # residual would start the same trial
                     failed_at[side] = cur.hp.size
-                    fixed.at_edge.discard(side)
-                    if got == EDGE:
-                        fixed.at_edge.add(side)
                     continue
-                fixed.at_edge.discard(side)
                 res, cur, lost = got
                 dropped += [_took_tail(r) for r in lost]
     return res, cur, dropped

@@ -54,7 +54,6 @@ from .modeset import (
     too_damped,
 )
 from .narrow import narrow_refusal, too_narrow
-from .out_of_band import more_helpers
 from .residual_peaks import (
     residual_view,
 )
@@ -329,7 +328,7 @@ def residual_search(
             if isinstance(got, RejectedMode) or got is None:
                 tried += start_records(got, p0, complex(p0) in from_diagram)
                 continue
-            res, cur = _edges_again(got, cur, fixed, band, (threshold, max_helpers), tried)
+            res, cur = got
             added, refused, crossed, scanned = True, [], set(), False
             if complex(p0) in from_diagram:
                 tried.append(rejected(p0, KEPT))
@@ -339,51 +338,11 @@ def residual_search(
             )
             if got2 is None:
                 break
-            res, cur = _edges_again(got2, cur, fixed, band, (threshold, max_helpers), tried)
+            res, cur = got2
             refused, crossed, scanned = [], set(), False
         elif not added:
             scan_next = True
     return res, cur, tried
-
-
-def _edges_again(
-    got: tuple[FitResult, ModeSet],
-    was: ModeSet,
-    fixed: FixedParts,
-    band: tuple[float, float],
-    limits: tuple[float, int],
-    tried: list[RejectedMode],
-) -> tuple[FitResult, ModeSet]:
-    """The fit and modes ``got`` of :func:`residual_search` (on ``fixed.fitter``), with
-    residual modes added on the sides whose helper trials ran into the band edge
-    (``fixed.at_edge``, :func:`~tyredamp.modal.search.out_of_band.more_helpers`)
-    where ``got`` holds a new outermost in-band mode (more modes than ``was``, the
-    one nearest that edge farther out than ``was``'s by more than ``2 MERGE``):
-    the structure at the edge may have been that mode, which hid the tails of the
-    modes outside; a mode added farther in leaves the edge's residual as it was.
-    ``limits``: the mode test's threshold and the most residual modes a side;
-    ``tried`` gets the records of the in-band modes those refits moved out of the
-    band."""
-    res, cur = got
-    if not fixed.at_edge or cur.m <= was.m:
-        return res, cur
-    sides = [s for s in sorted(fixed.at_edge, reverse=True) if _new_outermost(was, cur, s)]
-    if not sides:
-        return res, cur
-    res, cur, lost = more_helpers(fixed.fitter, got, fixed, band, sides, limits[0], limits[1])
-    tried += lost
-    return res, cur
-
-
-def _new_outermost(was: ModeSet, cur: ModeSet, side: float) -> bool:
-    """Whether the in-band mode of ``cur`` nearest the band edge on ``side`` (+1 upper,
-    -1 lower) lies beyond that of ``was`` by more than ``2 MERGE`` (relative)."""
-    w0, w1 = np.abs(was.poles.imag), np.abs(cur.poles.imag)
-    if not w0.size or not w1.size:
-        return bool(w1.size)
-    if side > 0:
-        return bool(np.max(w1) > np.max(w0) * (1 + 2 * MERGE))
-    return bool(np.min(w1) < np.min(w0) * (1 - 2 * MERGE))
 
 
 def _try_start(

@@ -35,19 +35,12 @@ class FixedParts:
     formed at the first trial against a mode set and passed to every trial
     against the same modes (equal poles and participation), across the search
     stages. Owned by the caller of the stages; the fitter keeps nothing.
-    ``at_edge``: the sides of the band (+1 above, -1 below) whose residual-mode
-    trials all ran into the band edge
-    (:func:`~tyredamp.modal.search.out_of_band.search_helpers`: in-band structure
-    at the edge, a missed mode there), searched again by
-    :func:`~tyredamp.modal.search.search.residual_search`
-    once it adds an in-band mode nearer that edge than every fitted one.
     """
 
     def __init__(self, fitter: ModalFitter) -> None:
         self.fitter = fitter
         self.modes: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None
         self.value: FixedPart | None = None
-        self.at_edge: set[float] = set()
 
     def release(self) -> None:
         """Drop the fixed part held when it holds pseudo-lines of its basis (a long
