@@ -126,8 +126,6 @@ def more_helpers(
     return res, cur, dropped
 
 
-#: :func:`_helper`'s answer when every trial of a side ran into the band edge
-EDGE = "edge"
 #: most starts of a side's helper trial (the scan's distinct maxima, best first)
 HELPER_STARTS = 3
 
@@ -144,12 +142,11 @@ def _helper(
 ) -> tuple[FitResult, ModeSet, list[RejectedMode]] | str | None:
     """A helper trial on ``side`` (+1 above the band, -1 below) of
     :func:`search_helpers` (:func:`helper_trial`): the refit with it, "lost" when
-    the joint refit lost it (into the band, or merged), ``EDGE`` when every trial
-    stopped at the band edge, None when it failed otherwise (not significant, at
-    the far limit, or moved out of its range)."""
+    the joint refit lost it (into the band, or merged), None when it failed (no
+    trial passed, or the helper moved out of its range)."""
     found = helper_trial(fitter, res, cur, fixed, band, side, zeta0, threshold)
-    if found is None or isinstance(found, str):
-        return found
+    if found is None:
+        return None
     p_t, l_t, _ = found
     try:
         trial, new, lost = fit_checked(
@@ -179,29 +176,23 @@ def helper_trial(
     side: float,
     zeta0: float,
     threshold: float,
-) -> tuple[complex, NDArray[np.complex128], float] | str | None:
+) -> tuple[complex, NDArray[np.complex128], float] | None:
     """The trial of a residual mode on ``side`` (+1 above the band, -1 below) against
     the fit ``res`` of the modes ``cur``, refined alone within a factor 2 of the
     band edge: its pole, participation and statistic ``T``. The trials start at the
     scan's maxima (:func:`_scan_starts`), the next when one stops at a limit of its
-    range or does not pass ``threshold``. ``EDGE`` when every trial stopped at the
-    band edge (the residual there is in-band structure), else None when none passes."""
+    range (at the band edge: in-band structure there, not a mode outside) or does
+    not pass ``threshold``; None when none passes."""
     lo, hi = band
     edge = (hi, 2 * hi) if side > 0 else (lo / 2, lo)
     w_lim = (2 * np.pi * edge[0], 2 * np.pi * edge[1])
-    at_edge = 0
     starts = _scan_starts(fitter, res, edge, side, zeta0, threshold)
     ones = np.ones(fitter.n_in, complex)
     for ph in starts:
         got = _trial(fitter, res, cur, fixed, ph, ones, w_lim, strict=False)
-        if got is None:
-            continue
-        stop = _toward(got[0], w_lim)
-        if stop == -side:
-            at_edge += 1  # in-band structure at the edge: no mode outside
-        elif stop == 0 and got[2] >= threshold:
+        if got is not None and _toward(got[0], w_lim) == 0 and got[2] >= threshold:
             return got
-    return EDGE if starts and at_edge == len(starts) else None
+    return None
 
 
 #: damping ratios of the scan for a residual mode's start, relative to the modes'
