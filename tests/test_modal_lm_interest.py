@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from numpy.testing import assert_allclose
 
+from tyredamp.exceptions import InputError
 from tyredamp.modal.fit._linalg import _levenberg_marquardt, interest_decrement
 from tyredamp.modal.fit.fit import ModalFitter
 
@@ -84,6 +86,10 @@ def test_interest_indices_of_the_first_modes() -> None:
     # 4 modes, 3 inputs: poles 0..7, then 4 participation entries per mode
     assert fit_c.interest(4, 2).tolist() == [0, 1, 2, 3, 8, 9, 10, 11, 12, 13, 14, 15]
     assert fit_c.interest(4, 4) is None
+    # no in-band mode: every parameter must converge; a negative count is refused
+    assert fit_c.interest(4, 0) is None
+    with pytest.raises(InputError, match="n_interest"):
+        fit_c.interest(4, -1)
     fit_r = ModalFitter(f, H, 0, "real", [])
     # real modes: 2 participation entries per mode
     assert fit_r.interest(3, 1).tolist() == [0, 1, 6, 7]

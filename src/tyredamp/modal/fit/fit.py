@@ -492,9 +492,9 @@ class ModalFitter:
         status = "lsfd"
         nit = 0
         warn: list[str] = []
+        keep = None if n_interest is None else self.interest(m, n_interest)
         for ip in range(max(1, passes if refine else 1)):
             if refine:
-                keep = None if n_interest is None else self.interest(m, n_interest)
                 th, nfev, status, sol = self._refine(
                     th, m, ref, w, max_nfev, tol=tol, interest=keep
                 )
@@ -516,8 +516,11 @@ class ModalFitter:
     def interest(self, m: int, n: int) -> NDArray[np.intp] | None:
         """Indices into a parameter vector of ``m`` modes (:meth:`pack` layout) of
         the poles and free participation entries of its first ``n`` modes (None
-        when that is every parameter)."""
-        if n >= m:
+        when that is every parameter, or no mode: then every parameter must
+        converge)."""
+        if n < 0:
+            raise InputError(f"n_interest: expected a mode count of at least 0, got {n}")
+        if n >= m or n == 0:
             return None
         per = (self.n_in - 1) * (2 if self.kind == "complex" else 1)
         poles = np.arange(2 * n)
