@@ -308,6 +308,40 @@ def residual_lines(
     return e
 
 
+def mode_atoms(
+    s: NDArray[np.complex128],
+    kap: NDArray[np.complex128],
+    poles: NDArray[np.complex128],
+    out: tuple[NDArray[np.complex128], NDArray[np.complex128]],
+    derivative: tuple[NDArray[np.complex128], NDArray[np.complex128]] | None = None,
+) -> None:
+    """The columns of complex modes with unit participation over the lines, written
+    into ``out = (u, v)`` and ``derivative = (u', v')`` (each (m, lines)).
+
+    ``u = a + b`` and ``v = i (a - b)`` with ``a = kappa / (s - p_n)`` and ``b =
+    kappa / (s - conj p_n)`` (spec eq. [10]): ``u = 2 t kappa / d``, ``v = -2 Omega_n
+    kappa / d`` with ``t = s + sigma_n`` and ``d = (s - p_n)(s - conj p_n) = t^2 +
+    Omega_n^2`` (one complex reciprocal per line and mode instead of two divisions);
+    their derivatives ``u' = a' + b'``, ``v' = i (a' - b')`` (``a' = a / (s - p_n)``,
+    ``d a / d p = a'``) are ``2 (t^2 - Omega_n^2) kappa / d^2`` and ``-4 Omega_n t
+    kappa / d^2``. ``s``, ``kap``: (lines,) of :func:`factors`; ``poles``: (m,)."""
+    om = poles.imag[:, None]
+    t = s[None, :] + (-poles.real)[:, None]
+    d = np.multiply(t, t)
+    d += om * om
+    r = np.reciprocal(d)
+    h = r * (2.0 * kap[None, :])  # 2 kappa / d
+    np.multiply(t, h, out=out[0])
+    np.multiply(h, -om, out=out[1])
+    if derivative is not None:
+        h *= r  # 2 kappa / d^2
+        d -= 2.0 * om * om  # t^2 - Omega^2
+        du, dv = derivative
+        np.multiply(d, h, out=du)
+        np.multiply(t, h, out=dv)
+        dv *= -2.0 * om
+
+
 def _model_block(
     fitter: FitterState,
     poles: NDArray[np.complex128],
@@ -327,13 +361,7 @@ def _model_block(
     s, kap, kap_low = factors(fitter, sb)
     cols = np.empty((rr.shape[1], s.size), complex)
     if m:
-        t = s[None, :] + (-poles.real)[:, None]
-        h = np.multiply(t, t)
-        h += (poles.imag**2)[:, None]
-        np.reciprocal(h, out=h)
-        h *= 2.0 * kap[None, :]  # 2 kappa / d
-        np.multiply(t, h, out=cols[0 : 2 * m : 2])
-        np.multiply(h, (-poles.imag)[:, None], out=cols[1 : 2 * m : 2])
+        mode_atoms(s, kap, poles, (cols[0 : 2 * m : 2], cols[1 : 2 * m : 2]))
     c = 2 * m
     for t_, kk in zip(terms, (kap, kap_low), strict=True):
         if t_ is not None:

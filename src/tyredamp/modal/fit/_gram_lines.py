@@ -143,11 +143,8 @@ def atoms(
 
     ``fac``: :func:`~tyredamp.modal.fit._basis.factors` of the lines (``s``,
     ``kappa``, ``kappa_low``, line weights included); ``residual``: with the
-    residual terms' atoms the fitter uses. Per mode one complex
-    reciprocal ``r = 1 / d`` (``d = t^2 + Omega^2``, ``t = s + sigma``), as
-    :func:`~tyredamp.modal.fit._basis.basis_ek` with one input: ``u = t h``, ``v =
-    -Omega h`` with ``h = 2 kappa r``, ``u' = (d - 2 Omega^2) h r``, ``v' = -2 Omega t h
-    r``.
+    residual terms' atoms the fitter uses. Each mode's ``u``, ``v`` (and ``u'``,
+    ``v'``) are :func:`~tyredamp.modal.fit._basis.mode_atoms`.
     """
     s, kap, kap_low = fac
     m, nf = poles.size, s.size
@@ -156,21 +153,10 @@ def atoms(
     n_phi = na * m + sum(terms)
     ft = np.empty((n_phi, nf), complex)
     if m:
-        om = poles.imag[:, None]
-        t = s[None, :] + (-poles.real)[:, None]
-        d = np.multiply(t, t)
-        d += om * om
-        r = np.reciprocal(d)
-        h = r * (2.0 * kap[None, :])  # 2 kappa / d
-        np.multiply(t, h, out=ft[0 : na * m : na])
-        np.multiply(h, -om, out=ft[1 : na * m : na])
-        if derivatives:
-            h *= r  # 2 kappa / d^2
-            d -= 2.0 * om * om  # t^2 - Omega^2
-            np.multiply(d, h, out=ft[2 : na * m : na])
-            o = ft[3 : na * m : na]
-            np.multiply(t, h, out=o)
-            o *= -2.0 * om
+        rows = [ft[j : na * m : na] for j in range(na)]
+        _basis.mode_atoms(
+            s, kap, poles, (rows[0], rows[1]), (rows[2], rows[3]) if derivatives else None
+        )
     c = na * m
     for use, kk in zip(terms, (kap, kap_low), strict=True):
         if use:
