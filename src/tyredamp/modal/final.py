@@ -91,40 +91,60 @@ def _problem(
     return "", -1
 
 
-class _PoleAtZero(Exception):
-    """An in-band mode's pole reached 0 Hz in a real-mode refinement (:class:`_RealFitter`)."""
+class _Stopped(Exception):
+    """A real-mode refinement stopped at its best point (:class:`_RealFitter`): mode
+    ``index`` at ``freq`` Hz, and why it is not acceptable there."""
 
-    def __init__(self, index: int, freq: float) -> None:
-        super().__init__(index, freq)
-        self.index, self.freq = index, freq
+    def __init__(self, index: int, freq: float, why: str) -> None:
+        super().__init__(index, freq, why)
+        self.index, self.freq, self.why = index, freq, why
 
 
 class _RealFitter(ModalFitter):
     """The real-mode fitter of :func:`fit_real`: while :attr:`watch` is set (``m``,
-    the in-band modes coming first), a refinement stops (:class:`_PoleAtZero`)
-    as soon as the best point it has evaluated in its pass holds an in-band
-    mode's pole at the lower bound of its frequency (``Omega = 1e-6 w_ref``,
-    :func:`~tyredamp.modal.fit.fit.pole_bounds`, :func:`_floor_hz`), where
-    :func:`_problem` would refuse the fit.
+    the in-band modes coming first), a refinement stops (:class:`_Stopped`) as soon
+    as the best point it has evaluated in its pass holds
 
-    Such a pole is at 0 Hz: the real-mode model uses it for what real modes
-    cannot hold (the out-of-phase part of complex residues, a lower residual
-    term), not for a mode of the band. The bounded Levenberg-Marquardt
-    iteration (:func:`~tyredamp.modal.fit._linalg._levenberg_marquardt`) holds a
-    parameter at its bound while its gradient points out and never accepts a
-    point of higher cost, so the pole comes back only if the other parameters
-    turn its gradient round with the cost still falling: not excluded in
-    general, so checked (``benchmarks/README.md``, "--model both against
-    --model complex": on the tyre cases, the package's tests and the real-data
-    gallery no refinement's best point held a pole there, while the synthetic
-    complex-mode cases that did took most or all of their budget, 100
-    evaluations per pass, to end rejected with the same model). The best point
-    is the lowest cost evaluated with the pass's weights: the iteration's
-    current point (it moves only to lower costs) but after steps of too small a
-    gain.
+    * an in-band mode's pole at the lower bound of its frequency (``Omega = 1e-6
+      w_ref``, :func:`~tyredamp.modal.fit.fit.pole_bounds`, :func:`_floor_hz`),
+      where :func:`_problem` would refuse the fit, or
+    * a residual mode outside the band (from index :attr:`outside` on) out of
+      the range of the residual modes: outside the band (:attr:`band`, Hz),
+      within a factor 2 beyond its edge
+      (:func:`~tyredamp.modal.search.modeset.outside_side`).
+
+    A pole at 0 Hz: the real-mode model uses it for what real modes cannot hold
+    (the out-of-phase part of complex residues, a lower residual term), not for
+    a mode of the band. The bounded Levenberg-Marquardt iteration
+    (:func:`~tyredamp.modal.fit._linalg._levenberg_marquardt`) holds a parameter
+    at its bound while its gradient points out and never accepts a point of
+    higher cost, so the pole comes back only if the other parameters turn its
+    gradient round with the cost still falling: not excluded in general, so
+    checked (``benchmarks/README.md``, "--model both against --model complex":
+    on the tyre cases, the package's tests and the real-data gallery no
+    refinement's best point held a pole there, while the synthetic complex-mode
+    cases that did took most or all of their budget, 100 evaluations per pass,
+    to end rejected with the same model).
+
+    A residual mode out of that range: the residual modes stand for the tails
+    of the modes outside the band where the residual terms do not hold them
+    (they are searched within that range,
+    :mod:`~tyredamp.modal.search.out_of_band`), and :func:`_problem` refuses one
+    in the band. With real modes one can run far away (to ten times the band
+    edge on a structure with non-proportional damping, its damping falling to
+    zero), where its column over the band is that of a residual term: the
+    basis loses its rank, the cost its curvature, and the refinement crawls
+    along the valley to its evaluation limit; or into the band with a damping
+    ratio near 1, to end refused there after as many evaluations.
+
+    The best point is the lowest cost evaluated with the pass's weights: the
+    iteration's current point (it moves only to lower costs) but after steps
+    of too small a gain.
     """
 
     watch: int | None = None
+    outside: int = 0
+    band: tuple[float, float] = (0.0, np.inf)
     _best: tuple[bytes, float] | None = None
 
     def _solve(self, th: Any, m: int, ref: Any, w: Any, *args: Any, **kw: Any) -> dict[str, Any]:
@@ -136,10 +156,24 @@ class _RealFitter(ModalFitter):
         if self._best is not None and self._best[0] == key and not cost <= self._best[1]:
             return sol
         self._best = (key, cost)
-        f = th[1 : 2 * n_band : 2] * self.w_ref / (2.0 * np.pi)
-        at = np.flatnonzero(f <= _floor_hz(self))
+        f = th[1 : 2 * m : 2] * self.w_ref / (2.0 * np.pi)
+        at = np.flatnonzero(f[:n_band] <= _floor_hz(self))
         if at.size:
-            raise _PoleAtZero(int(at[0]), float(f[at[0]]))
+            i = int(at[0])
+            raise _Stopped(i, float(f[i]), f"a pole crossed the band edge ({f[i]:.2f} Hz)")
+        lo, hi = self.band
+        fo = f[self.outside :]
+        within = ((fo > hi) & (fo <= 2 * hi)) | ((fo >= lo / 2) & (fo < lo))
+        far = self.outside + np.flatnonzero(~within)
+        if far.size:
+            i = int(far[0])
+            raise _Stopped(
+                i,
+                float(f[i]),
+                f"a residual mode left the range of the residual modes ({f[i]:.2f} Hz; "
+                f"they lie within a factor 2 beyond the band's edges, {lo / 2:.4g}-{lo:.4g} "
+                f"and {hi:.4g}-{2 * hi:.4g} Hz)",
+            )
         return sol
 
 
@@ -153,12 +187,16 @@ def fit_real(
 ) -> tuple[FitResult, int, list[str], NDArray[np.float64], NDArray[np.float64] | None]:
     """Real-mode fit (pole-pair optimisation) started from the complex-mode poles.
 
-    The real model keeps the modes of the complex model. When its refinement
-    is not acceptable (a pole crosses a band edge or two merge: real modes
-    that cannot describe strongly complex data), the poles are kept at the
-    complex-mode values, only the real residues are fitted, and a warning
-    says so; a refinement whose best point holds an in-band pole at 0 Hz stops
-    there with that outcome (:class:`_RealFitter`). ``search``: the compressed
+    The real model keeps the modes of the complex model. A residual mode
+    outside the band whose refinement is not acceptable is dropped and the
+    modes refined again (:func:`_refined`); when the refinement is not
+    acceptable for an in-band mode (its pole crosses a band edge or two merge:
+    real modes that cannot describe strongly complex data), the poles are kept
+    at the complex-mode values, only the real residues are fitted, and a
+    warning says so. A refinement whose best point holds an in-band pole at 0
+    Hz, or a residual mode beyond the range of the residual modes, stops there
+    (:class:`_RealFitter`); one whose band's modes have converged stops
+    whatever the residual modes still do (:func:`_watched`). ``search``: the compressed
     search fitter (a pre-fit on the output combinations) or None. ``start``:
     poles and participation of all modes (in-band first) and the mode set they
     belong to. ``sigma0``: the
@@ -187,8 +225,8 @@ def fit_real(
     if not refine:
         res = fitter.fit(p0, l0, refine=False, sigma=sigma)
         return res, m, [], noise_along_response(fitter, res, m), None
-    start_p, start_l = p0, l0
-    why, bad = "", -1
+    keep = np.arange(p0.size)
+    start_p, start_l, why = p0, l0, ""
     if search is not None:
         # real modes start far from the complex optimum: pre-fit on the combinations
         pre_fit = _RealFitter(
@@ -202,15 +240,11 @@ def fit_real(
             unit_weights=True,
             line_weights=problem.line_weights,
         )
-        pre, why, bad = _watched(pre_fit, p0, l0, m, nf, problem.band, passes=1)
+        pre, why, keep = _refined(pre_fit, p0, l0, m, nf, problem.band, passes=1)
         start_p, start_l = pre.poles, pre.participation
-    # an out-of-band residual mode that real modes cannot hold is dropped (it only
-    # shapes the band's edges); an in-band mode that crosses ends the refinement
-    for _ in range(start_p.size - m + 1):
-        if why:
-            break
+    if not why:
         # the evaluation limit bounds the time spent on data that real modes cannot fit
-        res, why, bad = _watched(
+        res, why, kept = _refined(
             fitter,
             start_p,
             start_l,
@@ -222,19 +256,16 @@ def fit_real(
             sigma=sigma,
             passes=passes,
         )
-        if not why:
-            ml = maximum_likelihood(problem, fitter, res)
-            if not _problem(ml, m, nf, problem.band, _floor_hz(fitter))[0]:
-                res = ml
-            # likelihood intervals where the linearised ones would be too short
-            res.intervals = fit_intervals(fitter, res, m, sigma0)
-            res, ratio = sandwiched(problem, fitter, res, m, sigma)
-            return res, m, [], noise_along_response(fitter, res, m), ratio
-        if bad >= m + nf:
-            keep = np.arange(start_p.size) != bad
-            start_p, start_l, p0, l0 = start_p[keep], start_l[keep], p0[keep], l0[keep]
-            why = ""
-    res = fitter.fit(p0, l0, refine=False, sigma=sigma)
+        keep = keep[kept]
+    if not why:
+        ml = maximum_likelihood(problem, fitter, res)
+        if not _problem(ml, m, nf, problem.band, _floor_hz(fitter))[0]:
+            res = ml
+        # likelihood intervals where the linearised ones would be too short
+        res.intervals = fit_intervals(fitter, res, m, sigma0)
+        res, ratio = sandwiched(problem, fitter, res, m, sigma)
+        return res, m, [], noise_along_response(fitter, res, m), ratio
+    res = fitter.fit(p0[keep], l0[keep], refine=False, sigma=sigma)
     return (
         res,
         m,
@@ -257,21 +288,45 @@ def _watched(
     **options: Any,
 ) -> tuple[FitResult, str, int]:
     """``fitter.fit(poles, part, **options)`` stopped once an in-band pole reaches 0
-    Hz (:class:`_RealFitter`), and why it is not acceptable with the mode concerned
+    Hz or a residual mode leaves the range of the residual modes
+    (:class:`_RealFitter`), and why it is not acceptable with the mode concerned
     (:func:`_problem`). A stopped refinement returns the start (its result is
-    rejected and not used)."""
+    rejected and not used). The refinement may stop once the band's modes (the
+    first ``m + n_free``) have converged, the residual modes outside it being
+    nuisance parameters (``n_interest`` of
+    :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit`)."""
     fitter.watch, fitter._best = m, None
+    fitter.outside, fitter.band = m + n_free, band
     try:
-        res = fitter.fit(poles, part, **options)
-    except _PoleAtZero as stop:
-        return (
-            fitter.fit(poles, part, refine=False, uncertainty=False),
-            f"a pole crossed the band edge ({stop.freq:.2f} Hz)",
-            stop.index,
-        )
+        res = fitter.fit(poles, part, n_interest=m + n_free, **options)
+    except _Stopped as stop:
+        return fitter.fit(poles, part, refine=False, uncertainty=False), stop.why, stop.index
     finally:
         fitter.watch, fitter._best = None, None
     return (res, *_problem(res, m, n_free, band, _floor_hz(fitter)))
+
+
+def _refined(
+    fitter: _RealFitter,
+    poles: NDArray[np.complex128],
+    part: NDArray[np.complex128],
+    m: int,
+    n_free: int,
+    band: tuple[float, float],
+    **options: Any,
+) -> tuple[FitResult, str, NDArray[np.intp]]:
+    """:func:`_watched`, refined again without each residual mode outside the band
+    that is not acceptable (it crossed into the band, merged with another mode or
+    left the range of the residual modes: real modes cannot hold what it stood
+    for, and it only shapes the band's edges). Returns the last fit, why it is
+    not acceptable ("" when it is) and the indices into ``poles`` of the modes
+    it holds."""
+    keep = np.arange(poles.size)
+    while True:
+        res, why, bad = _watched(fitter, poles[keep], part[keep], m, n_free, band, **options)
+        if not why or bad < m + n_free:
+            return res, why, keep
+        keep = np.delete(keep, bad)
 
 
 def noise_along_response(
