@@ -193,7 +193,7 @@ def _fixed_atoms(
     """The atoms of the fixed basis of every line (n_phi_f, n_f) and its coefficient
     tables (:mod:`._gram_lines`), when they apply (complex modes, several inputs)
     and are no larger than the data or one block of the fits; else None."""
-    if not _gram_lines.applies(fitter):
+    if fitter.kind != "complex" or not _gram_lines.applies(fitter):
         return None
     poles, part = fitter.unpack(th_f, m, ref)
     idx, val, n_phi = _gram_lines.coefficients(fitter, part, ref, False)

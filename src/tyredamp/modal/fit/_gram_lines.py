@@ -56,8 +56,8 @@ USE = True
 
 
 def applies(fitter: FitterState) -> bool:
-    """Does :func:`gram` apply to this fitter (complex modes, several inputs)?"""
-    return bool(USE and fitter.kind == "complex" and fitter.n_in >= 2)
+    """Does :func:`gram` apply to this fitter (complex or real modes, several inputs)?"""
+    return bool(USE and fitter.kind in ("complex", "real") and fitter.n_in >= 2)
 
 
 def coefficients(
@@ -165,6 +165,93 @@ def atoms(
     return ft
 
 
+def real_coefficients(
+    fitter: FitterState,
+    part: NDArray[np.complex128],
+    ref: NDArray[np.intp],
+    derivatives: bool,
+) -> tuple[NDArray[np.intp], NDArray[np.float64], int]:
+    """The real coefficients of every column of the real-mode basis ``[Phi | D]``
+    on the atoms of :func:`real_atoms` (tables as :func:`coefficients`).
+
+    The columns of :func:`~tyredamp.modal.fit._basis.real_rows` (mode ``n``
+    with real participation ``L_kn``, spec eq. [2]): ``Phi`` column ``n`` is
+    ``L_kn kappa / d`` at input ``k``, a residual column ``kappa`` (``kappa_low``)
+    at its input; the derivative columns of mode ``n`` are ``L_kn`` times the
+    atoms ``-2 sigma t kappa / d^2`` and ``-2 w_ref Omega kappa / d^2``, then
+    ``kappa / d`` at input ``k`` alone for each free participation entry (``k !=
+    ref[n]``). One atom per column and input: the second entry of every pair
+    is 0.
+    """
+    m, nin = part.shape
+    na = 3 if derivatives else 1
+    q = fitter.n_cols(m)
+    npm = nin + 1
+    nc = q + (npm * m if derivatives else 0)
+    idx = np.zeros((nin, nc, 2), np.intp)
+    val = np.zeros((nin, nc, 2))
+    lr = part.real.T  # (n_in, m)
+    a0 = na * np.arange(m)
+    idx[:, :m, 0], val[:, :m, 0] = a0, lr
+    n_phi, c0 = na * m, m
+    for use in (fitter.use_upper, fitter.use_lower):
+        if use:
+            ins = np.arange(nin)
+            idx[ins, c0 + ins, 0] = n_phi
+            val[ins, c0 + ins, 0] = 1.0
+            c0 += nin
+            n_phi += 1
+    if derivatives:
+        base = q + npm * np.arange(m)
+        for j in (1, 2):  # d / d x1, d / d x2: the atoms a0 + 1, a0 + 2 times L
+            idx[:, base + j - 1, 0], val[:, base + j - 1, 0] = a0 + j, lr
+        for n in range(m):
+            oth = [k for k in range(nin) if k != ref[n]]
+            for j, k in enumerate(oth):
+                idx[k, base[n] + 2 + j, 0], val[k, base[n] + 2 + j, 0] = a0[n], 1.0
+    return idx, val, n_phi
+
+
+def real_atoms(
+    fitter: FitterState,
+    poles: NDArray[np.complex128],
+    derivatives: bool,
+    fac: tuple[NDArray[np.complex128], NDArray[np.complex128], NDArray[np.complex128]],
+) -> NDArray[np.complex128]:
+    """The atoms of the real-mode basis over the lines as rows (n_phi, lines), complex:
+    per mode ``kappa / d`` (``t = s + sigma_n``, ``d = t^2 + Omega_n^2``) and, with
+    ``derivatives``, ``-2 sigma_n t kappa / d^2`` and ``-2 w_ref Omega_n kappa / d^2``
+    (the derivatives by ``x1``, ``sigma = w_ref e^x1``, and ``x2``, ``Omega = w_ref
+    x2``); then ``kappa`` and ``kappa_low`` of the residual terms the fitter uses
+    (:func:`real_coefficients`; the same products as
+    :func:`~tyredamp.modal.fit._basis.real_rows`). ``fac``:
+    :func:`~tyredamp.modal.fit._basis.factors` of the lines."""
+    s, kap, kap_low = fac
+    m, nf = poles.size, s.size
+    na = 3 if derivatives else 1
+    terms = (fitter.use_upper, fitter.use_lower)
+    ft = np.empty((na * m + sum(terms), nf), complex)
+    if m:
+        sig, om = (-poles.real)[:, None], poles.imag[:, None]
+        t = s[None, :] + sig
+        r = np.multiply(t, t)
+        r += om * om  # d
+        np.reciprocal(r, out=r)
+        base = ft[0 : na * m : na]
+        np.multiply(kap[None, :], r, out=base)  # kappa / d
+        if derivatives:
+            u = base * r  # kappa / d^2
+            t *= u
+            np.multiply(t, -2.0 * sig, out=ft[1 : na * m : na])
+            np.multiply(u, -2.0 * fitter.w_ref * om, out=ft[2 : na * m : na])
+    c = na * m
+    for use, kk in zip(terms, (kap, kap_low), strict=True):
+        if use:
+            ft[c] = kk
+            c += 1
+    return ft
+
+
 def gram(
     fitter: FitterState,
     pp: tuple[NDArray[np.complex128], NDArray[np.complex128]],
@@ -172,12 +259,13 @@ def gram(
     derivatives: bool,
     parts: list[slice],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``B^T B`` and ``B^T Y`` of the complex-mode basis with several inputs.
+    """``B^T B`` and ``B^T Y`` of the modal basis with several inputs.
 
     Parameters
     ----------
     fitter : FitterState
-        A fitter with complex modes and ``n_in >= 2`` (:func:`applies`).
+        A fitter with ``n_in >= 2`` (:func:`applies`): complex modes, or real
+        modes (:func:`real_coefficients`, :func:`real_atoms`).
     pp : (ndarray, ndarray)
         Poles (m,) in rad/s and participation (m, n_in) (``fitter.unpack``).
     ref : ndarray of int, shape (m,)
@@ -206,13 +294,14 @@ def gram(
     ``M_k`` has at most two entries per column, so its products are gathers.
     """
     poles, part = pp
-    idx, val, n_phi = coefficients(fitter, part, ref, derivatives)
-    return gram_of(
-        fitter,
-        lambda sl: atoms(fitter, poles, derivatives, _basis.factors(fitter, sl)),
-        (idx, val, n_phi),
-        parts,
-    )
+    real = fitter.kind == "real"
+    table = (real_coefficients if real else coefficients)(fitter, part, ref, derivatives)
+    form = real_atoms if real else atoms
+
+    def block_atoms(sl: slice) -> NDArray[np.complex128]:
+        return form(fitter, poles, derivatives, _basis.factors(fitter, sl))
+
+    return gram_of(fitter, block_atoms, table, parts)
 
 
 def gram_of(
