@@ -12,6 +12,7 @@ import pytest
 from tyredamp.frf import FRF
 from tyredamp.modal import ModalModel, final, identify_modes
 from tyredamp.modal.fit.fit import ModalFitter
+from tyredamp.modal.search.modeset import outside_side
 
 
 def _complex_modes_frf(n: int = 2000) -> FRF:
@@ -116,3 +117,66 @@ def test_pole_at_its_frequency_bound_is_out_of_the_band() -> None:
     assert bad == 1
     assert "band edge (0.00 Hz)" in why
     assert final._problem(above, 2, 0, band, floor) == ("", -1)
+
+
+def _watching(band: tuple[float, float]) -> final._RealFitter:
+    """A real-mode fitter of 2 inputs on random data, watching 2 in-band modes and
+    residual modes from index 2 on, as ``final._watched`` sets it."""
+    rng = np.random.default_rng(3)
+    f = np.linspace(1.0, 100.0, 200)
+    H = rng.normal(size=(3, 2, f.size)) + 1j * rng.normal(size=(3, 2, f.size))
+    fit = final._RealFitter(f, H, 2, "real", [(0, 0), (1, 1)])
+    fit.watch, fit._best, fit.outside, fit.band = 2, None, 2, band
+    return fit
+
+
+@pytest.mark.parametrize(
+    ("f_res", "stops"),
+    [(150.0, False), (200.0, False), (0.3, False), (250.0, True), (60.0, True), (0.2, True)],
+)
+def test_real_refinement_stops_at_a_residual_mode_out_of_its_range(
+    f_res: float, stops: bool
+) -> None:
+    # band 0.5-100 Hz: residual modes lie in 0.25-0.5 Hz or 100-200 Hz (a factor 2
+    # beyond the edges, modeset.outside_side); one beyond (250 Hz, 0.2 Hz) or in the
+    # band (60 Hz) stops the refinement at its best point, naming it
+    fit = _watching((0.5, 100.0))
+    fr = np.array([20.0, 45.0, f_res])
+    poles = 2 * np.pi * fr * (-0.02 + 1j)
+    part = np.ones((3, 2), complex)
+    ref = np.zeros(3, np.intp)
+    th = fit.pack(poles, part, ref)
+    w = fit.weights(None)
+    if not stops:
+        assert np.isfinite(fit._solve(th, 3, ref, w)["cost"])
+        assert outside_side(f_res, (0.5, 100.0)) != 0
+        return
+    with pytest.raises(final._Stopped) as stop:
+        fit._solve(th, 3, ref, w)
+    assert stop.value.index == 2
+    assert stop.value.freq == pytest.approx(f_res, rel=1e-12)  # Im p / 2 pi: the damped one
+    assert "left the range of the residual modes" in stop.value.why
+    # a point of higher cost than the best one is not watched (the iteration's point)
+    fit._best = (w.tobytes(), -1.0)
+    fit._solve(th, 3, ref, w)
+
+
+def test_refined_drops_the_residual_mode_that_left_its_range(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # _refined refits without each residual mode that is not acceptable, and gives up
+    # (for the caller's fall-back) at an in-band one
+    calls: list[int] = []
+    outcome = {4: ("a residual mode left the range", 3), 3: ("a pole crossed", 1)}
+
+    def watched(fitter: Any, poles: Any, part: Any, m: int, nf: int, band: Any, **o: Any) -> Any:
+        calls.append(poles.size)
+        why, bad = outcome.get(poles.size, ("", -1))
+        return SimpleNamespace(poles=poles), why, bad
+
+    monkeypatch.setattr(final, "_watched", watched)
+    p = np.arange(4) + 0j
+    _res, why, keep = final._refined(None, p, p[:, None], 2, 0, (1.0, 2.0))  # type: ignore[arg-type]
+    assert calls == [4, 3]
+    assert why == "a pole crossed"
+    assert keep.tolist() == [0, 1, 2]
