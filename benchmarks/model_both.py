@@ -1,6 +1,7 @@
 """CPU time of ``identify_modes(..., model="both")`` against ``model="complex"``.
 
-Run: ``python benchmarks/model_both.py [--cases tyre mem1e5 mimo4 mimo16] [--repeat 1]``.
+Run: ``python benchmarks/model_both.py [--cases tyre mem1e5 mimo4 mimo16 phys16 phys32
+phys64] [--repeat 1]``.
 
 ``model="both"`` (the default of ``tyredamp modal``) fits the complex-mode
 model and then the real-mode (proportional damping) model; this prints the
@@ -12,7 +13,12 @@ timed by wrapping it), on:
 * ``mem1e5``: the 1 x 1 case of ``modal_memory.py`` on 1e5 lines (six complex
   modes, residues ``1 + 0.1 i``, whole axis);
 * ``mimo4``: ``perf_common.mimo_case(4, 1, 20000, 10, 40.0)``;
-* ``mimo16``: ``perf_common.mimo_case(16, 2, 3000, 20, 35.0)``.
+* ``mimo16``: ``perf_common.mimo_case(16, 2, 3000, 20, 35.0)``;
+* ``phys16``, ``phys32``, ``phys64``: random physical structures with
+  non-proportional damping (``perf_common.physical_case``, the three several-input
+  cases of ``perf_compare.py --set physical``: 16 x 2 x 3000 lines, 20 modes, 40
+  dB; 32 x 2 x 4000, 24 modes, 35 dB; 64 x 3 x 8000, 30 modes, 30 dB), at the
+  automatic model order.
 
 Each case runs in a fresh process (``--repeat`` times; the smallest time is
 printed) so that one case's caches do not speed up another.
@@ -39,6 +45,8 @@ import tyredamp.modal.identify as ident
 lim = pc.limit_blas(1)
 name = sys.argv[1]
 band = None
+PHYSICAL = {"phys16": (16, 2, 3000, 20, 40.0), "phys32": (32, 2, 4000, 24, 35.0),
+            "phys64": (64, 3, 8000, 30, 30.0)}
 if name == "tyre":
     case = pc.tyre_case(); frf, band = case.frf, case.band
 elif name == "mem1e5":
@@ -57,6 +65,8 @@ elif name == "mimo4":
     case = pc.mimo_case(4, 1, 20000, 10, 40.0); frf, band = case.frf, case.band
 elif name == "mimo16":
     case = pc.mimo_case(16, 2, 3000, 20, 35.0); frf, band = case.frf, case.band
+elif name in PHYSICAL:
+    case = pc.physical_case(*PHYSICAL[name]); frf, band = case.frf, case.band
 else:
     raise SystemExit(f"unknown case {name}")
 acc = [0.0]
@@ -101,7 +111,11 @@ def run(name: str) -> dict[str, object]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cases", nargs="+", default=["tyre", "mem1e5", "mimo4", "mimo16"])
+    ap.add_argument(
+        "--cases",
+        nargs="+",
+        default=["tyre", "mem1e5", "mimo4", "mimo16", "phys16", "phys32", "phys64"],
+    )
     ap.add_argument("--repeat", type=int, default=1)
     args = ap.parse_args()
     print(f"{'case':>8} {'complex [s]':>12} {'both [s]':>9} {'fit_real [s]':>13} {'ratio':>6}")
