@@ -253,16 +253,28 @@ def _diagram_with(order: int, n_kept: int, share: float) -> Diagram:
 
 
 @pytest.mark.parametrize(
-    ("n_kept", "share", "kept"),
-    [(20, 0.9, True), (20, 0.4, False), (10, 0.9, False), (12, 0.6, False)],
+    ("cur_share", "n_kept", "share", "kept"),
+    [
+        (0.5, 20, 0.9, True),
+        (0.5, 20, 0.4, False),
+        (0.5, 10, 0.9, False),
+        (0.5, 12, 0.6, False),
+        # a settled current diagram: a settled trial with more clusters is kept at a
+        # lower share (30 modes, 3 inputs: 17 clusters at 0.90, 30 at 0.83); an
+        # unsettled one only at a larger share
+        (0.9, 30, 0.83, True),
+        (0.9, 30, 0.6, False),
+        (0.9, 11, 0.92, False),
+    ],
 )
-def test_peaks_trial_is_kept_only_with_more_clusters_and_a_larger_share(
-    monkeypatch: pytest.MonkeyPatch, n_kept: int, share: float, kept: bool
+def test_peaks_trial_is_kept_with_more_clusters_and_settled_or_a_larger_share(
+    monkeypatch: pytest.MonkeyPatch, cur_share: float, n_kept: int, share: float, kept: bool
 ) -> None:
     import tyredamp.modal.poles.order as order_mod
 
-    cur = _diagram_with(30, 12, 0.5)
+    cur = _diagram_with(30, 12, cur_share)
     trial = _diagram_with(84, n_kept, share)
+    assert trial.persistent_share() == pytest.approx(share, abs=0.02)  # the stand-in's share
     monkeypatch.setattr(order_mod, "diagram", lambda *a: trial)
     got = order_mod._peaks_trial(None, None, None, cur, 84)  # type: ignore[arg-type]
     assert got is (trial if kept else cur)
