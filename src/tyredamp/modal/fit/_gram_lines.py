@@ -112,15 +112,7 @@ def coefficients(
         val[:, cols, 0], val[:, cols, 1] = lr, li
         idx[:, cols + 1, 0], idx[:, cols + 1, 1] = a0 + j + 1, a0 + j
         val[:, cols + 1, 0], val[:, cols + 1, 1] = lr, -li
-    n_phi = na * m
-    c0 = 2 * m
-    for use in terms:
-        if use:
-            ins = np.arange(nin)
-            idx[ins, c0 + ins, 0] = n_phi
-            val[ins, c0 + ins, 0] = 1.0
-            c0 += nin
-            n_phi += 1
+    n_phi = _term_columns((idx, val), terms, 2 * m, na * m)
     if derivatives:
         # participation pairs [g + gb] = u, [i (g - gb)] = v at input k != ref[n]
         for n in range(m):
@@ -157,12 +149,43 @@ def atoms(
         _basis.mode_atoms(
             s, kap, poles, (rows[0], rows[1]), (rows[2], rows[3]) if derivatives else None
         )
-    c = na * m
-    for use, kk in zip(terms, (kap, kap_low), strict=True):
-        if use:
-            ft[c] = kk
-            c += 1
+    _term_atoms(ft, na * m, terms, (kap, kap_low))
     return ft
+
+
+def _term_columns(
+    table: tuple[NDArray[np.intp], NDArray[np.float64]],
+    terms: tuple[bool, bool],
+    c0: int,
+    n_phi: int,
+) -> int:
+    """Write the residual terms' columns into the coefficient tables ``table`` (idx,
+    val; :func:`coefficients`): from column ``c0`` on, ``kappa`` (then
+    ``kappa_low``) at each input in turn, on the atom after the ``n_phi`` modes'
+    (:func:`_term_atoms`), coefficient 1. Returns the number of atoms with them."""
+    idx, val = table
+    ins = np.arange(idx.shape[0])
+    for use in terms:
+        if use:
+            idx[ins, c0 + ins, 0] = n_phi
+            val[ins, c0 + ins, 0] = 1.0
+            c0 += ins.size
+            n_phi += 1
+    return n_phi
+
+
+def _term_atoms(
+    ft: NDArray[np.complex128],
+    c: int,
+    terms: tuple[bool, bool],
+    kk: tuple[NDArray[np.complex128], NDArray[np.complex128]],
+) -> None:
+    """Write the residual terms' atoms ``kappa``, ``kappa_low`` (``kk``) that ``terms``
+    use into the rows of ``ft`` from row ``c`` on (:func:`_term_columns`)."""
+    for use, k in zip(terms, kk, strict=True):
+        if use:
+            ft[c] = k
+            c += 1
 
 
 def real_coefficients(
@@ -193,14 +216,7 @@ def real_coefficients(
     lr = part.real.T  # (n_in, m)
     a0 = na * np.arange(m)
     idx[:, :m, 0], val[:, :m, 0] = a0, lr
-    n_phi, c0 = na * m, m
-    for use in (fitter.use_upper, fitter.use_lower):
-        if use:
-            ins = np.arange(nin)
-            idx[ins, c0 + ins, 0] = n_phi
-            val[ins, c0 + ins, 0] = 1.0
-            c0 += nin
-            n_phi += 1
+    n_phi = _term_columns((idx, val), (fitter.use_upper, fitter.use_lower), m, na * m)
     if derivatives:
         base = q + npm * np.arange(m)
         for j in (1, 2):  # d / d x1, d / d x2: the atoms a0 + 1, a0 + 2 times L
@@ -244,11 +260,7 @@ def real_atoms(
             t *= u
             np.multiply(t, -2.0 * sig, out=ft[1 : na * m : na])
             np.multiply(u, -2.0 * fitter.w_ref * om, out=ft[2 : na * m : na])
-    c = na * m
-    for use, kk in zip(terms, (kap, kap_low), strict=True):
-        if use:
-            ft[c] = kk
-            c += 1
+    _term_atoms(ft, na * m, terms, (kap, kap_low))
     return ft
 
 
