@@ -43,7 +43,10 @@ roots; ``limit = 2 n_freq / (n_in + 1) - 2``):
   the modes resolved (20 modes, 2 inputs, order 30: 8-15 persistent
   clusters); one more trial at the order the sizing rule asks for the modes
   the peaks shown can hold, ``ceil(4 (n M + 2) / n)`` (``M`` below), is kept
-  on the same rule (more persistent clusters and a larger share).
+  when it has more persistent clusters and either a larger share or a share
+  of its own that is settled (30 modes, 3 inputs: 17 clusters at order 43 and
+  a share of 0.90, all 30 at order 119 and 0.83, a settled diagram that an
+  order only too high would not give).
 
 No order exceeds ``limit``, nor the cap set by the modes the data show:
 ``max(p_start, ceil(8 (M + 2) / n))`` with ``M`` the resonance peaks of the
