@@ -126,7 +126,7 @@ def _watching(band: tuple[float, float]) -> final._RealFitter:
     f = np.linspace(1.0, 100.0, 200)
     H = rng.normal(size=(3, 2, f.size)) + 1j * rng.normal(size=(3, 2, f.size))
     fit = final._RealFitter(f, H, 2, "real", [(0, 0), (1, 1)])
-    fit.watch, fit._best, fit.outside, fit.band = 2, None, 2, band
+    fit.watch, fit._best = (2, 2, band), None
     return fit
 
 

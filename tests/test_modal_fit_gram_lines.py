@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterator
+from typing import Literal
 
 import numpy as np
 import pytest
@@ -20,17 +21,26 @@ F = np.linspace(2.0, 40.0, 300)
 
 
 def _fitter(
-    n_in: int, power: int, upper: bool, lower: bool, weights: bool, seed: int = 0
+    n_in: int,
+    power: int,
+    upper: bool,
+    lower: bool,
+    weights: bool,
+    seed: int = 0,
+    kind: Literal["complex", "real"] = "complex",
 ) -> tuple[ModalFitter, np.ndarray, int, np.ndarray]:
-    """A complex-mode fitter on random data, and a parameter vector of 4 modes."""
+    """A fitter of complex (or real) modes on random data, and a parameter vector of
+    4 modes (real participation for real modes)."""
     rng = np.random.default_rng(seed)
     n_out, m = 5, 4
     H = rng.normal(size=(n_out, n_in, F.size)) + 1j * rng.normal(size=(n_out, n_in, F.size))
     lw = rng.uniform(0.5, 2.0, F.size) if weights else None
     drive = [(k, k) for k in range(n_in)]
-    fit = ModalFitter(F, H, power, "complex", drive, upper=upper, lower=lower, line_weights=lw)
+    fit = ModalFitter(F, H, power, kind, drive, upper=upper, lower=lower, line_weights=lw)
     poles = 2 * np.pi * np.array([5.0, 12.0, 12.5, 30.0]) * (-0.03 + 1j)
-    part = rng.normal(size=(m, n_in)) + 1j * rng.normal(size=(m, n_in))
+    part = rng.normal(size=(m, n_in)) + 0j
+    if kind == "complex":
+        part = part + 1j * rng.normal(size=(m, n_in))
     ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
     return fit, fit.pack(poles, part, ref), m, ref
 

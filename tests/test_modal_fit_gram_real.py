@@ -11,23 +11,15 @@ from numpy.testing import assert_allclose
 from tyredamp.modal.fit import _basis, _gram_lines
 from tyredamp.modal.fit.fit import ModalFitter
 
-F = np.linspace(2.0, 40.0, 300)
+from .test_modal_fit_gram_lines import F
+from .test_modal_fit_gram_lines import _fitter as _any_fitter
 
 
 def _fitter(
     n_in: int, power: int, upper: bool, lower: bool, weights: bool, seed: int = 0
 ) -> tuple[ModalFitter, np.ndarray, int, np.ndarray]:
     """A real-mode fitter on random data, and a parameter vector of 4 modes."""
-    rng = np.random.default_rng(seed)
-    n_out, m = 5, 4
-    H = rng.normal(size=(n_out, n_in, F.size)) + 1j * rng.normal(size=(n_out, n_in, F.size))
-    lw = rng.uniform(0.5, 2.0, F.size) if weights else None
-    drive = [(k, k) for k in range(n_in)]
-    fit = ModalFitter(F, H, power, "real", drive, upper=upper, lower=lower, line_weights=lw)
-    poles = 2 * np.pi * np.array([5.0, 12.0, 12.5, 30.0]) * (-0.03 + 1j)
-    part = rng.normal(size=(m, n_in)) + 0j
-    ref = np.argmax(np.abs(part), axis=1).astype(np.intp)
-    return fit, fit.pack(poles, part, ref), m, ref
+    return _any_fitter(n_in, power, upper, lower, weights, seed, kind="real")
 
 
 CASES = [

@@ -36,6 +36,7 @@ from .fit.ml import fisher_scale, ml_refine
 from .fit.profile import fit_intervals
 from .problem.problem import FitProblem
 from .sandwich import sandwich_shapes
+from .search.modeset import outside_side
 from .search.refitted import refitted_statistics
 from .search.resolution import unresolved_pair, unresolved_pair_text
 from .search.search import (
@@ -102,15 +103,15 @@ class _Stopped(Exception):
 
 class _RealFitter(ModalFitter):
     """The real-mode fitter of :func:`fit_real`: while :attr:`watch` is set (``m``,
-    the in-band modes coming first), a refinement stops (:class:`_Stopped`) as soon
-    as the best point it has evaluated in its pass holds
+    the in-band modes coming first; the index of the first residual mode outside
+    the band; the band, Hz), a refinement stops (:class:`_Stopped`) as soon as the
+    best point it has evaluated in its pass holds
 
     * an in-band mode's pole at the lower bound of its frequency (``Omega = 1e-6
       w_ref``, :func:`~tyredamp.modal.fit.fit.pole_bounds`, :func:`_floor_hz`),
       where :func:`_problem` would refuse the fit, or
-    * a residual mode outside the band (from index :attr:`outside` on) out of
-      the range of the residual modes: outside the band (:attr:`band`, Hz),
-      within a factor 2 beyond its edge
+    * a residual mode outside the band out of the range of the residual modes:
+      outside the band, within a factor 2 beyond its edge
       (:func:`~tyredamp.modal.search.modeset.outside_side`).
 
     A pole at 0 Hz: the real-mode model uses it for what real modes cannot hold
@@ -142,16 +143,14 @@ class _RealFitter(ModalFitter):
     of too small a gain.
     """
 
-    watch: int | None = None
-    outside: int = 0
-    band: tuple[float, float] = (0.0, np.inf)
+    watch: tuple[int, int, tuple[float, float]] | None = None
     _best: tuple[bytes, float] | None = None
 
     def _solve(self, th: Any, m: int, ref: Any, w: Any, *args: Any, **kw: Any) -> dict[str, Any]:
         sol = super()._solve(th, m, ref, w, *args, **kw)
-        if self.watch is None or not kw.get("gradient", True) or m < self.watch:
+        if self.watch is None or not kw.get("gradient", True) or m < self.watch[0]:
             return sol
-        n_band = self.watch
+        n_band, outside, band = self.watch
         key, cost = w.tobytes(), float(sol["cost"])
         if self._best is not None and self._best[0] == key and not cost <= self._best[1]:
             return sol
@@ -161,12 +160,9 @@ class _RealFitter(ModalFitter):
         if at.size:
             i = int(at[0])
             raise _Stopped(i, float(f[i]), f"a pole crossed the band edge ({f[i]:.2f} Hz)")
-        lo, hi = self.band
-        fo = f[self.outside :]
-        within = ((fo > hi) & (fo <= 2 * hi)) | ((fo >= lo / 2) & (fo < lo))
-        far = self.outside + np.flatnonzero(~within)
-        if far.size:
-            i = int(far[0])
+        far = [i for i in range(outside, m) if outside_side(float(f[i]), band) == 0]
+        if far:
+            i, (lo, hi) = far[0], band
             raise _Stopped(
                 i,
                 float(f[i]),
@@ -295,8 +291,7 @@ def _watched(
     first ``m + n_free``) have converged, the residual modes outside it being
     nuisance parameters (``n_interest`` of
     :meth:`~tyredamp.modal.fit.fit.ModalFitter.fit`)."""
-    fitter.watch, fitter._best = m, None
-    fitter.outside, fitter.band = m + n_free, band
+    fitter.watch, fitter._best = (m, m + n_free, band), None
     try:
         res = fitter.fit(poles, part, n_interest=m + n_free, **options)
     except _Stopped as stop:

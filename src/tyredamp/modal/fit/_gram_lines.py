@@ -1,4 +1,4 @@
-"""The Gram blocks of the complex-mode basis with several inputs, from per-line sums.
+"""The Gram blocks of the modal basis with several inputs, from per-line sums.
 
 The real basis ``B = [Phi | E]`` of :func:`~tyredamp.modal.fit._basis.basis_ek`
 (complex modes, spec eq. [10], the model in the docstring of
@@ -38,6 +38,11 @@ n_in``), and the basis itself is not formed. The Gram blocks feed the
 variable projection of :meth:`~tyredamp.modal.fit.fit.ModalFitter._solve`
 (Golub & Pereyra, *SIAM J. Numer. Anal.* 10, 1973; Kaufman, *BIT* 15, 1975)
 exactly as ``B^T B`` and ``B^T Y`` do, equal to them up to rounding.
+
+The real-mode basis (spec eq. [2]; :func:`~tyredamp.modal.fit._basis.real_rows`)
+has the same structure with one atom per column and input: ``kappa / d`` of each
+mode and its derivatives by the two pole parameters (:func:`real_atoms`), the
+participation ``L_kn`` as the coefficients (:func:`real_coefficients`).
 """
 
 from __future__ import annotations

@@ -33,9 +33,9 @@ per complex mode the pole derivatives are ``-sigma [S]``, ``-sigma [i T]``,
 per free participation entry ``[g]``, ``[i g']``, ``[i g']``, ``-[g]``. An evaluation
 therefore needs only the Gram blocks of ``B = [Phi | E]`` and ``B^T Y`` (one
 symmetric rank-k update and one matrix product with the data, ``O(n_in n_freq
-(q + n_e) (q + n_e + n_out))``; with complex modes and several inputs they are
-summed from the modes' per-line functions without forming ``B``,
-``O(n_freq n_phi (n_phi + n_in n_out))`` with ``n_phi = 4 m + 2``:
+(q + n_e) (q + n_e + n_out))``; with several inputs they are summed from the
+modes' per-line functions without forming ``B``, ``O(n_freq n_phi (n_phi + n_in
+n_out))`` with ``n_phi = 4 m + 2`` (complex modes; ``3 m + 2`` real):
 :mod:`~tyredamp.modal.fit._gram_lines`): with the Cholesky factor ``R`` of ``Phi^T Phi``
 (``Phi = Q R``) follow ``Q^T E``, ``Q^T Y``, the coefficients, the cost
 ``||Y||^2 - ||Q^T Y||^2``, ``E^T P E`` and ``E^T r`` (``P`` the projector on the
@@ -350,7 +350,7 @@ class ModalFitter:
         one = None
         pl = None if len(parts) == 1 or residual else self._pseudo_lines()
         if pl is None and _gram_lines.applies(self):
-            # complex modes, several inputs: the Gram blocks from per-line sums of
+            # several inputs (complex or real modes): the Gram blocks from per-line sums of
             # the atoms (_gram_lines), the basis formed only for the QR route
             G, P = _gram_lines.gram(self, pp, ref, derivatives, parts)
             P = P * w
